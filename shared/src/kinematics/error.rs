@@ -1,0 +1,69 @@
+//! Errors of the kinematics.
+
+use core::fmt;
+
+/// Why a chain cannot reach a pose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum Reach {
+    /// The platform joint is at or beyond the rod length above or below the ring plane (`|Az| >= L`).
+    Height,
+    /// The rod's horizontal reach cannot span from the ring to the joint's projection (acos argument out of `[-1, 1]`).
+    Ring,
+    /// The platform joint is on the ring axis, where the carriage angle is undefined.
+    Centre,
+    /// A planar dyad cannot close: the pivot distance is out of `[|L2 - L3|, L2 + L3]`.
+    Dyad,
+}
+
+/// Why a kinematics computation has no answer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum KinematicsError {
+    /// An input (pose, actuators, guess) has a NaN or infinite coordinate.
+    NonFinite,
+    /// Chain `chain` (0-based) cannot reach the pose.
+    Unreachable {
+        /// 0-based chain index.
+        chain: u8,
+        /// Which condition failed.
+        reason: Reach,
+    },
+    /// The pose asks for motion along a coordinate the mechanism does not have (tool carrier yaw).
+    OutsideMobility,
+    /// The Jacobian needed for the computation is singular (velocities undefined).
+    Singular,
+    /// Forward kinematics came within the configured margin of a type-2 singularity.
+    NearSingularity,
+    /// Forward kinematics did not converge within the configured number of iterations.
+    NoConvergence {
+        /// Iterations run.
+        iterations: u8,
+    },
+}
+
+impl fmt::Display for Reach {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Height => "the joint is beyond rod length from the ring plane",
+            Self::Ring => "the rod cannot span from the ring to the joint",
+            Self::Centre => "the joint is on the ring axis",
+            Self::Dyad => "the dyad cannot close",
+        })
+    }
+}
+
+impl fmt::Display for KinematicsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::NonFinite => f.write_str("input has a NaN or infinite coordinate"),
+            Self::Unreachable { chain, reason } => write!(f, "unreachable: chain {} ({reason})", chain + 1),
+            Self::OutsideMobility => f.write_str("the mechanism cannot move along that coordinate"),
+            Self::Singular => f.write_str("singular Jacobian"),
+            Self::NearSingularity => f.write_str("too close to a type-2 singularity"),
+            Self::NoConvergence { iterations } => write!(f, "no convergence after {iterations} iterations"),
+        }
+    }
+}

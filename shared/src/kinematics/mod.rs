@@ -1,0 +1,93 @@
+//! Kinematics of parallel platforms on a circular guide (KINEMATICS.md).
+//!
+//! Every mechanism implements [`Mechanism`]: inverse kinematics (pose -> six actuators), the constraint
+//! residuals `F(p, q)` and their Jacobians `A = dF/dp`, `B = dF/dq` (section 3), forward kinematics by Newton
+//! iteration on `F(p, q) = 0` (a provided method), and the workspace checks of section 4 with margins.
+
+mod error;
+pub mod forward;
+pub mod geometry;
+mod multiturn;
+mod pose;
+pub mod presets;
+mod ring;
+mod tool;
+pub mod velocity;
+pub mod workspace;
+
+pub use error::{KinematicsError, Reach};
+pub use forward::{ForwardSolution, NewtonOptions};
+pub use geometry::{Branch, Chain, ChainKind, GeometryError, RingGeometry, RingLimits, ToolGeometry};
+pub use multiturn::MultiTurn;
+pub use pose::{Actuators, Pose};
+pub use ring::{ActuatorLoads, RingPlatform};
+pub use tool::ToolCarrier;
+pub use velocity::{Jacobians, Singularity};
+pub use workspace::{Check, WorkspaceReport};
+
+use nalgebra::Vector6;
+
+use crate::Real;
+
+/// What an actuator coordinate measures, which decides how it is unwrapped and converted to steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum AxisKind {
+    /// A carriage angle on the ring (rad): multi-turn, unwrapped to the branch nearest the previous value.
+    Ring,
+    /// A length (m).
+    Linear,
+    /// A bounded joint angle (rad), never unwrapped.
+    Angle,
+}
+
+/// A parallel mechanism: pose <-> six actuator coordinates.
+///
+/// Implementations never panic: every input class that has no answer returns a [`KinematicsError`].
+pub trait Mechanism<T: Real> {
+    /// Degrees of freedom of the platform: 6, or 5 for the tool carrier whose yaw is fixed at zero.
+    /// Pose coordinates from index `dof()` on are held at zero; actuators from index `dof()` on are auxiliary
+    /// (they follow the pose and are not inputs of the forward kinematics).
+    fn dof(&self) -> usize;
+
+    /// What each of the six actuator coordinates measures.
+    fn axes(&self) -> [AxisKind; 6];
+
+    /// A length typical of the mechanism (ring radius, link length): it makes residuals, Jacobian columns and
+    /// singularity indices scale-free.
+    fn characteristic_length(&self) -> T;
+
+    /// Inverse kinematics: the six actuator coordinates that put the platform at `pose`.
+    fn inverse(&self, pose: &Pose<T>) -> Result<Actuators<T>, KinematicsError>;
+
+    /// Constraint residuals `F(p, q)` (zero when `q` and `pose` belong together); rows from `dof()` on are the
+    /// auxiliary relations.
+    fn residuals(&self, pose: &Pose<T>, q: &Actuators<T>) -> Vector6<T>;
+
+    /// The velocity Jacobians `A = dF/dp` and `B = dF/dq` at a pose and its actuators.
+    fn jacobians(&self, pose: &Pose<T>, q: &Actuators<T>) -> Jacobians<T>;
+
+    /// Every workspace check of KINEMATICS.md 4 with its margin, for a pose and the actuators of its IK.
+    fn workspace(&self, pose: &Pose<T>, q: &Actuators<T>) -> WorkspaceReport<T>;
+
+    /// Forward kinematics: the pose that the actuators `q` put the platform in, found by Newton iteration on
+    /// `F(p, q) = 0` from `guess` (normally the last known pose).
+    fn forward(
+        &self,
+        q: &Actuators<T>,
+        guess: &Pose<T>,
+        options: &NewtonOptions<T>,
+    ) -> Result<ForwardSolution<T>, KinematicsError>
+    where
+        Self: Sized,
+    {
+        forward::newton(self, q, guess, options)
+    }
+
+    /// IK, then every workspace check: the actuators and the report, or the reason there is no solution.
+    fn inverse_checked(&self, pose: &Pose<T>) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
+        let q = self.inverse(pose)?;
+        Ok((q, self.workspace(pose, &q)))
+    }
+}

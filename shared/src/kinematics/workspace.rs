@@ -1,0 +1,102 @@
+//! The workspace checks of KINEMATICS.md 4, each with a margin: positive inside, negative outside.
+
+use core::fmt;
+
+use crate::Real;
+
+/// One workspace check. Each has its own unit of margin, given on the variant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Check {
+    /// 1. Rod reach and actuator stroke: the smallest slack of any reach condition or stroke limit (m).
+    Reach,
+    /// 2. Central angle between neighbouring carriages within `[min, max]` (rad).
+    CarriageSpacing,
+    /// 3. Neighbouring carriages keep their cyclic order, so rods cannot cross: smallest signed gap (rad).
+    RodCrossing,
+    /// 4. Ball-joint cones: smallest angle of a chain to the base or platform plane above its limit (rad).
+    JointCones,
+    /// 5. Scale-free singularity index of the transmitted wrenches above its threshold (dimensionless).
+    Singularity,
+    /// 6. Centre of mass projected inside the carriage polygon: distance to its nearest edge (m).
+    Stability,
+}
+
+impl Check {
+    /// All checks, in the order of KINEMATICS.md 4.
+    pub const ALL: [Check; 6] =
+        [Check::Reach, Check::CarriageSpacing, Check::RodCrossing, Check::JointCones, Check::Singularity, Check::Stability];
+
+    /// Short name for reports.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Check::Reach => "reach",
+            Check::CarriageSpacing => "carriage-spacing",
+            Check::RodCrossing => "rod-crossing",
+            Check::JointCones => "joint-cones",
+            Check::Singularity => "singularity",
+            Check::Stability => "stability",
+        }
+    }
+
+    /// Unit of the margin.
+    pub const fn unit(self) -> &'static str {
+        match self {
+            Check::Reach | Check::Stability => "m",
+            Check::CarriageSpacing | Check::RodCrossing | Check::JointCones => "rad",
+            Check::Singularity => "1",
+        }
+    }
+
+    const fn index(self) -> usize {
+        self as usize
+    }
+}
+
+impl fmt::Display for Check {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The margins of all six checks at one pose. `None`: the check does not apply to the mechanism.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WorkspaceReport<T> {
+    margins: [Option<T>; 6],
+    /// The raw singularity index behind [`Check::Singularity`] (before the threshold is subtracted).
+    pub singularity_index: T,
+}
+
+impl<T: Real> WorkspaceReport<T> {
+    /// A report from margins in the order of [`Check::ALL`].
+    pub fn new(margins: [Option<T>; 6], singularity_index: T) -> Self {
+        Self { margins, singularity_index }
+    }
+
+    /// Margin of one check (`None` when it does not apply). NaN never passes.
+    pub fn margin(&self, check: Check) -> Option<T> {
+        self.margins.get(check.index()).copied().flatten()
+    }
+
+    /// Whether one check passes (a check that does not apply passes).
+    pub fn passes(&self, check: Check) -> bool {
+        self.margin(check).is_none_or(|m| m >= T::zero())
+    }
+
+    /// Whether every check passes.
+    pub fn all_pass(&self) -> bool {
+        Check::ALL.iter().all(|c| self.passes(*c))
+    }
+
+    /// The first failing check in the order of [`Check::ALL`].
+    pub fn first_failure(&self) -> Option<Check> {
+        Check::ALL.into_iter().find(|c| !self.passes(*c))
+    }
+
+    /// The check with the smallest margin among those in the same unit is not meaningful across units, so this
+    /// returns each check with its margin, for display.
+    pub fn iter(&self) -> impl Iterator<Item = (Check, Option<T>)> + '_ {
+        Check::ALL.into_iter().map(|c| (c, self.margin(c)))
+    }
+}

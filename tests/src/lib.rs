@@ -1,0 +1,1 @@
+//! End-to-end tests of ringpod (grow with the host CLI and QEMU issues).
