@@ -37,6 +37,9 @@ pub enum KinematicsError {
     Singular,
     /// Forward kinematics came within the configured margin of a type-2 singularity.
     NearSingularity,
+    /// Forward kinematics converged to an assembly that the auxiliary actuators contradict (the tool carrier's
+    /// other four-bar assembly): the guess was too far from the platform's real pose.
+    OtherAssembly,
     /// Forward kinematics did not converge within the configured number of iterations.
     NoConvergence {
         /// Iterations run.
@@ -63,6 +66,7 @@ impl fmt::Display for KinematicsError {
             Self::OutsideMobility => f.write_str("the mechanism cannot move along that coordinate"),
             Self::Singular => f.write_str("singular Jacobian"),
             Self::NearSingularity => f.write_str("too close to a type-2 singularity"),
+            Self::OtherAssembly => f.write_str("converged to another assembly than the auxiliary actuators show"),
             Self::NoConvergence { iterations } => write!(f, "no convergence after {iterations} iterations"),
         }
     }

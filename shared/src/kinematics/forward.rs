@@ -73,6 +73,11 @@ pub fn newton<T: Real, M: Mechanism<T>>(
             let res = mechanism.residuals(&pose, &q);
             let residual = res.iter().take(dof).fold(T::zero(), |m, r| m.max(r.abs() * inv_len2));
             if residual <= options.tolerance {
+                // The auxiliary relations are not part of the iteration: they tell which assembly was found.
+                let aux = res.iter().skip(dof).fold(T::zero(), |m, r| m.max(r.abs() * inv_len));
+                if aux > options.tolerance.sqrt_() {
+                    return Err(KinematicsError::OtherAssembly);
+                }
                 return Ok(ForwardSolution { pose, iterations: iteration, residual });
             }
         }

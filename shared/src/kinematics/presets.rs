@@ -66,24 +66,35 @@ pub const TOOL5_EX: ToolGeometry = unwrap_geometry(ToolGeometry::new(
     0.02,
 ));
 
-/// Nominal heave of the trainer model: the centre of its motion range (m).
-pub const TRAINER_MODEL_HOME_Z: f64 = 0.120;
+/// Nominal heave of the trainer model: the centre of its heave range (m).
+pub const TRAINER_MODEL_HOME_Z: f64 = 0.227;
 
 /// The 1:20 model of the trainer that the firmware drives (KINEMATICS.md 6), in metres.
+///
+/// Ring radius 0.286 m, rods 0.312 m, platform joints of the rod pair at `(-+0.194, -0.031)` and of the radial
+/// pair at `(+-0.181, 0.160)`, nominal heave 0.227 m. Found by `examples/trainer_model_design.rs` (a hill climb on
+/// the worst normalised margin) and rounded to millimetres: every axis of the spec table swept over its whole range
+/// (surge/sway +-50 mm, heave +-40 mm, pitch/roll +-20 deg), at any yaw, passes all six checks with the source's joint
+/// limits. The combined corners of all ranges at once are not all reachable; the README gives the share that is.
+/// Linear actuators: 150 mm stroke, 160..310 mm (the range uses 174..294 mm).
 pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
     "trainer-model",
-    0.150,
-    0.150,
-    &[rod(Branch::Plus, -0.050, -0.050), rod(Branch::Minus, 0.050, -0.050), radial(0.050, 0.050), radial(-0.050, 0.050)],
+    0.286,
+    0.312,
+    &[rod(Branch::Plus, -0.194, -0.031), rod(Branch::Minus, 0.194, -0.031), radial(0.181, 0.160), radial(-0.181, 0.160)],
     RingLimits {
-        stroke: [0.040, 0.200],
+        stroke: [0.160, 0.310],
         carriage_spacing: SOURCE_SPACING,
         base_cone: 11.0 * DEG,
         platform_cone: 22.0 * DEG,
-        min_singularity_index: 0.01,
+        min_singularity_index: 0.02,
         centre_of_mass: [0.0, 0.0, 0.020],
     },
 ));
+
+/// Motion ranges of the model's spec table around [`TRAINER_MODEL_HOME_Z`]: surge, sway, heave (m), roll, pitch
+/// (rad); yaw is continuous.
+pub const TRAINER_MODEL_RANGES: [f64; 5] = [0.050, 0.050, 0.040, 20.0 * DEG, 20.0 * DEG];
 
 /// All ring presets, by name.
 pub const RING: [&RingGeometry; 3] = [&TRAINER_CH5, &ROTOPOD_CH4, &TRAINER_MODEL];

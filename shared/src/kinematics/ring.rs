@@ -187,19 +187,22 @@ impl<T: Real> RingPlatform<T> {
         Ok(ActuatorLoads { line_forces: f.into(), drives })
     }
 
-    fn reach_margin(&self, joints: &[Vector3<T>; 6], q: &Actuators<T>) -> T {
+    /// Reach margin of a pose (m), defined whether or not the pose is reachable: the smallest slack of the rod
+    /// conditions `|Az| < L` and `|Rr - rho| <= h <= Rr + rho`, and of the radial strokes `s_min <= s <= s_max`.
+    /// Negative outside, by how far.
+    pub fn reach_margin(&self, pose: &Pose<T>) -> T {
+        let joints = self.joints(pose);
         let mut margin = T::max_value().unwrap_or(T::one());
         for i in 0..self.n {
             let a = joints[i];
             let rho = (a.x * a.x + a.y * a.y).sqrt_();
             let m = match self.kinds[i] {
                 ChainKind::Rod(_) => {
-                    let h2 = self.rod * self.rod - a.z * a.z;
-                    let h = h2.max(T::zero()).sqrt_();
+                    let h = (self.rod * self.rod - a.z * a.z).max(T::zero()).sqrt_();
                     (self.rod - a.z.abs()).min(h - (self.rr - rho).abs()).min(self.rr + rho - h)
                 }
                 ChainKind::Radial => {
-                    let s = self.length_axis[i].and_then(|k| q.0.get(k).copied()).unwrap_or(T::zero());
+                    let s = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
                     (s - self.stroke[0]).min(self.stroke[1] - s)
                 }
             };
@@ -208,23 +211,29 @@ impl<T: Real> RingPlatform<T> {
         margin
     }
 
-    /// Spacing and crossing margins from the signed central angles between neighbouring carriages.
+    /// Spacing and crossing margins from the counter-clockwise central angles between neighbouring carriages.
+    ///
+    /// Each gap is measured counter-clockwise in `[0, 2pi)`. The carriages keep their order exactly when the gaps
+    /// add up to one turn; two turns or more means some carriage passed a neighbour, and the crossing margin is
+    /// then minus the smallest angle by which the order is broken.
     fn ring_order_margins(&self, q: &Actuators<T>) -> (T, T) {
+        let two_pi = T::two_pi();
         let mut spacing = T::max_value().unwrap_or(T::one());
-        let mut order = spacing;
+        let mut smallest = two_pi;
+        let mut largest = T::zero();
         let mut total = T::zero();
         for i in 0..self.n {
-            let next = (i + 1) % self.n;
-            let gap = wrap_pi(q.0[next] - q.0[i]);
+            let mut gap = wrap_pi(q.0[(i + 1) % self.n] - q.0[i]);
+            if gap < T::zero() {
+                gap += two_pi;
+            }
             total += gap;
             spacing = spacing.min(gap - self.spacing[0]).min(self.spacing[1] - gap);
-            order = order.min(gap);
+            smallest = smallest.min(gap);
+            largest = largest.max(gap);
         }
-        // Positive gaps that add up to more than one turn mean the carriages wound past each other.
-        let winding = (total - T::two_pi()).abs();
-        if winding > T::of(1e-3) {
-            order = order.min(-winding);
-        }
+        // A carriage that passed its neighbour by d leaves a gap of 2pi - d behind it.
+        let order = if total < two_pi + T::pi() { smallest } else { -(two_pi - largest) };
         (spacing, order)
     }
 
@@ -398,7 +407,7 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         let index = self.singularity_index(pose, q);
         WorkspaceReport::new(
             [
-                Some(self.reach_margin(&c.joints, q)),
+                Some(self.reach_margin(pose)),
                 Some(spacing),
                 Some(order),
                 Some(self.cone_margin(pose, &c)),
