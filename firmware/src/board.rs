@@ -5,14 +5,17 @@
 use embassy_stm32::gpio::{Level, Output, Pin, Speed};
 use embassy_stm32::{rcc, time::Hertz, Config, Peri};
 
-/// Clock tree: 25 MHz HSE crystal.
-/// SYSCLK: 25 MHz / 25 (PLLM) * 200 (PLLN) / 2 (PLLP) = 100 MHz.
-/// USB:    25 MHz / 25 (PLLM) * 192 ... the F411 derives 48 MHz from the same VCO: 200 MHz / 4 (PLLQ) = 50 MHz is
-/// out of USB tolerance, so the VCO runs at 384 MHz: 25 / 25 * 384 = 384 MHz, / 4 (PLLP) = 96 MHz SYSCLK,
-/// / 8 (PLLQ) = 48 MHz for USB. 96 MHz core with an exact 48 MHz USB clock is what a USB device needs.
+/// Clock tree from the 25 MHz HSE crystal. USB needs exactly 48 MHz from the same PLL as the core, and no VCO
+/// frequency gives both 100 MHz (PLLP) and 48 MHz (PLLQ), so the core runs at 96 MHz:
+/// VCO  = 25 MHz / 25 (PLLM) * 384 (PLLN) = 384 MHz
+/// SYSCLK = 384 MHz / 4 (PLLP) = 96 MHz;  USB = 384 MHz / 8 (PLLQ) = 48 MHz
+/// APB1 = 96 / 2 = 48 MHz (max 50), APB2 = 96 MHz (max 100).
 pub fn clocks() -> Config {
     let mut config = Config::default();
-    config.rcc.hse = Some(rcc::Hse { freq: Hertz(25_000_000), mode: rcc::HseMode::Oscillator });
+    config.rcc.hse = Some(rcc::Hse {
+        freq: Hertz(25_000_000),
+        mode: rcc::HseMode::Oscillator,
+    });
     config.rcc.pll_src = rcc::PllSource::HSE;
     config.rcc.pll = Some(rcc::Pll {
         prediv: rcc::PllPreDiv::DIV25,
@@ -22,13 +25,17 @@ pub fn clocks() -> Config {
         divr: None,
     });
     config.rcc.ahb_pre = rcc::AHBPrescaler::DIV1;
-    config.rcc.apb1_pre = rcc::APBPrescaler::DIV2; // APB1 max 50 MHz: 96 / 2 = 48 MHz
+    config.rcc.apb1_pre = rcc::APBPrescaler::DIV2;
     config.rcc.apb2_pre = rcc::APBPrescaler::DIV1;
     config.rcc.sys = rcc::Sysclk::PLL1_P;
     config
 }
 
 /// The outputs that can energise the machine, driven to their safe level at construction.
+///
+/// Owning them is the point: dropping an embassy `Output` returns the pin to a floating input, which must never
+/// happen to a relay or enable line. The supervisor task of the firmware issue will drive them.
+#[allow(dead_code)]
 pub struct SafeOutputs<'d> {
     /// Logic supply relay (LOGIC_EN), off.
     pub logic_relay: Output<'d>,

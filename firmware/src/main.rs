@@ -12,7 +12,7 @@ mod board;
 use defmt::info;
 use embassy_executor::Spawner;
 use embassy_time::{Duration, Ticker};
-use ringpod_core::kinematics::{presets, Mechanism, Pose, Trainer};
+use ringpod_core::kinematics::{presets, Mechanism, Pose, RingPlatform};
 use {defmt_rtt as _, panic_probe as _};
 
 #[embassy_executor::main]
@@ -22,13 +22,13 @@ async fn main(_spawner: Spawner) {
     let _outputs = board::SafeOutputs::new(p.PB12, p.PB13, p.PB14);
     info!("ringpod firmware up (kinematics self-check only)");
 
-    let trainer = Trainer::<f32>::new(&presets::TRAINER_MODEL);
+    let trainer = RingPlatform::<f32>::new(&presets::TRAINER_MODEL);
     let home = Pose::new(0.0, 0.0, presets::TRAINER_MODEL_HOME_Z as f32, 0.0, 0.0, 0.0);
     let mut ticker = Ticker::every(Duration::from_secs(1));
     loop {
         let start = embassy_time::Instant::now();
         match trainer.inverse(&home) {
-            Ok(q) => info!("IK at home: {=[f32]} ({} us)", q.as_array()[..], start.elapsed().as_micros()),
+            Ok(q) => info!("IK at home: {} ({} us)", q.as_array(), start.elapsed().as_micros()),
             Err(e) => defmt::error!("IK failed at home: {}", e),
         }
         ticker.next().await;

@@ -97,8 +97,15 @@ struct Design {
 
 impl Design {
     fn geometry(&self, stroke: [f64; 2], min_index: f64) -> Option<RingGeometry> {
-        let c = |kind, x: f64, y: f64| Chain { kind, platform_point: [x, y, 0.0] };
-        let (b1, b2) = if self.flipped { (Branch::Minus, Branch::Plus) } else { (Branch::Plus, Branch::Minus) };
+        let c = |kind, x: f64, y: f64| Chain {
+            kind,
+            platform_point: [x, y, 0.0],
+        };
+        let (b1, b2) = if self.flipped {
+            (Branch::Minus, Branch::Plus)
+        } else {
+            (Branch::Plus, Branch::Minus)
+        };
         RingGeometry::new(
             "candidate",
             self.rr,
@@ -137,7 +144,9 @@ impl Design {
     /// Smallest normalised margin over the poses (margins in units of 0.1 rad, 5 mm, and 0.05 for the
     /// singularity index); an unreachable pose scores by its reach margin, minus one.
     fn score(&self, poses: &[Pose<f64>]) -> f64 {
-        let Some(g) = self.geometry([0.001, 10.0], 0.0) else { return -10.0 };
+        let Some(g) = self.geometry([0.001, 10.0], 0.0) else {
+            return -10.0;
+        };
         let m = RingPlatform::<f64>::new(&g);
         let mut worst = f64::INFINITY;
         let mut unreachable = 0;
@@ -174,12 +183,19 @@ fn print(name: &str, worst: &[f64; 6], stroke: [f64; 2], index: f64) {
     for (c, m) in Check::ALL.iter().zip(worst) {
         println!("  {:<17} {:>10.5} {}", c.name(), m, c.unit());
     }
-    println!("  stroke used [{:.4}, {:.4}] m, smallest singularity index {:.4}", stroke[0], stroke[1], index);
+    println!(
+        "  stroke used [{:.4}, {:.4}] m, smallest singularity index {:.4}",
+        stroke[0], stroke[1], index
+    );
 }
 
 fn main() {
     let box_mode = std::env::args().any(|a| a == "--box");
-    let quick = if box_mode { spec_poses(0.0, 100) } else { axis_poses(0.0, 8) };
+    let quick = if box_mode {
+        spec_poses(0.0, 100)
+    } else {
+        axis_poses(0.0, 8)
+    };
     let mut rng = Rng(42);
     let mut best: Option<(f64, Design)> = None;
     for start in 0..60 {
@@ -209,7 +225,11 @@ fn main() {
         }
     }
     if let Some((_, d)) = best {
-        let full = if box_mode { spec_poses(d.z0, 5_000) } else { axis_poses(d.z0, 200) };
+        let full = if box_mode {
+            spec_poses(d.z0, 5_000)
+        } else {
+            axis_poses(d.z0, 200)
+        };
         if let Some(g) = d.geometry([0.001, 10.0], 0.0) {
             match evaluate(&g, &full) {
                 Some((worst, stroke, index)) => print("best design", &worst, stroke, index),
@@ -219,15 +239,28 @@ fn main() {
     }
     let g = &presets::TRAINER_MODEL;
     for (name, poses) in [
-        ("trainer-model preset, each axis over its range", axis_poses(presets::TRAINER_MODEL_HOME_Z, 200)),
-        ("trainer-model preset, whole combined box", spec_poses(presets::TRAINER_MODEL_HOME_Z, 20_000)),
+        (
+            "trainer-model preset, each axis over its range",
+            axis_poses(presets::TRAINER_MODEL_HOME_Z, 200),
+        ),
+        (
+            "trainer-model preset, whole combined box",
+            spec_poses(presets::TRAINER_MODEL_HOME_Z, 20_000),
+        ),
     ] {
         match evaluate(g, &poses) {
             Some((worst, stroke, index)) => print(name, &worst, stroke, index),
             None => println!("{name}: some pose is unreachable"),
         }
         let m = RingPlatform::<f64>::new(g);
-        let inside = poses.iter().filter(|p| m.inverse_checked(p).is_ok_and(|(_, r)| r.all_pass())).count();
-        println!("  {inside} of {} poses pass every check ({:.1} %)", poses.len(), 100.0 * inside as f64 / poses.len() as f64);
+        let inside = poses
+            .iter()
+            .filter(|p| m.inverse_checked(p).is_ok_and(|(_, r)| r.all_pass()))
+            .count();
+        println!(
+            "  {inside} of {} poses pass every check ({:.1} %)",
+            poses.len(),
+            100.0 * inside as f64 / poses.len() as f64
+        );
     }
 }

@@ -80,8 +80,26 @@ macro_rules! impl_real {
     };
 }
 
-impl_real!(f32, libm::sinf, libm::cosf, libm::atan2f, libm::acosf, libm::asinf, libm::sqrtf, libm::roundf);
-impl_real!(f64, libm::sin, libm::cos, libm::atan2, libm::acos, libm::asin, libm::sqrt, libm::round);
+impl_real!(
+    f32,
+    libm::sinf,
+    libm::cosf,
+    libm::atan2f,
+    libm::acosf,
+    libm::asinf,
+    libm::sqrtf,
+    libm::roundf
+);
+impl_real!(
+    f64,
+    libm::sin,
+    libm::cos,
+    libm::atan2,
+    libm::acos,
+    libm::asin,
+    libm::sqrt,
+    libm::round
+);
 
 /// Wraps an angle into `(-pi, pi]`.
 pub(crate) fn wrap_pi<T: Real>(a: T) -> T {

@@ -1,5 +1,8 @@
 //! Continuous yaw: carriages are multi-turn and keep step precision over 10,000 turns (KINEMATICS.md 3).
 
+// Index loops over parallel per-axis arrays read more plainly than zips here.
+#![allow(clippy::needless_range_loop)]
+
 use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
 
 /// 200 full steps x 16 microsteps x 8:1 ring gear = 25,600 steps per carriage revolution (about 4,074 steps/rad).
@@ -39,14 +42,20 @@ fn ten_thousand_turns_out_and_back_within_one_step() {
     for i in 0..4 {
         assert_eq!(pos.turns[i], 10_000, "axis {i} turns");
         let exact = 10_000 * STEPS_PER_TURN + (q64.0[i] * STEPS_PER_TURN as f64 / std::f64::consts::TAU).round() as i64;
-        assert!((pos.ring_steps(i, STEPS_PER_TURN) - exact).abs() <= 1, "axis {i} far out");
+        assert!(
+            (pos.ring_steps(i, STEPS_PER_TURN) - exact).abs() <= 1,
+            "axis {i} far out"
+        );
     }
     for k in (0..ticks).rev() {
         pos.inverse_near(&m, &pose_at(k, dyaw)).unwrap();
     }
     for i in 0..4 {
         assert_eq!(pos.turns[i], 0);
-        assert!((pos.ring_steps(i, STEPS_PER_TURN) - start[i]).abs() <= 1, "axis {i} back home");
+        assert!(
+            (pos.ring_steps(i, STEPS_PER_TURN) - start[i]).abs() <= 1,
+            "axis {i} back home"
+        );
     }
 }
 
@@ -56,7 +65,11 @@ fn one_float_angle_would_drift_by_steps() {
     let angle = (10_000.0 * std::f64::consts::TAU) as f32;
     let ulp = f32::from_bits(angle.to_bits() + 1) - angle;
     let steps_per_rad = STEPS_PER_TURN as f32 / std::f32::consts::TAU;
-    assert!(ulp * steps_per_rad > 10.0, "ulp {ulp} rad = {} steps", ulp * steps_per_rad);
+    assert!(
+        ulp * steps_per_rad > 10.0,
+        "ulp {ulp} rad = {} steps",
+        ulp * steps_per_rad
+    );
 }
 
 #[test]

@@ -1,9 +1,13 @@
 //! Invariants over many random inputs: IK/FK round trips, Jacobians against finite differences, velocity and
+
+// Index loops over parallel per-axis arrays read more plainly than zips here.
+#![allow(clippy::needless_range_loop)]
 //! statics consistency, multi-turn tracking, and no panic on any input.
 
 use proptest::prelude::*;
 use ringpod_core::kinematics::{
-    presets, Actuators, AxisKind, Check, KinematicsError, Mechanism, MultiTurn, NewtonOptions, Pose, RingPlatform, ToolCarrier,
+    presets, Actuators, AxisKind, Check, KinematicsError, Mechanism, MultiTurn, NewtonOptions, Pose, RingPlatform,
+    ToolCarrier,
 };
 
 fn trainer() -> RingPlatform<f64> {
@@ -25,7 +29,14 @@ fn trainer_pose() -> impl Strategy<Value = Pose<f64>> {
 }
 
 fn rotopod_pose() -> impl Strategy<Value = Pose<f64>> {
-    (-0.1..0.1f64, -0.1..0.1f64, 0.55..0.85f64, -0.15..0.15f64, -0.15..0.15f64, -7.0..7.0f64)
+    (
+        -0.1..0.1f64,
+        -0.1..0.1f64,
+        0.55..0.85f64,
+        -0.15..0.15f64,
+        -0.15..0.15f64,
+        -7.0..7.0f64,
+    )
         .prop_map(|(x, y, z, a, b, g)| Pose::new(x, y, z, a, b, g))
 }
 
@@ -50,13 +61,19 @@ fn offsets() -> impl Strategy<Value = [f64; 6]> {
 
 fn same_pose(a: &Pose<f64>, b: &Pose<f64>, tol: f64) -> bool {
     a.to_array().iter().zip(b.to_array()).enumerate().all(|(i, (x, y))| {
-        let d = if i == 5 { (x - y + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI } else { x - y };
+        let d = if i == 5 {
+            (x - y + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+        } else {
+            x - y
+        };
         d.abs() <= tol
     })
 }
 
 fn round_trip<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>, e: [f64; 6]) -> Result<(), TestCaseError> {
-    let Ok((q, report)) = m.inverse_checked(pose) else { return Ok(()) };
+    let Ok((q, report)) = m.inverse_checked(pose) else {
+        return Ok(());
+    };
     // Within 2x the singularity threshold the FK may rightly refuse; elsewhere it must converge.
     if report.singularity_index < 0.05 {
         return Ok(());
@@ -114,14 +131,24 @@ fn jacobians_match<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>) -> Result<(), Tes
         p0[k] -= h;
         let d = (m.residuals(&Pose::from_array(p1), &q) - m.residuals(&Pose::from_array(p0), &q)) / (2.0 * h);
         for r in 0..6 {
-            prop_assert!((d[r] - j.a[(r, k)]).abs() < 1e-6, "A[{r},{k}] {} vs {}", j.a[(r, k)], d[r]);
+            prop_assert!(
+                (d[r] - j.a[(r, k)]).abs() < 1e-6,
+                "A[{r},{k}] {} vs {}",
+                j.a[(r, k)],
+                d[r]
+            );
         }
         let (mut q1, mut q0) = (q, q);
         q1.0[k] += h;
         q0.0[k] -= h;
         let d = (m.residuals(pose, &q1) - m.residuals(pose, &q0)) / (2.0 * h);
         for r in 0..6 {
-            prop_assert!((d[r] - j.b[(r, k)]).abs() < 1e-6, "B[{r},{k}] {} vs {}", j.b[(r, k)], d[r]);
+            prop_assert!(
+                (d[r] - j.b[(r, k)]).abs() < 1e-6,
+                "B[{r},{k}] {} vs {}",
+                j.b[(r, k)],
+                d[r]
+            );
         }
     }
     Ok(())
@@ -130,7 +157,9 @@ fn jacobians_match<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>) -> Result<(), Tes
 /// Pose rates -> actuator rates -> pose rates is the identity over the DOF, and actuator rates match the IK's
 /// finite difference along the motion.
 fn rates_consistent<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>, dir: [f64; 6]) -> Result<(), TestCaseError> {
-    let Ok((q, report)) = m.inverse_checked(pose) else { return Ok(()) };
+    let Ok((q, report)) = m.inverse_checked(pose) else {
+        return Ok(());
+    };
     // Finite differences need distance from both singularity types (see drive_loads_balance_virtual_work).
     if report.singularity_index < 0.05 || report.margin(Check::Reach).unwrap() < 1e-3 {
         return Ok(());
@@ -152,7 +181,12 @@ fn rates_consistent<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>, dir: [f64; 6]) -
                 d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
             }
             // Central differences lose digits where rates are large (near type-1 edges); a wrong term is off by order one.
-            prop_assert!((d / (2.0 * h) - qd[i]).abs() < 1e-4 * (1.0 + qd[i].abs()), "axis {i}: {} vs {}", d / (2.0 * h), qd[i]);
+            prop_assert!(
+                (d / (2.0 * h) - qd[i]).abs() < 1e-4 * (1.0 + qd[i].abs()),
+                "axis {i}: {} vs {}",
+                d / (2.0 * h),
+                qd[i]
+            );
         }
     }
     Ok(())
@@ -234,9 +268,8 @@ fn never_panics<T: ringpod_core::Real, M: Mechanism<T>>(m: &M, v: [f64; 6], w: [
     let _ = j.pose_rates(&q.to_vector());
     let _ = j.classify(T::of(0.01));
     let _ = m.workspace(&pose, &q);
-    match m.forward(&q, &pose, &NewtonOptions::default()) {
-        Ok(sol) => assert!(sol.pose.to_array().iter().all(|c| c.finite())),
-        Err(_) => {}
+    if let Ok(sol) = m.forward(&q, &pose, &NewtonOptions::default()) {
+        assert!(sol.pose.to_array().iter().all(|c| c.finite()));
     }
     let mut mt = MultiTurn::new(q);
     let _ = mt.inverse_near(m, &pose);
@@ -302,7 +335,14 @@ fn usable<M: Mechanism<f64>>(m: &M, strategy: impl Strategy<Value = Pose<f64>>) 
 /// The round-trip properties skip unreachable and near-singular poses: make sure most samples are real trips.
 #[test]
 fn round_trips_are_not_vacuous() {
-    let (t, r, k) = (usable(&trainer(), trainer_pose()), usable(&rotopod(), rotopod_pose()), usable(&tool(), tool_pose()));
-    assert!(t > 400 && r > 900 && k > 500, "usable samples of 1000: trainer {t}, rotopod {r}, tool {k}");
+    let (t, r, k) = (
+        usable(&trainer(), trainer_pose()),
+        usable(&rotopod(), rotopod_pose()),
+        usable(&tool(), tool_pose()),
+    );
+    assert!(
+        t > 400 && r > 900 && k > 500,
+        "usable samples of 1000: trainer {t}, rotopod {r}, tool {k}"
+    );
     println!("usable samples of 1000: trainer {t}, rotopod {r}, tool {k}");
 }

@@ -1,4 +1,7 @@
 //! Every case of the reference files (`tests/reference/*.json`, copied from the project's shared reference
+
+// Index loops over parallel per-axis arrays read more plainly than zips here.
+#![allow(clippy::needless_range_loop)]
 //! folder) and the published examples of KINEMATICS.md, reproduced within their tolerances.
 
 use ringpod_core::kinematics::{
@@ -57,7 +60,11 @@ fn check_ring_file(file: &str, preset: &ringpod_core::kinematics::RingGeometry, 
         match (case.actuators, mechanism.inverse(&pose)) {
             (Some(expected), Ok(q)) => {
                 for (i, (got, want)) in q.0.iter().zip(expected).enumerate() {
-                    let err = if i < ring_axes { angle_diff(*got, want) } else { got - want };
+                    let err = if i < ring_axes {
+                        angle_diff(*got, want)
+                    } else {
+                        got - want
+                    };
                     assert!(
                         err.abs() <= reference.tolerance,
                         "{file} pose {:?} axis {i}: got {got}, want {want}",
@@ -105,7 +112,9 @@ fn trainer_ch4_radial_length_with_short_rods() {
         presets::TRAINER_CH5.limits,
     )
     .unwrap();
-    let q = RingPlatform::<f64>::new(&g).inverse(&Pose::new(0.0, 0.0, 0.172, 0.0, 0.0, 0.0)).unwrap();
+    let q = RingPlatform::<f64>::new(&g)
+        .inverse(&Pose::new(0.0, 0.0, 0.172, 0.0, 0.0, 0.0))
+        .unwrap();
     let want = ((3.0 - 5f64.sqrt()).powi(2) + 0.172f64.powi(2)).sqrt();
     assert!((q.0[4] - want).abs() < 1e-12 && (want - 0.783).abs() < 5e-4);
 }
@@ -113,7 +122,9 @@ fn trainer_ch4_radial_length_with_short_rods() {
 #[test]
 fn rotopod_published_values_match_the_formulas() {
     // KINEMATICS.md 2.2: q ~ (5.508, 0.775, 1.319, 2.869, 3.414, 4.964) at (0, 0, 0.7, 0, 0, 0).
-    let q = RingPlatform::<f64>::new(&presets::ROTOPOD_CH4).inverse(&Pose::new(0.0, 0.0, 0.7, 0.0, 0.0, 0.0)).unwrap();
+    let q = RingPlatform::<f64>::new(&presets::ROTOPOD_CH4)
+        .inverse(&Pose::new(0.0, 0.0, 0.7, 0.0, 0.0, 0.0))
+        .unwrap();
     for (got, want) in q.0.iter().zip([5.508, 0.775, 1.319, 2.869, 3.414, 4.964]) {
         assert!(angle_diff(*got, want).abs() < 1e-3, "{got} vs {want}");
     }
@@ -158,8 +169,16 @@ fn tool5_reference_cases_both_branches() {
             let m = ToolCarrier::<f64>::new(&presets::TOOL5_EX.with_branches(branch, branch));
             let q = m.inverse(&pose).unwrap();
             assert!((q.0[0] * 1e3 - case.q1).abs() <= reference.tolerance_mm);
-            assert!((q.0[1].to_degrees() - case.q2[k]).abs() <= reference.tolerance_deg, "q2 {}", q.0[1].to_degrees());
-            assert!((q.0[3].to_degrees() - case.q4[k]).abs() <= reference.tolerance_deg, "q4 {}", q.0[3].to_degrees());
+            assert!(
+                (q.0[1].to_degrees() - case.q2[k]).abs() <= reference.tolerance_deg,
+                "q2 {}",
+                q.0[1].to_degrees()
+            );
+            assert!(
+                (q.0[3].to_degrees() - case.q4[k]).abs() <= reference.tolerance_deg,
+                "q4 {}",
+                q.0[3].to_degrees()
+            );
             assert!((q.0[4].to_degrees() - case.q5).abs() <= reference.tolerance_deg);
         }
     }
@@ -172,17 +191,24 @@ fn tool5_published_minutes() {
     let dm = |d: f64, m: f64| d + m / 60.0;
     let q = m.inverse(&Pose::new(0.0, 0.0, 0.4, 0.0, 0.0, 0.0)).unwrap();
     assert!((q.0[1].to_degrees() - dm(40.0, 39.0)).abs() < 1.0 / 60.0);
-    let q = m.inverse(&Pose::new(0.0, 0.0, 0.4, 0.0, 30f64.to_radians(), 0.0)).unwrap();
+    let q = m
+        .inverse(&Pose::new(0.0, 0.0, 0.4, 0.0, 30f64.to_radians(), 0.0))
+        .unwrap();
     assert!((q.0[0] - 0.150).abs() < 1e-9 && (q.0[1].to_degrees() - dm(36.0, 12.0)).abs() < 1.0 / 60.0);
     let plus = ToolCarrier::<f64>::new(&presets::TOOL5_EX.with_branches(Branch::Plus, Branch::Plus));
-    let q = plus.inverse(&Pose::new(0.0, 0.0, 0.4, 0.0, 30f64.to_radians(), 0.0)).unwrap();
+    let q = plus
+        .inverse(&Pose::new(0.0, 0.0, 0.4, 0.0, 30f64.to_radians(), 0.0))
+        .unwrap();
     assert!((q.0[1].to_degrees() - dm(143.0, 48.0)).abs() < 1.0 / 60.0);
 }
 
 #[test]
 fn tool5_has_no_yaw() {
     let m = ToolCarrier::<f64>::new(&presets::TOOL5_EX);
-    assert_eq!(m.inverse(&Pose::new(0.0, 0.0, 0.4, 0.0, 0.0, 0.1)), Err(KinematicsError::OutsideMobility));
+    assert_eq!(
+        m.inverse(&Pose::new(0.0, 0.0, 0.4, 0.0, 0.0, 0.1)),
+        Err(KinematicsError::OutsideMobility)
+    );
 }
 
 #[test]
@@ -190,21 +216,35 @@ fn unreachable_reasons_are_specific() {
     let m = RingPlatform::<f64>::new(&presets::TRAINER_CH5);
     assert_eq!(
         m.inverse(&Pose::new(0.0, 0.0, 1.4, 0.0, 0.0, 0.0)),
-        Err(KinematicsError::Unreachable { chain: 0, reason: Reach::Height })
+        Err(KinematicsError::Unreachable {
+            chain: 0,
+            reason: Reach::Height
+        })
     );
     assert!(matches!(
         m.inverse(&Pose::new(0.0, 0.0, 1.0, 0.0, -0.087266463, 0.0)),
-        Err(KinematicsError::Unreachable { reason: Reach::Ring, .. })
+        Err(KinematicsError::Unreachable {
+            reason: Reach::Ring,
+            ..
+        })
     ));
     // Chain 1's joint a1 = (-1, -2) moved onto the ring axis.
     assert_eq!(
-        m.inverse(&Pose::new(1.0, 2.0, 1.0, 0.0, 0.0, 0.0)).map(|_| ()).unwrap_err(),
-        KinematicsError::Unreachable { chain: 0, reason: Reach::Centre }
+        m.inverse(&Pose::new(1.0, 2.0, 1.0, 0.0, 0.0, 0.0))
+            .map(|_| ())
+            .unwrap_err(),
+        KinematicsError::Unreachable {
+            chain: 0,
+            reason: Reach::Centre
+        }
     );
     let tool = ToolCarrier::<f64>::new(&presets::TOOL5_EX);
     assert!(matches!(
         tool.inverse(&Pose::new(0.0, 0.0, 1.5, 0.0, 0.0, 0.0)),
-        Err(KinematicsError::Unreachable { reason: Reach::Dyad, .. })
+        Err(KinematicsError::Unreachable {
+            reason: Reach::Dyad,
+            ..
+        })
     ));
 }
 

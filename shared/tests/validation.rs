@@ -1,15 +1,25 @@
 //! Bad input classes: geometries that cannot be built, and forward kinematics that has no answer.
 
+// Index loops over parallel per-axis arrays read more plainly than zips here.
+#![allow(clippy::needless_range_loop)]
+
 use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, RingGeometry, ToolGeometry, DEG};
 use ringpod_core::kinematics::{
-    presets, Actuators, Check, GeometryError, KinematicsError, Mechanism, NewtonOptions, Pose, RingPlatform, Singularity,
+    presets, Actuators, Check, GeometryError, KinematicsError, Mechanism, NewtonOptions, Pose, RingPlatform,
+    Singularity,
 };
 
 fn rod(x: f64, y: f64) -> Chain {
-    Chain { kind: ChainKind::Rod(Branch::Plus), platform_point: [x, y, 0.0] }
+    Chain {
+        kind: ChainKind::Rod(Branch::Plus),
+        platform_point: [x, y, 0.0],
+    }
 }
 fn radial(x: f64, y: f64) -> Chain {
-    Chain { kind: ChainKind::Radial, platform_point: [x, y, 0.0] }
+    Chain {
+        kind: ChainKind::Radial,
+        platform_point: [x, y, 0.0],
+    }
 }
 
 #[test]
@@ -22,10 +32,34 @@ fn ring_geometry_errors() {
     assert_eq!(new(0.3, 0.0, chains), Err(GeometryError::NonPositiveLength));
     assert_eq!(new(f64::NAN, 0.3, chains), Err(GeometryError::NonFinite));
     assert_eq!(new(0.3, f64::INFINITY, chains), Err(GeometryError::NonFinite));
-    assert_eq!(new(0.3, 0.3, &[rod(0.1, 0.0), rod(0.1, 0.0), radial(0.0, 0.1), radial(0.0, -0.1)]), Err(GeometryError::CoincidentPoints));
-    assert_eq!(new(0.3, 0.3, &[rod(0.1, 0.0), rod(0.0, 0.1), rod(-0.1, 0.0)]), Err(GeometryError::ChainCount));
-    assert_eq!(new(0.3, 0.3, &[radial(0.1, 0.0), radial(0.0, 0.1), radial(-0.1, 0.0), radial(0.0, -0.1)]), Err(GeometryError::ChainCount));
-    assert_eq!(new(0.3, 0.3, &[rod(0.1, f64::NAN), rod(0.0, 0.1), radial(-0.1, 0.0), radial(0.0, -0.1)]), Err(GeometryError::NonFinite));
+    assert_eq!(
+        new(
+            0.3,
+            0.3,
+            &[rod(0.1, 0.0), rod(0.1, 0.0), radial(0.0, 0.1), radial(0.0, -0.1)]
+        ),
+        Err(GeometryError::CoincidentPoints)
+    );
+    assert_eq!(
+        new(0.3, 0.3, &[rod(0.1, 0.0), rod(0.0, 0.1), rod(-0.1, 0.0)]),
+        Err(GeometryError::ChainCount)
+    );
+    assert_eq!(
+        new(
+            0.3,
+            0.3,
+            &[radial(0.1, 0.0), radial(0.0, 0.1), radial(-0.1, 0.0), radial(0.0, -0.1)]
+        ),
+        Err(GeometryError::ChainCount)
+    );
+    assert_eq!(
+        new(
+            0.3,
+            0.3,
+            &[rod(0.1, f64::NAN), rod(0.0, 0.1), radial(-0.1, 0.0), radial(0.0, -0.1)]
+        ),
+        Err(GeometryError::NonFinite)
+    );
     let bad = |f: &dyn Fn(&mut ringpod_core::kinematics::RingLimits)| {
         let mut l = limits;
         f(&mut l);
@@ -35,7 +69,10 @@ fn ring_geometry_errors() {
     assert_eq!(bad(&|l| l.carriage_spacing = [0.0, 7.0]), Err(GeometryError::BadLimits));
     assert_eq!(bad(&|l| l.platform_cone = 90.0 * DEG), Err(GeometryError::BadLimits));
     assert_eq!(bad(&|l| l.min_singularity_index = 1.0), Err(GeometryError::BadLimits));
-    assert_eq!(bad(&|l| l.centre_of_mass = [0.0, f64::NAN, 0.0]), Err(GeometryError::NonFinite));
+    assert_eq!(
+        bad(&|l| l.centre_of_mass = [0.0, f64::NAN, 0.0]),
+        Err(GeometryError::NonFinite)
+    );
 }
 
 #[test]
@@ -47,7 +84,10 @@ fn tool_geometry_errors() {
     assert_eq!(new(0.33, t.pivot_b, t.pivot_d), Ok(()));
     assert_eq!(new(0.0, t.pivot_b, t.pivot_d), Err(GeometryError::NonPositiveLength));
     assert_eq!(new(0.33, t.pivot_b, t.pivot_b), Err(GeometryError::CoincidentPoints));
-    assert_eq!(new(0.33, [f64::NAN, 0.0, 0.0], t.pivot_d), Err(GeometryError::NonFinite));
+    assert_eq!(
+        new(0.33, [f64::NAN, 0.0, 0.0], t.pivot_d),
+        Err(GeometryError::NonFinite)
+    );
 }
 
 #[test]
@@ -60,16 +100,46 @@ fn forward_errors() {
     impossible.0[4] = 2.0;
     impossible.0[5] = 2.0;
     let err = m.forward(&impossible, &home, &NewtonOptions::default()).unwrap_err();
-    assert!(matches!(err, KinematicsError::NoConvergence { .. } | KinematicsError::NearSingularity), "{err:?}");
+    assert!(
+        matches!(
+            err,
+            KinematicsError::NoConvergence { .. } | KinematicsError::NearSingularity
+        ),
+        "{err:?}"
+    );
     // A guess at a singular configuration: the platform flat in the ring plane makes every rod horizontal.
     let flat = Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    assert_eq!(m.forward(&q, &flat, &NewtonOptions::default()).map(|_| ()), Err(KinematicsError::NearSingularity));
+    assert_eq!(
+        m.forward(&q, &flat, &NewtonOptions::default()).map(|_| ()),
+        Err(KinematicsError::NearSingularity)
+    );
     // One iteration is not enough from 1 cm away.
-    let opts = NewtonOptions { max_iterations: 1, ..NewtonOptions::default() };
+    let opts = NewtonOptions {
+        max_iterations: 1,
+        ..NewtonOptions::default()
+    };
     let guess = Pose { x: 0.01, ..home };
-    assert_eq!(m.forward(&q, &guess, &opts).map(|_| ()), Err(KinematicsError::NoConvergence { iterations: 1 }));
-    assert_eq!(m.forward(&Actuators([f64::NAN; 6]), &home, &NewtonOptions::default()).map(|_| ()), Err(KinematicsError::NonFinite));
-    assert_eq!(m.forward(&q, &Pose { z: f64::INFINITY, ..home }, &NewtonOptions::default()).map(|_| ()), Err(KinematicsError::NonFinite));
+    assert_eq!(
+        m.forward(&q, &guess, &opts).map(|_| ()),
+        Err(KinematicsError::NoConvergence { iterations: 1 })
+    );
+    assert_eq!(
+        m.forward(&Actuators([f64::NAN; 6]), &home, &NewtonOptions::default())
+            .map(|_| ()),
+        Err(KinematicsError::NonFinite)
+    );
+    assert_eq!(
+        m.forward(
+            &q,
+            &Pose {
+                z: f64::INFINITY,
+                ..home
+            },
+            &NewtonOptions::default()
+        )
+        .map(|_| ()),
+        Err(KinematicsError::NonFinite)
+    );
 }
 
 #[test]
@@ -81,7 +151,10 @@ fn singularity_classification() {
     // Type 2: the platform in the ring plane, all chains horizontal, cannot resist a vertical force.
     let flat = Pose::new(0.0, 0.0, 1e-9, 0.0, 0.0, 0.0);
     let qf = m.inverse(&flat).unwrap();
-    assert!(matches!(m.jacobians(&flat, &qf).classify(0.01), Singularity::Type2 | Singularity::Type3));
+    assert!(matches!(
+        m.jacobians(&flat, &qf).classify(0.01),
+        Singularity::Type2 | Singularity::Type3
+    ));
     // Type 1: a rod chain at full stretch (joint at rod length from its carriage, rod horizontal through the ring
     // axis direction) cannot move its joint outward: B loses rank when the rod is tangent to the carriage circle.
     let ch5 = RingPlatform::<f64>::new(&presets::TRAINER_CH5);
@@ -101,7 +174,14 @@ fn trainer_model_covers_every_spec_axis() {
     for (axis, range) in presets::TRAINER_MODEL_RANGES.iter().enumerate() {
         for k in 0..=40 {
             for yaw in 0..36 {
-                let mut c = [0.0, 0.0, presets::TRAINER_MODEL_HOME_Z, 0.0, 0.0, yaw as f64 * 10.0 * DEG];
+                let mut c = [
+                    0.0,
+                    0.0,
+                    presets::TRAINER_MODEL_HOME_Z,
+                    0.0,
+                    0.0,
+                    yaw as f64 * 10.0 * DEG,
+                ];
                 c[axis] += -range + 2.0 * range * k as f64 / 40.0;
                 let (_, report) = m.inverse_checked(&Pose::from_array(c)).unwrap();
                 assert!(report.all_pass(), "{c:?}: {:?} fails", report.first_failure());
@@ -120,12 +200,21 @@ fn checks_fail_where_they_should() {
     // Stroke: far down the radial actuators are shorter than 160 mm.
     assert!(fails(Pose::new(0.0, 0.0, z0 - 0.09, 0.0, 0.0, 0.0), Check::Reach));
     // Tilted beyond the platform cone.
-    assert!(fails(Pose::new(0.0, 0.0, z0, 0.0, 40.0 * DEG, 0.0), Check::JointCones) || m.inverse(&Pose::new(0.0, 0.0, z0, 0.0, 40.0 * DEG, 0.0)).is_err());
+    assert!(
+        fails(Pose::new(0.0, 0.0, z0, 0.0, 40.0 * DEG, 0.0), Check::JointCones)
+            || m.inverse(&Pose::new(0.0, 0.0, z0, 0.0, 40.0 * DEG, 0.0)).is_err()
+    );
     // Centre of mass far outside the carriages when the platform shifts far sideways.
-    let g = RingGeometry::new("heavy-side", 0.286, 0.312, presets::TRAINER_MODEL.chains(), ringpod_core::kinematics::RingLimits {
-        centre_of_mass: [0.0, 0.5, 0.0],
-        ..presets::TRAINER_MODEL.limits
-    })
+    let g = RingGeometry::new(
+        "heavy-side",
+        0.286,
+        0.312,
+        presets::TRAINER_MODEL.chains(),
+        ringpod_core::kinematics::RingLimits {
+            centre_of_mass: [0.0, 0.5, 0.0],
+            ..presets::TRAINER_MODEL.limits
+        },
+    )
     .unwrap();
     let heavy = RingPlatform::<f64>::new(&g);
     let (_, r) = heavy.inverse_checked(&Pose::new(0.0, 0.0, z0, 0.0, 0.0, 0.0)).unwrap();

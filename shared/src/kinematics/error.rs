@@ -71,3 +71,5 @@ impl fmt::Display for KinematicsError {
         }
     }
 }
+
+impl core::error::Error for KinematicsError {}

@@ -18,7 +18,11 @@ pub struct NewtonOptions<T> {
 impl<T: Real> Default for NewtonOptions<T> {
     /// 30 iterations; tolerance a few hundred ulps of the scalar (about 1e-13 for f64, 5e-5 for f32); index 1e-6.
     fn default() -> Self {
-        Self { max_iterations: 30, tolerance: T::of(T::EPS * 400.0), min_singularity_index: T::of(1e-6) }
+        Self {
+            max_iterations: 30,
+            tolerance: T::of(T::EPS * 400.0),
+            min_singularity_index: T::of(1e-6),
+        }
     }
 }
 
@@ -60,7 +64,12 @@ pub fn newton<T: Real, M: Mechanism<T>>(
             f[r] = T::zero();
         }
         // A dp = -F over the degrees of freedom (fixed coordinates closed by unit rows).
-        let Some(dp) = jac.a_closed().lu().solve(&(-f)).filter(|v| v.iter().all(|c| c.finite())) else {
+        let Some(dp) = jac
+            .a_closed()
+            .lu()
+            .solve(&(-f))
+            .filter(|v| v.iter().all(|c| c.finite()))
+        else {
             return Err(KinematicsError::NearSingularity);
         };
         p += dp;
@@ -78,14 +87,22 @@ pub fn newton<T: Real, M: Mechanism<T>>(
                 if aux > options.tolerance.sqrt_() {
                     return Err(KinematicsError::OtherAssembly);
                 }
-                return Ok(ForwardSolution { pose, iterations: iteration, residual });
+                return Ok(ForwardSolution {
+                    pose,
+                    iterations: iteration,
+                    residual,
+                });
             }
         }
     }
-    Err(KinematicsError::NoConvergence { iterations: options.max_iterations })
+    Err(KinematicsError::NoConvergence {
+        iterations: options.max_iterations,
+    })
 }
 
 /// Largest step component, lengths made relative to the characteristic length.
 fn scaled_max<T: Real>(dp: &nalgebra::Vector6<T>, inv_len: T) -> T {
-    dp.iter().enumerate().fold(T::zero(), |m, (i, d)| m.max(if i < 3 { d.abs() * inv_len } else { d.abs() }))
+    dp.iter().enumerate().fold(T::zero(), |m, (i, d)| {
+        m.max(if i < 3 { d.abs() * inv_len } else { d.abs() })
+    })
 }

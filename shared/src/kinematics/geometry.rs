@@ -127,6 +127,11 @@ const fn distinct(a: [f64; 3], b: [f64; 3]) -> bool {
     dx * dx + dy * dy + dz * dz > 1e-18
 }
 
+/// `lo <= v < hi`, false for NaN.
+const fn in_range(v: f64, lo: f64, hi: f64) -> bool {
+    v >= lo && v < hi
+}
+
 const fn valid_interval(lo: f64, hi: f64) -> bool {
     lo.is_finite() && hi.is_finite() && lo >= 0.0 && lo < hi
 }
@@ -154,7 +159,10 @@ impl RingGeometry {
         if n < 3 || n > 6 {
             return Err(GeometryError::ChainCount);
         }
-        let mut stored = [Chain { kind: ChainKind::Radial, platform_point: [0.0; 3] }; 6];
+        let mut stored = [Chain {
+            kind: ChainKind::Radial,
+            platform_point: [0.0; 3],
+        }; 6];
         let mut actuators = n;
         let mut i = 0;
         while i < n {
@@ -179,20 +187,27 @@ impl RingGeometry {
             return Err(GeometryError::ChainCount);
         }
         let l = limits;
-        let right = core::f64::consts::FRAC_PI_2;
-        if !valid_interval(l.stroke[0], l.stroke[1])
-            || !valid_interval(l.carriage_spacing[0], l.carriage_spacing[1])
-            || l.carriage_spacing[1] > 2.0 * core::f64::consts::PI
-            || !(l.base_cone >= 0.0 && l.base_cone < right)
-            || !(l.platform_cone >= 0.0 && l.platform_cone < right)
-            || !(l.min_singularity_index >= 0.0 && l.min_singularity_index < 1.0)
-        {
+        // Written as "all in range" so that NaN, which compares false, fails.
+        let limits_ok = valid_interval(l.stroke[0], l.stroke[1])
+            && valid_interval(l.carriage_spacing[0], l.carriage_spacing[1])
+            && l.carriage_spacing[1] <= 2.0 * core::f64::consts::PI
+            && in_range(l.base_cone, 0.0, core::f64::consts::FRAC_PI_2)
+            && in_range(l.platform_cone, 0.0, core::f64::consts::FRAC_PI_2)
+            && in_range(l.min_singularity_index, 0.0, 1.0);
+        if !limits_ok {
             return Err(GeometryError::BadLimits);
         }
         if !finite3(l.centre_of_mass) {
             return Err(GeometryError::NonFinite);
         }
-        Ok(Self { name, ring_radius, rod_length, chains: stored, chain_count: n, limits })
+        Ok(Self {
+            name,
+            ring_radius,
+            rod_length,
+            chains: stored,
+            chain_count: n,
+            limits,
+        })
     }
 
     /// The chains, in counter-clockwise order around the ring.
@@ -244,10 +259,14 @@ impl ToolGeometry {
         branches: [Branch; 2],
         min_singularity_index: f64,
     ) -> Result<Self, GeometryError> {
-        if !(l1.is_finite() && l2.is_finite() && l3.is_finite() && a.is_finite() && b.is_finite())
-            || !finite3(pivot_b)
-            || !finite3(pivot_d)
-        {
+        let finite = l1.is_finite()
+            && l2.is_finite()
+            && l3.is_finite()
+            && a.is_finite()
+            && b.is_finite()
+            && finite3(pivot_b)
+            && finite3(pivot_d);
+        if !finite {
             return Err(GeometryError::NonFinite);
         }
         if l1 < 0.0 || l2 <= 0.0 || l3 <= 0.0 || a <= 0.0 || b <= 0.0 {
@@ -256,7 +275,7 @@ impl ToolGeometry {
         if !distinct(pivot_b, pivot_d) {
             return Err(GeometryError::CoincidentPoints);
         }
-        if !(min_singularity_index >= 0.0 && min_singularity_index < 1.0) {
+        if !in_range(min_singularity_index, 0.0, 1.0) {
             return Err(GeometryError::BadLimits);
         }
         Ok(Self {
@@ -281,3 +300,5 @@ impl ToolGeometry {
         self
     }
 }
+
+impl core::error::Error for GeometryError {}

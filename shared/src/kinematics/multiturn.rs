@@ -22,7 +22,10 @@ pub struct MultiTurn<T> {
 impl<T: Real> MultiTurn<T> {
     /// Starts at turn zero from an IK solution.
     pub fn new(q: Actuators<T>) -> Self {
-        Self { turns: [0; 6], within: q }
+        Self {
+            turns: [0; 6],
+            within: q,
+        }
     }
 
     /// Moves to `next` (an IK solution, ring angles in `(-pi, pi]`) along the branch nearest the current position:
@@ -63,6 +66,8 @@ impl<T: Real> MultiTurn<T> {
         let turns = i64::from(self.turns.get(i).copied().unwrap_or(0));
         let within = self.within.0.get(i).copied().unwrap_or(T::zero());
         let frac = (within * T::of(steps_per_turn as f64) / T::two_pi()).round_();
-        turns.saturating_mul(steps_per_turn).saturating_add(frac.to_f64() as i64)
+        turns
+            .saturating_mul(steps_per_turn)
+            .saturating_add(frac.to_f64() as i64)
     }
 }

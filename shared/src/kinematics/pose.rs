@@ -29,7 +29,14 @@ pub struct Pose<T> {
 impl<T: Real> Pose<T> {
     /// A pose from its six coordinates.
     pub const fn new(x: T, y: T, z: T, alpha: T, beta: T, gamma: T) -> Self {
-        Self { x, y, z, alpha, beta, gamma }
+        Self {
+            x,
+            y,
+            z,
+            alpha,
+            beta,
+            gamma,
+        }
     }
 
     /// The pose as `[x, y, z, alpha, beta, gamma]`.
@@ -40,7 +47,14 @@ impl<T: Real> Pose<T> {
     /// The pose from `[x, y, z, alpha, beta, gamma]`.
     pub fn from_array(v: [T; 6]) -> Self {
         let [x, y, z, alpha, beta, gamma] = v;
-        Self { x, y, z, alpha, beta, gamma }
+        Self {
+            x,
+            y,
+            z,
+            alpha,
+            beta,
+            gamma,
+        }
     }
 
     /// The pose as a column vector, in the order of [`Pose::to_array`].

@@ -5,11 +5,17 @@ use super::geometry::{
 };
 
 const fn rod(branch: Branch, x: f64, y: f64) -> Chain {
-    Chain { kind: ChainKind::Rod(branch), platform_point: [x, y, 0.0] }
+    Chain {
+        kind: ChainKind::Rod(branch),
+        platform_point: [x, y, 0.0],
+    }
 }
 
 const fn radial(x: f64, y: f64) -> Chain {
-    Chain { kind: ChainKind::Radial, platform_point: [x, y, 0.0] }
+    Chain {
+        kind: ChainKind::Radial,
+        platform_point: [x, y, 0.0],
+    }
 }
 
 /// Trainer of dissertation ch. 5 (normalised units): ring radius 3, platform 2 x 4, `L = sqrt(1 + (sqrt 8 - 2)^2)`.
@@ -17,7 +23,12 @@ pub const TRAINER_CH5: RingGeometry = unwrap_geometry(RingGeometry::new(
     "trainer-ch5",
     3.0,
     1.298_572_870_891_441_2,
-    &[rod(Branch::Plus, -1.0, -2.0), rod(Branch::Minus, 1.0, -2.0), radial(1.0, 2.0), radial(-1.0, 2.0)],
+    &[
+        rod(Branch::Plus, -1.0, -2.0),
+        rod(Branch::Minus, 1.0, -2.0),
+        radial(1.0, 2.0),
+        radial(-1.0, 2.0),
+    ],
     RingLimits {
         stroke: [0.3, 2.0],
         carriage_spacing: SOURCE_SPACING,
@@ -81,7 +92,12 @@ pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
     "trainer-model",
     0.286,
     0.312,
-    &[rod(Branch::Plus, -0.194, -0.031), rod(Branch::Minus, 0.194, -0.031), radial(0.181, 0.160), radial(-0.181, 0.160)],
+    &[
+        rod(Branch::Plus, -0.194, -0.031),
+        rod(Branch::Minus, 0.194, -0.031),
+        radial(0.181, 0.160),
+        radial(-0.181, 0.160),
+    ],
     RingLimits {
         stroke: [0.160, 0.310],
         carriage_spacing: SOURCE_SPACING,
@@ -96,8 +112,81 @@ pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
 /// (rad); yaw is continuous.
 pub const TRAINER_MODEL_RANGES: [f64; 5] = [0.050, 0.050, 0.040, 20.0 * DEG, 20.0 * DEG];
 
-/// All ring presets, by name.
-pub const RING: [&RingGeometry; 3] = [&TRAINER_CH5, &ROTOPOD_CH4, &TRAINER_MODEL];
+/// A built-in geometry, selectable by name (CLI `--mechanism`, protocol configuration).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub enum Preset {
+    /// [`TRAINER_CH5`].
+    TrainerCh5,
+    /// [`ROTOPOD_CH4`].
+    RotopodCh4,
+    /// [`TRAINER_MODEL`].
+    TrainerModel,
+    /// [`TOOL5_EX`].
+    Tool5Ex,
+}
 
-/// All tool-carrier presets, by name.
-pub const TOOL: [&ToolGeometry; 1] = [&TOOL5_EX];
+/// The geometry of a preset: a ring platform or a tool carrier.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PresetGeometry {
+    /// Trainer or rotopod.
+    Ring(&'static RingGeometry),
+    /// Tool carrier.
+    Tool(&'static ToolGeometry),
+}
+
+impl Preset {
+    /// Every preset.
+    pub const ALL: [Preset; 4] = [
+        Preset::TrainerModel,
+        Preset::TrainerCh5,
+        Preset::RotopodCh4,
+        Preset::Tool5Ex,
+    ];
+
+    /// The preset's name, as in the reference files.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Preset::TrainerCh5 => "trainer-ch5",
+            Preset::RotopodCh4 => "rotopod-ch4",
+            Preset::TrainerModel => "trainer-model",
+            Preset::Tool5Ex => "tool5-ex",
+        }
+    }
+
+    /// The preset of a name.
+    pub fn from_name(name: &str) -> Option<Preset> {
+        Self::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    /// One line on what the preset is.
+    pub const fn description(self) -> &'static str {
+        match self {
+            Preset::TrainerCh5 => "trainer of dissertation ch. 5, normalised units (ring radius 3)",
+            Preset::RotopodCh4 => "rotopod of dissertation ch. 4, six rod chains, normalised units",
+            Preset::TrainerModel => "1:20 trainer model driven by the firmware, metres (ring radius 0.286 m)",
+            Preset::Tool5Ex => "five-DOF tool carrier of the worked position problem, metres",
+        }
+    }
+
+    /// The geometry.
+    pub const fn geometry(self) -> PresetGeometry {
+        match self {
+            Preset::TrainerCh5 => PresetGeometry::Ring(&TRAINER_CH5),
+            Preset::RotopodCh4 => PresetGeometry::Ring(&ROTOPOD_CH4),
+            Preset::TrainerModel => PresetGeometry::Ring(&TRAINER_MODEL),
+            Preset::Tool5Ex => PresetGeometry::Tool(&TOOL5_EX),
+        }
+    }
+
+    /// The neutral pose `[x, y, z, alpha, beta, gamma]`: the reference pose of the source, or the model's home.
+    pub const fn home(self) -> [f64; 6] {
+        match self {
+            Preset::TrainerCh5 => [0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+            Preset::RotopodCh4 => [0.0, 0.0, 0.7, 0.0, 0.0, 0.0],
+            Preset::TrainerModel => [0.0, 0.0, TRAINER_MODEL_HOME_Z, 0.0, 0.0, 0.0],
+            Preset::Tool5Ex => [0.0, 0.0, 0.4, 0.0, 0.0, 0.0],
+        }
+    }
+}

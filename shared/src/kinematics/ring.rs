@@ -106,9 +106,15 @@ impl<T: Real> RingPlatform<T> {
         let mut dirs = [Vector3::zeros(); 6];
         for i in 0..self.n {
             carriages[i] = self.carriage(q.0[i]);
-            dirs[i] = (joints[i] - carriages[i]).try_normalize(T::zero()).unwrap_or_else(Vector3::z);
+            dirs[i] = (joints[i] - carriages[i])
+                .try_normalize(T::zero())
+                .unwrap_or_else(Vector3::z);
         }
-        Configuration { joints, carriages, dirs }
+        Configuration {
+            joints,
+            carriages,
+            dirs,
+        }
     }
 
     /// Rows of the wrench matrix: each chain's line `(u, B x u)`, then for each radial chain the tangent force
@@ -184,7 +190,10 @@ impl<T: Real> RingPlatform<T> {
                 extra += 1;
             }
         }
-        Ok(ActuatorLoads { line_forces: f.into(), drives })
+        Ok(ActuatorLoads {
+            line_forces: f.into(),
+            drives,
+        })
     }
 
     /// Reach margin of a pose (m), defined whether or not the pose is reachable: the smallest slack of the rod
@@ -193,13 +202,14 @@ impl<T: Real> RingPlatform<T> {
     pub fn reach_margin(&self, pose: &Pose<T>) -> T {
         let joints = self.joints(pose);
         let mut margin = T::max_value().unwrap_or(T::one());
-        for i in 0..self.n {
-            let a = joints[i];
+        for (a, kind) in joints.iter().zip(&self.kinds).take(self.n) {
             let rho = (a.x * a.x + a.y * a.y).sqrt_();
-            let m = match self.kinds[i] {
+            let m = match kind {
                 ChainKind::Rod(_) => {
                     let h = (self.rod * self.rod - a.z * a.z).max(T::zero()).sqrt_();
-                    (self.rod - a.z.abs()).min(h - (self.rr - rho).abs()).min(self.rr + rho - h)
+                    (self.rod - a.z.abs())
+                        .min(h - (self.rr - rho).abs())
+                        .min(self.rr + rho - h)
                 }
                 ChainKind::Radial => {
                     let s = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
@@ -233,7 +243,11 @@ impl<T: Real> RingPlatform<T> {
             largest = largest.max(gap);
         }
         // A carriage that passed its neighbour by d leaves a gap of 2pi - d behind it.
-        let order = if total < two_pi + T::pi() { smallest } else { -(two_pi - largest) };
+        let order = if total < two_pi + T::pi() {
+            smallest
+        } else {
+            -(two_pi - largest)
+        };
         (spacing, order)
     }
 
@@ -317,14 +331,20 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
             let rho2 = a.x * a.x + a.y * a.y;
             let rho = rho2.sqrt_();
             if rho <= tiny {
-                return Err(KinematicsError::Unreachable { chain, reason: Reach::Centre });
+                return Err(KinematicsError::Unreachable {
+                    chain,
+                    reason: Reach::Centre,
+                });
             }
             let theta = a.y.atan2_(a.x);
             match self.kinds[i] {
                 ChainKind::Rod(branch) => {
                     let h2 = self.rod * self.rod - a.z * a.z;
                     if h2 <= T::zero() {
-                        return Err(KinematicsError::Unreachable { chain, reason: Reach::Height });
+                        return Err(KinematicsError::Unreachable {
+                            chain,
+                            reason: Reach::Height,
+                        });
                     }
                     // (2 Rr rho sin phi)^2 factors into (h^2 - (Rr - rho)^2) ((Rr + rho)^2 - h^2): both factors
                     // non-negative is the reach condition, and atan2 keeps phi accurate near 0 and pi where acos
@@ -332,7 +352,10 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
                     let inner = h2 - (self.rr - rho) * (self.rr - rho);
                     let outer = (self.rr + rho) * (self.rr + rho) - h2;
                     if inner < T::zero() || outer < T::zero() {
-                        return Err(KinematicsError::Unreachable { chain, reason: Reach::Ring });
+                        return Err(KinematicsError::Unreachable {
+                            chain,
+                            reason: Reach::Ring,
+                        });
                     }
                     let phi = (inner * outer).sqrt_().atan2_(self.rr * self.rr + rho2 - h2);
                     q[i] = wrap_pi(match branch {
@@ -398,7 +421,13 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
                 }
             }
         }
-        Jacobians { a: a_mat, b: b_mat, dof: 6, length: self.rr, axes: self.axes }
+        Jacobians {
+            a: a_mat,
+            b: b_mat,
+            dof: 6,
+            length: self.rr,
+            axes: self.axes,
+        }
     }
 
     fn workspace(&self, pose: &Pose<T>, q: &Actuators<T>) -> WorkspaceReport<T> {

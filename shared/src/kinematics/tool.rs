@@ -17,8 +17,14 @@ use super::geometry::{Branch, ToolGeometry};
 use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
 
-const AXES: [AxisKind; 6] =
-    [AxisKind::Linear, AxisKind::Angle, AxisKind::Angle, AxisKind::Angle, AxisKind::Angle, AxisKind::Angle];
+const AXES: [AxisKind; 6] = [
+    AxisKind::Linear,
+    AxisKind::Angle,
+    AxisKind::Angle,
+    AxisKind::Angle,
+    AxisKind::Angle,
+    AxisKind::Angle,
+];
 
 /// The tool carrier in scalar type `T`.
 #[derive(Debug, Clone, Copy)]
@@ -51,7 +57,10 @@ impl<T: Real> ToolCarrier<T> {
             l2: T::of(g.l2),
             l3: T::of(g.l3),
             half_b: T::of(g.b / 2.0),
-            pivots: [(T::of(g.pivot_b[1]), T::of(g.pivot_b[2])), (T::of(g.pivot_d[1]), T::of(g.pivot_d[2]))],
+            pivots: [
+                (T::of(g.pivot_b[1]), T::of(g.pivot_b[2])),
+                (T::of(g.pivot_d[1]), T::of(g.pivot_d[2])),
+            ],
             branches: [g.branch_b, g.branch_d],
             min_index: T::of(g.min_singularity_index),
         }
@@ -69,7 +78,11 @@ impl<T: Real> ToolCarrier<T> {
         let (sb, cb) = (pose.beta.sin_(), pose.beta.cos_());
         let l1 = self.l1;
         FramePivot {
-            at: Vector3::new(pose.x + l1 * sb, pose.y + h * ca - l1 * cb * sa, pose.z + h * sa + l1 * cb * ca),
+            at: Vector3::new(
+                pose.x + l1 * sb,
+                pose.y + h * ca - l1 * cb * sa,
+                pose.z + h * sa + l1 * cb * ca,
+            ),
             d_alpha: Vector3::new(T::zero(), -h * sa - l1 * cb * ca, h * ca - l1 * cb * sa),
             d_beta: Vector3::new(l1 * cb, l1 * sb * sa, -l1 * sb * ca),
         }
@@ -87,12 +100,15 @@ impl<T: Real> ToolCarrier<T> {
         let (dy, dz) = (at.y - py, at.z - pz);
         let d = (dy * dy + dz * dz).sqrt_();
         let chain = if side == 0 { 1 } else { 3 };
-        let unreachable = KinematicsError::Unreachable { chain, reason: Reach::Dyad };
+        let unreachable = KinematicsError::Unreachable {
+            chain,
+            reason: Reach::Dyad,
+        };
         if d == T::zero() {
             return Err(unreachable);
         }
         let cos_kappa = (d * d + self.l2 * self.l2 - self.l3 * self.l3) / (T::of(2.0) * self.l2 * d);
-        if !(cos_kappa.abs() <= T::one()) {
+        if !cos_kappa.finite() || cos_kappa.abs() > T::one() {
             return Err(unreachable);
         }
         Ok((d, dz.atan2_(dy), cos_kappa.acos_()))
@@ -186,7 +202,13 @@ impl<T: Real> Mechanism<T> for ToolCarrier<T> {
             z, z, z, z, -o, z,
             z, z, z, l2 * (s6 * s4 + c6 * c4), z, ey * c6 + ez * s6,
         );
-        Jacobians { a, b, dof: 5, length: self.l2, axes: AXES }
+        Jacobians {
+            a,
+            b,
+            dof: 5,
+            length: self.l2,
+            axes: AXES,
+        }
     }
 
     /// Reach (dyad closure slack, m) and singularity (the smaller of `|sin|` of the D-dyad's elbow angle, a type-1
@@ -204,6 +226,9 @@ impl<T: Real> Mechanism<T> for ToolCarrier<T> {
         let elbow = (q[5] - q[3]).sin_().abs();
         let transmission = (q[5] - pose.alpha).sin_().abs();
         let index = elbow.min(transmission);
-        WorkspaceReport::new([Some(reach), None, None, None, Some(index - self.min_index), None], index)
+        WorkspaceReport::new(
+            [Some(reach), None, None, None, Some(index - self.min_index), None],
+            index,
+        )
     }
 }

@@ -40,7 +40,10 @@ impl<T: Real> Jacobians<T> {
     pub(crate) fn a_closed(&self) -> Matrix6<T> {
         let mut a = self.a;
         for r in self.dof..6 {
-            a.set_row(r, &nalgebra::RowVector6::from_fn(|_, c| if c == r { T::one() } else { T::zero() }));
+            a.set_row(
+                r,
+                &nalgebra::RowVector6::from_fn(|_, c| if c == r { T::one() } else { T::zero() }),
+            );
         }
         a
     }
@@ -48,7 +51,11 @@ impl<T: Real> Jacobians<T> {
     /// Actuator rates for pose rates: solves `B qdot = -A pdot`.
     pub fn actuator_rates(&self, pose_rates: &Vector6<T>) -> Result<Vector6<T>, KinematicsError> {
         let rhs = -(self.a * pose_rates);
-        self.b.lu().solve(&rhs).filter(all_finite).ok_or(KinematicsError::Singular)
+        self.b
+            .lu()
+            .solve(&rhs)
+            .filter(all_finite)
+            .ok_or(KinematicsError::Singular)
     }
 
     /// Pose rates for actuator rates: solves `A pdot = -B qdot` over the platform's degrees of freedom (auxiliary
@@ -58,7 +65,11 @@ impl<T: Real> Jacobians<T> {
         for r in self.dof..6 {
             rhs[r] = T::zero();
         }
-        self.a_closed().lu().solve(&rhs).filter(all_finite).ok_or(KinematicsError::Singular)
+        self.a_closed()
+            .lu()
+            .solve(&rhs)
+            .filter(all_finite)
+            .ok_or(KinematicsError::Singular)
     }
 
     /// Scale-free singularity index of `A` in `[0, 1]` (0 = type-2 singular); see [`hadamard_ratio`].

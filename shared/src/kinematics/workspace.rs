@@ -25,8 +25,14 @@ pub enum Check {
 
 impl Check {
     /// All checks, in the order of KINEMATICS.md 4.
-    pub const ALL: [Check; 6] =
-        [Check::Reach, Check::CarriageSpacing, Check::RodCrossing, Check::JointCones, Check::Singularity, Check::Stability];
+    pub const ALL: [Check; 6] = [
+        Check::Reach,
+        Check::CarriageSpacing,
+        Check::RodCrossing,
+        Check::JointCones,
+        Check::Singularity,
+        Check::Stability,
+    ];
 
     /// Short name for reports.
     pub const fn name(self) -> &'static str {
@@ -71,7 +77,10 @@ pub struct WorkspaceReport<T> {
 impl<T: Real> WorkspaceReport<T> {
     /// A report from margins in the order of [`Check::ALL`].
     pub fn new(margins: [Option<T>; 6], singularity_index: T) -> Self {
-        Self { margins, singularity_index }
+        Self {
+            margins,
+            singularity_index,
+        }
     }
 
     /// Margin of one check (`None` when it does not apply). NaN never passes.

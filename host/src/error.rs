@@ -1,0 +1,38 @@
+//! Errors of the command line.
+
+use ringpod_core::kinematics::KinematicsError;
+
+/// Exit code of a run that failed (bad input, no kinematic solution).
+pub const EXIT_ERROR: u8 = 1;
+/// Exit code of `check` when the pose has a solution but a workspace check fails.
+pub const EXIT_CHECK_FAILED: u8 = 3;
+
+/// Why a command could not produce its answer.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// `--mechanism` names no preset.
+    #[error("unknown mechanism `{0}`; `ringpod presets` lists them")]
+    UnknownMechanism(String),
+    /// A list of numbers could not be read.
+    #[error("--{what}: {reason}")]
+    BadNumbers {
+        /// The option.
+        what: &'static str,
+        /// What is wrong.
+        reason: String,
+    },
+    /// The kinematics have no answer.
+    #[error(transparent)]
+    Kinematics(#[from] KinematicsError),
+    /// The pose is out of reach; `margin` says how far (in the geometry's length unit: m for metric presets).
+    #[error("{reason}; the pose is {:.4} outside the reach limits", -margin)]
+    OutOfReach {
+        /// Which chain and why.
+        reason: KinematicsError,
+        /// Reach margin of the pose (negative).
+        margin: f64,
+    },
+    /// JSON output failed.
+    #[error("JSON output: {0}")]
+    Json(#[from] serde_json::Error),
+}

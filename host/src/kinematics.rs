@@ -1,0 +1,329 @@
+//! `presets`, `ik`, `check`, `fk`: the kinematics questions, answered as text or JSON.
+
+use std::fmt::Write;
+
+use ringpod_core::kinematics::presets::Preset;
+use ringpod_core::kinematics::{
+    AxisKind, Check, KinematicsError, Mechanism, NewtonOptions, Pose, Singularity, WorkspaceReport,
+};
+use serde::Serialize;
+
+use crate::cli::{Cli, Command, Common, FkArgs, PoseArgs};
+use crate::error::{CliError, EXIT_CHECK_FAILED};
+use crate::mechanism::AnyMechanism;
+use crate::numbers;
+
+/// What a command prints and its exit code.
+pub struct Outcome {
+    pub text: String,
+    pub code: u8,
+}
+
+impl Outcome {
+    fn ok(text: String) -> Self {
+        Self { text, code: 0 }
+    }
+}
+
+pub fn run(cli: &Cli) -> Result<Outcome, CliError> {
+    match &cli.command {
+        Command::Presets { json } => presets(*json),
+        Command::Ik(args) => ik(args, false),
+        Command::Check(args) => ik(args, true),
+        Command::Fk(args) => fk(args),
+    }
+}
+
+/// Angle conversion for `--degrees`.
+struct Units {
+    degrees: bool,
+}
+
+impl Units {
+    fn angle_out(&self, rad: f64) -> f64 {
+        if self.degrees {
+            rad.to_degrees()
+        } else {
+            rad
+        }
+    }
+    fn angle_in(&self, v: f64) -> f64 {
+        if self.degrees {
+            v.to_radians()
+        } else {
+            v
+        }
+    }
+    fn angle_unit(&self) -> &'static str {
+        if self.degrees {
+            "deg"
+        } else {
+            "rad"
+        }
+    }
+    /// Pose from the command line: metres, then angles.
+    fn pose_in(&self, v: [f64; 6]) -> Pose<f64> {
+        Pose::from_array(std::array::from_fn(|i| if i < 3 { v[i] } else { self.angle_in(v[i]) }))
+    }
+    fn pose_out(&self, p: &Pose<f64>) -> [f64; 6] {
+        let v = p.to_array();
+        std::array::from_fn(|i| if i < 3 { v[i] } else { self.angle_out(v[i]) })
+    }
+    fn axis_unit(&self, kind: AxisKind) -> &'static str {
+        match kind {
+            AxisKind::Linear => "m",
+            AxisKind::Ring | AxisKind::Angle => self.angle_unit(),
+        }
+    }
+    fn axis_out(&self, kind: AxisKind, v: f64) -> f64 {
+        match kind {
+            AxisKind::Linear => v,
+            AxisKind::Ring | AxisKind::Angle => self.angle_out(v),
+        }
+    }
+    fn margin_unit(&self, check: Check) -> &'static str {
+        if check.unit() == "rad" {
+            self.angle_unit()
+        } else {
+            check.unit()
+        }
+    }
+    fn margin_out(&self, check: Check, v: f64) -> f64 {
+        if check.unit() == "rad" {
+            self.angle_out(v)
+        } else {
+            v
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct PresetJson {
+    name: &'static str,
+    description: &'static str,
+    home: [f64; 6],
+}
+
+fn presets(json: bool) -> Result<Outcome, CliError> {
+    if json {
+        let list: Vec<_> = Preset::ALL
+            .iter()
+            .map(|p| PresetJson {
+                name: p.name(),
+                description: p.description(),
+                home: p.home(),
+            })
+            .collect();
+        return Ok(Outcome::ok(serde_json::to_string_pretty(&list)? + "\n"));
+    }
+    let mut text = String::new();
+    for p in Preset::ALL {
+        let _ = writeln!(text, "{:<14} {}", p.name(), p.description());
+        let h = p.home();
+        let _ = writeln!(text, "{:<14} home pose {:?}", "", h);
+    }
+    Ok(Outcome::ok(text))
+}
+
+#[derive(Serialize)]
+struct CheckJson {
+    name: &'static str,
+    /// None: the check does not apply to this mechanism.
+    margin: Option<f64>,
+    unit: &'static str,
+    pass: bool,
+}
+
+#[derive(Serialize)]
+struct IkJson<'a> {
+    mechanism: &'static str,
+    pose: [f64; 6],
+    axes: &'a [String; 6],
+    units: [&'static str; 6],
+    actuators: [f64; 6],
+    checks: Vec<CheckJson>,
+    singularity_index: f64,
+    singularity: &'static str,
+    all_pass: bool,
+}
+
+fn checks_json(report: &WorkspaceReport<f64>, units: &Units) -> Vec<CheckJson> {
+    report
+        .iter()
+        .map(|(c, m)| CheckJson {
+            name: c.name(),
+            margin: m.map(|m| units.margin_out(c, m)),
+            unit: units.margin_unit(c),
+            pass: report.passes(c),
+        })
+        .collect()
+}
+
+fn singularity_name(s: Singularity) -> &'static str {
+    match s {
+        Singularity::None => "none",
+        Singularity::Type1 => "type 1 (actuators lose a direction)",
+        Singularity::Type2 => "type 2 (platform gains mobility)",
+        Singularity::Type3 => "type 3 (both)",
+    }
+}
+
+fn pose_arg(common: &Common, preset: Preset, text: Option<&str>, what: &'static str) -> Result<Pose<f64>, CliError> {
+    let units = Units {
+        degrees: common.degrees,
+    };
+    Ok(match text {
+        Some(t) => units.pose_in(numbers::six(what, t)?),
+        None => Pose::from_array(preset.home()),
+    })
+}
+
+fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliError> {
+    let common = &args.common;
+    let units = Units {
+        degrees: common.degrees,
+    };
+    let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
+    let pose = pose_arg(common, preset, args.pose.as_deref(), "pose")?;
+    let (q, report) = m.inverse_checked(&pose).map_err(|reason| match (&m, reason) {
+        (AnyMechanism::Ring(r), KinematicsError::Unreachable { .. }) => CliError::OutOfReach {
+            reason,
+            margin: r.reach_margin(&pose),
+        },
+        _ => CliError::Kinematics(reason),
+    })?;
+    let axes = m.axes();
+    let names = m.axis_names();
+    let actuators: [f64; 6] = std::array::from_fn(|i| units.axis_out(axes[i], q.0[i]));
+    let singularity = m.jacobians(&pose, &q).classify(0.01);
+    let code = if exit_on_failed_check && !report.all_pass() {
+        EXIT_CHECK_FAILED
+    } else {
+        0
+    };
+    let text = if common.json {
+        let out = IkJson {
+            mechanism: preset.name(),
+            pose: units.pose_out(&pose),
+            axes: &names,
+            units: std::array::from_fn(|i| units.axis_unit(axes[i])),
+            actuators,
+            checks: checks_json(&report, &units),
+            singularity_index: report.singularity_index,
+            singularity: singularity_name(singularity),
+            all_pass: report.all_pass(),
+        };
+        serde_json::to_string_pretty(&out)? + "\n"
+    } else {
+        let mut t = String::new();
+        let shown: Vec<String> = units.pose_out(&pose).iter().map(|v| format!("{v:.6}")).collect();
+        let _ = writeln!(t, "{} at pose x,y,z,alpha,beta,gamma = {} (m, {})", preset.name(), shown.join(", "), units.angle_unit());
+        if !exit_on_failed_check {
+            for i in 0..6 {
+                let _ = writeln!(
+                    t,
+                    "  {:<4} {:>14.9} {}",
+                    names[i],
+                    actuators[i],
+                    units.axis_unit(axes[i])
+                );
+            }
+        }
+        let _ = writeln!(t, "checks (margin > 0 is inside):");
+        for (c, margin) in report.iter() {
+            let verdict = if report.passes(c) { "ok  " } else { "FAIL" };
+            match margin {
+                Some(v) => {
+                    let _ = writeln!(
+                        t,
+                        "  {verdict} {:<17} {:>12.6} {}",
+                        c.name(),
+                        units.margin_out(c, v),
+                        units.margin_unit(c)
+                    );
+                }
+                None => {
+                    let _ = writeln!(t, "  n/a  {:<17}", c.name());
+                }
+            }
+        }
+        let _ = writeln!(
+            t,
+            "singularity index {:.4} ({})",
+            report.singularity_index,
+            singularity_name(singularity)
+        );
+        if exit_on_failed_check {
+            let _ = writeln!(
+                t,
+                "{}",
+                if report.all_pass() {
+                    "inside the workspace"
+                } else {
+                    "OUTSIDE the workspace"
+                }
+            );
+        }
+        t
+    };
+    Ok(Outcome { text, code })
+}
+
+#[derive(Serialize)]
+struct FkJson {
+    mechanism: &'static str,
+    pose: [f64; 6],
+    iterations: u8,
+    residual: f64,
+}
+
+fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
+    let common = &args.common;
+    let units = Units {
+        degrees: common.degrees,
+    };
+    let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
+    let raw = numbers::six("actuators", &args.actuators)?;
+    let axes = m.axes();
+    let q = ringpod_core::kinematics::Actuators(std::array::from_fn(|i| match axes[i] {
+        AxisKind::Linear => raw[i],
+        AxisKind::Ring | AxisKind::Angle => units.angle_in(raw[i]),
+    }));
+    let guess = pose_arg(common, preset, args.guess.as_deref(), "guess")?;
+    let options = NewtonOptions {
+        max_iterations: args.max_iterations,
+        ..NewtonOptions::default()
+    };
+    let sol = m.forward(&q, &guess, &options)?;
+    let pose = units.pose_out(&sol.pose);
+    let text = if common.json {
+        let out = FkJson {
+            mechanism: preset.name(),
+            pose,
+            iterations: sol.iterations,
+            residual: sol.residual,
+        };
+        serde_json::to_string_pretty(&out)? + "\n"
+    } else {
+        let mut t = String::new();
+        let _ = writeln!(
+            t,
+            "{} pose ({} Newton iterations, residual {:.1e}):",
+            preset.name(),
+            sol.iterations,
+            sol.residual
+        );
+        for (name, (v, unit)) in ["x", "y", "z", "alpha", "beta", "gamma"].iter().zip(pose.iter().zip([
+            "m",
+            "m",
+            "m",
+            units.angle_unit(),
+            units.angle_unit(),
+            units.angle_unit(),
+        ])) {
+            let _ = writeln!(t, "  {name:<6} {v:>14.9} {unit}");
+        }
+        t
+    };
+    Ok(Outcome::ok(text))
+}

@@ -1,0 +1,168 @@
+//! The `ringpod` command line, run as a user runs it.
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+
+fn ringpod() -> Command {
+    Command::cargo_bin("ringpod").unwrap()
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let out = ringpod().args(args).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn ik_json_reproduces_the_reference() {
+    let v = json(&["ik", "--mechanism", "trainer-ch5", "--pose=0.1,0,1,0,0,0", "--json"]);
+    let want = [
+        -1.920367228,
+        -1.226396755,
+        1.067953116,
+        1.993650253,
+        1.230749913,
+        1.284901817,
+    ];
+    let got: Vec<f64> = v["actuators"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    for (g, w) in got.iter().zip(want) {
+        assert!((g - w).abs() < 1e-8, "{g} vs {w}");
+    }
+    assert_eq!(v["axes"][4], "s3");
+    assert_eq!(v["checks"].as_array().unwrap().len(), 6);
+}
+
+#[test]
+fn ik_degrees_in_and_out() {
+    let rad = json(&[
+        "ik",
+        "--pose=0,0,0.95,0.05235987756,0.03490658504,3.490658504",
+        "-m",
+        "trainer-ch5",
+        "--json",
+    ]);
+    let deg = json(&[
+        "ik",
+        "--pose=0,0,0.95,3,2,200",
+        "-m",
+        "trainer-ch5",
+        "--json",
+        "--degrees",
+    ]);
+    for i in 0..4 {
+        let (r, d) = (
+            rad["actuators"][i].as_f64().unwrap(),
+            deg["actuators"][i].as_f64().unwrap(),
+        );
+        assert!((r.to_degrees() - d).abs() < 1e-6);
+    }
+    assert_eq!(deg["units"][0], "deg");
+}
+
+#[test]
+fn ik_reports_failing_checks_but_exits_zero() {
+    // trainer-ch5 at home: carriage gaps of 134 degrees exceed the source's 120.
+    ringpod()
+        .args(["ik", "-m", "trainer-ch5"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("FAIL carriage-spacing"));
+}
+
+#[test]
+fn check_exit_codes() {
+    ringpod()
+        .args(["check"])
+        .assert()
+        .code(0)
+        .stdout(predicate::str::contains("inside the workspace"));
+    ringpod().args(["check", "-m", "trainer-ch5"]).assert().code(3);
+    ringpod()
+        .args(["check", "-m", "trainer-ch5", "--pose=0,0,1,0,-5,0", "--degrees"])
+        .assert()
+        .code(1)
+        .stderr(
+            predicate::str::contains("unreachable: chain 2").and(predicate::str::contains("outside the reach limits")),
+        );
+}
+
+#[test]
+fn no_solution_is_an_error() {
+    ringpod()
+        .args(["ik", "-m", "rotopod-ch4", "--pose=0,0,0.99,0,0,0"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("unreachable"));
+    ringpod()
+        .args(["ik", "-m", "tool5-ex", "--pose=0,0,0.4,0,0,0.1"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("cannot move"));
+}
+
+#[test]
+fn fk_inverts_ik() {
+    let pose = [0.02, -0.01, 0.24, 0.1, -0.05, 2.5];
+    let pose_arg = format!("--pose={}", pose.map(|v| v.to_string()).join(","));
+    let ik = json(&["ik", &pose_arg, "--json"]);
+    let q: Vec<String> = ik["actuators"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| format!("{:.17}", v.as_f64().unwrap()))
+        .collect();
+    let fk = json(&[
+        "fk",
+        &format!("--actuators={}", q.join(",")),
+        "--guess=0.02,-0.01,0.24,0.1,-0.05,2.5",
+        "--json",
+    ]);
+    for (i, want) in pose.iter().enumerate() {
+        assert!((fk["pose"][i].as_f64().unwrap() - want).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn bad_input_is_rejected_with_a_message() {
+    ringpod()
+        .args(["ik", "-m", "nope"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("unknown mechanism"));
+    ringpod()
+        .args(["ik", "--pose=1,2,3"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("expected 6 numbers"));
+    ringpod()
+        .args(["ik", "--pose=0,0,NaN,0,0,0"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("not a finite number"));
+    ringpod()
+        .args(["fk", "--actuators=a,b"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("--actuators"));
+    ringpod()
+        .args(["fk", "--actuators=0,0,0,0,0,0", "--max-iterations=3"])
+        .assert()
+        .code(1);
+}
+
+#[test]
+fn presets_lists_every_geometry() {
+    let v = json(&["presets", "--json"]);
+    let names: Vec<&str> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["trainer-model", "trainer-ch5", "rotopod-ch4", "tool5-ex"]);
+}
