@@ -217,7 +217,13 @@ fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliError> 
     } else {
         let mut t = String::new();
         let shown: Vec<String> = units.pose_out(&pose).iter().map(|v| format!("{v:.6}")).collect();
-        let _ = writeln!(t, "{} at pose x,y,z,alpha,beta,gamma = {} (m, {})", preset.name(), shown.join(", "), units.angle_unit());
+        let _ = writeln!(
+            t,
+            "{} at pose x,y,z,alpha,beta,gamma = {} (m, {})",
+            preset.name(),
+            shown.join(", "),
+            units.angle_unit()
+        );
         if !exit_on_failed_check {
             for i in 0..6 {
                 let _ = writeln!(

@@ -31,7 +31,10 @@ fn poses<T: Real>() -> Vec<Pose<T>> {
 fn bench_scalar<T: Real>(c: &mut Criterion, name: &str) {
     let m = RingPlatform::<T>::new(&presets::TRAINER_MODEL);
     let poses = poses::<T>();
-    let solved: Vec<(Pose<T>, Actuators<T>)> = poses.iter().filter_map(|p| m.inverse(p).ok().map(|q| (*p, q))).collect();
+    let solved: Vec<(Pose<T>, Actuators<T>)> = poses
+        .iter()
+        .filter_map(|p| m.inverse(p).ok().map(|q| (*p, q)))
+        .collect();
     assert_eq!(solved.len(), poses.len(), "every benchmark pose is reachable");
     let mut group = c.benchmark_group(format!("trainer-model {name}"));
     group.throughput(Throughput::Elements(1));
@@ -53,7 +56,11 @@ fn bench_scalar<T: Real>(c: &mut Criterion, name: &str) {
         b.iter(|| {
             i = (i + 1) & 255;
             let (pose, q) = &solved[i];
-            let guess = Pose { x: pose.x + T::of(1e-3), alpha: pose.alpha + T::of(0.0087), ..*pose };
+            let guess = Pose {
+                x: pose.x + T::of(1e-3),
+                alpha: pose.alpha + T::of(0.0087),
+                ..*pose
+            };
             black_box(m.forward(black_box(q), &guess, &options))
         })
     });
