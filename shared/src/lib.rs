@@ -19,6 +19,8 @@
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 pub mod kinematics;
+pub mod motion;
 mod real;
+pub mod safety;
 
 pub use real::Real;

@@ -49,7 +49,7 @@ pub const fn unwrap_geometry<G: Copy>(g: Result<G, GeometryError>) -> G {
 /// Which of the two solutions `q = theta +- phi` a rod chain takes (KINEMATICS.md 2.1, 2.2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub enum Branch {
     /// `q = theta + phi`.
     Plus,
@@ -60,7 +60,7 @@ pub enum Branch {
 /// The kind of a chain from a ring carriage to the platform.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub enum ChainKind {
     /// Carriage -> spherical joint -> rod of fixed length -> spherical joint. One actuator: the carriage angle.
     Rod(Branch),
@@ -70,8 +70,7 @@ pub enum ChainKind {
 }
 
 /// One chain: its kind and its platform joint in platform coordinates (m).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Chain {
     /// Rod or radial chain.
     pub kind: ChainKind,
@@ -80,8 +79,7 @@ pub struct Chain {
 }
 
 /// Limits that the workspace checks of KINEMATICS.md 4 enforce.
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RingLimits {
     /// Linear-actuator length range `[s_min, s_max]` (m).
     pub stroke: [f64; 2],
@@ -103,8 +101,7 @@ pub const SOURCE_SPACING: [f64; 2] = [12.0 * DEG, 120.0 * DEG];
 pub const DEG: f64 = core::f64::consts::PI / 180.0;
 
 /// A mechanism whose carriages run on a circular guide (KINEMATICS.md 2.1 and 2.2).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct RingGeometry {
     /// Preset name, for reports.
     pub name: &'static str,
@@ -217,8 +214,7 @@ impl RingGeometry {
 }
 
 /// The five-DOF parallel-serial tool carrier of KINEMATICS.md 2.3 (all lengths in metres).
-#[derive(Debug, Clone, Copy, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ToolGeometry {
     /// Preset name, for reports.
     pub name: &'static str,

@@ -32,7 +32,7 @@ use crate::Real;
 /// What an actuator coordinate measures, which decides how it is unwrapped and converted to steps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub enum AxisKind {
     /// A carriage angle on the ring (rad): multi-turn, unwrapped to the branch nearest the previous value.
     Ring,

@@ -9,8 +9,7 @@ use crate::Real;
 ///
 /// Orientation convention (KINEMATICS.md 1): `R = Rz(gamma) * Ry(beta) * Rx(alpha)`, i.e. rotate about X
 /// by `alpha`, then about Y by `beta`, then about Z by `gamma`, then translate by `(x, y, z)`.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Pose<T> {
     /// Surge: X of the platform centre (m).
     pub x: T,
@@ -115,8 +114,7 @@ pub(crate) fn rotation<T: Real>(alpha: T, beta: T, gamma: T) -> Matrix3<T> {
 /// Trainer: `[q1, q2, q3, q4, s3, s4]`; rotopod: `[q1..q6]`; tool carrier: `[q1..q6]` of KINEMATICS.md 2.3.
 /// Ring-carriage angles that come out of inverse kinematics lie in `(-pi, pi]`; the multi-turn position of a
 /// carriage is kept by [`super::MultiTurn`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Actuators<T>(pub [T; 6]);
 
 impl<T: Real> Actuators<T> {

@@ -115,7 +115,7 @@ pub const TRAINER_MODEL_RANGES: [f64; 5] = [0.050, 0.050, 0.040, 20.0 * DEG, 20.
 /// A built-in geometry, selectable by name (CLI `--mechanism`, protocol configuration).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub enum Preset {
     /// [`TRAINER_CH5`].
     TrainerCh5,

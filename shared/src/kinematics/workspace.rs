@@ -7,7 +7,7 @@ use crate::Real;
 /// One workspace check. Each has its own unit of margin, given on the variant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[derive(serde::Serialize, serde::Deserialize)]
 pub enum Check {
     /// 1. Rod reach and actuator stroke: the smallest slack of any reach condition or stroke limit (m).
     Reach,

@@ -1,0 +1,12 @@
+//! Motion: setpoint validation and interpolation, velocity/acceleration limits, IK per tick, conversion to motor
+//! steps, and the step scheduler that turns per-period step targets into timed pulses.
+
+pub mod limits;
+pub mod pipeline;
+pub mod scheduler;
+pub mod steps;
+
+pub use limits::{AxisTracker, MotionLimits};
+pub use pipeline::{Pipeline, PipelineConfig, PipelineEvent, RejectCounters, RejectReason, Setpoint};
+pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler};
+pub use steps::{AxisScale, StepConverter};

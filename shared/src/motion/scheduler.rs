@@ -1,0 +1,213 @@
+//! Step scheduling: per-period step targets to timed step pulses that a hardware timer can emit.
+//!
+//! For each period and axis the scheduler plans one [`AxisMove`]: a direction, the time of a DIR change if the
+//! direction reverses, and `count` steps spread evenly over a window `[start, period)`: step `k` at
+//! `start + (2k + 1) (period - start) / (2 count)` ns, integer arithmetic that a timer interrupt evaluates exactly,
+//! with no accumulated rounding. The window starts late enough that the first step is at least the minimum spacing
+//! after the previous period's last step, and, on a reversal, that DIR changes at least `dir_hold` after that last
+//! step and at least `dir_setup` before the next one. Every step of a period lies inside it, so the position at
+//! each period boundary is exactly the target. A target beyond what fits in one period (over the axis's top rate)
+//! is not lost: the rest is carried into the next periods and counted.
+
+/// Timing of the step signals (ns).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SchedulerConfig {
+    /// Control period.
+    pub period_ns: u32,
+    /// STEP high time.
+    pub pulse_ns: u32,
+    /// Smallest time between two step edges of one axis (pulse plus low time).
+    pub min_spacing_ns: u32,
+    /// DIR must be stable this long before a step.
+    pub dir_setup_ns: u32,
+    /// DIR must stay this long after a step.
+    pub dir_hold_ns: u32,
+}
+
+impl Default for SchedulerConfig {
+    /// 1 kHz; 2.5 us pulses at 5 us spacing (200 k steps/s per axis at most); 5 us DIR setup and hold.
+    fn default() -> Self {
+        Self {
+            period_ns: 1_000_000,
+            pulse_ns: 2_500,
+            min_spacing_ns: 5_000,
+            dir_setup_ns: 5_000,
+            dir_hold_ns: 5_000,
+        }
+    }
+}
+
+impl SchedulerConfig {
+    /// Whether the timing is consistent: a low time at least as long as the pulse, and room for a reversal.
+    pub fn is_valid(&self) -> bool {
+        self.pulse_ns > 0
+            && self.min_spacing_ns >= self.pulse_ns.saturating_mul(2)
+            && self
+                .dir_hold_ns
+                .saturating_add(self.dir_setup_ns)
+                .saturating_add(self.min_spacing_ns)
+                < self.period_ns
+    }
+
+    /// The most steps one axis can make in one period without a reversal.
+    pub fn max_steps_per_period(&self) -> u32 {
+        self.period_ns / self.min_spacing_ns.max(1)
+    }
+}
+
+/// Step direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub enum Direction {
+    /// Steps increase the position.
+    Forward,
+    /// Steps decrease the position.
+    Backward,
+}
+
+/// The pulses of one axis in one period.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AxisMove {
+    /// Direction of every step in this period.
+    pub direction: Direction,
+    /// When DIR changes (ns from the period start), if it does in this period.
+    pub dir_change_ns: Option<u32>,
+    /// Start of the window the steps are spread over (ns from the period start).
+    pub start_ns: u32,
+    /// Number of steps.
+    pub count: u32,
+    /// Period length (ns): the window is `[start_ns, period_ns)`.
+    pub period_ns: u32,
+}
+
+impl AxisMove {
+    /// Time of step `k` (ns from the period start), `k < count`.
+    pub fn step_ns(&self, k: u32) -> u32 {
+        let span = u64::from(self.period_ns.saturating_sub(self.start_ns));
+        let n = u64::from(self.count.max(1));
+        let t = u64::from(self.start_ns) + (2 * u64::from(k) + 1) * span / (2 * n);
+        t as u32
+    }
+
+    /// Times of all steps (ns from the period start).
+    pub fn times(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.count).map(|k| self.step_ns(k))
+    }
+
+    /// Signed step count.
+    pub fn signed(&self) -> i64 {
+        match self.direction {
+            Direction::Forward => i64::from(self.count),
+            Direction::Backward => -i64::from(self.count),
+        }
+    }
+}
+
+/// Turns per-period step targets of six axes into timed pulses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StepScheduler {
+    config: SchedulerConfig,
+    position: [i64; 6],
+    direction: [Direction; 6],
+    /// Time of each axis's last step relative to the start of the next period (ns, negative = in the past).
+    last_step: [i64; 6],
+    carried: u32,
+}
+
+impl StepScheduler {
+    /// A scheduler whose axes are at `position` (steps).
+    pub fn new(config: SchedulerConfig, position: [i64; 6]) -> Self {
+        Self {
+            config,
+            position,
+            direction: [Direction::Forward; 6],
+            last_step: [i64::MIN / 2; 6],
+            carried: 0,
+        }
+    }
+
+    /// Scheduled position of every axis at the end of the last planned period.
+    pub fn position(&self) -> [i64; 6] {
+        self.position
+    }
+
+    /// Redefines the positions (homing sets an axis's origin); no pulses.
+    pub fn set_position(&mut self, position: [i64; 6]) {
+        self.position = position;
+    }
+
+    /// Periods in which some axis could not reach its target (steps carried over).
+    pub fn carried(&self) -> u32 {
+        self.carried
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SchedulerConfig {
+        &self.config
+    }
+
+    /// Plans one period toward `targets` (steps at the end of the period).
+    pub fn plan(&mut self, targets: &[i64; 6]) -> [AxisMove; 6] {
+        let mut limited = false;
+        let moves = core::array::from_fn(|i| {
+            let (m, short) = self.plan_axis(i, targets[i]);
+            limited |= short;
+            m
+        });
+        if limited {
+            self.carried = self.carried.saturating_add(1);
+        }
+        moves
+    }
+
+    fn plan_axis(&mut self, i: usize, target: i64) -> (AxisMove, bool) {
+        let c = self.config;
+        let period = i64::from(c.period_ns);
+        let want = target.saturating_sub(self.position[i]);
+        let last = self.last_step[i];
+        let idle = AxisMove {
+            direction: self.direction[i],
+            dir_change_ns: None,
+            start_ns: 0,
+            count: 0,
+            period_ns: c.period_ns,
+        };
+        if want == 0 {
+            self.last_step[i] = last.saturating_sub(period);
+            return (idle, false);
+        }
+        let direction = if want > 0 {
+            Direction::Forward
+        } else {
+            Direction::Backward
+        };
+        let mut earliest = last.saturating_add(i64::from(c.min_spacing_ns));
+        let mut dir_change_ns = None;
+        if direction != self.direction[i] {
+            let change = last.saturating_add(i64::from(c.dir_hold_ns)).max(0);
+            earliest = earliest.max(change + i64::from(c.dir_setup_ns));
+            dir_change_ns = Some(change as u32);
+        }
+        // The first step sits half a gap into the window, so a window starting at `earliest` is always late enough.
+        let start = earliest.clamp(0, period - 1);
+        let room = (period - start) / i64::from(c.min_spacing_ns.max(1));
+        let count = want.unsigned_abs().min(room.max(0) as u64) as u32;
+        if count == 0 {
+            self.last_step[i] = last.saturating_sub(period);
+            return (idle, true);
+        }
+        let m = AxisMove {
+            direction,
+            dir_change_ns,
+            start_ns: start as u32,
+            count,
+            period_ns: c.period_ns,
+        };
+        self.direction[i] = direction;
+        self.position[i] = self.position[i].saturating_add(m.signed());
+        self.last_step[i] = i64::from(m.step_ns(count - 1)) - period;
+        (m, u64::from(count) < want.unsigned_abs())
+    }
+}

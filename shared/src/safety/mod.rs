@@ -1,0 +1,7 @@
+//! Safety: the interlock supervisor (FIRMWARE.md "Safety supervisor") and the homing sequence.
+
+pub mod homing;
+pub mod supervisor;
+
+pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};
+pub use supervisor::{Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig, Supplies};

@@ -1,0 +1,523 @@
+//! The interlock state machine. Its [`Outputs`] are the only way anything energises: the firmware drives the
+//! relays and the driver enable from them and nothing else, and the motion pipeline moves only when they allow it.
+//!
+//! States (FIRMWARE.md): `Off -> LogicOn (logic relay on, settle / LOGIC_OK) -> PowerOn (power relay on, settle /
+//! POWER_OK) -> Homing -> Ready -> Running`, `Stopping` (ramp to rest), `Fault` (latched, with a reason), and the
+//! shutdown sequence `ShuttingDown(Drivers)` (drivers disabled) -> `ShuttingDown(Discharge)` (power relay off) ->
+//! `Off` (logic relay off).
+//!
+//! Invariants that hold after every transition (checked by exhaustive enumeration in the tests):
+//! power never on without logic on and settled; logic never off while power is on (power goes off first); the
+//! drivers are enabled only with power on and no fault; an e-stop or end-of-travel switch with power on lands in
+//! `Fault` in the same step; a fault is left only by `ClearFault`; no stream motion before homing.
+//!
+//! Time is milliseconds spent in the current state, advanced by [`Event::Elapsed`] and saturating just past the
+//! longest configured delay, which keeps the state space finite and enumerable.
+
+use core::fmt;
+
+/// Supply sequencing and sensing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct SupervisorConfig {
+    /// The board has a LOGIC_OK input; without it, timing alone sequences.
+    pub logic_sense: bool,
+    /// The board has a POWER_OK input.
+    pub power_sense: bool,
+    /// Wait after the logic relay closes (and LOGIC_OK, if sensed) before the power relay may close (ms).
+    pub logic_settle_ms: u32,
+    /// Wait after the power relay closes (and POWER_OK, if sensed) before the drivers may be enabled (ms).
+    pub power_settle_ms: u32,
+    /// A sensed supply that is not up this long after its relay closed is a fault (ms).
+    pub supply_timeout_ms: u32,
+    /// Drivers disabled this long before the power relay opens on shutdown (ms).
+    pub driver_off_ms: u32,
+    /// Power supply discharge time before the logic relay opens on shutdown (ms).
+    pub discharge_ms: u32,
+}
+
+impl Default for SupervisorConfig {
+    fn default() -> Self {
+        Self {
+            logic_sense: true,
+            power_sense: true,
+            logic_settle_ms: 100,
+            power_settle_ms: 200,
+            supply_timeout_ms: 1000,
+            driver_off_ms: 20,
+            discharge_ms: 500,
+        }
+    }
+}
+
+impl SupervisorConfig {
+    fn timer_cap(&self) -> u32 {
+        let longest = self
+            .logic_settle_ms
+            .max(self.power_settle_ms)
+            .max(self.supply_timeout_ms);
+        longest.max(self.driver_off_ms).max(self.discharge_ms).saturating_add(1)
+    }
+}
+
+/// Why the supervisor latched a fault.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
+pub enum FaultReason {
+    /// The e-stop chain opened.
+    EStop,
+    /// An end-of-travel switch of this axis tripped.
+    Limit(u8),
+    /// LOGIC_OK dropped while logic was up.
+    LogicLost,
+    /// POWER_OK dropped while power was up.
+    PowerLost,
+    /// A sensed supply did not come up within the timeout.
+    SupplyTimeout,
+    /// Homing did not find a switch within its travel.
+    HomingFailed,
+    /// The independent watchdog reset the MCU.
+    Watchdog,
+    /// The motion pipeline could not keep the platform inside its workspace while stopping.
+    MotionFault,
+}
+
+impl fmt::Display for FaultReason {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::EStop => f.write_str("e-stop open"),
+            Self::Limit(axis) => write!(f, "limit switch of axis {axis}"),
+            Self::LogicLost => f.write_str("logic supply lost"),
+            Self::PowerLost => f.write_str("power supply lost"),
+            Self::SupplyTimeout => f.write_str("supply did not come up in time"),
+            Self::HomingFailed => f.write_str("homing failed"),
+            Self::Watchdog => f.write_str("watchdog reset"),
+            Self::MotionFault => f.write_str("motion left the workspace"),
+        }
+    }
+}
+
+/// Which supplies a state keeps on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub enum Supplies {
+    /// Both relays open.
+    None,
+    /// Logic relay closed, power relay open.
+    Logic,
+    /// Both relays closed.
+    Both,
+}
+
+/// Phase of the shutdown sequence.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub enum Shutdown {
+    /// Drivers disabled, power still on.
+    Drivers,
+    /// Power relay open, waiting for the supply to discharge; logic still on.
+    Discharge,
+}
+
+/// Supervisor state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub enum State {
+    /// Everything off.
+    Off,
+    /// Logic relay closed, waiting for it to settle.
+    LogicOn,
+    /// Power relay closed; `settled` once POWER_OK (if sensed) and the settle time are there. Not homed.
+    PowerOn {
+        /// Power is up and settled: homing may start.
+        settled: bool,
+    },
+    /// Drivers enabled, the homing sequence moves the axes.
+    Homing,
+    /// Homed, drivers enabled and holding, no stream.
+    Ready,
+    /// Streaming poses.
+    Running,
+    /// Ramping to rest (stop command or stream loss).
+    Stopping,
+    /// Latched fault; the supplies it keeps.
+    Fault(FaultReason, Supplies),
+    /// Shutdown sequence.
+    ShuttingDown(Shutdown),
+}
+
+/// What the supervisor lets the motion pipeline do.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub enum Motion {
+    /// Nothing moves.
+    None,
+    /// Only the homing sequence moves axes.
+    Homing,
+    /// The pose stream (and its stopping ramp) moves the platform.
+    Stream,
+}
+
+/// The supervisor's outputs: relays, driver enable, and what may move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub struct Outputs {
+    /// LOGIC_EN relay.
+    pub logic_relay: bool,
+    /// POWER_EN relay.
+    pub power_relay: bool,
+    /// Stepper driver enable.
+    pub driver_enable: bool,
+    /// What may move.
+    pub motion: Motion,
+}
+
+impl Outputs {
+    /// Everything off.
+    pub const OFF: Outputs = Outputs {
+        logic_relay: false,
+        power_relay: false,
+        driver_enable: false,
+        motion: Motion::None,
+    };
+}
+
+/// An event the supervisor reacts to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Event {
+    /// Command: bring up logic, then power.
+    Enable,
+    /// Command: shut down (drivers, power, then logic).
+    Disable,
+    /// Command: home the axes.
+    Home,
+    /// Command: start taking the pose stream.
+    Start,
+    /// Command: ramp to rest (or abort homing).
+    Stop,
+    /// Command: clear a latched fault.
+    ClearFault,
+    /// LOGIC_OK input level.
+    LogicOk(bool),
+    /// POWER_OK input level.
+    PowerOk(bool),
+    /// E-stop chain: `true` = open (stop).
+    EStop(bool),
+    /// End-of-travel switch of an axis: `true` = tripped.
+    Limit(u8, bool),
+    /// The homing sequence finished.
+    HomingDone,
+    /// The homing sequence failed.
+    HomingFailed,
+    /// The stopping ramp reached rest.
+    AtRest,
+    /// No valid setpoint within the stream timeout.
+    StreamLost,
+    /// The motion pipeline could not keep the platform inside its workspace.
+    MotionFault,
+    /// Reported once at boot when the reset cause was the watchdog.
+    WatchdogReset,
+    /// Time passed (ms).
+    Elapsed(u32),
+}
+
+/// Why a command was not carried out (the state is unchanged).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
+pub enum Refusal {
+    /// The command does not apply in the current state.
+    WrongState,
+    /// The e-stop chain is open.
+    EStopOpen,
+    /// An end-of-travel switch is tripped.
+    LimitActive,
+    /// A latched fault must be cleared first.
+    Faulted,
+}
+
+impl fmt::Display for Refusal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::WrongState => "not possible in the current state",
+            Self::EStopOpen => "e-stop is open",
+            Self::LimitActive => "a limit switch is tripped",
+            Self::Faulted => "a fault is latched: clear it first",
+        })
+    }
+}
+
+/// Input levels the supervisor remembers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+struct Inputs {
+    estop_open: bool,
+    limits: u16,
+    logic_ok: bool,
+    power_ok: bool,
+}
+
+/// The interlock state machine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Supervisor {
+    config: SupervisorConfig,
+    state: State,
+    timer_ms: u32,
+    homed: bool,
+    inputs: Inputs,
+}
+
+impl Supervisor {
+    /// Starts in `Off` with every output off.
+    pub fn new(config: SupervisorConfig) -> Self {
+        Self {
+            config,
+            state: State::Off,
+            timer_ms: 0,
+            homed: false,
+            inputs: Inputs::default(),
+        }
+    }
+
+    /// Current state.
+    pub fn state(&self) -> State {
+        self.state
+    }
+
+    /// Whether the axes are homed.
+    pub fn homed(&self) -> bool {
+        self.homed
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SupervisorConfig {
+        &self.config
+    }
+
+    /// Outputs of the current state.
+    pub fn outputs(&self) -> Outputs {
+        let (logic, power, enable, motion) = match self.state {
+            State::Off => (false, false, false, Motion::None),
+            State::LogicOn => (true, false, false, Motion::None),
+            State::PowerOn { .. } | State::ShuttingDown(Shutdown::Drivers) => (true, true, false, Motion::None),
+            State::Homing => (true, true, true, Motion::Homing),
+            State::Ready => (true, true, true, Motion::None),
+            State::Running | State::Stopping => (true, true, true, Motion::Stream),
+            State::Fault(_, supplies) => (
+                supplies != Supplies::None,
+                supplies == Supplies::Both,
+                false,
+                Motion::None,
+            ),
+            State::ShuttingDown(Shutdown::Discharge) => (true, false, false, Motion::None),
+        };
+        Outputs {
+            logic_relay: logic,
+            power_relay: power,
+            driver_enable: enable,
+            motion,
+        }
+    }
+
+    fn go(&mut self, state: State) {
+        if state != self.state {
+            self.state = state;
+            self.timer_ms = 0;
+        }
+    }
+
+    /// Latches a fault, keeping only the supplies that are safe to keep for that reason.
+    fn fault(&mut self, reason: FaultReason) {
+        let out = self.outputs();
+        let supplies = match reason {
+            // Losing the e-stop chain, a supply or the MCU's health removes power; logic stays as it was.
+            FaultReason::EStop
+            | FaultReason::LogicLost
+            | FaultReason::PowerLost
+            | FaultReason::SupplyTimeout
+            | FaultReason::Watchdog => {
+                if out.logic_relay {
+                    Supplies::Logic
+                } else {
+                    Supplies::None
+                }
+            }
+            // Motion faults keep the supplies: the drivers are disabled, nothing else needs to drop.
+            FaultReason::Limit(_) | FaultReason::HomingFailed | FaultReason::MotionFault => {
+                match (out.logic_relay, out.power_relay) {
+                    (true, true) => Supplies::Both,
+                    (true, false) => Supplies::Logic,
+                    _ => Supplies::None,
+                }
+            }
+        };
+        self.homed = false;
+        self.go(State::Fault(reason, supplies));
+    }
+
+    fn is_fault(&self) -> bool {
+        matches!(self.state, State::Fault(..))
+    }
+
+    /// Reacts to one event. Commands that do not apply return a [`Refusal`] and change nothing; inputs and time
+    /// always apply.
+    pub fn handle(&mut self, event: Event) -> Result<(), Refusal> {
+        let powered = self.outputs().power_relay;
+        match event {
+            Event::EStop(open) => {
+                self.inputs.estop_open = open;
+                if open && self.state != State::Off && !self.is_fault() {
+                    self.fault(FaultReason::EStop);
+                }
+            }
+            Event::Limit(axis, active) => {
+                let bit = 1u16.checked_shl(u32::from(axis)).unwrap_or(0);
+                if active {
+                    self.inputs.limits |= bit;
+                } else {
+                    self.inputs.limits &= !bit;
+                }
+                if active && powered && !self.is_fault() {
+                    self.fault(FaultReason::Limit(axis));
+                }
+            }
+            Event::LogicOk(ok) => {
+                self.inputs.logic_ok = ok;
+                let logic_up = !matches!(self.state, State::Off | State::LogicOn) && self.outputs().logic_relay;
+                if !ok && self.config.logic_sense && logic_up && !self.is_fault() {
+                    self.fault(FaultReason::LogicLost);
+                }
+            }
+            Event::PowerOk(ok) => {
+                self.inputs.power_ok = ok;
+                let power_up = powered && !matches!(self.state, State::PowerOn { settled: false });
+                if !ok && self.config.power_sense && power_up && !self.is_fault() {
+                    self.fault(FaultReason::PowerLost);
+                }
+            }
+            Event::WatchdogReset => {
+                if !self.is_fault() {
+                    self.fault(FaultReason::Watchdog);
+                }
+            }
+            Event::MotionFault => {
+                if matches!(self.state, State::Running | State::Stopping | State::Homing) {
+                    self.fault(FaultReason::MotionFault);
+                }
+            }
+            Event::Elapsed(ms) => self.elapse(ms),
+            Event::HomingDone => {
+                if self.state == State::Homing {
+                    self.homed = true;
+                    self.go(State::Ready);
+                }
+            }
+            Event::HomingFailed => {
+                if self.state == State::Homing {
+                    self.fault(FaultReason::HomingFailed);
+                }
+            }
+            Event::AtRest => {
+                if self.state == State::Stopping {
+                    self.go(State::Ready);
+                }
+            }
+            Event::StreamLost => {
+                if self.state == State::Running {
+                    self.go(State::Stopping);
+                }
+            }
+            Event::Enable | Event::Disable | Event::Home | Event::Start | Event::Stop | Event::ClearFault => {
+                return self.command(event)
+            }
+        }
+        Ok(())
+    }
+
+    fn command(&mut self, command: Event) -> Result<(), Refusal> {
+        if self.is_fault() && command != Event::ClearFault {
+            return Err(Refusal::Faulted);
+        }
+        match (command, self.state) {
+            (Event::Enable, State::Off) => {
+                if self.inputs.estop_open {
+                    return Err(Refusal::EStopOpen);
+                }
+                self.go(State::LogicOn);
+            }
+            (Event::Disable, State::LogicOn | State::PowerOn { .. } | State::Ready) => {
+                self.go(State::ShuttingDown(Shutdown::Drivers));
+            }
+            (Event::Home, State::PowerOn { settled: true } | State::Ready) => {
+                if self.inputs.estop_open {
+                    return Err(Refusal::EStopOpen);
+                }
+                if self.inputs.limits != 0 {
+                    return Err(Refusal::LimitActive);
+                }
+                self.homed = false;
+                self.go(State::Homing);
+            }
+            (Event::Start, State::Ready) => self.go(State::Running),
+            (Event::Stop, State::Running) => self.go(State::Stopping),
+            (Event::Stop, State::Homing) => {
+                self.homed = false;
+                self.go(State::PowerOn { settled: true });
+            }
+            (Event::ClearFault, State::Fault(_, supplies)) => {
+                if self.inputs.estop_open {
+                    return Err(Refusal::EStopOpen);
+                }
+                if self.inputs.limits != 0 {
+                    return Err(Refusal::LimitActive);
+                }
+                self.go(match supplies {
+                    Supplies::Both => State::PowerOn { settled: true },
+                    // Logic is kept, power is off: the way back up is the normal Enable sequence from Off, and
+                    // Off opens the logic relay, which is allowed because power is already off.
+                    Supplies::Logic | Supplies::None => State::Off,
+                });
+            }
+            _ => return Err(Refusal::WrongState),
+        }
+        Ok(())
+    }
+
+    fn elapse(&mut self, ms: u32) {
+        self.timer_ms = self.timer_ms.saturating_add(ms).min(self.config.timer_cap());
+        let c = self.config;
+        let t = self.timer_ms;
+        match self.state {
+            State::LogicOn => {
+                let up = self.inputs.logic_ok || !c.logic_sense;
+                if up && t >= c.logic_settle_ms {
+                    self.go(State::PowerOn { settled: false });
+                } else if !up && t >= c.supply_timeout_ms {
+                    self.fault(FaultReason::SupplyTimeout);
+                }
+            }
+            State::PowerOn { settled: false } => {
+                let up = self.inputs.power_ok || !c.power_sense;
+                if up && t >= c.power_settle_ms {
+                    self.go(State::PowerOn { settled: true });
+                } else if !up && t >= c.supply_timeout_ms {
+                    self.fault(FaultReason::SupplyTimeout);
+                }
+            }
+            State::ShuttingDown(Shutdown::Drivers) if t >= c.driver_off_ms => {
+                self.go(State::ShuttingDown(Shutdown::Discharge));
+            }
+            State::ShuttingDown(Shutdown::Discharge) if t >= c.discharge_ms => self.go(State::Off),
+            _ => {}
+        }
+    }
+}
