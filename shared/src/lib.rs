@@ -18,8 +18,10 @@
 // which the validated geometry bounds by the arrays' length of six.
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+pub mod controller;
 pub mod kinematics;
 pub mod motion;
+pub mod protocol;
 mod real;
 pub mod safety;
 

@@ -1,1 +1,5 @@
-//! End-to-end tests of ringpod (grow with the host CLI and QEMU issues).
+//! End-to-end testing of ringpod without hardware: the controller core with a simulated plant ([`plant`]) and
+//! data-driven scenarios ([`scenario`], files under `tests/scenarios/`).
+
+pub mod plant;
+pub mod scenario;

@@ -144,6 +144,8 @@ enum Mode {
     Hold,
     Streaming,
     Stopping,
+    /// A trusted move of the controller's own (to the home pose after homing): no stream timeout.
+    Moving,
 }
 
 /// The motion pipeline of one mechanism, in f32 (what the MCU runs).
@@ -218,6 +220,11 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     }
 
     /// The step converter (scales and homing offsets).
+    pub fn converter(&self) -> &StepConverter {
+        &self.converter
+    }
+
+    /// The step converter, to set homing offsets.
     pub fn converter_mut(&mut self) -> &mut StepConverter {
         &mut self.converter
     }
@@ -255,6 +262,11 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     /// The configuration.
     pub fn config(&self) -> &PipelineConfig {
         &self.config
+    }
+
+    /// Replaces the configuration (the controller allows it only at rest).
+    pub fn set_config(&mut self, config: PipelineConfig) {
+        self.config = config;
     }
 
     /// Whether every axis is at rest.
@@ -301,6 +313,30 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         self.actuator_velocity = [0.0; 6];
         self.from = self.pose;
         self.to = self.pose;
+    }
+
+    /// Moves to `pose` on a straight line under the limits (the controller's own move, e.g. to the home pose after
+    /// homing). The pose must pass every check; [`PipelineEvent::AtRest`] follows when it is reached.
+    pub fn move_to(&mut self, pose: Pose<f32>) -> Result<(), RejectReason> {
+        let pose = pose.validated().map_err(|_| RejectReason::NonFinite)?;
+        if self.solve(&pose).is_none() {
+            return Err(RejectReason::Unreachable);
+        }
+        // Long enough that no axis needs more than half its velocity limit.
+        let (a, b) = (self.pose.to_array(), pose.to_array());
+        let mut seconds = 0.0f32;
+        for i in 0..6 {
+            seconds = seconds.max(libm::fabsf(delta(i, b[i], a[i])) / (0.5 * self.config.limits.pose_velocity[i]));
+        }
+        self.from = self.pose;
+        self.to = Pose {
+            gamma: wrap_pi(pose.gamma),
+            ..pose
+        };
+        self.segment_ticks = ((seconds * 1e6) as u32 / self.config.tick_us.max(1)).max(1);
+        self.segment_done = 0;
+        self.mode = Mode::Moving;
+        Ok(())
     }
 
     /// Validates and takes a setpoint; a rejected one changes nothing but its counter.
@@ -399,7 +435,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         let mut step = [0.0f32; 6];
         match self.mode {
             Mode::Hold => {}
-            Mode::Streaming => {
+            Mode::Streaming | Mode::Moving => {
                 if self.segment_done < self.segment_ticks {
                     self.segment_done += 1;
                 }
@@ -416,18 +452,22 @@ impl<M: Mechanism<f32>> Pipeline<M> {
                 }
             }
             Mode::Stopping => {
-                for i in 0..6 {
-                    step[i] = self.trackers[i].brake(dt, limits.pose_acceleration[i]) * dt;
+                for ((s, t), a) in step.iter_mut().zip(&mut self.trackers).zip(limits.pose_acceleration) {
+                    *s = t.brake(dt, a) * dt;
                 }
             }
         }
         if step.iter().any(|s| *s != 0.0) && !self.advance(&step, dt) {
-            if self.mode == Mode::Stopping {
+            if matches!(self.mode, Mode::Stopping | Mode::Moving) {
                 event = Some(PipelineEvent::MotionFault);
             }
             self.halt_in_place();
         }
-        if self.mode == Mode::Stopping && self.at_rest() && event.is_none() {
+        let arrived = self.mode == Mode::Moving && self.segment_done >= self.segment_ticks && self.settled(dt);
+        if arrived {
+            self.trackers = [AxisTracker::default(); 6];
+        }
+        if (self.mode == Mode::Stopping || arrived) && self.at_rest() && event.is_none() {
             self.mode = Mode::Hold;
             event = Some(PipelineEvent::AtRest);
         }
@@ -484,6 +524,15 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         self.actuators = next;
         self.pose = pose;
         true
+    }
+
+    /// Every axis within a micrometre (microradian) of the reference and slow enough to stop in one tick.
+    fn settled(&self, dt: f32) -> bool {
+        let (p, r) = (self.pose.to_array(), self.reference().to_array());
+        (0..6).all(|i| {
+            libm::fabsf(delta(i, r[i], p[i])) <= 1e-6
+                && libm::fabsf(self.trackers[i].velocity) <= self.config.limits.pose_acceleration[i] * dt
+        })
     }
 
     fn actuator_delta(&self, i: usize, q: &Actuators<f32>) -> f32 {

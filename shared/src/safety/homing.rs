@@ -1,4 +1,5 @@
-//! Homing: each axis finds its home switch by approach, back-off and slow re-approach, one axis at a time.
+//! Homing: each axis finds its home switch by approach, back-off and slow re-approach, then moves off the switch
+//! again (an end switch used for homing is an end-of-travel limit afterwards); one axis at a time.
 //!
 //! Before homing nothing is known of the absolute positions, so the plan rests on one stated assumption: the
 //! platform was parked near its home pose, each carriage within its search travel of its home switch. Given that,
@@ -152,7 +153,8 @@ pub enum HomingStep {
         /// Signed speed (steps/s).
         rate: i32,
     },
-    /// The switch of `axis` tripped on the slow approach at position `at` (steps): this is its home.
+    /// The switch of `axis` tripped on the slow approach at position `at` (steps): this is its origin. The axis
+    /// then backs off the switch before the next one starts.
     Homed {
         /// Axis index.
         axis: u8,
@@ -170,6 +172,8 @@ enum Phase {
     Approach,
     BackOff,
     Slow,
+    /// Off the switch again, so that an end switch used for homing is free to act as a limit afterwards.
+    Clear,
 }
 
 /// Runs a [`HomingPlan`]: call [`HomingSequencer::update`] every control period with the axis positions and the
@@ -239,7 +243,9 @@ impl HomingSequencer {
             Phase::BackOff => self.back_off(axis, &cfg, pos, active),
             Phase::Slow => {
                 if active {
-                    self.next_axis(position);
+                    // The controller now calls this position `home_position`.
+                    self.phase = Phase::Clear;
+                    self.start = cfg.home_position;
                     return HomingStep::Homed { axis, at: pos };
                 }
                 if (pos - self.start) * toward > i64::from(cfg.backoff_steps) * 2 {
@@ -248,6 +254,19 @@ impl HomingSequencer {
                 HomingStep::Move {
                     axis,
                     rate: cfg.slow_rate as i32 * i32::from(cfg.toward),
+                }
+            }
+            Phase::Clear => {
+                if (self.start - pos) * toward < i64::from(cfg.backoff_steps) {
+                    return HomingStep::Move {
+                        axis,
+                        rate: -(cfg.slow_rate as i32) * i32::from(cfg.toward),
+                    };
+                }
+                self.next_axis(position);
+                match self.current_axis() {
+                    Some(_) => self.update(position, switches),
+                    None => HomingStep::Done,
                 }
             }
         }

@@ -1,0 +1,535 @@
+//! The controller: protocol dispatch, supervisor, homing, motion pipeline and step scheduler wired together.
+//!
+//! This is the whole decision-making of the device. The firmware calls it from its tasks (frames from USB,
+//! input levels from the switches, one [`Controller::tick`] per control period) and drives its pins from what it
+//! returns; the host simulator and the tests call exactly the same code.
+
+use crate::kinematics::presets::{Preset, PresetGeometry};
+use crate::kinematics::{AxisKind, KinematicsError, Mechanism, MultiTurn, Pose, RingPlatform};
+use crate::motion::{
+    AxisMove, AxisScale, Pipeline, PipelineConfig, PipelineEvent, SchedulerConfig, StepConverter, StepScheduler,
+};
+use crate::protocol::{
+    self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
+};
+use crate::safety::homing::{HomingConfig, HomingError, HomingPlan, RingHoming};
+use crate::safety::{Event, HomingSequencer, HomingStep, Motion, Outputs, State, Supervisor, SupervisorConfig};
+
+/// Everything the controller is configured with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControllerConfig {
+    /// The geometry (a ring platform).
+    pub preset: Preset,
+    /// Supply sequencing.
+    pub supervisor: SupervisorConfig,
+    /// Motion pipeline.
+    pub pipeline: PipelineConfig,
+    /// Step timing.
+    pub scheduler: SchedulerConfig,
+    /// Motor scale of every axis.
+    pub scales: [AxisScale; 6],
+    /// Homing of every axis.
+    pub homing: HomingConfig,
+}
+
+/// Why a configuration cannot run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// The preset is not a ring platform.
+    NotARingPlatform,
+    /// The home pose has no IK solution.
+    HomePose(KinematicsError),
+    /// The homing plan is unsafe or inconsistent.
+    Homing(HomingError),
+    /// The step timing is inconsistent.
+    Scheduler,
+}
+
+impl ControllerConfig {
+    /// The 1:20 trainer model with the FL20 drives of FIRMWARE.md: carriages home in the order 1, 3, 2, 4 after the
+    /// two linear actuators, searching up to 20 degrees of ring (linear actuators up to 40 mm); then the platform
+    /// moves to the home pose under the normal limits.
+    pub fn trainer_model() -> Self {
+        let carriage = crate::safety::homing::AxisHoming {
+            toward: 1,
+            search_steps: 1_422, // 20 degrees at 25,600 steps per turn
+            backoff_steps: 142,  // 2 degrees
+            fast_rate: 4_000,
+            slow_rate: 500,
+            home_position: 0, // the index flags sit at the carriages' home-pose angles
+        };
+        let linear = crate::safety::homing::AxisHoming {
+            toward: -1,
+            search_steps: 64_000, // 40 mm at 1.6 M steps/m
+            backoff_steps: 3_200, // 2 mm
+            fast_rate: 32_000,
+            slow_rate: 4_000,
+            // The lower end switch is 10 mm below the home-pose length of 231.3 mm: the platform parks low.
+            home_position: -16_000,
+        };
+        Self {
+            preset: Preset::TrainerModel,
+            supervisor: SupervisorConfig::default(),
+            pipeline: PipelineConfig::default(),
+            scheduler: SchedulerConfig::default(),
+            scales: [
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_LINEAR,
+                AxisScale::MODEL_LINEAR,
+            ],
+            homing: HomingConfig {
+                axes: [carriage, carriage, carriage, carriage, linear, linear],
+                order: [4, 5, 0, 2, 1, 3],
+            },
+        }
+    }
+}
+
+/// Switch and supply levels, as read from the pins (after debouncing and polarity).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Inputs {
+    /// E-stop chain open.
+    pub estop_open: bool,
+    /// Home switch of each axis (bit per axis): the carriage index switches and the linear actuators' home ends.
+    pub home: u16,
+    /// End-of-travel switch at the far end of each linear actuator (bit per axis).
+    pub limits: u16,
+    /// LOGIC_OK.
+    pub logic_ok: bool,
+    /// POWER_OK.
+    pub power_ok: bool,
+}
+
+/// What the firmware does in one control period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TickOutput {
+    /// Pulses of each axis for this period.
+    pub moves: [AxisMove; 6],
+    /// Relays, driver enable.
+    pub outputs: Outputs,
+}
+
+/// The controller.
+pub struct Controller {
+    config: ControllerConfig,
+    home_pose: Pose<f32>,
+    supervisor: Supervisor,
+    pipeline: Pipeline<RingPlatform<f32>>,
+    scheduler: StepScheduler,
+    plan: HomingPlan,
+    homing: Option<HomingSequencer>,
+    homing_carry: i64,
+    /// Homing found every switch; the platform is on its way to the home pose.
+    returning_home: bool,
+    connected: bool,
+    inputs: Inputs,
+    elapsed_us: u32,
+    bad_frames: u32,
+    tick_cost: u32,
+    queue_depth: u16,
+    pending_fault: bool,
+}
+
+impl Controller {
+    /// A controller in `Off`, axes at step position zero.
+    pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
+        let PresetGeometry::Ring(geometry) = config.preset.geometry() else {
+            return Err(ConfigError::NotARingPlatform);
+        };
+        if !config.scheduler.is_valid() {
+            return Err(ConfigError::Scheduler);
+        }
+        let mechanism = RingPlatform::<f32>::new(geometry);
+        let home_pose = Pose::from_array(config.preset.home()).cast::<f32>();
+        let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;
+        let n = geometry.chains().len();
+        let mut home_angles = [0.0; 6];
+        for (i, a) in home_angles.iter_mut().enumerate().take(n) {
+            *a = f64::from(home_q.0[i]);
+        }
+        let ring = RingHoming {
+            carriages: n,
+            home_angles,
+            min_spacing: geometry.limits.carriage_spacing[0],
+            steps_per_rad: config.scales[0].steps_per_turn as f64 / core::f64::consts::TAU,
+        };
+        let plan = HomingPlan::new(config.homing, &ring).map_err(ConfigError::Homing)?;
+        let converter = StepConverter::new(config.scales, mechanism.axes());
+        let pipeline =
+            Pipeline::new(mechanism, config.pipeline, converter, home_pose).map_err(ConfigError::HomePose)?;
+        Ok(Self {
+            config,
+            home_pose,
+            supervisor: Supervisor::new(config.supervisor),
+            pipeline,
+            scheduler: StepScheduler::new(config.scheduler, [0; 6]),
+            plan,
+            homing: None,
+            homing_carry: 0,
+            returning_home: false,
+            connected: false,
+            inputs: Inputs::default(),
+            elapsed_us: 0,
+            bad_frames: 0,
+            tick_cost: 0,
+            queue_depth: 0,
+            pending_fault: false,
+        })
+    }
+
+    /// The supervisor (state, outputs).
+    pub fn supervisor(&self) -> &Supervisor {
+        &self.supervisor
+    }
+
+    /// The motion pipeline.
+    pub fn pipeline(&self) -> &Pipeline<RingPlatform<f32>> {
+        &self.pipeline
+    }
+
+    /// Step position of every axis (what has been scheduled).
+    pub fn steps(&self) -> [i64; 6] {
+        self.scheduler.position()
+    }
+
+    /// The firmware reports the cost of its last tick and its step-queue depth for the status.
+    pub fn set_platform_stats(&mut self, tick_cost: u32, queue_depth: u16) {
+        self.tick_cost = tick_cost;
+        self.queue_depth = queue_depth;
+    }
+
+    /// Reports a watchdog reset (once, at boot).
+    pub fn watchdog_reset(&mut self) {
+        self.event(Event::WatchdogReset);
+    }
+
+    fn event(&mut self, e: Event) {
+        let was_fault = matches!(self.supervisor.state(), State::Fault(..));
+        // Inputs and time always apply; refusals only concern commands.
+        let _ = self.supervisor.handle(e);
+        self.after_transition(was_fault);
+    }
+
+    fn after_transition(&mut self, was_fault: bool) {
+        if matches!(self.supervisor.state(), State::Fault(..)) {
+            self.pipeline.halt();
+            self.homing = None;
+            self.returning_home = false;
+            if !was_fault {
+                self.pending_fault = true;
+            }
+        }
+    }
+
+    /// New input levels: changes become supervisor events. A linear actuator's home end is also an
+    /// end-of-travel limit outside homing; a carriage passes its index switch every turn, which is no fault.
+    pub fn set_inputs(&mut self, inputs: Inputs) {
+        let old = self.inputs;
+        self.inputs = inputs;
+        if inputs.estop_open != old.estop_open {
+            self.event(Event::EStop(inputs.estop_open));
+        }
+        if inputs.logic_ok != old.logic_ok {
+            self.event(Event::LogicOk(inputs.logic_ok));
+        }
+        if inputs.power_ok != old.power_ok {
+            self.event(Event::PowerOk(inputs.power_ok));
+        }
+        let homing_axis = self.homing.as_ref().and_then(|h| h.current_axis());
+        let axes = self.pipeline.mechanism().axes();
+        let limit_bits = |i: &Inputs| {
+            let mut bits = i.limits;
+            for (a, kind) in axes.iter().enumerate() {
+                if *kind == AxisKind::Linear && homing_axis != Some(a as u8) {
+                    bits |= i.home & (1 << a);
+                }
+            }
+            bits
+        };
+        let (was, now) = (limit_bits(&old), limit_bits(&inputs));
+        for a in 0..6u8 {
+            let bit = 1u16 << a;
+            if (was ^ now) & bit != 0 {
+                self.event(Event::Limit(a, now & bit != 0));
+            }
+        }
+    }
+
+    /// Handles one request; always exactly one response.
+    pub fn handle(&mut self, request: &Request) -> Response {
+        let body = match request.body {
+            HostMessage::Hello { version } => {
+                if version == PROTOCOL_VERSION {
+                    self.connected = true;
+                    DeviceMessage::Hello {
+                        version: PROTOCOL_VERSION,
+                        preset: self.config.preset,
+                    }
+                } else {
+                    self.connected = false;
+                    DeviceMessage::Nack(NackReason::VersionMismatch {
+                        device: PROTOCOL_VERSION,
+                    })
+                }
+            }
+            _ if !self.connected => DeviceMessage::Nack(NackReason::NotConnected),
+            HostMessage::Setpoint(sp) => match self.pipeline.submit(&sp) {
+                Ok(()) => DeviceMessage::Ack,
+                Err(reason) => DeviceMessage::Nack(NackReason::Rejected(reason)),
+            },
+            HostMessage::GetStatus => DeviceMessage::Status(self.status()),
+            HostMessage::GetConfig(key) => match self.get_config(key) {
+                Some(v) => DeviceMessage::Config(key, v),
+                None => DeviceMessage::Nack(NackReason::BadConfig),
+            },
+            HostMessage::SetConfig(key, value) => match self.set_config(key, value) {
+                Ok(()) => DeviceMessage::Ack,
+                Err(r) => DeviceMessage::Nack(r),
+            },
+            HostMessage::Enable => self.command(Event::Enable),
+            HostMessage::Disable => self.command(Event::Disable),
+            HostMessage::Home => self.command(Event::Home),
+            HostMessage::Start => self.command(Event::Start),
+            HostMessage::Stop => self.command(Event::Stop),
+            HostMessage::ClearFault => self.command(Event::ClearFault),
+        };
+        Response { id: request.id, body }
+    }
+
+    fn command(&mut self, e: Event) -> DeviceMessage {
+        let was_fault = matches!(self.supervisor.state(), State::Fault(..));
+        let result = self.supervisor.handle(e);
+        self.after_transition(was_fault);
+        if let Err(r) = result {
+            return DeviceMessage::Nack(NackReason::Refused(r));
+        }
+        match e {
+            Event::Home => {
+                self.homing = Some(HomingSequencer::new(self.plan, &self.scheduler.position()));
+                self.homing_carry = 0;
+                self.returning_home = false;
+            }
+            Event::Start => self.pipeline.start(),
+            Event::Stop => {
+                self.pipeline.stop();
+                if self.homing.take().is_some() || self.returning_home {
+                    self.pipeline.halt();
+                    self.returning_home = false;
+                }
+            }
+            _ => {}
+        }
+        DeviceMessage::Ack
+    }
+
+    /// Decodes a frame, handles it and encodes the response into `out`; returns the response length. A frame that
+    /// does not decode is counted and answered with a `Malformed` nack (id 0): it is never executed.
+    pub fn handle_frame(&mut self, frame: &[u8], out: &mut [u8]) -> usize {
+        let response = match protocol::decode::<Request>(frame) {
+            Ok(request) => self.handle(&request),
+            Err(_) => {
+                self.bad_frames = self.bad_frames.saturating_add(1);
+                Response {
+                    id: 0,
+                    body: DeviceMessage::Nack(NackReason::Malformed),
+                }
+            }
+        };
+        protocol::encode(&response, out).unwrap_or(0)
+    }
+
+    /// An unsolicited message to send, if one is pending (a newly latched fault).
+    pub fn unsolicited(&mut self) -> Option<Response> {
+        if !self.pending_fault {
+            return None;
+        }
+        self.pending_fault = false;
+        match self.supervisor.state() {
+            State::Fault(reason, _) => Some(Response {
+                id: 0,
+                body: DeviceMessage::Fault(reason),
+            }),
+            _ => None,
+        }
+    }
+
+    /// The status report.
+    pub fn status(&self) -> Status {
+        Status {
+            state: self.supervisor.state(),
+            homed: self.supervisor.homed(),
+            steps: self.scheduler.position(),
+            pose: self.pipeline.pose(),
+            applied: self.pipeline.applied(),
+            rejected: *self.pipeline.rejected(),
+            held: self.pipeline.held(),
+            carried: self.scheduler.carried(),
+            bad_frames: self.bad_frames,
+            tick_cost: self.tick_cost,
+            queue_depth: self.queue_depth,
+        }
+    }
+
+    fn get_config(&self, key: ConfigKey) -> Option<f32> {
+        let c = self.pipeline.config();
+        Some(match key {
+            ConfigKey::StreamTimeoutMs => c.stream_timeout_us as f32 / 1000.0,
+            ConfigKey::PoseVelocity(a) => *c.limits.pose_velocity.get(usize::from(a))?,
+            ConfigKey::PoseAcceleration(a) => *c.limits.pose_acceleration.get(usize::from(a))?,
+            ConfigKey::JumpTolerance => c.jump_tolerance,
+            ConfigKey::TickHz => 1e6 / c.tick_us as f32,
+        })
+    }
+
+    fn set_config(&mut self, key: ConfigKey, value: f32) -> Result<(), NackReason> {
+        if !matches!(self.supervisor.outputs().motion, Motion::None) {
+            return Err(NackReason::Refused(crate::safety::Refusal::WrongState));
+        }
+        if !(value.is_finite() && value > 0.0) {
+            return Err(NackReason::BadConfig);
+        }
+        let mut c = *self.pipeline.config();
+        match key {
+            ConfigKey::StreamTimeoutMs if value <= 10_000.0 => c.stream_timeout_us = (value * 1000.0) as u32,
+            ConfigKey::PoseVelocity(a) => {
+                *c.limits
+                    .pose_velocity
+                    .get_mut(usize::from(a))
+                    .ok_or(NackReason::BadConfig)? = value
+            }
+            ConfigKey::PoseAcceleration(a) => {
+                *c.limits
+                    .pose_acceleration
+                    .get_mut(usize::from(a))
+                    .ok_or(NackReason::BadConfig)? = value
+            }
+            ConfigKey::JumpTolerance if value <= 10.0 => c.jump_tolerance = value,
+            _ => return Err(NackReason::BadConfig),
+        }
+        self.pipeline.set_config(c);
+        Ok(())
+    }
+
+    /// One control period.
+    pub fn tick(&mut self) -> TickOutput {
+        let tick_us = self.pipeline.config().tick_us;
+        self.elapsed_us = self.elapsed_us.saturating_add(tick_us);
+        if self.elapsed_us >= 1000 {
+            let ms = self.elapsed_us / 1000;
+            self.elapsed_us %= 1000;
+            self.event(Event::Elapsed(ms));
+        }
+        let position = self.scheduler.position();
+        let outputs = self.supervisor.outputs();
+        let targets = match outputs.motion {
+            Motion::Stream => {
+                let (targets, event) = self.pipeline.tick();
+                match event {
+                    Some(PipelineEvent::StreamLost) => self.event(Event::StreamLost),
+                    Some(PipelineEvent::AtRest) => self.event(Event::AtRest),
+                    Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
+                    None => {}
+                }
+                if self.supervisor.outputs().motion == Motion::Stream {
+                    targets
+                } else {
+                    position
+                }
+            }
+            Motion::Homing => self.homing_tick(position, tick_us),
+            Motion::None => position,
+        };
+        let outputs = self.supervisor.outputs();
+        let targets = if outputs.driver_enable {
+            targets
+        } else {
+            self.scheduler.position()
+        };
+        TickOutput {
+            moves: self.scheduler.plan(&targets),
+            outputs,
+        }
+    }
+
+    /// After homing each axis's origin is known: step 0 is its value at the home pose, and its switch is at step
+    /// `home_position`. Sets the converter's origins and finds the platform's pose at the axes' current positions
+    /// by forward kinematics.
+    fn pose_after_homing(&mut self) -> Result<Pose<f32>, KinematicsError> {
+        let mechanism = *self.pipeline.mechanism();
+        let home = MultiTurn::new(mechanism.inverse(&self.home_pose)?);
+        let axes = mechanism.axes();
+        let converter = self.pipeline.converter_mut();
+        for a in 0..6 {
+            converter.set_home(a, &home, 0);
+        }
+        let position = self.scheduler.position();
+        let q = crate::kinematics::Actuators(core::array::from_fn(|a| {
+            let scale = &self.config.scales[a];
+            let per_unit = scale.per_unit(axes[a]) * if scale.invert { -1.0 } else { 1.0 };
+            home.within.0[a] + position[a] as f32 / per_unit
+        }));
+        let options = crate::kinematics::NewtonOptions::default();
+        Ok(mechanism.forward(&q, &self.home_pose, &options)?.pose)
+    }
+
+    fn homing_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
+        if self.returning_home {
+            let (targets, event) = self.pipeline.tick();
+            match event {
+                Some(PipelineEvent::AtRest) => {
+                    self.returning_home = false;
+                    self.event(Event::HomingDone);
+                }
+                Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
+                _ => {}
+            }
+            return targets;
+        }
+        let Some(homing) = self.homing.as_mut() else {
+            return position;
+        };
+        match homing.update(&position, self.inputs.home) {
+            HomingStep::Move { axis, rate } => {
+                // Steps this period at `rate`, the fraction carried so that the average rate is exact.
+                let total = i64::from(rate) * i64::from(tick_us) + self.homing_carry;
+                let steps = total / 1_000_000;
+                self.homing_carry = total % 1_000_000;
+                let mut t = position;
+                t[usize::from(axis % 6)] += steps;
+                t
+            }
+            HomingStep::Homed { axis, .. } => {
+                // The switch defines this axis's origin: here it is at step `home_position`.
+                let a = usize::from(axis % 6);
+                let mut p = position;
+                p[a] = self.config.homing.axes[a].home_position;
+                self.scheduler.set_position(p);
+                self.homing_carry = 0;
+                p
+            }
+            HomingStep::Done => {
+                self.homing = None;
+                let started = self
+                    .pose_after_homing()
+                    .ok()
+                    .and_then(|pose| self.pipeline.reset(pose).ok());
+                if started.is_some() && self.pipeline.move_to(self.home_pose).is_ok() {
+                    self.returning_home = true;
+                } else {
+                    self.event(Event::HomingFailed);
+                }
+                self.scheduler.position()
+            }
+            HomingStep::Failed(_) => {
+                self.homing = None;
+                self.event(Event::HomingFailed);
+                position
+            }
+        }
+    }
+}

@@ -1,0 +1,129 @@
+//! Framing: postcard payload, CRC-32C, COBS, `0x00` delimiter.
+
+use core::fmt;
+
+use serde::{de::DeserializeOwned, Serialize};
+
+/// Largest postcard payload of any message (bytes).
+pub const MAX_PAYLOAD: usize = 160;
+/// Largest encoded frame including the delimiter (bytes).
+pub const MAX_FRAME: usize = cobs::max_encoding_length(MAX_PAYLOAD + 4) + 1;
+
+const CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI);
+
+/// Why a frame could not be encoded or decoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
+pub enum FrameError {
+    /// The message does not fit in [`MAX_PAYLOAD`] or the output buffer.
+    TooLong,
+    /// Not valid COBS.
+    Cobs,
+    /// Shorter than a checksum.
+    TooShort,
+    /// The checksum does not match: the frame was corrupted.
+    Checksum,
+    /// The payload is not a message of this protocol (or has trailing bytes).
+    Payload,
+}
+
+impl fmt::Display for FrameError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::TooLong => "frame too long",
+            Self::Cobs => "invalid COBS framing",
+            Self::TooShort => "frame shorter than its checksum",
+            Self::Checksum => "checksum mismatch",
+            Self::Payload => "not a message of this protocol",
+        })
+    }
+}
+
+impl core::error::Error for FrameError {}
+
+/// Encodes `message` into `out` as one frame, delimiter included; returns its length.
+pub fn encode<M: Serialize>(message: &M, out: &mut [u8]) -> Result<usize, FrameError> {
+    let mut raw = [0u8; MAX_PAYLOAD + 4];
+    let len = postcard::to_slice(message, &mut raw[..MAX_PAYLOAD])
+        .map_err(|_| FrameError::TooLong)?
+        .len();
+    let crc = CRC.checksum(&raw[..len]).to_le_bytes();
+    raw[len..len + 4].copy_from_slice(&crc);
+    let n = cobs::try_encode(&raw[..len + 4], out).map_err(|_| FrameError::TooLong)?;
+    let end = out.get_mut(n).ok_or(FrameError::TooLong)?;
+    *end = 0;
+    Ok(n + 1)
+}
+
+/// Decodes one frame (its bytes up to, not including, the delimiter).
+pub fn decode<M: DeserializeOwned>(frame: &[u8]) -> Result<M, FrameError> {
+    let mut raw = [0u8; MAX_FRAME];
+    if frame.is_empty() || frame.len() > MAX_FRAME {
+        return Err(FrameError::Cobs);
+    }
+    let report = cobs::decode(frame, &mut raw).map_err(|_| FrameError::Cobs)?;
+    let len = report.frame_size();
+    if len < 5 {
+        return Err(FrameError::TooShort);
+    }
+    let (payload, crc) = raw[..len].split_at(len - 4);
+    if CRC.checksum(payload).to_le_bytes() != crc {
+        return Err(FrameError::Checksum);
+    }
+    match postcard::take_from_bytes::<M>(payload) {
+        Ok((message, [])) => Ok(message),
+        _ => Err(FrameError::Payload),
+    }
+}
+
+/// Splits a byte stream into frames at the `0x00` delimiters, with a fixed buffer. Bytes of a frame that overruns
+/// the buffer are dropped up to the next delimiter, and counted.
+#[derive(Debug, Clone)]
+pub struct FrameReader {
+    buf: [u8; MAX_FRAME],
+    len: usize,
+    overrun: bool,
+    overruns: u32,
+}
+
+impl Default for FrameReader {
+    fn default() -> Self {
+        Self {
+            buf: [0; MAX_FRAME],
+            len: 0,
+            overrun: false,
+            overruns: 0,
+        }
+    }
+}
+
+impl FrameReader {
+    /// Feeds one byte; returns a complete frame (without delimiter) when the byte ends one.
+    pub fn push(&mut self, byte: u8) -> Option<&[u8]> {
+        if byte == 0 {
+            let (len, overrun) = (self.len, self.overrun);
+            self.len = 0;
+            self.overrun = false;
+            if overrun {
+                self.overruns = self.overruns.saturating_add(1);
+                return None;
+            }
+            return if len == 0 { None } else { self.buf.get(..len) };
+        }
+        match self.buf.get_mut(self.len) {
+            Some(slot) if !self.overrun => {
+                *slot = byte;
+                self.len += 1;
+            }
+            _ => self.overrun = true,
+        }
+        None
+    }
+
+    /// Frames dropped because they were longer than [`MAX_FRAME`].
+    pub fn overruns(&self) -> u32 {
+        self.overruns
+    }
+}

@@ -1,0 +1,148 @@
+//! Message types. Every host request gets exactly one response with the same `id`; a device also sends
+//! unsolicited messages (faults) with `id` 0.
+
+use crate::kinematics::presets::Preset;
+use crate::kinematics::Pose;
+use crate::motion::{RejectCounters, RejectReason, Setpoint};
+use crate::safety::{FaultReason, Refusal, State};
+
+/// Protocol version; host and device must agree exactly.
+pub const PROTOCOL_VERSION: u16 = 1;
+
+/// The supervisor state, as reported.
+pub type StateCode = State;
+
+/// A host request.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Request {
+    /// Correlation id, echoed in the response.
+    pub id: u32,
+    /// What is asked.
+    pub body: HostMessage,
+}
+
+/// What the host asks of the device.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum HostMessage {
+    /// Version handshake; must come first.
+    Hello {
+        /// The host's [`PROTOCOL_VERSION`].
+        version: u16,
+    },
+    /// Bring up logic, then power.
+    Enable,
+    /// Shut down: drivers, power, logic.
+    Disable,
+    /// Home all axes.
+    Home,
+    /// Start taking pose setpoints.
+    Start,
+    /// Ramp to rest (or abort homing).
+    Stop,
+    /// Clear a latched fault.
+    ClearFault,
+    /// A pose setpoint.
+    Setpoint(Setpoint),
+    /// Ask for the status.
+    GetStatus,
+    /// Read a configuration value.
+    GetConfig(ConfigKey),
+    /// Write a configuration value (not while moving).
+    SetConfig(ConfigKey, f32),
+}
+
+/// A device message: the response to request `id`, or unsolicited with `id` 0.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Response {
+    /// The request's id, or 0.
+    pub id: u32,
+    /// The message.
+    pub body: DeviceMessage,
+}
+
+/// What the device says.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum DeviceMessage {
+    /// Handshake answer.
+    Hello {
+        /// The device's [`PROTOCOL_VERSION`].
+        version: u16,
+        /// The geometry it drives.
+        preset: Preset,
+    },
+    /// Done.
+    Ack,
+    /// Not done, and why.
+    Nack(NackReason),
+    /// Status and telemetry.
+    Status(Status),
+    /// A configuration value.
+    Config(ConfigKey, f32),
+    /// A fault was latched (unsolicited).
+    Fault(FaultReason),
+}
+
+/// Why a request was not carried out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum NackReason {
+    /// The versions differ; the device's is given.
+    VersionMismatch {
+        /// The device's version.
+        device: u16,
+    },
+    /// No successful hello yet.
+    NotConnected,
+    /// The supervisor refused the command.
+    Refused(Refusal),
+    /// The setpoint was rejected.
+    Rejected(RejectReason),
+    /// The configuration value is out of range, or cannot change now.
+    BadConfig,
+    /// The frame could not be decoded (id unknown, so the response has id 0).
+    Malformed,
+}
+
+/// Configuration values that can be read and written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ConfigKey {
+    /// Stream timeout (ms).
+    StreamTimeoutMs,
+    /// Velocity limit of a pose axis (m/s or rad/s).
+    PoseVelocity(u8),
+    /// Acceleration limit of a pose axis.
+    PoseAcceleration(u8),
+    /// Allowed excess over the velocity limit for a setpoint jump (fraction).
+    JumpTolerance,
+    /// Control rate (Hz, read-only).
+    TickHz,
+}
+
+/// Status and telemetry.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Status {
+    /// Supervisor state.
+    pub state: StateCode,
+    /// Whether the axes are homed.
+    pub homed: bool,
+    /// Step position of every axis.
+    pub steps: [i64; 6],
+    /// Commanded pose.
+    pub pose: Pose<f32>,
+    /// Setpoints accepted.
+    pub applied: u32,
+    /// Setpoints rejected, per reason.
+    pub rejected: RejectCounters,
+    /// Ticks on which the path failed a check and the platform held.
+    pub held: u32,
+    /// Periods in which an axis had to carry steps over.
+    pub carried: u32,
+    /// Frames that failed to decode.
+    pub bad_frames: u32,
+    /// Cost of the last control tick (CPU cycles on the MCU, ns in the simulator).
+    pub tick_cost: u32,
+    /// Step-queue depth of the pulse generator.
+    pub queue_depth: u16,
+}

@@ -1,0 +1,15 @@
+//! The wire protocol between host and controller: one definition for both sides.
+//!
+//! Messages are serde types encoded with postcard; a frame is `COBS(postcard(message) ++ CRC-32C(payload))`
+//! followed by a `0x00` delimiter. CRC-32 rather than CRC-16: a fuzz run feeds tens of millions of corrupted
+//! frames, and a 16-bit check would let about one in 65,536 random corruptions through. The first exchange is
+//! [`HostMessage::Hello`] with [`PROTOCOL_VERSION`]; a device answers any other request before a matching hello with
+//! [`NackReason::NotConnected`], and a different version with [`NackReason::VersionMismatch`].
+
+mod frame;
+mod messages;
+
+pub use frame::{decode, encode, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
+pub use messages::{
+    ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, StateCode, Status, PROTOCOL_VERSION,
+};

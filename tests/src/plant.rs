@@ -1,0 +1,117 @@
+//! A simulated machine: six axes that count the controller's steps, switches that trip at their positions, and
+//! supplies whose sense lines follow the relays.
+
+use ringpod_core::controller::{Controller, Inputs, TickOutput};
+
+/// Where the switches of one axis are (physical steps).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisSwitches {
+    /// The home switch trips in `[home, home + width)` (a carriage's index flag) or, for a linear actuator's home
+    /// end, at or below `home`.
+    pub home: i64,
+    /// Width of a carriage's index flag (steps); `None` for a linear actuator's end switch.
+    pub flag_width: Option<i64>,
+    /// A linear actuator's far end-of-travel switch trips at or above this.
+    pub far_limit: Option<i64>,
+}
+
+/// The simulated plant.
+#[derive(Debug, Clone)]
+pub struct Plant {
+    /// Physical position of each axis (steps from its home switch).
+    pub position: [i64; 6],
+    /// Switch positions.
+    pub switches: [AxisSwitches; 6],
+    /// The e-stop chain is open.
+    pub estop_open: bool,
+    /// Supplies fail to come up (sense stays low).
+    pub supply_dead: bool,
+    /// Steps received while the drivers were disabled (must stay zero).
+    pub steps_while_disabled: u64,
+    /// Total steps received per axis.
+    pub steps_received: [u64; 6],
+}
+
+impl Plant {
+    /// The trainer model parked near home: carriages a few degrees before their index flags, linear actuators
+    /// some millimetres above their home ends.
+    pub fn trainer_model(start: [i64; 6]) -> Self {
+        let carriage = AxisSwitches {
+            home: 0,
+            flag_width: Some(60),
+            far_limit: None,
+        };
+        let linear = AxisSwitches {
+            home: 0,
+            flag_width: None,
+            far_limit: Some(240_000),
+        };
+        Self {
+            position: start,
+            switches: [carriage, carriage, carriage, carriage, linear, linear],
+            estop_open: false,
+            supply_dead: false,
+            steps_while_disabled: 0,
+            steps_received: [0; 6],
+        }
+    }
+
+    /// Switch and supply levels for the controller, given the relays of the last tick.
+    pub fn inputs(&self, logic_relay: bool, power_relay: bool) -> Inputs {
+        let mut home = 0u16;
+        let mut limits = 0u16;
+        for (a, (p, s)) in self.position.iter().zip(&self.switches).enumerate() {
+            let active = match s.flag_width {
+                Some(w) => *p >= s.home && *p < s.home + w,
+                None => *p <= s.home,
+            };
+            if active {
+                home |= 1 << a;
+            }
+            if s.far_limit.is_some_and(|f| *p >= f) {
+                limits |= 1 << a;
+            }
+        }
+        Inputs {
+            estop_open: self.estop_open,
+            home,
+            limits,
+            logic_ok: logic_relay && !self.supply_dead,
+            power_ok: power_relay && !self.supply_dead,
+        }
+    }
+
+    /// Applies one period's pulses.
+    pub fn apply(&mut self, out: &TickOutput) {
+        for (a, m) in out.moves.iter().enumerate() {
+            if m.count > 0 && !out.outputs.driver_enable {
+                self.steps_while_disabled += u64::from(m.count);
+            }
+            self.position[a] += m.signed();
+            self.steps_received[a] += u64::from(m.count);
+        }
+    }
+}
+
+/// Controller and plant in one loop, one call per control period.
+pub struct Rig {
+    /// The controller core, as the firmware runs it.
+    pub controller: Controller,
+    /// The machine.
+    pub plant: Plant,
+    /// Control periods run.
+    pub ticks: u64,
+}
+
+impl Rig {
+    /// One control period: inputs from the plant, tick, pulses to the plant.
+    pub fn tick(&mut self) -> TickOutput {
+        let o = self.controller.supervisor().outputs();
+        self.controller
+            .set_inputs(self.plant.inputs(o.logic_relay, o.power_relay));
+        let out = self.controller.tick();
+        self.plant.apply(&out);
+        self.ticks += 1;
+        out
+    }
+}
