@@ -106,3 +106,15 @@ pub(crate) fn wrap_pi<T: Real>(a: T) -> T {
     // atan2 of (sin, cos) is exact enough near the branch cut and never loops on huge inputs.
     a.sin_().atan2_(a.cos_())
 }
+
+/// Brings an angle that is at most one turn outside `(-pi, pi]` back into it, by one exact addition: unlike
+/// [`wrap_pi`] it leaves angles already in range untouched, so a yaw integrated tick by tick keeps its precision.
+pub(crate) fn wrap_once<T: Real>(a: T) -> T {
+    if a > T::pi() {
+        a - T::two_pi()
+    } else if a <= -T::pi() {
+        a + T::two_pi()
+    } else {
+        a
+    }
+}

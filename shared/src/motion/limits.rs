@@ -17,22 +17,23 @@ pub struct MotionLimits {
 impl MotionLimits {
     /// The 1:20 trainer model: 0.05 m/s (spec table), 1.9 rad/s of yaw (its test motion) and 1 rad/s of tilt;
     /// accelerations of 1 m/s^2 and 20 rad/s^2 let the 50 Hz vibration tests run at small amplitude. Actuators:
-    /// 2 rad/s on the carriages (8 k steps/s) and 0.06 m/s on the linear actuators (96 k steps/s), inside the
-    /// 100 k steps/s the step generator sustains.
+    /// 2.4 rad/s on the carriages (9.8 k steps/s) and 0.06 m/s on the linear actuators (96 k steps/s), inside the
+    /// 100 k steps/s the step generator sustains. Actuator accelerations (100 rad/s^2, 5 m/s^2) are above what the
+    /// pose limits ask through the Jacobian over the workspace, so they bind only near singularities, where the
+    /// motion is slowed to keep the steppers from losing steps.
     pub const TRAINER_MODEL: MotionLimits = MotionLimits {
         pose_velocity: [0.05, 0.05, 0.05, 1.0, 1.0, 1.9],
         pose_acceleration: [1.0, 1.0, 1.0, 20.0, 20.0, 20.0],
         actuator_velocity: [2.4, 2.4, 2.4, 2.4, 0.06, 0.06],
-        actuator_acceleration: [60.0, 60.0, 60.0, 60.0, 1.5, 1.5],
+        actuator_acceleration: [100.0, 100.0, 100.0, 100.0, 5.0, 5.0],
     };
 }
 
 /// One axis following a reference under a velocity and an acceleration limit, in discrete time.
 ///
-/// The speed it commands toward the reference is never more than it can brake from before reaching it:
-/// decelerating by `a * dt` a tick from speed `v` covers `v (v / (a dt) + 1) dt / 2`, so the largest speed that still
-/// stops within the remaining error `e` is `a dt (sqrt(1/4 + 2 e / (a dt^2)) - 1/2)`. A reference that stops is
-/// therefore reached without overshoot.
+/// The speed it commands toward the reference is never more than it can brake from, a tick at a time, before the
+/// point where the reference stops (see [`AxisTracker::step`] for the exact discrete bound): a reference that stops
+/// is reached without overshoot.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct AxisTracker {
     /// Current speed (units/s).
@@ -40,11 +41,18 @@ pub struct AxisTracker {
 }
 
 impl AxisTracker {
-    /// Speed for the next tick toward `error` (reference minus position), limited by `vmax` and `amax`.
-    pub fn step(&mut self, error: f32, dt: f32, vmax: f32, amax: f32) -> f32 {
+    /// Speed for the next tick toward `error` (reference minus position), limited by `vmax` and `amax`, never
+    /// faster than it can brake from within `stop_distance` (the distance to where the reference will stop).
+    pub fn step(&mut self, error: f32, stop_distance: f32, dt: f32, vmax: f32, amax: f32) -> f32 {
         let adt = amax * dt;
+        let d = libm::fabsf(stop_distance);
         let stop = if adt > 0.0 {
-            adt * (libm::sqrtf(0.25 + 2.0 * libm::fabsf(error) / (adt * dt)) - 0.5)
+            // Braking from v covers dt (v + (v - a dt) + ... ) down to the last positive speed. With n whole braking
+            // steps (n a dt <= v < (n + 1) a dt) that is dt (n + 1) (v - n a dt / 2), so the fastest speed that stops
+            // within d is d / ((n + 1) dt) + n a dt / 2; the continuous estimate picks n.
+            let k = libm::sqrtf(0.25 + 2.0 * d / (adt * dt)) - 0.5;
+            let n = libm::floorf(k.max(0.0));
+            (d / ((n + 1.0) * dt) + n * adt * 0.5).min((n + 1.0) * adt)
         } else {
             0.0
         };

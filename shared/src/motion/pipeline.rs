@@ -15,7 +15,7 @@
 //!   only when [`Pipeline::start`] is called again (an explicit command).
 
 use crate::kinematics::{Actuators, AxisKind, Check, KinematicsError, Mechanism, MultiTurn, Pose};
-use crate::real::wrap_pi;
+use crate::real::{wrap_once, wrap_pi};
 
 use super::limits::{AxisTracker, MotionLimits};
 use super::steps::StepConverter;
@@ -412,7 +412,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         Pose::from_array(core::array::from_fn(|i| {
             let v = a[i] + delta(i, b[i], a[i]) * f;
             if i == 5 {
-                wrap_pi(v)
+                wrap_once(v)
             } else {
                 v
             }
@@ -440,10 +440,23 @@ impl<M: Mechanism<f32>> Pipeline<M> {
                     self.segment_done += 1;
                 }
                 let r = self.reference().to_array();
+                let end = self.to.to_array();
                 let p = self.pose.to_array();
                 for i in 0..6 {
+                    let error = delta(i, r[i], p[i]);
+                    // Brake for where the reference stops (the setpoint), not for where it is now: a reference
+                    // that stops at the end of its segment is then never passed.
+                    let to_end = delta(i, end[i], p[i]);
+                    // Ahead of the moving reference but short of the setpoint (braking is limited): wait for the
+                    // reference rather than back up, so a monotone stream gives a monotone motion.
+                    let (error, stop_distance) = if to_end * error >= 0.0 {
+                        (error, to_end)
+                    } else {
+                        (0.0, to_end)
+                    };
                     let v = self.trackers[i].step(
-                        delta(i, r[i], p[i]),
+                        error,
+                        stop_distance,
                         dt,
                         limits.pose_velocity[i],
                         limits.pose_acceleration[i],
@@ -481,7 +494,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         let candidate = |s: f32| {
             Pose::from_array(core::array::from_fn(|i| {
                 if i == 5 {
-                    wrap_pi(p[i] + step[i] * s)
+                    wrap_once(p[i] + step[i] * s)
                 } else {
                     p[i] + step[i] * s
                 }

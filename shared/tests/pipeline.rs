@@ -1,0 +1,277 @@
+//! The motion pipeline: interpolation without overshoot, limits held on every tick, stream loss braking without a
+//! jump, rejected setpoints that never move anything.
+
+// Index loops over parallel per-axis arrays read more plainly than zips here.
+#![allow(clippy::needless_range_loop)]
+
+use proptest::prelude::*;
+use ringpod_core::kinematics::{presets, AxisKind, Mechanism, Pose, RingPlatform};
+use ringpod_core::motion::{
+    AxisScale, MotionLimits, Pipeline, PipelineConfig, PipelineEvent, RejectReason, Setpoint, StepConverter,
+};
+
+const HOME: [f32; 6] = [0.0, 0.0, presets::TRAINER_MODEL_HOME_Z as f32, 0.0, 0.0, 0.0];
+
+fn pipeline() -> Pipeline<RingPlatform<f32>> {
+    let m = RingPlatform::<f32>::new(&presets::TRAINER_MODEL);
+    let c = AxisScale::MODEL_CARRIAGE;
+    let l = AxisScale::MODEL_LINEAR;
+    let converter = StepConverter::new([c, c, c, c, l, l], m.axes());
+    let mut p = Pipeline::new(m, PipelineConfig::default(), converter, Pose::from_array(HOME)).unwrap();
+    p.start();
+    p
+}
+
+fn pose_with(axis: usize, v: f32) -> Pose<f32> {
+    let mut a = HOME;
+    a[axis] += v;
+    Pose::from_array(a)
+}
+
+/// Per-tick history: checks the pose velocity and acceleration limits and the actuator speed limits on every tick.
+struct Trace {
+    last: Option<[f32; 6]>,
+    velocity: [f32; 6],
+    actuators: Option<[f64; 6]>,
+}
+
+impl Trace {
+    fn new() -> Self {
+        Self {
+            last: None,
+            velocity: [0.0; 6],
+            actuators: None,
+        }
+    }
+
+    fn record(&mut self, p: &Pipeline<RingPlatform<f32>>, limits: &MotionLimits, dt: f32) -> Result<(), TestCaseError> {
+        let q: [f64; 6] = std::array::from_fn(|i| p.actuators().total(i));
+        if let Some(last) = self.actuators {
+            for i in 0..6 {
+                let v = ((q[i] - last[i]) / f64::from(dt)) as f32;
+                prop_assert!(
+                    v.abs() <= limits.actuator_velocity[i] * 1.001 + 1e-4,
+                    "actuator {i}: {v}"
+                );
+            }
+        }
+        self.actuators = Some(q);
+        let pose = p.pose();
+        let now = pose.to_array();
+        if let Some(last) = self.last {
+            for i in 0..6 {
+                let mut d = now[i] - last[i];
+                // Unwrap only across the +-pi seam: rem_euclid around pi would cost the digits being measured.
+                if i == 5 && d > std::f32::consts::PI {
+                    d -= std::f32::consts::TAU;
+                } else if i == 5 && d < -std::f32::consts::PI {
+                    d += std::f32::consts::TAU;
+                }
+                let v = d / dt;
+                // Positions are f32: allow a few ulps of the values differentiated (yaw near 2 pi: 5e-7 rad).
+                let slack_v = 4.0 * now[i].abs().max(last[i].abs()).max(1e-3) * f32::EPSILON / dt;
+                prop_assert!(
+                    v.abs() <= limits.pose_velocity[i] * (1.0 + 1e-4) + slack_v,
+                    "axis {i}: {v} > {}",
+                    limits.pose_velocity[i]
+                );
+                let a = (v - self.velocity[i]) / dt;
+                prop_assert!(
+                    a.abs() <= limits.pose_acceleration[i] * (1.0 + 1e-3) + slack_v / dt,
+                    "axis {i}: accel {a}"
+                );
+                self.velocity[i] = v;
+            }
+        }
+        self.last = Some(now);
+        Ok(())
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    /// A monotone 60 Hz stream on one axis: the commanded position is monotone and never passes the last setpoint.
+    #[test]
+    fn interpolation_never_overshoots(axis in 0usize..5, steps in prop::collection::vec(0.0f32..1.0, 5..40), sign in prop::bool::ANY) {
+        let mut p = pipeline();
+        let limits = p.config().limits;
+        let dt = 1e-3;
+        let per_setpoint_max = limits.pose_velocity[axis] * (1.0 / 60.0);
+        let s = if sign { 1.0 } else { -1.0 };
+        let mut target = 0.0f32;
+        let mut trace = Trace::new();
+        trace.record(&p, &limits, dt)?;
+        let mut last_pos = 0.0f32;
+        let mut t_us = 0u64;
+        let mut accepted = 0;
+        for (k, frac) in steps.iter().enumerate() {
+            // Stay inside the spec range of the axis.
+            let next = (target + s * frac * per_setpoint_max).clamp(-presets::TRAINER_MODEL_RANGES[axis] as f32 * 0.9, presets::TRAINER_MODEL_RANGES[axis] as f32 * 0.9);
+            t_us += 16_667;
+            if p.submit(&Setpoint { seq: k as u32 + 1, time_us: t_us, pose: pose_with(axis, next) }).is_ok() {
+                target = next;
+                accepted += 1;
+            }
+            for _ in 0..17 {
+                let (_, event) = p.tick();
+                prop_assert!(event.is_none(), "{event:?}");
+                trace.record(&p, &limits, dt)?;
+                let pos = p.pose().to_array()[axis] - HOME[axis];
+                prop_assert!((pos - last_pos) * s >= -1e-6, "not monotone: {last_pos} -> {pos}");
+                prop_assert!((pos - target) * s <= 1e-6, "overshoot: {pos} beyond {target}");
+                last_pos = pos;
+            }
+        }
+        prop_assert!(accepted > 0);
+    }
+
+    /// Pull the stream in the middle of a fast motion: braking within the acceleration limits, then at rest.
+    #[test]
+    fn stream_loss_ramps_to_rest(axis in 0usize..6, cut_ms in 100u32..900) {
+        let mut p = pipeline();
+        let limits = p.config().limits;
+        let mut trace = Trace::new();
+        trace.record(&p, &limits, 1e-3)?;
+        let rate = limits.pose_velocity[axis] * 0.9;
+        let mut events = Vec::new();
+        for ms in 1..=3000u32 {
+            if ms <= cut_ms && ms % 10 == 0 {
+                let v = rate * ms as f32 * 1e-3;
+                let v = if axis == 5 { v.rem_euclid(std::f32::consts::TAU) } else { v.min(presets::TRAINER_MODEL_RANGES[axis.min(4)] as f32 * 0.8) };
+                p.submit(&Setpoint { seq: ms, time_us: u64::from(ms) * 1000, pose: pose_with(axis, v) }).unwrap();
+            }
+            let (_, e) = p.tick();
+            trace.record(&p, &limits, 1e-3)?;
+            if let Some(e) = e {
+                events.push((ms, e));
+            }
+        }
+        prop_assert_eq!(events.len(), 2, "{:?}", events);
+        prop_assert_eq!(events[0].1, PipelineEvent::StreamLost);
+        // The stream timeout is 100 ms after the last setpoint (sent every 10 ms).
+        let last = cut_ms - cut_ms % 10;
+        prop_assert!(events[0].0 >= last + 100 && events[0].0 <= last + 101, "{:?}", events);
+        prop_assert_eq!(events[1].1, PipelineEvent::AtRest);
+        prop_assert!(p.at_rest());
+        // After a loss the stream stays closed until started again.
+        let next = Setpoint { seq: 5000, time_us: 5_000_000, pose: p.pose() };
+        prop_assert_eq!(p.submit(&next), Err(RejectReason::NotStreaming));
+        p.start();
+        prop_assert_eq!(p.submit(&next), Ok(()));
+    }
+
+    /// The yaw spins at 1.9 rad/s for many turns: carriages follow, steps stay exact.
+    #[test]
+    fn continuous_yaw_stream(turns in 1u32..4) {
+        let mut p = pipeline();
+        let limits = p.config().limits;
+        let mut trace = Trace::new();
+        trace.record(&p, &limits, 1e-3)?;
+        let rate = 1.8f64;
+        let total_ms = (f64::from(turns) * std::f64::consts::TAU / rate * 1000.0) as u32;
+        for ms in 1..=total_ms {
+            if ms % 10 == 0 {
+                let yaw = (rate * f64::from(ms) * 1e-3).rem_euclid(std::f64::consts::TAU) as f32;
+                p.submit(&Setpoint { seq: ms, time_us: u64::from(ms) * 1000, pose: pose_with(5, yaw) }).unwrap();
+            }
+            p.tick();
+            trace.record(&p, &limits, 1e-3)?;
+        }
+        prop_assert_eq!(p.rejected().total(), 0);
+        prop_assert!(p.actuators().turns[..4].iter().all(|t| t.unsigned_abs() >= turns - 1), "{:?}", p.actuators().turns);
+    }
+}
+
+#[test]
+fn rejected_setpoints_never_move() {
+    let mut p = pipeline();
+    let start = p.steps();
+    let bad = [
+        (Pose::new(f32::NAN, 0.0, 0.227, 0.0, 0.0, 0.0), RejectReason::NonFinite),
+        (Pose::new(0.0, 0.0, 0.5, 0.0, 0.0, 0.0), RejectReason::TooFast),
+        (Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0), RejectReason::Stale),
+    ];
+    for (k, (pose, reason)) in bad.iter().enumerate() {
+        // The first two carry new sequence numbers; the last repeats the sequence number of the accepted one.
+        let seq = if *reason == RejectReason::Stale {
+            10
+        } else {
+            k as u32 + 1
+        };
+        if *reason == RejectReason::Stale {
+            p.submit(&Setpoint {
+                seq: 10,
+                time_us: 10_000,
+                pose: Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0),
+            })
+            .unwrap();
+        }
+        assert_eq!(
+            p.submit(&Setpoint {
+                seq,
+                time_us: 20_000 + k as u64,
+                pose: *pose
+            }),
+            Err(*reason)
+        );
+    }
+    for _ in 0..100 {
+        p.tick();
+    }
+    assert_eq!(p.steps(), start, "only the accepted home setpoint applied: no motion");
+    assert_eq!(p.rejected().total(), 3);
+    // Outside the workspace but reachable within the jump limit: a check fails.
+    let mut far = pipeline();
+    let mut z = HOME[2];
+    let mut last = Ok(());
+    for k in 1..200u32 {
+        z -= 0.0008;
+        last = far.submit(&Setpoint {
+            seq: k,
+            time_us: u64::from(k) * 20_000,
+            pose: pose_with(2, z - HOME[2]),
+        });
+        if last.is_err() {
+            break;
+        }
+        for _ in 0..20 {
+            far.tick();
+        }
+    }
+    assert!(
+        matches!(last, Err(RejectReason::Workspace(_)) | Err(RejectReason::Unreachable)),
+        "{last:?}"
+    );
+    assert!(
+        far.mechanism().inverse_checked(&far.pose()).unwrap().1.all_pass(),
+        "the platform held inside"
+    );
+}
+
+#[test]
+fn steps_follow_the_actuators() {
+    let mut p = pipeline();
+    for k in 1..=50u32 {
+        p.submit(&Setpoint {
+            seq: k,
+            time_us: u64::from(k) * 10_000,
+            pose: pose_with(2, k as f32 * 4e-4),
+        })
+        .unwrap();
+        for _ in 0..10 {
+            p.tick();
+        }
+    }
+    let q = p.actuators();
+    let s = p.steps();
+    for i in 0..6 {
+        let per = if p.mechanism().axes()[i] == AxisKind::Ring {
+            25_600.0 / std::f64::consts::TAU
+        } else {
+            1.6e6
+        };
+        let want = (q.total(i) * per).round() as i64;
+        assert!((s[i] - want).abs() <= 1, "axis {i}: {} vs {want}", s[i]);
+    }
+}
