@@ -1,6 +1,9 @@
 //! Homing: the plan refuses orders that could bring carriages too close, and the sequence finds switches, backs
 //! off them, and fails on a missing or stuck switch.
 
+// Index loops over parallel per-axis arrays read more plainly than zips here.
+#![allow(clippy::needless_range_loop)]
+
 use ringpod_core::controller::ControllerConfig;
 use ringpod_core::kinematics::geometry::DEG;
 use ringpod_core::safety::homing::{AxisHoming, HomingConfig, HomingError, HomingPlan, RingHoming};
