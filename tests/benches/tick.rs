@@ -56,20 +56,24 @@ fn pose_at(k: u64) -> Pose<f32> {
     )
 }
 
+/// Setpoint `k` of the 1 kHz stream.
+fn setpoint(k: u64) -> HostMessage {
+    HostMessage::Setpoint(Setpoint {
+        seq: k as u32,
+        time_us: k * 1000,
+        pose: pose_at(k),
+    })
+}
+
 fn tick(c: &mut Criterion) {
     let mut rig = running_rig();
     let mut k = 0u64;
     c.bench_function("control tick (setpoint + pipeline + scheduler + supervisor)", |b| {
         b.iter(|| {
             k += 1;
-            let sp = Setpoint {
-                seq: k as u32,
-                time_us: k * 1000,
-                pose: pose_at(k),
-            };
             black_box(rig.controller.handle(&Request {
                 id: k as u32,
-                body: HostMessage::Setpoint(sp),
+                body: setpoint(k),
             }));
             black_box(rig.controller.tick())
         })
@@ -84,15 +88,10 @@ fn tick(c: &mut Criterion) {
     c.bench_function("decode + dispatch of one setpoint frame", |b| {
         b.iter(|| {
             k += 1;
-            let sp = Setpoint {
-                seq: k as u32,
-                time_us: k * 1000,
-                pose: pose_at(k),
-            };
             let n = protocol::encode(
                 &Request {
                     id: 7,
-                    body: HostMessage::Setpoint(sp),
+                    body: setpoint(k),
                 },
                 &mut frame,
             )
