@@ -25,6 +25,80 @@ pub enum Command {
     Check(PoseArgs),
     /// Forward kinematics: the pose for six actuator values, by Newton iteration from a guess.
     Fk(FkArgs),
+    /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
+    /// powers up and homes if needed, streams, then stops and waits for rest.
+    Stream(StreamArgs),
+    /// One command to the controller (--port, or a fresh simulated controller with --sim).
+    Device(DeviceArgs),
+}
+
+/// Device commands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DeviceAction {
+    /// Print the status as JSON.
+    Status,
+    /// Power up (logic, then power).
+    Enable,
+    /// Shut down (drivers, power, logic).
+    Disable,
+    /// Home all axes (waits until done).
+    Home,
+    /// Start taking setpoints.
+    Start,
+    /// Ramp to rest.
+    Stop,
+    /// Clear a latched fault.
+    Clear,
+}
+
+#[derive(Debug, Args)]
+pub struct DeviceArgs {
+    /// What to do.
+    #[arg(value_enum)]
+    pub action: DeviceAction,
+    /// Serial port of the board (USB CDC).
+    #[arg(long, conflicts_with = "sim")]
+    pub port: Option<String>,
+    /// A fresh in-process simulated controller.
+    #[arg(long)]
+    pub sim: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct StreamArgs {
+    /// Serial port of the board (USB CDC).
+    #[arg(long, conflicts_with = "sim")]
+    pub port: Option<String>,
+    /// The in-process simulated controller (same core as the firmware, real framed bytes).
+    #[arg(long)]
+    pub sim: bool,
+    /// With --sim: run as fast as possible instead of in real time.
+    #[arg(long, requires = "sim")]
+    pub fast: bool,
+    /// Built-in motion.
+    #[arg(long, value_enum, conflicts_with = "input")]
+    pub motion: Option<crate::stream::Motion>,
+    /// Length of a built-in motion (s).
+    #[arg(long, default_value_t = 20.0)]
+    pub duration: f64,
+    /// CSV file with header t,x,y,z,alpha,beta,gamma (s, m, rad unless --degrees).
+    #[arg(long)]
+    pub input: Option<std::path::PathBuf>,
+    /// Angles of --input in degrees.
+    #[arg(long)]
+    pub degrees: bool,
+    /// Setpoints per second for built-in motions.
+    #[arg(long, default_value_t = 1000.0)]
+    pub rate: f64,
+    /// Home even if the device is homed.
+    #[arg(long)]
+    pub home: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print one JSON report at the end.
+    #[arg(long)]
+    pub report_json: bool,
 }
 
 #[derive(Debug, Args)]

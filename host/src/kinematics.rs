@@ -31,6 +31,11 @@ pub fn run(cli: &Cli) -> Result<Outcome, CliError> {
         Command::Ik(args) => ik(args, false),
         Command::Check(args) => ik(args, true),
         Command::Fk(args) => fk(args),
+        // Streaming and device commands talk to a device: main runs them with their own error handling.
+        Command::Stream(_) | Command::Device(_) => Ok(Outcome {
+            text: String::new(),
+            code: crate::error::EXIT_ERROR,
+        }),
     }
 }
 

@@ -1,10 +1,13 @@
 //! `ringpod`: the command line of the ringpod motion controller.
 
 mod cli;
+mod client;
 mod error;
 mod kinematics;
 mod mechanism;
 mod numbers;
+mod stream;
+mod transport;
 
 use std::process::ExitCode;
 
@@ -12,6 +15,20 @@ use clap::Parser;
 
 fn main() -> ExitCode {
     let cli = cli::Cli::parse();
+    let device_run = match &cli.command {
+        cli::Command::Stream(args) => Some(stream_command(args)),
+        cli::Command::Device(args) => Some(device_command(args)),
+        _ => None,
+    };
+    if let Some(result) = device_run {
+        return match result {
+            Ok(code) => ExitCode::from(code),
+            Err(e) => {
+                eprintln!("ringpod: {e:#}");
+                ExitCode::from(error::EXIT_ERROR)
+            }
+        };
+    }
     match kinematics::run(&cli) {
         Ok(outcome) => {
             print!("{}", outcome.text);
@@ -22,4 +39,91 @@ fn main() -> ExitCode {
             ExitCode::from(error::EXIT_ERROR)
         }
     }
+}
+
+/// `ringpod stream`: exit 0 when the run ended at rest without a fault, 1 otherwise.
+fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+
+    let interrupted = Arc::new(AtomicBool::new(false));
+    let flag = interrupted.clone();
+    ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))?;
+    let (source, input_errors) = match (&args.input, args.motion) {
+        (Some(path), _) => {
+            let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let (poses, errors) = stream::read_csv(&text, args.degrees);
+            for e in &errors {
+                eprintln!("{}: line {}: {}", path.display(), e.line, e.reason);
+            }
+            (stream::Source::Poses(poses), errors)
+        }
+        (None, motion) => (
+            stream::Source::Motion {
+                motion: motion.unwrap_or(stream::Motion::Demo),
+                seconds: args.duration,
+            },
+            Vec::new(),
+        ),
+    };
+    let mut client = client::Client::new(connect(args.port.as_deref(), args.sim, !args.fast)?);
+    // The bar draws on stderr (and hides itself without a terminal), the report on stdout.
+    let options = stream::Options {
+        rate_hz: args.rate,
+        home: args.home,
+        quiet: args.quiet,
+    };
+    let report = stream::run(&mut client, source, input_errors, &options, &|| {
+        interrupted.load(Ordering::SeqCst)
+    })?;
+    if args.report_json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        let rejected: u32 = report.rejected.values().sum();
+        println!(
+            "{} setpoints sent, {} applied, {} rejected; final state {}; steps {:?}",
+            report.setpoints_sent, report.setpoints_applied, rejected, report.state, report.final_steps
+        );
+        for (reason, n) in &report.rejected {
+            println!("  rejected {reason}: {n}");
+        }
+    }
+    Ok(if report.faults.is_empty() && report.state == "Ready" {
+        0
+    } else {
+        1
+    })
+}
+
+/// The transport named on the command line.
+fn connect(port: Option<&str>, sim: bool, realtime: bool) -> anyhow::Result<transport::AnyTransport> {
+    Ok(match (port, sim) {
+        (Some(port), _) => transport::AnyTransport::Serial(transport::Serial::open(port)?),
+        (None, true) => transport::AnyTransport::Sim(Box::new(transport::SimDevice::new(realtime))),
+        (None, false) => anyhow::bail!("say where the controller is: --port PATH or --sim"),
+    })
+}
+
+/// `ringpod device ACTION`.
+fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
+    use cli::DeviceAction as A;
+    let mut client = client::Client::new(connect(args.port.as_deref(), args.sim, false)?);
+    client.hello()?;
+    match args.action {
+        A::Status => {}
+        A::Enable => client.enable()?,
+        A::Disable => client.disable()?,
+        A::Home => {
+            client.home()?;
+            client.wait_for(std::time::Duration::from_secs(120), |s| {
+                !matches!(s.state, ringpod_core::safety::State::Homing)
+            })?;
+        }
+        A::Start => client.start()?,
+        A::Stop => client.stop()?,
+        A::Clear => client.clear()?,
+    }
+    let status = client.status()?;
+    println!("{}", serde_json::to_string_pretty(&status)?);
+    Ok(0)
 }

@@ -62,12 +62,13 @@ impl ControllerConfig {
         };
         let linear = crate::safety::homing::AxisHoming {
             toward: -1,
-            search_steps: 64_000, // 40 mm at 1.6 M steps/m
+            search_steps: 64_000, // 40 mm at 1.6 M steps/m: the platform parks within 40 mm of the switches
             backoff_steps: 3_200, // 2 mm
             fast_rate: 32_000,
             slow_rate: 4_000,
-            // The lower end switch is 10 mm below the home-pose length of 231.3 mm: the platform parks low.
-            home_position: -16_000,
+            // The lower end switch is at 165 mm, below the 173 mm the spec ranges use and above the 160 mm stroke
+            // minimum: 231.31 - 165 = 66.31 mm = 106,096 steps below the home-pose length. The platform parks low.
+            home_position: -106_096,
         };
         Self {
             preset: Preset::TrainerModel,

@@ -24,5 +24,6 @@ pub mod motion;
 pub mod protocol;
 mod real;
 pub mod safety;
+pub mod sim;
 
 pub use real::Real;

@@ -1,5 +1,7 @@
 //! End-to-end testing of ringpod without hardware: the controller core with a simulated plant ([`plant`]) and
 //! data-driven scenarios ([`scenario`], files under `tests/scenarios/`).
 
-pub mod plant;
 pub mod scenario;
+
+/// The simulated plant lives in the core, where the host's simulator uses it too.
+pub use ringpod_core::sim as plant;

@@ -1,7 +1,8 @@
 //! A simulated machine: six axes that count the controller's steps, switches that trip at their positions, and
-//! supplies whose sense lines follow the relays.
+//! supplies whose sense lines follow the relays. The host's simulator and the end-to-end tests drive the controller
+//! with it when no board is attached.
 
-use ringpod_core::controller::{Controller, Inputs, TickOutput};
+use crate::controller::{Controller, Inputs, TickOutput};
 
 /// Where the switches of one axis are (physical steps).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,0 +1,210 @@
+//! A typed client of the controller over any byte transport: a serial port to a board, or the in-process
+//! simulator. Transport errors and device-reported refusals are kept apart in [`ClientError`].
+
+use std::collections::VecDeque;
+use std::time::Duration;
+
+use ringpod_core::kinematics::presets::Preset;
+use ringpod_core::motion::{RejectReason, Setpoint};
+use ringpod_core::protocol::{
+    self, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
+};
+use ringpod_core::safety::FaultReason;
+
+/// A byte pipe to a controller, with its notion of time.
+pub trait Transport {
+    /// Writes bytes.
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()>;
+    /// Reads what has arrived (0 when nothing has).
+    fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize>;
+    /// Lets `dt` pass: a real device runs on its own clock (sleep); the simulator ticks through it.
+    fn elapse(&mut self, dt: Duration);
+}
+
+/// Why a request did not produce its answer.
+#[derive(Debug, thiserror::Error)]
+pub enum ClientError {
+    /// The transport failed.
+    #[error("transport: {0}")]
+    Io(#[from] std::io::Error),
+    /// No answer in time.
+    #[error("no answer from the device within {0:?}")]
+    Timeout(Duration),
+    /// The device refused the request.
+    #[error("device refused: {0:?}")]
+    Device(NackReason),
+    /// Host and device speak different protocol versions.
+    #[error("protocol version mismatch: host {host}, device {device}")]
+    VersionMismatch {
+        /// Ours.
+        host: u16,
+        /// Theirs.
+        device: u16,
+    },
+    /// An answer of the wrong kind.
+    #[error("unexpected answer: {0}")]
+    Unexpected(String),
+}
+
+/// The client.
+pub struct Client<T: Transport> {
+    transport: T,
+    reader: FrameReader,
+    next_id: u32,
+    inbox: VecDeque<Response>,
+    /// Faults the device reported on its own.
+    pub faults: Vec<FaultReason>,
+    /// How long to wait for an answer.
+    pub timeout: Duration,
+}
+
+impl<T: Transport> Client<T> {
+    /// A client over a transport.
+    pub fn new(transport: T) -> Self {
+        Self {
+            transport,
+            reader: FrameReader::default(),
+            next_id: 0,
+            inbox: VecDeque::new(),
+            faults: Vec::new(),
+            timeout: Duration::from_secs(2),
+        }
+    }
+
+    /// The transport (to let time pass).
+    pub fn transport(&mut self) -> &mut T {
+        &mut self.transport
+    }
+
+    fn pump(&mut self) -> Result<(), ClientError> {
+        let mut buf = [0u8; 512];
+        loop {
+            let n = self.transport.receive(&mut buf)?;
+            if n == 0 {
+                return Ok(());
+            }
+            for &b in &buf[..n] {
+                if let Some(frame) = self.reader.push(b) {
+                    // A frame that does not decode is dropped: the request it answered times out and says so.
+                    if let Ok(response) = protocol::decode::<Response>(frame) {
+                        if let (0, DeviceMessage::Fault(reason)) = (response.id, response.body) {
+                            self.faults.push(reason);
+                        } else {
+                            self.inbox.push_back(response);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sends one request and waits for its response.
+    pub fn request(&mut self, body: HostMessage) -> Result<DeviceMessage, ClientError> {
+        self.next_id = self.next_id.wrapping_add(1).max(1);
+        let id = self.next_id;
+        let mut frame = [0u8; protocol::MAX_FRAME];
+        let n = protocol::encode(&Request { id, body }, &mut frame)
+            .map_err(|e| ClientError::Unexpected(format!("request does not encode: {e}")))?;
+        self.transport.send(&frame[..n])?;
+        let step = Duration::from_micros(200);
+        let mut waited = Duration::ZERO;
+        loop {
+            self.pump()?;
+            while let Some(r) = self.inbox.pop_front() {
+                if r.id == id {
+                    return Ok(r.body);
+                }
+            }
+            if waited >= self.timeout {
+                return Err(ClientError::Timeout(self.timeout));
+            }
+            self.transport.elapse(step);
+            waited += step;
+        }
+    }
+
+    fn ack(&mut self, body: HostMessage) -> Result<(), ClientError> {
+        match self.request(body)? {
+            DeviceMessage::Ack => Ok(()),
+            DeviceMessage::Nack(reason) => Err(ClientError::Device(reason)),
+            other => Err(ClientError::Unexpected(format!("{other:?}"))),
+        }
+    }
+
+    /// Version handshake; returns the geometry the device drives.
+    pub fn hello(&mut self) -> Result<Preset, ClientError> {
+        match self.request(HostMessage::Hello {
+            version: PROTOCOL_VERSION,
+        })? {
+            DeviceMessage::Hello { version, preset } if version == PROTOCOL_VERSION => Ok(preset),
+            DeviceMessage::Hello { version, .. }
+            | DeviceMessage::Nack(NackReason::VersionMismatch { device: version }) => {
+                Err(ClientError::VersionMismatch {
+                    host: PROTOCOL_VERSION,
+                    device: version,
+                })
+            }
+            other => Err(ClientError::Unexpected(format!("{other:?}"))),
+        }
+    }
+
+    /// Power up (logic, then power).
+    pub fn enable(&mut self) -> Result<(), ClientError> {
+        self.ack(HostMessage::Enable)
+    }
+    /// Shut down.
+    pub fn disable(&mut self) -> Result<(), ClientError> {
+        self.ack(HostMessage::Disable)
+    }
+    /// Home all axes.
+    pub fn home(&mut self) -> Result<(), ClientError> {
+        self.ack(HostMessage::Home)
+    }
+    /// Start taking setpoints.
+    pub fn start(&mut self) -> Result<(), ClientError> {
+        self.ack(HostMessage::Start)
+    }
+    /// Ramp to rest.
+    pub fn stop(&mut self) -> Result<(), ClientError> {
+        self.ack(HostMessage::Stop)
+    }
+    /// Clear a latched fault.
+    pub fn clear(&mut self) -> Result<(), ClientError> {
+        self.ack(HostMessage::ClearFault)
+    }
+
+    /// The device's status.
+    pub fn status(&mut self) -> Result<Status, ClientError> {
+        match self.request(HostMessage::GetStatus)? {
+            DeviceMessage::Status(s) => Ok(s),
+            other => Err(ClientError::Unexpected(format!("{other:?}"))),
+        }
+    }
+
+    /// Sends a setpoint: `Ok(Err(reason))` when the device rejected it.
+    pub fn setpoint(&mut self, sp: Setpoint) -> Result<Result<(), RejectReason>, ClientError> {
+        match self.request(HostMessage::Setpoint(sp))? {
+            DeviceMessage::Ack => Ok(Ok(())),
+            DeviceMessage::Nack(NackReason::Rejected(r)) => Ok(Err(r)),
+            DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
+            other => Err(ClientError::Unexpected(format!("{other:?}"))),
+        }
+    }
+
+    /// Polls the status every 10 ms until `done` says so, or `limit` passes.
+    pub fn wait_for(&mut self, limit: Duration, done: impl Fn(&Status) -> bool) -> Result<Status, ClientError> {
+        let step = Duration::from_millis(10);
+        let mut waited = Duration::ZERO;
+        loop {
+            let s = self.status()?;
+            if done(&s) {
+                return Ok(s);
+            }
+            if waited >= limit {
+                return Err(ClientError::Timeout(limit));
+            }
+            self.transport.elapse(step);
+            waited += step;
+        }
+    }
+}

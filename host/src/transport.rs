@@ -1,0 +1,159 @@
+//! Transports: a serial port to a board, and the in-process simulated controller.
+
+use std::collections::VecDeque;
+use std::io::{Read, Write};
+use std::time::{Duration, Instant};
+
+use ringpod_core::controller::{Controller, ControllerConfig};
+use ringpod_core::protocol::{self, FrameReader};
+use ringpod_core::sim::{Plant, Rig};
+
+use crate::client::Transport;
+
+/// USB CDC serial to a board.
+pub struct Serial {
+    port: Box<dyn serialport::SerialPort>,
+}
+
+impl Serial {
+    /// Opens a port (the baud rate is ignored by USB CDC but required by the API).
+    pub fn open(path: &str) -> Result<Self, serialport::Error> {
+        let port = serialport::new(path, 115_200)
+            .timeout(Duration::from_millis(1))
+            .open()?;
+        Ok(Self { port })
+    }
+}
+
+impl Transport for Serial {
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.port.write_all(bytes)
+    }
+    fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self.port.read(buf) {
+            Ok(n) => Ok(n),
+            Err(e) if e.kind() == std::io::ErrorKind::TimedOut => Ok(0),
+            Err(e) => Err(e),
+        }
+    }
+    fn elapse(&mut self, dt: Duration) {
+        std::thread::sleep(dt);
+    }
+}
+
+/// The simulated controller: the same controller core as the firmware (dispatch, supervisor, pipeline, step
+/// scheduler) with a simulated plant, behind the real framed bytes. Time passes only through [`Transport::elapse`]:
+/// in real time (sleeping to keep pace with the wall clock) or as fast as the machine can compute.
+pub struct SimDevice {
+    rig: Rig,
+    reader: FrameReader,
+    outbox: VecDeque<u8>,
+    tick_us: u64,
+    owed_us: u64,
+    realtime: bool,
+    started: Instant,
+    simulated_us: u64,
+}
+
+impl SimDevice {
+    /// A simulated trainer model, parked near home, powered off.
+    pub fn new(realtime: bool) -> Self {
+        let config = ControllerConfig::trainer_model();
+        let tick_us = u64::from(config.pipeline.tick_us);
+        let controller = Controller::new(config).expect("the built-in model configuration is valid");
+        let rig = Rig {
+            controller,
+            plant: Plant::trainer_model([-500, -400, -300, -200, 8_000, 9_000]),
+            ticks: 0,
+        };
+        Self {
+            rig,
+            reader: FrameReader::default(),
+            outbox: VecDeque::new(),
+            tick_us,
+            owed_us: 0,
+            realtime,
+            started: Instant::now(),
+            simulated_us: 0,
+        }
+    }
+
+    fn flush_unsolicited(&mut self) {
+        let mut out = [0u8; protocol::MAX_FRAME];
+        while let Some(msg) = self.rig.controller.unsolicited() {
+            if let Ok(n) = protocol::encode(&msg, &mut out) {
+                self.outbox.extend(&out[..n]);
+            }
+        }
+    }
+}
+
+impl Transport for SimDevice {
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        let mut out = [0u8; protocol::MAX_FRAME];
+        for &b in bytes {
+            if let Some(frame) = self.reader.push(b) {
+                let frame = frame.to_vec();
+                let n = self.rig.controller.handle_frame(&frame, &mut out);
+                self.outbox.extend(&out[..n]);
+            }
+        }
+        Ok(())
+    }
+
+    fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = buf.len().min(self.outbox.len());
+        for (slot, b) in buf.iter_mut().zip(self.outbox.drain(..n)) {
+            *slot = b;
+        }
+        Ok(n)
+    }
+
+    fn elapse(&mut self, dt: Duration) {
+        self.owed_us += dt.as_micros() as u64;
+        while self.owed_us >= self.tick_us {
+            self.owed_us -= self.tick_us;
+            let started = Instant::now();
+            self.rig.tick();
+            let cost = started.elapsed().as_nanos().min(u128::from(u32::MAX)) as u32;
+            self.rig.controller.set_platform_stats(cost, 0);
+            self.simulated_us += self.tick_us;
+        }
+        self.flush_unsolicited();
+        if self.realtime {
+            let due = self.started + Duration::from_micros(self.simulated_us);
+            if let Some(wait) = due.checked_duration_since(Instant::now()) {
+                std::thread::sleep(wait);
+            }
+        }
+    }
+}
+
+/// Either transport, chosen on the command line.
+pub enum AnyTransport {
+    /// A board.
+    Serial(Serial),
+    /// The simulator.
+    Sim(Box<SimDevice>),
+}
+
+impl Transport for AnyTransport {
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        match self {
+            Self::Serial(t) => t.send(bytes),
+            Self::Sim(t) => t.send(bytes),
+        }
+    }
+    fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self {
+            Self::Serial(t) => t.receive(buf),
+            Self::Sim(t) => t.receive(buf),
+        }
+    }
+    fn elapse(&mut self, dt: Duration) {
+        match self {
+            Self::Serial(t) => t.elapse(dt),
+            Self::Sim(t) => t.elapse(dt),
+        }
+    }
+}
