@@ -30,6 +30,20 @@ pub enum Command {
     Stream(StreamArgs),
     /// One command to the controller (--port, or a fresh simulated controller with --sim).
     Device(DeviceArgs),
+    /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
+    Loads(LoadsArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct LoadsArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// Payload mass (kg), at the geometry's centre of mass.
+    #[arg(long)]
+    pub mass: f64,
 }
 
 /// Device commands.

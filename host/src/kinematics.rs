@@ -8,7 +8,7 @@ use ringpod_core::kinematics::{
 };
 use serde::Serialize;
 
-use crate::cli::{Cli, Command, Common, FkArgs, PoseArgs};
+use crate::cli::{Cli, Command, Common, FkArgs, LoadsArgs, PoseArgs};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::mechanism::AnyMechanism;
 use crate::numbers;
@@ -31,6 +31,7 @@ pub fn run(cli: &Cli) -> Result<Outcome, CliError> {
         Command::Ik(args) => ik(args, false),
         Command::Check(args) => ik(args, true),
         Command::Fk(args) => fk(args),
+        Command::Loads(args) => loads(args),
         // Streaming and device commands talk to a device: main runs them with their own error handling.
         Command::Stream(_) | Command::Device(_) => Ok(Outcome {
             text: String::new(),
@@ -333,6 +334,61 @@ fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
             units.angle_unit(),
         ])) {
             let _ = writeln!(t, "  {name:<6} {v:>14.9} {unit}");
+        }
+        t
+    };
+    Ok(Outcome::ok(text))
+}
+
+#[derive(Serialize)]
+struct LoadsJson<'a> {
+    mechanism: &'static str,
+    mass_kg: f64,
+    axes: &'a [String; 6],
+    /// Carriage torque about the ring axis (N m) or linear-actuator force (N, positive = compression).
+    drives: [f64; 6],
+    units: [&'static str; 6],
+    /// Force along each transmitted line (N), wrench-matrix row order.
+    line_forces: [f64; 6],
+}
+
+fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
+    let common = &args.common;
+    let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
+    let AnyMechanism::Ring(ring) = &m else {
+        return Err(CliError::BadNumbers {
+            what: "mechanism",
+            reason: "statics are for ring platforms".into(),
+        });
+    };
+    if !(args.mass.is_finite() && args.mass >= 0.0) {
+        return Err(CliError::BadNumbers {
+            what: "mass",
+            reason: "must be a finite number >= 0".into(),
+        });
+    }
+    let pose = pose_arg(common, preset, args.pose.as_deref(), "pose")?;
+    let q = m.inverse(&pose)?;
+    let wrench = ring.gravity_wrench(&pose, args.mass);
+    let l = ring.loads(&pose, &q, &wrench)?;
+    let axes = m.axes();
+    let names = m.axis_names();
+    let units: [&'static str; 6] = std::array::from_fn(|i| if axes[i] == AxisKind::Linear { "N" } else { "N m" });
+    let text = if common.json {
+        let out = LoadsJson {
+            mechanism: preset.name(),
+            mass_kg: args.mass,
+            axes: &names,
+            drives: l.drives,
+            units,
+            line_forces: l.line_forces,
+        };
+        serde_json::to_string_pretty(&out)? + "\n"
+    } else {
+        let mut t = String::new();
+        let _ = writeln!(t, "{} holding {} kg at its centre of mass:", preset.name(), args.mass);
+        for i in 0..6 {
+            let _ = writeln!(t, "  {:<4} {:>12.4} {}", names[i], l.drives[i], units[i]);
         }
         t
     };

@@ -166,3 +166,25 @@ fn presets_lists_every_geometry() {
         .collect();
     assert_eq!(names, ["trainer-model", "trainer-ch5", "rotopod-ch4", "tool5-ex"]);
 }
+
+#[test]
+fn loads_scale_with_the_mass_and_mirror_at_home() {
+    let one = json(&["loads", "--mass", "1", "--json"]);
+    let two = json(&["loads", "--mass", "2", "--json"]);
+    for i in 0..6 {
+        let (a, b) = (one["drives"][i].as_f64().unwrap(), two["drives"][i].as_f64().unwrap());
+        assert!(
+            (2.0 * a - b).abs() < 1e-9 * b.abs().max(1.0),
+            "statics are linear in the load"
+        );
+    }
+    // The model is symmetric about the YZ plane: mirrored carriages carry opposite torques at home.
+    let d = |i: usize| one["drives"][i].as_f64().unwrap();
+    assert!((d(0) + d(1)).abs() < 1e-9 && (d(2) + d(3)).abs() < 1e-9 && (d(4) - d(5)).abs() < 1e-9);
+    assert_eq!(one["units"][0], "N m");
+    ringpod()
+        .args(["loads", "--mass", "1", "-m", "tool5-ex"])
+        .assert()
+        .code(1);
+    ringpod().args(["loads", "--mass=-1"]).assert().code(1);
+}
