@@ -32,6 +32,13 @@ pub enum Command {
     Device(DeviceArgs),
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
     Loads(LoadsArgs),
+    /// Serves the simulated controller on a pseudo-terminal and prints its path, so that the serial transport
+    /// (and any other program) can talk to it as to a board. Runs until interrupted.
+    Simulate {
+        /// Serve on a pseudo-terminal (the only transport for now).
+        #[arg(long)]
+        pty: bool,
+    },
 }
 
 #[derive(Debug, Args)]

@@ -6,9 +6,11 @@ mod error;
 mod kinematics;
 mod mechanism;
 mod numbers;
+mod pty;
 mod stream;
 mod transport;
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -18,6 +20,7 @@ fn main() -> ExitCode {
     let device_run = match &cli.command {
         cli::Command::Stream(args) => Some(stream_command(args)),
         cli::Command::Device(args) => Some(device_command(args)),
+        cli::Command::Simulate { pty } => Some(simulate_command(*pty)),
         _ => None,
     };
     if let Some(result) = device_run {
@@ -31,7 +34,8 @@ fn main() -> ExitCode {
     }
     match kinematics::run(&cli) {
         Ok(outcome) => {
-            print!("{}", outcome.text);
+            // A closed pipe (`| head`) is not an error of ours.
+            let _ = std::io::Write::write_all(&mut std::io::stdout(), outcome.text.as_bytes());
             ExitCode::from(outcome.code)
         }
         Err(e) => {
@@ -77,7 +81,7 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         interrupted.load(Ordering::SeqCst)
     })?;
     if args.report_json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&report)?);
     } else {
         let rejected: u32 = report.rejected.values().sum();
         println!(
@@ -124,6 +128,15 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
         A::Clear => client.clear()?,
     }
     let status = client.status()?;
-    println!("{}", serde_json::to_string_pretty(&status)?);
+    let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&status)?);
+    Ok(0)
+}
+
+/// `ringpod simulate --pty`.
+fn simulate_command(pty: bool) -> anyhow::Result<u8> {
+    if !pty {
+        anyhow::bail!("say how to serve the simulator: --pty");
+    }
+    pty::serve()?;
     Ok(0)
 }

@@ -144,3 +144,45 @@ fn stream_needs_a_device() {
         .assert()
         .code(1);
 }
+
+/// `ringpod simulate --pty` serves the simulated controller on a pseudo-terminal; `stream --port` reaches it
+/// through the real serial transport, in real time.
+#[test]
+fn stream_through_a_pseudo_terminal() {
+    use std::io::BufRead;
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let mut server = std::process::Command::new(&exe)
+        .args(["simulate", "--pty"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut path = String::new();
+    std::io::BufReader::new(server.stdout.take().unwrap())
+        .read_line(&mut path)
+        .unwrap();
+    let path = path.trim().to_owned();
+    assert!(path.starts_with("/dev/pts/"), "{path}");
+    let csv =
+        "t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n0.05,0.001,0,0.228,0.01,0,0.05\n0.1,0.002,0,0.229,0.02,0,0.1\n";
+    let file = std::env::temp_dir().join(format!("ringpod-pty-{}.csv", std::process::id()));
+    std::fs::write(&file, csv).unwrap();
+    let out = std::process::Command::new(&exe)
+        .args(["stream", "--port", &path, "--report-json", "--quiet", "--input"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let _ = server.kill();
+    let _ = server.wait();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["state"], "Ready");
+    assert_eq!(report["counts_agree"], true);
+    let last: Vec<f64> = numbers(&report["last_applied_pose"]);
+    let want = steps_at(last.try_into().unwrap());
+    for (g, w) in numbers(&report["final_steps"]).iter().zip(want) {
+        assert!(
+            (*g as i64 - w).abs() <= 1,
+            "final steps vs IK of the last pose: {g} {w}"
+        );
+    }
+}

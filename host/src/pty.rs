@@ -1,0 +1,51 @@
+//! The simulated controller on a pseudo-terminal: a program opens the printed path as it would a board's
+//! USB serial port.
+
+use std::io::{Read, Write};
+use std::os::fd::AsRawFd;
+use std::time::Duration;
+
+use nix::fcntl::{fcntl, FcntlArg, OFlag};
+use nix::pty::openpty;
+use nix::sys::termios::{cfmakeraw, tcgetattr, tcsetattr, SetArg};
+
+use crate::client::Transport;
+use crate::transport::SimDevice;
+
+/// Opens a pseudo-terminal, prints the path of its device side, and runs the simulated controller behind it in
+/// real time (1 ms steps) until the process is interrupted.
+pub fn serve() -> anyhow::Result<()> {
+    let pty = openpty(None, None)?;
+    // Raw mode on the device side: no echo, no line editing, no newline translation of the framed bytes.
+    let mut termios = tcgetattr(&pty.slave)?;
+    cfmakeraw(&mut termios);
+    tcsetattr(&pty.slave, SetArg::TCSANOW, &termios)?;
+    let path = std::fs::read_link(format!("/proc/self/fd/{}", pty.slave.as_raw_fd()))?;
+    let flags = OFlag::from_bits_truncate(fcntl(&pty.master, FcntlArg::F_GETFL)?);
+    fcntl(&pty.master, FcntlArg::F_SETFL(flags | OFlag::O_NONBLOCK))?;
+    let mut master = std::fs::File::from(pty.master);
+    // Keep the device side open so that the terminal survives clients that come and go.
+    let _slave = pty.slave;
+    println!("{}", path.display());
+    std::io::stdout().flush()?;
+    let mut device = SimDevice::new(true);
+    let mut buf = [0u8; 1024];
+    loop {
+        match master.read(&mut buf) {
+            Ok(n) if n > 0 => device.send(&buf[..n])?,
+            Ok(_) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {}
+            // EIO: no client has the device side open right now.
+            Err(e) if e.raw_os_error() == Some(nix::libc::EIO) => {}
+            Err(e) => return Err(e.into()),
+        }
+        device.elapse(Duration::from_millis(1));
+        loop {
+            let n = device.receive(&mut buf)?;
+            if n == 0 {
+                break;
+            }
+            master.write_all(&buf[..n])?;
+        }
+    }
+}
