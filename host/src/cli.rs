@@ -32,6 +32,9 @@ pub enum Command {
     Device(DeviceArgs),
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
     Loads(LoadsArgs),
+    /// Scans the workspace with all checks (in parallel), draws a section coloured by the limiting check, and
+    /// prints the section's area, the reachable ranges, the volume, and whether the spec ranges are inside.
+    Workspace(WorkspaceArgs),
     /// Serves the simulated controller on a pseudo-terminal and prints its path, so that the serial transport
     /// (and any other program) can talk to it as to a board. Runs until interrupted.
     Simulate {
@@ -157,4 +160,35 @@ pub struct FkArgs {
     /// Maximum Newton iterations.
     #[arg(long, default_value_t = 30)]
     pub max_iterations: u8,
+}
+
+/// Which plane `ringpod workspace` draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Section {
+    /// Horizontal, at height --z.
+    Xy,
+    /// Vertical through the ring axis (y = 0).
+    Xz,
+}
+
+#[derive(Debug, Args)]
+pub struct WorkspaceArgs {
+    /// Geometry (a ring platform).
+    #[arg(long, short, default_value = "trainer-model")]
+    pub mechanism: String,
+    /// The plane.
+    #[arg(long, value_enum, default_value = "xy")]
+    pub section: Section,
+    /// Height of the xy section (m). Default: the preset's home height.
+    #[arg(long)]
+    pub z: Option<f64>,
+    /// Grid cells along each side of the section.
+    #[arg(long, default_value_t = 240)]
+    pub cells: usize,
+    /// Output picture: .svg (with labels) or .png.
+    #[arg(long)]
+    pub out: std::path::PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
 }

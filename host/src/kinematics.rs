@@ -33,7 +33,7 @@ pub fn run(cli: &Cli) -> Result<Outcome, CliError> {
         Command::Fk(args) => fk(args),
         Command::Loads(args) => loads(args),
         // Streaming and device commands talk to a device: main runs them with their own error handling.
-        Command::Stream(_) | Command::Device(_) | Command::Simulate { .. } => Ok(Outcome {
+        Command::Stream(_) | Command::Device(_) | Command::Simulate { .. } | Command::Workspace(_) => Ok(Outcome {
             text: String::new(),
             code: crate::error::EXIT_ERROR,
         }),

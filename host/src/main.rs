@@ -9,6 +9,7 @@ mod numbers;
 mod pty;
 mod stream;
 mod transport;
+mod workspace;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -21,6 +22,10 @@ fn main() -> ExitCode {
         cli::Command::Stream(args) => Some(stream_command(args)),
         cli::Command::Device(args) => Some(device_command(args)),
         cli::Command::Simulate { pty } => Some(simulate_command(*pty)),
+        cli::Command::Workspace(args) => Some(workspace::run(args).map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+            0
+        })),
         _ => None,
     };
     if let Some(result) = device_run {

@@ -188,3 +188,32 @@ fn loads_scale_with_the_mass_and_mirror_at_home() {
         .code(1);
     ringpod().args(["loads", "--mass=-1"]).assert().code(1);
 }
+
+#[test]
+fn workspace_scan_draws_and_reports() {
+    let dir = std::env::temp_dir().join(format!("ringpod-ws-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("ws.png");
+    let out = ringpod()
+        .args(["workspace", "--cells", "40", "--quiet", "--out"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("7380 of 7380 poses inside: all inside"), "{text}");
+    assert!(text.contains("m^3"), "{text}");
+    assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+    let svg = dir.join("ws.svg");
+    ringpod()
+        .args(["workspace", "--section", "xz", "--cells", "20", "--quiet", "--out"])
+        .arg(&svg)
+        .assert()
+        .success();
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+    ringpod()
+        .args(["workspace", "-m", "tool5-ex", "--out"])
+        .arg(dir.join("x.png"))
+        .assert()
+        .code(1);
+}

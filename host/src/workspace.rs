@@ -1,0 +1,294 @@
+//! `ringpod workspace`: the reachable region of a ring platform, scanned with every check.
+
+use std::path::Path;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use plotters::prelude::*;
+use rayon::prelude::*;
+use ringpod_core::kinematics::geometry::DEG;
+use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
+use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
+
+use crate::cli::{Section, WorkspaceArgs};
+
+/// What limits a grid point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Cell {
+    /// No IK solution.
+    Unreachable,
+    /// The first check that fails.
+    Fails(Check),
+    /// Inside, with its singularity index.
+    Inside(f64),
+}
+
+fn classify(m: &RingPlatform<f64>, pose: &Pose<f64>) -> Cell {
+    match m.inverse_checked(pose) {
+        Err(_) => Cell::Unreachable,
+        Ok((_, r)) => match r.first_failure() {
+            Some(c) => Cell::Fails(c),
+            None => Cell::Inside(r.singularity_index),
+        },
+    }
+}
+
+fn colour(cell: Cell) -> RGBColor {
+    match cell {
+        Cell::Unreachable => RGBColor(235, 235, 235),
+        Cell::Fails(Check::Reach) => RGBColor(200, 200, 200),
+        Cell::Fails(Check::CarriageSpacing) => RGBColor(240, 180, 120),
+        Cell::Fails(Check::RodCrossing) => RGBColor(220, 120, 120),
+        Cell::Fails(Check::JointCones) => RGBColor(180, 150, 220),
+        Cell::Fails(Check::Singularity) => RGBColor(90, 90, 90),
+        Cell::Fails(Check::Stability) => RGBColor(230, 210, 120),
+        // Inside: from light green (index near the threshold) to dark green (well-conditioned).
+        Cell::Inside(i) => {
+            let t = (i / 0.3).clamp(0.0, 1.0);
+            RGBColor(
+                (150.0 - 120.0 * t) as u8,
+                (220.0 - 90.0 * t) as u8,
+                (150.0 - 110.0 * t) as u8,
+            )
+        }
+    }
+}
+
+/// Runs the command; returns the text to print.
+pub fn run(args: &WorkspaceArgs) -> anyhow::Result<String> {
+    let preset =
+        Preset::from_name(&args.mechanism).ok_or_else(|| anyhow::anyhow!("unknown mechanism `{}`", args.mechanism))?;
+    let PresetGeometry::Ring(g) = preset.geometry() else {
+        anyhow::bail!("the workspace scan is for ring platforms")
+    };
+    let m = RingPlatform::<f64>::new(g);
+    let home = preset.home();
+    let r = g.ring_radius;
+    let n = args.cells.clamp(10, 2000);
+    let z0 = args.z.unwrap_or(home[2]);
+    // Plane coordinates (u, v) -> pose.
+    let (u_range, v_range) = match args.section {
+        Section::Xy => ((-r, r), (-r, r)),
+        Section::Xz => ((-r, r), (0.0, 2.0 * g.rod_length.max(r))),
+    };
+    let pose_at = |u: f64, v: f64| match args.section {
+        Section::Xy => Pose::new(u, v, z0, 0.0, 0.0, 0.0),
+        Section::Xz => Pose::new(u, 0.0, v, 0.0, 0.0, 0.0),
+    };
+    let du = (u_range.1 - u_range.0) / n as f64;
+    let dv = (v_range.1 - v_range.0) / n as f64;
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(n as u64)
+    };
+    bar.set_style(
+        ProgressStyle::with_template("scanning {bar:40} {pos}/{len} rows")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let grid: Vec<Vec<Cell>> = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let v = v_range.0 + (j as f64 + 0.5) * dv;
+            let row = (0..n)
+                .map(|i| classify(&m, &pose_at(u_range.0 + (i as f64 + 0.5) * du, v)))
+                .collect();
+            bar.inc(1);
+            row
+        })
+        .collect();
+    bar.finish_and_clear();
+    draw(&args.out, &grid, u_range, v_range, args.section, g.name)?;
+
+    let mut text = String::new();
+    let inside: Vec<(f64, f64)> = grid
+        .iter()
+        .enumerate()
+        .flat_map(|(j, row)| {
+            row.iter()
+                .enumerate()
+                .filter(|(_, c)| matches!(c, Cell::Inside(_)))
+                .map(move |(i, _)| (i, j))
+        })
+        .map(|(i, j)| (u_range.0 + (i as f64 + 0.5) * du, v_range.0 + (j as f64 + 0.5) * dv))
+        .collect();
+    let (un, vn) = match args.section {
+        Section::Xy => ("x", "y"),
+        Section::Xz => ("x", "z"),
+    };
+    text += &format!(
+        "{} section of {} ({n} x {n} cells): {:.5} m^2 inside every check\n",
+        if args.section == Section::Xy {
+            format!("xy at z = {z0}")
+        } else {
+            "xz".into()
+        },
+        g.name,
+        inside.len() as f64 * du * dv
+    );
+    if let (Some(umin), Some(umax), Some(vmin), Some(vmax)) = (
+        inside.iter().map(|p| p.0).reduce(f64::min),
+        inside.iter().map(|p| p.0).reduce(f64::max),
+        inside.iter().map(|p| p.1).reduce(f64::min),
+        inside.iter().map(|p| p.1).reduce(f64::max),
+    ) {
+        text += &format!("  reachable {un} in [{umin:.4}, {umax:.4}] m, {vn} in [{vmin:.4}, {vmax:.4}] m\n");
+    }
+    text += &format!(
+        "volume at zero orientation: {:.6} m^3 (60^3 grid)\n",
+        volume(&m, r, g.rod_length)
+    );
+    for (axis, name) in ["roll", "pitch"].iter().enumerate() {
+        let range = angle_range(&m, home, 3 + axis);
+        text += &format!(
+            "  {name} at home within [{:.1}, {:.1}] deg\n",
+            range.0 / DEG,
+            range.1 / DEG
+        );
+    }
+    if preset == Preset::TrainerModel {
+        let (inside, total) = spec_axes(&m, home);
+        text += &format!(
+            "trainer-model spec ranges (each axis over its range, every 10 deg of yaw): {inside} of {total} poses inside: {}\n",
+            if inside == total { "all inside" } else { "NOT all inside" }
+        );
+    }
+    text += &format!("picture: {}\n", args.out.display());
+    Ok(text)
+}
+
+/// Reachable volume at zero orientation on a 60^3 grid (m^3).
+fn volume(m: &RingPlatform<f64>, r: f64, rod: f64) -> f64 {
+    let n = 60;
+    let (x0, z1) = (-r, 2.0 * rod.max(r));
+    let d = 2.0 * r / n as f64;
+    let dz = z1 / n as f64;
+    let count: usize = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            let z = (k as f64 + 0.5) * dz;
+            let mut c = 0;
+            for j in 0..n {
+                for i in 0..n {
+                    let p = Pose::new(x0 + (i as f64 + 0.5) * d, x0 + (j as f64 + 0.5) * d, z, 0.0, 0.0, 0.0);
+                    if m.inverse_checked(&p).is_ok_and(|(_, r)| r.all_pass()) {
+                        c += 1;
+                    }
+                }
+            }
+            c
+        })
+        .sum();
+    count as f64 * d * d * dz
+}
+
+/// The contiguous range of one angle around `home` that passes every check (rad), in 0.5 degree steps.
+fn angle_range(m: &RingPlatform<f64>, home: [f64; 6], axis: usize) -> (f64, f64) {
+    let ok = |a: f64| {
+        let mut p = home;
+        p[axis] = a;
+        m.inverse_checked(&Pose::from_array(p)).is_ok_and(|(_, r)| r.all_pass())
+    };
+    let step = 0.5 * DEG;
+    let mut hi = 0.0;
+    while hi < 90.0 * DEG && ok(hi + step) {
+        hi += step;
+    }
+    let mut lo = 0.0;
+    while lo > -90.0 * DEG && ok(lo - step) {
+        lo -= step;
+    }
+    (lo, hi)
+}
+
+/// Each spec axis swept over its range (41 points) at every 10 degrees of yaw: (inside, total).
+fn spec_axes(m: &RingPlatform<f64>, home: [f64; 6]) -> (usize, usize) {
+    let mut poses = Vec::new();
+    for (axis, range) in TRAINER_MODEL_RANGES.iter().enumerate() {
+        for k in 0..=40 {
+            for yaw in 0..36 {
+                let mut c = home;
+                c[axis] += -range + 2.0 * range * k as f64 / 40.0;
+                c[5] = yaw as f64 * 10.0 * DEG;
+                poses.push(Pose::from_array(c));
+            }
+        }
+    }
+    let inside = poses
+        .par_iter()
+        .filter(|p| m.inverse_checked(p).is_ok_and(|(_, r)| r.all_pass()))
+        .count();
+    (inside, poses.len())
+}
+
+fn draw(
+    out: &Path,
+    grid: &[Vec<Cell>],
+    u: (f64, f64),
+    v: (f64, f64),
+    section: Section,
+    name: &str,
+) -> anyhow::Result<()> {
+    let svg = out.extension().is_some_and(|e| e == "svg");
+    let size = (760, 640);
+    let plane = match section {
+        Section::Xy => ("x (m)", "y (m)"),
+        Section::Xz => ("x (m)", "z (m)"),
+    };
+    // SVG carries text as text; PNG text would need a system font library, so PNG pictures have no labels.
+    if svg {
+        let root = SVGBackend::new(out, size).into_drawing_area();
+        paint(&root, grid, u, v, Some((name, plane)))?;
+        root.present()?;
+    } else {
+        let root = BitMapBackend::new(out, size).into_drawing_area();
+        paint(&root, grid, u, v, None)?;
+        root.present()?;
+    }
+    Ok(())
+}
+
+fn paint<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    grid: &[Vec<Cell>],
+    u: (f64, f64),
+    v: (f64, f64),
+    labels: Option<(&str, (&str, &str))>,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let n = grid.len().max(1);
+    let (du, dv) = ((u.1 - u.0) / n as f64, (v.1 - v.0) / n as f64);
+    let mut builder = ChartBuilder::on(root);
+    builder.margin(20);
+    if let Some((name, _)) = labels {
+        builder
+            .caption(
+                format!("{name}: workspace section (green: inside, darker = better conditioned)"),
+                ("sans-serif", 18),
+            )
+            .x_label_area_size(40)
+            .y_label_area_size(60);
+    }
+    let mut chart = builder
+        .build_cartesian_2d(u.0..u.1, v.0..v.1)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some((_, (xl, yl))) = labels {
+        chart
+            .configure_mesh()
+            .x_desc(xl)
+            .y_desc(yl)
+            .draw()
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+    }
+    chart
+        .draw_series(grid.iter().enumerate().flat_map(|(j, row)| {
+            row.iter().enumerate().map(move |(i, c)| {
+                let (x0, y0) = (u.0 + i as f64 * du, v.0 + j as f64 * dv);
+                Rectangle::new([(x0, y0), (x0 + du, y0 + dv)], colour(*c).filled())
+            })
+        }))
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(())
+}
