@@ -106,9 +106,16 @@ pub struct StreamArgs {
     #[arg(long, default_value_t = 20.0)]
     pub duration: f64,
     /// CSV file with header t,x,y,z,alpha,beta,gamma (s, m, rad unless --degrees).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "udp")]
     pub input: Option<std::path::PathBuf>,
-    /// Angles of --input in degrees.
+    /// Receive poses from motion-simulator software: one datagram = one text line of six numbers
+    /// `x y z alpha beta gamma` (spaces, commas or semicolons; m and rad unless --degrees), sent as they arrive.
+    #[arg(long, conflicts_with = "motion")]
+    pub udp: Option<std::net::SocketAddr>,
+    /// With --udp: end the stream after this many seconds without a datagram.
+    #[arg(long, default_value_t = 2.0)]
+    pub udp_idle: f64,
+    /// Angles of --input or --udp in degrees.
     #[arg(long)]
     pub degrees: bool,
     /// Setpoints per second for built-in motions.

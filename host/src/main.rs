@@ -59,6 +59,19 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     let flag = interrupted.clone();
     ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))?;
     let (source, input_errors) = match (&args.input, args.motion) {
+        _ if args.udp.is_some() => {
+            let addr = args.udp.ok_or_else(|| anyhow::anyhow!("--udp"))?;
+            let socket = std::net::UdpSocket::bind(addr).map_err(|e| anyhow::anyhow!("--udp {addr}: {e}"))?;
+            let idle = std::time::Duration::from_secs_f64(args.udp_idle.clamp(0.01, 3600.0));
+            (
+                stream::Source::Udp {
+                    socket,
+                    degrees: args.degrees,
+                    idle,
+                },
+                Vec::new(),
+            )
+        }
         (Some(path), _) => {
             let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             let (poses, errors) = stream::read_csv(&text, args.degrees);

@@ -34,6 +34,30 @@ pub enum Source {
     Motion { motion: Motion, seconds: f64 },
     /// Timed poses from a CSV file: `(line, t, pose)`.
     Poses(Vec<TimedPose>),
+    /// Poses from UDP datagrams, sent as they arrive until `idle` passes without one.
+    Udp {
+        /// The bound socket.
+        socket: std::net::UdpSocket,
+        /// Angles in degrees.
+        degrees: bool,
+        /// End after this long without a datagram.
+        idle: Duration,
+    },
+}
+
+/// Parses one datagram: six numbers separated by spaces, commas or semicolons.
+pub fn parse_datagram(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
+    let text = std::str::from_utf8(bytes).map_err(|_| "not text".to_string())?;
+    let v: Vec<f64> = text
+        .split(|c: char| c.is_whitespace() || c == ',' || c == ';')
+        .filter(|s| !s.is_empty())
+        .map(|s| s.parse::<f64>().map_err(|e| format!("`{s}`: {e}")))
+        .collect::<Result<_, _>>()?;
+    if v.len() != 6 {
+        return Err(format!("expected 6 numbers, got {}", v.len()));
+    }
+    let a = |x: f64| if degrees { x.to_radians() } else { x };
+    Ok(Pose::new(v[0], v[1], v[2], a(v[3]), a(v[4]), a(v[5])))
 }
 
 /// A CSV line that could not be used.
@@ -265,6 +289,7 @@ pub fn run<T: Transport>(
                 .collect()
         }
         Source::Poses(p) => p.iter().map(|(line, t, pose)| (Some(*line), *t, *pose)).collect(),
+        Source::Udp { .. } => Vec::new(),
     };
     // Lead-in: from where the platform is to the first pose, at a quarter of the velocity limits.
     let now = client.status()?.pose.cast::<f64>();
@@ -327,15 +352,59 @@ pub fn run<T: Transport>(
             bar.set_message(format!("rejected {total}"));
         }
     }
+    let mut input_errors = input_errors;
+    if let Source::Udp { socket, degrees, idle } = &source {
+        socket.set_read_timeout(Some(Duration::from_millis(1)))?;
+        bar.suspend(|| {
+            eprintln!(
+                "streaming: send datagrams to {}",
+                socket.local_addr().map_or("?".into(), |a| a.to_string())
+            )
+        });
+        let mut buf = [0u8; 512];
+        let (mut quiet_for, mut datagrams) = (Duration::ZERO, 0usize);
+        let mut wall = std::time::Instant::now();
+        while quiet_for < *idle && !interrupted() {
+            let got = socket.recv(&mut buf);
+            let now = std::time::Instant::now();
+            let dt = now - wall;
+            wall = now;
+            client.transport().elapse(dt);
+            clock_us += (dt.as_micros() as u64).max(1);
+            match got {
+                Ok(n) => {
+                    datagrams += 1;
+                    quiet_for = Duration::ZERO;
+                    match parse_datagram(&buf[..n], *degrees) {
+                        Ok(pose) => {
+                            counts.send(client, pose, clock_us, None, &bar)?;
+                            bar.inc(1);
+                        }
+                        Err(reason) => {
+                            bar.suspend(|| eprintln!("datagram {datagrams}: {reason}"));
+                            input_errors.push(InputError {
+                                line: datagrams,
+                                reason,
+                            });
+                        }
+                    }
+                }
+                Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {
+                    quiet_for += dt
+                }
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
     // End of input: hold the last pose for a settle time, as simulator software does when it stops, so that the
     // platform arrives there (the device runs one setpoint interval behind); then stop. Ctrl-C or an error: stop now.
     let running = result.is_ok() && client.status().is_ok_and(|s| s.state == State::Running);
     if running && !interrupted() {
-        if let Some((_, _, last)) = schedule.last() {
+        if let Some(last) = counts.last_applied.or(schedule.last().map(|s| s.2)) {
             for _ in 0..25 {
                 client.transport().elapse(Duration::from_millis(10));
                 clock_us += 10_000;
-                counts.send(client, *last, clock_us, None, &bar)?;
+                counts.send(client, last, clock_us, None, &bar)?;
             }
         }
     }

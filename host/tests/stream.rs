@@ -186,3 +186,62 @@ fn stream_through_a_pseudo_terminal() {
         );
     }
 }
+
+/// Poses from UDP datagrams, as motion-simulator software sends them.
+#[test]
+fn stream_from_udp_datagrams() {
+    use std::io::BufRead;
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let mut child = std::process::Command::new(&exe)
+        .args([
+            "stream",
+            "--sim",
+            "--fast",
+            "--udp",
+            "127.0.0.1:0",
+            "--udp-idle",
+            "0.3",
+            "--report-json",
+            "--quiet",
+            "--degrees",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while !line.contains("send datagrams to") {
+        line.clear();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "the stream announces its address"
+        );
+    }
+    let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    for k in 0..=50 {
+        let z = 0.227 + 0.0002 * f64::from(k);
+        socket
+            .send_to(format!("0 0 {z} 0 {} 1", 0.05 * f64::from(k)).as_bytes(), &addr)
+            .unwrap();
+        if k == 20 {
+            socket.send_to(b"0 0 nonsense", &addr).unwrap();
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let out = child.wait_with_output().unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["state"], "Ready");
+    assert_eq!(report["rejected"], serde_json::json!({}), "{report}");
+    assert_eq!(report["input_errors"].as_array().unwrap().len(), 1);
+    let last: Vec<f64> = numbers(&report["last_applied_pose"]);
+    assert!(
+        (last[2] - 0.237).abs() < 1e-9 && (last[4] - 2.5f64.to_radians()).abs() < 1e-9,
+        "{last:?}"
+    );
+    let want = steps_at(last.try_into().unwrap());
+    for (g, w) in numbers(&report["final_steps"]).iter().zip(want) {
+        assert!((*g as i64 - w).abs() <= 1);
+    }
+}
