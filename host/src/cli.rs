@@ -30,6 +30,8 @@ pub enum Command {
     Stream(StreamArgs),
     /// One command to the controller (--port, or a fresh simulated controller with --sim).
     Device(DeviceArgs),
+    /// Lists the serial ports (a board shows up as a USB CDC port, /dev/ttyACM* on Linux).
+    Ports,
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
     Loads(LoadsArgs),
     /// Scans the workspace with all checks (in parallel), draws a section coloured by the limiting check, and

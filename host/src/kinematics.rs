@@ -33,10 +33,12 @@ pub fn run(cli: &Cli) -> Result<Outcome, CliError> {
         Command::Fk(args) => fk(args),
         Command::Loads(args) => loads(args),
         // Streaming and device commands talk to a device: main runs them with their own error handling.
-        Command::Stream(_) | Command::Device(_) | Command::Simulate { .. } | Command::Workspace(_) => Ok(Outcome {
-            text: String::new(),
-            code: crate::error::EXIT_ERROR,
-        }),
+        Command::Stream(_) | Command::Device(_) | Command::Ports | Command::Simulate { .. } | Command::Workspace(_) => {
+            Ok(Outcome {
+                text: String::new(),
+                code: crate::error::EXIT_ERROR,
+            })
+        }
     }
 }
 

@@ -21,6 +21,7 @@ fn main() -> ExitCode {
     let device_run = match &cli.command {
         cli::Command::Stream(args) => Some(stream_command(args)),
         cli::Command::Device(args) => Some(device_command(args)),
+        cli::Command::Ports => Some(ports_command()),
         cli::Command::Simulate { pty } => Some(simulate_command(*pty)),
         cli::Command::Workspace(args) => Some(workspace::run(args).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
@@ -156,5 +157,26 @@ fn simulate_command(pty: bool) -> anyhow::Result<u8> {
         anyhow::bail!("say how to serve the simulator: --pty");
     }
     pty::serve()?;
+    Ok(0)
+}
+
+/// `ringpod ports`.
+fn ports_command() -> anyhow::Result<u8> {
+    let ports = serialport::available_ports()?;
+    let mut out = std::io::stdout();
+    if ports.is_empty() {
+        let _ = writeln!(out, "no serial ports found");
+    }
+    for p in ports {
+        let kind = match p.port_type {
+            serialport::SerialPortType::UsbPort(u) => {
+                format!("USB {:04x}:{:04x} {}", u.vid, u.pid, u.product.unwrap_or_default())
+            }
+            serialport::SerialPortType::PciPort => "PCI".into(),
+            serialport::SerialPortType::BluetoothPort => "Bluetooth".into(),
+            serialport::SerialPortType::Unknown => "unknown".into(),
+        };
+        let _ = writeln!(out, "{}  {kind}", p.port_name);
+    }
     Ok(0)
 }

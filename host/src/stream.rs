@@ -389,7 +389,13 @@ pub fn run<T: Transport>(
                         }
                     }
                 }
-                Err(e) if matches!(e.kind(), std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut) => {
+                // A signal (Ctrl-C) interrupts the wait: nothing arrived, and the loop then sees the flag.
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                    ) =>
+                {
                     quiet_for += dt
                 }
                 Err(e) => return Err(e.into()),

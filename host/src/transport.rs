@@ -32,7 +32,7 @@ impl Transport for Serial {
     fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         match self.port.read(buf) {
             Ok(n) => Ok(n),
-            Err(e) if e.kind() == std::io::ErrorKind::TimedOut => Ok(0),
+            Err(e) if matches!(e.kind(), std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted) => Ok(0),
             Err(e) => Err(e),
         }
     }

@@ -245,3 +245,56 @@ fn stream_from_udp_datagrams() {
         assert!((*g as i64 - w).abs() <= 1);
     }
 }
+
+/// Ctrl-C (SIGINT) in the middle of a stream ends it with a stop and a wait for rest, and still reports.
+#[test]
+fn ctrl_c_stops_and_reports() {
+    use std::io::BufRead;
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    // UDP source: the stream is then certainly running (it announces itself) when the signal comes.
+    let mut child = std::process::Command::new(&exe)
+        .args([
+            "stream",
+            "--sim",
+            "--udp",
+            "127.0.0.1:0",
+            "--udp-idle",
+            "60",
+            "--report-json",
+            "--quiet",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while !line.contains("send datagrams to") {
+        line.clear();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "the stream announces its address"
+        );
+    }
+    let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    for k in 0..20 {
+        socket
+            .send_to(format!("0 0 {} 0 0 0", 0.227 + 0.0001 * f64::from(k)).as_bytes(), &addr)
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    nix::sys::signal::kill(
+        nix::unistd::Pid::from_raw(child.id() as i32),
+        nix::sys::signal::Signal::SIGINT,
+    )
+    .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let mut rest = String::new();
+    let _ = std::io::Read::read_to_string(&mut stderr, &mut rest);
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; stderr: {rest}", out.status));
+    assert_eq!(report["state"], "Ready", "stopped and at rest");
+    assert!(report["setpoints_applied"].as_u64().unwrap() >= 1);
+    assert_eq!(report["counts_agree"], true);
+}
