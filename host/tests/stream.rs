@@ -187,24 +187,19 @@ fn stream_through_a_pseudo_terminal() {
     }
 }
 
-/// Poses from UDP datagrams, as motion-simulator software sends them.
-#[test]
-fn stream_from_udp_datagrams() {
+/// Starts `ringpod stream --udp 127.0.0.1:0 ARGS` and waits until it announces the address to send to.
+fn spawn_udp_stream(
+    args: &[&str],
+) -> (
+    std::process::Child,
+    std::io::BufReader<std::process::ChildStderr>,
+    String,
+) {
     use std::io::BufRead;
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let mut child = std::process::Command::new(&exe)
-        .args([
-            "stream",
-            "--sim",
-            "--fast",
-            "--udp",
-            "127.0.0.1:0",
-            "--udp-idle",
-            "0.3",
-            "--report-json",
-            "--quiet",
-            "--degrees",
-        ])
+        .args(["stream", "--sim", "--udp", "127.0.0.1:0", "--report-json", "--quiet"])
+        .args(args)
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -219,6 +214,13 @@ fn stream_from_udp_datagrams() {
         );
     }
     let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
+    (child, stderr, addr)
+}
+
+/// Poses from UDP datagrams, as motion-simulator software sends them.
+#[test]
+fn stream_from_udp_datagrams() {
+    let (child, _stderr, addr) = spawn_udp_stream(&["--fast", "--udp-idle", "0.3", "--degrees"]);
     let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     for k in 0..=50 {
         let z = 0.227 + 0.0002 * f64::from(k);
@@ -249,34 +251,8 @@ fn stream_from_udp_datagrams() {
 /// Ctrl-C (SIGINT) in the middle of a stream ends it with a stop and a wait for rest, and still reports.
 #[test]
 fn ctrl_c_stops_and_reports() {
-    use std::io::BufRead;
-    let exe = assert_cmd::cargo::cargo_bin("ringpod");
     // UDP source: the stream is then certainly running (it announces itself) when the signal comes.
-    let mut child = std::process::Command::new(&exe)
-        .args([
-            "stream",
-            "--sim",
-            "--udp",
-            "127.0.0.1:0",
-            "--udp-idle",
-            "60",
-            "--report-json",
-            "--quiet",
-        ])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    while !line.contains("send datagrams to") {
-        line.clear();
-        assert!(
-            stderr.read_line(&mut line).unwrap() > 0,
-            "the stream announces its address"
-        );
-    }
-    let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
+    let (child, mut stderr, addr) = spawn_udp_stream(&["--udp-idle", "60"]);
     let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     for k in 0..20 {
         socket
