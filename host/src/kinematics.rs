@@ -8,7 +8,7 @@ use ringpod_core::kinematics::{
 };
 use serde::Serialize;
 
-use crate::cli::{Cli, Command, Common, FkArgs, LoadsArgs, PoseArgs};
+use crate::cli::{Common, FkArgs, LoadsArgs, PoseArgs};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::mechanism::AnyMechanism;
 use crate::numbers;
@@ -22,23 +22,6 @@ pub struct Outcome {
 impl Outcome {
     fn ok(text: String) -> Self {
         Self { text, code: 0 }
-    }
-}
-
-pub fn run(cli: &Cli) -> Result<Outcome, CliError> {
-    match &cli.command {
-        Command::Presets { json } => presets(*json),
-        Command::Ik(args) => ik(args, false),
-        Command::Check(args) => ik(args, true),
-        Command::Fk(args) => fk(args),
-        Command::Loads(args) => loads(args),
-        // Streaming and device commands talk to a device: main runs them with their own error handling.
-        Command::Stream(_) | Command::Device(_) | Command::Ports | Command::Simulate { .. } | Command::Workspace(_) => {
-            Ok(Outcome {
-                text: String::new(),
-                code: crate::error::EXIT_ERROR,
-            })
-        }
     }
 }
 
@@ -112,7 +95,7 @@ struct PresetJson {
     home: [f64; 6],
 }
 
-fn presets(json: bool) -> Result<Outcome, CliError> {
+pub fn presets(json: bool) -> Result<Outcome, CliError> {
     if json {
         let list: Vec<_> = Preset::ALL
             .iter()
@@ -186,7 +169,7 @@ fn pose_arg(common: &Common, preset: Preset, text: Option<&str>, what: &'static 
     })
 }
 
-fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliError> {
+pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliError> {
     let common = &args.common;
     let units = Units {
         degrees: common.degrees,
@@ -291,7 +274,7 @@ struct FkJson {
     residual: f64,
 }
 
-fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
+pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
     let common = &args.common;
     let units = Units {
         degrees: common.degrees,
@@ -354,7 +337,7 @@ struct LoadsJson<'a> {
     line_forces: [f64; 6],
 }
 
-fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
+pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
     let common = &args.common;
     let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
     let AnyMechanism::Ring(ring) = &m else {

@@ -17,38 +17,38 @@ use std::process::ExitCode;
 use clap::Parser;
 
 fn main() -> ExitCode {
+    use cli::Command as C;
     let cli = cli::Cli::parse();
-    let device_run = match &cli.command {
-        cli::Command::Stream(args) => Some(stream_command(args)),
-        cli::Command::Device(args) => Some(device_command(args)),
-        cli::Command::Ports => Some(ports_command()),
-        cli::Command::Simulate { pty } => Some(simulate_command(*pty)),
-        cli::Command::Workspace(args) => Some(workspace::run(args).map(|text| {
+    let result = match &cli.command {
+        C::Presets { json } => answer(kinematics::presets(*json)),
+        C::Ik(args) => answer(kinematics::ik(args, false)),
+        C::Check(args) => answer(kinematics::ik(args, true)),
+        C::Fk(args) => answer(kinematics::fk(args)),
+        C::Loads(args) => answer(kinematics::loads(args)),
+        C::Stream(args) => stream_command(args),
+        C::Device(args) => device_command(args),
+        C::Ports => ports_command(),
+        C::Simulate { pty } => simulate_command(*pty),
+        C::Workspace(args) => workspace::run(args).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
-        })),
-        _ => None,
+        }),
     };
-    if let Some(result) = device_run {
-        return match result {
-            Ok(code) => ExitCode::from(code),
-            Err(e) => {
-                eprintln!("ringpod: {e:#}");
-                ExitCode::from(error::EXIT_ERROR)
-            }
-        };
-    }
-    match kinematics::run(&cli) {
-        Ok(outcome) => {
-            // A closed pipe (`| head`) is not an error of ours.
-            let _ = std::io::Write::write_all(&mut std::io::stdout(), outcome.text.as_bytes());
-            ExitCode::from(outcome.code)
-        }
+    match result {
+        Ok(code) => ExitCode::from(code),
         Err(e) => {
-            eprintln!("ringpod: {:#}", anyhow::Error::from(e));
+            eprintln!("ringpod: {e:#}");
             ExitCode::from(error::EXIT_ERROR)
         }
     }
+}
+
+/// Prints a kinematics command's text and passes on its exit code.
+fn answer(outcome: Result<kinematics::Outcome, error::CliError>) -> anyhow::Result<u8> {
+    let outcome = outcome?;
+    // A closed pipe (`| head`) is not an error of ours.
+    let _ = std::io::stdout().write_all(outcome.text.as_bytes());
+    Ok(outcome.code)
 }
 
 /// `ringpod stream`: exit 0 when the run ended at rest without a fault, 1 otherwise.

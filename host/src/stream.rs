@@ -296,12 +296,17 @@ pub fn run<T: Transport>(
     let first = schedule.first().map_or(now, |s| s.2);
     let limits = MotionLimits::TRAINER_MODEL;
     let (a, b) = (now.to_array(), first.to_array());
-    let lead_s = (0..6).fold(0.0f64, |m, i| {
-        let mut d = b[i] - a[i];
+    // The way from here to the first pose; yaw the short way round.
+    let way: [f64; 6] = std::array::from_fn(|i| {
+        let d = b[i] - a[i];
         if i == 5 {
-            d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+            (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+        } else {
+            d
         }
-        m.max(d.abs() / (0.25 * f64::from(limits.pose_velocity[i])))
+    });
+    let lead_s = (0..6).fold(0.0f64, |m, i| {
+        m.max(way[i].abs() / (0.25 * f64::from(limits.pose_velocity[i])))
     });
     let lead_n = (lead_s * 100.0).ceil() as usize;
     let bar = if options.quiet {
@@ -317,13 +322,7 @@ pub fn run<T: Transport>(
     let mut clock_us = 0u64;
     for k in 1..=lead_n {
         let f = k as f64 / lead_n as f64;
-        let pose = Pose::from_array(std::array::from_fn(|i| {
-            let mut d = b[i] - a[i];
-            if i == 5 {
-                d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-            }
-            a[i] + d * f
-        }));
+        let pose = Pose::from_array(std::array::from_fn(|i| a[i] + way[i] * f));
         client.transport().elapse(Duration::from_millis(10));
         clock_us += 10_000;
         counts.send(client, pose, clock_us, None, &bar)?;
