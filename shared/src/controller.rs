@@ -6,12 +6,14 @@
 
 use crate::kinematics::presets::{Preset, PresetGeometry};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, MultiTurn, Pose, RingPlatform};
+use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{
     AxisMove, AxisScale, Pipeline, PipelineConfig, PipelineEvent, SchedulerConfig, StepConverter, StepScheduler,
 };
 use crate::protocol::{
     self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
 };
+use crate::safety::debounce::InputConfig;
 use crate::safety::homing::{HomingConfig, HomingError, HomingPlan, RingHoming};
 use crate::safety::{Event, HomingSequencer, HomingStep, Motion, Outputs, State, Supervisor, SupervisorConfig};
 
@@ -30,7 +32,15 @@ pub struct ControllerConfig {
     pub scales: [AxisScale; 6],
     /// Homing of every axis.
     pub homing: HomingConfig,
+    /// Input polarity and debouncing.
+    pub inputs: InputConfig,
 }
+
+/// Slot of the step generator (ns): the boards' timers emit one GPIO set/reset word per slot
+/// ([`crate::motion::pulse`]). 2.5 us is the shortest STEP pulse of FIRMWARE.md.
+pub const STEP_SLOT_NS: u32 = 2_500;
+/// Longest step buffer a board holds (slots): one period of 2 ms at [`STEP_SLOT_NS`].
+pub const MAX_STEP_SLOTS: usize = 800;
 
 /// Why a configuration cannot run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -45,6 +55,10 @@ pub enum ConfigError {
     Homing(HomingError),
     /// The step timing is inconsistent.
     Scheduler,
+    /// The step generator's slot grid cannot render the step timing faithfully.
+    StepTiming(PulseTimingError),
+    /// A value is out of its key's range (or the key does not exist for this machine).
+    Value,
 }
 
 impl ControllerConfig {
@@ -87,7 +101,113 @@ impl ControllerConfig {
                 axes: [carriage, carriage, carriage, carriage, linear, linear],
                 order: [4, 5, 0, 2, 1, 3],
             },
+            inputs: InputConfig::default(),
         }
+    }
+
+    /// The step generator's slot grid for this configuration.
+    pub fn pulse_timing(&self) -> Result<PulseTiming, PulseTimingError> {
+        PulseTiming::new(&self.scheduler, STEP_SLOT_NS, MAX_STEP_SLOTS)
+    }
+
+    /// Whether a controller can run this configuration (what [`Controller::new`] checks).
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        Controller::new(*self).map(|_| ())
+    }
+
+    /// The value of a setting.
+    pub fn get(&self, key: ConfigKey) -> Option<f32> {
+        let c = &self.pipeline;
+        Some(match key {
+            ConfigKey::StreamTimeoutMs => c.stream_timeout_us as f32 / 1000.0,
+            ConfigKey::PoseVelocity(a) => *c.limits.pose_velocity.get(usize::from(a))?,
+            ConfigKey::PoseAcceleration(a) => *c.limits.pose_acceleration.get(usize::from(a))?,
+            ConfigKey::JumpTolerance => c.jump_tolerance,
+            ConfigKey::TickHz => 1e6 / c.tick_us as f32,
+            ConfigKey::StepsPerUnit(a) => {
+                let scale = self.scales.get(usize::from(a))?;
+                match self.axis_kind(a)? {
+                    AxisKind::Ring => scale.steps_per_turn as f32,
+                    AxisKind::Linear | AxisKind::Angle => scale.steps_per_unit,
+                }
+            }
+            ConfigKey::InputActiveLow => f32::from(self.inputs.active_low),
+            ConfigKey::DebounceMs => f32::from(self.inputs.debounce_samples),
+        })
+    }
+
+    fn axis_kind(&self, axis: u8) -> Option<AxisKind> {
+        let PresetGeometry::Ring(geometry) = self.preset.geometry() else {
+            return None;
+        };
+        RingPlatform::<f32>::new(geometry)
+            .axes()
+            .get(usize::from(axis))
+            .copied()
+    }
+
+    /// Changes a setting after checking its range; the whole configuration is checked by [`Self::validate`].
+    /// Changing an axis's steps per unit scales its homing distances and rates with it, so that they stay the
+    /// same physical lengths and speeds.
+    pub fn set(&mut self, key: ConfigKey, value: f32) -> Result<(), ConfigError> {
+        if !value.is_finite() || value < 0.0 {
+            return Err(ConfigError::Value);
+        }
+        let integer = value == libm::floorf(value);
+        let c = &mut self.pipeline;
+        match key {
+            ConfigKey::StreamTimeoutMs if (1.0..=10_000.0).contains(&value) => {
+                c.stream_timeout_us = (value * 1000.0) as u32
+            }
+            ConfigKey::PoseVelocity(a) if value > 0.0 => {
+                *c.limits
+                    .pose_velocity
+                    .get_mut(usize::from(a))
+                    .ok_or(ConfigError::Value)? = value
+            }
+            ConfigKey::PoseAcceleration(a) if value > 0.0 => {
+                *c.limits
+                    .pose_acceleration
+                    .get_mut(usize::from(a))
+                    .ok_or(ConfigError::Value)? = value
+            }
+            ConfigKey::JumpTolerance if value <= 10.0 => c.jump_tolerance = value,
+            ConfigKey::TickHz if value == 500.0 || value == 1000.0 || value == 2000.0 => {
+                let tick_us = (1e6 / value) as u32;
+                c.tick_us = tick_us;
+                self.scheduler.period_ns = tick_us * 1000;
+            }
+            ConfigKey::StepsPerUnit(a) if integer && (1.0..=16_777_216.0).contains(&value) => {
+                let kind = self.axis_kind(a).ok_or(ConfigError::Value)?;
+                let i = usize::from(a);
+                let scale = &mut self.scales[i];
+                let old = f64::from(scale.per_unit(kind));
+                match kind {
+                    AxisKind::Ring => {
+                        scale.steps_per_turn = value as i64;
+                        scale.steps_per_unit = value / core::f32::consts::TAU;
+                    }
+                    AxisKind::Linear | AxisKind::Angle => scale.steps_per_unit = value,
+                }
+                let ratio = f64::from(scale.per_unit(kind)) / old;
+                let h = &mut self.homing.axes[i];
+                let steps = |v: i64| libm::round(v as f64 * ratio) as i64;
+                let rate = |v: u32| libm::round(f64::from(v) * ratio).clamp(1.0, f64::from(u32::MAX)) as u32;
+                h.search_steps = rate(h.search_steps);
+                h.backoff_steps = rate(h.backoff_steps);
+                h.home_position = steps(h.home_position);
+                h.fast_rate = rate(h.fast_rate);
+                h.slow_rate = rate(h.slow_rate);
+            }
+            ConfigKey::InputActiveLow if integer && value <= f32::from(u16::MAX) => {
+                self.inputs.active_low = value as u16
+            }
+            ConfigKey::DebounceMs if integer && (1.0..=50.0).contains(&value) => {
+                self.inputs.debounce_samples = value as u8
+            }
+            _ => return Err(ConfigError::Value),
+        }
+        Ok(())
     }
 }
 
@@ -117,7 +237,12 @@ pub struct TickOutput {
 
 /// The controller.
 pub struct Controller {
+    /// The configuration running now.
     config: ControllerConfig,
+    /// The configuration as stored: equal to `config` but for settings that take effect at the next start.
+    saved: ControllerConfig,
+    /// Settings changed since the firmware last took them for storing (bit per [`ConfigKey::code`]).
+    unsaved: u64,
     home_pose: Pose<f32>,
     supervisor: Supervisor,
     pipeline: Pipeline<RingPlatform<f32>>,
@@ -142,9 +267,10 @@ impl Controller {
         let PresetGeometry::Ring(geometry) = config.preset.geometry() else {
             return Err(ConfigError::NotARingPlatform);
         };
-        if !config.scheduler.is_valid() {
+        if !config.scheduler.is_valid() || config.scheduler.period_ns != config.pipeline.tick_us.saturating_mul(1000) {
             return Err(ConfigError::Scheduler);
         }
+        config.pulse_timing().map_err(ConfigError::StepTiming)?;
         let mechanism = RingPlatform::<f32>::new(geometry);
         let home_pose = Pose::from_array(config.preset.home()).cast::<f32>();
         let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;
@@ -165,6 +291,8 @@ impl Controller {
             Pipeline::new(mechanism, config.pipeline, converter, home_pose).map_err(ConfigError::HomePose)?;
         Ok(Self {
             config,
+            saved: config,
+            unsaved: 0,
             home_pose,
             supervisor: Supervisor::new(config.supervisor),
             pipeline,
@@ -376,43 +504,55 @@ impl Controller {
         }
     }
 
+    /// The configuration running now.
+    pub fn config(&self) -> &ControllerConfig {
+        &self.config
+    }
+
+    /// The configuration as stored (what the next start runs).
+    pub fn saved_config(&self) -> &ControllerConfig {
+        &self.saved
+    }
+
+    /// A setting changed over the protocol that the firmware has not stored yet, with its value; each change is
+    /// handed out once. Nothing is lost: a key changed twice before it is taken is stored once, with its last value.
+    pub fn take_unsaved(&mut self) -> Option<(ConfigKey, f32)> {
+        while self.unsaved != 0 {
+            let code = self.unsaved.trailing_zeros();
+            self.unsaved &= !(1u64 << code);
+            if let Some(key) = ConfigKey::from_code(code as u8) {
+                if let Some(value) = self.saved.get(key) {
+                    return Some((key, value));
+                }
+            }
+        }
+        None
+    }
+
+    /// Whether settings wait to be stored.
+    pub fn has_unsaved(&self) -> bool {
+        self.unsaved != 0
+    }
+
     fn get_config(&self, key: ConfigKey) -> Option<f32> {
-        let c = self.pipeline.config();
-        Some(match key {
-            ConfigKey::StreamTimeoutMs => c.stream_timeout_us as f32 / 1000.0,
-            ConfigKey::PoseVelocity(a) => *c.limits.pose_velocity.get(usize::from(a))?,
-            ConfigKey::PoseAcceleration(a) => *c.limits.pose_acceleration.get(usize::from(a))?,
-            ConfigKey::JumpTolerance => c.jump_tolerance,
-            ConfigKey::TickHz => 1e6 / c.tick_us as f32,
-        })
+        self.saved.get(key)
     }
 
     fn set_config(&mut self, key: ConfigKey, value: f32) -> Result<(), NackReason> {
         if !matches!(self.supervisor.outputs().motion, Motion::None) {
             return Err(NackReason::Refused(crate::safety::Refusal::WrongState));
         }
-        if !(value.is_finite() && value > 0.0) {
-            return Err(NackReason::BadConfig);
+        let mut saved = self.saved;
+        saved.set(key, value).map_err(|_| NackReason::BadConfig)?;
+        saved.validate().map_err(|_| NackReason::BadConfig)?;
+        if key.is_live() {
+            let mut live = self.config;
+            live.set(key, value).map_err(|_| NackReason::BadConfig)?;
+            self.config = live;
+            self.pipeline.set_config(live.pipeline);
         }
-        let mut c = *self.pipeline.config();
-        match key {
-            ConfigKey::StreamTimeoutMs if value <= 10_000.0 => c.stream_timeout_us = (value * 1000.0) as u32,
-            ConfigKey::PoseVelocity(a) => {
-                *c.limits
-                    .pose_velocity
-                    .get_mut(usize::from(a))
-                    .ok_or(NackReason::BadConfig)? = value
-            }
-            ConfigKey::PoseAcceleration(a) => {
-                *c.limits
-                    .pose_acceleration
-                    .get_mut(usize::from(a))
-                    .ok_or(NackReason::BadConfig)? = value
-            }
-            ConfigKey::JumpTolerance if value <= 10.0 => c.jump_tolerance = value,
-            _ => return Err(NackReason::BadConfig),
-        }
-        self.pipeline.set_config(c);
+        self.saved = saved;
+        self.unsaved |= 1u64 << key.code();
         Ok(())
     }
 

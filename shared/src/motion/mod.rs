@@ -3,6 +3,7 @@
 
 pub mod limits;
 pub mod pipeline;
+pub mod pulse;
 pub mod scheduler;
 pub mod steps;
 

@@ -7,7 +7,7 @@ use crate::motion::{RejectCounters, RejectReason, Setpoint};
 use crate::safety::{FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly.
-pub const PROTOCOL_VERSION: u16 = 1;
+pub const PROTOCOL_VERSION: u16 = 2;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -104,20 +104,69 @@ pub enum NackReason {
     Malformed,
 }
 
-/// Configuration values that can be read and written.
+/// Configuration values that can be read and written. Values are `f32`; integers (rates, step counts, masks) are
+/// exact up to 2^24. Keys marked *live* take effect at once; the others are stored and take effect at the next
+/// start of the controller (a reset of the board). [`ConfigKey::code`] is the key's number in the device's flash.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum ConfigKey {
-    /// Stream timeout (ms).
+    /// Stream timeout (ms), live.
     StreamTimeoutMs,
-    /// Velocity limit of a pose axis (m/s or rad/s).
+    /// Velocity limit of a pose axis (m/s or rad/s), live.
     PoseVelocity(u8),
-    /// Acceleration limit of a pose axis.
+    /// Acceleration limit of a pose axis, live.
     PoseAcceleration(u8),
-    /// Allowed excess over the velocity limit for a setpoint jump (fraction).
+    /// Allowed excess over the velocity limit for a setpoint jump (fraction), live.
     JumpTolerance,
-    /// Control rate (Hz, read-only).
+    /// Control rate (Hz): 500, 1,000 or 2,000; at the next start.
     TickHz,
+    /// Motor steps per carriage turn (ring axes, an integer) or per metre (linear axes); at the next start.
+    StepsPerUnit(u8),
+    /// Inputs active when low, a bit per input in the order of `safety::debounce::InputBit`, live.
+    InputActiveLow,
+    /// Debouncing: equal samples (1 ms apart) before an input level is accepted (1-50), live.
+    DebounceMs,
+}
+
+impl ConfigKey {
+    /// Every key, in code order.
+    pub fn all() -> impl Iterator<Item = ConfigKey> {
+        (0..=u8::MAX).filter_map(ConfigKey::from_code)
+    }
+
+    /// The key's stable number (its key in flash): never reuse or renumber one.
+    pub const fn code(self) -> u8 {
+        match self {
+            ConfigKey::StreamTimeoutMs => 1,
+            ConfigKey::JumpTolerance => 2,
+            ConfigKey::TickHz => 3,
+            ConfigKey::InputActiveLow => 4,
+            ConfigKey::DebounceMs => 5,
+            ConfigKey::PoseVelocity(a) => 16 + (a & 7),
+            ConfigKey::PoseAcceleration(a) => 24 + (a & 7),
+            ConfigKey::StepsPerUnit(a) => 32 + (a & 7),
+        }
+    }
+
+    /// The key with this code (axes 0-5 only).
+    pub const fn from_code(code: u8) -> Option<ConfigKey> {
+        Some(match code {
+            1 => ConfigKey::StreamTimeoutMs,
+            2 => ConfigKey::JumpTolerance,
+            3 => ConfigKey::TickHz,
+            4 => ConfigKey::InputActiveLow,
+            5 => ConfigKey::DebounceMs,
+            16..=21 => ConfigKey::PoseVelocity(code - 16),
+            24..=29 => ConfigKey::PoseAcceleration(code - 24),
+            32..=37 => ConfigKey::StepsPerUnit(code - 32),
+            _ => return None,
+        })
+    }
+
+    /// Whether a new value takes effect at once (otherwise at the next start).
+    pub const fn is_live(self) -> bool {
+        !matches!(self, ConfigKey::TickHz | ConfigKey::StepsPerUnit(_))
+    }
 }
 
 /// Status and telemetry.

@@ -1,5 +1,6 @@
 //! Safety: the interlock supervisor (FIRMWARE.md "Safety supervisor") and the homing sequence.
 
+pub mod debounce;
 pub mod homing;
 pub mod supervisor;
 

@@ -1,0 +1,254 @@
+//! The step generator's slot buffers: random trajectories through the real step scheduler, rendered period by
+//! period, then the port replayed slot by slot as the DMA would write it. Every scheduled step is exactly one STEP
+//! pulse with the right DIR level, and the pulse width, low time and DIR setup and hold hold on the slot grid.
+
+// Index loops over parallel per-axis arrays read more plainly than zips here.
+#![allow(clippy::needless_range_loop)]
+
+use proptest::prelude::*;
+use ringpod_core::controller::{ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
+use ringpod_core::motion::pulse::{PortMap, PulseRenderer, PulseTiming, PulseTimingError};
+use ringpod_core::motion::{AxisMove, Direction, SchedulerConfig, StepScheduler};
+
+/// The Black Pill's map: STEP on PB0-PB5, DIR on PB6-PB10 and PB12; axis 2 wired the other way round.
+const MAP: PortMap = PortMap {
+    step: [0, 1, 2, 3, 4, 5],
+    dir: [6, 7, 8, 9, 10, 12],
+    dir_forward_low: 0b000100,
+};
+
+/// The port as the DMA leaves it, with what the checks need to know about each axis.
+struct Port {
+    level: u16,
+    slot: i64,
+    /// Per axis: slot of the last DIR change, slot of the last rising STEP edge, slot of the last falling edge.
+    dir_changed: [i64; 6],
+    rose: [i64; 6],
+    fell: [i64; 6],
+    steps: [i64; 6],
+}
+
+impl Port {
+    fn new(map: &PortMap) -> Self {
+        let idle = map.idle_word();
+        Self {
+            level: (idle & 0xffff) as u16,
+            slot: 0,
+            dir_changed: [-1_000; 6],
+            rose: [-1_000; 6],
+            fell: [-1_000; 6],
+            steps: [0; 6],
+        }
+    }
+
+    /// Applies one word (BSRR: set wins over reset) and checks the timing of every edge it makes.
+    fn apply(&mut self, word: u32, map: &PortMap, timing: &PulseTiming, sched: &SchedulerConfig) -> Result<(), String> {
+        let set = (word & 0xffff) as u16;
+        let reset = (word >> 16) as u16 & !set;
+        let next = (self.level | set) & !reset;
+        let slot_ns = i64::from(timing.slot_ns);
+        for a in 0..6 {
+            let (s, d) = (1u16 << map.step[a], 1u16 << map.dir[a]);
+            if (self.level ^ next) & d != 0 {
+                if next & s != 0 || self.level & s != 0 {
+                    return Err(format!("axis {a}: DIR changed while STEP high at slot {}", self.slot));
+                }
+                if (self.slot - self.rose[a]) * slot_ns < i64::from(sched.dir_hold_ns) {
+                    return Err(format!("axis {a}: DIR hold violated at slot {}", self.slot));
+                }
+                self.dir_changed[a] = self.slot;
+            }
+            if self.level & s == 0 && next & s != 0 {
+                if (self.slot - self.dir_changed[a]) * slot_ns < i64::from(sched.dir_setup_ns) {
+                    return Err(format!("axis {a}: DIR setup violated at slot {}", self.slot));
+                }
+                if (self.slot - self.fell[a]) * slot_ns < i64::from(sched.min_spacing_ns - sched.pulse_ns) {
+                    return Err(format!("axis {a}: low time too short at slot {}", self.slot));
+                }
+                let forward = (next & d != 0) != (map.dir_forward_low & (1 << a) != 0);
+                self.steps[a] += if forward { 1 } else { -1 };
+                self.rose[a] = self.slot;
+            }
+            if self.level & s != 0 && next & s == 0 {
+                if (self.slot - self.rose[a]) * slot_ns < i64::from(sched.pulse_ns) {
+                    return Err(format!("axis {a}: pulse too short at slot {}", self.slot));
+                }
+                self.fell[a] = self.slot;
+            }
+        }
+        self.level = next;
+        self.slot += 1;
+        Ok(())
+    }
+}
+
+/// Plans `targets` period by period, renders and replays them, then two idle periods; returns the port's step
+/// counts, which must equal the scheduler's positions.
+fn replay(sched: SchedulerConfig, targets: &[[i64; 6]]) -> Result<([i64; 6], [i64; 6]), String> {
+    let timing = PulseTiming::new(&sched, STEP_SLOT_NS, MAX_STEP_SLOTS).map_err(|e| format!("{e:?}"))?;
+    let mut renderer = PulseRenderer::new(MAP, timing).map_err(|e| format!("{e:?}"))?;
+    let mut scheduler = StepScheduler::new(sched, [0; 6]);
+    let mut port = Port::new(&MAP);
+    let mut buf = vec![0u32; timing.slots];
+    let last = *targets.last().unwrap_or(&[0; 6]);
+    for t in targets.iter().chain([last, last].iter()) {
+        let moves = scheduler.plan(t);
+        let report = renderer.render(&moves, &mut buf).ok_or("buffer too short")?;
+        if report.collisions != 0 {
+            return Err(format!("{} collisions", report.collisions));
+        }
+        for a in 0..6 {
+            if report.steps[a] != moves[a].count {
+                return Err(format!(
+                    "axis {a}: rendered {} of {} steps",
+                    report.steps[a], moves[a].count
+                ));
+            }
+        }
+        for &w in &buf {
+            port.apply(w, &MAP, &timing, &sched)?;
+        }
+    }
+    let step_mask = MAP.step.iter().fold(0u16, |m, &p| m | 1 << p);
+    if port.level & step_mask != 0 {
+        return Err("a STEP pin stayed high".into());
+    }
+    Ok((port.steps, scheduler.position()))
+}
+
+fn trajectory() -> impl Strategy<Value = Vec<[i64; 6]>> {
+    // Per period and axis a change of up to +-260 steps (beyond the 200 that fit: carried over), often reversing.
+    prop::collection::vec(prop::array::uniform6(-260i64..=260), 1..60).prop_map(|deltas| {
+        let mut p = [0i64; 6];
+        deltas
+            .iter()
+            .map(|d| {
+                for a in 0..6 {
+                    p[a] += d[a];
+                }
+                p
+            })
+            .collect()
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1_500))]
+
+    #[test]
+    fn rendered_pulses_are_the_scheduled_steps(targets in trajectory()) {
+        let (port, scheduled) = replay(SchedulerConfig::default(), &targets).map_err(TestCaseError::fail)?;
+        prop_assert_eq!(port, scheduled);
+    }
+
+    #[test]
+    fn other_rates_render_faithfully(targets in trajectory(), hz in prop::sample::select(vec![500u32, 2_000])) {
+        let mut config = ControllerConfig::trainer_model();
+        config.set(ringpod_core::protocol::ConfigKey::TickHz, hz as f32).unwrap();
+        let (port, scheduled) = replay(config.scheduler, &targets).map_err(TestCaseError::fail)?;
+        prop_assert_eq!(port, scheduled);
+    }
+}
+
+#[test]
+fn six_axes_at_full_rate_with_reversals() {
+    // 200 steps per period on every axis (200 k steps/s), reversing every third period.
+    let mut p = [0i64; 6];
+    let targets: Vec<[i64; 6]> = (0..30)
+        .map(|k| {
+            let d = if (k / 3) % 2 == 0 { 200 } else { -200 };
+            for a in 0..6 {
+                p[a] += d;
+            }
+            p
+        })
+        .collect();
+    let (port, scheduled) = replay(SchedulerConfig::default(), &targets).unwrap();
+    assert_eq!(port, scheduled);
+    assert!(port.iter().all(|&s| s != 0 || scheduled.iter().all(|&x| x == 0)));
+}
+
+#[test]
+fn a_pulse_at_the_end_of_a_period_ends_in_the_next_buffer() {
+    let timing = ControllerConfig::trainer_model().pulse_timing().unwrap();
+    let mut renderer = PulseRenderer::new(MAP, timing).unwrap();
+    let period = timing.slots as u32 * timing.slot_ns;
+    // One step, late in the window: at start + span/2 = period - slot/2, in the last slot.
+    let late = AxisMove {
+        direction: Direction::Forward,
+        dir_change_ns: None,
+        start_ns: period - timing.slot_ns,
+        count: 1,
+        period_ns: period,
+    };
+    let idle = AxisMove {
+        count: 0,
+        start_ns: 0,
+        ..late
+    };
+    let mut buf = vec![0u32; timing.slots];
+    renderer
+        .render(&[late, idle, idle, idle, idle, idle], &mut buf)
+        .unwrap();
+    assert_eq!(buf[timing.slots - 1] & 1, 1, "STEP rises in the last slot");
+    assert!(
+        buf.iter().all(|w| w & (1 << 16) == 0),
+        "and does not fall in this buffer"
+    );
+    renderer.render(&[idle; 6], &mut buf).unwrap();
+    assert_eq!(
+        buf[0] & (1 << 16),
+        1 << 16,
+        "it falls in the first slot of the next one"
+    );
+}
+
+#[test]
+fn timings_the_grid_cannot_render_are_refused() {
+    let ok = SchedulerConfig::default();
+    assert!(PulseTiming::new(&ok, 2_500, 800).is_ok());
+    // The slot must divide the period, and the period must fit the buffer.
+    assert_eq!(PulseTiming::new(&ok, 3_000, 800), Err(PulseTimingError::Slots));
+    assert_eq!(PulseTiming::new(&ok, 2_500, 399), Err(PulseTimingError::Slots));
+    assert_eq!(PulseTiming::new(&ok, 0, 800), Err(PulseTimingError::Slots));
+    // 5 us spacing on a 5 us grid leaves no low time after a 2.5 us pulse rounded up to a slot.
+    assert_eq!(PulseTiming::new(&ok, 5_000, 800), Err(PulseTimingError::Spacing));
+    // A 6 us DIR setup quantised to 2.5 us slots could shrink to 5 us.
+    let setup = SchedulerConfig {
+        dir_setup_ns: 6_000,
+        ..ok
+    };
+    assert_eq!(PulseTiming::new(&setup, 2_500, 800), Err(PulseTimingError::Direction));
+    let hold = SchedulerConfig {
+        dir_hold_ns: 2_000,
+        ..ok
+    };
+    assert_eq!(PulseTiming::new(&hold, 2_500, 800), Err(PulseTimingError::Direction));
+    // A pin map that uses a pin twice.
+    let timing = PulseTiming::new(&ok, 2_500, 800).unwrap();
+    let twice = PortMap {
+        dir: [6, 7, 8, 9, 10, 0],
+        ..MAP
+    };
+    assert_eq!(PulseRenderer::new(twice, timing), Err(PulseTimingError::Pins));
+    let off_port = PortMap {
+        dir: [6, 7, 8, 9, 10, 16],
+        ..MAP
+    };
+    assert_eq!(PulseRenderer::new(off_port, timing), Err(PulseTimingError::Pins));
+}
+
+#[test]
+fn a_short_buffer_renders_nothing() {
+    let timing = ControllerConfig::trainer_model().pulse_timing().unwrap();
+    let mut renderer = PulseRenderer::new(MAP, timing).unwrap();
+    let mut short = vec![0u32; timing.slots - 1];
+    let idle = AxisMove {
+        direction: Direction::Forward,
+        dir_change_ns: None,
+        start_ns: 0,
+        count: 0,
+        period_ns: 1_000_000,
+    };
+    assert_eq!(renderer.render(&[idle; 6], &mut short), None);
+}

@@ -1,0 +1,273 @@
+//! Input debouncing and the device settings: keys and their flash codes, live and next-start settings, the set of
+//! unsaved changes the firmware stores, and the restore at boot that replays them.
+
+use proptest::prelude::*;
+use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
+use ringpod_core::protocol::{ConfigKey, DeviceMessage, HostMessage, NackReason, Request, PROTOCOL_VERSION};
+use ringpod_core::safety::debounce::{from_inputs, to_inputs, Debouncer, InputBit, InputConfig};
+
+fn config(samples: u8) -> InputConfig {
+    InputConfig {
+        active_low: 0,
+        debounce_samples: samples,
+    }
+}
+
+/// The definition: a level is accepted on the sample that completes `n` equal samples in a row of a level other
+/// than the accepted one.
+fn reference(initial: bool, samples: &[bool], n: usize) -> Vec<bool> {
+    let mut accepted = initial;
+    let mut run = 0;
+    let mut out = Vec::new();
+    for (i, &s) in samples.iter().enumerate() {
+        if s != accepted {
+            run += 1;
+            // The run counts only samples of the new level since the last sample of the accepted level.
+            if run >= n && samples[i + 1 - n..=i].iter().all(|&x| x == s) {
+                accepted = s;
+                run = 0;
+            }
+        } else {
+            run = 0;
+        }
+        out.push(accepted);
+    }
+    out
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2_000))]
+
+    #[test]
+    fn debouncing_matches_its_definition(
+        samples in prop::collection::vec(any::<bool>(), 0..200),
+        n in 1u8..6,
+        initial in any::<bool>(),
+        bit in 0u32..15,
+    ) {
+        let mask = 1u16 << bit;
+        let mut d = Debouncer::new(config(n), if initial { mask } else { 0 });
+        let expected = reference(initial, &samples, usize::from(n));
+        for (s, e) in samples.iter().zip(expected) {
+            let accepted = d.sample(if *s { mask } else { 0 });
+            prop_assert_eq!(accepted & mask != 0, e);
+            prop_assert_eq!(accepted & !mask, 0, "other inputs stay where they are");
+        }
+    }
+
+    #[test]
+    fn inputs_round_trip_through_the_logical_word(
+        estop in any::<bool>(), home in 0u16..64, limits in 0u16..64, logic_ok in any::<bool>(), power_ok in any::<bool>()
+    ) {
+        let inputs = Inputs { estop_open: estop, home, limits, logic_ok, power_ok };
+        prop_assert_eq!(to_inputs(from_inputs(&inputs)), inputs);
+    }
+}
+
+#[test]
+fn a_bounce_shorter_than_the_window_changes_nothing() {
+    let estop = InputBit::EStop.mask();
+    let mut d = Debouncer::new(config(3), 0);
+    for _ in 0..10 {
+        assert_eq!(d.sample(estop), 0);
+        assert_eq!(d.sample(estop), 0);
+        assert_eq!(d.sample(0), 0);
+    }
+    assert!(!d.settling());
+    assert_eq!(d.sample(estop), 0);
+    assert!(d.settling());
+    assert_eq!(d.sample(estop), 0);
+    assert_eq!(d.sample(estop), estop, "accepted on the third equal sample");
+    assert!(!d.settling());
+}
+
+#[test]
+fn polarity_maps_electrical_levels() {
+    let defaults = InputConfig::default();
+    // At rest: switches with pull-ups read high (not pressed), the e-stop chain is closed (low), supplies down.
+    let at_rest = defaults.active_low;
+    let d = Debouncer::new(defaults, at_rest);
+    assert_eq!(to_inputs(d.stable()), Inputs::default());
+    // A pressed home switch of axis 2 pulls its pin low.
+    let mut d = Debouncer::new(
+        InputConfig {
+            debounce_samples: 1,
+            ..defaults
+        },
+        at_rest,
+    );
+    let pressed = at_rest & !InputBit::Home(2).mask();
+    assert_eq!(to_inputs(d.sample(pressed)).home, 1 << 2);
+    // The e-stop chain opening pulls its pin high.
+    let open = pressed | InputBit::EStop.mask();
+    assert!(to_inputs(d.sample(open)).estop_open);
+    assert_eq!(InputBit::Home(6).mask(), 0, "no seventh axis");
+}
+
+#[test]
+fn every_key_has_a_unique_code_that_round_trips() {
+    let keys: Vec<ConfigKey> = ConfigKey::all().collect();
+    assert_eq!(keys.len(), 5 + 3 * 6);
+    let mut codes: Vec<u8> = keys.iter().map(|k| k.code()).collect();
+    codes.sort_unstable();
+    codes.dedup();
+    assert_eq!(codes.len(), keys.len());
+    for k in &keys {
+        assert_eq!(ConfigKey::from_code(k.code()), Some(*k));
+        assert!(k.code() < 64, "the unsaved set is a 64-bit mask");
+    }
+    let defaults = ControllerConfig::trainer_model();
+    for k in &keys {
+        assert!(defaults.get(*k).is_some(), "{k:?} has a value");
+    }
+}
+
+fn connected() -> Controller {
+    let mut c = Controller::new(ControllerConfig::trainer_model()).unwrap();
+    let hello = c.handle(&Request {
+        id: 1,
+        body: HostMessage::Hello {
+            version: PROTOCOL_VERSION,
+        },
+    });
+    assert!(matches!(hello.body, DeviceMessage::Hello { .. }));
+    c
+}
+
+fn set(c: &mut Controller, key: ConfigKey, value: f32) -> DeviceMessage {
+    c.handle(&Request {
+        id: 7,
+        body: HostMessage::SetConfig(key, value),
+    })
+    .body
+}
+
+fn get(c: &mut Controller, key: ConfigKey) -> DeviceMessage {
+    c.handle(&Request {
+        id: 8,
+        body: HostMessage::GetConfig(key),
+    })
+    .body
+}
+
+#[test]
+fn live_settings_apply_at_once_and_next_start_settings_are_stored() {
+    let mut c = connected();
+    assert_eq!(set(&mut c, ConfigKey::PoseVelocity(2), 0.02), DeviceMessage::Ack);
+    assert_eq!(c.pipeline().config().limits.pose_velocity[2], 0.02);
+    assert_eq!(
+        get(&mut c, ConfigKey::PoseVelocity(2)),
+        DeviceMessage::Config(ConfigKey::PoseVelocity(2), 0.02)
+    );
+
+    assert_eq!(set(&mut c, ConfigKey::TickHz, 2_000.0), DeviceMessage::Ack);
+    assert_eq!(
+        c.pipeline().config().tick_us,
+        1_000,
+        "the running rate stays until the next start"
+    );
+    assert_eq!(c.saved_config().pipeline.tick_us, 500);
+    assert_eq!(c.saved_config().scheduler.period_ns, 500_000);
+    assert_eq!(
+        get(&mut c, ConfigKey::TickHz),
+        DeviceMessage::Config(ConfigKey::TickHz, 2_000.0)
+    );
+
+    assert_eq!(
+        set(&mut c, ConfigKey::InputActiveLow, 0x0001 as f32),
+        DeviceMessage::Ack
+    );
+    assert_eq!(c.config().inputs.active_low, 1);
+}
+
+#[test]
+fn bad_values_are_refused_and_nothing_is_stored() {
+    let mut c = connected();
+    let bad = [
+        (ConfigKey::TickHz, 1_500.0),
+        (ConfigKey::TickHz, 4_000.0),
+        (ConfigKey::PoseVelocity(6), 1.0),
+        (ConfigKey::PoseVelocity(0), 0.0),
+        (ConfigKey::PoseAcceleration(1), f32::NAN),
+        (ConfigKey::StreamTimeoutMs, f32::INFINITY),
+        (ConfigKey::StreamTimeoutMs, 0.5),
+        (ConfigKey::StepsPerUnit(0), 25_600.5),
+        (ConfigKey::StepsPerUnit(4), -1.0),
+        (ConfigKey::StepsPerUnit(7), 1_000.0),
+        (ConfigKey::InputActiveLow, 70_000.0),
+        (ConfigKey::DebounceMs, 0.0),
+        (ConfigKey::DebounceMs, 51.0),
+        (ConfigKey::JumpTolerance, 11.0),
+    ];
+    let before = *c.saved_config();
+    for (key, value) in bad {
+        assert_eq!(
+            set(&mut c, key, value),
+            DeviceMessage::Nack(NackReason::BadConfig),
+            "{key:?} = {value}"
+        );
+    }
+    assert_eq!(*c.saved_config(), before);
+    assert!(!c.has_unsaved());
+    assert_eq!(c.take_unsaved(), None);
+}
+
+#[test]
+fn a_coarser_motor_that_breaks_the_homing_proof_is_refused() {
+    // 400 steps per carriage turn: the homing search of 20 degrees becomes 22 steps, and the scaled back-off
+    // rounds to 2; the plan must still validate or be refused as a whole, never half-applied.
+    let mut c = connected();
+    let reply = set(&mut c, ConfigKey::StepsPerUnit(0), 400.0);
+    let config = *c.saved_config();
+    match reply {
+        DeviceMessage::Ack => assert_eq!(config.scales[0].steps_per_turn, 400),
+        DeviceMessage::Nack(NackReason::BadConfig) => assert_eq!(config, ControllerConfig::trainer_model()),
+        other => panic!("unexpected {other:?}"),
+    }
+}
+
+#[test]
+fn steps_per_unit_keeps_homing_distances_physical() {
+    let mut config = ControllerConfig::trainer_model();
+    let before = config.homing.axes[4];
+    config.set(ConfigKey::StepsPerUnit(4), 3.2e6).unwrap();
+    let after = config.homing.axes[4];
+    assert_eq!(after.search_steps, before.search_steps * 2);
+    assert_eq!(after.home_position, before.home_position * 2);
+    assert_eq!(after.fast_rate, before.fast_rate * 2);
+    assert_eq!(config.get(ConfigKey::StepsPerUnit(4)), Some(3.2e6));
+    assert_eq!(config.get(ConfigKey::StepsPerUnit(0)), Some(25_600.0));
+    config.validate().unwrap();
+}
+
+#[test]
+fn unsaved_changes_are_handed_out_once_with_their_last_value_and_restore_at_boot() {
+    let mut c = connected();
+    assert_eq!(set(&mut c, ConfigKey::StreamTimeoutMs, 250.0), DeviceMessage::Ack);
+    assert_eq!(set(&mut c, ConfigKey::StreamTimeoutMs, 300.0), DeviceMessage::Ack);
+    assert_eq!(set(&mut c, ConfigKey::TickHz, 500.0), DeviceMessage::Ack);
+    assert_eq!(set(&mut c, ConfigKey::StepsPerUnit(5), 3.2e6), DeviceMessage::Ack);
+    assert_eq!(set(&mut c, ConfigKey::DebounceMs, 5.0), DeviceMessage::Ack);
+    let mut stored = Vec::new();
+    while let Some(kv) = c.take_unsaved() {
+        stored.push(kv);
+    }
+    assert_eq!(
+        stored,
+        vec![
+            (ConfigKey::StreamTimeoutMs, 300.0),
+            (ConfigKey::TickHz, 500.0),
+            (ConfigKey::DebounceMs, 5.0),
+            (ConfigKey::StepsPerUnit(5), 3.2e6),
+        ]
+    );
+    assert!(!c.has_unsaved());
+    // Boot: the defaults, then every stored pair replayed through the same checks.
+    let mut boot = ControllerConfig::trainer_model();
+    for (k, v) in &stored {
+        boot.set(*k, *v).unwrap();
+    }
+    assert_eq!(boot, *c.saved_config());
+    let restarted = Controller::new(boot).unwrap();
+    assert_eq!(restarted.pipeline().config().tick_us, 2_000);
+}
