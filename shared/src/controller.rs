@@ -337,6 +337,12 @@ impl Controller {
         self.event(Event::WatchdogReset);
     }
 
+    /// The step generator could not keep its output buffer ahead of the hardware: steps may have been played out
+    /// of order, so the position is no longer known. Latches a motion fault (drivers off, homing needed).
+    pub fn step_generator_fault(&mut self) {
+        self.event(Event::MotionFault);
+    }
+
     fn event(&mut self, e: Event) {
         let was_fault = matches!(self.supervisor.state(), State::Fault(..));
         // Inputs and time always apply; refusals only concern commands.

@@ -1,0 +1,66 @@
+//! The control tick: inputs to the controller, one `tick()` per period, relays and driver enable from the
+//! supervisor's outputs, the period's step moves to the step generator, and the watchdog fed only when all of
+//! that happened.
+
+use core::sync::atomic::Ordering;
+
+use embassy_time::{Duration, Ticker};
+use ringpod_core::controller::Inputs;
+use ringpod_core::motion::AxisMove;
+use ringpod_core::safety::Outputs;
+
+use super::Shared;
+
+/// The board's side of the control loop.
+pub trait Machine {
+    /// The debounced inputs now.
+    fn inputs(&mut self, shared: &Shared) -> Inputs;
+    /// Drives the relays and the driver enable.
+    fn outputs(&mut self, outputs: &Outputs);
+    /// Hands one period's moves to the step generator (waits while its queue is full).
+    async fn steps(&mut self, moves: &[AxisMove; 6], shared: &Shared);
+    /// Periods queued for the step generator.
+    fn queue_depth(&self, shared: &Shared) -> u16;
+    /// A free-running cycle counter (DWT CYCCNT on a board).
+    fn cycles(&self) -> u32;
+    /// Reloads the independent watchdog.
+    fn feed_watchdog(&mut self);
+}
+
+/// Runs the control loop at the controller's rate, forever.
+pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
+    let tick_us = shared.with(|c| c.pipeline().config().tick_us);
+    let mut ticker = Ticker::every(Duration::from_micros(u64::from(tick_us)));
+    let mut worst = 0u32;
+    let mut n = 0u32;
+    loop {
+        ticker.next().await;
+        let inputs = machine.inputs(shared);
+        let step_fault = shared.step_fault.swap(false, Ordering::Relaxed);
+        let start = machine.cycles();
+        let (out, message) = shared.with(|c| {
+            if step_fault {
+                c.step_generator_fault();
+            }
+            c.set_inputs(inputs);
+            let out = c.tick();
+            (out, c.unsolicited())
+        });
+        let cost = machine.cycles().wrapping_sub(start);
+        // Outputs first: a fault's disable reaches the drivers before anything else happens.
+        machine.outputs(&out.outputs);
+        machine.steps(&out.moves, shared).await;
+        let depth = machine.queue_depth(shared);
+        shared.with(|c| c.set_platform_stats(cost, depth));
+        if let Some(m) = message {
+            // The fault stays latched in the state whether or not the message fits; the host sees it in the status.
+            let _ = shared.outbox.try_send(m);
+        }
+        worst = worst.max(cost);
+        n = n.wrapping_add(1);
+        if n.is_multiple_of(5_000) {
+            defmt::info!("tick: {} cycles (worst {}), step queue {}", cost, worst, depth);
+        }
+        machine.feed_watchdog();
+    }
+}

@@ -1,0 +1,62 @@
+//! The controller's tasks, the same code on every board: the host link, the control tick, input debouncing, the
+//! step queue and settings storage. Each is an `async fn` over a small trait that a board module implements
+//! (`board/*.rs`: pins, timers, USB or UART); the board module's `#[embassy_executor::task]`s call them, because
+//! embassy tasks cannot be generic.
+//!
+//! Every decision is `ringpod_core::controller::Controller`'s; these functions only move bytes, levels and step
+//! buffers between it and the hardware.
+
+pub mod control;
+pub mod inputs;
+pub mod link;
+pub mod settings;
+pub mod steps;
+
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicU16, AtomicU32};
+
+use embassy_sync::blocking_mutex::raw::{CriticalSectionRawMutex, ThreadModeRawMutex};
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::channel::Channel;
+use ringpod_core::controller::Controller;
+use ringpod_core::motion::AxisMove;
+use ringpod_core::protocol::Response;
+
+/// Periods of step moves the control tick may run ahead of the step generator.
+pub const STEP_QUEUE: usize = 4;
+
+/// What the tasks share. The controller is only touched from thread mode (link, control, inputs, settings),
+/// briefly and never across an `.await`; the step queue crosses to the step generator's interrupt priority.
+pub struct Shared {
+    /// The control core.
+    pub controller: Mutex<ThreadModeRawMutex, RefCell<Controller>>,
+    /// Unsolicited messages (faults) for the link to send.
+    pub outbox: Channel<ThreadModeRawMutex, Response, 4>,
+    /// One period's step moves per entry, from the control tick to the step generator.
+    pub steps: Channel<CriticalSectionRawMutex, [AxisMove; 6], STEP_QUEUE>,
+    /// Debounced logical input levels (`safety::debounce` layout), written by the inputs task.
+    pub inputs: AtomicU16,
+    /// Periods the step generator had to fill with no steps because the queue was empty.
+    pub step_underruns: AtomicU32,
+    /// The step generator found its buffer overrun (the DMA lapped it): a fault for the control tick to latch.
+    pub step_fault: core::sync::atomic::AtomicBool,
+}
+
+impl Shared {
+    /// Shares `controller`, with the inputs as the board read them at reset.
+    pub fn new(controller: Controller, inputs: u16) -> Self {
+        Self {
+            controller: Mutex::new(RefCell::new(controller)),
+            outbox: Channel::new(),
+            steps: Channel::new(),
+            inputs: AtomicU16::new(inputs),
+            step_underruns: AtomicU32::new(0),
+            step_fault: core::sync::atomic::AtomicBool::new(false),
+        }
+    }
+
+    /// Runs `f` on the controller.
+    pub fn with<R>(&self, f: impl FnOnce(&mut Controller) -> R) -> R {
+        self.controller.lock(|c| f(&mut c.borrow_mut()))
+    }
+}

@@ -1,0 +1,445 @@
+//! Board: STM32F411CE "Black Pill" (25 MHz crystal, USB-C, 512 KiB flash, 128 KiB RAM).
+//!
+//! Everything specific to this chip is here: clocks, the pin map, interrupt bindings, USB CDC-ACM, the
+//! TIM1 + DMA2 step generator, EXTI switch inputs, the independent watchdog and the settings flash. Another STM32
+//! (F446, G474, H743) is another module like this one plus its `memory.x`; `app` stays as it is.
+//!
+//! | signal | pin | | signal | pin |
+//! |---|---|---|---|---|
+//! | STEP 1-6 | PB0-PB5 | | E-STOP (NC chain) | PA0 |
+//! | DIR 1-6 | PB6-PB10, PB12 | | HOME 1-6 | PA1-PA6 |
+//! | ENABLE (active low) | PB13 | | LIMIT 5, 6 (far ends) | PA7, PA8 |
+//! | LOGIC_EN relay | PB14 | | LOGIC_OK, POWER_OK | PA9, PA10 |
+//! | POWER_EN relay | PB15 | | USB D-/D+ | PA11/PA12 |
+//!
+//! All STEP and DIR pins are on port B so that one 32-bit write to `GPIOB.BSRR` sets and clears all of them at
+//! once: the step generator is TIM1 updating every 2.5 us and DMA2 stream 5 (channel 6, TIM1_UP) copying one word
+//! per update from a ring of rendered periods into `BSRR`. The CPU renders a period per millisecond; it never
+//! touches a pin per step. Inputs are on port A, lines 0-10, each on its own EXTI line.
+
+use core::sync::atomic::Ordering;
+
+use embassy_embedded_hal::adapter::BlockingAsync;
+use embassy_executor::{InterruptExecutor, Spawner};
+use embassy_stm32::dma::{self, TransferOptions, WritableRingBuffer};
+use embassy_stm32::exti::{self, ExtiInput};
+use embassy_stm32::flash::{Blocking, Flash};
+use embassy_stm32::gpio::{Level, Output, Pull, Speed};
+use embassy_stm32::interrupt::{self, InterruptExt, Priority};
+use embassy_stm32::mode::Async;
+use embassy_stm32::time::Hertz;
+use embassy_stm32::timer::low_level::{RoundTo, Timer};
+use embassy_stm32::timer::UpDma;
+use embassy_stm32::usb::{self, Driver};
+use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config};
+use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
+use embassy_usb::{Builder, UsbDevice};
+use ringpod_core::controller::{Controller, Inputs, MAX_STEP_SLOTS};
+use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
+use ringpod_core::motion::AxisMove;
+use ringpod_core::safety::debounce::{to_inputs, InputBit};
+use ringpod_core::safety::Outputs;
+use static_cell::StaticCell;
+use {defmt_rtt as _, panic_probe as _};
+
+use crate::app::link::{Disconnected, Link};
+use crate::app::steps::{Overrun, PortOutput};
+use crate::app::{self, control::Machine, inputs::InputPins, Shared};
+
+bind_interrupts!(struct Irqs {
+    OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
+    DMA2_STREAM5 => dma::InterruptHandler<peripherals::DMA2_CH5>;
+    EXTI0 => exti::InterruptHandler<interrupt::typelevel::EXTI0>;
+    EXTI1 => exti::InterruptHandler<interrupt::typelevel::EXTI1>;
+    EXTI2 => exti::InterruptHandler<interrupt::typelevel::EXTI2>;
+    EXTI3 => exti::InterruptHandler<interrupt::typelevel::EXTI3>;
+    EXTI4 => exti::InterruptHandler<interrupt::typelevel::EXTI4>;
+    EXTI9_5 => exti::InterruptHandler<interrupt::typelevel::EXTI9_5>;
+    EXTI15_10 => exti::InterruptHandler<interrupt::typelevel::EXTI15_10>;
+});
+
+/// STEP on PB0-PB5, DIR on PB6-PB10 and PB12 (PB11 is not bonded out on the F411CE's package).
+pub const PORT_MAP: PortMap = PortMap {
+    step: [0, 1, 2, 3, 4, 5],
+    dir: [6, 7, 8, 9, 10, 12],
+    dir_forward_low: 0,
+};
+
+/// The settings live in flash sectors 6 and 7 (0x0804_0000-0x0807_FFFF, two 128 KiB erase pages); `memory.x`
+/// gives the program the first 256 KiB. Offsets are from the start of flash.
+const SETTINGS: core::ops::Range<u32> = 0x0004_0000..0x0008_0000;
+
+/// Normal watchdog timeout: 50 control periods.
+const WATCHDOG_US: u32 = 50_000;
+/// While a settings write may erase a 128 KiB sector (up to 2 s at 3.3 V with x32 parallelism): supplies are off.
+const WATCHDOG_FLASH_US: u32 = 4_000_000;
+
+/// The step generator's DMA ring: three periods of the longest buffer, so the renderer is always a period ahead.
+const RING: usize = 3 * MAX_STEP_SLOTS;
+
+/// Clock tree from the 25 MHz HSE crystal. USB needs exactly 48 MHz from the same PLL as the core, and no VCO
+/// frequency gives both 100 MHz (PLLP) and 48 MHz (PLLQ), so the core runs at 96 MHz:
+/// VCO  = 25 MHz / 25 (PLLM) * 384 (PLLN) = 384 MHz
+/// SYSCLK = 384 MHz / 4 (PLLP) = 96 MHz;  USB = 384 MHz / 8 (PLLQ) = 48 MHz
+/// APB1 = 96 / 2 = 48 MHz (max 50), APB2 = 96 MHz (max 100); TIM1 on APB2 counts at 96 MHz: 2.5 us = 240 counts.
+pub fn clocks() -> Config {
+    let mut config = Config::default();
+    config.rcc.hse = Some(rcc::Hse {
+        freq: Hertz(25_000_000),
+        mode: rcc::HseMode::Oscillator,
+    });
+    config.rcc.pll_src = rcc::PllSource::HSE;
+    config.rcc.pll = Some(rcc::Pll {
+        prediv: rcc::PllPreDiv::DIV25,
+        mul: rcc::PllMul::MUL384,
+        divp: Some(rcc::PllPDiv::DIV4),
+        divq: Some(rcc::PllQDiv::DIV8),
+        divr: None,
+    });
+    config.rcc.ahb_pre = rcc::AHBPrescaler::DIV1;
+    config.rcc.apb1_pre = rcc::APBPrescaler::DIV2;
+    config.rcc.apb2_pre = rcc::APBPrescaler::DIV1;
+    config.rcc.sys = rcc::Sysclk::PLL1_P;
+    config
+}
+
+/// The independent watchdog, on its registers: embassy's driver cannot change the timeout once running, and a
+/// settings write must widen it over a sector erase.
+mod watchdog {
+    use embassy_stm32::pac;
+    use embassy_stm32::pac::iwdg::vals::{Key, Pr};
+
+    /// LSI (32 kHz nominal) / 256 = 125 Hz: 8 ms per count, up to 32.7 s.
+    fn set(timeout_us: u32) {
+        let iwdg = pac::IWDG;
+        while iwdg.sr().read().pvu() || iwdg.sr().read().rvu() {}
+        iwdg.kr().write(|w| w.set_key(Key::ENABLE));
+        iwdg.pr().write(|w| w.set_pr(Pr::DIVIDE_BY256));
+        let counts = (timeout_us / 8_000).clamp(1, 0x0fff);
+        iwdg.rlr().write(|w| w.set_rl(counts as u16));
+        pet();
+    }
+
+    /// Starts the watchdog with `timeout_us` (it cannot be stopped again).
+    pub fn start(timeout_us: u32) {
+        pac::IWDG.kr().write(|w| w.set_key(Key::START));
+        set(timeout_us);
+    }
+
+    /// Changes the timeout.
+    pub fn set_timeout(timeout_us: u32) {
+        set(timeout_us);
+    }
+
+    /// Reloads the counter.
+    pub fn pet() {
+        pac::IWDG.kr().write(|w| w.set_key(Key::RESET));
+    }
+
+    /// Whether the last reset came from the watchdog; clears the reset flags.
+    pub fn caused_last_reset() -> bool {
+        let rcc = pac::RCC;
+        let was = rcc.csr().read().wdgrstf();
+        rcc.csr().modify(|w| w.set_rmvf(true));
+        was
+    }
+}
+
+/// Relays, driver enable, step queue, cycle counter, watchdog: the control loop's hardware.
+struct BlackPill {
+    logic_relay: Output<'static>,
+    power_relay: Output<'static>,
+    driver_enable_n: Output<'static>,
+}
+
+impl Machine for BlackPill {
+    fn inputs(&mut self, shared: &Shared) -> Inputs {
+        to_inputs(shared.inputs.load(Ordering::Relaxed))
+    }
+
+    fn outputs(&mut self, o: &Outputs) {
+        // The supervisor never asks for power without logic; the order of the writes keeps it so within a tick.
+        self.driver_enable_n.set_level(Level::from(!o.driver_enable));
+        if o.logic_relay {
+            self.logic_relay.set_high();
+            self.power_relay.set_level(Level::from(o.power_relay));
+        } else {
+            self.power_relay.set_level(Level::from(o.power_relay));
+            self.logic_relay.set_low();
+        }
+    }
+
+    async fn steps(&mut self, moves: &[AxisMove; 6], shared: &Shared) {
+        shared.steps.send(*moves).await;
+    }
+
+    fn queue_depth(&self, shared: &Shared) -> u16 {
+        shared.steps.len() as u16
+    }
+
+    fn cycles(&self) -> u32 {
+        cortex_m::peripheral::DWT::cycle_count()
+    }
+
+    fn feed_watchdog(&mut self) {
+        watchdog::pet();
+    }
+}
+
+/// The switch inputs on PA0-PA10 (order of `InputBit`).
+struct Switches {
+    pins: [ExtiInput<'static, Async>; 11],
+}
+
+/// Which logical bit each of `Switches::pins` is.
+const SWITCH_BITS: [InputBit; 11] = [
+    InputBit::EStop,
+    InputBit::Home(0),
+    InputBit::Home(1),
+    InputBit::Home(2),
+    InputBit::Home(3),
+    InputBit::Home(4),
+    InputBit::Home(5),
+    InputBit::Limit(4),
+    InputBit::Limit(5),
+    InputBit::LogicOk,
+    InputBit::PowerOk,
+];
+
+impl InputPins for Switches {
+    fn read(&mut self) -> u16 {
+        self.pins
+            .iter()
+            .zip(SWITCH_BITS)
+            .fold(0, |w, (p, b)| if p.is_high() { w | b.mask() } else { w })
+    }
+
+    async fn edge(&mut self) {
+        let waits = self.pins.each_mut().map(|p| p.wait_for_any_edge());
+        embassy_futures::select::select_array(waits).await;
+    }
+}
+
+/// USB CDC-ACM: 64-byte packets; a write that ends on a full packet is closed by a zero-length packet.
+struct UsbLink {
+    class: CdcAcmClass<'static, Driver<'static, peripherals::USB_OTG_FS>>,
+}
+
+impl Link for UsbLink {
+    async fn connected(&mut self) {
+        self.class.wait_connection().await;
+    }
+
+    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Disconnected> {
+        self.class.read_packet(buf).await.map_err(|_| Disconnected)
+    }
+
+    async fn write(&mut self, bytes: &[u8]) -> Result<(), Disconnected> {
+        for chunk in bytes.chunks(64) {
+            self.class.write_packet(chunk).await.map_err(|_| Disconnected)?;
+        }
+        if bytes.len().is_multiple_of(64) {
+            self.class.write_packet(&[]).await.map_err(|_| Disconnected)?;
+        }
+        Ok(())
+    }
+}
+
+/// The DMA ring into GPIOB.BSRR.
+struct DmaPort {
+    ring: WritableRingBuffer<'static, u32>,
+}
+
+impl PortOutput for DmaPort {
+    async fn write(&mut self, words: &[u32]) -> Result<(), Overrun> {
+        self.ring.write_exact(words).await.map(|_| ()).map_err(|_| Overrun)
+    }
+}
+
+static SHARED: StaticCell<Shared> = StaticCell::new();
+static STEP_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
+
+/// The step generator's executor runs in the USART6 interrupt (unused on this board), above everything else.
+#[embassy_stm32::interrupt]
+#[allow(non_snake_case)]
+unsafe fn USART6() {
+    // SAFETY: the executor is started on this interrupt below and this is its only handler.
+    unsafe { STEP_EXECUTOR.on_interrupt() }
+}
+
+#[embassy_executor::task]
+async fn usb_task(mut device: UsbDevice<'static, Driver<'static, peripherals::USB_OTG_FS>>) -> ! {
+    device.run().await
+}
+
+#[embassy_executor::task]
+async fn link_task(mut link: UsbLink, shared: &'static Shared) -> ! {
+    app::link::serve(&mut link, shared).await
+}
+
+#[embassy_executor::task]
+async fn control_task(mut machine: BlackPill, shared: &'static Shared) -> ! {
+    app::control::run(&mut machine, shared).await
+}
+
+#[embassy_executor::task]
+async fn inputs_task(mut switches: Switches, shared: &'static Shared) -> ! {
+    app::inputs::run(&mut switches, shared).await
+}
+
+#[embassy_executor::task]
+async fn steps_task(mut port: DmaPort, renderer: PulseRenderer, shared: &'static Shared) -> ! {
+    app::steps::run(&mut port, renderer, shared).await
+}
+
+#[embassy_executor::task]
+async fn settings_task(mut flash: BlockingAsync<Flash<'static, Blocking>>, shared: &'static Shared) -> ! {
+    app::settings::run(&mut flash, SETTINGS, shared, |wide| {
+        watchdog::set_timeout(if wide { WATCHDOG_FLASH_US } else { WATCHDOG_US })
+    })
+    .await
+}
+
+/// Brings the board up and spawns the tasks.
+pub async fn start(spawner: Spawner) {
+    let watchdog_reset = watchdog::caused_last_reset();
+    let p = embassy_stm32::init(clocks());
+
+    // Safe state first: drivers disabled, relays off, STEP low and DIR at its idle level, before anything else.
+    // (During reset and clock start-up the pins float: the wiring's pull resistors hold the same levels.)
+    let driver_enable_n = Output::new(p.PB13, Level::High, Speed::Low);
+    let logic_relay = Output::new(p.PB14, Level::Low, Speed::Low);
+    let power_relay = Output::new(p.PB15, Level::Low, Speed::Low);
+    let idle = PORT_MAP.idle_word();
+    let level = |pin: u8| Level::from(idle & (1 << pin) != 0);
+    let _step_dir = [
+        Output::new(p.PB0, level(0), Speed::VeryHigh),
+        Output::new(p.PB1, level(1), Speed::VeryHigh),
+        Output::new(p.PB2, level(2), Speed::VeryHigh),
+        Output::new(p.PB3, level(3), Speed::VeryHigh),
+        Output::new(p.PB4, level(4), Speed::VeryHigh),
+        Output::new(p.PB5, level(5), Speed::VeryHigh),
+        Output::new(p.PB6, level(6), Speed::VeryHigh),
+        Output::new(p.PB7, level(7), Speed::VeryHigh),
+        Output::new(p.PB8, level(8), Speed::VeryHigh),
+        Output::new(p.PB9, level(9), Speed::VeryHigh),
+        Output::new(p.PB10, level(10), Speed::VeryHigh),
+        Output::new(p.PB12, level(12), Speed::VeryHigh),
+    ];
+    // The pins stay outputs for the life of the program; the DMA writes their levels through BSRR.
+    core::mem::forget(_step_dir);
+
+    let mut core = unwrap_core();
+    core.DCB.enable_trace();
+    core.DWT.enable_cycle_counter();
+
+    // Settings: the compiled-in defaults with what flash holds replayed over them.
+    let mut flash = BlockingAsync::new(Flash::new_blocking(p.FLASH));
+    let (config, restored) = app::settings::restore(&mut flash, SETTINGS).await;
+    defmt::info!("settings: {}", restored);
+    let controller = match Controller::new(config) {
+        Ok(c) => c,
+        Err(e) => defmt::panic!("the compiled-in configuration cannot run: {}", e),
+    };
+    let renderer = match config.pulse_timing().and_then(|t| PulseRenderer::new(PORT_MAP, t)) {
+        Ok(r) => r,
+        Err(e) => defmt::panic!("step timing: {}", e),
+    };
+
+    let switches = Switches {
+        pins: [
+            ExtiInput::new(p.PA0, p.EXTI0, Pull::None, Irqs),
+            ExtiInput::new(p.PA1, p.EXTI1, Pull::Up, Irqs),
+            ExtiInput::new(p.PA2, p.EXTI2, Pull::Up, Irqs),
+            ExtiInput::new(p.PA3, p.EXTI3, Pull::Up, Irqs),
+            ExtiInput::new(p.PA4, p.EXTI4, Pull::Up, Irqs),
+            ExtiInput::new(p.PA5, p.EXTI5, Pull::Up, Irqs),
+            ExtiInput::new(p.PA6, p.EXTI6, Pull::Up, Irqs),
+            ExtiInput::new(p.PA7, p.EXTI7, Pull::Up, Irqs),
+            ExtiInput::new(p.PA8, p.EXTI8, Pull::Up, Irqs),
+            ExtiInput::new(p.PA9, p.EXTI9, Pull::Down, Irqs),
+            ExtiInput::new(p.PA10, p.EXTI10, Pull::Down, Irqs),
+        ],
+    };
+    let mut switches = switches;
+    let shared: &'static Shared = SHARED.init(Shared::new(controller, {
+        let raw = switches.read();
+        raw ^ config.inputs.active_low
+    }));
+    if watchdog_reset {
+        defmt::error!("the last reset was the watchdog's");
+        shared.with(|c| c.watchdog_reset());
+    }
+
+    // Step generator: DMA ring first (it starts playing zeros: no pin changes), then the timer that paces it.
+    static RING_BUF: StaticCell<[u32; RING]> = StaticCell::new();
+    let ring_buf = RING_BUF.init([0; RING]);
+    let request = p.DMA2_CH5.request();
+    let bsrr = pac::GPIOB.bsrr().as_ptr() as *mut u32;
+    // SAFETY: the ring buffer owns the channel and its memory for the life of the program; the peripheral address
+    // is GPIOB's set/reset register, which accepts any 32-bit word.
+    let mut ring = unsafe {
+        WritableRingBuffer::new(
+            dma::Channel::new(p.DMA2_CH5, Irqs),
+            request,
+            bsrr,
+            ring_buf,
+            TransferOptions::default(),
+        )
+    };
+    ring.start();
+    let timer = Timer::new(p.TIM1);
+    timer.set_frequency(Hertz(1_000_000_000 / ringpod_core::controller::STEP_SLOT_NS), RoundTo::Faster);
+    timer.enable_update_dma(true);
+    timer.start();
+    core::mem::forget(timer);
+
+    interrupt::USART6.set_priority(Priority::P1);
+    let high = STEP_EXECUTOR.start(interrupt::USART6);
+    high.spawn(steps_task(DmaPort { ring }, renderer, shared).expect("one step task"));
+
+    // USB CDC-ACM.
+    static EP_OUT: StaticCell<[u8; 256]> = StaticCell::new();
+    static CONFIG_DESC: StaticCell<[u8; 256]> = StaticCell::new();
+    static BOS_DESC: StaticCell<[u8; 256]> = StaticCell::new();
+    static CONTROL_BUF: StaticCell<[u8; 64]> = StaticCell::new();
+    static CDC_STATE: StaticCell<State> = StaticCell::new();
+    let mut usb_config = usb::Config::default();
+    // The Black Pill does not wire VBUS to PA9 (PA9 is LOGIC_OK here).
+    usb_config.vbus_detection = false;
+    let driver = Driver::new_fs(p.USB_OTG_FS, Irqs, p.PA12, p.PA11, EP_OUT.init([0; 256]), usb_config);
+    let mut device_config = embassy_usb::Config::new(0x1209, 0x0001);
+    device_config.manufacturer = Some("ringpod");
+    device_config.product = Some("ringpod motion controller");
+    device_config.serial_number = Some("ringpod-f411");
+    let mut builder = Builder::new(
+        driver,
+        device_config,
+        CONFIG_DESC.init([0; 256]),
+        BOS_DESC.init([0; 256]),
+        &mut [],
+        CONTROL_BUF.init([0; 64]),
+    );
+    let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), 64);
+    let device = builder.build();
+
+    watchdog::start(WATCHDOG_US);
+    let machine = BlackPill {
+        logic_relay,
+        power_relay,
+        driver_enable_n,
+    };
+    spawner.spawn(control_task(machine, shared).expect("one control task"));
+    spawner.spawn(inputs_task(switches, shared).expect("one inputs task"));
+    spawner.spawn(usb_task(device).expect("one usb task"));
+    spawner.spawn(link_task(UsbLink { class }, shared).expect("one link task"));
+    spawner.spawn(settings_task(flash, shared).expect("one settings task"));
+    defmt::info!("ringpod firmware up: {} Hz control tick", 1_000_000 / config.pipeline.tick_us);
+}
+
+fn unwrap_core() -> cortex_m::Peripherals {
+    match cortex_m::Peripherals::take() {
+        Some(p) => p,
+        None => defmt::panic!("core peripherals taken twice"),
+    }
+}
