@@ -3,23 +3,15 @@
 //! `main` only starts the board: the board module (`board/*.rs`, chosen by a cargo feature) brings up clocks and
 //! pins in their safe state, restores the settings and spawns the tasks of `app`, which wire the shared control
 //! core (`ringpod_core::controller`) to the host link, the control tick, the switches and the step generator.
-//! `board-f411` (the default) is the STM32F411CE Black Pill; `board-mps2` runs the same tasks on QEMU's
-//! mps2-an386 with a UART link and a simulated machine.
+//! `board-f411` (the default) is the STM32F411CE Black Pill.
 
 #![no_std]
 #![no_main]
-
-#[cfg(all(feature = "board-f411", feature = "board-mps2"))]
-compile_error!("choose one board: --no-default-features --features board-mps2 for QEMU");
 
 mod app;
 
 #[cfg(feature = "board-f411")]
 #[path = "board/stm32f411.rs"]
-mod board;
-
-#[cfg(feature = "board-mps2")]
-#[path = "board/mps2_an386.rs"]
 mod board;
 
 #[embassy_executor::main]

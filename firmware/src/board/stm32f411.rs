@@ -389,7 +389,10 @@ pub async fn start(spawner: Spawner) {
     };
     ring.start();
     let timer = Timer::new(p.TIM1);
-    timer.set_frequency(Hertz(1_000_000_000 / ringpod_core::controller::STEP_SLOT_NS), RoundTo::Faster);
+    timer.set_frequency(
+        Hertz(1_000_000_000 / ringpod_core::controller::STEP_SLOT_NS),
+        RoundTo::Faster,
+    );
     timer.enable_update_dma(true);
     timer.start();
     core::mem::forget(timer);
@@ -434,7 +437,10 @@ pub async fn start(spawner: Spawner) {
     spawner.spawn(usb_task(device).expect("one usb task"));
     spawner.spawn(link_task(UsbLink { class }, shared).expect("one link task"));
     spawner.spawn(settings_task(flash, shared).expect("one settings task"));
-    defmt::info!("ringpod firmware up: {} Hz control tick", 1_000_000 / config.pipeline.tick_us);
+    defmt::info!(
+        "ringpod firmware up: {} Hz control tick",
+        1_000_000 / config.pipeline.tick_us
+    );
 }
 
 fn unwrap_core() -> cortex_m::Peripherals {
