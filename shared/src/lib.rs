@@ -24,6 +24,7 @@ pub mod motion;
 pub mod protocol;
 mod real;
 pub mod safety;
+pub mod selfcheck;
 pub mod sim;
 
 pub use real::Real;
