@@ -113,20 +113,36 @@ fn reference_ik(d: &mut Digest) -> bool {
     let cases: [([f32; 6], [f32; 6]); 2] = [
         (
             [0.0, 0.0, 0.7, 0.0, 0.0, 0.0],
-            [-0.775_067_4, 0.775_067_4, 1.319_288_5, 2.869_467_5, -2.869_467_5, -1.319_288_5],
+            [
+                -0.775_067_4,
+                0.775_067_4,
+                1.319_288_5,
+                2.869_467_5,
+                -2.869_467_5,
+                -1.319_288_5,
+            ],
         ),
         (
             [0.02, 0.0, 0.7, 0.0, 0.0, 0.0],
-            [-0.769_907_2, 0.769_907_2, 1.297_106_8, 2.851_999_4, -2.851_999_4, -1.297_106_8],
+            [
+                -0.769_907_2,
+                0.769_907_2,
+                1.297_106_8,
+                2.851_999_4,
+                -2.851_999_4,
+                -1.297_106_8,
+            ],
         ),
     ];
-    cases.iter().all(|(pose, expected)| match rotopod.inverse(&Pose::from_array(*pose)) {
-        Ok(q) => q.0.iter().zip(expected).all(|(a, e)| {
-            d.f32(*a);
-            libm::fabsf(a - e) < 2e-5
-        }),
-        Err(_) => false,
-    })
+    cases
+        .iter()
+        .all(|(pose, expected)| match rotopod.inverse(&Pose::from_array(*pose)) {
+            Ok(q) => q.0.iter().zip(expected).all(|(a, e)| {
+                d.f32(*a);
+                libm::fabsf(a - e) < 2e-5
+            }),
+            Err(_) => false,
+        })
 }
 
 fn round_trip(d: &mut Digest) -> bool {
@@ -142,7 +158,14 @@ fn round_trip(d: &mut Digest) -> bool {
             d.f32(m);
         }
         d.f32(report.singularity_index);
-        let guess = Pose::new(pose.x + 1e-3, pose.y - 1e-3, pose.z, pose.alpha, pose.beta + 0.01, pose.gamma);
+        let guess = Pose::new(
+            pose.x + 1e-3,
+            pose.y - 1e-3,
+            pose.z,
+            pose.alpha,
+            pose.beta + 0.01,
+            pose.gamma,
+        );
         match trainer.forward(&q, &guess, &options) {
             Ok(fk) => {
                 d.i64(i64::from(fk.iterations));
@@ -222,8 +245,8 @@ fn frames(d: &mut Digest) -> bool {
     back == Ok(request) && protocol::decode::<Request>(&corrupted[..n - 1]).is_err()
 }
 
-/// A controller and the simulated plant, powered up, homed and streaming.
-fn running_rig(d: &mut Digest) -> Option<Rig> {
+/// A controller and the simulated plant, powered up (Enable), homed and started: `Running`, at the home pose.
+pub fn running_rig(d: &mut Digest) -> Option<Rig> {
     let mut rig = Rig {
         controller: Controller::new(ControllerConfig::trainer_model()).ok()?,
         plant: Plant::trainer_model([-500, -400, -300, -200, 8_000, 9_000]),
@@ -235,7 +258,12 @@ fn running_rig(d: &mut Digest) -> Option<Rig> {
         rig.controller.handle(&Request { id, body }).body
     };
     let ack = |m: DeviceMessage| matches!(m, DeviceMessage::Ack);
-    let hello = ask(&mut rig, HostMessage::Hello { version: PROTOCOL_VERSION });
+    let hello = ask(
+        &mut rig,
+        HostMessage::Hello {
+            version: PROTOCOL_VERSION,
+        },
+    );
     if !matches!(hello, DeviceMessage::Hello { .. }) || !ack(ask(&mut rig, HostMessage::Enable)) {
         return None;
     }
@@ -280,7 +308,6 @@ fn stream(d: &mut Digest) -> bool {
     // from here on exactly when every pulse reached the plant.
     let offset: [i64; 6] = core::array::from_fn(|a| rig.plant.position[a] - rig.controller.steps()[a]);
     let mut last = home();
-    let mut id = 1_000;
     for k in 1..=120u32 {
         // A recorded 2 s motion: surge and heave sweeps with a yaw turn, 60 Hz.
         let t = k as f32 / 60.0;
@@ -293,13 +320,19 @@ fn stream(d: &mut Digest) -> bool {
             0.05 * libm::sinf(2.0 * t),
             0.3 * t,
         );
-        id += 1;
+        let id = 1_000 + k;
         let sp = Setpoint {
             seq: k,
             time_us: u64::from(k) * 16_667,
             pose: last,
         };
-        let reply = rig.controller.handle(&Request { id, body: HostMessage::Setpoint(sp) }).body;
+        let reply = rig
+            .controller
+            .handle(&Request {
+                id,
+                body: HostMessage::Setpoint(sp),
+            })
+            .body;
         if reply != DeviceMessage::Ack {
             return false;
         }
@@ -317,14 +350,21 @@ fn stream(d: &mut Digest) -> bool {
     for s in status.steps {
         d.i64(s);
     }
-    let reached = status.pose.to_array().iter().zip(last.to_array()).all(|(a, b)| libm::fabsf(a - b) < 1e-5);
+    let reached = status
+        .pose
+        .to_array()
+        .iter()
+        .zip(last.to_array())
+        .all(|(a, b)| libm::fabsf(a - b) < 1e-5);
     let steps = rig.controller.steps();
     let counted = (0..6).all(|a| rig.plant.position[a] - steps[a] == offset[a]) && rig.plant.steps_while_disabled == 0;
-    let response = Response { id: 0, body: DeviceMessage::Status(status) };
+    let response = Response {
+        id: 0,
+        body: DeviceMessage::Status(status),
+    };
     let mut buf = [0u8; protocol::MAX_FRAME];
     if let Ok(n) = protocol::encode(&response, &mut buf) {
         d.bytes(&buf[..n]);
     }
     reached && counted && status.applied == 120
 }
-

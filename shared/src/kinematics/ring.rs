@@ -6,7 +6,7 @@ use nalgebra::{Matrix3, Matrix6, RowVector6, Vector3, Vector6};
 use super::geometry::{Branch, ChainKind, RingGeometry};
 use super::velocity::hadamard_ratio;
 use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
-use crate::real::wrap_pi;
+use crate::real::{wrap_once, wrap_pi};
 use crate::Real;
 
 /// A ring platform in scalar type `T`, built from a validated [`RingGeometry`].
@@ -38,8 +38,11 @@ pub struct ActuatorLoads<T> {
     pub drives: [T; 6],
 }
 
-/// Carriages per chain, positions of the platform joints and chain directions at one configuration.
+/// Carriages per chain, positions of the platform joints and chain directions at one configuration, computed once
+/// for all the checks of a pose (each would otherwise redo the rotation and the joints).
 struct Configuration<T: Real> {
+    /// Platform orientation.
+    rotation: Matrix3<T>,
     joints: [Vector3<T>; 6],
     carriages: [Vector3<T>; 6],
     /// Unit vector from carriage to platform joint.
@@ -91,7 +94,10 @@ impl<T: Real> RingPlatform<T> {
 
     /// Platform joints `A_i = R a_i + p` in the base frame.
     pub fn joints(&self, pose: &Pose<T>) -> [Vector3<T>; 6] {
-        let r = pose.rotation();
+        self.joints_with(&pose.rotation(), pose)
+    }
+
+    fn joints_with(&self, r: &Matrix3<T>, pose: &Pose<T>) -> [Vector3<T>; 6] {
         let p = pose.position();
         self.points.map(|a| r * a + p)
     }
@@ -101,7 +107,8 @@ impl<T: Real> RingPlatform<T> {
     }
 
     fn configuration(&self, pose: &Pose<T>, q: &Actuators<T>) -> Configuration<T> {
-        let joints = self.joints(pose);
+        let rotation = pose.rotation();
+        let joints = self.joints_with(&rotation, pose);
         let mut carriages = [Vector3::zeros(); 6];
         let mut dirs = [Vector3::zeros(); 6];
         for i in 0..self.n {
@@ -111,6 +118,7 @@ impl<T: Real> RingPlatform<T> {
                 .unwrap_or_else(Vector3::z);
         }
         Configuration {
+            rotation,
             joints,
             carriages,
             dirs,
@@ -120,7 +128,10 @@ impl<T: Real> RingPlatform<T> {
     /// Rows of the wrench matrix: each chain's line `(u, B x u)`, then for each radial chain the tangent force
     /// through its platform joint `(v, A x v)` (KINEMATICS.md 4.5), in SI units about the ring centre.
     pub fn wrench_matrix(&self, pose: &Pose<T>, q: &Actuators<T>) -> Matrix6<T> {
-        let c = self.configuration(pose, q);
+        self.wrench_of(&self.configuration(pose, q), q)
+    }
+
+    fn wrench_of(&self, c: &Configuration<T>, q: &Actuators<T>) -> Matrix6<T> {
         let mut w = Matrix6::zeros();
         let mut extra = self.n;
         for i in 0..self.n {
@@ -141,7 +152,11 @@ impl<T: Real> RingPlatform<T> {
     /// Scale-free singularity index of the wrench matrix: moments divided by the ring radius, then
     /// [`hadamard_ratio`]. 1 for six orthogonal lines, 0 at a singularity.
     pub fn singularity_index(&self, pose: &Pose<T>, q: &Actuators<T>) -> T {
-        let mut w = self.wrench_matrix(pose, q);
+        self.singularity_of(&self.configuration(pose, q), q)
+    }
+
+    fn singularity_of(&self, c: &Configuration<T>, q: &Actuators<T>) -> T {
+        let mut w = self.wrench_of(c, q);
         let inv = T::one() / self.rr;
         for c in 3..6 {
             w.column_mut(c).scale_mut(inv);
@@ -200,7 +215,10 @@ impl<T: Real> RingPlatform<T> {
     /// conditions `|Az| < L` and `|Rr - rho| <= h <= Rr + rho`, and of the radial strokes `s_min <= s <= s_max`.
     /// Negative outside, by how far.
     pub fn reach_margin(&self, pose: &Pose<T>) -> T {
-        let joints = self.joints(pose);
+        self.reach_of(&self.joints(pose))
+    }
+
+    fn reach_of(&self, joints: &[Vector3<T>; 6]) -> T {
         let mut margin = T::max_value().unwrap_or(T::one());
         for (a, kind) in joints.iter().zip(&self.kinds).take(self.n) {
             let rho = (a.x * a.x + a.y * a.y).sqrt_();
@@ -233,7 +251,14 @@ impl<T: Real> RingPlatform<T> {
         let mut largest = T::zero();
         let mut total = T::zero();
         for i in 0..self.n {
-            let mut gap = wrap_pi(q.0[(i + 1) % self.n] - q.0[i]);
+            let diff = q.0[(i + 1) % self.n] - q.0[i];
+            // IK's angles are within (-pi, pi], so one exact addition wraps their difference; other inputs (a
+            // multi-turn angle) take the general wrap.
+            let mut gap = if diff.abs() <= T::two_pi() {
+                wrap_once(diff)
+            } else {
+                wrap_pi(diff)
+            };
             if gap < T::zero() {
                 gap += two_pi;
             }
@@ -251,8 +276,8 @@ impl<T: Real> RingPlatform<T> {
         (spacing, order)
     }
 
-    fn cone_margin(&self, pose: &Pose<T>, c: &Configuration<T>) -> T {
-        let normal = pose.rotation().column(2).into_owned();
+    fn cone_margin(&self, c: &Configuration<T>) -> T {
+        let normal = c.rotation.column(2).into_owned();
         let mut margin = T::max_value().unwrap_or(T::one());
         for u in c.dirs.iter().take(self.n) {
             let base = u.z.clamp(-T::one(), T::one()).asin_() - self.cones[0];
@@ -263,7 +288,7 @@ impl<T: Real> RingPlatform<T> {
     }
 
     fn stability_margin(&self, pose: &Pose<T>, c: &Configuration<T>) -> T {
-        let com = pose.rotation() * self.com + pose.position();
+        let com = c.rotation * self.com + pose.position();
         let mut margin = T::max_value().unwrap_or(T::one());
         for i in 0..self.n {
             let (p0, p1) = (c.carriages[i], c.carriages[(i + 1) % self.n]);
@@ -358,7 +383,8 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
                         });
                     }
                     let phi = (inner * outer).sqrt_().atan2_(self.rr * self.rr + rho2 - h2);
-                    q[i] = wrap_pi(match branch {
+                    // theta is in [-pi, pi] and phi in [0, pi]: one exact addition wraps the sum.
+                    q[i] = wrap_once(match branch {
                         Branch::Plus => theta + phi,
                         Branch::Minus => theta - phi,
                     });
@@ -433,13 +459,13 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
     fn workspace(&self, pose: &Pose<T>, q: &Actuators<T>) -> WorkspaceReport<T> {
         let c = self.configuration(pose, q);
         let (spacing, order) = self.ring_order_margins(q);
-        let index = self.singularity_index(pose, q);
+        let index = self.singularity_of(&c, q);
         WorkspaceReport::new(
             [
-                Some(self.reach_margin(pose)),
+                Some(self.reach_of(&c.joints)),
                 Some(spacing),
                 Some(order),
-                Some(self.cone_margin(pose, &c)),
+                Some(self.cone_margin(&c)),
                 Some(index - self.min_index),
                 Some(self.stability_margin(pose, &c)),
             ],

@@ -1,0 +1,186 @@
+//! ringpod-core on an emulated Cortex-M4F (QEMU `mps2-an386`): the self-check workload with its checks and
+//! digest, then the cost of the control path in instructions. Output over semihosting, one result a line, read by
+//! `cargo run -p ringpod-tests --bin qemu`.
+//!
+//! Instruction counts: QEMU's `-icount shift=0` advances virtual time by 1 ns per instruction, and SysTick counts the
+//! 25 MHz core clock of the AN386 image, so one SysTick count is a fixed number of instructions (40). The number is
+//! not assumed: a calibration loop of a known instruction count measures it first.
+
+#![no_std]
+#![no_main]
+
+use core::hint::black_box;
+
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m::peripheral::SYST;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use ringpod_core::kinematics::presets::TRAINER_MODEL;
+use ringpod_core::kinematics::{Mechanism, NewtonOptions, Pose, RingPlatform};
+use ringpod_core::motion::Setpoint;
+use ringpod_core::protocol::{self, HostMessage, Request};
+use ringpod_core::selfcheck::{self, Digest, CHECKS};
+
+/// SysTick counts elapsed between two reads (it counts down, 24 bits).
+fn elapsed(start: u32, end: u32) -> u32 {
+    start.wrapping_sub(end) & 0x00ff_ffff
+}
+
+/// Counts of `f` (which must stay under 2^24 counts, about 670 M instructions).
+fn counts(mut f: impl FnMut()) -> u32 {
+    let start = SYST::get_current();
+    f();
+    elapsed(start, SYST::get_current())
+}
+
+/// A loop of exactly `2 n` instructions (`subs` and `bne`).
+fn known_loop(n: u32) {
+    // SAFETY: only a register is used and changed.
+    unsafe {
+        core::arch::asm!("1:", "subs {0}, #1", "bne 1b", inout(reg) n => _, options(nomem, nostack));
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let mut core = match cortex_m::Peripherals::take() {
+        Some(p) => p,
+        None => fail("core peripherals"),
+    };
+
+    let outcome = selfcheck::run();
+    for (name, ok) in CHECKS.iter().zip(outcome.passed) {
+        hprintln!("CHECK {} {}", if ok { "PASS" } else { "FAIL" }, name);
+    }
+    hprintln!("DIGEST {:016x}", outcome.digest);
+
+    core.SYST.set_clock_source(SystClkSource::Core);
+    core.SYST.set_reload(0x00ff_ffff);
+    core.SYST.clear_current();
+    core.SYST.enable_counter();
+
+    // Calibration: instructions per SysTick count, from 2 M instructions (in hundredths).
+    let calibration = counts(|| known_loop(1_000_000)).max(1);
+    let per_count_x100 = 200_000_000 / calibration;
+    hprintln!("CALIBRATION {} instructions per count (x100)", per_count_x100);
+    let report = |name: &str, total: u32, calls: u32| {
+        let instructions = u64::from(total) * u64::from(per_count_x100) / 100 / u64::from(calls.max(1));
+        hprintln!("COST {} {}", instructions, name);
+    };
+
+    let trainer = RingPlatform::<f32>::new(&TRAINER_MODEL);
+    let poses: [Pose<f32>; 64] = {
+        let mut all = [Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0); 64];
+        for (slot, p) in all.iter_mut().zip(selfcheck::poses(64)) {
+            *slot = p;
+        }
+        all
+    };
+    let mut q = [trainer.inverse(&poses[0]).unwrap_or_else(|_| fail("ik")); 64];
+    for (qi, p) in q.iter_mut().zip(&poses) {
+        *qi = trainer.inverse(p).unwrap_or_else(|_| fail("ik"));
+    }
+
+    let ik = counts(|| {
+        for p in &poses {
+            let _ = black_box(trainer.inverse(black_box(p)));
+        }
+    });
+    report("trainer IK (f32)", ik, 64);
+
+    let checks = counts(|| {
+        for p in &poses {
+            if let Ok(q) = trainer.inverse(black_box(p)) {
+                black_box(trainer.workspace(p, &q));
+            }
+        }
+    });
+    report("trainer IK + all six checks (f32)", checks, 64);
+
+    let options = NewtonOptions::default();
+    let mut iterations = 0u32;
+    let fk = counts(|| {
+        for (p, qi) in poses.iter().zip(&q) {
+            let guess = Pose::new(p.x + 1e-3, p.y - 1e-3, p.z, p.alpha, p.beta + 0.01, p.gamma);
+            if let Ok(s) = trainer.forward(black_box(qi), &guess, &options) {
+                iterations += u32::from(s.iterations);
+            }
+        }
+    });
+    report("trainer FK, Newton from 1 mm / 0.6 deg off (f32)", fk, 64);
+    hprintln!("FK_ITERATIONS {} per solve (x100)", iterations * 100 / 64);
+
+    // A controller brought to Running through power-up and homing, then fed a setpoint frame every tick.
+    let mut d = Digest::default();
+    let mut rig = selfcheck::running_rig(&mut d).unwrap_or_else(|| fail("controller did not reach Running"));
+    let home = rig.controller.pipeline().pose();
+    let mut out = [0u8; protocol::MAX_FRAME];
+    let mut frame = [0u8; protocol::MAX_FRAME];
+    let (mut tick_total, mut decode_total) = (0u32, 0u32);
+    let n = 500u32;
+    for k in 1..=n {
+        let t = k as f32 / 1000.0;
+        let pose = Pose::new(0.01 * libm_sin(2.0 * t), 0.0, home.z, 0.0, 0.0, 0.2 * t);
+        let request = Request {
+            id: k,
+            body: HostMessage::Setpoint(Setpoint {
+                seq: k,
+                time_us: u64::from(k) * 1_000,
+                pose,
+            }),
+        };
+        let len = protocol::encode(&request, &mut frame).unwrap_or(1);
+        decode_total += counts(|| {
+            black_box(rig.controller.handle_frame(&frame[..len - 1], &mut out));
+        });
+        let o = rig.controller.supervisor().outputs();
+        rig.controller
+            .set_inputs(rig.plant.inputs(o.logic_relay, o.power_relay));
+        let mut tick = None;
+        tick_total += counts(|| tick = Some(rig.controller.tick()));
+        if let Some(t) = tick {
+            rig.plant.apply(&t);
+        }
+    }
+    if rig.controller.status().applied != n {
+        fail("setpoints were rejected");
+    }
+    report(
+        "control tick: pipeline (limits, IK + checks) + scheduler + supervisor",
+        tick_total,
+        n,
+    );
+    report(
+        "decode + dispatch of one setpoint frame (COBS, CRC, postcard, validation)",
+        decode_total,
+        n,
+    );
+    hprintln!("DONE");
+    debug::exit(debug::EXIT_SUCCESS);
+    halt()
+}
+
+/// `sinf` through libm, as the core calls it.
+fn libm_sin(x: f32) -> f32 {
+    ringpod_core::Real::sin_(x)
+}
+
+fn fail(what: &str) -> ! {
+    hprintln!("ERROR {}", what);
+    debug::exit(debug::EXIT_FAILURE);
+    halt()
+}
+
+/// Semihosting's exit ends QEMU; should it not, wait for interrupts forever.
+fn halt() -> ! {
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("ERROR panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    halt()
+}
