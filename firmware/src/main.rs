@@ -8,8 +8,6 @@
 #![no_std]
 #![no_main]
 
-mod app;
-
 #[cfg(feature = "board-f411")]
 #[path = "board/stm32f411.rs"]
 mod board;

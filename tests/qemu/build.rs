@@ -11,5 +11,7 @@ fn main() {
     if env::var("TARGET").is_ok_and(|t| t.starts_with("thumb")) {
         println!("cargo:rustc-link-arg-bins=--nmagic");
         println!("cargo:rustc-link-arg-bins=-Tlink.x");
+        // The controller links the firmware's tasks, which log through defmt.
+        println!("cargo:rustc-link-arg-bin=ringpod-qemu-controller=-Tdefmt.x");
     }
 }

@@ -42,9 +42,9 @@ use ringpod_core::safety::Outputs;
 use static_cell::StaticCell;
 use {defmt_rtt as _, panic_probe as _};
 
-use crate::app::link::{Disconnected, Link};
-use crate::app::steps::{Overrun, PortOutput};
-use crate::app::{self, control::Machine, inputs::InputPins, Shared};
+use ringpod_firmware::app::link::{Disconnected, Link};
+use ringpod_firmware::app::steps::{Overrun, PortOutput};
+use ringpod_firmware::app::{self, control::Machine, inputs::InputPins, Shared};
 
 bind_interrupts!(struct Irqs {
     OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;

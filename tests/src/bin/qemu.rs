@@ -52,8 +52,10 @@ fn build(bin: &str) -> Result<PathBuf, String> {
     Ok(qemu_dir().join("target/thumbv7em-none-eabihf/release").join(bin))
 }
 
-/// QEMU's command line for an ELF on mps2-an386, semihosting on, one instruction per virtual nanosecond.
-fn qemu(elf: &Path) -> Command {
+/// QEMU's command line for an ELF on mps2-an386 with semihosting. With `icount`, virtual time advances one
+/// nanosecond per instruction (the instruction counter of the cost table); without, it follows the host's clock,
+/// which a controller streamed in real time needs.
+fn qemu(elf: &Path, icount: bool) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args([
         "-machine",
@@ -64,20 +66,17 @@ fn qemu(elf: &Path) -> Command {
         "-monitor",
         "none",
     ])
-    .args([
-        "-semihosting-config",
-        "enable=on,target=native",
-        "-icount",
-        "shift=0",
-        "-kernel",
-    ])
-    .arg(elf);
+    .args(["-semihosting-config", "enable=on,target=native"]);
+    if icount {
+        c.args(["-icount", "shift=0"]);
+    }
+    c.arg("-kernel").arg(elf);
     c
 }
 
 /// Runs a program to its end (or the limit) and returns what it printed.
 fn run_to_end(elf: &Path) -> Result<String, String> {
-    let mut child = qemu(elf)
+    let mut child = qemu(elf, true)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
@@ -175,9 +174,257 @@ fn core_on_m4f(t: &mut Tally) {
     println!();
 }
 
+/// QEMU running the controller program, its UART on a pseudo-terminal.
+struct Emulated {
+    child: std::process::Child,
+    pty: String,
+}
+
+impl Drop for Emulated {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// Starts the controller program and waits for its pty and its `READY`.
+fn start_controller(elf: &Path) -> Result<Emulated, String> {
+    let mut child = qemu(elf, false)
+        .args(["-serial", "pty"])
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("qemu-system-arm: {e}"))?;
+    let (tx, rx) = std::sync::mpsc::channel::<String>();
+    for stream in [
+        child.stdout.take().map(|s| Box::new(s) as Box<dyn Read + Send>),
+        child.stderr.take().map(|s| Box::new(s) as Box<dyn Read + Send>),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        let tx = tx.clone();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stream).lines().map_while(Result::ok) {
+                let _ = tx.send(line);
+            }
+        });
+    }
+    let mut emulated = Emulated {
+        child,
+        pty: String::new(),
+    };
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let mut ready = false;
+    while !ready || emulated.pty.is_empty() {
+        let left = deadline.saturating_duration_since(Instant::now());
+        let line = rx
+            .recv_timeout(left)
+            .map_err(|_| "the controller did not come up in 30 s".to_string())?;
+        if let Some(at) = line.find("/dev/pts/") {
+            emulated.pty = line[at..].split_whitespace().next().unwrap_or("").to_string();
+        }
+        ready |= line.trim() == "READY";
+        if line.starts_with("ERROR") {
+            return Err(line);
+        }
+    }
+    Ok(emulated)
+}
+
+fn ringpod() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"));
+    target.join("release/ringpod")
+}
+
+/// Runs the CLI and parses the JSON it prints.
+fn ringpod_json(args: &[&str]) -> Result<serde_json::Value, String> {
+    let out = Command::new(ringpod())
+        .args(args)
+        .stdin(Stdio::null())
+        .output()
+        .map_err(|e| format!("ringpod: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("ringpod {args:?}: {}", String::from_utf8_lossy(&out.stderr)));
+    }
+    serde_json::from_slice(&out.stdout).map_err(|e| format!("ringpod {args:?}: {e}"))
+}
+
+/// A 3 s input: 2 s of motion on every axis, then 1 s holding the last pose, so that both runs end at rest at the
+/// same pose whatever their timing.
+fn write_input(path: &Path) -> std::io::Result<()> {
+    let mut csv = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for k in 0..=300 {
+        let t = f64::from(k) * 0.01;
+        let u = t.min(2.0);
+        csv += &format!(
+            "{t:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}\n",
+            0.01 * (2.0 * u).sin(),
+            0.008 * (1.5 * u).sin(),
+            0.227 + 0.006 * (2.5 * u).sin(),
+            0.03 * u.sin(),
+            0.04 * (2.0 * u).sin(),
+            0.3 * u
+        );
+    }
+    std::fs::write(path, csv)
+}
+
+/// Writes `garbage` to the device's pty and returns what it answers within half a second.
+fn send_garbage(pty: &str, garbage: &[u8]) -> Result<Vec<u8>, String> {
+    use std::io::Write;
+    let status = Command::new("stty")
+        .args(["-F", pty, "raw", "-echo", "min", "0", "time", "5"])
+        .status()
+        .map_err(|e| format!("stty: {e}"))?;
+    if !status.success() {
+        return Err("stty failed".into());
+    }
+    let mut port = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(pty)
+        .map_err(|e| format!("{pty}: {e}"))?;
+    // QEMU's pty backend notices an opened slave side by polling (about once a second) and drops what the guest
+    // sends until then.
+    std::thread::sleep(Duration::from_millis(1_500));
+    port.write_all(garbage).map_err(|e| e.to_string())?;
+    let mut answer = Vec::new();
+    let mut buf = [0u8; 256];
+    while let Ok(n) = port.read(&mut buf) {
+        if n == 0 {
+            break;
+        }
+        answer.extend_from_slice(&buf[..n]);
+    }
+    Ok(answer)
+}
+
+/// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
+fn controller_on_m4f(t: &mut Tally) {
+    println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let cli = Command::new(&cargo)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .args(["build", "--release", "-p", "ringpod"])
+        .status();
+    if !cli.is_ok_and(|s| s.success()) {
+        t.check(false, "the host CLI builds");
+        return;
+    }
+    let emulated = match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf)) {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("{e}");
+            t.check(false, "the controller starts on the emulated Cortex-M4F");
+            return;
+        }
+    };
+    let pty = emulated.pty.as_str();
+    println!("controller on {pty}");
+    let input = std::env::temp_dir().join(format!("ringpod-qemu-{}.csv", std::process::id()));
+    if write_input(&input).is_err() {
+        t.check(false, "the input file is written");
+        return;
+    }
+    let file = input.to_string_lossy().to_string();
+    let emu = ringpod_json(&["stream", "--port", pty, "--input", &file, "--quiet", "--report-json"]);
+    let sim = ringpod_json(&[
+        "stream",
+        "--sim",
+        "--fast",
+        "--input",
+        &file,
+        "--quiet",
+        "--report-json",
+    ]);
+    let _ = std::fs::remove_file(&input);
+    match (&emu, &sim) {
+        (Ok(e), Ok(s)) => {
+            println!(
+                "emulated: final steps {}, simulator: {}",
+                e["final_steps"], s["final_steps"]
+            );
+            t.check(
+                e["state"] == "Ready" && e["counts_agree"] == true && e["rejected"] == serde_json::json!({}),
+                "stream a CSV: homed, every setpoint applied, back at rest, the counts add up",
+            );
+            t.check(
+                e["final_steps"] == s["final_steps"] && e["setpoints_applied"] == s["setpoints_applied"],
+                "the emulated controller ends at the host simulator's step positions",
+            );
+        }
+        (Err(e), _) | (_, Err(e)) => {
+            eprintln!("{e}");
+            t.check(false, "stream a CSV into the emulated controller and the simulator");
+        }
+    }
+
+    // A frame of garbage: answered with a Malformed nack (id 0), counted, never executed.
+    let garbage = [0x05, 0x11, 0x22, 0x33, 0x44, 0x55, 0x00];
+    let malformed = send_garbage(pty, &garbage).ok().and_then(|bytes| {
+        let frame = bytes.split(|b| *b == 0).next()?.to_vec();
+        ringpod_core::protocol::decode::<ringpod_core::protocol::Response>(&frame).ok()
+    });
+    t.check(
+        malformed.is_some_and(|r| {
+            r.id == 0
+                && r.body == ringpod_core::protocol::DeviceMessage::Nack(ringpod_core::protocol::NackReason::Malformed)
+        }),
+        "a corrupted frame is answered with a Malformed nack",
+    );
+    let status = ringpod_json(&["device", "status", "--port", pty]);
+    t.check(
+        status
+            .as_ref()
+            .is_ok_and(|s| s["bad_frames"] == 1 && s["state"] == "Ready"),
+        "the device counted the bad frame and moved nothing",
+    );
+
+    // Stream loss: the host dies mid-stream; the controller brakes to rest by itself.
+    let streaming = Command::new(ringpod())
+        .args([
+            "stream",
+            "--port",
+            pty,
+            "--motion",
+            "demo",
+            "--duration",
+            "30",
+            "--quiet",
+        ])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn();
+    let Ok(mut streaming) = streaming else {
+        t.check(false, "a stream starts");
+        return;
+    };
+    std::thread::sleep(Duration::from_secs(4));
+    let _ = streaming.kill();
+    let _ = streaming.wait();
+    std::thread::sleep(Duration::from_millis(1_500));
+    let after = ringpod_json(&["device", "status", "--port", pty]);
+    t.check(
+        after
+            .as_ref()
+            .is_ok_and(|s| s["state"] == "Ready" && s["applied"].as_u64().unwrap_or(0) > 0),
+        "a host killed mid-stream leaves the platform braked to rest (Ready)",
+    );
+    if let Ok(s) = &after {
+        println!("after the stream loss: state {}, steps {}", s["state"], s["steps"]);
+    }
+    drop(emulated);
+}
+
 fn main() -> ExitCode {
     let mut t = Tally { passed: 0, failed: 0 };
     core_on_m4f(&mut t);
+    controller_on_m4f(&mut t);
     println!("{} passed, {} failed", t.passed, t.failed);
     if t.failed == 0 {
         ExitCode::SUCCESS
