@@ -75,6 +75,8 @@ pub enum DeviceAction {
     Stop,
     /// Clear a latched fault.
     Clear,
+    /// Settings: `config` lists them all, `config get KEY`, `config set KEY VALUE` (stored in the board's flash).
+    Config,
 }
 
 #[derive(Debug, Args)]
@@ -82,6 +84,9 @@ pub struct DeviceArgs {
     /// What to do.
     #[arg(value_enum)]
     pub action: DeviceAction,
+    /// For `config`: `get KEY` or `set KEY VALUE`. Keys: stream-timeout-ms, jump-tolerance, tick-hz,
+    /// input-active-low, debounce-ms, and per axis (0-5) pose-velocity.N, pose-acceleration.N, steps-per-unit.N.
+    pub config: Vec<String>,
     /// Serial port of the board (USB CDC).
     #[arg(long, conflicts_with = "sim")]
     pub port: Option<String>,

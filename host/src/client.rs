@@ -7,7 +7,7 @@ use std::time::Duration;
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::motion::{RejectReason, Setpoint};
 use ringpod_core::protocol::{
-    self, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
+    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
 };
 use ringpod_core::safety::FaultReason;
 
@@ -171,6 +171,20 @@ impl<T: Transport> Client<T> {
     /// Clear a latched fault.
     pub fn clear(&mut self) -> Result<(), ClientError> {
         self.ack(HostMessage::ClearFault)
+    }
+
+    /// A setting's value on the device (as stored: effective now for live keys, after a restart for the others).
+    pub fn get_config(&mut self, key: ConfigKey) -> Result<f32, ClientError> {
+        match self.request(HostMessage::GetConfig(key))? {
+            DeviceMessage::Config(k, v) if k == key => Ok(v),
+            DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
+            other => Err(ClientError::Unexpected(format!("{other:?}"))),
+        }
+    }
+
+    /// Changes a setting (refused while anything may move, or out of range).
+    pub fn set_config(&mut self, key: ConfigKey, value: f32) -> Result<(), ClientError> {
+        self.ack(HostMessage::SetConfig(key, value))
     }
 
     /// The device's status.

@@ -7,6 +7,7 @@ mod kinematics;
 mod mechanism;
 mod numbers;
 mod pty;
+mod settings;
 mod stream;
 mod transport;
 mod workspace;
@@ -130,6 +131,9 @@ fn connect(port: Option<&str>, sim: bool, realtime: bool) -> anyhow::Result<tran
 /// `ringpod device ACTION`.
 fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
     use cli::DeviceAction as A;
+    if args.action != A::Config && !args.config.is_empty() {
+        anyhow::bail!("only `device config` takes further words");
+    }
     let mut client = client::Client::new(connect(args.port.as_deref(), args.sim, false)?);
     client.hello()?;
     match args.action {
@@ -145,6 +149,11 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
         A::Start => client.start()?,
         A::Stop => client.stop()?,
         A::Clear => client.clear()?,
+        A::Config => {
+            let json = settings::run(&mut client, &args.config)?;
+            let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&json)?);
+            return Ok(0);
+        }
     }
     let status = client.status()?;
     let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&status)?);

@@ -217,3 +217,36 @@ fn workspace_scan_draws_and_reports() {
         .assert()
         .code(1);
 }
+
+#[test]
+fn device_config_reads_writes_and_refuses() {
+    // Every setting is listed with its value.
+    let all = json(&["device", "config", "--sim"]);
+    assert_eq!(all["tick-hz"], 1000.0);
+    assert_eq!(all["steps-per-unit.0"], 25_600.0);
+    assert_eq!(all.as_object().unwrap().len(), 23);
+    // A set answers with the value read back from the device; a next-start key says it is not live.
+    let set = json(&["device", "config", "set", "pose-velocity.2", "0.02", "--sim"]);
+    assert_eq!(set["value"], 0.02);
+    assert_eq!(set["live"], true);
+    let tick = json(&["device", "config", "set", "tick-hz", "2000", "--sim"]);
+    assert_eq!(
+        (tick["value"].as_f64(), tick["live"].as_bool()),
+        (Some(2000.0), Some(false))
+    );
+    // Out of range, unknown, malformed, or extra words: an error, exit 1.
+    for args in [
+        &["device", "config", "set", "tick-hz", "1500", "--sim"][..],
+        &["device", "config", "set", "debounce-ms", "0", "--sim"],
+        &["device", "config", "get", "no-such-key", "--sim"],
+        &["device", "config", "set", "jump-tolerance", "lots", "--sim"],
+        &["device", "config", "fetch", "tick-hz", "--sim"],
+        &["device", "status", "tick-hz", "--sim"],
+    ] {
+        ringpod().args(args).assert().code(1);
+    }
+    ringpod()
+        .args(["device", "config", "set", "tick-hz", "1500", "--sim"])
+        .assert()
+        .stderr(predicates::str::contains("BadConfig"));
+}
