@@ -399,7 +399,7 @@ pub async fn start(spawner: Spawner) {
 
     interrupt::USART6.set_priority(Priority::P1);
     let high = STEP_EXECUTOR.start(interrupt::USART6);
-    high.spawn(steps_task(DmaPort { ring }, renderer, shared).expect("one step task"));
+    high.spawn(defmt::unwrap!(steps_task(DmaPort { ring }, renderer, shared)));
 
     // USB CDC-ACM.
     static EP_OUT: StaticCell<[u8; 256]> = StaticCell::new();
@@ -432,11 +432,11 @@ pub async fn start(spawner: Spawner) {
         power_relay,
         driver_enable_n,
     };
-    spawner.spawn(control_task(machine, shared).expect("one control task"));
-    spawner.spawn(inputs_task(switches, shared).expect("one inputs task"));
-    spawner.spawn(usb_task(device).expect("one usb task"));
-    spawner.spawn(link_task(UsbLink { class }, shared).expect("one link task"));
-    spawner.spawn(settings_task(flash, shared).expect("one settings task"));
+    spawner.spawn(defmt::unwrap!(control_task(machine, shared)));
+    spawner.spawn(defmt::unwrap!(inputs_task(switches, shared)));
+    spawner.spawn(defmt::unwrap!(usb_task(device)));
+    spawner.spawn(defmt::unwrap!(link_task(UsbLink { class }, shared)));
+    spawner.spawn(defmt::unwrap!(settings_task(flash, shared)));
     defmt::info!(
         "ringpod firmware up: {} Hz control tick",
         1_000_000 / config.pipeline.tick_us

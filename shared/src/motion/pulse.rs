@@ -71,6 +71,7 @@ impl PortMap {
 /// Why a slot timing cannot render the scheduler's pulses faithfully.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum PulseTimingError {
     /// The slot does not divide the period, or the period has more slots than the buffer.
     Slots,
@@ -81,6 +82,19 @@ pub enum PulseTimingError {
     /// The pin map uses a pin twice or a pin above 15.
     Pins,
 }
+
+impl core::fmt::Display for PulseTimingError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::Slots => "the slot does not divide the period, or the period does not fit the buffer",
+            Self::Spacing => "on the slot grid, the low time between steps would be shorter than required",
+            Self::Direction => "on the slot grid, DIR setup or hold would be shorter than required",
+            Self::Pins => "the pin map uses a pin twice or a pin above 15",
+        })
+    }
+}
+
+impl core::error::Error for PulseTimingError {}
 
 /// Slot grid of the step generator.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
