@@ -20,6 +20,7 @@ use ringpod_core::kinematics::{Mechanism, NewtonOptions, Pose, RingPlatform};
 use ringpod_core::motion::Setpoint;
 use ringpod_core::protocol::{self, HostMessage, Request};
 use ringpod_core::selfcheck::{self, Digest, CHECKS};
+use ringpod_qemu::{fail, halt};
 
 /// SysTick counts elapsed between two reads (it counts down, 24 bits).
 fn elapsed(start: u32, end: u32) -> u32 {
@@ -163,24 +164,4 @@ fn main() -> ! {
 /// `sinf` through libm, as the core calls it.
 fn libm_sin(x: f32) -> f32 {
     ringpod_core::Real::sin_(x)
-}
-
-fn fail(what: &str) -> ! {
-    hprintln!("ERROR {}", what);
-    debug::exit(debug::EXIT_FAILURE);
-    halt()
-}
-
-/// Semihosting's exit ends QEMU; should it not, wait for interrupts forever.
-fn halt() -> ! {
-    loop {
-        cortex_m::asm::wfi();
-    }
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("ERROR panic: {}", info);
-    debug::exit(debug::EXIT_FAILURE);
-    halt()
 }

@@ -19,7 +19,7 @@ use core::task::Waker;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::NVIC;
 use cortex_m_rt::exception;
-use cortex_m_semihosting::{debug, hprintln};
+use cortex_m_semihosting::hprintln;
 use critical_section::Mutex as CsMutex;
 use embassy_executor::Spawner;
 use embassy_sync::blocking_mutex::raw::CriticalSectionRawMutex;
@@ -33,6 +33,7 @@ use ringpod_core::sim::Plant;
 use ringpod_firmware::app::control::Machine;
 use ringpod_firmware::app::link::{Disconnected, Link};
 use ringpod_firmware::app::{self, Shared};
+use ringpod_qemu::fail;
 use static_cell::StaticCell;
 
 /// SysTick period: 100 us of the 25 MHz core clock.
@@ -233,23 +234,6 @@ async fn main(spawner: Spawner) {
     spawner.spawn(link_task(UartLink, shared).unwrap_or_else(|_| fail("spawn")));
     spawner.spawn(control_task(machine, shared).unwrap_or_else(|_| fail("spawn")));
     hprintln!("READY");
-}
-
-fn fail(what: &str) -> ! {
-    hprintln!("ERROR {}", what);
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::wfi();
-    }
-}
-
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    hprintln!("ERROR panic: {}", info);
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::wfi();
-    }
 }
 
 /// defmt's output goes nowhere here: the program reports over semihosting and the host reads the device's state
