@@ -522,7 +522,14 @@ impl Controller {
 
     /// A setting changed over the protocol that the firmware has not stored yet, with its value; each change is
     /// handed out once. Nothing is lost: a key changed twice before it is taken is stored once, with its last value.
+    ///
+    /// Only while the power relay and the drivers are off: writing flash can stall the CPU (a sector erase on an
+    /// STM32F4 for up to 2 s), which must never happen while anything could move.
     pub fn take_unsaved(&mut self) -> Option<(ConfigKey, f32)> {
+        let o = self.supervisor.outputs();
+        if o.power_relay || o.driver_enable {
+            return None;
+        }
         while self.unsaved != 0 {
             let code = self.unsaved.trailing_zeros();
             self.unsaved &= !(1u64 << code);

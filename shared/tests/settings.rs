@@ -271,3 +271,52 @@ fn unsaved_changes_are_handed_out_once_with_their_last_value_and_restore_at_boot
     let restarted = Controller::new(boot).unwrap();
     assert_eq!(restarted.pipeline().config().tick_us, 2_000);
 }
+
+#[test]
+fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
+    use ringpod_core::safety::State;
+    use ringpod_core::sim::{Plant, Rig};
+    let mut rig = Rig {
+        controller: connected(),
+        plant: Plant::trainer_model([0; 6]),
+        ticks: 0,
+    };
+    assert_eq!(
+        rig.controller
+            .handle(&Request {
+                id: 2,
+                body: HostMessage::Enable
+            })
+            .body,
+        DeviceMessage::Ack
+    );
+    for _ in 0..5_000 {
+        if matches!(rig.controller.supervisor().state(), State::PowerOn { settled: true }) {
+            break;
+        }
+        rig.tick();
+    }
+    assert!(rig.controller.supervisor().outputs().power_relay);
+    // Nothing moves in PowerOn, so the setting is taken, but it is not handed out for flash while power is on.
+    assert_eq!(set(&mut rig.controller, ConfigKey::DebounceMs, 7.0), DeviceMessage::Ack);
+    assert!(rig.controller.has_unsaved());
+    assert_eq!(rig.controller.take_unsaved(), None);
+    assert_eq!(
+        rig.controller
+            .handle(&Request {
+                id: 3,
+                body: HostMessage::Disable
+            })
+            .body,
+        DeviceMessage::Ack
+    );
+    for _ in 0..5_000 {
+        if rig.controller.supervisor().state() == State::Off {
+            break;
+        }
+        rig.tick();
+    }
+    assert_eq!(rig.controller.supervisor().state(), State::Off);
+    assert_eq!(rig.controller.take_unsaved(), Some((ConfigKey::DebounceMs, 7.0)));
+    assert_eq!(rig.controller.take_unsaved(), None);
+}

@@ -53,20 +53,14 @@ pub async fn restore<F: NorFlash>(flash: &mut F, range: Range<u32>) -> (Controll
     (config, report)
 }
 
-/// Stores the controller's unsaved settings, one at a time, whenever the supplies are off. `widen` is called
+/// Stores the controller's unsaved settings, one at a time, as it hands them out (only with the supplies off). `widen` is called
 /// around each write with `true` and then `false`, for the board to lengthen its watchdog over a possible erase.
 pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared, mut widen: impl FnMut(bool)) -> ! {
     let mut buf = [0u8; 32];
     loop {
         Timer::after(Duration::from_millis(100)).await;
-        let next = shared.with(|c| {
-            let o = c.supervisor().outputs();
-            if o.power_relay || o.driver_enable {
-                None
-            } else {
-                c.take_unsaved()
-            }
-        });
+        // The controller hands settings out only while the supplies are off.
+        let next = shared.with(|c| c.take_unsaved());
         let Some((key, value)) = next else { continue };
         widen(true);
         let result = store_item(flash, range.clone(), &mut NoCache::new(), &mut buf, &key.code(), &value).await;
