@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use ringpod_core::controller::{Controller, ControllerConfig};
 use ringpod_core::protocol::{self, FrameReader};
-use ringpod_core::sim::{Plant, Rig};
+use ringpod_core::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
 
 use crate::client::Transport;
 
@@ -63,7 +63,7 @@ impl SimDevice {
         let controller = Controller::new(config).expect("the built-in model configuration is valid");
         let rig = Rig {
             controller,
-            plant: Plant::trainer_model([-500, -400, -300, -200, 8_000, 9_000]),
+            plant: Plant::trainer_model(TRAINER_MODEL_PARKED),
             ticks: 0,
         };
         Self {

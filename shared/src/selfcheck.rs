@@ -11,7 +11,7 @@ use crate::kinematics::{Mechanism, NewtonOptions, Pose, RingPlatform};
 use crate::motion::{SchedulerConfig, Setpoint, StepScheduler};
 use crate::protocol::{self, DeviceMessage, HostMessage, Request, Response, PROTOCOL_VERSION};
 use crate::safety::State;
-use crate::sim::{Plant, Rig};
+use crate::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
 
 /// FNV-1a over the bits of everything the workload computes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -249,7 +249,7 @@ fn frames(d: &mut Digest) -> bool {
 pub fn running_rig(d: &mut Digest) -> Option<Rig> {
     let mut rig = Rig {
         controller: Controller::new(ControllerConfig::trainer_model()).ok()?,
-        plant: Plant::trainer_model([-500, -400, -300, -200, 8_000, 9_000]),
+        plant: Plant::trainer_model(TRAINER_MODEL_PARKED),
         ticks: 0,
     };
     let mut id = 0;

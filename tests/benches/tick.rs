@@ -2,45 +2,17 @@
 //! and the decode + dispatch of one setpoint frame. `cargo bench -p ringpod-tests --bench tick`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use ringpod_core::controller::{Controller, ControllerConfig};
 use ringpod_core::kinematics::Pose;
 use ringpod_core::motion::Setpoint;
-use ringpod_core::protocol::{self, HostMessage, Request, PROTOCOL_VERSION};
-use ringpod_core::safety::State;
-use ringpod_tests::plant::{Plant, Rig};
+use ringpod_core::protocol::{self, HostMessage, Request};
+use ringpod_core::selfcheck;
+use ringpod_core::sim::Rig;
 use std::hint::black_box;
 
+/// A controller brought to `Running` through power-up and homing, with its simulated plant (the same procedure the
+/// self-check and the QEMU cost table use).
 fn running_rig() -> Rig {
-    let controller = Controller::new(ControllerConfig::trainer_model()).unwrap();
-    let mut rig = Rig {
-        controller,
-        plant: Plant::trainer_model([-500, -400, -300, -200, 8_000, 9_000]),
-        ticks: 0,
-    };
-    for body in [
-        HostMessage::Hello {
-            version: PROTOCOL_VERSION,
-        },
-        HostMessage::Enable,
-    ] {
-        rig.controller.handle(&Request { id: 1, body });
-    }
-    for _ in 0..400 {
-        rig.tick();
-    }
-    rig.controller.handle(&Request {
-        id: 2,
-        body: HostMessage::Home,
-    });
-    while rig.controller.supervisor().state() != State::Ready {
-        rig.tick();
-        assert!(rig.ticks < 60_000, "homing finished");
-    }
-    rig.controller.handle(&Request {
-        id: 3,
-        body: HostMessage::Start,
-    });
-    rig
+    selfcheck::running_rig(&mut selfcheck::Digest::default()).expect("the controller reaches Running")
 }
 
 /// The demo-like motion: every axis moving, within the limits at 1 kHz.

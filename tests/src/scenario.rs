@@ -46,7 +46,7 @@ pub struct Scenario {
 }
 
 fn default_start() -> [i64; 6] {
-    [-500, -400, -300, -200, 8_000, 9_000]
+    ringpod_core::sim::TRAINER_MODEL_PARKED
 }
 
 /// One timed step.

@@ -7,7 +7,7 @@ use ringpod_core::motion::Setpoint;
 use ringpod_core::protocol::{
     self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, PROTOCOL_VERSION,
 };
-use ringpod_tests::plant::{Plant, Rig};
+use ringpod_tests::plant::{Plant, Rig, TRAINER_MODEL_PARKED};
 
 /// xorshift64*: fast and repeatable.
 struct Rng(u64);
@@ -107,7 +107,7 @@ fn ten_million_frames() {
     let controller = Controller::new(ControllerConfig::trainer_model()).unwrap();
     let mut rig = Rig {
         controller,
-        plant: Plant::trainer_model([-500, -400, -300, -200, 8_000, 9_000]),
+        plant: Plant::trainer_model(TRAINER_MODEL_PARKED),
         ticks: 0,
     };
     let mut rng = Rng(0x5eed_1234_abcd_0001);

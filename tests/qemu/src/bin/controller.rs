@@ -29,7 +29,7 @@ use embassy_time_queue_utils::Queue;
 use ringpod_core::controller::{Controller, ControllerConfig, Inputs, TickOutput};
 use ringpod_core::motion::AxisMove;
 use ringpod_core::safety::Outputs;
-use ringpod_core::sim::Plant;
+use ringpod_core::sim::{Plant, TRAINER_MODEL_PARKED};
 use ringpod_firmware::app::control::Machine;
 use ringpod_firmware::app::link::{Disconnected, Link};
 use ringpod_firmware::app::{self, Shared};
@@ -225,7 +225,7 @@ async fn main(spawner: Spawner) {
 
     // The host simulator's machine: the same configuration and the same parking positions.
     let controller = Controller::new(ControllerConfig::trainer_model()).unwrap_or_else(|_| fail("configuration"));
-    let plant = Plant::trainer_model([-500, -400, -300, -200, 8_000, 9_000]);
+    let plant = Plant::trainer_model(TRAINER_MODEL_PARKED);
     let shared: &'static Shared = SHARED.init(Shared::new(controller, 0));
     let machine = VirtualMachine {
         plant,
