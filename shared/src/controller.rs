@@ -8,7 +8,7 @@ use crate::kinematics::presets::{Preset, PresetGeometry};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, MultiTurn, Pose, RingPlatform};
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{
-    AxisMove, AxisScale, Pipeline, PipelineConfig, PipelineEvent, SchedulerConfig, StepConverter, StepScheduler,
+    Accepted, AxisMove, AxisScale, FollowMode, Pipeline, PipelineConfig, PipelineEvent, SchedulerConfig, StepConverter, StepScheduler,
 };
 use crate::protocol::{
     self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
@@ -122,7 +122,9 @@ impl ControllerConfig {
             ConfigKey::StreamTimeoutMs => c.stream_timeout_us as f32 / 1000.0,
             ConfigKey::PoseVelocity(a) => *c.limits.pose_velocity.get(usize::from(a))?,
             ConfigKey::PoseAcceleration(a) => *c.limits.pose_acceleration.get(usize::from(a))?,
-            ConfigKey::JumpTolerance => c.jump_tolerance,
+            ConfigKey::GrossJumpMs => c.gross_jump_us as f32 / 1000.0,
+            ConfigKey::FollowDirect => f32::from(u8::from(c.follow == FollowMode::Direct)),
+            ConfigKey::EnvelopeMargin(i) => *c.margins.0.get(usize::from(i))?,
             ConfigKey::TickHz => 1e6 / c.tick_us as f32,
             ConfigKey::StepsPerUnit(a) => {
                 let scale = self.scales.get(usize::from(a))?;
@@ -171,7 +173,18 @@ impl ControllerConfig {
                     .get_mut(usize::from(a))
                     .ok_or(ConfigError::Value)? = value
             }
-            ConfigKey::JumpTolerance if value <= 10.0 => c.jump_tolerance = value,
+            ConfigKey::GrossJumpMs if (10.0..=10_000.0).contains(&value) => c.gross_jump_us = (value * 1000.0) as u32,
+            ConfigKey::FollowDirect if value == 0.0 || value == 1.0 => {
+                c.follow = if value == 1.0 {
+                    FollowMode::Direct
+                } else {
+                    FollowMode::Interpolate
+                }
+            }
+            // No margin may take more than a tenth of the check's natural scale (0.1 m, 0.1 rad, 0.1 of the index).
+            ConfigKey::EnvelopeMargin(i) if value <= 0.1 => {
+                *c.margins.0.get_mut(usize::from(i)).ok_or(ConfigError::Value)? = value
+            }
             ConfigKey::TickHz if value == 500.0 || value == 1000.0 || value == 2000.0 => {
                 let tick_us = (1e6 / value) as u32;
                 c.tick_us = tick_us;
@@ -252,6 +265,8 @@ pub struct Controller {
     homing_carry: i64,
     /// Homing found every switch; the platform is on its way to the home pose.
     returning_home: bool,
+    /// Re-homing a homed machine: the platform is on its way to the parking pose near the switches first.
+    parking: bool,
     connected: bool,
     inputs: Inputs,
     elapsed_us: u32,
@@ -301,6 +316,7 @@ impl Controller {
             homing: None,
             homing_carry: 0,
             returning_home: false,
+            parking: false,
             connected: false,
             inputs: Inputs::default(),
             elapsed_us: 0,
@@ -355,6 +371,7 @@ impl Controller {
             self.pipeline.halt();
             self.homing = None;
             self.returning_home = false;
+            self.parking = false;
             if !was_fault {
                 self.pending_fault = true;
             }
@@ -414,7 +431,8 @@ impl Controller {
             }
             _ if !self.connected => DeviceMessage::Nack(NackReason::NotConnected),
             HostMessage::Setpoint(sp) => match self.pipeline.submit(&sp) {
-                Ok(()) => DeviceMessage::Ack,
+                Ok(Accepted::Applied) => DeviceMessage::Ack,
+                Ok(Accepted::Limited(report)) => DeviceMessage::Limited(report),
                 Err(reason) => DeviceMessage::Nack(NackReason::Rejected(reason)),
             },
             HostMessage::GetStatus => DeviceMessage::Status(self.status()),
@@ -438,6 +456,7 @@ impl Controller {
 
     fn command(&mut self, e: Event) -> DeviceMessage {
         let was_fault = matches!(self.supervisor.state(), State::Fault(..));
+        let was_homed = self.supervisor.homed() && self.supervisor.state() == State::Ready;
         let result = self.supervisor.handle(e);
         self.after_transition(was_fault);
         if let Err(r) = result {
@@ -445,16 +464,25 @@ impl Controller {
         }
         match e {
             Event::Home => {
-                self.homing = Some(HomingSequencer::new(self.plan, &self.scheduler.position()));
                 self.homing_carry = 0;
                 self.returning_home = false;
+                // A homed machine knows where its switches are: it first moves, under the normal limits and
+                // checks, to where the first homing started (each axis a little before its switch), so that
+                // every search is as short as the first one was. The home pose is often further from a linear
+                // actuator's end switch than its search travel.
+                self.parking = was_homed
+                    && self
+                        .parking_pose()
+                        .is_ok_and(|pose| self.pipeline.move_to(pose).is_ok());
+                self.homing = (!self.parking).then(|| HomingSequencer::new(self.plan, &self.scheduler.position()));
             }
             Event::Start => self.pipeline.start(),
             Event::Stop => {
                 self.pipeline.stop();
-                if self.homing.take().is_some() || self.returning_home {
+                if self.homing.take().is_some() || self.returning_home || self.parking {
                     self.pipeline.halt();
                     self.returning_home = false;
+                    self.parking = false;
                 }
             }
             _ => {}
@@ -501,6 +529,7 @@ impl Controller {
             steps: self.scheduler.position(),
             pose: self.pipeline.pose(),
             applied: self.pipeline.applied(),
+            limited: *self.pipeline.limited(),
             rejected: *self.pipeline.rejected(),
             held: self.pipeline.held(),
             carried: self.scheduler.carried(),
@@ -616,12 +645,29 @@ impl Controller {
     fn pose_after_homing(&mut self) -> Result<Pose<f32>, KinematicsError> {
         let mechanism = *self.pipeline.mechanism();
         let home = MultiTurn::new(mechanism.inverse(&self.home_pose)?);
-        let axes = mechanism.axes();
         let converter = self.pipeline.converter_mut();
         for a in 0..6 {
             converter.set_home(a, &home, 0);
         }
-        let position = self.scheduler.position();
+        self.pose_at_steps(&self.scheduler.position())
+    }
+
+    /// Where re-homing starts: every axis two back-off distances before its switch (homed coordinates), found
+    /// by forward kinematics.
+    fn parking_pose(&self) -> Result<Pose<f32>, KinematicsError> {
+        let axes = &self.config.homing.axes;
+        let steps = core::array::from_fn(|a| {
+            let h = &axes[a];
+            h.home_position - i64::from(h.toward) * 2 * i64::from(h.backoff_steps)
+        });
+        self.pose_at_steps(&steps)
+    }
+
+    /// The pose at motor step positions in homed coordinates (step 0 of each axis at the home pose).
+    fn pose_at_steps(&self, position: &[i64; 6]) -> Result<Pose<f32>, KinematicsError> {
+        let mechanism = *self.pipeline.mechanism();
+        let home = MultiTurn::new(mechanism.inverse(&self.home_pose)?);
+        let axes = mechanism.axes();
         let q = crate::kinematics::Actuators(core::array::from_fn(|a| {
             let scale = &self.config.scales[a];
             let per_unit = scale.per_unit(axes[a]) * if scale.invert { -1.0 } else { 1.0 };
@@ -632,6 +678,18 @@ impl Controller {
     }
 
     fn homing_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
+        if self.parking {
+            let (targets, event) = self.pipeline.tick();
+            match event {
+                Some(PipelineEvent::AtRest) => {
+                    self.parking = false;
+                    self.homing = Some(HomingSequencer::new(self.plan, &targets));
+                }
+                Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
+                _ => {}
+            }
+            return targets;
+        }
         if self.returning_home {
             let (targets, event) = self.pipeline.tick();
             match event {

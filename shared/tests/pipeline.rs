@@ -5,9 +5,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use proptest::prelude::*;
-use ringpod_core::kinematics::{presets, AxisKind, Mechanism, Pose, RingPlatform};
+use ringpod_core::kinematics::{presets, AxisKind, Check, Mechanism, Pose, RingPlatform};
 use ringpod_core::motion::{
-    AxisScale, MotionLimits, Pipeline, PipelineConfig, PipelineEvent, RejectReason, Setpoint, StepConverter,
+    Accepted, AxisScale, MotionLimits, Pipeline, PipelineConfig, PipelineEvent, RejectReason, Setpoint, StepConverter,
 };
 
 const HOME: [f32; 6] = [0.0, 0.0, presets::TRAINER_MODEL_HOME_Z as f32, 0.0, 0.0, 0.0];
@@ -158,7 +158,7 @@ proptest! {
         let next = Setpoint { seq: 5000, time_us: 5_000_000, pose: p.pose() };
         prop_assert_eq!(p.submit(&next), Err(RejectReason::NotStreaming));
         p.start();
-        prop_assert_eq!(p.submit(&next), Ok(()));
+        prop_assert_eq!(p.submit(&next), Ok(Accepted::Applied));
     }
 
     /// The yaw spins at 1.9 rad/s for many turns: carriages follow, steps stay exact.
@@ -187,9 +187,13 @@ proptest! {
 fn rejected_setpoints_never_move() {
     let mut p = pipeline();
     let start = p.steps();
+    let jump = RejectReason::GrossJump {
+        outside: Some(Check::Reach),
+    };
     let bad = [
         (Pose::new(f32::NAN, 0.0, 0.227, 0.0, 0.0, 0.0), RejectReason::NonFinite),
-        (Pose::new(0.0, 0.0, 0.5, 0.0, 0.0, 0.0), RejectReason::TooFast),
+        // 27 cm up in one setpoint: a broken source, and out of reach as well (both are said).
+        (Pose::new(0.0, 0.0, 0.5, 0.0, 0.0, 0.0), jump),
         (Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0), RejectReason::Stale),
     ];
     for (k, (pose, reason)) in bad.iter().enumerate() {
@@ -221,32 +225,48 @@ fn rejected_setpoints_never_move() {
     }
     assert_eq!(p.steps(), start, "only the accepted home setpoint applied: no motion");
     assert_eq!(p.rejected().total(), 3);
-    // Outside the workspace but reachable within the jump limit: a check fails.
+    assert_eq!(p.rejected().gross_jump, 1);
+}
+
+#[test]
+fn a_stream_out_of_the_workspace_is_limited_not_refused() {
+    // Heave down 0.8 mm a setpoint at 50 Hz until far below the workspace: every setpoint is taken, those
+    // outside are limited to the edge (with the margin), and the platform stays inside every check.
     let mut far = pipeline();
+    let margins = far.config().margins;
     let mut z = HOME[2];
-    let mut last = Ok(());
+    let mut limited = 0;
     for k in 1..200u32 {
         z -= 0.0008;
-        last = far.submit(&Setpoint {
+        let answer = far.submit(&Setpoint {
             seq: k,
             time_us: u64::from(k) * 20_000,
             pose: pose_with(2, z - HOME[2]),
         });
-        if last.is_err() {
-            break;
+        match answer {
+            Ok(Accepted::Applied) => assert_eq!(limited, 0, "inside again after the edge"),
+            Ok(Accepted::Limited(report)) => {
+                limited += 1;
+                assert!(report.translation > 0.0 && report.translation < 0.2, "{report:?}");
+            }
+            Err(e) => panic!("setpoint {k} refused: {e:?}"),
         }
         for _ in 0..20 {
             far.tick();
+            let (_, report) = far.mechanism().inverse_checked(&far.pose()).unwrap();
+            assert!(report.all_pass(), "{:?}", far.pose());
         }
     }
-    assert!(
-        matches!(last, Err(RejectReason::Workspace(_)) | Err(RejectReason::Unreachable)),
-        "{last:?}"
-    );
-    assert!(
-        far.mechanism().inverse_checked(&far.pose()).unwrap().1.all_pass(),
-        "the platform held inside"
-    );
+    assert!(limited > 50, "{limited}");
+    assert_eq!(far.limited().count, limited);
+    assert_eq!(far.applied(), 199);
+    assert_eq!(far.held(), 0);
+    assert_eq!(far.rejected().total(), 0);
+    // The platform rests at the edge, inside the margin of the check that bound it.
+    let (_, report) = far.mechanism().inverse_checked(&far.pose()).unwrap();
+    assert_eq!(margins.first_short(&report), None, "{report:?}");
+    let largest = far.limited().largest_translation;
+    assert!((largest - (HOME[2] - 0.0008 * 199.0 - far.pose().z).abs()).abs() < 1e-4, "{largest}");
 }
 
 #[test]

@@ -107,7 +107,8 @@ fn polarity_maps_electrical_levels() {
 #[test]
 fn every_key_has_a_unique_code_that_round_trips() {
     let keys: Vec<ConfigKey> = ConfigKey::all().collect();
-    assert_eq!(keys.len(), 5 + 3 * 6);
+    // stream timeout, gross jump, follow mode, tick rate, polarity, debounce; per axis three; per check one.
+    assert_eq!(keys.len(), 6 + 3 * 6 + 6);
     let mut codes: Vec<u8> = keys.iter().map(|k| k.code()).collect();
     codes.sort_unstable();
     codes.dedup();
@@ -197,7 +198,10 @@ fn bad_values_are_refused_and_nothing_is_stored() {
         (ConfigKey::InputActiveLow, 70_000.0),
         (ConfigKey::DebounceMs, 0.0),
         (ConfigKey::DebounceMs, 51.0),
-        (ConfigKey::JumpTolerance, 11.0),
+        (ConfigKey::GrossJumpMs, 5.0),
+        (ConfigKey::FollowDirect, 0.5),
+        (ConfigKey::EnvelopeMargin(0), 0.2),
+        (ConfigKey::EnvelopeMargin(6), 0.001),
     ];
     let before = *c.saved_config();
     for (key, value) in bad {

@@ -1,6 +1,7 @@
 //! Motion: setpoint validation and interpolation, velocity/acceleration limits, IK per tick, conversion to motor
 //! steps, and the step scheduler that turns per-period step targets into timed pulses.
 
+pub mod envelope;
 pub mod limits;
 pub mod pipeline;
 pub mod pulse;
@@ -8,6 +9,10 @@ pub mod scheduler;
 pub mod steps;
 
 pub use limits::{AxisTracker, MotionLimits};
-pub use pipeline::{Pipeline, PipelineConfig, PipelineEvent, RejectCounters, RejectReason, Setpoint};
+pub use envelope::{EnvelopeMargins, Limited};
+pub use pipeline::{
+    Accepted, FollowMode, LimitCounters, LimitReport, Pipeline, PipelineConfig, PipelineEvent, RejectCounters, RejectReason,
+    Setpoint,
+};
 pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler};
 pub use steps::{AxisScale, StepConverter};

@@ -1,12 +1,17 @@
 //! One control tick: the newest valid setpoint, interpolated and limited, through IK and the workspace checks to
 //! motor step targets for the end of the next period.
 //!
-//! - Setpoints are validated when they arrive: finite, newer than the last, reachable, inside every workspace check,
-//!   and not a jump faster than the velocity limits allow over the time since the previous one. A rejected setpoint
-//!   moves nothing; its reason is counted and returned.
-//! - Accepted setpoints are interpolated linearly over their own interval (60 Hz simulator output into a 1 kHz loop):
-//!   the reference moves on the straight line from where it is to the new setpoint, a convex combination that never
-//!   passes it. This delays motion by one setpoint interval, the price of a jitter-free path.
+//! - Setpoints are checked when they arrive. Garbage is refused: not finite, not newer than the last, a gross jump
+//!   (further from the previous setpoint than the platform travels at its velocity limits in the jump window: a
+//!   broken source, not a fast one), or the controller not streaming. A refused setpoint moves nothing; its reason
+//!   is counted and returned.
+//! - Everything else is followed as closely as the envelope and the limits allow: a setpoint outside the workspace
+//!   is limited into it ([`super::envelope`]), answered as limited and counted per check that bound it, with the
+//!   largest correction kept; a setpoint faster than the velocity limits is followed at the limits.
+//! - [`FollowMode::Interpolate`]: accepted setpoints are interpolated linearly over their own interval (60 Hz
+//!   simulator output into a 1 kHz loop): the reference moves on the straight line from where it is to the new
+//!   setpoint, a convex combination that never passes it. This delays motion by one setpoint interval, the price
+//!   of a jitter-free path. [`FollowMode::Direct`] heads for each setpoint at once.
 //! - Each pose axis follows the reference under its velocity and acceleration limits ([`AxisTracker`]); actuator
 //!   speed and acceleration limits scale the whole pose step down when the mechanism needs it.
 //! - IK takes the previous actuators (multi-turn carriages); a pose that fails IK or a check on the way is not
@@ -17,6 +22,7 @@
 use crate::kinematics::{Actuators, AxisKind, Check, KinematicsError, Mechanism, MultiTurn, Pose};
 use crate::real::{wrap_once, wrap_pi};
 
+use super::envelope::{self, EnvelopeMargins};
 use super::limits::{AxisTracker, MotionLimits};
 use super::steps::StepConverter;
 
@@ -39,12 +45,14 @@ pub struct Setpoint {
 pub enum RejectReason {
     /// A coordinate is NaN or infinite.
     NonFinite,
-    /// No IK solution.
+    /// No IK solution (the controller's own moves; a streamed setpoint is limited instead).
     Unreachable,
-    /// A workspace check fails.
-    Workspace(Check),
-    /// Reaching it would take more than the velocity limit (a jump).
-    TooFast,
+    /// Further from the previous setpoint than the platform travels at its velocity limits in the jump window: a
+    /// broken source. `outside` names the first check the pose fails as well, if it does.
+    GrossJump {
+        /// The first workspace check the pose fails (zero margin), `Check::Reach` when it has no IK.
+        outside: Option<Check>,
+    },
     /// Its sequence number or time stamp is not newer than the last accepted one.
     Stale,
     /// The controller is not streaming (not started, stopping, or after a stream loss).
@@ -58,10 +66,8 @@ pub struct RejectCounters {
     pub non_finite: u32,
     /// [`RejectReason::Unreachable`].
     pub unreachable: u32,
-    /// [`RejectReason::Workspace`], per check in the order of [`Check::ALL`].
-    pub workspace: [u32; 6],
-    /// [`RejectReason::TooFast`].
-    pub too_fast: u32,
+    /// [`RejectReason::GrossJump`].
+    pub gross_jump: u32,
     /// [`RejectReason::Stale`].
     pub stale: u32,
     /// [`RejectReason::NotStreaming`].
@@ -73,11 +79,7 @@ impl RejectCounters {
         let c = match reason {
             RejectReason::NonFinite => &mut self.non_finite,
             RejectReason::Unreachable => &mut self.unreachable,
-            RejectReason::Workspace(check) => {
-                let i = Check::ALL.iter().position(|c| *c == check).unwrap_or(0);
-                &mut self.workspace[i]
-            }
-            RejectReason::TooFast => &mut self.too_fast,
+            RejectReason::GrossJump { .. } => &mut self.gross_jump,
             RejectReason::Stale => &mut self.stale,
             RejectReason::NotStreaming => &mut self.not_streaming,
         };
@@ -86,18 +88,71 @@ impl RejectCounters {
 
     /// Total of all reasons.
     pub fn total(&self) -> u32 {
-        let ws: u32 = self.workspace.iter().fold(0u32, |a, b| a.saturating_add(*b));
         [
             self.non_finite,
             self.unreachable,
-            ws,
-            self.too_fast,
+            self.gross_jump,
             self.stale,
             self.not_streaming,
         ]
         .iter()
         .fold(0u32, |a, b| a.saturating_add(*b))
     }
+}
+
+/// Setpoints limited into the envelope: how many, by which check, and the largest correction.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
+pub struct LimitCounters {
+    /// Setpoints limited (each is also counted as applied).
+    pub count: u32,
+    /// Per check that bound them, in the order of [`Check::ALL`].
+    pub by_check: [u32; 6],
+    /// The largest translation taken off a setpoint (m).
+    pub largest_translation: f32,
+    /// The largest roll or pitch taken off a setpoint (rad).
+    pub largest_rotation: f32,
+}
+
+impl LimitCounters {
+    fn count(&mut self, limit: &LimitReport) {
+        self.count = self.count.saturating_add(1);
+        let i = Check::ALL.iter().position(|c| *c == limit.check).unwrap_or(0);
+        self.by_check[i] = self.by_check[i].saturating_add(1);
+        self.largest_translation = self.largest_translation.max(limit.translation);
+        self.largest_rotation = self.largest_rotation.max(limit.rotation);
+    }
+}
+
+/// How a setpoint was limited (the answer to a limited setpoint).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LimitReport {
+    /// The check that bound it.
+    pub check: Check,
+    /// Translation taken off (m).
+    pub translation: f32,
+    /// Roll or pitch taken off, the larger (rad).
+    pub rotation: f32,
+}
+
+/// What became of an accepted setpoint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Accepted {
+    /// Followed as it was.
+    Applied,
+    /// Limited into the envelope.
+    Limited(LimitReport),
+}
+
+/// How the reference moves toward a new setpoint.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FollowMode {
+    /// Linearly over the setpoint's own interval: a smooth path, one interval behind the source.
+    Interpolate,
+    /// At once: the trackers head for the newest setpoint under the limits (no interval of delay; the path of a
+    /// slow source is followed in steps).
+    Direct,
 }
 
 /// Pipeline settings.
@@ -109,8 +164,15 @@ pub struct PipelineConfig {
     pub stream_timeout_us: u32,
     /// The longest interval interpolated over; a longer gap is treated as this long (us).
     pub max_interval_us: u32,
-    /// A setpoint may ask for up to `1 + jump_tolerance` times the velocity limit over its interval (jitter room).
-    pub jump_tolerance: f32,
+    /// A setpoint further from the previous one than any axis travels at its velocity limit in this window is a
+    /// gross jump (refused); anything nearer is followed at the limits (us).
+    pub gross_jump_us: u32,
+    /// Room that a limited setpoint leaves inside each check.
+    pub margins: EnvelopeMargins,
+    /// IK + check evaluations the envelope search may spend on one setpoint (resolution `2^-(n-1)` of the segment).
+    pub limit_evaluations: u8,
+    /// How the reference moves toward a new setpoint.
+    pub follow: FollowMode,
     /// Velocity and acceleration limits.
     pub limits: MotionLimits,
 }
@@ -121,7 +183,10 @@ impl Default for PipelineConfig {
             tick_us: 1_000,
             stream_timeout_us: 100_000,
             max_interval_us: 50_000,
-            jump_tolerance: 0.5,
+            gross_jump_us: 500_000,
+            margins: EnvelopeMargins::default(),
+            limit_evaluations: 8,
+            follow: FollowMode::Interpolate,
             limits: MotionLimits::TRAINER_MODEL,
         }
     }
@@ -167,9 +232,11 @@ pub struct Pipeline<M: Mechanism<f32>> {
     to: Pose<f32>,
     segment_ticks: u32,
     segment_done: u32,
+    /// Sequence number, time and pose (as sent, unlimited) of the last accepted setpoint.
     last: Option<(u32, u64, Pose<f32>)>,
     since_setpoint_us: u32,
     rejected: RejectCounters,
+    limited: LimitCounters,
     applied: u32,
     held: u32,
 }
@@ -209,6 +276,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             last: None,
             since_setpoint_us: 0,
             rejected: RejectCounters::default(),
+            limited: LimitCounters::default(),
             applied: 0,
             held: 0,
         })
@@ -249,7 +317,12 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         &self.rejected
     }
 
-    /// Accepted setpoints.
+    /// Setpoints limited into the envelope.
+    pub fn limited(&self) -> &LimitCounters {
+        &self.limited
+    }
+
+    /// Accepted setpoints (limited ones included).
     pub fn applied(&self) -> u32 {
         self.applied
     }
@@ -339,32 +412,55 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         Ok(())
     }
 
-    /// Validates and takes a setpoint; a rejected one changes nothing but its counter.
-    pub fn submit(&mut self, sp: &Setpoint) -> Result<(), RejectReason> {
-        let verdict = self.validate(sp);
-        match verdict {
-            Ok(interval_us) => {
-                let ticks = (interval_us / self.config.tick_us.max(1)).max(1);
-                self.from = self.reference();
-                self.to = Pose {
-                    gamma: wrap_pi(sp.pose.gamma),
-                    ..sp.pose
-                };
-                self.segment_ticks = ticks;
-                self.segment_done = 0;
-                self.last = Some((sp.seq, sp.time_us, self.to));
-                self.since_setpoint_us = 0;
-                self.applied = self.applied.saturating_add(1);
-                Ok(())
-            }
+    /// Checks and takes a setpoint, limited into the envelope where needed; a refused one changes nothing but its
+    /// counter.
+    pub fn submit(&mut self, sp: &Setpoint) -> Result<Accepted, RejectReason> {
+        let interval_us = match self.validate(sp) {
+            Ok(interval) => interval,
             Err(reason) => {
                 self.rejected.count(reason);
-                Err(reason)
+                return Err(reason);
             }
-        }
+        };
+        let config = &self.config;
+        let limited = envelope::limit(
+            &self.mechanism,
+            &self.to,
+            &sp.pose,
+            &config.margins,
+            config.limit_evaluations,
+        );
+        let accepted = match limited.bound_by {
+            None => Accepted::Applied,
+            Some(check) => {
+                let (translation, rotation) = envelope::correction(&sp.pose, &limited.pose);
+                let report = LimitReport {
+                    check,
+                    translation,
+                    rotation,
+                };
+                self.limited.count(&report);
+                Accepted::Limited(report)
+            }
+        };
+        let ticks = match config.follow {
+            FollowMode::Interpolate => (interval_us / config.tick_us.max(1)).max(1),
+            FollowMode::Direct => 1,
+        };
+        self.from = self.reference();
+        self.to = Pose {
+            gamma: wrap_pi(limited.pose.gamma),
+            ..limited.pose
+        };
+        self.segment_ticks = ticks;
+        self.segment_done = 0;
+        self.last = Some((sp.seq, sp.time_us, sp.pose));
+        self.since_setpoint_us = 0;
+        self.applied = self.applied.saturating_add(1);
+        Ok(accepted)
     }
 
-    /// Returns the interval to interpolate over (us).
+    /// Refuses garbage; returns the interval to interpolate over (us).
     fn validate(&self, sp: &Setpoint) -> Result<u32, RejectReason> {
         if self.mode != Mode::Streaming {
             return Err(RejectReason::NotStreaming);
@@ -383,23 +479,20 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             // The first setpoint of a stream starts from the commanded pose, over the longest interval.
             None => (self.pose, self.config.max_interval_us),
         };
-        let interval = interval.max(self.config.tick_us);
-        let allowed = (1.0 + self.config.jump_tolerance) * interval as f32 * 1e-6;
-        let target = pose.to_array();
-        let from = from.to_array();
-        for i in 0..6 {
-            if libm::fabsf(delta(i, target[i], from[i])) > self.config.limits.pose_velocity[i] * allowed {
-                return Err(RejectReason::TooFast);
-            }
+        let window = self.config.gross_jump_us as f32 * 1e-6;
+        let (target, from) = (pose.to_array(), from.to_array());
+        let jump = (0..6).any(|i| {
+            let d = libm::fabsf(delta(i, target[i], from[i]));
+            !(d <= self.config.limits.pose_velocity[i] * window)
+        });
+        if jump {
+            let outside = match self.mechanism.inverse_checked(&pose) {
+                Ok((_, report)) => report.first_failure(),
+                Err(_) => Some(Check::Reach),
+            };
+            return Err(RejectReason::GrossJump { outside });
         }
-        let (_, report) = self.mechanism.inverse_checked(&pose).map_err(|e| match e {
-            KinematicsError::NonFinite => RejectReason::NonFinite,
-            _ => RejectReason::Unreachable,
-        })?;
-        if let Some(check) = report.first_failure() {
-            return Err(RejectReason::Workspace(check));
-        }
-        Ok(interval)
+        Ok(interval.max(self.config.tick_us))
     }
 
     /// Where the interpolated reference is now.

@@ -3,11 +3,11 @@
 
 use crate::kinematics::presets::Preset;
 use crate::kinematics::Pose;
-use crate::motion::{RejectCounters, RejectReason, Setpoint};
+use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 use crate::safety::{FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly.
-pub const PROTOCOL_VERSION: u16 = 2;
+pub const PROTOCOL_VERSION: u16 = 3;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -72,6 +72,8 @@ pub enum DeviceMessage {
     },
     /// Done.
     Ack,
+    /// The setpoint was taken, limited into the envelope: by which check and how much.
+    Limited(LimitReport),
     /// Not done, and why.
     Nack(NackReason),
     /// Status and telemetry.
@@ -116,8 +118,14 @@ pub enum ConfigKey {
     PoseVelocity(u8),
     /// Acceleration limit of a pose axis, live.
     PoseAcceleration(u8),
-    /// Allowed excess over the velocity limit for a setpoint jump (fraction), live.
-    JumpTolerance,
+    /// Gross-jump window (ms): a setpoint further from the previous one than any axis travels at its velocity
+    /// limit in this time is refused as a broken source, live.
+    GrossJumpMs,
+    /// Follow mode: 0 interpolates over each setpoint's interval, 1 heads for each setpoint at once, live.
+    FollowDirect,
+    /// Room a limited setpoint leaves inside a workspace check (in the check's unit), by check in the order of
+    /// `Check::ALL`, live.
+    EnvelopeMargin(u8),
     /// Control rate (Hz): 500, 1,000 or 2,000; at the next start.
     TickHz,
     /// Motor steps per carriage turn (ring axes, an integer) or per metre (linear axes); at the next start.
@@ -138,13 +146,16 @@ impl ConfigKey {
     pub const fn code(self) -> u8 {
         match self {
             ConfigKey::StreamTimeoutMs => 1,
-            ConfigKey::JumpTolerance => 2,
+            // 2 was the jump tolerance of protocol version 2: never reuse it.
+            ConfigKey::GrossJumpMs => 6,
+            ConfigKey::FollowDirect => 7,
             ConfigKey::TickHz => 3,
             ConfigKey::InputActiveLow => 4,
             ConfigKey::DebounceMs => 5,
             ConfigKey::PoseVelocity(a) => 16 + (a & 7),
             ConfigKey::PoseAcceleration(a) => 24 + (a & 7),
             ConfigKey::StepsPerUnit(a) => 32 + (a & 7),
+            ConfigKey::EnvelopeMargin(c) => 40 + (c & 7),
         }
     }
 
@@ -152,13 +163,15 @@ impl ConfigKey {
     pub const fn from_code(code: u8) -> Option<ConfigKey> {
         Some(match code {
             1 => ConfigKey::StreamTimeoutMs,
-            2 => ConfigKey::JumpTolerance,
+            6 => ConfigKey::GrossJumpMs,
+            7 => ConfigKey::FollowDirect,
             3 => ConfigKey::TickHz,
             4 => ConfigKey::InputActiveLow,
             5 => ConfigKey::DebounceMs,
             16..=21 => ConfigKey::PoseVelocity(code - 16),
             24..=29 => ConfigKey::PoseAcceleration(code - 24),
             32..=37 => ConfigKey::StepsPerUnit(code - 32),
+            40..=45 => ConfigKey::EnvelopeMargin(code - 40),
             _ => return None,
         })
     }
@@ -180,8 +193,10 @@ pub struct Status {
     pub steps: [i64; 6],
     /// Commanded pose.
     pub pose: Pose<f32>,
-    /// Setpoints accepted.
+    /// Setpoints accepted (limited ones included).
     pub applied: u32,
+    /// Setpoints limited into the envelope.
+    pub limited: LimitCounters,
     /// Setpoints rejected, per reason.
     pub rejected: RejectCounters,
     /// Ticks on which the path failed a check and the platform held.

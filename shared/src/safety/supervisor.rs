@@ -455,6 +455,9 @@ impl Supervisor {
                 self.go(State::LogicOn);
             }
             (Event::Disable, State::LogicOn | State::PowerOn { .. } | State::Ready) => {
+                // Without drive current the steppers hold nothing: the axes may be moved by hand or by gravity,
+                // so the positions homing found are no longer known.
+                self.homed = false;
                 self.go(State::ShuttingDown(Shutdown::Drivers));
             }
             (Event::Home, State::PowerOn { settled: true } | State::Ready) => {

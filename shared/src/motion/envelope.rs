@@ -1,0 +1,159 @@
+//! Envelope limiting: a setpoint outside the workspace becomes the pose nearest to it, along the segment from the
+//! last accepted target, that passes every check with a margin.
+//!
+//! Motion-simulator software clamps each axis to the rig's limits; a ring platform's envelope is not a box (the
+//! trainer model holds each spec axis alone but less than half of the combined extremes), so the clamp has to be
+//! the workspace checks themselves. The search runs on the segment `from -> to` in `x, y, z, alpha, beta`, with
+//! the target's yaw throughout: the ring turns with the platform, so yaw never limits a ring platform, and a
+//! limited stream keeps turning with its source.
+//!
+//! The search is a bisection with a fixed number of IK + check evaluations, so its cost is bounded (one evaluation
+//! when the target is inside). It assumes `from` passes (the caller's last accepted target, which did) and returns
+//! the last point found to pass: a pose that passes, never one that does not. On a non-convex boundary it finds a
+//! crossing, not necessarily the first; the tick checks every commanded pose anyway.
+//!
+//! The margin keeps targets that far inside each check, so that the path the trackers take between two targets
+//! (per axis, under acceleration limits, not exactly on the straight line) stays inside too. The host limits its
+//! poses with the same code in `f64` before it sends them, so a board sees few setpoints to limit.
+
+use crate::kinematics::{Actuators, Check, Mechanism, Pose, WorkspaceReport};
+use crate::Real;
+
+/// How much room each check must leave, in the unit of the check ([`Check::unit`]), in the order of [`Check::ALL`].
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct EnvelopeMargins(pub [f32; 6]);
+
+impl Default for EnvelopeMargins {
+    /// 2 mm of reach and stroke, 1 degree of carriage spacing and of rod crossing, 0.5 degree of joint cone,
+    /// 0.01 of singularity index, 2 mm of stability: about what the trackers' path deviates from the straight line
+    /// between two targets at the trainer model's limits, with room.
+    fn default() -> Self {
+        const DEG: f32 = core::f32::consts::PI / 180.0;
+        Self([0.002, DEG, DEG, 0.5 * DEG, 0.01, 0.002])
+    }
+}
+
+impl EnvelopeMargins {
+    /// The margin of one check.
+    pub fn of(&self, check: Check) -> f32 {
+        let i = Check::ALL.iter().position(|c| *c == check).unwrap_or(0);
+        self.0[i]
+    }
+
+    /// The first check whose margin is below its required room (a check that does not apply passes), or `None`
+    /// when the report passes them all. NaN never passes.
+    pub fn first_short<T: Real>(&self, report: &WorkspaceReport<T>) -> Option<Check> {
+        Check::ALL.into_iter().find(|c| match report.margin(*c) {
+            None => false,
+            Some(m) => !(m >= T::of(f64::from(self.of(*c)))),
+        })
+    }
+}
+
+/// The outcome of [`limit`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limited<T> {
+    /// The pose to command: the target itself when it passes.
+    pub pose: Pose<T>,
+    /// Its actuators (IK), when the pose was evaluated; `None` when the result is `from` unchanged, which the
+    /// caller evaluated when it accepted it.
+    pub actuators: Option<Actuators<T>>,
+    /// The check that bound the target (the first check short of its margin at the nearest failing point found);
+    /// `None` when the target passes.
+    pub bound_by: Option<Check>,
+    /// How far along `from -> to` the pose is (1 when the target passes).
+    pub fraction: T,
+}
+
+impl<T: Real> Limited<T> {
+    /// Whether the target had to be limited.
+    pub fn is_limited(&self) -> bool {
+        self.bound_by.is_some()
+    }
+}
+
+/// Why a pose fails the envelope: no IK (reach), or the first check short of its margin.
+fn evaluate<T: Real, M: Mechanism<T>>(
+    mechanism: &M,
+    pose: &Pose<T>,
+    margins: &EnvelopeMargins,
+) -> Result<Actuators<T>, Check> {
+    match mechanism.inverse_checked(pose) {
+        Ok((q, report)) => match margins.first_short(&report) {
+            None => Ok(q),
+            Some(check) => Err(check),
+        },
+        // No solution: the rods do not reach (or the pose is not finite, which the caller refuses first).
+        Err(_) => Err(Check::Reach),
+    }
+}
+
+/// The point at `s` of the segment `from -> to` in `x, y, z, alpha, beta`, with the target's yaw.
+fn along<T: Real>(from: &Pose<T>, to: &Pose<T>, s: T) -> Pose<T> {
+    let (a, b) = (from.to_array(), to.to_array());
+    Pose::from_array(core::array::from_fn(|i| if i == 5 { b[5] } else { a[i] + (b[i] - a[i]) * s }))
+}
+
+/// Limits `to` into the envelope along the segment from `from` (which must pass), with at most `evaluations`
+/// IK + check evaluations (at least one: the target). Never returns a pose that fails a check's margin.
+pub fn limit<T: Real, M: Mechanism<T>>(
+    mechanism: &M,
+    from: &Pose<T>,
+    to: &Pose<T>,
+    margins: &EnvelopeMargins,
+    evaluations: u8,
+) -> Limited<T> {
+    let first = match evaluate(mechanism, to, margins) {
+        Ok(q) => {
+            return Limited {
+                pose: *to,
+                actuators: Some(q),
+                bound_by: None,
+                fraction: T::one(),
+            }
+        }
+        Err(check) => check,
+    };
+    let (mut lo, mut hi) = (T::zero(), T::one());
+    let mut best: Option<(Pose<T>, Actuators<T>)> = None;
+    let mut bound_by = first;
+    let half = T::of(0.5);
+    for _ in 1..evaluations.max(1) {
+        let mid = (lo + hi) * half;
+        let pose = along(from, to, mid);
+        match evaluate(mechanism, &pose, margins) {
+            Ok(q) => {
+                lo = mid;
+                best = Some((pose, q));
+            }
+            Err(check) => {
+                hi = mid;
+                bound_by = check;
+            }
+        }
+    }
+    match best {
+        Some((pose, q)) => Limited {
+            pose,
+            actuators: Some(q),
+            bound_by: Some(bound_by),
+            fraction: lo,
+        },
+        None => Limited {
+            pose: *from,
+            actuators: None,
+            bound_by: Some(bound_by),
+            fraction: T::zero(),
+        },
+    }
+}
+
+/// How far a limited pose is from what was asked: the translation (m) and the largest roll or pitch difference
+/// (rad); yaw passes through and is never corrected.
+pub fn correction<T: Real>(asked: &Pose<T>, limited: &Pose<T>) -> (T, T) {
+    let (a, b) = (asked.to_array(), limited.to_array());
+    let d: [T; 6] = core::array::from_fn(|i| a[i] - b[i]);
+    let translation = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt_();
+    let rotation = d[3].abs().max(d[4].abs());
+    (translation, rotation)
+}
