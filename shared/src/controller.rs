@@ -8,7 +8,8 @@ use crate::kinematics::presets::{Preset, PresetGeometry};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, MultiTurn, Pose, RingPlatform};
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{
-    Accepted, AxisMove, AxisScale, FollowMode, Pipeline, PipelineConfig, PipelineEvent, SchedulerConfig, StepConverter, StepScheduler,
+    Accepted, AxisMove, AxisScale, FollowMode, Pipeline, PipelineConfig, PipelineEvent, SchedulerConfig, StepConverter,
+    StepScheduler,
 };
 use crate::protocol::{
     self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,

@@ -91,7 +91,13 @@ fn evaluate<T: Real, M: Mechanism<T>>(
 /// The point at `s` of the segment `from -> to` in `x, y, z, alpha, beta`, with the target's yaw.
 fn along<T: Real>(from: &Pose<T>, to: &Pose<T>, s: T) -> Pose<T> {
     let (a, b) = (from.to_array(), to.to_array());
-    Pose::from_array(core::array::from_fn(|i| if i == 5 { b[5] } else { a[i] + (b[i] - a[i]) * s }))
+    Pose::from_array(core::array::from_fn(|i| {
+        if i == 5 {
+            b[5]
+        } else {
+            a[i] + (b[i] - a[i]) * s
+        }
+    }))
 }
 
 /// Limits `to` into the envelope along the segment from `from` (which must pass), with at most `evaluations`

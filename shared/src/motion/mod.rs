@@ -8,11 +8,11 @@ pub mod pulse;
 pub mod scheduler;
 pub mod steps;
 
-pub use limits::{AxisTracker, MotionLimits};
 pub use envelope::{EnvelopeMargins, Limited};
+pub use limits::{AxisTracker, MotionLimits};
 pub use pipeline::{
-    Accepted, FollowMode, LimitCounters, LimitReport, Pipeline, PipelineConfig, PipelineEvent, RejectCounters, RejectReason,
-    Setpoint,
+    Accepted, FollowMode, LimitCounters, LimitReport, Pipeline, PipelineConfig, PipelineEvent, RejectCounters,
+    RejectReason, Setpoint,
 };
 pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler};
 pub use steps::{AxisScale, StepConverter};

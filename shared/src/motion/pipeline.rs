@@ -111,6 +111,13 @@ pub struct LimitCounters {
     pub largest_translation: f32,
     /// The largest roll or pitch taken off a setpoint (rad).
     pub largest_rotation: f32,
+    /// Ticks on which the trackers' path met the edge of the workspace and only part of the step was taken (the
+    /// pose decelerates faster than its limit there: staying inside comes first).
+    pub edge_ticks: u32,
+    /// Ticks on which the actuators' speed or acceleration limits slowed the whole pose step. They take precedence
+    /// over the pose acceleration limits (a stepper past its limits loses steps), so on these ticks the pose may
+    /// decelerate faster than its limit.
+    pub actuator_ticks: u32,
 }
 
 impl LimitCounters {
@@ -224,6 +231,10 @@ pub struct Pipeline<M: Mechanism<f32>> {
     /// Commanded pose (yaw kept within a turn) and its per-axis trackers.
     pose: Pose<f32>,
     trackers: [AxisTracker; 6],
+    /// The middle of the workspace (the pose the pipeline was made at: the home pose).
+    centre: Pose<f32>,
+    /// The trackers' speeds at the start of this tick (what the pose moved at in the last one).
+    velocity_before: [f32; 6],
     /// Actuators of the commanded pose and their speeds.
     actuators: MultiTurn<f32>,
     actuator_velocity: [f32; 6],
@@ -267,6 +278,8 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             mode: Mode::Hold,
             pose,
             trackers: [AxisTracker::default(); 6],
+            velocity_before: [0.0; 6],
+            centre: pose,
             actuators: MultiTurn::new(q),
             actuator_velocity: [0.0; 6],
             from: pose,
@@ -300,6 +313,11 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     /// The commanded pose.
     pub fn pose(&self) -> Pose<f32> {
         self.pose
+    }
+
+    /// The target the reference heads for: the last accepted setpoint as limited (yaw within a turn).
+    pub fn target(&self) -> Pose<f32> {
+        self.to
     }
 
     /// Actuator positions of the commanded pose.
@@ -526,6 +544,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         }
         let limits = self.config.limits;
         let mut step = [0.0f32; 6];
+        self.velocity_before = self.trackers.map(|t| t.velocity);
         match self.mode {
             Mode::Hold => {}
             Mode::Streaming | Mode::Moving => {
@@ -583,25 +602,67 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     /// Moves the commanded pose by `step`, scaled down if an actuator would exceed its limits. False when the new
     /// pose fails IK or a check (nothing moved).
     fn advance(&mut self, step: &[f32; 6], dt: f32) -> bool {
-        let p = self.pose.to_array();
-        let candidate = |s: f32| {
-            Pose::from_array(core::array::from_fn(|i| {
-                if i == 5 {
-                    wrap_once(p[i] + step[i] * s)
-                } else {
-                    p[i] + step[i] * s
+        let mut step = *step;
+        let (full, q_full) = match self.solve(&self.stepped(&step, 1.0)) {
+            Some(found) => found,
+            None => {
+                let Some((taken, found)) = self.along_edge(&step, dt) else {
+                    return false;
+                };
+                step = taken;
+                for (t, s) in self.trackers.iter_mut().zip(step) {
+                    t.velocity = s / dt;
                 }
-            }))
+                self.limited.edge_ticks = self.limited.edge_ticks.saturating_add(1);
+                found
+            }
         };
-        let Some((full, q_full)) = self.solve(&candidate(1.0)) else {
-            return false;
-        };
-        let limits = self.config.limits;
-        // Largest fraction of the step that keeps every actuator inside its speed and acceleration limits
-        // (actuator motion is linear in the step over one tick).
+        // Scale the step down until every actuator stays inside its speed and acceleration limits. Actuator motion
+        // is nearly linear in the step over one tick, so one scaling nearly always suffices; a second catches the
+        // curvature of a long step.
+        let (mut pose, mut q) = (full, q_full);
+        for _ in 0..3 {
+            let scale = self.actuator_scale(&q, dt);
+            if scale >= 1.0 {
+                break;
+            }
+            step = step.map(|s| s * scale);
+            let mut taken = scale;
+            // On the edge (a margin within rounding of zero) a shorter step in the same direction may fail where
+            // the longer one passed: take the part of it that stays inside.
+            let scaled = match self.solve(&self.stepped(&step, 1.0)) {
+                Some(found) => found,
+                None => {
+                    let Some((fraction, part, found)) = self.inside_part(&step) else {
+                        return false;
+                    };
+                    step = part;
+                    taken *= fraction;
+                    found
+                }
+            };
+            for t in &mut self.trackers {
+                t.velocity *= taken;
+            }
+            self.limited.actuator_ticks = self.limited.actuator_ticks.saturating_add(1);
+            (pose, q) = scaled;
+        }
+        let mut next = self.actuators;
+        next.follow(&q, &self.axes);
+        for i in 0..6 {
+            self.actuator_velocity[i] = (next.total(i) - self.actuators.total(i)) as f32 / dt;
+        }
+        self.actuators = next;
+        self.pose = pose;
+        true
+    }
+
+    /// The largest fraction of the move to `q` that keeps every actuator inside its speed and acceleration limits.
+    fn actuator_scale(&self, q: &Actuators<f32>, dt: f32) -> f32 {
+        let limits = &self.config.limits;
         let mut scale = 1.0f32;
         for i in 0..6 {
-            let d = self.actuator_delta(i, &q_full);
+            let d = self.actuator_delta(i, q);
             if d == 0.0 {
                 continue;
             }
@@ -611,25 +672,82 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             let bound = if d > 0.0 { hi / d } else { lo / d };
             scale = scale.min(bound.max(0.0));
         }
-        let (pose, q) = if scale < 1.0 {
-            let Some(scaled) = self.solve(&candidate(scale)) else {
-                return false;
-            };
-            for t in &mut self.trackers {
-                t.velocity *= scale;
+        scale
+    }
+
+    /// The commanded pose moved by `s` times `step`.
+    fn stepped(&self, step: &[f32; 6], s: f32) -> Pose<f32> {
+        let p = self.pose.to_array();
+        Pose::from_array(core::array::from_fn(|i| {
+            let v = p[i] + step[i] * s;
+            if i == 5 {
+                wrap_once(v)
+            } else {
+                v
             }
-            scaled
-        } else {
-            (full, q_full)
+        }))
+    }
+
+    /// The trackers' path (per axis, not on the straight line between two targets) met the edge of the
+    /// workspace. Staying inside comes first. Grazing it (at least half of the step stays inside), take that part.
+    /// Otherwise head on a straight line for the target (which passed every check with a margin), else for the
+    /// middle of the workspace (furthest from every edge) while the yaw keeps turning toward the target, else for
+    /// the middle at this yaw: the workspace is not convex, and it turns with the yaw. Each at the speed the
+    /// limits allow from here. Returns the step taken, or `None` when no part of any of them stays inside.
+    fn along_edge(&self, step: &[f32; 6], dt: f32) -> Option<([f32; 6], (Pose<f32>, Actuators<f32>))> {
+        let (fraction, part) = match self.inside_part(step) {
+            Some((fraction, taken, found)) => (fraction, Some((taken, found))),
+            None => (0.0, None),
         };
-        let mut next = self.actuators;
-        next.follow(&q, &self.axes);
-        for i in 0..6 {
-            self.actuator_velocity[i] = (next.total(i) - self.actuators.total(i)) as f32 / dt;
+        if self.mode == Mode::Stopping || fraction >= 0.5 {
+            return part;
         }
-        self.actuators = next;
-        self.pose = pose;
-        true
+        let middle = |gamma| Pose { gamma, ..self.centre };
+        for goal in [self.to, middle(self.to.gamma), middle(self.pose.gamma)] {
+            let line = self.line_step(&goal, dt);
+            if let Some(found) = self.solve(&self.stepped(&line, 1.0)) {
+                return Some((line, found));
+            }
+            if let Some((_, taken, found)) = self.inside_part(&line) {
+                return Some((taken, found));
+            }
+        }
+        part
+    }
+
+    /// A step on the straight line toward `goal`, at the largest speed at which no axis exceeds its velocity
+    /// limit or gains more than its acceleration allows, and that does not pass the goal within the tick.
+    fn line_step(&self, goal: &Pose<f32>, dt: f32) -> [f32; 6] {
+        let limits = &self.config.limits;
+        let (p, t) = (self.pose.to_array(), goal.to_array());
+        let error: [f32; 6] = core::array::from_fn(|i| delta(i, t[i], p[i]));
+        let mut k = 1.0 / dt;
+        for i in 0..6 {
+            let e = libm::fabsf(error[i]);
+            if e > 0.0 {
+                let gain = limits.pose_acceleration[i] * dt;
+                let v = limits.pose_velocity[i].min(libm::fabsf(self.velocity_before[i]) + gain);
+                k = k.min(v / e);
+            }
+        }
+        error.map(|e| e * k * dt)
+    }
+
+    /// The largest part of a step (bisection, 6 evaluations: to 1/64) whose pose passes every check.
+    fn inside_part(&self, step: &[f32; 6]) -> Option<(f32, [f32; 6], (Pose<f32>, Actuators<f32>))> {
+        let (mut lo, mut hi) = (0.0f32, 1.0f32);
+        let mut best = None;
+        for _ in 0..6 {
+            let mid = 0.5 * (lo + hi);
+            match self.solve(&self.stepped(step, mid)) {
+                Some(found) => {
+                    lo = mid;
+                    best = Some((mid, step.map(|s| s * mid), found));
+                }
+                None => hi = mid,
+            }
+        }
+        best
     }
 
     /// Every axis within a micrometre (microradian) of the reference and slow enough to stop in one tick.
