@@ -26,7 +26,10 @@ pub enum Command {
     /// Forward kinematics: the pose for six actuator values, by Newton iteration from a guess.
     Fk(FkArgs),
     /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
-    /// powers up and homes if needed, streams, then stops and waits for rest.
+    /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
+    /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
+    /// lines that could not be read, 4 setpoints the device refused, 5 the device stopped streaming or faulted,
+    /// 6 the link was lost, 130 interrupted.
     Stream(StreamArgs),
     /// One command to the controller (--port, or a fresh simulated controller with --sim).
     Device(DeviceArgs),
@@ -84,8 +87,10 @@ pub struct DeviceArgs {
     /// What to do.
     #[arg(value_enum)]
     pub action: DeviceAction,
-    /// For `config`: `get KEY` or `set KEY VALUE`. Keys: stream-timeout-ms, jump-tolerance, tick-hz,
-    /// input-active-low, debounce-ms, and per axis (0-5) pose-velocity.N, pose-acceleration.N, steps-per-unit.N.
+    /// For `config`: `get KEY` or `set KEY VALUE`. Keys: stream-timeout-ms, gross-jump-ms, follow-direct (0 or
+    /// 1), tick-hz, input-active-low, debounce-ms, per axis (0-5) pose-velocity.N, pose-acceleration.N,
+    /// steps-per-unit.N, and per check envelope-margin.CHECK (reach, carriage-spacing, rod-crossing, joint-cones,
+    /// singularity, stability; in the check's unit).
     pub config: Vec<String>,
     /// Serial port of the board (USB CDC).
     #[arg(long, conflicts_with = "sim")]
@@ -119,6 +124,9 @@ pub struct StreamArgs {
     /// `x y z alpha beta gamma` (spaces, commas or semicolons; m and rad unless --degrees), sent as they arrive.
     #[arg(long, conflicts_with = "motion")]
     pub udp: Option<std::net::SocketAddr>,
+    /// With --udp: take datagrams from this sender only (others are counted and ignored).
+    #[arg(long, requires = "udp")]
+    pub udp_from: Option<std::net::IpAddr>,
     /// With --udp: end the stream after this many seconds without a datagram.
     #[arg(long, default_value_t = 2.0)]
     pub udp_idle: f64,

@@ -5,7 +5,7 @@ use std::collections::VecDeque;
 use std::time::Duration;
 
 use ringpod_core::kinematics::presets::Preset;
-use ringpod_core::motion::{RejectReason, Setpoint};
+use ringpod_core::motion::{Accepted, RejectReason, Setpoint};
 use ringpod_core::protocol::{
     self, ConfigKey, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
 };
@@ -44,6 +44,9 @@ pub enum ClientError {
     /// An answer of the wrong kind.
     #[error("unexpected answer: {0}")]
     Unexpected(String),
+    /// The user interrupted a wait (Ctrl-C).
+    #[error("interrupted")]
+    Interrupted,
 }
 
 /// The client.
@@ -56,6 +59,8 @@ pub struct Client<T: Transport> {
     pub faults: Vec<FaultReason>,
     /// How long to wait for an answer.
     pub timeout: Duration,
+    /// Set by Ctrl-C: long waits ([`Client::wait_for`]) end with [`ClientError::Interrupted`].
+    pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
 }
 
 impl<T: Transport> Client<T> {
@@ -68,6 +73,7 @@ impl<T: Transport> Client<T> {
             inbox: VecDeque::new(),
             faults: Vec::new(),
             timeout: Duration::from_secs(2),
+            cancel: None,
         }
     }
 
@@ -102,10 +108,12 @@ impl<T: Transport> Client<T> {
     pub fn request(&mut self, body: HostMessage) -> Result<DeviceMessage, ClientError> {
         self.next_id = self.next_id.wrapping_add(1).max(1);
         let id = self.next_id;
-        let mut frame = [0u8; protocol::MAX_FRAME];
-        let n = protocol::encode(&Request { id, body }, &mut frame)
+        // A leading delimiter ends whatever partial frame line noise left in the device's reader, so that this
+        // request is read on its own (an empty frame is nothing to the reader).
+        let mut frame = [0u8; protocol::MAX_FRAME + 1];
+        let n = protocol::encode(&Request { id, body }, &mut frame[1..])
             .map_err(|e| ClientError::Unexpected(format!("request does not encode: {e}")))?;
-        self.transport.send(&frame[..n])?;
+        self.transport.send(&frame[..n + 1])?;
         let step = Duration::from_micros(200);
         let mut waited = Duration::ZERO;
         loop {
@@ -195,10 +203,11 @@ impl<T: Transport> Client<T> {
         }
     }
 
-    /// Sends a setpoint: `Ok(Err(reason))` when the device rejected it.
-    pub fn setpoint(&mut self, sp: Setpoint) -> Result<Result<(), RejectReason>, ClientError> {
+    /// Sends a setpoint: `Ok(Ok(accepted))` as applied or limited, `Ok(Err(reason))` when the device refused it.
+    pub fn setpoint(&mut self, sp: Setpoint) -> Result<Result<Accepted, RejectReason>, ClientError> {
         match self.request(HostMessage::Setpoint(sp))? {
-            DeviceMessage::Ack => Ok(Ok(())),
+            DeviceMessage::Ack => Ok(Ok(Accepted::Applied)),
+            DeviceMessage::Limited(report) => Ok(Ok(Accepted::Limited(report))),
             DeviceMessage::Nack(NackReason::Rejected(r)) => Ok(Err(r)),
             DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
             other => Err(ClientError::Unexpected(format!("{other:?}"))),
@@ -213,6 +222,13 @@ impl<T: Transport> Client<T> {
             let s = self.status()?;
             if done(&s) {
                 return Ok(s);
+            }
+            if self
+                .cancel
+                .as_ref()
+                .is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst))
+            {
+                return Err(ClientError::Interrupted);
             }
             if waited >= limit {
                 return Err(ClientError::Timeout(limit));

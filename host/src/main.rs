@@ -52,7 +52,7 @@ fn answer(outcome: Result<kinematics::Outcome, error::CliError>) -> anyhow::Resu
     Ok(outcome.code)
 }
 
-/// `ringpod stream`: exit 0 when the run ended at rest without a fault, 1 otherwise.
+/// `ringpod stream`: the exit codes of [`stream::exit`].
 fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     use std::sync::atomic::{AtomicBool, Ordering};
     use std::sync::Arc;
@@ -60,23 +60,32 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     let interrupted = Arc::new(AtomicBool::new(false));
     let flag = interrupted.clone();
     ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))?;
+    let positive = |name: &str, v: f64, max: f64| {
+        if v.is_finite() && v > 0.0 && v <= max {
+            Ok(v)
+        } else {
+            Err(anyhow::anyhow!(
+                "--{name} {v}: must be a number of at most {max:e}, above 0"
+            ))
+        }
+    };
     let (source, input_errors) = match (&args.input, args.motion) {
         _ if args.udp.is_some() => {
             let addr = args.udp.ok_or_else(|| anyhow::anyhow!("--udp"))?;
+            let idle = positive("udp-idle", args.udp_idle, 1e6)?;
             let socket = std::net::UdpSocket::bind(addr).map_err(|e| anyhow::anyhow!("--udp {addr}: {e}"))?;
-            let idle = std::time::Duration::from_secs_f64(args.udp_idle.clamp(0.01, 3600.0));
-            (
-                stream::Source::Udp {
-                    socket,
-                    degrees: args.degrees,
-                    idle,
-                },
-                Vec::new(),
-            )
+            let source = stream::UdpSource {
+                socket,
+                degrees: args.degrees,
+                idle: std::time::Duration::from_secs_f64(idle),
+                from: args.udp_from,
+            };
+            (stream::Source::Udp(source), Vec::new())
         }
         (Some(path), _) => {
             let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-            let (poses, errors) = stream::read_csv(&text, args.degrees);
+            let (poses, errors) =
+                stream::read_csv(&text, args.degrees).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             for e in &errors {
                 eprintln!("{}: line {}: {}", path.display(), e.line, e.reason);
             }
@@ -85,38 +94,55 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         (None, motion) => (
             stream::Source::Motion {
                 motion: motion.unwrap_or(stream::Motion::Demo),
-                seconds: args.duration,
+                seconds: positive("duration", args.duration, 1e9)?,
+                rate_hz: positive("rate", args.rate, 10_000.0)?,
             },
             Vec::new(),
         ),
     };
     let mut client = client::Client::new(connect(args.port.as_deref(), args.sim, !args.fast)?);
+    client.cancel = Some(interrupted.clone());
     // The bar draws on stderr (and hides itself without a terminal), the report on stdout.
     let options = stream::Options {
-        rate_hz: args.rate,
         home: args.home,
         quiet: args.quiet,
     };
-    let report = stream::run(&mut client, source, input_errors, &options, &|| {
+    let report = match stream::run(&mut client, source, input_errors, &options, args.fast, &|| {
         interrupted.load(Ordering::SeqCst)
-    })?;
+    }) {
+        Ok(report) => report,
+        Err(client::ClientError::Interrupted) => {
+            eprintln!("ringpod: interrupted before the stream started");
+            return Ok(stream::exit::INTERRUPTED);
+        }
+        Err(e) => {
+            eprintln!("ringpod: the stream could not start: {e}");
+            return Ok(stream::exit::NOT_STARTED);
+        }
+    };
     if args.report_json {
         let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&report)?);
     } else {
         let rejected: u32 = report.rejected.values().sum();
         println!(
-            "{} setpoints sent, {} applied, {} rejected; final state {}; steps {:?}",
-            report.setpoints_sent, report.setpoints_applied, rejected, report.state, report.final_steps
+            "{}: {} setpoints sent, {} applied ({} limited on the host, {} on the device), {} refused; final state {}; steps {:?}",
+            report.outcome,
+            report.setpoints_sent,
+            report.setpoints_applied,
+            report.limited.host,
+            report.limited.device,
+            rejected,
+            report.state,
+            report.final_steps
         );
         for (reason, n) in &report.rejected {
-            println!("  rejected {reason}: {n}");
+            println!("  refused {reason}: {n}");
         }
     }
-    Ok(if report.faults.is_empty() && report.state == "Ready" {
-        0
-    } else {
-        1
-    })
+    if let Some(reason) = &report.reason {
+        eprintln!("ringpod: {reason}");
+    }
+    Ok(report.exit_code)
 }
 
 /// The transport named on the command line.

@@ -8,13 +8,20 @@ use crate::client::{Client, Transport};
 pub fn name(key: ConfigKey) -> String {
     match key {
         ConfigKey::StreamTimeoutMs => "stream-timeout-ms".into(),
-        ConfigKey::JumpTolerance => "jump-tolerance".into(),
+        ConfigKey::GrossJumpMs => "gross-jump-ms".into(),
+        ConfigKey::FollowDirect => "follow-direct".into(),
         ConfigKey::TickHz => "tick-hz".into(),
         ConfigKey::InputActiveLow => "input-active-low".into(),
         ConfigKey::DebounceMs => "debounce-ms".into(),
         ConfigKey::PoseVelocity(a) => format!("pose-velocity.{a}"),
         ConfigKey::PoseAcceleration(a) => format!("pose-acceleration.{a}"),
         ConfigKey::StepsPerUnit(a) => format!("steps-per-unit.{a}"),
+        ConfigKey::EnvelopeMargin(c) => format!(
+            "envelope-margin.{}",
+            ringpod_core::kinematics::Check::ALL
+                .get(usize::from(c))
+                .map_or("?", |c| c.name())
+        ),
     }
 }
 

@@ -1,16 +1,40 @@
-//! `ringpod stream`: poses from a file or a built-in motion to the controller, at a fixed rate.
+//! `ringpod stream`: poses from a file, a built-in motion or UDP datagrams to the controller.
+//!
+//! Every pose is limited into the envelope on the host first, by the core's own [`envelope::limit`] in `f64` with
+//! the device's margins, so that a board sees few setpoints it has to limit itself; the device limits what is left
+//! and refuses only garbage. The run ends with a stop, a wait for rest and a report whose outcome and exit code say
+//! whether the input was followed.
 
 use std::collections::BTreeMap;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
-use ringpod_core::kinematics::presets::{Preset, TRAINER_MODEL_RANGES};
-use ringpod_core::kinematics::Pose;
-use ringpod_core::motion::{MotionLimits, RejectReason, Setpoint};
+use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
+use ringpod_core::kinematics::{Check, Pose, RingPlatform};
+use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, MotionLimits, RejectReason, Setpoint};
+use ringpod_core::protocol::{ConfigKey, Status};
 use ringpod_core::safety::{FaultReason, State};
 use serde::Serialize;
 
 use crate::client::{Client, ClientError, Transport};
+
+/// Exit codes of `ringpod stream` (the most serious applies).
+pub mod exit {
+    /// Every input pose was followed (limited ones included).
+    pub const FOLLOWED: u8 = 0;
+    /// The stream could not start: no device, bad options, the device not ready.
+    pub const NOT_STARTED: u8 = 1;
+    /// Input lines or datagrams could not be read (never sent); everything readable was followed.
+    pub const INPUT_ERRORS: u8 = 3;
+    /// The device refused setpoints (not finite, a gross jump, out of order).
+    pub const REFUSED: u8 = 4;
+    /// The device stopped streaming by itself or latched a fault.
+    pub const DEVICE_STOPPED: u8 = 5;
+    /// The link to the device was lost.
+    pub const TRANSPORT_LOST: u8 = 6;
+    /// Interrupted (Ctrl-C).
+    pub const INTERRUPTED: u8 = 130;
+}
 
 /// Built-in motions (trainer-model ranges and the test motions of the physical model).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -30,19 +54,31 @@ pub type TimedPose = (usize, f64, Pose<f64>);
 
 /// Where poses come from.
 pub enum Source {
-    /// A motion, sampled at the stream rate for `seconds`.
-    Motion { motion: Motion, seconds: f64 },
-    /// Timed poses from a CSV file: `(line, t, pose)`.
-    Poses(Vec<TimedPose>),
-    /// Poses from UDP datagrams, sent as they arrive until `idle` passes without one.
-    Udp {
-        /// The bound socket.
-        socket: std::net::UdpSocket,
-        /// Angles in degrees.
-        degrees: bool,
-        /// End after this long without a datagram.
-        idle: Duration,
+    /// A motion, sampled at `rate_hz` for `seconds` (generated as it is sent).
+    Motion {
+        /// Which.
+        motion: Motion,
+        /// How long (s).
+        seconds: f64,
+        /// Setpoints per second.
+        rate_hz: f64,
     },
+    /// Timed poses from a CSV file.
+    Poses(Vec<TimedPose>),
+    /// Poses from UDP datagrams, sent as they arrive.
+    Udp(UdpSource),
+}
+
+/// A live source of poses: motion-simulator software sending one datagram per pose.
+pub struct UdpSource {
+    /// The bound socket.
+    pub socket: std::net::UdpSocket,
+    /// Angles in degrees.
+    pub degrees: bool,
+    /// End after this long without a datagram.
+    pub idle: Duration,
+    /// Take datagrams from this address only.
+    pub from: Option<std::net::IpAddr>,
 }
 
 /// Parses one datagram: six numbers separated by spaces, commas or semicolons.
@@ -60,29 +96,50 @@ pub fn parse_datagram(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> 
     Ok(Pose::new(v[0], v[1], v[2], a(v[3]), a(v[4]), a(v[5])))
 }
 
-/// A CSV line that could not be used.
+/// A line or datagram that could not be used, or a setpoint the device refused.
 #[derive(Debug, Clone, Serialize)]
 pub struct InputError {
-    /// 1-based line number.
+    /// 1-based line number (datagram number for UDP).
     pub line: usize,
     /// What is wrong.
     pub reason: String,
 }
 
-/// Reads `t,x,y,z,alpha,beta,gamma` (seconds, metres, radians or degrees). Bad lines are returned, not fatal.
-pub fn read_csv(text: &str, degrees: bool) -> (Vec<TimedPose>, Vec<InputError>) {
+/// The columns of an input file, by name.
+const COLUMNS: [&str; 7] = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
+/// Input times beyond this (s, about 115 days) are refused as garbage.
+const MAX_TIME_S: f64 = 1e7;
+
+/// Reads a CSV whose header names the columns `t,x,y,z,alpha,beta,gamma` in any order (seconds, metres, radians
+/// or degrees). Lines may end in LF, CRLF or CR. Bad lines are returned, not fatal; a missing or wrong header is.
+pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputError>), String> {
+    let text = text.replace("\r\n", "\n").replace('\r', "\n");
     let mut poses = Vec::new();
     let mut errors = Vec::new();
     let mut last_t = f64::NEG_INFINITY;
+    let mut columns: Option<[usize; 7]> = None;
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let raw = raw.trim();
-        if raw.is_empty() || raw.starts_with('#') || (line == 1 && raw.starts_with('t')) {
+        if raw.is_empty() || raw.starts_with('#') {
             continue;
         }
-        let fields: Result<Vec<f64>, _> = raw.split(',').map(|f| f.trim().parse::<f64>()).collect();
-        let v = match fields {
-            Ok(v) if v.len() == 7 => v,
+        let fields: Vec<&str> = raw.split(',').map(str::trim).collect();
+        let Some(order) = columns else {
+            let find = |name: &str| fields.iter().position(|f| f.eq_ignore_ascii_case(name));
+            let found: Vec<Option<usize>> = COLUMNS.iter().map(|c| find(c)).collect();
+            if fields.len() != 7 || found.iter().any(Option::is_none) {
+                return Err(format!(
+                    "line {line}: the header must name the columns {} (in any order), found `{raw}`",
+                    COLUMNS.join(",")
+                ));
+            }
+            columns = Some(std::array::from_fn(|k| found[k].unwrap_or(k)));
+            continue;
+        };
+        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
+        let v = match values {
+            Ok(v) if v.len() == 7 => order.map(|k| v[k]),
             Ok(v) => {
                 errors.push(InputError {
                     line,
@@ -98,7 +155,14 @@ pub fn read_csv(text: &str, degrees: bool) -> (Vec<TimedPose>, Vec<InputError>) 
                 continue;
             }
         };
-        if !v[0].is_finite() || v[0] <= last_t {
+        if !(v[0].is_finite() && v[0].abs() <= MAX_TIME_S) {
+            errors.push(InputError {
+                line,
+                reason: format!("time {} is not a number of seconds within +-{MAX_TIME_S:e}", v[0]),
+            });
+            continue;
+        }
+        if v[0] <= last_t {
             errors.push(InputError {
                 line,
                 reason: "time is not increasing".into(),
@@ -107,24 +171,29 @@ pub fn read_csv(text: &str, degrees: bool) -> (Vec<TimedPose>, Vec<InputError>) 
         }
         last_t = v[0];
         let a = |x: f64| if degrees { x.to_radians() } else { x };
-        // NaN and infinity in a pose are passed on: the device rejects them with a reason, which is the point.
+        // NaN and infinity in a pose are passed on: the device refuses them with a reason, which is the point.
         poses.push((line, v[0], Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6]))));
     }
-    (poses, errors)
+    if columns.is_none() {
+        return Err(format!("no header line naming the columns {}", COLUMNS.join(",")));
+    }
+    Ok((poses, errors))
 }
 
-/// Pose of a built-in motion at time `t` (s) around `home`.
+/// Pose of a built-in motion at time `t` (s) around `home`. Every motion stays inside the envelope at any time
+/// and yaw (tested for 120 s each), so host limiting leaves it unchanged.
 pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6]) -> Pose<f64> {
     let mut p = home;
     let tau = std::f64::consts::TAU;
     let limits = MotionLimits::TRAINER_MODEL;
     match motion {
         Motion::Demo => {
-            // Half of each range, frequencies low enough for the 0.05 m/s and 1 rad/s limits; the motion starts at
-            // home and eases in over the first two seconds.
+            // A third of each range (the combined extremes of half the ranges leave the envelope at some yaws),
+            // frequencies low enough for the 0.05 m/s and 1 rad/s limits; the motion starts at home and eases in
+            // over the first two seconds.
             let ease = (t / 2.0).min(1.0);
             for (i, f) in [0.2, 0.15, 0.25, 0.3, 0.22].iter().enumerate() {
-                p[i] += ease * 0.5 * TRAINER_MODEL_RANGES[i] * (tau * f * t).sin();
+                p[i] += ease * TRAINER_MODEL_RANGES[i] / 3.0 * (tau * f * t).sin();
             }
             p[5] = (0.5 * t * ease).rem_euclid(tau);
         }
@@ -147,33 +216,78 @@ pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6]) -> Pose<f64> {
     Pose::from_array(p)
 }
 
+/// How much was limited into the envelope.
+#[derive(Debug, Default, Serialize)]
+pub struct LimitedReport {
+    /// Input poses the host limited before sending.
+    pub host: u32,
+    /// Setpoints the device limited (of those this run sent).
+    pub device: u32,
+    /// Per check that bound them (host and device).
+    pub by_check: BTreeMap<String, u32>,
+    /// The largest translation taken off a pose (mm).
+    pub largest_mm: f64,
+    /// The largest roll or pitch taken off a pose (deg).
+    pub largest_deg: f64,
+}
+
+/// What came over UDP.
+#[derive(Debug, Default, Serialize)]
+pub struct DatagramReport {
+    /// Datagrams received from the source.
+    pub received: u32,
+    /// Datagrams that did not parse (also in `input_errors`).
+    pub unreadable: u32,
+    /// Datagrams from other senders than `--udp-from`, ignored.
+    pub other_senders: u32,
+    /// Times the source paused longer than the stream timeout and the stream was led in and started again.
+    pub resumed: u32,
+}
+
 /// The end-of-run report (`--report-json`).
 #[derive(Debug, Serialize)]
 pub struct Report {
+    /// `followed`, `input_errors`, `refused`, `device_stopped`, `transport_lost` or `interrupted`.
+    pub outcome: &'static str,
+    /// Why the run ended as it did, when not simply followed.
+    pub reason: Option<String>,
+    /// The exit code (see [`exit`]).
+    pub exit_code: u8,
     /// Final device state.
     pub state: String,
-    /// Setpoints sent.
+    /// Input setpoints sent (lead-in and settle not included).
     pub setpoints_sent: u32,
-    /// Setpoints the device accepted.
+    /// Of those, accepted by the device (limited ones included).
     pub setpoints_applied: u32,
-    /// Setpoints the device rejected, by reason.
+    /// Limiting into the envelope.
+    pub limited: LimitedReport,
+    /// Of the input setpoints, refused by the device, by reason.
     pub rejected: BTreeMap<String, u32>,
+    /// Each refused input setpoint: its line (or datagram number) and the reason.
+    pub refusals: Vec<InputError>,
+    /// Lead-in setpoints (from where the platform was to the first pose, and after each restart).
+    pub lead_in_sent: u32,
+    /// Settle setpoints (the last pose held at the end).
+    pub settle_sent: u32,
+    /// Times a gap in the input longer than the stream timeout let the platform come to rest and the stream was
+    /// started again.
+    pub restarts: u32,
     /// Step position of each axis at the end.
     pub final_steps: [i64; 6],
     /// Faults the device reported.
     pub faults: Vec<String>,
-    /// Input lines that could not be used (never sent).
+    /// Input lines or datagrams that could not be used (never sent).
     pub input_errors: Vec<InputError>,
-    /// The last pose the device accepted.
+    /// UDP sources: what arrived.
+    pub datagrams: Option<DatagramReport>,
+    /// The last input pose the device accepted, as sent (after host limiting).
     pub last_applied_pose: Option<[f64; 6]>,
-    /// The device's own counters agree with what the host counted.
+    /// The device's counters for this run agree with the host's, and every setpoint sent was answered.
     pub counts_agree: bool,
 }
 
 /// Stream settings.
 pub struct Options {
-    /// Setpoints per second (motions; files keep their own times).
-    pub rate_hz: f64,
     /// Home even if the device is homed already.
     pub home: bool,
     /// No progress bar.
@@ -182,59 +296,369 @@ pub struct Options {
 
 fn reason_name(r: RejectReason) -> String {
     match r {
-        RejectReason::Workspace(c) => format!("workspace:{}", c.name()),
-        other => format!("{other:?}")
-            .to_lowercase()
-            .replace("nonfinite", "non_finite")
-            .replace("toofast", "too_fast")
-            .replace("notstreaming", "not_streaming"),
+        RejectReason::NonFinite => "non_finite".into(),
+        RejectReason::Unreachable => "unreachable".into(),
+        RejectReason::GrossJump { outside: None } => "gross_jump".into(),
+        RejectReason::GrossJump { outside: Some(c) } => format!("gross_jump+outside:{}", c.name()),
+        RejectReason::Stale => "stale".into(),
+        RejectReason::NotStreaming => "not_streaming".into(),
+        other => format!("{other:?}").to_lowercase(),
     }
 }
 
-/// What the host counted while streaming.
-#[derive(Default)]
-struct Counts {
+/// Why streaming ended early.
+enum Stop {
+    /// The device stopped streaming or faulted: the reason.
+    Device(String),
+    /// Ctrl-C.
+    Interrupted,
+}
+
+/// What a setpoint is for.
+#[derive(Clone, Copy, PartialEq)]
+enum Kind {
+    /// An input pose, with its line or datagram number.
+    Input(Option<usize>),
+    LeadIn,
+    Settle,
+}
+
+/// One run: the client, the host's clock and envelope, and everything counted.
+struct Streamer<'a, T: Transport> {
+    client: &'a mut Client<T>,
+    interrupted: &'a dyn Fn() -> bool,
+    bar: ProgressBar,
+    mechanism: RingPlatform<f64>,
+    margins: EnvelopeMargins,
+    limits: MotionLimits,
+    stream_timeout: Duration,
+    /// The middle of the workspace, from which poses are limited (the home pose).
+    centre: Pose<f64>,
+    /// The last pose sent (limited).
+    last_sent: Pose<f64>,
+    clock_us: u64,
     seq: u32,
-    sent: u32,
-    applied: u32,
+    baseline: Status,
+    // Counts.
+    sent_all: u32,
+    applied_all: u32,
+    rejected_all: u32,
+    device_limited: u32,
+    input_sent: u32,
+    input_applied: u32,
+    lead_in: u32,
+    settle: u32,
+    restarts: u32,
     rejected: BTreeMap<String, u32>,
+    refusals: Vec<InputError>,
+    limited: LimitedReport,
     last_applied: Option<Pose<f64>>,
 }
 
-impl Counts {
-    /// Sends one setpoint and counts the device's answer; a rejected line of a file is reported with its number.
-    fn send<T: Transport>(
-        &mut self,
-        client: &mut Client<T>,
-        pose: Pose<f64>,
-        t_us: u64,
-        line: Option<usize>,
-        bar: &ProgressBar,
-    ) -> Result<(), ClientError> {
-        self.seq += 1;
-        self.sent += 1;
-        match client.setpoint(Setpoint {
+impl<'a, T: Transport> Streamer<'a, T> {
+    /// Lets `dt` pass on the device's clock, in slices so that Ctrl-C is seen within 50 ms.
+    fn elapse(&mut self, dt: Duration) -> Result<(), Stop> {
+        let mut left = dt;
+        while !left.is_zero() {
+            if (self.interrupted)() {
+                return Err(Stop::Interrupted);
+            }
+            let slice = left.min(Duration::from_millis(50));
+            self.client.transport().elapse(slice);
+            left -= slice;
+        }
+        self.clock_us = self.clock_us.saturating_add((dt.as_micros() as u64).max(1));
+        Ok(())
+    }
+
+    /// Limits a pose into the envelope (host side, f64) from the last pose sent.
+    fn limit(&mut self, pose: Pose<f64>) -> Pose<f64> {
+        if !pose.to_array().iter().all(|c| c.is_finite()) {
+            // Garbage goes to the device as it is, to be refused with its reason.
+            return pose;
+        }
+        let limited = envelope::limit(&self.mechanism, &self.centre, &pose, &self.margins, 16);
+        if let Some(check) = limited.bound_by {
+            let (mm, rad) = envelope::correction(&pose, &limited.pose);
+            self.limited.host += 1;
+            self.count_limit(check, mm, rad);
+        }
+        limited.pose
+    }
+
+    fn count_limit(&mut self, check: Check, translation_m: f64, rotation_rad: f64) {
+        *self.limited.by_check.entry(check.name().to_string()).or_default() += 1;
+        self.limited.largest_mm = self.limited.largest_mm.max(translation_m * 1e3);
+        self.limited.largest_deg = self.limited.largest_deg.max(rotation_rad.to_degrees());
+    }
+
+    /// Sends one setpoint and counts the answer. A device that stops streaming ends the run.
+    fn send(&mut self, pose: Pose<f64>, kind: Kind) -> Result<(), StreamError> {
+        self.seq = self.seq.wrapping_add(1);
+        self.sent_all += 1;
+        if let Kind::Input(_) = kind {
+            self.input_sent += 1;
+        }
+        let answer = self.client.setpoint(Setpoint {
             seq: self.seq,
-            time_us: t_us,
+            time_us: self.clock_us,
             pose: pose.cast(),
-        })? {
-            Ok(()) => {
-                self.applied += 1;
-                self.last_applied = Some(pose);
+        })?;
+        match answer {
+            Ok(accepted) => {
+                self.applied_all += 1;
+                if let Accepted::Limited(r) = accepted {
+                    self.device_limited += 1;
+                    self.count_limit(r.check, f64::from(r.translation), f64::from(r.rotation));
+                }
+                if pose.to_array().iter().all(|c| c.is_finite()) {
+                    self.last_sent = pose;
+                }
+                if let Kind::Input(_) = kind {
+                    self.input_applied += 1;
+                    self.last_applied = Some(pose);
+                }
             }
             Err(reason) => {
-                *self.rejected.entry(reason_name(reason)).or_default() += 1;
-                if let Some(line) = line {
-                    bar.suspend(|| eprintln!("line {line}: rejected by the device: {}", reason_name(reason)));
+                self.rejected_all += 1;
+                if let Kind::Input(line) = kind {
+                    let name = reason_name(reason);
+                    *self.rejected.entry(name.clone()).or_default() += 1;
+                    let number = line.unwrap_or(self.input_sent as usize);
+                    self.bar
+                        .suspend(|| eprintln!("line {number}: refused by the device: {name}"));
+                    self.refusals.push(InputError {
+                        line: number,
+                        reason: name,
+                    });
+                }
+                if reason == RejectReason::NotStreaming {
+                    let status = self.client.status()?;
+                    let fault = self
+                        .client
+                        .faults
+                        .last()
+                        .map_or(String::new(), |f| format!(": fault {f}"));
+                    return Err(StreamError::Stop(Stop::Device(format!(
+                        "the device stopped streaming ({:?}){fault}",
+                        status.state
+                    ))));
                 }
             }
         }
+        if let Some(f) = self.client.faults.last() {
+            return Err(StreamError::Stop(Stop::Device(format!(
+                "the device latched a fault: {f}"
+            ))));
+        }
         Ok(())
+    }
+
+    /// Starts the stream (the device must be `Ready`) and leads the platform from where it is to `first` at a
+    /// quarter of the speed limits, at 100 Hz. Returns `first` as limited.
+    fn start_and_lead_in(&mut self, first: Pose<f64>) -> Result<Pose<f64>, StreamError> {
+        let status = self.client.wait_for(Duration::from_secs(10), |s| {
+            !matches!(s.state, State::Running | State::Stopping)
+        })?;
+        if status.state != State::Ready {
+            return Err(StreamError::Stop(Stop::Device(format!(
+                "the device is in {:?}, not ready to stream",
+                status.state
+            ))));
+        }
+        self.client.start()?;
+        let now = status.pose.cast::<f64>();
+        self.last_sent = now;
+        let first = self.limit(first);
+        let (a, b) = (now.to_array(), first.to_array());
+        // The way from here to the first pose; yaw the short way round.
+        let way: [f64; 6] = std::array::from_fn(|i| {
+            let d = b[i] - a[i];
+            if i == 5 {
+                (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+            } else {
+                d
+            }
+        });
+        let seconds = (0..6).fold(0.0f64, |m, i| {
+            m.max(way[i].abs() / (0.25 * f64::from(self.limits.pose_velocity[i])))
+        });
+        let n = (seconds * 100.0).ceil() as usize;
+        for k in 1..=n {
+            let f = k as f64 / n as f64;
+            let pose = Pose::from_array(std::array::from_fn(|i| a[i] + way[i] * f));
+            self.elapse(Duration::from_millis(10))?;
+            let pose = self.limit(pose);
+            self.send(pose, Kind::LeadIn)?;
+            self.lead_in += 1;
+        }
+        // The first pose follows the lead-in by one of its intervals.
+        self.elapse(Duration::from_millis(10))?;
+        Ok(first)
+    }
+
+    /// Holds the last pose for 250 ms so the platform arrives there (the device runs one setpoint interval
+    /// behind in its interpolating mode).
+    fn settle(&mut self) -> Result<(), StreamError> {
+        let last = self.last_sent;
+        for _ in 0..25 {
+            self.elapse(Duration::from_millis(10))?;
+            self.send(last, Kind::Settle)?;
+            self.settle += 1;
+        }
+        Ok(())
+    }
+
+    /// Streams timed poses (a file or a motion): each at its own time; a gap longer than the stream timeout
+    /// lets the platform come to rest, and the stream is led in and started again at the next pose.
+    fn timed(
+        &mut self,
+        poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>)>,
+        fast: bool,
+    ) -> Result<(), StreamError> {
+        let mut last_t: Option<f64> = None;
+        for (line, t, pose) in poses {
+            if (self.interrupted)() {
+                return Err(StreamError::Stop(Stop::Interrupted));
+            }
+            let gap = last_t.map_or(0.0, |l| (t - l).max(0.0));
+            let pose = match last_t {
+                None => self.start_and_lead_in(pose)?,
+                Some(_) if gap > self.stream_timeout.as_secs_f64() => {
+                    // The device brakes to rest by itself; nothing happens after that, so a fast run does not
+                    // compute the rest of the gap.
+                    let wait = if fast { gap.min(3.0) } else { gap };
+                    self.elapse(Duration::from_secs_f64(wait))?;
+                    self.restarts += 1;
+                    self.bar
+                        .suspend(|| eprintln!("{gap:.3} s gap in the input: the platform rests, then leads in again"));
+                    self.start_and_lead_in(pose)?
+                }
+                Some(_) => {
+                    self.elapse(Duration::from_secs_f64(gap))?;
+                    self.limit(pose)
+                }
+            };
+            last_t = Some(t);
+            self.send(pose, Kind::Input(line))?;
+            self.bar.inc(1);
+        }
+        if last_t.is_some() {
+            self.settle()?;
+        }
+        Ok(())
+    }
+
+    /// Streams datagrams as they arrive: the platform waits where it is for the first one, leads in and starts;
+    /// a pause longer than the stream timeout brakes it to rest, and the next datagram leads in and starts again;
+    /// `idle` without a datagram ends the session.
+    fn live(
+        &mut self,
+        source: &UdpSource,
+        report: &mut DatagramReport,
+        errors: &mut Vec<InputError>,
+    ) -> Result<(), StreamError> {
+        source
+            .socket
+            .set_read_timeout(Some(Duration::from_millis(1)))
+            .map_err(ClientError::Io)?;
+        self.bar.suspend(|| {
+            eprintln!(
+                "streaming: send datagrams to {}",
+                source.socket.local_addr().map_or("?".into(), |a| a.to_string())
+            )
+        });
+        // The largest UDP payload: no datagram is ever cut.
+        let mut buf = vec![0u8; 65_536];
+        let mut wall = Instant::now();
+        let mut last_datagram = Instant::now();
+        let mut streaming = false;
+        loop {
+            if (self.interrupted)() {
+                return Err(StreamError::Stop(Stop::Interrupted));
+            }
+            let got = source.socket.recv_from(&mut buf);
+            let now = Instant::now();
+            self.elapse(now - wall)?;
+            wall = now;
+            let (n, from) = match got {
+                Ok(got) => got,
+                // A signal (Ctrl-C) interrupts the wait: nothing arrived, and the loop then sees the flag.
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                    ) =>
+                {
+                    let quiet = now - last_datagram;
+                    if streaming && quiet > self.stream_timeout {
+                        // The source paused (a game's menu): the device brakes to rest by itself.
+                        streaming = false;
+                        if self.last_applied.is_some() {
+                            self.bar.suspend(|| eprintln!("the source paused: the platform rests"));
+                        }
+                    }
+                    if quiet >= source.idle {
+                        return Ok(());
+                    }
+                    continue;
+                }
+                Err(e) => return Err(ClientError::Io(e).into()),
+            };
+            if source.from.is_some_and(|ip| ip != from.ip()) {
+                report.other_senders += 1;
+                continue;
+            }
+            last_datagram = now;
+            report.received += 1;
+            let number = report.received as usize;
+            let pose = match parse_datagram(&buf[..n], source.degrees) {
+                Ok(pose) => pose,
+                Err(reason) => {
+                    report.unreadable += 1;
+                    self.bar.suspend(|| eprintln!("datagram {number}: {reason}"));
+                    errors.push(InputError { line: number, reason });
+                    continue;
+                }
+            };
+            let pose = if streaming {
+                self.limit(pose)
+            } else {
+                if self.last_applied.is_some() {
+                    report.resumed += 1;
+                }
+                streaming = true;
+                self.start_and_lead_in(pose)?
+            };
+            self.send(pose, Kind::Input(Some(number)))?;
+            self.bar.inc(1);
+        }
     }
 }
 
-/// Brings the device to `Running`: hello, power up, home if needed, start.
-fn prepare<T: Transport>(client: &mut Client<T>, home: bool) -> Result<(), ClientError> {
+/// How a stream ended early.
+enum StreamError {
+    Stop(Stop),
+    Client(ClientError),
+}
+
+impl From<ClientError> for StreamError {
+    fn from(e: ClientError) -> Self {
+        match e {
+            ClientError::Interrupted => StreamError::Stop(Stop::Interrupted),
+            other => StreamError::Client(other),
+        }
+    }
+}
+
+impl From<Stop> for StreamError {
+    fn from(s: Stop) -> Self {
+        StreamError::Stop(s)
+    }
+}
+
+/// Brings the device to `Ready`: hello, power up, home if needed. Errors here mean the stream never started.
+fn prepare<T: Transport>(client: &mut Client<T>, home: bool) -> Result<Status, ClientError> {
     let preset = client.hello()?;
     if preset != Preset::TrainerModel {
         eprintln!("note: the device drives {}", preset.name());
@@ -246,6 +670,10 @@ fn prepare<T: Transport>(client: &mut Client<T>, home: bool) -> Result<(), Clien
             status.state
         )));
     }
+    if matches!(status.state, State::Running | State::Stopping) {
+        client.stop()?;
+        status = client.wait_for(Duration::from_secs(10), |s| !matches!(s.state, State::Stopping))?;
+    }
     if status.state == State::Off {
         client.enable()?;
         status = client.wait_for(Duration::from_secs(5), |s| {
@@ -254,9 +682,17 @@ fn prepare<T: Transport>(client: &mut Client<T>, home: bool) -> Result<(), Clien
     }
     if !status.homed || home {
         client.home()?;
-        status = client.wait_for(Duration::from_secs(120), |s| {
+        let homed = client.wait_for(Duration::from_secs(120), |s| {
             matches!(s.state, State::Ready | State::Fault(..))
-        })?;
+        });
+        status = match homed {
+            Ok(s) => s,
+            Err(e) => {
+                // Ctrl-C or a timeout during homing: abort it before saying so.
+                let _ = client.stop();
+                return Err(e);
+            }
+        };
     }
     if status.state != State::Ready {
         return Err(ClientError::Unexpected(format!(
@@ -264,180 +700,186 @@ fn prepare<T: Transport>(client: &mut Client<T>, home: bool) -> Result<(), Clien
             status.state
         )));
     }
-    client.start()
+    Ok(status)
 }
 
-/// Streams a source and returns the report. Ctrl-C, the end of the input and errors all end with a stop and a
-/// wait for rest.
+/// The device's envelope margins and stream timeout (the host limits with the same margins, a rounding more).
+fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<(EnvelopeMargins, Duration), ClientError> {
+    let mut margins = EnvelopeMargins::default();
+    for (i, m) in margins.0.iter_mut().enumerate() {
+        // f32 on the device: 1e-6 of each unit more, so a pose the host passed passes there too.
+        *m = client.get_config(ConfigKey::EnvelopeMargin(i as u8))? + 1e-6;
+    }
+    let timeout_ms = client.get_config(ConfigKey::StreamTimeoutMs)?;
+    Ok((margins, Duration::from_secs_f64(f64::from(timeout_ms) / 1000.0)))
+}
+
+/// Streams a source and returns the report (also for runs that ended early: its outcome says how). `Err` only
+/// when the stream could not start.
 pub fn run<T: Transport>(
     client: &mut Client<T>,
     source: Source,
     input_errors: Vec<InputError>,
     options: &Options,
+    fast: bool,
     interrupted: &dyn Fn() -> bool,
 ) -> Result<Report, ClientError> {
-    prepare(client, options.home)?;
-    let home = Preset::TrainerModel.home();
-    let schedule: Vec<(Option<usize>, f64, Pose<f64>)> = match &source {
-        Source::Motion { motion, seconds } => {
-            let n = (seconds * options.rate_hz).round() as usize;
-            (0..=n)
-                .map(|k| {
-                    let t = k as f64 / options.rate_hz;
-                    (None, t, motion_pose(*motion, t, home))
-                })
-                .collect()
-        }
-        Source::Poses(p) => p.iter().map(|(line, t, pose)| (Some(*line), *t, *pose)).collect(),
-        Source::Udp { .. } => Vec::new(),
+    let baseline = prepare(client, options.home)?;
+    let (margins, stream_timeout) = device_envelope(client)?;
+    let PresetGeometry::Ring(geometry) = Preset::TrainerModel.geometry() else {
+        return Err(ClientError::Unexpected("the trainer model is a ring platform".into()));
     };
-    // Lead-in: from where the platform is to the first pose, at a quarter of the velocity limits.
-    let now = client.status()?.pose.cast::<f64>();
-    let first = schedule.first().map_or(now, |s| s.2);
-    let limits = MotionLimits::TRAINER_MODEL;
-    let (a, b) = (now.to_array(), first.to_array());
-    // The way from here to the first pose; yaw the short way round.
-    let way: [f64; 6] = std::array::from_fn(|i| {
-        let d = b[i] - a[i];
-        if i == 5 {
-            (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
-        } else {
-            d
-        }
-    });
-    let lead_s = (0..6).fold(0.0f64, |m, i| {
-        m.max(way[i].abs() / (0.25 * f64::from(limits.pose_velocity[i])))
-    });
-    let lead_n = (lead_s * 100.0).ceil() as usize;
+    let total = match &source {
+        Source::Motion { seconds, rate_hz, .. } => (seconds * rate_hz).round() as u64 + 1,
+        Source::Poses(p) => p.len() as u64,
+        Source::Udp(_) => 0,
+    };
     let bar = if options.quiet {
         ProgressBar::hidden()
+    } else if total > 0 {
+        ProgressBar::new(total)
     } else {
-        ProgressBar::new((schedule.len() + lead_n) as u64)
+        ProgressBar::new_spinner()
     };
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} setpoints {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let mut counts = Counts::default();
-    let mut clock_us = 0u64;
-    for k in 1..=lead_n {
-        let f = k as f64 / lead_n as f64;
-        let pose = Pose::from_array(std::array::from_fn(|i| a[i] + way[i] * f));
-        client.transport().elapse(Duration::from_millis(10));
-        clock_us += 10_000;
-        counts.send(client, pose, clock_us, None, &bar)?;
-        bar.inc(1);
-    }
-    let mut t_prev = schedule.first().map_or(0.0, |s| s.1);
-    let mut result = Ok(());
-    for (i, (line, t, pose)) in schedule.iter().enumerate() {
-        if interrupted() {
-            bar.suspend(|| eprintln!("interrupted: stopping"));
-            break;
-        }
-        let dt = (t - t_prev).max(0.0);
-        t_prev = *t;
-        if i > 0 {
-            client.transport().elapse(Duration::from_secs_f64(dt));
-        }
-        clock_us += ((dt * 1e6).round() as u64).max(1);
-        if let Err(e) = counts.send(client, *pose, clock_us, *line, &bar) {
-            result = Err(e);
-            break;
-        }
-        bar.inc(1);
-        if i % 100 == 0 {
-            let total: u32 = counts.rejected.values().sum();
-            bar.set_message(format!("rejected {total}"));
-        }
-    }
+    let mut s = Streamer {
+        client,
+        interrupted,
+        bar,
+        mechanism: RingPlatform::new(geometry),
+        margins,
+        limits: MotionLimits::TRAINER_MODEL,
+        stream_timeout,
+        centre: Pose::from_array(Preset::TrainerModel.home()),
+        last_sent: baseline.pose.cast(),
+        clock_us: 0,
+        seq: 0,
+        baseline,
+        sent_all: 0,
+        applied_all: 0,
+        rejected_all: 0,
+        device_limited: 0,
+        input_sent: 0,
+        input_applied: 0,
+        lead_in: 0,
+        settle: 0,
+        restarts: 0,
+        rejected: BTreeMap::new(),
+        refusals: Vec::new(),
+        limited: LimitedReport::default(),
+        last_applied: None,
+    };
     let mut input_errors = input_errors;
-    if let Source::Udp { socket, degrees, idle } = &source {
-        socket.set_read_timeout(Some(Duration::from_millis(1)))?;
-        bar.suspend(|| {
-            eprintln!(
-                "streaming: send datagrams to {}",
-                socket.local_addr().map_or("?".into(), |a| a.to_string())
-            )
+    let mut datagrams = None;
+    let home = Preset::TrainerModel.home();
+    let outcome = match &source {
+        Source::Motion {
+            motion,
+            seconds,
+            rate_hz,
+        } => {
+            let n = (seconds * rate_hz).round() as u64;
+            let mut poses = (0..=n).map(|k| {
+                let t = k as f64 / rate_hz;
+                (None, t, motion_pose(*motion, t, home))
+            });
+            s.timed(&mut poses, fast)
+        }
+        Source::Poses(p) => {
+            let mut poses = p.iter().map(|(line, t, pose)| (Some(*line), *t, *pose));
+            s.timed(&mut poses, fast)
+        }
+        Source::Udp(udp) => {
+            let mut d = DatagramReport::default();
+            let r = s.live(udp, &mut d, &mut input_errors);
+            datagrams = Some(d);
+            r
+        }
+    };
+    s.bar.finish_and_clear();
+    // Stop, and wait for rest (also after Ctrl-C or a device that stopped by itself).
+    let (stop, transport) = match outcome {
+        Ok(()) => (None, None),
+        Err(StreamError::Stop(stop)) => (Some(stop), None),
+        Err(StreamError::Client(e)) => (None, Some(e)),
+    };
+    let status = if transport.is_none() {
+        let _ = s.client.stop();
+        let cancel = s.client.cancel.take();
+        let status = s.client.wait_for(Duration::from_secs(10), |st| {
+            !matches!(st.state, State::Running | State::Stopping)
         });
-        let mut buf = [0u8; 512];
-        let (mut quiet_for, mut datagrams) = (Duration::ZERO, 0usize);
-        let mut wall = std::time::Instant::now();
-        while quiet_for < *idle && !interrupted() {
-            let got = socket.recv(&mut buf);
-            let now = std::time::Instant::now();
-            let dt = now - wall;
-            wall = now;
-            client.transport().elapse(dt);
-            clock_us += (dt.as_micros() as u64).max(1);
-            match got {
-                Ok(n) => {
-                    datagrams += 1;
-                    quiet_for = Duration::ZERO;
-                    match parse_datagram(&buf[..n], *degrees) {
-                        Ok(pose) => {
-                            counts.send(client, pose, clock_us, None, &bar)?;
-                            bar.inc(1);
-                        }
-                        Err(reason) => {
-                            bar.suspend(|| eprintln!("datagram {datagrams}: {reason}"));
-                            input_errors.push(InputError {
-                                line: datagrams,
-                                reason,
-                            });
-                        }
-                    }
-                }
-                // A signal (Ctrl-C) interrupts the wait: nothing arrived, and the loop then sees the flag.
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
-                    ) =>
-                {
-                    quiet_for += dt
-                }
-                Err(e) => return Err(e.into()),
-            }
-        }
-    }
-    // End of input: hold the last pose for a settle time, as simulator software does when it stops, so that the
-    // platform arrives there (the device runs one setpoint interval behind); then stop. Ctrl-C or an error: stop now.
-    let running = result.is_ok() && client.status().is_ok_and(|s| s.state == State::Running);
-    if running && !interrupted() {
-        if let Some(last) = counts.last_applied.or(schedule.last().map(|s| s.2)) {
-            for _ in 0..25 {
-                client.transport().elapse(Duration::from_millis(10));
-                clock_us += 10_000;
-                counts.send(client, last, clock_us, None, &bar)?;
-            }
-        }
-    }
-    bar.finish_and_clear();
-    // Stop, and wait for rest.
-    let _ = client.stop();
-    let status = client.wait_for(Duration::from_secs(10), |s| {
-        !matches!(s.state, State::Running | State::Stopping)
-    })?;
-    result?;
-    let Counts {
-        sent,
-        applied,
-        rejected,
-        last_applied,
-        ..
-    } = counts;
-    let device_rejected = status.rejected.total();
-    let host_rejected: u32 = rejected.values().sum();
+        s.client.cancel = cancel;
+        status.ok()
+    } else {
+        None
+    };
+    let (status, transport) = match (status, transport) {
+        (Some(st), None) => (Some(st), None),
+        (None, None) => (None, Some("the device did not answer after the stop".to_string())),
+        (_, Some(e)) => (None, Some(e.to_string())),
+    };
+    let refused: u32 = s.rejected.values().sum();
+    let (outcome, reason, code) = if let Some(t) = transport {
+        ("transport_lost", Some(t), exit::TRANSPORT_LOST)
+    } else if let Some(Stop::Device(why)) = &stop {
+        ("device_stopped", Some(why.clone()), exit::DEVICE_STOPPED)
+    } else if let Some(Stop::Interrupted) = &stop {
+        (
+            "interrupted",
+            Some("interrupted (Ctrl-C)".to_string()),
+            exit::INTERRUPTED,
+        )
+    } else if refused > 0 {
+        (
+            "refused",
+            Some(format!("the device refused {refused} setpoints")),
+            exit::REFUSED,
+        )
+    } else if !input_errors.is_empty() {
+        (
+            "input_errors",
+            Some(format!("{} input lines could not be read", input_errors.len())),
+            exit::INPUT_ERRORS,
+        )
+    } else if s.input_sent == 0 {
+        (
+            "input_errors",
+            Some("no pose in the input".to_string()),
+            exit::INPUT_ERRORS,
+        )
+    } else {
+        ("followed", None, exit::FOLLOWED)
+    };
+    let counts_agree = status.as_ref().is_some_and(|st| {
+        let b = &s.baseline;
+        st.applied.wrapping_sub(b.applied) == s.applied_all
+            && st.rejected.total().wrapping_sub(b.rejected.total()) == s.rejected_all
+            && st.limited.count.wrapping_sub(b.limited.count) == s.device_limited
+            && s.sent_all == s.applied_all + s.rejected_all
+    });
+    s.limited.device = s.device_limited;
     Ok(Report {
-        state: format!("{:?}", status.state),
-        setpoints_sent: sent,
-        setpoints_applied: applied,
-        rejected,
-        final_steps: status.steps,
-        faults: client.faults.iter().map(|f: &FaultReason| f.to_string()).collect(),
+        outcome,
+        reason,
+        exit_code: code,
+        state: status.as_ref().map_or("unknown".into(), |st| format!("{:?}", st.state)),
+        setpoints_sent: s.input_sent,
+        setpoints_applied: s.input_applied,
+        limited: s.limited,
+        rejected: s.rejected,
+        refusals: s.refusals,
+        lead_in_sent: s.lead_in,
+        settle_sent: s.settle,
+        restarts: s.restarts,
+        final_steps: status.as_ref().map_or([0; 6], |st| st.steps),
+        faults: s.client.faults.iter().map(|f: &FaultReason| f.to_string()).collect(),
         input_errors,
-        last_applied_pose: last_applied.map(|p| p.to_array()),
-        counts_agree: status.applied == applied && device_rejected == host_rejected && sent == applied + host_rejected,
+        datagrams,
+        last_applied_pose: s.last_applied.map(|p| p.to_array()),
+        counts_agree,
     })
 }

@@ -13,6 +13,10 @@ use crate::client::Transport;
 /// USB CDC serial to a board.
 pub struct Serial {
     port: Box<dyn serialport::SerialPort>,
+    /// The host's clock: time let pass since the port opened. [`Transport::elapse`] sleeps until the wall clock
+    /// reaches it, so round trips do not add up to a stream that falls behind real time.
+    epoch: Instant,
+    owed: Duration,
 }
 
 impl Serial {
@@ -21,7 +25,11 @@ impl Serial {
         let port = serialport::new(path, 115_200)
             .timeout(Duration::from_millis(1))
             .open()?;
-        Ok(Self { port })
+        Ok(Self {
+            port,
+            epoch: Instant::now(),
+            owed: Duration::ZERO,
+        })
     }
 }
 
@@ -37,7 +45,16 @@ impl Transport for Serial {
         }
     }
     fn elapse(&mut self, dt: Duration) {
-        std::thread::sleep(dt);
+        self.owed = self.owed.saturating_add(dt);
+        // Behind the clock (slow round trips): catch up without sleeping.
+        if let Some(wait) = (self.epoch + self.owed).checked_duration_since(Instant::now()) {
+            std::thread::sleep(wait);
+        } else if let Some(late) = Instant::now().checked_duration_since(self.epoch + self.owed) {
+            // Never owe more than a second: after a long stall, pace from now rather than rush.
+            if late > Duration::from_secs(1) {
+                self.owed += late - Duration::from_secs(1);
+            }
+        }
     }
 }
 

@@ -87,7 +87,9 @@ pub const TRAINER_MODEL_HOME_Z: f64 = 0.227;
 /// the worst normalised margin) and rounded to millimetres: every axis of the spec table swept over its whole range
 /// (surge/sway +-50 mm, heave +-40 mm, pitch/roll +-20 deg), at any yaw, passes all six checks with the source's joint
 /// limits. The combined corners of all ranges at once are not all reachable; the README gives the share that is.
-/// Linear actuators: 150 mm stroke, 160..310 mm (the range uses 174..294 mm).
+/// Linear actuators: 160..310 mm of travel between the end stops, of which 166..310 mm is the working stroke: the
+/// lower end switch sits at 165 mm (homing leaves the actuator 2 mm above it), and limited motion keeps the 2 mm
+/// reach margin above 166 mm, so it never trips the switch (the spec ranges use 174..294 mm).
 pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
     "trainer-model",
     0.286,
@@ -99,7 +101,7 @@ pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
         radial(-0.181, 0.160),
     ],
     RingLimits {
-        stroke: [0.160, 0.310],
+        stroke: [0.166, 0.310],
         carriage_spacing: SOURCE_SPACING,
         base_cone: 11.0 * DEG,
         platform_cone: 22.0 * DEG,

@@ -1,16 +1,20 @@
-//! Envelope limiting: a setpoint outside the workspace becomes the pose nearest to it, along the segment from the
-//! last accepted target, that passes every check with a margin.
+//! Envelope limiting: a setpoint outside the workspace becomes the pose nearest to it, on the ray from the middle
+//! of the workspace, that passes every check with a margin.
 //!
-//! Motion-simulator software clamps each axis to the rig's limits; a ring platform's envelope is not a box (the
-//! trainer model holds each spec axis alone but less than half of the combined extremes), so the clamp has to be
-//! the workspace checks themselves. The search runs on the segment `from -> to` in `x, y, z, alpha, beta`, with
-//! the target's yaw throughout: the ring turns with the platform, so yaw never limits a ring platform, and a
-//! limited stream keeps turning with its source.
+//! Motion-simulator software clamps each axis to the rig's limits, scaling the excursion from the neutral pose; a
+//! ring platform's envelope is not a box (the trainer model holds each spec axis alone but less than half of the
+//! combined extremes), so the clamp has to be the workspace checks themselves. The search runs on the ray from the
+//! centre (the home pose) to the target in `x, y, z, alpha, beta`, with the target's yaw throughout: the ring turns
+//! with the platform and the trainer's home pose passes at every yaw, so a limited stream keeps turning with its
+//! source. A ray from the centre, not a segment from the last target: the last target of a limited stream lies on
+//! the edge, and the segment from it to the next target outside leaves the workspace at once, so the platform
+//! would stick where it first met the edge (and its yaw with it, since the workspace turns with the yaw). From the
+//! centre, a continuous source gives a continuous limited path wherever the workspace is star-shaped about its
+//! centre.
 //!
-//! The search is a bisection with a fixed number of IK + check evaluations, so its cost is bounded (one evaluation
-//! when the target is inside). It assumes `from` passes (the caller's last accepted target, which did) and returns
-//! the last point found to pass: a pose that passes, never one that does not. On a non-convex boundary it finds a
-//! crossing, not necessarily the first; the tick checks every commanded pose anyway.
+//! The search is a short scan inward from the target for the first point that passes, then a bisection, with a
+//! fixed number of IK + check evaluations, so its cost is bounded (one evaluation when the target is inside). It
+//! returns the last point found to pass: a pose that passes, never one that does not.
 //!
 //! The margin keeps targets that far inside each check, so that the path the trackers take between two targets
 //! (per axis, under acceleration limits, not exactly on the straight line) stays inside too. The host limits its
@@ -55,13 +59,12 @@ impl EnvelopeMargins {
 pub struct Limited<T> {
     /// The pose to command: the target itself when it passes.
     pub pose: Pose<T>,
-    /// Its actuators (IK), when the pose was evaluated; `None` when the result is `from` unchanged, which the
-    /// caller evaluated when it accepted it.
+    /// Its actuators (IK), when the pose was evaluated; `None` when it is the centre (at the target's yaw).
     pub actuators: Option<Actuators<T>>,
     /// The check that bound the target (the first check short of its margin at the nearest failing point found);
     /// `None` when the target passes.
     pub bound_by: Option<Check>,
-    /// How far along `from -> to` the pose is (1 when the target passes).
+    /// How far along `centre -> to` the pose is (1 when the target passes).
     pub fraction: T,
 }
 
@@ -88,9 +91,9 @@ fn evaluate<T: Real, M: Mechanism<T>>(
     }
 }
 
-/// The point at `s` of the segment `from -> to` in `x, y, z, alpha, beta`, with the target's yaw.
-fn along<T: Real>(from: &Pose<T>, to: &Pose<T>, s: T) -> Pose<T> {
-    let (a, b) = (from.to_array(), to.to_array());
+/// The point at `s` of the ray `centre -> to` in `x, y, z, alpha, beta`, with the target's yaw.
+fn along<T: Real>(centre: &Pose<T>, to: &Pose<T>, s: T) -> Pose<T> {
+    let (a, b) = (centre.to_array(), to.to_array());
     Pose::from_array(core::array::from_fn(|i| {
         if i == 5 {
             b[5]
@@ -100,11 +103,12 @@ fn along<T: Real>(from: &Pose<T>, to: &Pose<T>, s: T) -> Pose<T> {
     }))
 }
 
-/// Limits `to` into the envelope along the segment from `from` (which must pass), with at most `evaluations`
-/// IK + check evaluations (at least one: the target). Never returns a pose that fails a check's margin.
+/// Limits `to` into the envelope along the ray from `centre` (a pose in the middle of the workspace that passes
+/// at every yaw: the home pose) with at most `evaluations` IK + check evaluations (at least one: the target).
+/// Never returns a pose that fails a check's margin.
 pub fn limit<T: Real, M: Mechanism<T>>(
     mechanism: &M,
-    from: &Pose<T>,
+    centre: &Pose<T>,
     to: &Pose<T>,
     margins: &EnvelopeMargins,
     evaluations: u8,
@@ -120,13 +124,33 @@ pub fn limit<T: Real, M: Mechanism<T>>(
         }
         Err(check) => check,
     };
+    // The excursion may leave the workspace and come back along the ray (it need not be convex): scan inward
+    // from the target in a few even steps for the first point that passes, so that the point found is the one
+    // nearest the target; then bisect between it and the last point that failed.
+    let budget = evaluations.max(1) - 1;
+    let scan = (budget / 2).min(4);
     let (mut lo, mut hi) = (T::zero(), T::one());
     let mut best: Option<(Pose<T>, Actuators<T>)> = None;
     let mut bound_by = first;
+    for k in (1..=scan).rev() {
+        let s = T::of(f64::from(k) / f64::from(scan + 1));
+        let pose = along(centre, to, s);
+        match evaluate(mechanism, &pose, margins) {
+            Ok(q) => {
+                lo = s;
+                best = Some((pose, q));
+                break;
+            }
+            Err(check) => {
+                hi = s;
+                bound_by = check;
+            }
+        }
+    }
     let half = T::of(0.5);
-    for _ in 1..evaluations.max(1) {
+    for _ in 0..budget.saturating_sub(scan) {
         let mid = (lo + hi) * half;
-        let pose = along(from, to, mid);
+        let pose = along(centre, to, mid);
         match evaluate(mechanism, &pose, margins) {
             Ok(q) => {
                 lo = mid;
@@ -145,8 +169,9 @@ pub fn limit<T: Real, M: Mechanism<T>>(
             bound_by: Some(bound_by),
             fraction: lo,
         },
+        // Nothing on the ray passed but the centre, which passes at every yaw.
         None => Limited {
-            pose: *from,
+            pose: along(centre, to, T::zero()),
             actuators: None,
             bound_by: Some(bound_by),
             fraction: T::zero(),

@@ -443,7 +443,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         let config = &self.config;
         let limited = envelope::limit(
             &self.mechanism,
-            &self.to,
+            &self.centre,
             &sp.pose,
             &config.margins,
             config.limit_evaluations,
