@@ -224,7 +224,10 @@ fn device_config_reads_writes_and_refuses() {
     let all = json(&["device", "config", "--sim"]);
     assert_eq!(all["tick-hz"], 1000.0);
     assert_eq!(all["steps-per-unit.0"], 25_600.0);
-    assert_eq!(all.as_object().unwrap().len(), 23);
+    assert_eq!(all.as_object().unwrap().len(), 30);
+    assert_eq!(all["envelope-margin.reach"], 0.002);
+    assert_eq!(all["gross-jump-ms"], 500.0);
+    assert_eq!(all["follow-direct"], 0.0);
     // A set answers with the value read back from the device; a next-start key says it is not live.
     let set = json(&["device", "config", "set", "pose-velocity.2", "0.02", "--sim"]);
     assert_eq!(set["value"], 0.02);
@@ -239,7 +242,9 @@ fn device_config_reads_writes_and_refuses() {
         &["device", "config", "set", "tick-hz", "1500", "--sim"][..],
         &["device", "config", "set", "debounce-ms", "0", "--sim"],
         &["device", "config", "get", "no-such-key", "--sim"],
-        &["device", "config", "set", "jump-tolerance", "lots", "--sim"],
+        &["device", "config", "set", "gross-jump-ms", "lots", "--sim"],
+        &["device", "config", "set", "follow-direct", "2", "--sim"],
+        &["device", "config", "set", "envelope-margin.reach", "0.5", "--sim"],
         &["device", "config", "fetch", "tick-hz", "--sim"],
         &["device", "status", "tick-hz", "--sim"],
     ] {

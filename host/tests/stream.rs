@@ -92,13 +92,19 @@ fn bad_lines_are_reported_and_counts_add_up() {
     let errors = report["input_errors"].as_array().unwrap();
     let lines: Vec<u64> = errors.iter().map(|e| e["line"].as_u64().unwrap()).collect();
     assert_eq!(lines, [4, 5, 8], "malformed number, short line, time not increasing");
-    assert!(
-        stderr.contains("line 6: rejected by the device: non_finite"),
-        "{stderr}"
-    );
-    assert!(stderr.contains("line 7: rejected by the device: too_fast"), "{stderr}");
+    assert!(stderr.contains("line 6: refused by the device: non_finite"), "{stderr}");
+    // 27 cm up in 10 ms: a gross jump; the host's limiting brought it inside, so it is not outside as well.
+    assert!(stderr.contains("line 7: refused by the device: gross_jump"), "{stderr}");
     assert_eq!(report["rejected"]["non_finite"], 1);
-    assert_eq!(report["rejected"]["too_fast"], 1);
+    assert_eq!(report["rejected"]["gross_jump"], 1);
+    // Every refusal with its line, in the report as on stderr.
+    let refusals: Vec<(u64, String)> = report["refusals"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| (r["line"].as_u64().unwrap(), r["reason"].as_str().unwrap().to_owned()))
+        .collect();
+    assert_eq!(refusals, [(6, "non_finite".into()), (7, "gross_jump".into())]);
     let sent = report["setpoints_sent"].as_u64().unwrap();
     let applied = report["setpoints_applied"].as_u64().unwrap();
     let rejected: u64 = report["rejected"]
@@ -107,19 +113,258 @@ fn bad_lines_are_reported_and_counts_add_up() {
         .values()
         .map(|v| v.as_u64().unwrap())
         .sum();
+    assert_eq!(
+        (sent, applied),
+        (5, 3),
+        "input setpoints only: lead-in and settle apart"
+    );
     assert_eq!(sent, applied + rejected);
     assert_eq!(report["counts_agree"], true);
     assert_eq!(report["state"], "Ready");
+    assert_eq!(report["outcome"], "refused");
+    assert_eq!(out.status.code(), Some(4), "device refusals outrank input errors");
 }
 
 #[test]
-fn a_gap_in_the_stream_ends_at_rest() {
-    // 0.3 s without setpoints: the device brakes to rest, then refuses the rest until started again.
+fn a_gap_in_the_stream_rests_then_leads_in_again() {
+    // 0.4 s without setpoints: the device brakes to rest; the host leads in and starts again, and every pose is
+    // applied.
     let csv = "t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n0.01,0,0,0.2271,0,0,0\n0.4,0,0,0.2272,0,0,0\n0.41,0,0,0.2273,0,0,0\n";
-    let (report, _) = stream(&[], Some(csv));
-    assert_eq!(report["rejected"]["not_streaming"], 2);
+    let (report, out) = stream(&[], Some(csv));
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(report["restarts"], 1);
+    assert_eq!(report["setpoints_applied"], 4);
+    assert_eq!(report["rejected"], serde_json::json!({}));
     assert_eq!(report["state"], "Ready");
     assert_eq!(report["counts_agree"], true);
+}
+
+/// The runs of the issue that found every stream stalling: each ends with every setpoint applied (limited where
+/// needed), state Ready and exit 0.
+#[test]
+fn streams_beyond_the_envelope_and_the_limits_flow() {
+    // The demo for 20 s (it left the workspace at 18.9 s before), and a combined motion whose every axis stays
+    // inside the spec table while all move at once, yaw turning.
+    let (demo, out) = stream(&["--motion", "demo", "--duration", "20", "--rate", "250"], None);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(demo["setpoints_applied"], demo["setpoints_sent"]);
+    let mut combined = String::from("t,x,y,z,alpha,beta,gamma\n");
+    let mut fast = combined.clone();
+    for k in 0..=1200 {
+        let t = f64::from(k) / 60.0;
+        let r = 18f64.to_radians();
+        combined += &format!(
+            "{t},{},{},{},{},{},{}\n",
+            0.045 * (0.9 * t).sin(),
+            0.045 * (1.1 * t + 1.0).sin(),
+            0.227 + 0.03 * (1.3 * t + 2.0).sin(),
+            r * (0.8 * t + 0.5).sin(),
+            r * (0.7 * t + 1.5).sin(),
+            0.3 * t
+        );
+        // Surge peaking at 0.075 m/s, half again the 0.05 m/s limit.
+        if k <= 600 {
+            fast += &format!("{t},{},0,0.227,0,0,0\n", 0.03 * (2.5 * t).sin());
+        }
+    }
+    for (name, csv, limited) in [("combined", &combined, true), ("fast", &fast, false)] {
+        let (report, out) = stream(&[], Some(csv));
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(report["outcome"], "followed", "{name}");
+        assert_eq!(report["state"], "Ready", "{name}");
+        assert_eq!(report["setpoints_applied"], report["setpoints_sent"], "{name}");
+        assert_eq!(report["counts_agree"], true, "{name}");
+        let host_limited = report["limited"]["host"].as_u64().unwrap();
+        assert_eq!(host_limited > 0, limited, "{name}: {}", report["limited"]);
+        if limited {
+            // The host limits with the device's margins: the device has (almost) nothing left to limit.
+            assert!(
+                report["limited"]["device"].as_u64().unwrap() * 100 <= host_limited,
+                "{}",
+                report["limited"]
+            );
+            assert!(report["limited"]["largest_mm"].as_f64().unwrap() > 1.0);
+        }
+    }
+}
+
+/// A stream that turns to garbage ends non-zero with the reason.
+#[test]
+fn a_stream_that_turns_to_nan_ends_non_zero() {
+    let mut csv = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for k in 0..200 {
+        let z = if k < 100 { "0.227" } else { "NaN" };
+        csv += &format!("{},0,0,{z},0,0,0\n", f64::from(k) * 0.01);
+    }
+    let (report, out) = stream(&[], Some(&csv));
+    assert_eq!(out.status.code(), Some(5), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(report["outcome"], "device_stopped");
+    assert!(report["rejected"]["non_finite"].as_u64().unwrap() >= 5);
+    assert!(
+        report["reason"].as_str().unwrap().contains("stopped streaming"),
+        "{}",
+        report["reason"]
+    );
+    assert_eq!(report["state"], "Ready");
+    assert_eq!(report["counts_agree"], true);
+}
+
+/// Adversarial input: each ends with a clear error or a correct result, a report, and the right exit code.
+#[test]
+fn garbage_input_gets_a_clear_answer() {
+    // A time of 1e308 is refused with its line, the rest is followed; no panic.
+    let (report, out) = stream(
+        &[],
+        Some("t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n1e308,0,0,0.227,0,0,0\n"),
+    );
+    assert_eq!(out.status.code(), Some(3), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(report["input_errors"][0]["line"], 3);
+    assert_eq!(report["setpoints_applied"], 1);
+    // A gap of a million seconds under --fast ends (the device rests; nothing to compute for the rest of it).
+    let (report, out) = stream(
+        &[],
+        Some("t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n1000000,0,0,0.228,0,0,0\n"),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        (report["restarts"].as_u64(), report["setpoints_applied"].as_u64()),
+        (Some(1), Some(2))
+    );
+    // Columns by name, in any order; a wrong header is an error before anything moves.
+    let (report, out) = stream(
+        &[],
+        Some("z,t,x,y,alpha,beta,gamma\n0.23,0,0,0,0,0,0\n0.231,0.01,0,0,0,0,0\n"),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!((report["last_applied_pose"][2].as_f64().unwrap() - 0.231).abs() < 1e-12);
+    for (csv, why) in [
+        ("t,x,y,z,roll,pitch,yaw\n0,0,0,0.227,0,0,0\n", "header"),
+        ("0,0,0,0.227,0,0,0\n", "header"),
+        ("", "no header"),
+    ] {
+        let dir = std::env::temp_dir().join(format!("ringpod-bad-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("bad.csv");
+        std::fs::write(&path, csv).unwrap();
+        Command::cargo_bin("ringpod")
+            .unwrap()
+            .args(["stream", "--sim", "--fast", "--quiet", "--input"])
+            .arg(&path)
+            .assert()
+            .code(1)
+            .stderr(predicates::str::contains(why));
+    }
+    // Old Mac line ends (CR only) are lines.
+    let (report, out) = stream(
+        &[],
+        Some("t,x,y,z,alpha,beta,gamma\r0,0,0,0.227,0,0,0\r0.01,0,0,0.2271,0,0,0\r"),
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(report["setpoints_applied"], 2);
+    // A header and nothing else: nothing was followed, and the exit code says so.
+    let (report, out) = stream(&[], Some("t,x,y,z,alpha,beta,gamma\n"));
+    assert_eq!(out.status.code(), Some(3));
+    assert_eq!(report["reason"], "no pose in the input");
+    // Options that are not numbers of the right size are errors before anything starts.
+    for args in [
+        &["--motion", "demo", "--duration", "inf"][..],
+        &["--motion", "demo", "--duration", "NaN"],
+        &["--motion", "demo", "--duration", "0"],
+        &["--motion", "demo", "--rate", "0"],
+        &["--udp", "127.0.0.1:0", "--udp-idle", "NaN"],
+    ] {
+        Command::cargo_bin("ringpod")
+            .unwrap()
+            .args(["stream", "--sim", "--fast", "--quiet"])
+            .args(args)
+            .assert()
+            .code(1)
+            .stderr(predicates::str::contains("must be a number"));
+    }
+}
+
+/// A built-in motion of a very long duration is generated as it is sent, not built in memory first; Ctrl-C ends
+/// it with a stop, a report, and an exit code that is not success.
+#[test]
+fn long_motions_start_at_once_and_stop_on_ctrl_c() {
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let interrupt_after = |args: &[&str], ms: u64| {
+        let child = std::process::Command::new(&exe)
+            .args(["stream", "--sim", "--report-json", "--quiet"])
+            .args(args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(ms));
+        nix::sys::signal::kill(
+            nix::unistd::Pid::from_raw(child.id() as i32),
+            nix::sys::signal::Signal::SIGINT,
+        )
+        .unwrap();
+        let sent = std::time::Instant::now();
+        let out = child.wait_with_output().unwrap();
+        (out, sent.elapsed())
+    };
+    // In real time, Ctrl-C during homing aborts it at once (homing takes seconds).
+    let (out, took) = interrupt_after(&["--motion", "demo"], 1000);
+    assert_eq!(out.status.code(), Some(130));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("interrupted"));
+    assert!(took < std::time::Duration::from_secs(2), "{took:?}");
+    let (out, _) = interrupt_after(&["--fast", "--motion", "demo", "--duration", "1e8"], 1500);
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+    assert_eq!(out.status.code(), Some(130), "an interrupted run is not a success");
+    assert_eq!(report["outcome"], "interrupted");
+    assert_eq!(report["state"], "Ready");
+    assert_eq!(report["counts_agree"], true);
+}
+
+/// A second stream to the same device: its counters are this run's, and it agrees with the device's. Garbage
+/// on the line does not break the next request.
+#[test]
+fn a_second_stream_to_the_same_device_agrees() {
+    use std::io::BufRead;
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let mut server = std::process::Command::new(&exe)
+        .args(["simulate", "--pty"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut path = String::new();
+    std::io::BufReader::new(server.stdout.take().unwrap())
+        .read_line(&mut path)
+        .unwrap();
+    let path = path.trim().to_owned();
+    let file = std::env::temp_dir().join(format!("ringpod-twice-{}.csv", std::process::id()));
+    std::fs::write(
+        &file,
+        "t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n0.05,0.001,0,0.228,0,0,0\n",
+    )
+    .unwrap();
+    for run in 0..2 {
+        if run == 1 {
+            // Line noise without a delimiter, as a loose connector makes.
+            use std::io::Write;
+            let mut port = std::fs::OpenOptions::new().write(true).open(&path).unwrap();
+            port.write_all(b"\x13\x37garbage").unwrap();
+        }
+        let out = std::process::Command::new(&exe)
+            .args(["stream", "--port", &path, "--report-json", "--quiet", "--input"])
+            .arg(&file)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "run {run}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["counts_agree"], true, "run {run}");
+        assert_eq!(report["setpoints_applied"], 2, "run {run}");
+    }
+    let _ = server.kill();
+    let _ = server.wait();
 }
 
 #[test]
@@ -273,4 +518,55 @@ fn ctrl_c_stops_and_reports() {
     assert_eq!(report["state"], "Ready", "stopped and at rest");
     assert!(report["setpoints_applied"].as_u64().unwrap() >= 1);
     assert_eq!(report["counts_agree"], true);
+}
+
+/// A live session as a user has it: ringpod starts first, the game later; the game pauses (a menu) longer than
+/// the stream timeout and resumes. The platform waits, leads in, rests in the pause, leads in again: every
+/// datagram is applied. Datagrams of any size are read whole; other senders are ignored with `--udp-from`.
+#[test]
+fn a_live_session_starts_late_pauses_and_resumes() {
+    let (child, _stderr, addr) = spawn_udp_stream(&["--udp-idle", "0.4", "--udp-from", "127.0.0.1"]);
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let stranger = std::net::UdpSocket::bind("127.0.0.2:0").unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let mut k = 0;
+    for burst in 0..2 {
+        for _ in 0..30 {
+            k += 1;
+            let z = 0.227 + 0.0001 * f64::from(k);
+            let mut text = format!("0.001 0 {z} 0 0 {}", 0.01 * f64::from(k));
+            if k == 5 {
+                // Padded past the 512 bytes a datagram was once cut at.
+                text += &" ".repeat(2000);
+            }
+            socket.send_to(text.as_bytes(), &addr).unwrap();
+            if k == 10 {
+                stranger.send_to(b"0 0 0.3 0 0 0", &addr).unwrap();
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        if burst == 0 {
+            std::thread::sleep(std::time::Duration::from_millis(300));
+        }
+    }
+    let out = child.wait_with_output().unwrap();
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+    assert_eq!(out.status.code(), Some(0), "{report}");
+    assert_eq!(report["outcome"], "followed");
+    assert_eq!(report["setpoints_applied"], 60, "{report}");
+    assert_eq!(report["rejected"], serde_json::json!({}));
+    assert_eq!(report["datagrams"]["received"], 60);
+    assert_eq!(report["datagrams"]["other_senders"], 1);
+    assert_eq!(report["datagrams"]["resumed"], 1);
+    assert!(report["lead_in_sent"].as_u64().unwrap() >= 2, "led in twice");
+    assert_eq!(report["counts_agree"], true);
+    let last: Vec<f64> = numbers(&report["last_applied_pose"]);
+    let want = steps_at(last.try_into().unwrap());
+    for (g, w) in numbers(&report["final_steps"]).iter().zip(want) {
+        assert!(
+            (*g as i64 - w).abs() <= 1,
+            "final steps vs IK of the last pose: {g} {w}"
+        );
+    }
 }

@@ -16,7 +16,7 @@
 //! stream = { kind = "sine", axis = 2, amplitude = 0.02, frequency_hz = 1.0, rate_hz = 60.0, duration_ms = 2000 }
 //! [[step]]
 //! at_ms = 50
-//! setpoint = { pose = [0, 0, 0.227, 0, 0, 0], expect = "Nack(Rejected(TooFast" }
+//! setpoint = { pose = [0, 0, 0.5, 0, 0, 0], expect = "Nack(Rejected(GrossJump" }
 //! [[step]]
 //! at_ms = 3000
 //! expect = { state = "Ready", logic = true, power = true, enable = true, homed = true, at_pose = [0, 0, 0.227, 0, 0, 0] }
@@ -27,7 +27,7 @@ use std::fmt::Write;
 use ringpod_core::controller::{Controller, ControllerConfig};
 use ringpod_core::kinematics::{presets, Pose};
 use ringpod_core::motion::Setpoint;
-use ringpod_core::protocol::{self, HostMessage, Request, Response, PROTOCOL_VERSION};
+use ringpod_core::protocol::{self, DeviceMessage, HostMessage, Request, Response, PROTOCOL_VERSION};
 use serde::Deserialize;
 
 use crate::plant::{Plant, Rig};
@@ -85,7 +85,7 @@ pub struct InputChange {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Stream {
-    /// `sine` (one pose axis), `yaw` (constant yaw rate), `demo` (all axes).
+    /// `sine` (one pose axis), `yaw` (constant yaw rate), `demo` (all axes), `hold` (one pose, `pose`).
     pub kind: String,
     /// Pose axis for `sine` (0..6).
     #[serde(default)]
@@ -96,6 +96,9 @@ pub struct Stream {
     /// Frequency (Hz).
     #[serde(default)]
     pub frequency_hz: f64,
+    /// The pose of a `hold` stream.
+    #[serde(default)]
+    pub pose: [f64; 6],
     /// Setpoints per second.
     pub rate_hz: f64,
     /// How long (ms).
@@ -136,6 +139,10 @@ pub struct Expect {
     pub applied: Option<u32>,
     /// Every setpoint sent was either accepted or rejected (nothing lost).
     pub counts_add_up: Option<bool>,
+    /// Setpoints limited into the envelope, at least this many.
+    pub limited_at_least: Option<u32>,
+    /// Setpoints limited into the envelope, exactly.
+    pub limited: Option<u32>,
 }
 
 /// What a run did, for assertions beyond the file.
@@ -175,6 +182,15 @@ impl Host {
         assert_eq!(response.id, self.next_id, "response to the request sent");
         response
     }
+
+    /// Remembers where an accepted setpoint sends the platform: the pose itself, or the pose it was limited to.
+    fn accepted(&mut self, c: &Controller, answer: &DeviceMessage, pose: Pose<f32>) {
+        match answer {
+            DeviceMessage::Ack => self.last_accepted = Some(pose),
+            DeviceMessage::Limited(_) => self.last_accepted = Some(c.pipeline().target()),
+            _ => {}
+        }
+    }
 }
 
 fn command(name: &str) -> Result<HostMessage, String> {
@@ -200,6 +216,7 @@ fn stream_pose(s: &Stream, t: f64) -> Pose<f64> {
     match s.kind.as_str() {
         "sine" => p[s.axis.min(5)] += s.amplitude * (w * t).sin(),
         "yaw" => p[5] = (s.amplitude * t).rem_euclid(std::f64::consts::TAU),
+        "hold" => p = s.pose,
         _ => {
             // demo: every axis at once, at half its range, different frequencies; starts at home
             let r = presets::TRAINER_MODEL_RANGES;
@@ -280,9 +297,7 @@ pub fn run(scenario: &Scenario) -> Result<Report, String> {
                         s.pose, s.expect
                     ));
                 }
-                if text == "Ack" {
-                    host.last_accepted = Some(pose);
-                }
+                host.accepted(&rig.controller, &response.body, pose);
             }
             if let Some(s) = &step.stream {
                 streams.push(ActiveStream {
@@ -307,11 +322,8 @@ pub fn run(scenario: &Scenario) -> Result<Report, String> {
                     time_us: (s.next_ms * 1000.0) as u64,
                     pose,
                 };
-                if let ringpod_core::protocol::DeviceMessage::Ack =
-                    host.send(&mut rig.controller, HostMessage::Setpoint(sp)).body
-                {
-                    host.last_accepted = Some(pose);
-                }
+                let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
+                host.accepted(&rig.controller, &response.body, pose);
                 s.next_ms += 1000.0 / s.stream.rate_hz;
             }
         }
@@ -381,6 +393,11 @@ fn check(rig: &Rig, host: &Host, report: &Report, e: &Expect) -> Result<(), Stri
         if status.applied != a {
             return Err(format!("{} applied, expected {a}", status.applied));
         }
+    }
+    if e.limited.is_some_and(|n| status.limited.count != n)
+        || e.limited_at_least.is_some_and(|n| status.limited.count < n)
+    {
+        return Err(format!("{} limited ({:?})", status.limited.count, status.limited));
     }
     if e.counts_add_up == Some(true) && status.applied + status.rejected.total() != report.sent {
         return Err(format!(
