@@ -139,6 +139,10 @@ pub struct StreamArgs {
     /// Home even if the device is homed.
     #[arg(long)]
     pub home: bool,
+    /// Send poses as they come, without limiting them into the envelope on the host first: the device limits them
+    /// (it always does; this shows it doing all of it, as a board streamed by other software would).
+    #[arg(long)]
+    pub device_limits_only: bool,
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,

@@ -105,6 +105,7 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     // The bar draws on stderr (and hides itself without a terminal), the report on stdout.
     let options = stream::Options {
         home: args.home,
+        host_limits: !args.device_limits_only,
         quiet: args.quiet,
     };
     let report = match stream::run(&mut client, source, input_errors, &options, args.fast, &|| {

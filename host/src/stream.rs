@@ -290,6 +290,8 @@ pub struct Report {
 pub struct Options {
     /// Home even if the device is homed already.
     pub home: bool,
+    /// Limit poses into the envelope on the host before sending them (the device limits what is left).
+    pub host_limits: bool,
     /// No progress bar.
     pub quiet: bool,
 }
@@ -330,6 +332,7 @@ struct Streamer<'a, T: Transport> {
     bar: ProgressBar,
     mechanism: RingPlatform<f64>,
     margins: EnvelopeMargins,
+    host_limits: bool,
     limits: MotionLimits,
     stream_timeout: Duration,
     /// The middle of the workspace, from which poses are limited (the home pose).
@@ -373,7 +376,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
 
     /// Limits a pose into the envelope (host side, f64) from the last pose sent.
     fn limit(&mut self, pose: Pose<f64>) -> Pose<f64> {
-        if !pose.to_array().iter().all(|c| c.is_finite()) {
+        if !self.host_limits || !pose.to_array().iter().all(|c| c.is_finite()) {
             // Garbage goes to the device as it is, to be refused with its reason.
             return pose;
         }
@@ -497,14 +500,27 @@ impl<'a, T: Transport> Streamer<'a, T> {
         Ok(first)
     }
 
-    /// Holds the last pose for 250 ms so the platform arrives there (the device runs one setpoint interval
-    /// behind in its interpolating mode).
+    /// Holds the last pose until the platform has arrived there (the device's commanded pose equals its target),
+    /// at least 250 ms and at most 10 s: a platform slowed by its limits can be far behind its source when the
+    /// source ends, and stopping before it arrives would leave it wherever braking ends.
     fn settle(&mut self) -> Result<(), StreamError> {
         let last = self.last_sent;
-        for _ in 0..25 {
+        for k in 1..=1000u32 {
             self.elapse(Duration::from_millis(10))?;
             self.send(last, Kind::Settle)?;
             self.settle += 1;
+            if k >= 25 && k % 5 == 0 {
+                let s = self.client.status()?;
+                let (p, t) = (s.pose.to_array(), s.target.to_array());
+                let arrived = (0..6).all(|i| {
+                    let d = t[i] - p[i];
+                    let d = if i == 5 { d.sin().atan2(d.cos()) } else { d };
+                    d.abs() <= 2e-6
+                });
+                if arrived {
+                    break;
+                }
+            }
         }
         Ok(())
     }
@@ -753,6 +769,7 @@ pub fn run<T: Transport>(
         bar,
         mechanism: RingPlatform::new(geometry),
         margins,
+        host_limits: options.host_limits,
         limits: MotionLimits::TRAINER_MODEL,
         stream_timeout,
         centre: Pose::from_array(Preset::TrainerModel.home()),

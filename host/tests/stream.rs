@@ -367,16 +367,21 @@ fn a_second_stream_to_the_same_device_agrees() {
     let _ = server.wait();
 }
 
+/// Every built-in motion stays inside the envelope (nothing to limit) and the limits (nothing refused) for 120 s,
+/// at every yaw it turns through.
 #[test]
-fn motions_stay_inside_the_limits() {
+fn motions_stay_inside_the_envelope_and_the_limits() {
     for motion in ["demo", "heave", "yaw", "vibration"] {
-        let (report, out) = stream(&["--motion", motion, "--duration", "3", "--rate", "500"], None);
+        let (report, out) = stream(&["--motion", motion, "--duration", "120", "--rate", "100"], None);
         assert!(
             out.status.success(),
             "{motion}: {}",
             String::from_utf8_lossy(&out.stderr)
         );
         assert_eq!(report["rejected"], serde_json::json!({}), "{motion}");
+        assert_eq!(report["limited"]["host"], 0, "{motion}: {}", report["limited"]);
+        assert_eq!(report["limited"]["device"], 0, "{motion}: {}", report["limited"]);
+        assert_eq!(report["setpoints_applied"], 12_001, "{motion}");
         assert_eq!(report["state"], "Ready", "{motion}");
     }
 }

@@ -529,6 +529,7 @@ impl Controller {
             homed: self.supervisor.homed(),
             steps: self.scheduler.position(),
             pose: self.pipeline.pose(),
+            target: self.pipeline.target(),
             applied: self.pipeline.applied(),
             limited: *self.pipeline.limited(),
             rejected: *self.pipeline.rejected(),

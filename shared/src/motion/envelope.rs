@@ -20,6 +20,8 @@
 //! (per axis, under acceleration limits, not exactly on the straight line) stays inside too. The host limits its
 //! poses with the same code in `f64` before it sends them, so a board sees few setpoints to limit.
 
+use core::cmp::Ordering;
+
 use crate::kinematics::{Actuators, Check, Mechanism, Pose, WorkspaceReport};
 use crate::Real;
 
@@ -49,7 +51,11 @@ impl EnvelopeMargins {
     pub fn first_short<T: Real>(&self, report: &WorkspaceReport<T>) -> Option<Check> {
         Check::ALL.into_iter().find(|c| match report.margin(*c) {
             None => false,
-            Some(m) => !(m >= T::of(f64::from(self.of(*c)))),
+            // NaN compares as nothing: it never passes.
+            Some(m) => !matches!(
+                m.partial_cmp(&T::of(f64::from(self.of(*c)))),
+                Some(Ordering::Greater | Ordering::Equal)
+            ),
         })
     }
 }

@@ -26,6 +26,9 @@ use super::envelope::{self, EnvelopeMargins};
 use super::limits::{AxisTracker, MotionLimits};
 use super::steps::StepConverter;
 
+/// A pose that passed every check, with its actuators.
+type Solved = (Pose<f32>, Actuators<f32>);
+
 /// A pose setpoint from the host.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Setpoint {
@@ -501,7 +504,11 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         let (target, from) = (pose.to_array(), from.to_array());
         let jump = (0..6).any(|i| {
             let d = libm::fabsf(delta(i, target[i], from[i]));
-            !(d <= self.config.limits.pose_velocity[i] * window)
+            // NaN compares as nothing: a jump.
+            !matches!(
+                d.partial_cmp(&(self.config.limits.pose_velocity[i] * window)),
+                Some(core::cmp::Ordering::Less | core::cmp::Ordering::Equal)
+            )
         });
         if jump {
             let outside = match self.mechanism.inverse_checked(&pose) {
@@ -694,7 +701,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     /// middle of the workspace (furthest from every edge) while the yaw keeps turning toward the target, else for
     /// the middle at this yaw: the workspace is not convex, and it turns with the yaw. Each at the speed the
     /// limits allow from here. Returns the step taken, or `None` when no part of any of them stays inside.
-    fn along_edge(&self, step: &[f32; 6], dt: f32) -> Option<([f32; 6], (Pose<f32>, Actuators<f32>))> {
+    fn along_edge(&self, step: &[f32; 6], dt: f32) -> Option<([f32; 6], Solved)> {
         let (fraction, part) = match self.inside_part(step) {
             Some((fraction, taken, found)) => (fraction, Some((taken, found))),
             None => (0.0, None),
@@ -722,8 +729,8 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         let (p, t) = (self.pose.to_array(), goal.to_array());
         let error: [f32; 6] = core::array::from_fn(|i| delta(i, t[i], p[i]));
         let mut k = 1.0 / dt;
-        for i in 0..6 {
-            let e = libm::fabsf(error[i]);
+        for (i, e) in error.iter().enumerate() {
+            let e = libm::fabsf(*e);
             if e > 0.0 {
                 let gain = limits.pose_acceleration[i] * dt;
                 let v = limits.pose_velocity[i].min(libm::fabsf(self.velocity_before[i]) + gain);
@@ -734,7 +741,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     }
 
     /// The largest part of a step (bisection, 6 evaluations: to 1/64) whose pose passes every check.
-    fn inside_part(&self, step: &[f32; 6]) -> Option<(f32, [f32; 6], (Pose<f32>, Actuators<f32>))> {
+    fn inside_part(&self, step: &[f32; 6]) -> Option<(f32, [f32; 6], Solved)> {
         let (mut lo, mut hi) = (0.0f32, 1.0f32);
         let mut best = None;
         for _ in 0..6 {
@@ -768,7 +775,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         }
     }
 
-    fn solve(&self, pose: &Pose<f32>) -> Option<(Pose<f32>, Actuators<f32>)> {
+    fn solve(&self, pose: &Pose<f32>) -> Option<Solved> {
         let (q, report) = self.mechanism.inverse_checked(pose).ok()?;
         report.all_pass().then_some((*pose, q))
     }

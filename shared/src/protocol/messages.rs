@@ -193,6 +193,9 @@ pub struct Status {
     pub steps: [i64; 6],
     /// Commanded pose.
     pub pose: Pose<f32>,
+    /// Where the commanded pose is heading: the last accepted setpoint as limited (the commanded pose itself
+    /// outside streaming).
+    pub target: Pose<f32>,
     /// Setpoints accepted (limited ones included).
     pub applied: u32,
     /// Setpoints limited into the envelope.

@@ -273,6 +273,33 @@ fn write_input(path: &Path) -> std::io::Result<()> {
     std::fs::write(path, csv)
 }
 
+/// A 6 s stream as simulator software sends it, beyond what the model can do: every axis at once up to 1.5 times
+/// its spec range, surge at up to twice its speed limit, yaw turning, at 100 Hz; the excursion fades out over the
+/// last 1.5 s and the input holds home for its last 0.5 s, so both runs end at rest at the same pose.
+fn write_beyond_envelope(path: &Path) -> std::io::Result<()> {
+    let mut csv = String::from(
+        "t,x,y,z,alpha,beta,gamma
+",
+    );
+    let r = ringpod_core::kinematics::presets::TRAINER_MODEL_RANGES;
+    for k in 0..=600 {
+        let t = f64::from(k) * 0.01;
+        let fade = (t / 0.5).min(1.0) * ((5.5 - t) / 1.5).clamp(0.0, 1.0);
+        let a = |i: usize| 1.5 * r[i] * fade;
+        csv += &format!(
+            "{t:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}
+",
+            a(0) * (1.3 * t).sin(),
+            a(1) * (0.9 * t + 1.0).sin(),
+            0.227 + a(2) * (1.1 * t + 2.0).sin(),
+            a(3) * (0.8 * t + 0.5).sin(),
+            a(4) * (0.7 * t + 1.5).sin(),
+            0.4 * t.min(5.5)
+        );
+    }
+    std::fs::write(path, csv)
+}
+
 /// Writes `garbage` to the device's pty and returns what it answers within half a second.
 fn send_garbage(pty: &str, garbage: &[u8]) -> Result<Vec<u8>, String> {
     use std::io::Write;
@@ -360,6 +387,46 @@ fn controller_on_m4f(t: &mut Tally) {
         (Err(e), _) | (_, Err(e)) => {
             eprintln!("{e}");
             t.check(false, "stream a CSV into the emulated controller and the simulator");
+        }
+    }
+
+    // Beyond the envelope and the limits, limited by the device itself (no host limiting): every setpoint
+    // applied, many limited on the M4F, none refused, and the same end as the simulator's.
+    let beyond = std::env::temp_dir().join(format!("ringpod-qemu-beyond-{}.csv", std::process::id()));
+    if write_beyond_envelope(&beyond).is_err() {
+        t.check(false, "the input file is written");
+        return;
+    }
+    let file = beyond.to_string_lossy().to_string();
+    let args = ["--input", &file, "--device-limits-only", "--quiet", "--report-json"];
+    let emu = ringpod_json(&[&["stream", "--port", pty][..], &args].concat());
+    let sim = ringpod_json(&[&["stream", "--sim", "--fast"][..], &args].concat());
+    let _ = std::fs::remove_file(&beyond);
+    match (&emu, &sim) {
+        (Ok(e), Ok(s)) => {
+            println!(
+                "beyond the envelope: {} of {} limited on the emulated device, final steps {} (simulator {})",
+                e["limited"]["device"], e["setpoints_sent"], e["final_steps"], s["final_steps"]
+            );
+            t.check(
+                e["outcome"] == "followed"
+                    && e["state"] == "Ready"
+                    && e["counts_agree"] == true
+                    && e["rejected"] == serde_json::json!({})
+                    && e["limited"]["device"].as_u64().unwrap_or(0) > 50,
+                "a stream beyond the envelope and the limits flows: every setpoint applied, limited on the M4F",
+            );
+            t.check(
+                e["final_steps"] == s["final_steps"] && e["limited"]["device"] == s["limited"]["device"],
+                "the emulated controller limits as the host simulator does and ends at its step positions",
+            );
+        }
+        (Err(e), _) | (_, Err(e)) => {
+            eprintln!("{e}");
+            t.check(
+                false,
+                "stream beyond the envelope into the emulated controller and the simulator",
+            );
         }
     }
 
