@@ -15,9 +15,9 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use ringpod_core::kinematics::presets::TRAINER_MODEL;
+use ringpod_core::kinematics::presets::{TRAINER_MODEL, TRAINER_MODEL_HOME_Z};
 use ringpod_core::kinematics::{Mechanism, NewtonOptions, Pose, RingPlatform};
-use ringpod_core::motion::Setpoint;
+use ringpod_core::motion::{envelope, PipelineConfig, Setpoint};
 use ringpod_core::protocol::{self, HostMessage, Request};
 use ringpod_core::selfcheck::{self, Digest, CHECKS};
 use ringpod_qemu::{fail, halt};
@@ -110,6 +110,41 @@ fn main() -> ! {
     });
     report("trainer FK, Newton from 1 mm / 0.6 deg off (f32)", fk, 64);
     hprintln!("FK_ITERATIONS {} per solve (x100)", iterations * 100 / 64);
+
+    // One setpoint limited into the envelope: the same 64 poses with their excursions from home tripled (all
+    // outside), limited on the ray from home with the pipeline's budget of evaluations.
+    let centre = Pose::new(0.0, 0.0, TRAINER_MODEL_HOME_Z as f32, 0.0, 0.0, 0.0);
+    let config = PipelineConfig::default();
+    let mut outside = poses;
+    for p in &mut outside {
+        let (a, c) = (p.to_array(), centre.to_array());
+        *p = Pose::from_array(core::array::from_fn(|i| {
+            if i == 5 {
+                a[5]
+            } else {
+                c[i] + 3.0 * (a[i] - c[i])
+            }
+        }));
+    }
+    let mut limited = 0u32;
+    let limit = counts(|| {
+        for p in &outside {
+            let l = envelope::limit(
+                &trainer,
+                &centre,
+                black_box(p),
+                &config.margins,
+                config.limit_evaluations,
+            );
+            limited += u32::from(l.is_limited());
+        }
+    });
+    report(
+        "one setpoint limited into the envelope (8 IK + check evaluations)",
+        limit,
+        64,
+    );
+    hprintln!("LIMITED {} of 64", limited);
 
     // A controller brought to Running through power-up and homing, then fed a setpoint frame every tick.
     let mut d = Digest::default();
