@@ -5,7 +5,7 @@ use std::collections::VecDeque;
 use std::time::Duration;
 
 use ringpod_core::kinematics::presets::Preset;
-use ringpod_core::motion::{Accepted, RejectReason, Setpoint};
+use ringpod_core::motion::{Accepted, RejectReason};
 use ringpod_core::protocol::{
     self, ConfigKey, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
 };
@@ -104,8 +104,9 @@ impl<T: Transport> Client<T> {
         }
     }
 
-    /// Sends one request and waits for its response.
-    pub fn request(&mut self, body: HostMessage) -> Result<DeviceMessage, ClientError> {
+    /// Sends one request without waiting; returns its id. Its response waits in the inbox for
+    /// [`Client::take_response`] (answers to other requests never displace it).
+    pub fn send(&mut self, body: HostMessage) -> Result<u32, ClientError> {
         self.next_id = self.next_id.wrapping_add(1).max(1);
         let id = self.next_id;
         // A leading delimiter ends whatever partial frame line noise left in the device's reader, so that this
@@ -114,14 +115,27 @@ impl<T: Transport> Client<T> {
         let n = protocol::encode(&Request { id, body }, &mut frame[1..])
             .map_err(|e| ClientError::Unexpected(format!("request does not encode: {e}")))?;
         self.transport.send(&frame[..n + 1])?;
+        Ok(id)
+    }
+
+    /// The response to request `id` if it has arrived (reads what the transport has, does not wait).
+    pub fn take_response(&mut self, id: u32) -> Result<Option<DeviceMessage>, ClientError> {
+        self.pump()?;
+        Ok(self
+            .inbox
+            .iter()
+            .position(|r| r.id == id)
+            .and_then(|i| self.inbox.remove(i))
+            .map(|r| r.body))
+    }
+
+    /// Waits for the response to request `id`, up to the timeout.
+    pub fn wait_response(&mut self, id: u32) -> Result<DeviceMessage, ClientError> {
         let step = Duration::from_micros(200);
         let mut waited = Duration::ZERO;
         loop {
-            self.pump()?;
-            while let Some(r) = self.inbox.pop_front() {
-                if r.id == id {
-                    return Ok(r.body);
-                }
+            if let Some(body) = self.take_response(id)? {
+                return Ok(body);
             }
             if waited >= self.timeout {
                 return Err(ClientError::Timeout(self.timeout));
@@ -129,6 +143,12 @@ impl<T: Transport> Client<T> {
             self.transport.elapse(step);
             waited += step;
         }
+    }
+
+    /// Sends one request and waits for its response.
+    pub fn request(&mut self, body: HostMessage) -> Result<DeviceMessage, ClientError> {
+        let id = self.send(body)?;
+        self.wait_response(id)
     }
 
     fn ack(&mut self, body: HostMessage) -> Result<(), ClientError> {
@@ -203,17 +223,6 @@ impl<T: Transport> Client<T> {
         }
     }
 
-    /// Sends a setpoint: `Ok(Ok(accepted))` as applied or limited, `Ok(Err(reason))` when the device refused it.
-    pub fn setpoint(&mut self, sp: Setpoint) -> Result<Result<Accepted, RejectReason>, ClientError> {
-        match self.request(HostMessage::Setpoint(sp))? {
-            DeviceMessage::Ack => Ok(Ok(Accepted::Applied)),
-            DeviceMessage::Limited(report) => Ok(Ok(Accepted::Limited(report))),
-            DeviceMessage::Nack(NackReason::Rejected(r)) => Ok(Err(r)),
-            DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
-            other => Err(ClientError::Unexpected(format!("{other:?}"))),
-        }
-    }
-
     /// Polls the status every 10 ms until `done` says so, or `limit` passes.
     pub fn wait_for(&mut self, limit: Duration, done: impl Fn(&Status) -> bool) -> Result<Status, ClientError> {
         let step = Duration::from_millis(10);
@@ -236,5 +245,17 @@ impl<T: Transport> Client<T> {
             self.transport.elapse(step);
             waited += step;
         }
+    }
+}
+
+/// What a device's answer to a setpoint means: `Ok(Ok(accepted))` as applied or limited, `Ok(Err(reason))` when
+/// refused, `Err` for an answer that is no answer to a setpoint.
+pub fn setpoint_answer(answer: DeviceMessage) -> Result<Result<Accepted, RejectReason>, ClientError> {
+    match answer {
+        DeviceMessage::Ack => Ok(Ok(Accepted::Applied)),
+        DeviceMessage::Limited(report) => Ok(Ok(Accepted::Limited(report))),
+        DeviceMessage::Nack(NackReason::Rejected(r)) => Ok(Err(r)),
+        DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
+        other => Err(ClientError::Unexpected(format!("{other:?}"))),
     }
 }

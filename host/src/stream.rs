@@ -5,18 +5,21 @@
 //! and refuses only garbage. The run ends with a stop, a wait for rest and a report whose outcome and exit code say
 //! whether the input was followed.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
 use ringpod_core::kinematics::{Check, Pose, RingPlatform};
 use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, MotionLimits, RejectReason, Setpoint};
-use ringpod_core::protocol::{ConfigKey, Status};
+use ringpod_core::protocol::{ConfigKey, HostMessage, Status};
 use ringpod_core::safety::{FaultReason, State};
 use serde::Serialize;
 
-use crate::client::{Client, ClientError, Transport};
+use crate::client::{setpoint_answer, Client, ClientError, Transport};
+
+/// Setpoints sent ahead of their answers: 16 ms of a 1 kHz stream, far more than a USB or pty round trip.
+const IN_FLIGHT: usize = 16;
 
 /// Exit codes of `ringpod stream` (the most serious applies).
 pub mod exit {
@@ -356,6 +359,10 @@ struct Streamer<'a, T: Transport> {
     refusals: Vec<InputError>,
     limited: LimitedReport,
     last_applied: Option<Pose<f64>>,
+    /// Setpoints sent and not yet answered: request id, input line or datagram number, pose.
+    in_flight: VecDeque<(u32, Option<usize>, Pose<f64>)>,
+    refused_in_a_row: u32,
+    last_refusal: Option<String>,
 }
 
 impl<'a, T: Transport> Streamer<'a, T> {
@@ -395,59 +402,49 @@ impl<'a, T: Transport> Streamer<'a, T> {
         self.limited.largest_deg = self.limited.largest_deg.max(rotation_rad.to_degrees());
     }
 
-    /// Sends one setpoint and counts the answer. A device that stops streaming ends the run.
+    /// Sends one setpoint without waiting for its answer (a round trip per setpoint would cap the rate at one
+    /// per round trip: 1 kHz needs them in flight), then counts the answers that have arrived, waiting while more
+    /// than [`IN_FLIGHT`] are outstanding. A device that stops streaming ends the run.
     fn send(&mut self, pose: Pose<f64>, kind: Kind) -> Result<(), StreamError> {
         self.seq = self.seq.wrapping_add(1);
         self.sent_all += 1;
         if let Kind::Input(_) = kind {
             self.input_sent += 1;
         }
-        let answer = self.client.setpoint(Setpoint {
+        let id = self.client.send(HostMessage::Setpoint(Setpoint {
             seq: self.seq,
             time_us: self.clock_us,
             pose: pose.cast(),
-        })?;
-        match answer {
-            Ok(accepted) => {
-                self.applied_all += 1;
-                if let Accepted::Limited(r) = accepted {
-                    self.device_limited += 1;
-                    self.count_limit(r.check, f64::from(r.translation), f64::from(r.rotation));
+        }))?;
+        if pose.to_array().iter().all(|c| c.is_finite()) {
+            self.last_sent = pose;
+        }
+        let number = match kind {
+            Kind::Input(line) => Some(line.unwrap_or(self.input_sent as usize)),
+            _ => None,
+        };
+        self.in_flight.push_back((id, number, pose));
+        self.collect(IN_FLIGHT)
+    }
+
+    /// Counts the answers to setpoints in flight, in order, until at most `keep` are outstanding.
+    fn collect(&mut self, keep: usize) -> Result<(), StreamError> {
+        let step = Duration::from_micros(200);
+        let mut waited = Duration::ZERO;
+        while let Some(&(id, number, pose)) = self.in_flight.front() {
+            let Some(answer) = self.client.take_response(id)? else {
+                if self.in_flight.len() <= keep {
+                    break;
                 }
-                if pose.to_array().iter().all(|c| c.is_finite()) {
-                    self.last_sent = pose;
+                if waited >= self.client.timeout {
+                    return Err(ClientError::Timeout(self.client.timeout).into());
                 }
-                if let Kind::Input(_) = kind {
-                    self.input_applied += 1;
-                    self.last_applied = Some(pose);
-                }
-            }
-            Err(reason) => {
-                self.rejected_all += 1;
-                if let Kind::Input(line) = kind {
-                    let name = reason_name(reason);
-                    *self.rejected.entry(name.clone()).or_default() += 1;
-                    let number = line.unwrap_or(self.input_sent as usize);
-                    self.bar
-                        .suspend(|| eprintln!("line {number}: refused by the device: {name}"));
-                    self.refusals.push(InputError {
-                        line: number,
-                        reason: name,
-                    });
-                }
-                if reason == RejectReason::NotStreaming {
-                    let status = self.client.status()?;
-                    let fault = self
-                        .client
-                        .faults
-                        .last()
-                        .map_or(String::new(), |f| format!(": fault {f}"));
-                    return Err(StreamError::Stop(Stop::Device(format!(
-                        "the device stopped streaming ({:?}){fault}",
-                        status.state
-                    ))));
-                }
-            }
+                self.client.transport().elapse(step);
+                waited += step;
+                continue;
+            };
+            self.in_flight.pop_front();
+            self.answered(setpoint_answer(answer)?, number, pose)?;
         }
         if let Some(f) = self.client.faults.last() {
             return Err(StreamError::Stop(Stop::Device(format!(
@@ -457,9 +454,68 @@ impl<'a, T: Transport> Streamer<'a, T> {
         Ok(())
     }
 
+    /// Counts one answer; `number` is an input setpoint's line or datagram number (`None`: lead-in or settle).
+    fn answered(
+        &mut self,
+        answer: Result<Accepted, RejectReason>,
+        number: Option<usize>,
+        pose: Pose<f64>,
+    ) -> Result<(), StreamError> {
+        match answer {
+            Ok(accepted) => {
+                self.applied_all += 1;
+                self.refused_in_a_row = 0;
+                if let Accepted::Limited(r) = accepted {
+                    self.device_limited += 1;
+                    self.count_limit(r.check, f64::from(r.translation), f64::from(r.rotation));
+                }
+                if number.is_some() {
+                    self.input_applied += 1;
+                    self.last_applied = Some(pose);
+                }
+            }
+            Err(reason) => {
+                self.rejected_all += 1;
+                let name = reason_name(reason);
+                if let Some(number) = number {
+                    *self.rejected.entry(name.clone()).or_default() += 1;
+                    self.bar
+                        .suspend(|| eprintln!("line {number}: refused by the device: {name}"));
+                    self.refusals.push(InputError {
+                        line: number,
+                        reason: name.clone(),
+                    });
+                }
+                if reason == RejectReason::NotStreaming {
+                    let status = self.client.status()?;
+                    let fault = self
+                        .client
+                        .faults
+                        .last()
+                        .map_or(String::new(), |f| format!(": fault {f}"));
+                    let before = match &self.last_refusal {
+                        Some(last) if self.refused_in_a_row > 0 => format!(
+                            ", after {} refused setpoints in a row (the last: {last})",
+                            self.refused_in_a_row
+                        ),
+                        _ => String::new(),
+                    };
+                    return Err(StreamError::Stop(Stop::Device(format!(
+                        "the device stopped streaming ({:?}){fault}{before}",
+                        status.state
+                    ))));
+                }
+                self.refused_in_a_row += 1;
+                self.last_refusal = Some(name);
+            }
+        }
+        Ok(())
+    }
+
     /// Starts the stream (the device must be `Ready`) and leads the platform from where it is to `first` at a
     /// quarter of the speed limits, at 100 Hz. Returns `first` as limited.
     fn start_and_lead_in(&mut self, first: Pose<f64>) -> Result<Pose<f64>, StreamError> {
+        self.collect(0)?;
         let status = self.client.wait_for(Duration::from_secs(10), |s| {
             !matches!(s.state, State::Running | State::Stopping)
         })?;
@@ -510,6 +566,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             self.send(last, Kind::Settle)?;
             self.settle += 1;
             if k >= 25 && k % 5 == 0 {
+                self.collect(0)?;
                 let s = self.client.status()?;
                 let (p, t) = (s.pose.to_array(), s.target.to_array());
                 let arrived = (0..6).all(|i| {
@@ -562,7 +619,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
         if last_t.is_some() {
             self.settle()?;
         }
-        Ok(())
+        self.collect(0)
     }
 
     /// Streams datagrams as they arrive: the platform waits where it is for the first one, leads in and starts;
@@ -615,7 +672,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
                         }
                     }
                     if quiet >= source.idle {
-                        return Ok(());
+                        return self.collect(0);
                     }
                     continue;
                 }
@@ -790,6 +847,9 @@ pub fn run<T: Transport>(
         refusals: Vec::new(),
         limited: LimitedReport::default(),
         last_applied: None,
+        in_flight: VecDeque::new(),
+        refused_in_a_row: 0,
+        last_refusal: None,
     };
     let mut input_errors = input_errors;
     let mut datagrams = None;
@@ -826,6 +886,12 @@ pub fn run<T: Transport>(
         Err(StreamError::Client(e)) => (None, Some(e)),
     };
     let status = if transport.is_none() {
+        // The answers still in flight count too (a device that stopped streaming has refused them).
+        while !s.in_flight.is_empty() {
+            if let Err(StreamError::Client(_)) = s.collect(0) {
+                break;
+            }
+        }
         let _ = s.client.stop();
         let cancel = s.client.cancel.take();
         let status = s.client.wait_for(Duration::from_secs(10), |st| {

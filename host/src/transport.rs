@@ -38,7 +38,14 @@ impl Transport for Serial {
         self.port.write_all(bytes)
     }
     fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        match self.port.read(buf) {
+        // Never block: a read with nothing to read would wait out the port's timeout (1 ms) on every poll, and a
+        // 1 kHz stream has no millisecond to spare.
+        let ready = self.port.bytes_to_read().map_err(std::io::Error::from)? as usize;
+        if ready == 0 {
+            return Ok(0);
+        }
+        let want = ready.min(buf.len());
+        match self.port.read(&mut buf[..want]) {
             Ok(n) => Ok(n),
             Err(e) if matches!(e.kind(), std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted) => Ok(0),
             Err(e) => Err(e),

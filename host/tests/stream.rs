@@ -575,3 +575,50 @@ fn a_live_session_starts_late_pauses_and_resumes() {
         );
     }
 }
+
+/// The link dies mid-stream (the board unplugged; here the simulator's process killed): the run ends with a
+/// report that says so and exit code 6.
+#[test]
+fn a_lost_link_ends_with_a_report() {
+    use std::io::BufRead;
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let mut server = std::process::Command::new(&exe)
+        .args(["simulate", "--pty"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut path = String::new();
+    std::io::BufReader::new(server.stdout.take().unwrap())
+        .read_line(&mut path)
+        .unwrap();
+    let path = path.trim().to_owned();
+    let mut child = std::process::Command::new(&exe)
+        .args([
+            "stream",
+            "--port",
+            &path,
+            "--motion",
+            "demo",
+            "--duration",
+            "60",
+            "--report-json",
+            "--quiet",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    // Homing in real time takes about 9 s; then it streams.
+    std::thread::sleep(std::time::Duration::from_secs(11));
+    let _ = server.kill();
+    let _ = server.wait();
+    let out = child.wait_with_output().unwrap();
+    let mut rest = String::new();
+    let _ = std::io::Read::read_to_string(&mut stderr, &mut rest);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {rest}"));
+    assert_eq!(out.status.code(), Some(6), "{report}");
+    assert_eq!(report["outcome"], "transport_lost");
+    assert!(report["setpoints_applied"].as_u64().unwrap() > 0, "{report}");
+    assert!(rest.contains("ringpod:"), "{rest}");
+}

@@ -8,7 +8,7 @@ fn every_scenario_file_passes() {
     let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
     files.retain(|p| p.extension().is_some_and(|e| e == "toml"));
     files.sort();
-    assert!(files.len() >= 6, "scenario files found: {}", files.len());
+    assert!(files.len() >= 9, "scenario files found: {}", files.len());
     let mut failures = Vec::new();
     for path in &files {
         let scenario = ringpod_tests::scenario::load(path).unwrap();
