@@ -39,6 +39,21 @@ fn steps_at(pose: [f64; 6]) -> [i64; 6] {
     conv.to_steps(&q)
 }
 
+/// Starts `ringpod simulate --pty` and returns it with the path of its pseudo-terminal.
+fn simulator_on_a_pty() -> (std::process::Child, String) {
+    use std::io::BufRead;
+    let mut server = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["simulate", "--pty"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut path = String::new();
+    std::io::BufReader::new(server.stdout.take().unwrap())
+        .read_line(&mut path)
+        .unwrap();
+    (server, path.trim().to_owned())
+}
+
 fn numbers(v: &serde_json::Value) -> Vec<f64> {
     v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
@@ -324,18 +339,8 @@ fn long_motions_start_at_once_and_stop_on_ctrl_c() {
 /// on the line does not break the next request.
 #[test]
 fn a_second_stream_to_the_same_device_agrees() {
-    use std::io::BufRead;
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
-    let mut server = std::process::Command::new(&exe)
-        .args(["simulate", "--pty"])
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut path = String::new();
-    std::io::BufReader::new(server.stdout.take().unwrap())
-        .read_line(&mut path)
-        .unwrap();
-    let path = path.trim().to_owned();
+    let (mut server, path) = simulator_on_a_pty();
     let file = std::env::temp_dir().join(format!("ringpod-twice-{}.csv", std::process::id()));
     std::fs::write(
         &file,
@@ -399,18 +404,8 @@ fn stream_needs_a_device() {
 /// through the real serial transport, in real time.
 #[test]
 fn stream_through_a_pseudo_terminal() {
-    use std::io::BufRead;
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
-    let mut server = std::process::Command::new(&exe)
-        .args(["simulate", "--pty"])
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut path = String::new();
-    std::io::BufReader::new(server.stdout.take().unwrap())
-        .read_line(&mut path)
-        .unwrap();
-    let path = path.trim().to_owned();
+    let (mut server, path) = simulator_on_a_pty();
     assert!(path.starts_with("/dev/pts/"), "{path}");
     let csv =
         "t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n0.05,0.001,0,0.228,0.01,0,0.05\n0.1,0.002,0,0.229,0.02,0,0.1\n";
@@ -580,18 +575,8 @@ fn a_live_session_starts_late_pauses_and_resumes() {
 /// report that says so and exit code 6.
 #[test]
 fn a_lost_link_ends_with_a_report() {
-    use std::io::BufRead;
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
-    let mut server = std::process::Command::new(&exe)
-        .args(["simulate", "--pty"])
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut path = String::new();
-    std::io::BufReader::new(server.stdout.take().unwrap())
-        .read_line(&mut path)
-        .unwrap();
-    let path = path.trim().to_owned();
+    let (mut server, path) = simulator_on_a_pty();
     let mut child = std::process::Command::new(&exe)
         .args([
             "stream",
