@@ -54,6 +54,19 @@ fn simulator_on_a_pty() -> (std::process::Child, String) {
     (server, path.trim().to_owned())
 }
 
+/// The run ended with every axis within a step of the IK of the last pose the device applied.
+fn assert_at_the_last_pose(report: &serde_json::Value) {
+    let last: Vec<f64> = numbers(&report["last_applied_pose"]);
+    let want = steps_at(last.try_into().unwrap());
+    let got = numbers(&report["final_steps"]);
+    for (g, w) in got.iter().zip(want) {
+        assert!(
+            (*g as i64 - w).abs() <= 1,
+            "final steps {got:?}, IK of the last pose {want:?}"
+        );
+    }
+}
+
 fn numbers(v: &serde_json::Value) -> Vec<f64> {
     v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
@@ -422,14 +435,7 @@ fn stream_through_a_pseudo_terminal() {
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["state"], "Ready");
     assert_eq!(report["counts_agree"], true);
-    let last: Vec<f64> = numbers(&report["last_applied_pose"]);
-    let want = steps_at(last.try_into().unwrap());
-    for (g, w) in numbers(&report["final_steps"]).iter().zip(want) {
-        assert!(
-            (*g as i64 - w).abs() <= 1,
-            "final steps vs IK of the last pose: {g} {w}"
-        );
-    }
+    assert_at_the_last_pose(&report);
 }
 
 /// Starts `ringpod stream --udp 127.0.0.1:0 ARGS` and waits until it announces the address to send to.
@@ -561,14 +567,7 @@ fn a_live_session_starts_late_pauses_and_resumes() {
     assert_eq!(report["datagrams"]["resumed"], 1);
     assert!(report["lead_in_sent"].as_u64().unwrap() >= 2, "led in twice");
     assert_eq!(report["counts_agree"], true);
-    let last: Vec<f64> = numbers(&report["last_applied_pose"]);
-    let want = steps_at(last.try_into().unwrap());
-    for (g, w) in numbers(&report["final_steps"]).iter().zip(want) {
-        assert!(
-            (*g as i64 - w).abs() <= 1,
-            "final steps vs IK of the last pose: {g} {w}"
-        );
-    }
+    assert_at_the_last_pose(&report);
 }
 
 /// The link dies mid-stream (the board unplugged; here the simulator's process killed): the run ends with a
