@@ -26,6 +26,9 @@ use super::envelope::{self, EnvelopeMargins};
 use super::limits::{AxisTracker, MotionLimits};
 use super::steps::StepConverter;
 
+/// Ticks a pipeline backs off the edge of the workspace before its trackers try again.
+const BACK_OFF_TICKS: u16 = 200;
+
 /// A pose that passed every check, with its actuators.
 type Solved = (Pose<f32>, Actuators<f32>);
 
@@ -234,6 +237,8 @@ pub struct Pipeline<M: Mechanism<f32>> {
     /// Commanded pose (yaw kept within a turn) and its per-axis trackers.
     pose: Pose<f32>,
     trackers: [AxisTracker; 6],
+    /// Ticks left backing off the edge of the workspace toward its middle (see `along_edge`).
+    backing_off: u16,
     /// The middle of the workspace (the pose the pipeline was made at: the home pose).
     centre: Pose<f32>,
     /// The trackers' speeds at the start of this tick (what the pose moved at in the last one).
@@ -282,6 +287,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             pose,
             trackers: [AxisTracker::default(); 6],
             velocity_before: [0.0; 6],
+            backing_off: 0,
             centre: pose,
             actuators: MultiTurn::new(q),
             actuator_velocity: [0.0; 6],
@@ -610,7 +616,14 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     /// pose fails IK or a check (nothing moved).
     fn advance(&mut self, step: &[f32; 6], dt: f32) -> bool {
         let mut step = *step;
-        let (full, q_full) = match self.solve(&self.stepped(&step, 1.0)) {
+        // Backing off the edge: the trackers wait until the platform is well inside again.
+        let tracker = if self.backing_off > 0 && self.mode != Mode::Stopping {
+            self.backing_off -= 1;
+            None
+        } else {
+            self.solve(&self.stepped(&step, 1.0))
+        };
+        let (full, q_full) = match tracker {
             Some(found) => found,
             None => {
                 let Some((taken, found)) = self.along_edge(&step, dt) else {
@@ -697,29 +710,39 @@ impl<M: Mechanism<f32>> Pipeline<M> {
 
     /// The trackers' path (per axis, not on the straight line between two targets) met the edge of the
     /// workspace. Staying inside comes first. Grazing it (at least half of the step stays inside), take that part.
-    /// Otherwise head on a straight line for the target (which passed every check with a margin), else for the
-    /// middle of the workspace (furthest from every edge) while the yaw keeps turning toward the target, else for
-    /// the middle at this yaw: the workspace is not convex, and it turns with the yaw. Each at the speed the
-    /// limits allow from here. Returns the step taken, or `None` when no part of any of them stays inside.
-    fn along_edge(&self, step: &[f32; 6], dt: f32) -> Option<([f32; 6], Solved)> {
-        let (fraction, part) = match self.inside_part(step) {
-            Some((fraction, taken, found)) => (fraction, Some((taken, found))),
-            None => (0.0, None),
-        };
-        if self.mode == Mode::Stopping || fraction >= 0.5 {
-            return part;
+    /// Otherwise head on a straight line for the target (which passed every check with a margin); failing that,
+    /// back off toward the middle of the workspace (furthest from every edge) for [`BACK_OFF_TICKS`], with the yaw
+    /// turning toward the target's, or at this yaw: the workspace is not convex and turns with the yaw, and
+    /// trackers let loose at once would push straight back out. A sliver of a step is no way out: each way must
+    /// keep at least half its step inside, and the longest part found is the last resort. Each step is at the
+    /// speed the limits allow from here. Returns the step taken, or `None` when no part of any of them stays inside.
+    fn along_edge(&mut self, step: &[f32; 6], dt: f32) -> Option<([f32; 6], Solved)> {
+        let mut best = self.inside_part(step);
+        let grazing = best.as_ref().is_some_and(|(fraction, ..)| *fraction >= 0.5);
+        if self.mode == Mode::Stopping || (self.backing_off == 0 && grazing) {
+            return best.map(|(_, taken, found)| (taken, found));
         }
         let middle = |gamma| Pose { gamma, ..self.centre };
-        for goal in [self.to, middle(self.to.gamma), middle(self.pose.gamma)] {
+        let target = (self.backing_off == 0).then_some(self.to);
+        let goals = [target, Some(middle(self.to.gamma)), Some(middle(self.pose.gamma))];
+        for goal in goals.into_iter().flatten() {
+            if goal != self.to && self.backing_off == 0 {
+                // Heading for the target failed: back off the edge toward the middle for a while, so that the
+                // trackers do not push straight back out (a stall on the edge).
+                self.backing_off = BACK_OFF_TICKS;
+            }
             let line = self.line_step(&goal, dt);
             if let Some(found) = self.solve(&self.stepped(&line, 1.0)) {
                 return Some((line, found));
             }
-            if let Some((_, taken, found)) = self.inside_part(&line) {
-                return Some((taken, found));
+            // A sliver of a step is no way out: try the next way, and keep the longest part found for the last.
+            match self.inside_part(&line) {
+                Some((fraction, taken, found)) if fraction >= 0.5 => return Some((taken, found)),
+                Some(part) if best.as_ref().is_none_or(|b| part.0 > b.0) => best = Some(part),
+                _ => {}
             }
         }
-        part
+        best.map(|(_, taken, found)| (taken, found))
     }
 
     /// A step on the straight line toward `goal`, at the largest speed at which no axis exceeds its velocity
