@@ -19,6 +19,7 @@
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 pub mod controller;
+pub mod cueing;
 pub mod kinematics;
 pub mod motion;
 pub mod protocol;
