@@ -40,6 +40,10 @@ pub enum Command {
     /// Scans the workspace with all checks (in parallel), draws a section coloured by the limiting check, and
     /// prints the section's area, the reachable ranges, the volume, and whether the spec ranges are inside.
     Workspace(WorkspaceArgs),
+    /// Motion cueing: vehicle telemetry (specific force, angular rates) to platform poses by the classical washout
+    /// (translation high-passed, sustained force by tilt coordination, yaw by heading), every pose limited into the
+    /// envelope; writes the pose CSV that `stream --input` reads. Exits 0, or 3 when rows could not be used.
+    Cue(CueArgs),
     /// Serves the simulated controller on a pseudo-terminal and prints its path, so that the serial transport
     /// (and any other program) can talk to it as to a board. Runs until interrupted.
     Simulate {
@@ -217,4 +221,24 @@ pub struct WorkspaceArgs {
     /// No progress bar.
     #[arg(long)]
     pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct CueArgs {
+    /// Telemetry CSV with the header t,ax,ay,az,wx,wy,wz (s; specific force in m/s^2 in the vehicle frame, x
+    /// forward, y left, z up, +9.81 on z at rest; angular rates in rad/s).
+    #[arg(long)]
+    pub input: std::path::PathBuf,
+    /// Output pose CSV (t,x,y,z,alpha,beta,gamma in s, m, rad).
+    #[arg(long)]
+    pub out: std::path::PathBuf,
+    /// Washout parameters (TOML; every key optional, see the README).
+    #[arg(long)]
+    pub config: Option<std::path::PathBuf>,
+    /// A plot of the cues (SVG): per axis the specific force asked and delivered, and the angular rates.
+    #[arg(long)]
+    pub plot: Option<std::path::PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -2,6 +2,7 @@
 
 mod cli;
 mod client;
+mod cue;
 mod error;
 mod kinematics;
 mod mechanism;
@@ -9,6 +10,7 @@ mod numbers;
 mod pty;
 mod settings;
 mod stream;
+mod table;
 mod transport;
 mod workspace;
 
@@ -30,6 +32,10 @@ fn main() -> ExitCode {
         C::Device(args) => device_command(args),
         C::Ports => ports_command(),
         C::Simulate { pty } => simulate_command(*pty),
+        C::Cue(args) => cue::run(args).map(|(text, code)| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+            code
+        }),
         C::Workspace(args) => workspace::run(args).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0

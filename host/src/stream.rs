@@ -99,87 +99,21 @@ pub fn parse_datagram(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> 
     Ok(Pose::new(v[0], v[1], v[2], a(v[3]), a(v[4]), a(v[5])))
 }
 
-/// A line or datagram that could not be used, or a setpoint the device refused.
-#[derive(Debug, Clone, Serialize)]
-pub struct InputError {
-    /// 1-based line number (datagram number for UDP).
-    pub line: usize,
-    /// What is wrong.
-    pub reason: String,
-}
+pub use crate::table::InputError;
 
-/// The columns of an input file, by name.
-const COLUMNS: [&str; 7] = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
-/// Input times beyond this (s, about 115 days) are refused as garbage.
-const MAX_TIME_S: f64 = 1e7;
+/// The columns of a pose file.
+pub const POSE_COLUMNS: [&str; 7] = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
 
-/// Reads a CSV whose header names the columns `t,x,y,z,alpha,beta,gamma` in any order (seconds, metres, radians
-/// or degrees). Lines may end in LF, CRLF or CR. Bad lines are returned, not fatal; a missing or wrong header is.
+/// Reads a pose file: `t,x,y,z,alpha,beta,gamma` named in its header in any order (seconds, metres, radians or
+/// degrees; [`crate::table::read`]). NaN and infinity in a pose are passed on: the device refuses them with a
+/// reason, which is the point.
 pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputError>), String> {
-    let text = text.replace("\r\n", "\n").replace('\r', "\n");
-    let mut poses = Vec::new();
-    let mut errors = Vec::new();
-    let mut last_t = f64::NEG_INFINITY;
-    let mut columns: Option<[usize; 7]> = None;
-    for (i, raw) in text.lines().enumerate() {
-        let line = i + 1;
-        let raw = raw.trim();
-        if raw.is_empty() || raw.starts_with('#') {
-            continue;
-        }
-        let fields: Vec<&str> = raw.split(',').map(str::trim).collect();
-        let Some(order) = columns else {
-            let find = |name: &str| fields.iter().position(|f| f.eq_ignore_ascii_case(name));
-            let found: Vec<Option<usize>> = COLUMNS.iter().map(|c| find(c)).collect();
-            if fields.len() != 7 || found.iter().any(Option::is_none) {
-                return Err(format!(
-                    "line {line}: the header must name the columns {} (in any order), found `{raw}`",
-                    COLUMNS.join(",")
-                ));
-            }
-            columns = Some(std::array::from_fn(|k| found[k].unwrap_or(k)));
-            continue;
-        };
-        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
-        let v = match values {
-            Ok(v) if v.len() == 7 => order.map(|k| v[k]),
-            Ok(v) => {
-                errors.push(InputError {
-                    line,
-                    reason: format!("expected 7 fields, got {}", v.len()),
-                });
-                continue;
-            }
-            Err(e) => {
-                errors.push(InputError {
-                    line,
-                    reason: format!("not a number: {e}"),
-                });
-                continue;
-            }
-        };
-        if !(v[0].is_finite() && v[0].abs() <= MAX_TIME_S) {
-            errors.push(InputError {
-                line,
-                reason: format!("time {} is not a number of seconds within +-{MAX_TIME_S:e}", v[0]),
-            });
-            continue;
-        }
-        if v[0] <= last_t {
-            errors.push(InputError {
-                line,
-                reason: "time is not increasing".into(),
-            });
-            continue;
-        }
-        last_t = v[0];
-        let a = |x: f64| if degrees { x.to_radians() } else { x };
-        // NaN and infinity in a pose are passed on: the device refuses them with a reason, which is the point.
-        poses.push((line, v[0], Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6]))));
-    }
-    if columns.is_none() {
-        return Err(format!("no header line naming the columns {}", COLUMNS.join(",")));
-    }
+    let (rows, errors) = crate::table::read(text, &POSE_COLUMNS)?;
+    let a = |x: f64| if degrees { x.to_radians() } else { x };
+    let poses = rows
+        .into_iter()
+        .map(|(line, v)| (line, v[0], Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6]))))
+        .collect();
     Ok((poses, errors))
 }
 

@@ -255,3 +255,144 @@ fn device_config_reads_writes_and_refuses() {
         .assert()
         .stderr(predicates::str::contains("BadConfig"));
 }
+
+/// A drive (accelerating, braking, a long corner, bumps) as telemetry.
+fn drive_csv(rows: &mut dyn FnMut(f64, &mut [f64; 6])) -> String {
+    let g = 9.80665;
+    let mut csv = String::from("t,ax,ay,az,wx,wy,wz\n");
+    for k in 0..=2000 {
+        let t = f64::from(k) / 100.0;
+        let mut v = [0.0, 0.0, g, 0.0, 0.0, 0.0];
+        if (2.0..5.0).contains(&t) {
+            v[0] = 3.0;
+        }
+        if (8.0..10.0).contains(&t) {
+            v[0] = -6.0;
+        }
+        if (10.0..16.0).contains(&t) {
+            v[1] = 4.0;
+            v[5] = 0.4;
+        }
+        if (17.0..18.0).contains(&t) {
+            v[2] = g + 2.0 * (std::f64::consts::TAU * 8.0 * t).sin();
+        }
+        rows(t, &mut v);
+        csv += &format!("{t},{},{},{},{},{},{}\n", v[0], v[1], v[2], v[3], v[4], v[5]);
+    }
+    csv
+}
+
+#[test]
+fn cue_turns_a_drive_into_poses_that_stream_without_refusals() {
+    let dir = std::env::temp_dir().join(format!("ringpod-cue-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("drive.csv");
+    std::fs::write(&input, drive_csv(&mut |_, _| {})).unwrap();
+    let (poses, plot) = (dir.join("poses.csv"), dir.join("cue.svg"));
+    let summary = json(&[
+        "cue",
+        "--json",
+        "--input",
+        input.to_str().unwrap(),
+        "--out",
+        poses.to_str().unwrap(),
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        (summary["rows"].as_u64(), summary["poses"].as_u64()),
+        (Some(2001), Some(2001))
+    );
+    assert_eq!(summary["input_errors"], serde_json::json!([]));
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    for label in [
+        "longitudinal specific force",
+        "platform delivers",
+        "time (s)",
+        "m/s^2",
+        "vehicle yaw rate",
+    ] {
+        assert!(svg.contains(label), "{label}");
+    }
+    // The corner's heading: 6 s at 0.4 rad/s.
+    let last = std::fs::read_to_string(&poses).unwrap();
+    let yaw: f64 = last
+        .lines()
+        .last()
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((yaw - 2.4).abs() < 1e-6, "{yaw}");
+    let out = ringpod()
+        .args(["stream", "--sim", "--fast", "--quiet", "--report-json", "--input"])
+        .arg(&poses)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["setpoints_applied"], 2001);
+    assert_eq!(report["rejected"], serde_json::json!({}));
+    assert_eq!(report["limited"]["device"], 0);
+}
+
+#[test]
+fn cue_reports_bad_rows_and_refuses_bad_parameters_by_name() {
+    let dir = std::env::temp_dir().join(format!("ringpod-cue-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("drive.csv");
+    // A NaN at 3 s (the platform holds), and a 2 s gap after 12 s (the washout starts again at neutral).
+    let csv = drive_csv(&mut |t, v| {
+        if (t - 3.0).abs() < 1e-9 {
+            v[0] = f64::NAN;
+        }
+    });
+    let csv: String = csv
+        .lines()
+        .filter(|l| {
+            let t: f64 = l.split(',').next().unwrap().parse().unwrap_or(-1.0);
+            !(12.0 < t && t < 14.0)
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&input, csv).unwrap();
+    let poses = dir.join("poses.csv");
+    let out = ringpod()
+        .args(["cue", "--json", "--input"])
+        .arg(&input)
+        .arg("--out")
+        .arg(&poses)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(3));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let errors = summary["input_errors"].as_array().unwrap();
+    assert_eq!(errors.len(), 2, "{errors:?}");
+    assert_eq!(errors[0]["line"], 302, "the row of t = 3 s");
+    assert!(errors[0]["reason"].as_str().unwrap().contains("not finite"));
+    assert!(errors[1]["reason"].as_str().unwrap().contains("neutral"));
+    for (toml, key) in [
+        ("tilt_rate_deg = -3.0\n", "tilt_rate_deg"),
+        ("tilt_rate = 3.0\n", "tilt_rate"),
+        (
+            "translation_high_pass = { omega = 0.0, zeta = 1.0 }\n",
+            "translation_high_pass",
+        ),
+        ("forward = \"up\"\n", "forward"),
+    ] {
+        let config = dir.join("cue.toml");
+        std::fs::write(&config, toml).unwrap();
+        ringpod()
+            .args(["cue", "--input"])
+            .arg(&input)
+            .arg("--out")
+            .arg(&poses)
+            .arg("--config")
+            .arg(&config)
+            .assert()
+            .code(1)
+            .stderr(predicates::str::contains(key));
+    }
+}

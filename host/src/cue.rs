@@ -1,0 +1,346 @@
+//! `ringpod cue`: vehicle telemetry to platform poses by the core's classical washout, every pose limited into the
+//! envelope, written as the pose CSV that `ringpod stream --input` reads, with an optional plot of the cues.
+
+use std::io::Write;
+use std::path::Path;
+
+use plotters::prelude::*;
+use ringpod_core::cueing::{self, CueConfig, SampleError, Telemetry, Washout};
+use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
+use ringpod_core::kinematics::{Pose, RingPlatform};
+use ringpod_core::motion::{envelope, EnvelopeMargins};
+use serde::Serialize;
+
+use crate::cli::CueArgs;
+use crate::table::{self, InputError};
+
+/// The columns of a telemetry file.
+pub const TELEMETRY_COLUMNS: [&str; 7] = ["t", "ax", "ay", "az", "wx", "wy", "wz"];
+
+/// Exit code when input rows could not be used (the rest was cued).
+pub const EXIT_INPUT_ERRORS: u8 = 3;
+
+/// What `cue` did.
+#[derive(Debug, Serialize)]
+pub struct Summary {
+    /// Telemetry rows read.
+    pub rows: usize,
+    /// Poses written (one per row read).
+    pub poses: usize,
+    /// Poses the envelope limited.
+    pub limited: usize,
+    /// Rows that could not be used: unreadable, not finite (the platform held), or after a gap of more than a
+    /// second (the washout went back to neutral).
+    pub input_errors: Vec<InputError>,
+}
+
+/// Loads a washout configuration from TOML (every key optional); errors name the key.
+pub fn load_config(path: Option<&Path>) -> anyhow::Result<CueConfig> {
+    let Some(path) = path else {
+        return Ok(CueConfig::default());
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let config: CueConfig = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    config
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    Ok(config)
+}
+
+/// One cued sample, for the output and the plot.
+struct Cued {
+    t: f64,
+    input: Telemetry<f64>,
+    pose: Pose<f64>,
+}
+
+/// Runs the command; returns the summary as text and the exit code.
+pub fn run(args: &CueArgs) -> anyhow::Result<(String, u8)> {
+    let config = load_config(args.config.as_deref())?;
+    let text = std::fs::read_to_string(&args.input).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
+    let (rows, mut errors) =
+        table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
+    let preset = Preset::TrainerModel;
+    let PresetGeometry::Ring(geometry) = preset.geometry() else {
+        anyhow::bail!("the trainer model is a ring platform");
+    };
+    let mechanism = RingPlatform::<f64>::new(geometry);
+    let neutral = Pose::from_array(preset.home());
+    let margins = EnvelopeMargins::default();
+    let mut washout = Washout::<f64>::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
+    let mut limited = 0;
+    let mut last_t: Option<f64> = None;
+    let mut held = neutral;
+    for (line, v) in &rows {
+        let t = v[0];
+        let sample = Telemetry {
+            force: [v[1], v[2], v[3]],
+            rate: [v[4], v[5], v[6]],
+        };
+        let offset = match last_t.map(|l| washout.step(&sample, t - l)) {
+            // The first row starts the washout at neutral.
+            None => Ok(washout.offset()),
+            Some(result) => result,
+        };
+        last_t = Some(t);
+        let pose = match offset {
+            Ok(offset) => {
+                let wanted = cueing::pose(&neutral, &offset);
+                let l = envelope::limit(&mechanism, &neutral, &wanted, &margins, 16);
+                limited += usize::from(l.is_limited());
+                l.pose
+            }
+            Err(SampleError::NonFinite) => {
+                errors.push(InputError {
+                    line: *line,
+                    reason: "a value is not finite: the platform holds".into(),
+                });
+                held
+            }
+            Err(SampleError::Interval) => {
+                errors.push(InputError {
+                    line: *line,
+                    reason: "more than a second after the row before: the washout starts again at neutral".into(),
+                });
+                washout.reset();
+                cueing::pose(&neutral, &washout.offset())
+            }
+        };
+        held = pose;
+        cued.push(Cued { t, input: sample, pose });
+    }
+    errors.sort_by_key(|e| e.line);
+    write_poses(&args.out, &cued)?;
+    if let Some(plot) = &args.plot {
+        draw(plot, &cued, &neutral)?;
+    }
+    let summary = Summary {
+        rows: rows.len(),
+        poses: cued.len(),
+        limited,
+        input_errors: errors,
+    };
+    let code = if summary.input_errors.is_empty() && summary.rows > 0 {
+        0
+    } else {
+        EXIT_INPUT_ERRORS
+    };
+    let text = if args.json {
+        serde_json::to_string_pretty(&summary)? + "\n"
+    } else {
+        let mut s = format!(
+            "{} rows, {} poses written to {} ({} limited into the envelope)\n",
+            summary.rows,
+            summary.poses,
+            args.out.display(),
+            summary.limited
+        );
+        for e in &summary.input_errors {
+            s += &format!("line {}: {}\n", e.line, e.reason);
+        }
+        s
+    };
+    Ok((text, code))
+}
+
+fn write_poses(path: &Path, cued: &[Cued]) -> anyhow::Result<()> {
+    let mut out =
+        std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?);
+    writeln!(out, "t,x,y,z,alpha,beta,gamma")?;
+    for c in cued {
+        let p = c.pose.to_array();
+        writeln!(
+            out,
+            "{},{:.7},{:.7},{:.7},{:.7},{:.7},{:.7}",
+            c.t, p[0], p[1], p[2], p[3], p[4], p[5]
+        )?;
+    }
+    out.flush()?;
+    Ok(())
+}
+
+/// The specific force the platform delivers at each sample (platform axes): its acceleration by central
+/// differences of its positions, and gravity in its tilted frame.
+fn delivered_forces(cued: &[Cued]) -> Vec<[f64; 3]> {
+    (0..cued.len())
+        .map(|k| {
+            let accel = if k == 0 || k + 1 == cued.len() {
+                [0.0; 3]
+            } else {
+                let (a, b, c) = (&cued[k - 1], &cued[k], &cued[k + 1]);
+                let (h0, h1) = (b.t - a.t, c.t - b.t);
+                let (pa, pb, pc) = (a.pose.to_array(), b.pose.to_array(), c.pose.to_array());
+                std::array::from_fn(|i| 2.0 * ((pc[i] - pb[i]) / h1 - (pb[i] - pa[i]) / h0) / (h0 + h1))
+            };
+            cueing::delivered(accel, cued[k].pose.alpha, cued[k].pose.beta)
+        })
+        .collect()
+}
+
+/// Draws the cues: per axis the specific force asked (scaled as the washout scales it) and delivered, and the
+/// angular rates asked and delivered. SVG, with labels (PNG text would need a system font library).
+fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
+    if path.extension().is_none_or(|e| e != "svg") {
+        anyhow::bail!(
+            "{}: the plot is SVG (labels need text; PNG text would need a system font library)",
+            path.display()
+        );
+    }
+    let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: {e}", path.display());
+    let delivered = delivered_forces(cued);
+    let rates: Vec<[f64; 3]> = (0..cued.len())
+        .map(|k| {
+            if k == 0 {
+                return [0.0; 3];
+            }
+            let (a, b) = (cued[k - 1].pose.to_array(), cued[k].pose.to_array());
+            let h = cued[k].t - cued[k - 1].t;
+            [(b[3] - a[3]) / h, (b[4] - a[4]) / h, (b[5] - a[5]) / h]
+        })
+        .collect();
+    let t0 = cued.first().map_or(0.0, |c| c.t);
+    let t1 = cued.last().map_or(1.0, |c| c.t).max(t0 + 1e-3);
+    let root = SVGBackend::new(path, (1000, 1000)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let root = root
+        .titled(
+            &format!(
+                "ringpod cue: telemetry in, platform cues out (neutral z = {:.3} m)",
+                neutral.z
+            ),
+            ("sans-serif", 20),
+        )
+        .map_err(|e| err(&e))?;
+    let panels = root.split_evenly((4, 1));
+    let g = cueing::G;
+    type Series<'a> = (&'a str, Vec<(f64, f64)>, RGBColor);
+    let panel_data: [(&str, &str, Vec<Series>); 4] = [
+        (
+            "longitudinal specific force",
+            "m/s^2",
+            vec![
+                (
+                    "vehicle ax",
+                    cued.iter().map(|c| (c.t, c.input.force[0])).collect(),
+                    BLUE,
+                ),
+                (
+                    "platform delivers",
+                    cued.iter().zip(&delivered).map(|(c, d)| (c.t, d[0])).collect(),
+                    RED,
+                ),
+            ],
+        ),
+        (
+            "lateral specific force",
+            "m/s^2",
+            vec![
+                (
+                    "vehicle ay",
+                    cued.iter().map(|c| (c.t, c.input.force[1])).collect(),
+                    BLUE,
+                ),
+                (
+                    "platform delivers",
+                    cued.iter().zip(&delivered).map(|(c, d)| (c.t, d[1])).collect(),
+                    RED,
+                ),
+            ],
+        ),
+        (
+            "vertical specific force minus g",
+            "m/s^2",
+            vec![
+                (
+                    "vehicle az - g",
+                    cued.iter().map(|c| (c.t, c.input.force[2] - g)).collect(),
+                    BLUE,
+                ),
+                (
+                    "platform delivers - g",
+                    cued.iter().zip(&delivered).map(|(c, d)| (c.t, d[2] - g)).collect(),
+                    RED,
+                ),
+            ],
+        ),
+        (
+            "angular rates",
+            "rad/s",
+            vec![
+                (
+                    "vehicle roll rate",
+                    cued.iter().map(|c| (c.t, c.input.rate[0])).collect(),
+                    BLUE,
+                ),
+                (
+                    "platform roll rate",
+                    cued.iter().zip(&rates).map(|(c, r)| (c.t, r[0])).collect(),
+                    RED,
+                ),
+                (
+                    "vehicle pitch rate",
+                    cued.iter().map(|c| (c.t, c.input.rate[1])).collect(),
+                    CYAN,
+                ),
+                (
+                    "platform pitch rate",
+                    cued.iter().zip(&rates).map(|(c, r)| (c.t, r[1])).collect(),
+                    MAGENTA,
+                ),
+                (
+                    "vehicle yaw rate",
+                    cued.iter().map(|c| (c.t, c.input.rate[2])).collect(),
+                    GREEN,
+                ),
+                (
+                    "platform yaw rate",
+                    cued.iter().zip(&rates).map(|(c, r)| (c.t, r[2])).collect(),
+                    BLACK,
+                ),
+            ],
+        ),
+    ];
+    for (area, (title, unit, series)) in panels.iter().zip(panel_data) {
+        let (lo, hi) = series
+            .iter()
+            .flat_map(|s| s.1.iter().map(|p| p.1))
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+        let (lo, hi) = if lo.is_finite() {
+            (lo, hi.max(lo + 1e-3))
+        } else {
+            (-1.0, 1.0)
+        };
+        let pad = 0.05 * (hi - lo);
+        let mut chart = ChartBuilder::on(area)
+            .caption(title, ("sans-serif", 16))
+            .margin(8)
+            .x_label_area_size(30)
+            .y_label_area_size(60)
+            .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc("time (s)")
+            .y_desc(unit)
+            .draw()
+            .map_err(|e| err(&e))?;
+        for (name, points, colour) in series {
+            chart
+                .draw_series(LineSeries::new(points.into_iter().filter(|p| p.1.is_finite()), colour))
+                .map_err(|e| err(&e))?
+                .label(name)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
+    }
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}

@@ -1,0 +1,93 @@
+//! Number tables in CSV whose header names the columns: the pose files of `stream`, the telemetry of `cue`.
+
+use serde::Serialize;
+
+/// A line that could not be used, or a setpoint the device refused.
+#[derive(Debug, Clone, Serialize)]
+pub struct InputError {
+    /// 1-based line number (datagram number for UDP).
+    pub line: usize,
+    /// What is wrong.
+    pub reason: String,
+}
+
+/// Input times beyond this (s, about 115 days) are refused as garbage.
+pub const MAX_TIME_S: f64 = 1e7;
+
+/// One row: its line number and its numbers in the order of the requested columns.
+pub type Row = (usize, Vec<f64>);
+
+/// Reads a CSV whose header names `columns` in any order (case-insensitive; no other columns). Lines may end in LF,
+/// CRLF or CR; blank lines and lines starting with `#` are skipped. The first column is a time in seconds that
+/// must increase from row to row. Bad rows are returned with their line numbers, not fatal; a missing or wrong
+/// header is.
+pub fn read(text: &str, columns: &[&str]) -> Result<(Vec<Row>, Vec<InputError>), String> {
+    let text = text.replace("\r\n", "\n").replace('\r', "\n");
+    let mut rows = Vec::new();
+    let mut errors = Vec::new();
+    let mut last_t = f64::NEG_INFINITY;
+    let mut order: Option<Vec<usize>> = None;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let raw = raw.trim();
+        if raw.is_empty() || raw.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = raw.split(',').map(str::trim).collect();
+        let Some(order) = &order else {
+            let found: Option<Vec<usize>> = columns
+                .iter()
+                .map(|c| fields.iter().position(|f| f.eq_ignore_ascii_case(c)))
+                .collect();
+            match found {
+                Some(found) if fields.len() == columns.len() => order = Some(found),
+                _ => {
+                    return Err(format!(
+                        "line {line}: the header must name the columns {} (in any order), found `{raw}`",
+                        columns.join(",")
+                    ))
+                }
+            }
+            continue;
+        };
+        let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
+        let v = match values {
+            Ok(v) if v.len() == columns.len() => order.iter().map(|k| v[*k]).collect::<Vec<f64>>(),
+            Ok(v) => {
+                errors.push(InputError {
+                    line,
+                    reason: format!("expected {} fields, got {}", columns.len(), v.len()),
+                });
+                continue;
+            }
+            Err(e) => {
+                errors.push(InputError {
+                    line,
+                    reason: format!("not a number: {e}"),
+                });
+                continue;
+            }
+        };
+        let t = v[0];
+        if !(t.is_finite() && t.abs() <= MAX_TIME_S) {
+            errors.push(InputError {
+                line,
+                reason: format!("time {t} is not a number of seconds within +-{MAX_TIME_S:e}"),
+            });
+            continue;
+        }
+        if t <= last_t {
+            errors.push(InputError {
+                line,
+                reason: "time is not increasing".into(),
+            });
+            continue;
+        }
+        last_t = t;
+        rows.push((line, v));
+    }
+    if order.is_none() {
+        return Err(format!("no header line naming the columns {}", columns.join(",")));
+    }
+    Ok((rows, errors))
+}
