@@ -128,10 +128,21 @@ pub struct StreamArgs {
     /// `x y z alpha beta gamma` (spaces, commas or semicolons; m and rad unless --degrees), sent as they arrive.
     #[arg(long, conflicts_with = "motion")]
     pub udp: Option<std::net::SocketAddr>,
-    /// With --udp: take datagrams from this sender only (others are counted and ignored).
-    #[arg(long, requires = "udp")]
+    /// Receive vehicle telemetry from simulator software and cue it with the classical washout (as `ringpod cue`
+    /// does with a file): one datagram per sample, in --telemetry-format.
+    #[arg(long, conflicts_with_all = ["udp", "input", "motion"])]
+    pub telemetry_udp: Option<std::net::SocketAddr>,
+    /// With --telemetry-udp: `text` (`[t] ax ay az wx wy wz`, the units of `ringpod cue`) or `outsim` (Live for
+    /// Speed's OutSim packet, also sent by BeamNG.drive).
+    #[arg(long, value_enum, default_value = "text")]
+    pub telemetry_format: crate::datagram::TelemetryFormat,
+    /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`).
+    #[arg(long)]
+    pub cue_config: Option<std::path::PathBuf>,
+    /// With --udp or --telemetry-udp: take datagrams from this sender only (others are counted and ignored).
+    #[arg(long)]
     pub udp_from: Option<std::net::IpAddr>,
-    /// With --udp: end the stream after this many seconds without a datagram.
+    /// With --udp or --telemetry-udp: end the stream after this many seconds without a datagram.
     #[arg(long, default_value_t = 2.0)]
     pub udp_idle: f64,
     /// Angles of --input or --udp in degrees.

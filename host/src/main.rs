@@ -3,6 +3,7 @@
 mod cli;
 mod client;
 mod cue;
+mod datagram;
 mod error;
 mod kinematics;
 mod mechanism;
@@ -76,13 +77,31 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         }
     };
     let (source, input_errors) = match (&args.input, args.motion) {
-        _ if args.udp.is_some() => {
-            let addr = args.udp.ok_or_else(|| anyhow::anyhow!("--udp"))?;
+        _ if args.udp.is_some() || args.telemetry_udp.is_some() => {
+            let (addr, decoder) = match (args.udp, args.telemetry_udp) {
+                (Some(addr), _) => (addr, datagram::Decoder::Poses { degrees: args.degrees }),
+                (None, Some(addr)) => {
+                    let config = cue::load_config(args.cue_config.as_deref())?;
+                    let washout = ringpod_core::cueing::Washout::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+                    let neutral = ringpod_core::kinematics::Pose::from_array(
+                        ringpod_core::kinematics::presets::Preset::TrainerModel.home(),
+                    );
+                    let decoder = datagram::Decoder::Telemetry {
+                        format: args.telemetry_format,
+                        washout: Box::new(washout),
+                        neutral,
+                        last: None,
+                        gaps: 0,
+                    };
+                    (addr, decoder)
+                }
+                (None, None) => anyhow::bail!("--udp or --telemetry-udp"),
+            };
             let idle = positive("udp-idle", args.udp_idle, 1e6)?;
-            let socket = std::net::UdpSocket::bind(addr).map_err(|e| anyhow::anyhow!("--udp {addr}: {e}"))?;
+            let socket = std::net::UdpSocket::bind(addr).map_err(|e| anyhow::anyhow!("{addr}: {e}"))?;
             let source = stream::UdpSource {
                 socket,
-                degrees: args.degrees,
+                decoder,
                 idle: std::time::Duration::from_secs_f64(idle),
                 from: args.udp_from,
             };

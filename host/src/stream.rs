@@ -72,31 +72,16 @@ pub enum Source {
     Udp(UdpSource),
 }
 
-/// A live source of poses: motion-simulator software sending one datagram per pose.
+/// A live source of poses: simulator software sending one datagram per pose or per telemetry sample.
 pub struct UdpSource {
     /// The bound socket.
     pub socket: std::net::UdpSocket,
-    /// Angles in degrees.
-    pub degrees: bool,
+    /// What a datagram means.
+    pub decoder: crate::datagram::Decoder,
     /// End after this long without a datagram.
     pub idle: Duration,
     /// Take datagrams from this address only.
     pub from: Option<std::net::IpAddr>,
-}
-
-/// Parses one datagram: six numbers separated by spaces, commas or semicolons.
-pub fn parse_datagram(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
-    let text = std::str::from_utf8(bytes).map_err(|_| "not text".to_string())?;
-    let v: Vec<f64> = text
-        .split(|c: char| c.is_whitespace() || c == ',' || c == ';')
-        .filter(|s| !s.is_empty())
-        .map(|s| s.parse::<f64>().map_err(|e| format!("`{s}`: {e}")))
-        .collect::<Result<_, _>>()?;
-    if v.len() != 6 {
-        return Err(format!("expected 6 numbers, got {}", v.len()));
-    }
-    let a = |x: f64| if degrees { x.to_radians() } else { x };
-    Ok(Pose::new(v[0], v[1], v[2], a(v[3]), a(v[4]), a(v[5])))
 }
 
 pub use crate::table::InputError;
@@ -179,6 +164,8 @@ pub struct DatagramReport {
     pub other_senders: u32,
     /// Times the source paused longer than the stream timeout and the stream was led in and started again.
     pub resumed: u32,
+    /// Telemetry: pauses of more than a second after which the washout started again at neutral.
+    pub telemetry_gaps: u32,
 }
 
 /// The end-of-run report (`--report-json`).
@@ -561,7 +548,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// `idle` without a datagram ends the session.
     fn live(
         &mut self,
-        source: &UdpSource,
+        source: &mut UdpSource,
         report: &mut DatagramReport,
         errors: &mut Vec<InputError>,
     ) -> Result<(), StreamError> {
@@ -619,7 +606,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             last_datagram = now;
             report.received += 1;
             let number = report.received as usize;
-            let pose = match parse_datagram(&buf[..n], source.degrees) {
+            let pose = match source.decoder.decode(&buf[..n], now) {
                 Ok(pose) => pose,
                 Err(reason) => {
                     report.unreadable += 1;
@@ -788,16 +775,18 @@ pub fn run<T: Transport>(
     let mut input_errors = input_errors;
     let mut datagrams = None;
     let home = Preset::TrainerModel.home();
-    let outcome = match &source {
+    let mut source = source;
+    let outcome = match &mut source {
         Source::Motion {
             motion,
             seconds,
             rate_hz,
         } => {
+            let (motion, seconds, rate_hz) = (*motion, *seconds, *rate_hz);
             let n = (seconds * rate_hz).round() as u64;
             let mut poses = (0..=n).map(|k| {
                 let t = k as f64 / rate_hz;
-                (None, t, motion_pose(*motion, t, home))
+                (None, t, motion_pose(motion, t, home))
             });
             s.timed(&mut poses, fast)
         }
@@ -808,6 +797,7 @@ pub fn run<T: Transport>(
         Source::Udp(udp) => {
             let mut d = DatagramReport::default();
             let r = s.live(udp, &mut d, &mut input_errors);
+            d.telemetry_gaps = udp.decoder.gaps();
             datagrams = Some(d);
             r
         }

@@ -446,10 +446,21 @@ fn spawn_udp_stream(
     std::io::BufReader<std::process::ChildStderr>,
     String,
 ) {
+    spawn_live_stream(&[&["--udp", "127.0.0.1:0"][..], args].concat())
+}
+
+/// Starts `ringpod stream --sim ARGS` with a live source and waits until it announces the address to send to.
+fn spawn_live_stream(
+    args: &[&str],
+) -> (
+    std::process::Child,
+    std::io::BufReader<std::process::ChildStderr>,
+    String,
+) {
     use std::io::BufRead;
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let mut child = std::process::Command::new(&exe)
-        .args(["stream", "--sim", "--udp", "127.0.0.1:0", "--report-json", "--quiet"])
+        .args(["stream", "--sim", "--report-json", "--quiet"])
         .args(args)
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
@@ -605,4 +616,36 @@ fn a_lost_link_ends_with_a_report() {
     assert_eq!(report["outcome"], "transport_lost");
     assert!(report["setpoints_applied"].as_u64().unwrap() > 0, "{report}");
     assert!(rest.contains("ringpod:"), "{rest}");
+}
+
+/// Vehicle telemetry over UDP, cued live: braking then a left-hand corner, as text datagrams at 100 Hz. Every
+/// sample is applied, the platform ends pitched and turned as the washout says, and bad datagrams are reported.
+#[test]
+fn telemetry_over_udp_is_cued_live() {
+    let (child, _stderr, addr) = spawn_live_stream(&["--telemetry-udp", "127.0.0.1:0", "--fast", "--udp-idle", "0.3"]);
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let g = 9.80665;
+    for k in 0..150 {
+        let t = f64::from(k) * 0.01;
+        let (ax, ay, wz) = if k < 80 { (-6.0, 0.0, 0.0) } else { (0.0, 4.0, 0.4) };
+        socket
+            .send_to(format!("{t} {ax} {ay} {g} 0 0 {wz}").as_bytes(), &addr)
+            .unwrap();
+        if k == 40 {
+            socket.send_to(b"not telemetry", &addr).unwrap();
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let out = child.wait_with_output().unwrap();
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
+    assert_eq!(out.status.code(), Some(3), "one unreadable datagram: {report}");
+    assert_eq!(report["setpoints_applied"], 150, "{report}");
+    assert_eq!(report["rejected"], serde_json::json!({}));
+    assert_eq!(report["datagrams"]["unreadable"], 1);
+    let last = numbers(&report["last_applied_pose"]);
+    // 0.7 s of the corner at 0.4 rad/s of heading; the braking's nose-down pitch not yet washed back.
+    assert!((last[5] - 0.28).abs() < 1e-6, "{last:?}");
+    assert!(last[4] > 0.0, "{last:?}");
+    assert_at_the_last_pose(&report);
 }
