@@ -180,6 +180,31 @@ impl Decoder {
         }
     }
 
+    /// A telemetry source paused for `dt` more seconds (until `now`): the pose of the vehicle at rest through the
+    /// washout (washing out to neutral), or `None` for a pose source (the platform holds).
+    pub fn idle(&mut self, dt: f64, now: Instant) -> Option<Pose<f64>> {
+        match self {
+            Decoder::Poses { .. } => None,
+            Decoder::Telemetry {
+                washout, neutral, last, ..
+            } => {
+                // The next sample's interval runs from here, by arrival: the washout has covered the pause.
+                *last = Some((None, now));
+                let rest = Telemetry {
+                    force: [0.0, 0.0, G],
+                    rate: [0.0; 3],
+                };
+                let offset = washout.step(&rest, dt).ok()?;
+                Some(cueing::pose(neutral, &offset))
+            }
+        }
+    }
+
+    /// Whether a pause of the source washes out (telemetry) rather than letting the platform rest where it is.
+    pub fn washes_out(&self) -> bool {
+        matches!(self, Decoder::Telemetry { .. })
+    }
+
     /// Gaps after which the washout started again (telemetry only).
     pub fn gaps(&self) -> u32 {
         match self {

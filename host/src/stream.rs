@@ -193,6 +193,8 @@ pub struct Report {
     pub lead_in_sent: u32,
     /// Settle setpoints (the last pose held at the end).
     pub settle_sent: u32,
+    /// Telemetry: setpoints of the washout to neutral while the source paused.
+    pub washout_sent: u32,
     /// Times a gap in the input longer than the stream timeout let the platform come to rest and the stream was
     /// started again.
     pub restarts: u32,
@@ -247,6 +249,8 @@ enum Kind {
     Input(Option<usize>),
     LeadIn,
     Settle,
+    /// A telemetry source paused: the washout of a vehicle at rest.
+    Washout,
 }
 
 /// One run: the client, the host's clock and envelope, and everything counted.
@@ -275,6 +279,7 @@ struct Streamer<'a, T: Transport> {
     input_applied: u32,
     lead_in: u32,
     settle: u32,
+    washout: u32,
     restarts: u32,
     rejected: BTreeMap<String, u32>,
     refusals: Vec<InputError>,
@@ -566,6 +571,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
         let mut buf = vec![0u8; 65_536];
         let mut wall = Instant::now();
         let mut last_datagram = Instant::now();
+        let mut last_idle = Instant::now();
         let mut streaming = false;
         loop {
             if (self.interrupted)() {
@@ -585,7 +591,19 @@ impl<'a, T: Transport> Streamer<'a, T> {
                     ) =>
                 {
                     let quiet = now - last_datagram;
-                    if streaming && quiet > self.stream_timeout {
+                    // Telemetry that pauses washes out: the vehicle at rest, through the washout, every 10 ms
+                    // from half the stream timeout on, so the platform glides back to neutral.
+                    if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= Duration::from_millis(10) {
+                        let dt = (now - last_idle).min(Duration::from_millis(20)).as_secs_f64();
+                        last_idle = now;
+                        if let Some(pose) = source.decoder.idle(dt, now) {
+                            let pose = self.limit(pose);
+                            self.send(pose, Kind::Washout)?;
+                            self.washout += 1;
+                            continue;
+                        }
+                    }
+                    if streaming && quiet > self.stream_timeout && !source.decoder.washes_out() {
                         // The source paused (a game's menu): the device brakes to rest by itself.
                         streaming = false;
                         if self.last_applied.is_some() {
@@ -604,6 +622,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
                 continue;
             }
             last_datagram = now;
+            last_idle = now;
             report.received += 1;
             let number = report.received as usize;
             let pose = match source.decoder.decode(&buf[..n], now) {
@@ -763,6 +782,7 @@ pub fn run<T: Transport>(
         input_applied: 0,
         lead_in: 0,
         settle: 0,
+        washout: 0,
         restarts: 0,
         rejected: BTreeMap::new(),
         refusals: Vec::new(),
@@ -883,6 +903,7 @@ pub fn run<T: Transport>(
         refusals: s.refusals,
         lead_in_sent: s.lead_in,
         settle_sent: s.settle,
+        washout_sent: s.washout,
         restarts: s.restarts,
         final_steps: status.as_ref().map_or([0; 6], |st| st.steps),
         faults: s.client.faults.iter().map(|f: &FaultReason| f.to_string()).collect(),
