@@ -39,6 +39,17 @@ fn steps_at(pose: [f64; 6]) -> [i64; 6] {
     conv.to_steps(&q)
 }
 
+/// Starts `ringpod stream --sim --report-json --quiet ARGS` with its output piped.
+fn spawn_sim_stream(args: &[&str]) -> std::process::Child {
+    std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["stream", "--sim", "--report-json", "--quiet"])
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 /// Starts `ringpod simulate --pty` and returns it with the path of its pseudo-terminal.
 fn simulator_on_a_pty() -> (std::process::Child, String) {
     use std::io::BufRead;
@@ -315,15 +326,8 @@ fn garbage_input_gets_a_clear_answer() {
 /// it with a stop, a report, and an exit code that is not success.
 #[test]
 fn long_motions_start_at_once_and_stop_on_ctrl_c() {
-    let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let interrupt_after = |args: &[&str], ms: u64| {
-        let child = std::process::Command::new(&exe)
-            .args(["stream", "--sim", "--report-json", "--quiet"])
-            .args(args)
-            .stdout(std::process::Stdio::piped())
-            .stderr(std::process::Stdio::piped())
-            .spawn()
-            .unwrap();
+        let child = spawn_sim_stream(args);
         std::thread::sleep(std::time::Duration::from_millis(ms));
         nix::sys::signal::kill(
             nix::unistd::Pid::from_raw(child.id() as i32),
@@ -458,14 +462,7 @@ fn spawn_live_stream(
     String,
 ) {
     use std::io::BufRead;
-    let exe = assert_cmd::cargo::cargo_bin("ringpod");
-    let mut child = std::process::Command::new(&exe)
-        .args(["stream", "--sim", "--report-json", "--quiet"])
-        .args(args)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_sim_stream(args);
     let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
     let mut line = String::new();
     while !line.contains("send datagrams to") {
