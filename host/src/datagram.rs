@@ -12,7 +12,7 @@ pub enum TelemetryFormat {
     /// One text line `t ax ay az wx wy wz` (or without `t`: the arrival time), separated by spaces, commas or
     /// semicolons; the units and axes of `ringpod cue`.
     Text,
-    /// Live for Speed's OutSim packet (64 bytes, or 68 with an ID); see [`outsim`].
+    /// Live for Speed's OutSim packet (64 bytes, or 68 with an ID; layout in the README).
     Outsim,
 }
 

@@ -42,7 +42,7 @@ pub mod exit {
 /// Built-in motions (trainer-model ranges and the test motions of the physical model).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Motion {
-    /// All six axes at once within half their ranges, yaw turning at 0.5 rad/s.
+    /// All six axes at once within a third of their ranges, yaw turning at 0.5 rad/s.
     Demo,
     /// Vertical vibration sweep 1 -> 50 Hz, amplitude limited to stay inside the speed and acceleration limits.
     Vibration,
@@ -307,7 +307,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
         Ok(())
     }
 
-    /// Limits a pose into the envelope (host side, f64) from the last pose sent.
+    /// Limits a pose into the envelope (host side, f64) on the ray from the centre, as the device does.
     fn limit(&mut self, pose: Pose<f64>) -> Pose<f64> {
         if !self.host_limits || !pose.to_array().iter().all(|c| c.is_finite()) {
             // Garbage goes to the device as it is, to be refused with its reason.
