@@ -488,7 +488,66 @@ fn controller_on_m4f(t: &mut Tally) {
     drop(emulated);
 }
 
+/// Makes sure `qemu-system-arm` is there: on a fresh Debian or Ubuntu machine it installs it (as root, or through
+/// `sudo` without a password), as the README's test command promises; otherwise it says what to install.
+fn ensure_qemu() -> Result<(), String> {
+    let present = || {
+        Command::new("qemu-system-arm")
+            .arg("--version")
+            .stdout(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    if present() {
+        return Ok(());
+    }
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    let sudo = !root
+        && Command::new("sudo")
+            .args(["-n", "true"])
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+    let apt = Command::new("apt-get")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .status()
+        .is_ok();
+    let help = "qemu-system-arm is missing: install it (Debian and Ubuntu: apt-get install qemu-system-arm)";
+    if !apt || !(root || sudo) {
+        return Err(help.into());
+    }
+    println!("== qemu-system-arm is missing: installing it with apt-get");
+    let apt_get = |args: &[&str]| {
+        let mut c = if root {
+            Command::new("apt-get")
+        } else {
+            Command::new("sudo")
+        };
+        if !root {
+            c.arg("apt-get");
+        }
+        c.args(args)
+            .env("DEBIAN_FRONTEND", "noninteractive")
+            .status()
+            .is_ok_and(|s| s.success())
+    };
+    if apt_get(&["update"]) && apt_get(&["install", "-y", "qemu-system-arm"]) && present() {
+        Ok(())
+    } else {
+        Err(help.into())
+    }
+}
+
 fn main() -> ExitCode {
+    if let Err(e) = ensure_qemu() {
+        eprintln!("{e}");
+        println!("0 passed, 1 failed");
+        return ExitCode::FAILURE;
+    }
     let mut t = Tally { passed: 0, failed: 0 };
     core_on_m4f(&mut t);
     controller_on_m4f(&mut t);
