@@ -160,10 +160,35 @@ impl<T: Transport> Client<T> {
     }
 
     /// Version handshake; returns the geometry the device drives.
+    ///
+    /// The first request on a port that was just opened can be lost: a board still enumerating, or a pseudo
+    /// terminal whose other side is polled only now and then (QEMU's, about once a second). Hello changes nothing,
+    /// so it is sent again every half second until the whole timeout (at least 5 s) has passed; the answers to
+    /// earlier tries are dropped.
     pub fn hello(&mut self) -> Result<Preset, ClientError> {
-        match self.request(HostMessage::Hello {
-            version: PROTOCOL_VERSION,
-        })? {
+        let patience = self.timeout.max(Duration::from_secs(5));
+        let per_try = Duration::from_millis(500);
+        let timeout = self.timeout;
+        self.timeout = per_try;
+        let mut tries = Vec::new();
+        let answer = loop {
+            let id = match self.send(HostMessage::Hello {
+                version: PROTOCOL_VERSION,
+            }) {
+                Ok(id) => id,
+                Err(e) => break Err(e),
+            };
+            tries.push(id);
+            match self.wait_response(id) {
+                Err(ClientError::Timeout(_)) if per_try * tries.len() as u32 <= patience => continue,
+                Err(ClientError::Timeout(_)) => break Err(ClientError::Timeout(patience)),
+                other => break other,
+            }
+        };
+        self.timeout = timeout;
+        self.pump()?;
+        self.inbox.retain(|r| !tries.contains(&r.id));
+        match answer? {
             DeviceMessage::Hello { version, preset } if version == PROTOCOL_VERSION => Ok(preset),
             DeviceMessage::Hello { version, .. }
             | DeviceMessage::Nack(NackReason::VersionMismatch { device: version }) => {
@@ -257,5 +282,73 @@ pub fn setpoint_answer(answer: DeviceMessage) -> Result<Result<Accepted, RejectR
         DeviceMessage::Nack(NackReason::Rejected(r)) => Ok(Err(r)),
         DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
         other => Err(ClientError::Unexpected(format!("{other:?}"))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::transport::SimDevice;
+
+    /// The simulated device behind a link that loses the first `lose` frames the host sends, and counts the time.
+    struct Lossy {
+        device: SimDevice,
+        lose: usize,
+        elapsed: Duration,
+    }
+
+    impl Transport for Lossy {
+        fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+            if self.lose > 0 {
+                self.lose -= 1;
+                return Ok(());
+            }
+            self.device.send(bytes)
+        }
+        fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+            self.device.receive(buf)
+        }
+        fn elapse(&mut self, dt: Duration) {
+            self.elapsed += dt;
+            self.device.elapse(dt);
+        }
+    }
+
+    fn lossy(lose: usize) -> Client<Lossy> {
+        Client::new(Lossy {
+            device: SimDevice::new(false),
+            lose,
+            elapsed: Duration::ZERO,
+        })
+    }
+
+    #[test]
+    fn hello_is_sent_again_when_the_first_is_lost() {
+        let mut client = lossy(3);
+        assert!(client.hello().is_ok());
+        // Three tries lost at half a second each, the fourth answered.
+        let elapsed = client.transport().elapsed;
+        assert!(
+            elapsed >= Duration::from_millis(1_500) && elapsed < Duration::from_millis(2_000),
+            "{elapsed:?}"
+        );
+        // The link works normally afterwards, and no stale answer is left behind.
+        assert!(client.hello().is_ok());
+        assert!(client.inbox.is_empty());
+    }
+
+    #[test]
+    fn hello_gives_up_after_its_patience() {
+        let mut client = lossy(usize::MAX);
+        match client.hello() {
+            Err(ClientError::Timeout(t)) => assert_eq!(t, Duration::from_secs(5)),
+            other => panic!("{other:?}"),
+        }
+        assert!(client.transport().elapsed <= Duration::from_millis(5_600));
+        assert_eq!(
+            client.timeout,
+            Duration::from_secs(2),
+            "the request timeout is restored"
+        );
     }
 }

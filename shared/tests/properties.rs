@@ -117,6 +117,31 @@ proptest! {
         zero(&rotopod(), &rp)?;
         zero(&tool(), &tp)?;
     }
+
+    /// The fused IK + checks (carriages from the IK's triangle, no angle) reports what the checks of the pose and
+    /// its actuators report (carriages from the angles), in f64 and in the f32 the MCU runs.
+    #[test]
+    fn fused_checks_agree_with_separate_ones(pose in trainer_pose(), rp in rotopod_pose()) {
+        fn agree<T: ringpod_core::Real>(m: &RingPlatform<T>, p: &Pose<f64>, tol: f64) -> Result<(), TestCaseError> {
+            let p = p.cast::<T>();
+            let Ok((q, fused)) = m.inverse_checked(&p) else {
+                prop_assert!(m.inverse(&p).is_err());
+                return Ok(());
+            };
+            prop_assert_eq!(m.inverse(&p).ok(), Some(q));
+            let separate = m.workspace(&p, &q);
+            for check in Check::ALL {
+                let (a, b) = (fused.margin(check).map(|v| v.to_f64()), separate.margin(check).map(|v| v.to_f64()));
+                let (a, b) = (a.unwrap_or(f64::NAN), b.unwrap_or(f64::NAN));
+                prop_assert!((a - b).abs() <= tol, "{check}: fused {a} vs separate {b}");
+            }
+            Ok(())
+        }
+        agree(&trainer(), &pose, 1e-12)?;
+        agree(&rotopod(), &rp, 1e-12)?;
+        agree(&RingPlatform::<f32>::new(&presets::TRAINER_MODEL), &pose, 2e-5)?;
+        agree(&RingPlatform::<f32>::new(&presets::ROTOPOD_CH4), &rp, 2e-5)?;
+    }
 }
 
 /// Central differences of the residuals against the analytic Jacobians.

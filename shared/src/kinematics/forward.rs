@@ -1,5 +1,8 @@
 //! Forward kinematics by Newton-Raphson iteration on `F(p, q) = 0` (KINEMATICS.md 3).
 
+use nalgebra::Vector6;
+
+use super::velocity::hadamard_ratio_in_place;
 use super::{Actuators, KinematicsError, Mechanism, Pose};
 use crate::Real;
 
@@ -56,22 +59,22 @@ pub fn newton<T: Real, M: Mechanism<T>>(
     for iteration in 1..=options.max_iterations {
         let pose = Pose::from_vector(&p);
         let jac = mechanism.jacobians(&pose, &q);
-        if jac.index_a() < options.min_singularity_index {
+        // One decomposition of the scale-free A gives both the singularity index and the step.
+        let mut rows = jac.a_closed_scaled();
+        let (index, lu) = hadamard_ratio_in_place(&mut rows);
+        if index < options.min_singularity_index {
             return Err(KinematicsError::NearSingularity);
         }
         let mut f = mechanism.residuals(&pose, &q);
         for r in dof..6 {
             f[r] = T::zero();
         }
-        // A dp = -F over the degrees of freedom (fixed coordinates closed by unit rows).
-        let Some(dp) = jac
-            .a_closed()
-            .lu()
-            .solve(&(-f))
-            .filter(|v| v.iter().all(|c| c.finite()))
-        else {
+        // A dp = -F over the degrees of freedom (fixed coordinates closed by unit rows), solved for
+        // (dx, dy, dz, L dalpha, L dbeta, L dgamma).
+        let Some(y) = lu.solve(&(-f).into()) else {
             return Err(KinematicsError::NearSingularity);
         };
+        let dp = Vector6::from_fn(|i, _| if i < 3 { y[i] } else { y[i] * inv_len });
         p += dp;
         let step = scaled_max(&dp, inv_len);
         if !p.iter().all(|c| c.finite()) {
@@ -101,7 +104,7 @@ pub fn newton<T: Real, M: Mechanism<T>>(
 }
 
 /// Largest step component, lengths made relative to the characteristic length.
-fn scaled_max<T: Real>(dp: &nalgebra::Vector6<T>, inv_len: T) -> T {
+fn scaled_max<T: Real>(dp: &Vector6<T>, inv_len: T) -> T {
     dp.iter().enumerate().fold(T::zero(), |m, (i, d)| {
         m.max(if i < 3 { d.abs() * inv_len } else { d.abs() })
     })

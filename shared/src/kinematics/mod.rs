@@ -7,6 +7,7 @@
 mod error;
 pub mod forward;
 pub mod geometry;
+mod lu;
 mod multiturn;
 mod pose;
 pub mod presets;

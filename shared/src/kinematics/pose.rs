@@ -85,6 +85,49 @@ impl<T: Real> Pose<T> {
         rotation(self.alpha, self.beta, self.gamma)
     }
 
+    /// `dR/dalpha`, `dR/dbeta`, `dR/dgamma` of [`Pose::rotation`], written out (one set of sines and cosines).
+    pub(crate) fn rotation_partials(&self) -> [Matrix3<T>; 3] {
+        let (sa, ca) = (self.alpha.sin_(), self.alpha.cos_());
+        let (sb, cb) = (self.beta.sin_(), self.beta.cos_());
+        let (sg, cg) = (self.gamma.sin_(), self.gamma.cos_());
+        let z = T::zero();
+        [
+            Matrix3::new(
+                z,
+                cg * sb * ca + sg * sa,
+                sg * ca - cg * sa * sb,
+                z,
+                sg * sb * ca - cg * sa,
+                -sg * sa * sb - cg * ca,
+                z,
+                cb * ca,
+                -cb * sa,
+            ),
+            Matrix3::new(
+                -cg * sb,
+                cg * cb * sa,
+                cg * ca * cb,
+                -sg * sb,
+                sg * cb * sa,
+                sg * ca * cb,
+                -cb,
+                -sb * sa,
+                -sb * ca,
+            ),
+            Matrix3::new(
+                -sg * cb,
+                -sg * sb * sa - cg * ca,
+                cg * sa - sg * ca * sb,
+                cg * cb,
+                cg * sb * sa - sg * ca,
+                cg * ca * sb + sg * sa,
+                z,
+                z,
+                z,
+            ),
+        ]
+    }
+
     /// Converts each coordinate to another scalar type.
     pub fn cast<U: Real>(&self) -> Pose<U> {
         Pose::from_array(self.to_array().map(|c| U::of(c.to_f64())))

@@ -2,6 +2,7 @@
 
 use nalgebra::{Matrix6, Vector6};
 
+pub(crate) use super::lu::{rows_of, Lu6};
 use super::{AxisKind, KinematicsError};
 use crate::Real;
 
@@ -51,11 +52,7 @@ impl<T: Real> Jacobians<T> {
     /// Actuator rates for pose rates: solves `B qdot = -A pdot`.
     pub fn actuator_rates(&self, pose_rates: &Vector6<T>) -> Result<Vector6<T>, KinematicsError> {
         let rhs = -(self.a * pose_rates);
-        self.b
-            .lu()
-            .solve(&rhs)
-            .filter(all_finite)
-            .ok_or(KinematicsError::Singular)
+        solve(&self.b, &rhs)
     }
 
     /// Pose rates for actuator rates: solves `A pdot = -B qdot` over the platform's degrees of freedom (auxiliary
@@ -65,21 +62,19 @@ impl<T: Real> Jacobians<T> {
         for r in self.dof..6 {
             rhs[r] = T::zero();
         }
-        self.a_closed()
-            .lu()
-            .solve(&rhs)
-            .filter(all_finite)
-            .ok_or(KinematicsError::Singular)
+        solve(&self.a_closed(), &rhs)
+    }
+
+    /// Rows of `A` closed (see `a_closed`) with its angle columns divided by the characteristic length: the
+    /// scale-free matrix of [`Jacobians::index_a`], and the system forward kinematics solves for `(dx, L dangle)`.
+    pub(crate) fn a_closed_scaled(&self) -> [[T; 6]; 6] {
+        let a = self.a_closed();
+        core::array::from_fn(|r| core::array::from_fn(|c| if c < 3 { a[(r, c)] } else { a[(r, c)] / self.length }))
     }
 
     /// Scale-free singularity index of `A` in `[0, 1]` (0 = type-2 singular); see [`hadamard_ratio`].
     pub fn index_a(&self) -> T {
-        let inv = T::one() / self.length;
-        let mut a = self.a_closed();
-        for c in 3..6 {
-            a.column_mut(c).scale_mut(inv);
-        }
-        hadamard_ratio(&a)
+        hadamard_ratio_in_place(&mut self.a_closed_scaled()).0
     }
 
     /// Scale-free singularity index of `B` in `[0, 1]` (0 = type-1 singular).
@@ -105,8 +100,11 @@ impl<T: Real> Jacobians<T> {
     }
 }
 
-fn all_finite<T: Real>(v: &Vector6<T>) -> bool {
-    v.iter().all(|c| c.finite())
+fn solve<T: Real>(m: &Matrix6<T>, rhs: &Vector6<T>) -> Result<Vector6<T>, KinematicsError> {
+    Lu6::in_place(&mut rows_of(m))
+        .solve(&(*rhs).into())
+        .map(Vector6::from)
+        .ok_or(KinematicsError::Singular)
 }
 
 /// `|det M| / prod_i |row_i|`: 1 for orthogonal rows, 0 for a singular matrix, unchanged by scaling any row.
@@ -115,18 +113,22 @@ fn all_finite<T: Real>(v: &Vector6<T>) -> bool {
 /// measure of how far the rows are from linear dependence. It costs one LU decomposition, unlike an inverse
 /// condition number (an SVD), which matters inside a 1 kHz control tick on a Cortex-M4F.
 pub fn hadamard_ratio<T: Real>(m: &Matrix6<T>) -> T {
+    hadamard_ratio_in_place(&mut rows_of(m)).0
+}
+
+/// [`hadamard_ratio`] of the matrix given by its rows, and their decomposition (the rows become its factors;
+/// forward kinematics goes on to solve with it).
+pub(crate) fn hadamard_ratio_in_place<T: Real>(rows: &mut [[T; 6]; 6]) -> (T, Lu6<'_, T>) {
     let mut norms = T::one();
-    for r in 0..6 {
-        let n = m.row(r).norm();
-        if n == T::zero() || !n.finite() {
-            return T::zero();
-        }
+    for row in rows.iter() {
+        let n = row.iter().fold(T::zero(), |s, v| s + *v * *v).sqrt_();
         norms *= n;
     }
-    let det = m.lu().determinant();
-    if det.finite() {
-        (det / norms).abs()
-    } else {
-        T::zero()
+    let lu = Lu6::in_place(rows);
+    if norms == T::zero() || !norms.finite() {
+        return (T::zero(), lu);
     }
+    let det = lu.determinant();
+    let ratio = if det.finite() { (det / norms).abs() } else { T::zero() };
+    (ratio, lu)
 }

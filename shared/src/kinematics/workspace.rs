@@ -69,7 +69,10 @@ impl fmt::Display for Check {
 /// The margins of all six checks at one pose. `None`: the check does not apply to the mechanism.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WorkspaceReport<T> {
-    margins: [Option<T>; 6],
+    /// Margins in the order of [`Check::ALL`]; one that does not apply is zero and its bit in `applies` clear.
+    /// (Not `[Option<T>; 6]`: its tags make an odd-sized copy, a byte-wise `memcpy` call on the M4F every pose.)
+    margins: [T; 6],
+    applies: u8,
     /// The raw singularity index behind [`Check::Singularity`] (before the threshold is subtracted).
     pub singularity_index: T,
 }
@@ -77,15 +80,23 @@ pub struct WorkspaceReport<T> {
 impl<T: Real> WorkspaceReport<T> {
     /// A report from margins in the order of [`Check::ALL`].
     pub fn new(margins: [Option<T>; 6], singularity_index: T) -> Self {
+        let mut applies = 0;
+        for (i, m) in margins.iter().enumerate() {
+            if m.is_some() {
+                applies |= 1 << i;
+            }
+        }
         Self {
-            margins,
+            margins: margins.map(|m| m.unwrap_or(T::zero())),
+            applies,
             singularity_index,
         }
     }
 
     /// Margin of one check (`None` when it does not apply). NaN never passes.
     pub fn margin(&self, check: Check) -> Option<T> {
-        self.margins.get(check.index()).copied().flatten()
+        let i = check.index();
+        (self.applies & (1 << i) != 0).then(|| self.margins[i])
     }
 
     /// Whether one check passes (a check that does not apply passes).

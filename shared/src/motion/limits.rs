@@ -50,7 +50,7 @@ impl AxisTracker {
             // Braking from v covers dt (v + (v - a dt) + ... ) down to the last positive speed. With n whole braking
             // steps (n a dt <= v < (n + 1) a dt) that is dt (n + 1) (v - n a dt / 2), so the fastest speed that stops
             // within d is d / ((n + 1) dt) + n a dt / 2; the continuous estimate picks n.
-            let k = libm::sqrtf(0.25 + 2.0 * d / (adt * dt)) - 0.5;
+            let k = crate::real::sqrtf(0.25 + 2.0 * d / (adt * dt)) - 0.5;
             let n = libm::floorf(k.max(0.0));
             (d / ((n + 1.0) * dt) + n * adt * 0.5).min((n + 1.0) * adt)
         } else {

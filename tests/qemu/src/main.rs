@@ -91,9 +91,7 @@ fn main() -> ! {
 
     let checks = counts(|| {
         for p in &poses {
-            if let Ok(q) = trainer.inverse(black_box(p)) {
-                black_box(trainer.workspace(p, &q));
-            }
+            let _ = black_box(trainer.inverse_checked(black_box(p)));
         }
     });
     report("trainer IK + all six checks (f32)", checks, 64);

@@ -1,0 +1,181 @@
+//! The six workspace checks of a ring platform (KINEMATICS.md 4), each with a signed margin, from one
+//! [`Configuration`] computed once per pose.
+//!
+//! The control tick runs these for every commanded pose, so each is written for the Cortex-M4F: no check repeats
+//! the rotation, the joints or the carriages, the cone margins take two `asin` instead of twelve (`asin` is
+//! increasing, so the smallest angle is the `asin` of the smallest sine), and the singularity index decomposes its
+//! 6x6 matrix on plain arrays.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::RingPlatform;
+use crate::kinematics::velocity::hadamard_ratio_in_place;
+use crate::kinematics::{Actuators, ChainKind, Pose, WorkspaceReport};
+use crate::real::{wrap_once, wrap_pi};
+use crate::Real;
+
+/// Where everything of one pose is: computed once for all the checks (and for the statics).
+pub(super) struct Configuration<T: Real> {
+    /// Platform orientation.
+    pub rotation: Matrix3<T>,
+    /// Platform joints `A_i` in the base frame.
+    pub joints: [Vector3<T>; 6],
+    /// Carriage joints `B_i` on the ring.
+    pub carriages: [Vector3<T>; 6],
+    /// Unit vector from carriage to platform joint.
+    pub dirs: [Vector3<T>; 6],
+}
+
+impl<T: Real> Configuration<T> {
+    /// Everything at zero, to be filled in place (these arrays are too large to move around on the M4F: each move
+    /// is a `memcpy` call).
+    pub fn zeroed() -> Self {
+        Self {
+            rotation: Matrix3::zeros(),
+            joints: [Vector3::zeros(); 6],
+            carriages: [Vector3::zeros(); 6],
+            dirs: [Vector3::z(); 6],
+        }
+    }
+
+    /// The directions of the first `n` chains, from their joints and carriages.
+    pub fn direct(&mut self, n: usize) {
+        for i in 0..n.min(6) {
+            let d = self.joints[i] - self.carriages[i];
+            let len = (d.x * d.x + d.y * d.y + d.z * d.z).sqrt_();
+            if len > T::zero() {
+                self.dirs[i] = d / len;
+            }
+        }
+    }
+}
+
+impl<T: Real> RingPlatform<T> {
+    /// The configuration of a pose with given actuators (carriages from their angles).
+    pub(super) fn configuration(&self, pose: &Pose<T>, q: &Actuators<T>) -> Configuration<T> {
+        let mut c = Configuration::zeroed();
+        c.rotation = pose.rotation();
+        self.place_joints(pose, &mut c);
+        for (b, qi) in c.carriages.iter_mut().zip(&q.0).take(self.n) {
+            *b = self.carriage(*qi);
+        }
+        c.direct(self.n);
+        c
+    }
+
+    /// All six margins, in the order of [`crate::kinematics::Check::ALL`].
+    pub(super) fn report(&self, pose: &Pose<T>, q: &Actuators<T>, c: &Configuration<T>) -> WorkspaceReport<T> {
+        let (spacing, order) = self.ring_order_margins(q);
+        let index = self.singularity_of(c);
+        WorkspaceReport::new(
+            [
+                Some(self.reach_of(&c.joints)),
+                Some(spacing),
+                Some(order),
+                Some(self.cone_margin(c)),
+                Some(index - self.min_index),
+                Some(self.stability_margin(pose, c)),
+            ],
+            index,
+        )
+    }
+
+    pub(super) fn reach_of(&self, joints: &[Vector3<T>; 6]) -> T {
+        let mut margin = T::max_value().unwrap_or(T::one());
+        for (a, kind) in joints.iter().zip(&self.kinds).take(self.n) {
+            let rho = (a.x * a.x + a.y * a.y).sqrt_();
+            let m = match kind {
+                ChainKind::Rod(_) => {
+                    let h = (self.rod * self.rod - a.z * a.z).max_(T::zero()).sqrt_();
+                    (self.rod - a.z.abs())
+                        .min_(h - (self.rr - rho).abs())
+                        .min_(self.rr + rho - h)
+                }
+                ChainKind::Radial => {
+                    let s = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
+                    (s - self.stroke[0]).min_(self.stroke[1] - s)
+                }
+            };
+            margin = margin.min_(m);
+        }
+        margin
+    }
+
+    /// Spacing and crossing margins from the counter-clockwise central angles between neighbouring carriages.
+    ///
+    /// Each gap is measured counter-clockwise in `[0, 2pi)`. The carriages keep their order exactly when the gaps
+    /// add up to one turn; two turns or more means some carriage passed a neighbour, and the crossing margin is
+    /// then minus the smallest angle by which the order is broken.
+    pub(super) fn ring_order_margins(&self, q: &Actuators<T>) -> (T, T) {
+        let two_pi = T::two_pi();
+        let mut spacing = T::max_value().unwrap_or(T::one());
+        let mut smallest = two_pi;
+        let mut largest = T::zero();
+        let mut total = T::zero();
+        for i in 0..self.n {
+            let diff = q.0[(i + 1) % self.n] - q.0[i];
+            // IK's angles are within (-pi, pi], so one exact addition wraps their difference; other inputs (a
+            // multi-turn angle) take the general wrap.
+            let mut gap = if diff.abs() <= T::two_pi() {
+                wrap_once(diff)
+            } else {
+                wrap_pi(diff)
+            };
+            if gap < T::zero() {
+                gap += two_pi;
+            }
+            total += gap;
+            spacing = spacing.min_(gap - self.spacing[0]).min_(self.spacing[1] - gap);
+            smallest = smallest.min_(gap);
+            largest = largest.max_(gap);
+        }
+        // A carriage that passed its neighbour by d leaves a gap of 2pi - d behind it.
+        let order = if total < two_pi + T::pi() {
+            smallest
+        } else {
+            -(two_pi - largest)
+        };
+        (spacing, order)
+    }
+
+    /// The smallest angle of a chain to the base plane and to the platform plane, each above its cone limit.
+    fn cone_margin(&self, c: &Configuration<T>) -> T {
+        let normal = c.rotation.column(2).into_owned();
+        let (mut base, mut platform) = (T::one(), T::one());
+        for u in c.dirs.iter().take(self.n) {
+            base = base.min_(u.z);
+            platform = platform.min_(u.dot(&normal));
+        }
+        let angle = |sine: T| sine.clamp(-T::one(), T::one()).asin_();
+        (angle(base) - self.cones[0]).min_(angle(platform) - self.cones[1])
+    }
+
+    /// The scale-free singularity index of the wrench matrix (moments divided by the ring radius).
+    pub(super) fn singularity_of(&self, c: &Configuration<T>) -> T {
+        let inv = T::one() / self.rr;
+        let mut rows = self.wrench_rows(c);
+        for row in &mut rows {
+            for m in &mut row[3..] {
+                *m *= inv;
+            }
+        }
+        hadamard_ratio_in_place(&mut rows).0
+    }
+
+    fn stability_margin(&self, pose: &Pose<T>, c: &Configuration<T>) -> T {
+        let com = c.rotation * self.com + pose.position();
+        let mut margin = T::max_value().unwrap_or(T::one());
+        for i in 0..self.n {
+            let (p0, p1) = (c.carriages[i], c.carriages[(i + 1) % self.n]);
+            let edge = p1 - p0;
+            let len = (edge.x * edge.x + edge.y * edge.y).sqrt_();
+            if len == T::zero() {
+                return T::zero();
+            }
+            // Counter-clockwise polygon: the inside is on the left of each edge.
+            let cross = edge.x * (com.y - p0.y) - edge.y * (com.x - p0.x);
+            margin = margin.min_(cross / len);
+        }
+        margin
+    }
+}

@@ -1,0 +1,271 @@
+//! Ring platforms: carriages on a circular guide with rod chains and radial linear-actuator chains
+//! (KINEMATICS.md 2.1 trainer, 2.2 rotopod, 3 velocities; the checks of 4 in [`checks`], the statics of 5 in
+//! [`statics`]).
+
+mod checks;
+mod statics;
+
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+
+use self::checks::Configuration;
+pub use self::statics::ActuatorLoads;
+use super::geometry::{Branch, ChainKind, RingGeometry};
+use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
+use crate::Real;
+
+/// A ring platform in scalar type `T`, built from a validated [`RingGeometry`].
+#[derive(Debug, Clone, Copy)]
+pub struct RingPlatform<T: Real> {
+    geometry: RingGeometry,
+    rr: T,
+    rod: T,
+    n: usize,
+    points: [Vector3<T>; 6],
+    kinds: [ChainKind; 6],
+    /// Actuator index of the length of each radial chain.
+    length_axis: [Option<usize>; 6],
+    axes: [AxisKind; 6],
+    stroke: [T; 2],
+    spacing: [T; 2],
+    cones: [T; 2],
+    min_index: T,
+    com: Vector3<T>,
+}
+
+impl<T: Real> RingPlatform<T> {
+    /// The mechanism of a geometry, in scalar type `T`.
+    pub fn new(geometry: &RingGeometry) -> Self {
+        let chains = geometry.chains();
+        let n = chains.len();
+        let mut points = [Vector3::zeros(); 6];
+        let mut kinds = [ChainKind::Radial; 6];
+        let mut length_axis = [None; 6];
+        let mut axes = [AxisKind::Ring; 6];
+        let mut next_length = n;
+        // The validated geometry has at most six chains and exactly six actuators, so every index is in range.
+        for (i, c) in chains.iter().enumerate() {
+            points[i] = Vector3::from(c.platform_point.map(T::of));
+            kinds[i] = c.kind;
+            if c.kind == ChainKind::Radial {
+                length_axis[i] = Some(next_length);
+                axes[next_length] = AxisKind::Linear;
+                next_length += 1;
+            }
+        }
+        let l = &geometry.limits;
+        Self {
+            geometry: *geometry,
+            rr: T::of(geometry.ring_radius),
+            rod: T::of(geometry.rod_length),
+            n,
+            points,
+            kinds,
+            length_axis,
+            axes,
+            stroke: l.stroke.map(T::of),
+            spacing: l.carriage_spacing.map(T::of),
+            cones: [T::of(l.base_cone), T::of(l.platform_cone)],
+            min_index: T::of(l.min_singularity_index),
+            com: Vector3::from(l.centre_of_mass.map(T::of)),
+        }
+    }
+
+    /// The geometry this mechanism was built from.
+    pub fn geometry(&self) -> &RingGeometry {
+        &self.geometry
+    }
+
+    /// Platform joints `A_i = R a_i + p` in the base frame.
+    pub fn joints(&self, pose: &Pose<T>) -> [Vector3<T>; 6] {
+        self.joints_with(&pose.rotation(), pose)
+    }
+
+    fn joints_with(&self, r: &Matrix3<T>, pose: &Pose<T>) -> [Vector3<T>; 6] {
+        let p = pose.position();
+        self.points.map(|a| r * a + p)
+    }
+
+    /// The platform joints of a pose into a configuration whose rotation is the pose's.
+    fn place_joints(&self, pose: &Pose<T>, c: &mut Configuration<T>) {
+        let p = pose.position();
+        for (joint, a) in c.joints.iter_mut().zip(&self.points).take(self.n) {
+            *joint = c.rotation * a + p;
+        }
+    }
+
+    fn carriage(&self, q: T) -> Vector3<T> {
+        Vector3::new(self.rr * q.cos_(), self.rr * q.sin_(), T::zero())
+    }
+
+    /// Reach margin of a pose (m), defined whether or not the pose is reachable: the smallest slack of the rod
+    /// conditions `|Az| < L` and `|Rr - rho| <= h <= Rr + rho`, and of the radial strokes `s_min <= s <= s_max`.
+    /// Negative outside, by how far.
+    pub fn reach_margin(&self, pose: &Pose<T>) -> T {
+        self.reach_of(&self.joints(pose))
+    }
+
+    /// Scale-free singularity index of the wrench matrix: moments divided by the ring radius, then
+    /// [`super::velocity::hadamard_ratio`]. 1 for six orthogonal lines, 0 at a singularity.
+    pub fn singularity_index(&self, pose: &Pose<T>, q: &Actuators<T>) -> T {
+        self.singularity_of(&self.configuration(pose, q))
+    }
+
+    /// Inverse kinematics that leaves the rotation, the platform joints and the carriages it found in `c`: the
+    /// actuators, or why the pose has no solution.
+    ///
+    /// Each carriage comes from the triangle of ring radius, rod and the joint's distance from the axis, without
+    /// an angle: with `theta` the joint's azimuth and `phi` the angle at the centre, `2 Rr rho (cos phi, sin phi)`
+    /// is `(C, S)` with `C = Rr^2 + rho^2 - h^2` and `S = sqrt(inner * outer)`, so the carriage direction
+    /// `(cos(theta +- phi), sin(theta +- phi))` is `(x C -+ y S, y C +- x S)` over `2 Rr rho^2`. One `atan2` of it
+    /// gives the angle (instead of one for `theta` and one for `phi`), already within `(-pi, pi]`, and the checks
+    /// take the carriages as they are instead of a sine and a cosine of each angle.
+    fn solve(&self, pose: &Pose<T>, c: &mut Configuration<T>) -> Result<Actuators<T>, KinematicsError> {
+        let pose = pose.validated()?;
+        c.rotation = pose.rotation();
+        self.place_joints(&pose, c);
+        let mut q = [T::zero(); 6];
+        let tiny = self.rr * T::of(T::EPS * 16.0);
+        for i in 0..self.n {
+            let a = c.joints[i];
+            let chain = i as u8;
+            let rho2 = a.x * a.x + a.y * a.y;
+            let rho = rho2.sqrt_();
+            if rho <= tiny {
+                return Err(KinematicsError::Unreachable {
+                    chain,
+                    reason: Reach::Centre,
+                });
+            }
+            match self.kinds[i] {
+                ChainKind::Rod(branch) => {
+                    let h2 = self.rod * self.rod - a.z * a.z;
+                    if h2 <= T::zero() {
+                        return Err(KinematicsError::Unreachable {
+                            chain,
+                            reason: Reach::Height,
+                        });
+                    }
+                    // (2 Rr rho sin phi)^2 factors into (h^2 - (Rr - rho)^2) ((Rr + rho)^2 - h^2): both factors
+                    // non-negative is the reach condition, and the factored form keeps sin phi accurate near 0 and
+                    // pi, where the cosine rule alone would lose half the digits.
+                    let inner = h2 - (self.rr - rho) * (self.rr - rho);
+                    let outer = (self.rr + rho) * (self.rr + rho) - h2;
+                    if inner < T::zero() || outer < T::zero() {
+                        return Err(KinematicsError::Unreachable {
+                            chain,
+                            reason: Reach::Ring,
+                        });
+                    }
+                    let sine = (inner * outer).sqrt_();
+                    let cosine = self.rr * self.rr + rho2 - h2;
+                    let sine = match branch {
+                        Branch::Plus => sine,
+                        Branch::Minus => -sine,
+                    };
+                    let (cx, cy) = (a.x * cosine - a.y * sine, a.y * cosine + a.x * sine);
+                    q[i] = cy.atan2_(cx);
+                    let scale = T::one() / (rho2 + rho2);
+                    c.carriages[i] = Vector3::new(cx * scale, cy * scale, T::zero());
+                }
+                ChainKind::Radial => {
+                    q[i] = a.y.atan2_(a.x);
+                    let scale = self.rr / rho;
+                    c.carriages[i] = Vector3::new(a.x * scale, a.y * scale, T::zero());
+                    if let Some(k) = self.length_axis[i] {
+                        q[k] = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
+                    }
+                }
+            }
+        }
+        Ok(Actuators(q))
+    }
+}
+
+impl<T: Real> Mechanism<T> for RingPlatform<T> {
+    fn dof(&self) -> usize {
+        6
+    }
+
+    fn axes(&self) -> [AxisKind; 6] {
+        self.axes
+    }
+
+    fn characteristic_length(&self) -> T {
+        self.rr
+    }
+
+    fn inverse(&self, pose: &Pose<T>) -> Result<Actuators<T>, KinematicsError> {
+        self.solve(pose, &mut Configuration::zeroed())
+    }
+
+    /// IK and the checks on what it found (the rotation, joints and carriages are not computed twice).
+    fn inverse_checked(&self, pose: &Pose<T>) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
+        let mut c = Configuration::zeroed();
+        let q = self.solve(pose, &mut c)?;
+        c.direct(self.n);
+        Ok((q, self.report(pose, &q, &c)))
+    }
+
+    fn residuals(&self, pose: &Pose<T>, q: &Actuators<T>) -> Vector6<T> {
+        let joints = self.joints(pose);
+        let mut f = Vector6::zeros();
+        let mut extra = self.n;
+        for i in 0..self.n {
+            let (a, qi) = (joints[i], q.0[i]);
+            let d = a - self.carriage(qi);
+            let length = match self.length_axis[i] {
+                Some(k) => q.0[k],
+                None => self.rod,
+            };
+            f[i] = d.dot(&d) - length * length;
+            if self.kinds[i] == ChainKind::Radial && extra < 6 {
+                f[extra] = a.x * qi.sin_() - a.y * qi.cos_();
+                extra += 1;
+            }
+        }
+        f
+    }
+
+    fn jacobians(&self, pose: &Pose<T>, q: &Actuators<T>) -> Jacobians<T> {
+        let joints = self.joints(pose);
+        let [da, db, dg] = pose.rotation_partials();
+        let mut a_mat = Matrix6::zeros();
+        let mut b_mat = Matrix6::zeros();
+        let mut extra = self.n;
+        let two = T::of(2.0);
+        for i in 0..self.n {
+            let (a, qi) = (joints[i], q.0[i]);
+            let (s, c) = (qi.sin_(), qi.cos_());
+            let d = a - self.carriage(qi);
+            let p = &self.points[i];
+            // Columns dA/dp_k of this joint.
+            let partials = [Vector3::x(), Vector3::y(), Vector3::z(), da * p, db * p, dg * p];
+            for (k, da) in partials.iter().enumerate() {
+                a_mat[(i, k)] = two * d.dot(da);
+            }
+            // dF/dq = -2 d . dB/dq with dB/dq = Rr (-sin q, cos q, 0).
+            b_mat[(i, i)] = -two * self.rr * (-d.x * s + d.y * c);
+            if let Some(k) = self.length_axis[i] {
+                b_mat[(i, k)] = -two * q.0[k];
+                if extra < 6 {
+                    for (col, da) in partials.iter().enumerate() {
+                        a_mat[(extra, col)] = s * da.x - c * da.y;
+                    }
+                    b_mat[(extra, i)] = a.x * c + a.y * s;
+                    extra += 1;
+                }
+            }
+        }
+        Jacobians {
+            a: a_mat,
+            b: b_mat,
+            dof: 6,
+            length: self.rr,
+            axes: self.axes,
+        }
+    }
+
+    fn workspace(&self, pose: &Pose<T>, q: &Actuators<T>) -> WorkspaceReport<T> {
+        self.report(pose, q, &self.configuration(pose, q))
+    }
+}
