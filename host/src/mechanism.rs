@@ -58,6 +58,8 @@ macro_rules! delegate {
 }
 
 impl Mechanism<f64> for AnyMechanism {
+    type Guard = ();
+
     fn dof(&self) -> usize {
         delegate!(self, m => m.dof())
     }
@@ -78,5 +80,8 @@ impl Mechanism<f64> for AnyMechanism {
     }
     fn workspace(&self, pose: &Pose<f64>, q: &Actuators<f64>) -> WorkspaceReport<f64> {
         delegate!(self, m => m.workspace(pose, q))
+    }
+    fn inverse_checked(&self, pose: &Pose<f64>) -> Result<(Actuators<f64>, WorkspaceReport<f64>), KinematicsError> {
+        delegate!(self, m => m.inverse_checked(pose))
     }
 }

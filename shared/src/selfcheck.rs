@@ -247,8 +247,13 @@ fn frames(d: &mut Digest) -> bool {
 
 /// A controller and the simulated plant, powered up (Enable), homed and started: `Running`, at the home pose.
 pub fn running_rig(d: &mut Digest) -> Option<Rig> {
+    running_rig_with(d, ControllerConfig::trainer_model())
+}
+
+/// [`running_rig`] with a configuration of the trainer model's (another tick rate, say).
+pub fn running_rig_with(d: &mut Digest, config: ControllerConfig) -> Option<Rig> {
     let mut rig = Rig {
-        controller: Controller::new(ControllerConfig::trainer_model()).ok()?,
+        controller: Controller::new(config).ok()?,
         plant: Plant::trainer_model(TRAINER_MODEL_PARKED),
         ticks: 0,
     };

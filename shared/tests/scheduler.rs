@@ -2,7 +2,7 @@
 //! minimum pulse spacing, DIR setup and hold, and nothing lost when a target is beyond the top rate.
 
 use proptest::prelude::*;
-use ringpod_core::motion::{Direction, SchedulerConfig, StepScheduler};
+use ringpod_core::motion::{AxisMove, Direction, SchedulerConfig, StepScheduler};
 
 /// One emitted edge on the absolute timeline (ns).
 #[derive(Debug, Clone, Copy)]
@@ -164,4 +164,27 @@ fn invalid_timing_is_detected() {
         ..ok
     }
     .is_valid());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 2_000, ..ProptestConfig::default() })]
+
+    /// The incremental step times are exactly the closed form, for any window and count (large counts take the
+    /// closed form itself).
+    #[test]
+    fn incremental_step_times_equal_the_closed_form(
+        period in 1u32..=1_000_000_000,
+        start_fraction in 0.0..1.0f64,
+        count in prop_oneof![1u32..=400, 400u32..=200_000, Just(u32::MAX / 2 + 7)],
+    ) {
+        let start = ((f64::from(period) * start_fraction) as u32).min(period - 1);
+        let m = AxisMove { direction: Direction::Forward, dir_change_ns: None, start_ns: start, count, period_ns: period };
+        let take = count.min(2_000);
+        for (k, t) in m.times().take(take as usize).enumerate() {
+            prop_assert_eq!(t, m.step_ns(k as u32), "step {}", k);
+        }
+        if count <= 2_000 {
+            prop_assert_eq!(m.times().count(), count as usize);
+        }
+    }
 }

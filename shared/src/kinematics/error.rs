@@ -18,9 +18,13 @@ pub enum Reach {
 }
 
 /// Why a kinematics computation has no answer.
+///
+/// Aligned to four bytes: in a `Result` beside `f32` arrays its byte-sized fields otherwise put the payload at an
+/// odd offset, and moving that result out is a byte-wise `memcpy` call on the M4F (measured in the control tick).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
+#[repr(align(4))]
 pub enum KinematicsError {
     /// An input (pose, actuators, guess) has a NaN or infinite coordinate.
     NonFinite,

@@ -21,7 +21,7 @@ pub use forward::{ForwardSolution, NewtonOptions};
 pub use geometry::{Branch, Chain, ChainKind, GeometryError, RingGeometry, RingLimits, ToolGeometry};
 pub use multiturn::MultiTurn;
 pub use pose::{Actuators, Pose};
-pub use ring::{ActuatorLoads, RingPlatform};
+pub use ring::{ActuatorLoads, RingPlatform, SlowCheckGuard};
 pub use tool::ToolCarrier;
 pub use velocity::{Jacobians, Singularity};
 pub use workspace::{Check, WorkspaceReport};
@@ -47,6 +47,9 @@ pub enum AxisKind {
 ///
 /// Implementations never panic: every input class that has no answer returns a [`KinematicsError`].
 pub trait Mechanism<T: Real> {
+    /// What [`Mechanism::inverse_guarded`] remembers between calls (`()` for a mechanism that proves nothing).
+    type Guard: Default + Clone + Copy + core::fmt::Debug;
+
     /// Degrees of freedom of the platform: 6, or 5 for the tool carrier whose yaw is fixed at zero.
     /// Pose coordinates from index `dof()` on are held at zero; actuators from index `dof()` on are auxiliary
     /// (they follow the pose and are not inputs of the forward kinematics).
@@ -90,5 +93,17 @@ pub trait Mechanism<T: Real> {
     fn inverse_checked(&self, pose: &Pose<T>) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
         let q = self.inverse(pose)?;
         Ok((q, self.workspace(pose, &q)))
+    }
+
+    /// [`Mechanism::inverse_checked`] for a sequence of nearby poses (a control loop's): checks that change slowly
+    /// may be proved from where `guard` last evaluated them instead of evaluated again. Every check still passes
+    /// exactly when it would have; a proved margin is reported as its lower bound. The default evaluates everything.
+    fn inverse_guarded(
+        &self,
+        pose: &Pose<T>,
+        guard: &mut Self::Guard,
+    ) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
+        let _ = guard;
+        self.inverse_checked(pose)
     }
 }

@@ -39,7 +39,7 @@ impl<T: Real> MultiTurn<T> {
                 let delta = wrap_pi(nxt - cur);
                 // cur + delta equals nxt up to a whole turn: that turn is the crossing of +-pi.
                 let crossed = ((cur + delta - nxt) / two_pi).round_();
-                self.turns[i] = self.turns[i].saturating_add(crossed.to_f64() as i32);
+                self.turns[i] = self.turns[i].saturating_add(crossed.to_i64().clamp(-1, 1) as i32);
                 self.within.0[i] = nxt;
             } else {
                 self.within.0[i] = nxt;
@@ -61,13 +61,33 @@ impl<T: Real> MultiTurn<T> {
         turns * core::f64::consts::TAU + within
     }
 
+    /// How far axis `i` is from where it is in `earlier` (ring axes across whole turns), in this type: the
+    /// whole turns that differ times 2 pi plus the difference within the turn. Exact for the turn or so one
+    /// control period moves; not through `f64` (software arithmetic on the M4F).
+    pub fn delta_from(&self, earlier: &Self, i: usize) -> T {
+        let i = i.min(5);
+        let turns = self.turns[i].saturating_sub(earlier.turns[i]);
+        T::of_i32(turns) * T::two_pi() + (self.within.0[i] - earlier.within.0[i])
+    }
+
     /// Step position of ring axis `i` for a drive with `steps_per_turn` steps per carriage revolution.
     pub fn ring_steps(&self, i: usize, steps_per_turn: i64) -> i64 {
         let turns = i64::from(self.turns.get(i).copied().unwrap_or(0));
         let within = self.within.0.get(i).copied().unwrap_or(T::zero());
-        let frac = (within * T::of(steps_per_turn as f64) / T::two_pi()).round_();
-        turns
-            .saturating_mul(steps_per_turn)
-            .saturating_add(frac.to_f64() as i64)
+        // i64 -> f64 -> T as before (the same rounding for any count), but only for counts an i32 cannot hold:
+        // the M4F converts through f64 in software.
+        let per_turn = match i32::try_from(steps_per_turn) {
+            Ok(n) => T::of_i32(n),
+            Err(_) => T::of(steps_per_turn as f64),
+        };
+        let frac = (within * per_turn / T::two_pi()).round_to_i64();
+        // Mostly within the first turn; an i32 count times i32 turns cannot overflow (one SMULL on the M4F, where
+        // a saturating i64 product is a library call).
+        let whole = match i32::try_from(steps_per_turn) {
+            _ if turns == 0 => 0,
+            Ok(n) => turns * i64::from(n),
+            Err(_) => turns.saturating_mul(steps_per_turn),
+        };
+        whole.saturating_add(frac)
     }
 }

@@ -87,9 +87,9 @@ impl<T: Real> Pose<T> {
 
     /// `dR/dalpha`, `dR/dbeta`, `dR/dgamma` of [`Pose::rotation`], written out (one set of sines and cosines).
     pub(crate) fn rotation_partials(&self) -> [Matrix3<T>; 3] {
-        let (sa, ca) = (self.alpha.sin_(), self.alpha.cos_());
-        let (sb, cb) = (self.beta.sin_(), self.beta.cos_());
-        let (sg, cg) = (self.gamma.sin_(), self.gamma.cos_());
+        let (sa, ca) = self.alpha.sin_cos_();
+        let (sb, cb) = self.beta.sin_cos_();
+        let (sg, cg) = self.gamma.sin_cos_();
         let z = T::zero();
         [
             Matrix3::new(
@@ -136,9 +136,9 @@ impl<T: Real> Pose<T> {
 
 /// `Rz(gamma) * Ry(beta) * Rx(alpha)`.
 pub(crate) fn rotation<T: Real>(alpha: T, beta: T, gamma: T) -> Matrix3<T> {
-    let (sa, ca) = (alpha.sin_(), alpha.cos_());
-    let (sb, cb) = (beta.sin_(), beta.cos_());
-    let (sg, cg) = (gamma.sin_(), gamma.cos_());
+    let (sa, ca) = alpha.sin_cos_();
+    let (sb, cb) = beta.sin_cos_();
+    let (sg, cg) = gamma.sin_cos_();
     Matrix3::new(
         cg * cb,
         cg * sb * sa - sg * ca,

@@ -74,8 +74,8 @@ impl<T: Real> ToolCarrier<T> {
     /// Frame pivot `A2` (`side = 0`, `+b/2`) or `A3` (`side = 1`, `-b/2`).
     fn pivot(&self, pose: &Pose<T>, side: usize) -> FramePivot<T> {
         let h = if side == 0 { self.half_b } else { -self.half_b };
-        let (sa, ca) = (pose.alpha.sin_(), pose.alpha.cos_());
-        let (sb, cb) = (pose.beta.sin_(), pose.beta.cos_());
+        let (sa, ca) = pose.alpha.sin_cos_();
+        let (sb, cb) = pose.beta.sin_cos_();
         let l1 = self.l1;
         FramePivot {
             at: Vector3::new(
@@ -123,6 +123,8 @@ impl<T: Real> ToolCarrier<T> {
 }
 
 impl<T: Real> Mechanism<T> for ToolCarrier<T> {
+    type Guard = ();
+
     fn dof(&self) -> usize {
         5
     }
@@ -180,8 +182,8 @@ impl<T: Real> Mechanism<T> for ToolCarrier<T> {
         let (ey, ez) = (p3.at.y - cy, p3.at.z - cz);
         let two = T::of(2.0);
         let (o, z) = (T::one(), T::zero());
-        let (s6, c6) = (q[5].sin_(), q[5].cos_());
-        let (s4, c4) = (q[3].sin_(), q[3].cos_());
+        let (s6, c6) = q[5].sin_cos_();
+        let (s4, c4) = q[3].sin_cos_();
         #[rustfmt::skip]
         let a = Matrix6::new(
             o, z, z, z, self.l1 * pose.beta.cos_(), z,

@@ -1,5 +1,7 @@
 //! Velocity and acceleration limits, and the per-axis tracker that enforces them.
 
+use crate::Real;
+
 /// Limits per pose axis (`x, y, z` in m/s and m/s^2; `alpha, beta, gamma` in rad/s and rad/s^2) and per actuator
 /// (rad/s or m/s, and per second squared).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -51,14 +53,18 @@ impl AxisTracker {
             // steps (n a dt <= v < (n + 1) a dt) that is dt (n + 1) (v - n a dt / 2), so the fastest speed that stops
             // within d is d / ((n + 1) dt) + n a dt / 2; the continuous estimate picks n.
             let k = crate::real::sqrtf(0.25 + 2.0 * d / (adt * dt)) - 0.5;
-            let n = libm::floorf(k.max(0.0));
-            (d / ((n + 1.0) * dt) + n * adt * 0.5).min((n + 1.0) * adt)
+            // floor of a non-negative value: a truncating conversion (one VCVT on the M4F; libm's floorf works on
+            // the bits); from 2^23 on every f32 is a whole number already.
+            let k = k.max_(0.0);
+            let n = if k < 8_388_608.0 { (k as i32) as f32 } else { k };
+            (d / ((n + 1.0) * dt) + n * adt * 0.5).min_((n + 1.0) * adt)
         } else {
             0.0
         };
         let reach = libm::fabsf(error) / dt;
-        let wanted = libm::copysignf(reach.min(stop).min(vmax), error);
-        self.velocity = wanted.clamp(self.velocity - adt, self.velocity + adt);
+        let wanted = libm::copysignf(reach.min_(stop).min_(vmax), error);
+        // Not f32::clamp: it asserts its bounds are ordered, a panic path (adt is never negative here).
+        self.velocity = wanted.max_(self.velocity - adt).min_(self.velocity + adt);
         self.velocity
     }
 

@@ -14,5 +14,5 @@ pub use pipeline::{
     Accepted, FollowMode, LimitCounters, LimitReport, Pipeline, PipelineConfig, PipelineEvent, RejectCounters,
     RejectReason, Setpoint,
 };
-pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler};
+pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler, StepTimes};
 pub use steps::{AxisScale, StepConverter};

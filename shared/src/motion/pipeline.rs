@@ -21,6 +21,7 @@
 
 use crate::kinematics::{Actuators, AxisKind, Check, KinematicsError, Mechanism, MultiTurn, Pose};
 use crate::real::{wrap_once, wrap_pi};
+use crate::Real;
 
 use super::envelope::{self, EnvelopeMargins};
 use super::limits::{AxisTracker, MotionLimits};
@@ -230,6 +231,8 @@ enum Mode {
 #[derive(Debug, Clone)]
 pub struct Pipeline<M: Mechanism<f32>> {
     mechanism: M,
+    /// Where the slow checks were last evaluated (see [`Mechanism::inverse_guarded`]).
+    guard: M::Guard,
     axes: [AxisKind; 6],
     config: PipelineConfig,
     converter: StepConverter,
@@ -280,6 +283,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         let axes = mechanism.axes();
         Ok(Self {
             mechanism,
+            guard: M::Guard::default(),
             axes,
             config,
             converter,
@@ -670,7 +674,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         let mut next = self.actuators;
         next.follow(&q, &self.axes);
         for i in 0..6 {
-            self.actuator_velocity[i] = (next.total(i) - self.actuators.total(i)) as f32 / dt;
+            self.actuator_velocity[i] = next.delta_from(&self.actuators, i) / dt;
         }
         self.actuators = next;
         self.pose = pose;
@@ -687,10 +691,10 @@ impl<M: Mechanism<f32>> Pipeline<M> {
                 continue;
             }
             let v_prev = self.actuator_velocity[i];
-            let hi = limits.actuator_velocity[i].min(v_prev + limits.actuator_acceleration[i] * dt) * dt;
-            let lo = (-limits.actuator_velocity[i]).max(v_prev - limits.actuator_acceleration[i] * dt) * dt;
+            let hi = limits.actuator_velocity[i].min_(v_prev + limits.actuator_acceleration[i] * dt) * dt;
+            let lo = (-limits.actuator_velocity[i]).max_(v_prev - limits.actuator_acceleration[i] * dt) * dt;
             let bound = if d > 0.0 { hi / d } else { lo / d };
-            scale = scale.min(bound.max(0.0));
+            scale = scale.min_(bound.max_(0.0));
         }
         scale
     }
@@ -756,15 +760,15 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             let e = libm::fabsf(*e);
             if e > 0.0 {
                 let gain = limits.pose_acceleration[i] * dt;
-                let v = limits.pose_velocity[i].min(libm::fabsf(self.velocity_before[i]) + gain);
-                k = k.min(v / e);
+                let v = limits.pose_velocity[i].min_(libm::fabsf(self.velocity_before[i]) + gain);
+                k = k.min_(v / e);
             }
         }
         error.map(|e| e * k * dt)
     }
 
     /// The largest part of a step (bisection, 6 evaluations: to 1/64) whose pose passes every check.
-    fn inside_part(&self, step: &[f32; 6]) -> Option<(f32, [f32; 6], Solved)> {
+    fn inside_part(&mut self, step: &[f32; 6]) -> Option<(f32, [f32; 6], Solved)> {
         let (mut lo, mut hi) = (0.0f32, 1.0f32);
         let mut best = None;
         for _ in 0..6 {
@@ -798,8 +802,9 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         }
     }
 
-    fn solve(&self, pose: &Pose<f32>) -> Option<Solved> {
-        let (q, report) = self.mechanism.inverse_checked(pose).ok()?;
+    /// IK and every check of a pose near the commanded one (the slow checks proved where they can be).
+    fn solve(&mut self, pose: &Pose<f32>) -> Option<Solved> {
+        let (q, report) = self.mechanism.inverse_guarded(pose, &mut self.guard).ok()?;
         report.all_pass().then_some((*pose, q))
     }
 

@@ -200,20 +200,21 @@ impl PulseRenderer {
             *c = 0;
         }
         let mut report = RenderReport::default();
-        let slot_ns = u64::from(self.timing.slot_ns);
+        // u32 divisions: one instruction each on the M4F (u64 ones are software), one per step rendered.
+        let slot_ns = self.timing.slot_ns.max(1);
         for (a, m) in moves.iter().enumerate() {
             let step_bit = 1u32 << (self.map.step[a] & 15);
             match m.dir_change_ns {
                 Some(t) => {
-                    let s = ((u64::from(t) / slot_ns) as usize).min(slots - 1);
+                    let s = ((t / slot_ns) as usize).min(slots - 1);
                     out[s] |= self.map.dir_word(a, m.direction);
                 }
                 // Rewriting the level DIR already has keeps a missed buffer from leaving it wrong; it is no edge.
                 None if m.count > 0 => out[0] |= self.map.dir_word(a, m.direction),
                 None => {}
             }
-            for k in 0..m.count {
-                let s = (u64::from(m.step_ns(k)) / slot_ns) as usize;
+            for t in m.times() {
+                let s = (t / slot_ns) as usize;
                 let Some(word) = out.get_mut(s) else {
                     report.collisions += 1;
                     continue;

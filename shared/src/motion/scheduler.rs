@@ -38,9 +38,11 @@ impl Default for SchedulerConfig {
 }
 
 impl SchedulerConfig {
-    /// Whether the timing is consistent: a low time at least as long as the pulse, and room for a reversal.
+    /// Whether the timing is consistent: a low time at least as long as the pulse, room for a reversal, and a
+    /// period of at most a second (times within a period are then `i32`: hardware arithmetic on the M4F).
     pub fn is_valid(&self) -> bool {
         self.pulse_ns > 0
+            && self.period_ns <= 1_000_000_000
             && self.min_spacing_ns >= self.pulse_ns.saturating_mul(2)
             && self
                 .dir_hold_ns
@@ -85,15 +87,41 @@ pub struct AxisMove {
 impl AxisMove {
     /// Time of step `k` (ns from the period start), `k < count`.
     pub fn step_ns(&self, k: u32) -> u32 {
-        let span = u64::from(self.period_ns.saturating_sub(self.start_ns));
-        let n = u64::from(self.count.max(1));
-        let t = u64::from(self.start_ns) + (2 * u64::from(k) + 1) * span / (2 * n);
-        t as u32
+        let span = self.period_ns.saturating_sub(self.start_ns);
+        let n = self.count.max(1);
+        // In u32 whenever the product fits (any period up to about 4 ms at the default step spacing): the M4F
+        // divides u32 in one instruction and u64 in software (about 100 instructions, for every step rendered).
+        let narrow = k
+            .checked_mul(2)
+            .and_then(|k2| k2.checked_add(1))
+            .and_then(|odd| odd.checked_mul(span))
+            .zip(n.checked_mul(2));
+        let offset = match narrow {
+            Some((num, den)) => num / den,
+            None => ((2 * u64::from(k) + 1) * u64::from(span) / (2 * u64::from(n))) as u32,
+        };
+        self.start_ns.saturating_add(offset)
     }
 
-    /// Times of all steps (ns from the period start).
-    pub fn times(&self) -> impl Iterator<Item = u32> + '_ {
-        (0..self.count).map(|k| self.step_ns(k))
+    /// Times of all steps (ns from the period start), the values of [`AxisMove::step_ns`] without a division
+    /// each: the numerator `(2k + 1) span` grows by `2 span` a step, so its quotient by `2 count` grows by
+    /// `span / count` and its remainder by `2 (span % count)`, carried when it reaches `2 count`. The pulse
+    /// renderer runs this for every step of every axis.
+    pub fn times(&self) -> StepTimes {
+        let span = self.period_ns.saturating_sub(self.start_ns);
+        let n = self.count.max(1);
+        // 2n and the remainders stay below 2^32 for any count a valid period holds (at most 2e5 steps); larger
+        // counts fall back to step_ns.
+        let den = n.checked_mul(2).filter(|d| *d <= u32::MAX / 2);
+        StepTimes {
+            axis: *self,
+            k: 0,
+            quotient: den.map_or(0, |d| span / d),
+            remainder: den.map_or(0, |d| span % d),
+            step: span / n,
+            carry: 2 * (span % n),
+            den: den.unwrap_or(0),
+        }
     }
 
     /// Signed step count.
@@ -105,14 +133,54 @@ impl AxisMove {
     }
 }
 
+/// A last step this long ago (ns) constrains nothing: every spacing, hold and setup is shorter than a valid period.
+const LONG_AGO: i32 = -(1 << 30);
+
+/// The step times of one [`AxisMove`], in order (see [`AxisMove::times`]).
+#[derive(Debug, Clone)]
+pub struct StepTimes {
+    axis: AxisMove,
+    k: u32,
+    quotient: u32,
+    remainder: u32,
+    step: u32,
+    carry: u32,
+    /// `2 count`, or 0 when it is too large for the increments (then each time is computed).
+    den: u32,
+}
+
+impl Iterator for StepTimes {
+    type Item = u32;
+
+    fn next(&mut self) -> Option<u32> {
+        if self.k >= self.axis.count {
+            return None;
+        }
+        let k = self.k;
+        self.k += 1;
+        if self.den == 0 {
+            return Some(self.axis.step_ns(k));
+        }
+        let t = self.axis.start_ns.saturating_add(self.quotient);
+        self.quotient += self.step;
+        self.remainder += self.carry;
+        if self.remainder >= self.den {
+            self.remainder -= self.den;
+            self.quotient += 1;
+        }
+        Some(t)
+    }
+}
+
 /// Turns per-period step targets of six axes into timed pulses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StepScheduler {
     config: SchedulerConfig,
     position: [i64; 6],
     direction: [Direction; 6],
-    /// Time of each axis's last step relative to the start of the next period (ns, negative = in the past).
-    last_step: [i64; 6],
+    /// Time of each axis's last step relative to the start of the next period (ns, negative = in the past; never
+    /// before [`LONG_AGO`]).
+    last_step: [i32; 6],
     carried: u32,
 }
 
@@ -123,7 +191,7 @@ impl StepScheduler {
             config,
             position,
             direction: [Direction::Forward; 6],
-            last_step: [i64::MIN / 2; 6],
+            last_step: [LONG_AGO; 6],
             carried: 0,
         }
     }
@@ -150,9 +218,10 @@ impl StepScheduler {
 
     /// Plans one period toward `targets` (steps at the end of the period).
     pub fn plan(&mut self, targets: &[i64; 6]) -> [AxisMove; 6] {
+        let timing = Timing::of(&self.config);
         let mut limited = false;
         let moves = core::array::from_fn(|i| {
-            let (m, short) = self.plan_axis(i, targets[i]);
+            let (m, short) = self.plan_axis(&timing, i, targets[i]);
             limited |= short;
             m
         });
@@ -162,20 +231,19 @@ impl StepScheduler {
         moves
     }
 
-    fn plan_axis(&mut self, i: usize, target: i64) -> (AxisMove, bool) {
-        let c = self.config;
-        let period = i64::from(c.period_ns);
+    fn plan_axis(&mut self, t: &Timing, i: usize, target: i64) -> (AxisMove, bool) {
         let want = target.saturating_sub(self.position[i]);
         let last = self.last_step[i];
+        let forget = |at: i32| (at - t.period).max(LONG_AGO);
         let idle = AxisMove {
             direction: self.direction[i],
             dir_change_ns: None,
             start_ns: 0,
             count: 0,
-            period_ns: c.period_ns,
+            period_ns: t.period as u32,
         };
         if want == 0 {
-            self.last_step[i] = last.saturating_sub(period);
+            self.last_step[i] = forget(last);
             return (idle, false);
         }
         let direction = if want > 0 {
@@ -183,19 +251,19 @@ impl StepScheduler {
         } else {
             Direction::Backward
         };
-        let mut earliest = last.saturating_add(i64::from(c.min_spacing_ns));
+        let mut earliest = last + t.spacing;
         let mut dir_change_ns = None;
         if direction != self.direction[i] {
-            let change = last.saturating_add(i64::from(c.dir_hold_ns)).max(0);
-            earliest = earliest.max(change + i64::from(c.dir_setup_ns));
+            let change = (last + t.hold).max(0);
+            earliest = earliest.max(change + t.setup);
             dir_change_ns = Some(change as u32);
         }
         // The first step sits half a gap into the window, so a window starting at `earliest` is always late enough.
-        let start = earliest.clamp(0, period - 1);
-        let room = (period - start) / i64::from(c.min_spacing_ns.max(1));
-        let count = want.unsigned_abs().min(room.max(0) as u64) as u32;
+        let start = earliest.clamp(0, t.period - 1);
+        let room = (t.period - start) as u32 / t.spacing as u32;
+        let count = want.unsigned_abs().min(u64::from(room)) as u32;
         if count == 0 {
-            self.last_step[i] = last.saturating_sub(period);
+            self.last_step[i] = forget(last);
             return (idle, true);
         }
         let m = AxisMove {
@@ -203,11 +271,32 @@ impl StepScheduler {
             dir_change_ns,
             start_ns: start as u32,
             count,
-            period_ns: c.period_ns,
+            period_ns: t.period as u32,
         };
         self.direction[i] = direction;
         self.position[i] = self.position[i].saturating_add(m.signed());
-        self.last_step[i] = i64::from(m.step_ns(count - 1)) - period;
+        self.last_step[i] = forget(m.step_ns(count - 1) as i32);
         (m, u64::from(count) < want.unsigned_abs())
+    }
+}
+
+/// The timing of a period in `i32` ns (the M4F's own width), worked out once per period for all six axes. A valid
+/// configuration has a period of at most 1e9 ns and every other time shorter; out-of-range values are capped.
+struct Timing {
+    period: i32,
+    spacing: i32,
+    hold: i32,
+    setup: i32,
+}
+
+impl Timing {
+    fn of(c: &SchedulerConfig) -> Self {
+        let ns = |v: u32| v.min(1_000_000_000) as i32;
+        Self {
+            period: ns(c.period_ns).max(1),
+            spacing: ns(c.min_spacing_ns).max(1),
+            hold: ns(c.dir_hold_ns),
+            setup: ns(c.dir_setup_ns),
+        }
     }
 }

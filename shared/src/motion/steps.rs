@@ -1,6 +1,7 @@
 //! Conversion between actuator positions and motor steps.
 
 use crate::kinematics::{AxisKind, MultiTurn};
+use crate::Real;
 
 /// How one axis's motor relates to its actuator coordinate.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -63,7 +64,7 @@ impl StepConverter {
             let s = &self.scales[i];
             let raw = match self.axes[i] {
                 AxisKind::Ring => q.ring_steps(i, s.steps_per_turn),
-                AxisKind::Linear | AxisKind::Angle => libm::roundf(q.within.0[i] * s.steps_per_unit) as i64,
+                AxisKind::Linear | AxisKind::Angle => (q.within.0[i] * s.steps_per_unit).round_to_i64(),
             };
             let signed = if s.invert { raw.saturating_neg() } else { raw };
             signed.saturating_add(self.offsets[i])

@@ -15,10 +15,12 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
+use ringpod_core::controller::{ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
 use ringpod_core::kinematics::presets::{TRAINER_MODEL, TRAINER_MODEL_HOME_Z};
 use ringpod_core::kinematics::{Mechanism, NewtonOptions, Pose, RingPlatform};
-use ringpod_core::motion::{envelope, PipelineConfig, Setpoint};
-use ringpod_core::protocol::{self, HostMessage, Request};
+use ringpod_core::motion::pulse::{PortMap, PulseRenderer, PulseTiming};
+use ringpod_core::motion::{envelope, PipelineConfig, SchedulerConfig, Setpoint, StepScheduler};
+use ringpod_core::protocol::{self, ConfigKey, HostMessage, Request};
 use ringpod_core::selfcheck::{self, Digest, CHECKS};
 use ringpod_qemu::{fail, halt};
 
@@ -145,21 +147,79 @@ fn main() -> ! {
     hprintln!("LIMITED {} of 64", limited);
 
     // A controller brought to Running through power-up and homing, then fed a setpoint frame every tick.
+    let (tick, frame, n) = stream_costs(ControllerConfig::trainer_model(), 1_000);
+    report(
+        "control tick: pipeline (limits, IK + checks) + scheduler + supervisor",
+        tick,
+        n,
+    );
+    report(
+        "decode + dispatch of one setpoint frame (COBS, CRC, postcard, validation, envelope check)",
+        frame,
+        n,
+    );
+    let mut fast = ControllerConfig::trainer_model();
+    if fast.set(ConfigKey::TickHz, 2_000.0).is_err() {
+        fail("tick-hz 2000");
+    }
+    let (tick, _, n) = stream_costs(fast, 2_000);
+    report("control tick at 2 kHz (the same work, half the period)", tick, n);
+
+    // The step generator's CPU work: one period's pulse buffer at 100 k steps/s on all six axes (100 steps each in
+    // 1 ms), DIR reversing on every axis.
+    let scheduler = SchedulerConfig::default();
+    let timing = PulseTiming::new(&scheduler, STEP_SLOT_NS, MAX_STEP_SLOTS).unwrap_or_else(|_| fail("pulse timing"));
+    let map = PortMap {
+        step: [0, 1, 2, 3, 4, 5],
+        dir: [6, 7, 8, 9, 10, 11],
+        dir_forward_low: 0,
+    };
+    let mut renderer = PulseRenderer::new(map, timing).unwrap_or_else(|_| fail("pulse renderer"));
+    let mut plan = StepScheduler::new(scheduler, [0; 6]);
+    let mut buffer = [0u32; MAX_STEP_SLOTS];
+    let (mut render_total, mut rendered) = (0u32, 0u32);
+    for k in 0..20i64 {
+        let target = if k % 2 == 0 { 100 } else { 0 };
+        let moves = plan.plan(&[target; 6]);
+        render_total += counts(|| {
+            if let Some(r) = renderer.render(black_box(&moves), &mut buffer) {
+                rendered += r.steps.iter().sum::<u32>();
+            }
+        });
+    }
+    if rendered != 20 * 600 {
+        fail("rendered steps");
+    }
+    report(
+        "render one period of step buffers (6 axes x 100 k steps/s, 1 kHz)",
+        render_total,
+        20,
+    );
+    hprintln!("DONE");
+    debug::exit(debug::EXIT_SUCCESS);
+    halt()
+}
+
+/// SysTick counts of the control ticks and of the setpoint frames of 500 ticks of a stream moving
+/// surge and yaw, for a controller brought to `Running` with `config` ticking at `rate_hz`.
+fn stream_costs(config: ControllerConfig, rate_hz: u32) -> (u32, u32, u32) {
     let mut d = Digest::default();
-    let mut rig = selfcheck::running_rig(&mut d).unwrap_or_else(|| fail("controller did not reach Running"));
+    let mut rig =
+        selfcheck::running_rig_with(&mut d, config).unwrap_or_else(|| fail("controller did not reach Running"));
     let home = rig.controller.pipeline().pose();
     let mut out = [0u8; protocol::MAX_FRAME];
     let mut frame = [0u8; protocol::MAX_FRAME];
     let (mut tick_total, mut decode_total) = (0u32, 0u32);
     let n = 500u32;
+    let period_us = 1_000_000 / rate_hz;
     for k in 1..=n {
-        let t = k as f32 / 1000.0;
+        let t = (k * period_us) as f32 * 1e-6;
         let pose = Pose::new(0.01 * libm_sin(2.0 * t), 0.0, home.z, 0.0, 0.0, 0.2 * t);
         let request = Request {
             id: k,
             body: HostMessage::Setpoint(Setpoint {
                 seq: k,
-                time_us: u64::from(k) * 1_000,
+                time_us: u64::from(k * period_us),
                 pose,
             }),
         };
@@ -179,19 +239,8 @@ fn main() -> ! {
     if rig.controller.status().applied != n {
         fail("setpoints were rejected");
     }
-    report(
-        "control tick: pipeline (limits, IK + checks) + scheduler + supervisor",
-        tick_total,
-        n,
-    );
-    report(
-        "decode + dispatch of one setpoint frame (COBS, CRC, postcard, validation)",
-        decode_total,
-        n,
-    );
-    hprintln!("DONE");
-    debug::exit(debug::EXIT_SUCCESS);
-    halt()
+    // Totals in counts, and the number of calls (the caller's report scales and divides).
+    (tick_total, decode_total, n)
 }
 
 /// `sinf` through libm, as the core calls it.

@@ -11,11 +11,13 @@ use nalgebra::{Matrix3, Vector3};
 use super::RingPlatform;
 use crate::kinematics::velocity::hadamard_ratio_in_place;
 use crate::kinematics::{Actuators, ChainKind, Pose, WorkspaceReport};
-use crate::real::{wrap_once, wrap_pi};
+use crate::real::{length, wrap_once, wrap_pi};
 use crate::Real;
 
 /// Where everything of one pose is: computed once for all the checks (and for the statics).
 pub(super) struct Configuration<T: Real> {
+    /// The actuators.
+    pub q: Actuators<T>,
     /// Platform orientation.
     pub rotation: Matrix3<T>,
     /// Platform joints `A_i` in the base frame.
@@ -26,11 +28,20 @@ pub(super) struct Configuration<T: Real> {
     pub dirs: [Vector3<T>; 6],
 }
 
+/// The checks that cost the most and change slowly with the pose: the joint-cone margin (rad) and the raw
+/// singularity index.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct SlowMargins<T> {
+    pub cones: T,
+    pub index: T,
+}
+
 impl<T: Real> Configuration<T> {
     /// Everything at zero, to be filled in place (these arrays are too large to move around on the M4F: each move
     /// is a `memcpy` call).
     pub fn zeroed() -> Self {
         Self {
+            q: Actuators([T::zero(); 6]),
             rotation: Matrix3::zeros(),
             joints: [Vector3::zeros(); 6],
             carriages: [Vector3::zeros(); 6],
@@ -42,7 +53,7 @@ impl<T: Real> Configuration<T> {
     pub fn direct(&mut self, n: usize) {
         for i in 0..n.min(6) {
             let d = self.joints[i] - self.carriages[i];
-            let len = (d.x * d.x + d.y * d.y + d.z * d.z).sqrt_();
+            let len = length(&d);
             if len > T::zero() {
                 self.dirs[i] = d / len;
             }
@@ -54,6 +65,7 @@ impl<T: Real> RingPlatform<T> {
     /// The configuration of a pose with given actuators (carriages from their angles).
     pub(super) fn configuration(&self, pose: &Pose<T>, q: &Actuators<T>) -> Configuration<T> {
         let mut c = Configuration::zeroed();
+        c.q = *q;
         c.rotation = pose.rotation();
         self.place_joints(pose, &mut c);
         for (b, qi) in c.carriages.iter_mut().zip(&q.0).take(self.n) {
@@ -64,19 +76,32 @@ impl<T: Real> RingPlatform<T> {
     }
 
     /// All six margins, in the order of [`crate::kinematics::Check::ALL`].
-    pub(super) fn report(&self, pose: &Pose<T>, q: &Actuators<T>, c: &Configuration<T>) -> WorkspaceReport<T> {
-        let (spacing, order) = self.ring_order_margins(q);
-        let index = self.singularity_of(c);
+    pub(super) fn report(&self, pose: &Pose<T>, c: &Configuration<T>) -> WorkspaceReport<T> {
+        let slow = SlowMargins {
+            cones: self.cone_margin(c),
+            index: self.singularity_of(c),
+        };
+        self.report_with(pose, c, &slow)
+    }
+
+    /// The margins with the slow ones given (evaluated, or proved by [`super::guard`]).
+    pub(super) fn report_with(
+        &self,
+        pose: &Pose<T>,
+        c: &Configuration<T>,
+        slow: &SlowMargins<T>,
+    ) -> WorkspaceReport<T> {
+        let (spacing, order) = self.ring_order_margins(&c.q);
         WorkspaceReport::new(
             [
                 Some(self.reach_of(&c.joints)),
                 Some(spacing),
                 Some(order),
-                Some(self.cone_margin(c)),
-                Some(index - self.min_index),
+                Some(slow.cones),
+                Some(slow.index - self.min_index),
                 Some(self.stability_margin(pose, c)),
             ],
-            index,
+            slow.index,
         )
     }
 
@@ -139,7 +164,7 @@ impl<T: Real> RingPlatform<T> {
     }
 
     /// The smallest angle of a chain to the base plane and to the platform plane, each above its cone limit.
-    fn cone_margin(&self, c: &Configuration<T>) -> T {
+    pub(super) fn cone_margin(&self, c: &Configuration<T>) -> T {
         let normal = c.rotation.column(2).into_owned();
         let (mut base, mut platform) = (T::one(), T::one());
         for u in c.dirs.iter().take(self.n) {

@@ -3,11 +3,13 @@
 //! [`statics`]).
 
 mod checks;
+mod guard;
 mod statics;
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use self::checks::Configuration;
+pub use self::guard::SlowCheckGuard;
 pub use self::statics::ActuatorLoads;
 use super::geometry::{Branch, ChainKind, RingGeometry};
 use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
@@ -94,7 +96,8 @@ impl<T: Real> RingPlatform<T> {
     }
 
     fn carriage(&self, q: T) -> Vector3<T> {
-        Vector3::new(self.rr * q.cos_(), self.rr * q.sin_(), T::zero())
+        let (s, c) = q.sin_cos_();
+        Vector3::new(self.rr * c, self.rr * s, T::zero())
     }
 
     /// Reach margin of a pose (m), defined whether or not the pose is reachable: the smallest slack of the rod
@@ -119,11 +122,14 @@ impl<T: Real> RingPlatform<T> {
     /// `(cos(theta +- phi), sin(theta +- phi))` is `(x C -+ y S, y C +- x S)` over `2 Rr rho^2`. One `atan2` of it
     /// gives the angle (instead of one for `theta` and one for `phi`), already within `(-pi, pi]`, and the checks
     /// take the carriages as they are instead of a sine and a cosine of each angle.
-    fn solve(&self, pose: &Pose<T>, c: &mut Configuration<T>) -> Result<Actuators<T>, KinematicsError> {
+    ///
+    /// The actuators go into `c` as well: returned in a `Result`, the compiler moved them through a copy at an odd
+    /// offset, a `memcpy` call on the M4F (measured).
+    fn solve(&self, pose: &Pose<T>, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
         let pose = pose.validated()?;
         c.rotation = pose.rotation();
         self.place_joints(&pose, c);
-        let mut q = [T::zero(); 6];
+        let q = &mut c.q.0;
         let tiny = self.rr * T::of(T::EPS * 16.0);
         for i in 0..self.n {
             let a = c.joints[i];
@@ -177,11 +183,13 @@ impl<T: Real> RingPlatform<T> {
                 }
             }
         }
-        Ok(Actuators(q))
+        Ok(())
     }
 }
 
 impl<T: Real> Mechanism<T> for RingPlatform<T> {
+    type Guard = SlowCheckGuard<T>;
+
     fn dof(&self) -> usize {
         6
     }
@@ -195,15 +203,30 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
     }
 
     fn inverse(&self, pose: &Pose<T>) -> Result<Actuators<T>, KinematicsError> {
-        self.solve(pose, &mut Configuration::zeroed())
+        let mut c = Configuration::zeroed();
+        self.solve(pose, &mut c)?;
+        Ok(c.q)
     }
 
     /// IK and the checks on what it found (the rotation, joints and carriages are not computed twice).
     fn inverse_checked(&self, pose: &Pose<T>) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
         let mut c = Configuration::zeroed();
-        let q = self.solve(pose, &mut c)?;
+        self.solve(pose, &mut c)?;
         c.direct(self.n);
-        Ok((q, self.report(pose, &q, &c)))
+        Ok((c.q, self.report(pose, &c)))
+    }
+
+    /// IK and the checks, the joint cones and the singularity index proved by [`SlowCheckGuard`] when they can be.
+    fn inverse_guarded(
+        &self,
+        pose: &Pose<T>,
+        guard: &mut SlowCheckGuard<T>,
+    ) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
+        let mut c = Configuration::zeroed();
+        self.solve(pose, &mut c)?;
+        c.direct(self.n);
+        let (slow, _) = self.slow_margins(&c, guard);
+        Ok((c.q, self.report_with(pose, &c, &slow)))
     }
 
     fn residuals(&self, pose: &Pose<T>, q: &Actuators<T>) -> Vector6<T> {
@@ -219,7 +242,8 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
             };
             f[i] = d.dot(&d) - length * length;
             if self.kinds[i] == ChainKind::Radial && extra < 6 {
-                f[extra] = a.x * qi.sin_() - a.y * qi.cos_();
+                let (s, c) = qi.sin_cos_();
+                f[extra] = a.x * s - a.y * c;
                 extra += 1;
             }
         }
@@ -235,7 +259,7 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         let two = T::of(2.0);
         for i in 0..self.n {
             let (a, qi) = (joints[i], q.0[i]);
-            let (s, c) = (qi.sin_(), qi.cos_());
+            let (s, c) = qi.sin_cos_();
             let d = a - self.carriage(qi);
             let p = &self.points[i];
             // Columns dA/dp_k of this joint.
@@ -266,6 +290,6 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
     }
 
     fn workspace(&self, pose: &Pose<T>, q: &Actuators<T>) -> WorkspaceReport<T> {
-        self.report(pose, q, &self.configuration(pose, q))
+        self.report(pose, &self.configuration(pose, q))
     }
 }

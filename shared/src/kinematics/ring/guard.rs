@@ -1,0 +1,104 @@
+//! Proving the slow checks instead of evaluating them: the control tick moves the platform a few micrometres, and the
+//! joint-cone margin and the singularity index (half the cost of all six checks on the M4F) cannot change by more
+//! than a bound computed from how far the joints moved since they were last evaluated.
+//!
+//! The bounds, for chain directions `u_i` (unit), carriages `B_i` on the ring of radius `Rr`, platform joints `A_i`
+//! and the platform normal `n`, each compared with its value at the last full check:
+//!
+//! - Angles: two unit vectors a chord `c` apart are `2 asin(c / 2) <= (pi / 2) c` apart. A chain's angle to the base
+//!   plane, `asin(u.z)`, changes by at most the angle `u` turned; its angle to the platform plane, `asin(u . n)`, by
+//!   at most that plus the angle `n` turned. So the cone margin drops by at most
+//!   `(pi / 2) max_i (|du_i| + |dn|)`.
+//! - The singularity index is `|det W|` of the wrench matrix with unit rows (the Hadamard ratio). The determinant is
+//!   linear in each row and, by Hadamard's inequality, a row's cofactor is at most the product of the other rows'
+//!   norms, 1. Changing the rows one at a time, `|d index| <= sum_i |d w_i|` over the unit rows, and a unit row
+//!   moves at most twice as far as the raw row `w = (u, B x u / Rr)` (whose norm is at least `|u| = 1`):
+//!   `|d w| <= |du| + (|dB| + Rr |du|) / Rr = 2 |du| + |dB| / Rr`. A radial chain's tangent row
+//!   `(v, A x v / Rr)` with `v = (-B_y, B_x, 0) / Rr` moves at most `|dB| / Rr + (|dA| + |A| |dB| / Rr) / Rr`.
+//!
+//! Each bound takes only differences of vectors IK and the fast checks compute anyway. While both margins stay
+//! above their bounds (with [`SLACK`] for rounding), the checks pass and report those lower bounds; otherwise they
+//! are evaluated, and the guard starts again from there. Tested against full evaluation on random walks
+//! (`shared/tests/guard.rs`).
+
+use nalgebra::Vector3;
+
+use super::checks::{Configuration, SlowMargins};
+use super::RingPlatform;
+use crate::kinematics::ChainKind;
+use crate::real::length;
+use crate::Real;
+
+/// Room kept for rounding: `f32` evaluations of the margins differ from the true values by a few 1e-7.
+const SLACK: f64 = 1e-5;
+
+/// Where the slow checks were last evaluated, and what they gave.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SlowCheckGuard<T> {
+    at: Option<Reference<T>>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Reference<T> {
+    dirs: [Vector3<T>; 6],
+    carriages: [Vector3<T>; 6],
+    joints: [Vector3<T>; 6],
+    normal: Vector3<T>,
+    slow: SlowMargins<T>,
+}
+
+impl<T: Real> SlowCheckGuard<T> {
+    /// Forgets the last evaluation: the next check evaluates everything.
+    pub fn reset(&mut self) {
+        self.at = None;
+    }
+}
+
+impl<T: Real> RingPlatform<T> {
+    /// The slow margins of `c`: proved from the guard's reference when its bounds allow, else evaluated (and the
+    /// reference moved here). Returns whether they were evaluated.
+    pub(super) fn slow_margins(&self, c: &Configuration<T>, guard: &mut SlowCheckGuard<T>) -> (SlowMargins<T>, bool) {
+        if let Some(reference) = &guard.at {
+            if let Some(proved) = self.proved(reference, c) {
+                return (proved, false);
+            }
+        }
+        let slow = SlowMargins {
+            cones: self.cone_margin(c),
+            index: self.singularity_of(c),
+        };
+        guard.at = Some(Reference {
+            dirs: c.dirs,
+            carriages: c.carriages,
+            joints: c.joints,
+            normal: c.rotation.column(2).into_owned(),
+            slow,
+        });
+        (slow, true)
+    }
+
+    /// Lower bounds of the slow margins at `c` from those at the reference, if both still pass with them.
+    fn proved(&self, r: &Reference<T>, c: &Configuration<T>) -> Option<SlowMargins<T>> {
+        let quarter_turn = T::frac_pi_2();
+        let inv_rr = T::one() / self.rr;
+        let tilt = length(&(c.rotation.column(2) - r.normal));
+        let mut turn = T::zero();
+        let mut rows = T::zero();
+        for i in 0..self.n {
+            let du = length(&(c.dirs[i] - r.dirs[i]));
+            let db = length(&(c.carriages[i] - r.carriages[i]));
+            turn = turn.max_(du);
+            rows += du + du + db * inv_rr;
+            if self.kinds[i] == ChainKind::Radial {
+                let da = length(&(c.joints[i] - r.joints[i]));
+                let reach = length(&r.joints[i]) * inv_rr;
+                rows += db * inv_rr + (da + reach * db) * inv_rr;
+            }
+        }
+        let slack = T::of(SLACK);
+        let cones = r.slow.cones - quarter_turn * (turn + tilt) - slack;
+        // Two for each unit row moving up to twice as far as its raw row.
+        let index = r.slow.index - (rows + rows) - slack;
+        (cones >= T::zero() && index >= self.min_index).then_some(SlowMargins { cones, index })
+    }
+}

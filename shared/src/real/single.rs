@@ -1,0 +1,246 @@
+//! Single-precision functions for the MCU's scalar, each measured under QEMU against what it replaces.
+//!
+//! musl's `f32` functions (through `libm`) often compute in `f64`, which the Cortex-M4F has no hardware for, and
+//! `libm::sqrtf` has no ARM code at all. These use only IEEE additions, multiplications, divisions and square roots
+//! (Rust never contracts them into fused operations), so they give the same bits on every target, and the tests
+//! below hold each to the correctly rounded value.
+
+/// Sine and cosine in single precision, for `f32` (the MCU's scalar).
+///
+/// `libm::sinf` and `cosf` (musl's) evaluate their kernels in `f64`, which a Cortex-M4F has no hardware for: about
+/// 1,300 instructions a call, measured under QEMU, and the pose rotation alone needs six. These are Cephes' `sinf`
+/// and `cosf` (S. L. Moshier): the argument reduced by multiples of pi/4 with pi/4 split into three parts, so the
+/// reduction is exact for |x| <= 8192, then minimax polynomials, all in `f32` (about 40 instructions; relative
+/// error a few times 1e-8). Only IEEE additions and multiplications, which Rust never contracts into fused ones:
+/// the same bits on every target. NaN, infinities and |x| > 8192 go to `libm` (exact reduction of huge arguments).
+pub(super) fn sincosf(x: f32) -> (f32, f32) {
+    const FOUR_OVER_PI: f32 = 1.273_239_5;
+    const DP1: f32 = 0.785_156_25;
+    const DP2: f32 = 2.418_756_5e-4;
+    const DP3: f32 = 3.774_895e-8;
+    let ax = libm::fabsf(x);
+    if ax.is_nan() || ax > 8192.0 {
+        return (libm::sinf(x), libm::cosf(x));
+    }
+    let mut j = (ax * FOUR_OVER_PI) as u32;
+    let mut y = j as f32;
+    // Map zeros to the origin: octants 1, 3, 5, 7 round up to the next even one.
+    if j & 1 != 0 {
+        j += 1;
+        y += 1.0;
+    }
+    let z = ((ax - y * DP1) - y * DP2) - y * DP3;
+    let zz = z * z;
+    let s = ((-1.951_529_6e-4 * zz + 8.332_161e-3) * zz - 1.666_665_5e-1) * zz * z + z;
+    let c = ((2.443_315_7e-5 * zz - 1.388_731_6e-3) * zz + 4.166_664_6e-2) * zz * zz - 0.5 * zz + 1.0;
+    let (sin, cos) = match (j >> 1) & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    };
+    (if x < 0.0 { -sin } else { sin }, cos)
+}
+
+pub(super) fn sinf(x: f32) -> f32 {
+    sincosf(x).0
+}
+
+pub(super) fn cosf(x: f32) -> f32 {
+    sincosf(x).1
+}
+
+/// Square root in single precision: the FPU's `vsqrt.f32` on the Cortex-M4F, `libm` elsewhere.
+///
+/// `libm::sqrtf` has no ARM implementation and computes the root digit by digit in integers (measured under QEMU:
+/// about 110 instructions a call, and the IK and checks of one pose take 36 of them). IEEE 754 requires the square
+/// root to be correctly rounded, as VSQRT is and as `libm`'s is: the same bits either way, which the self-check's
+/// digest confirms (host and M4F equal).
+#[inline]
+pub(crate) fn sqrtf(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        let mut bits = x.to_bits();
+        // Rust's `sreg` operand class needs the double-precision `vfp2` feature, which the M4F's single-precision
+        // FPU target does not enable; a named register does not: the value travels in a core register through s15
+        // (caller-saved, declared clobbered).
+        // SAFETY: only s15 (declared) and the FPU's sticky flags change.
+        unsafe {
+            core::arch::asm!(
+                "vmov s15, {0}",
+                "vsqrt.f32 s15, s15",
+                "vmov {0}, s15",
+                inout(reg) bits,
+                out("s15") _,
+                options(pure, nomem, nostack, preserves_flags),
+            );
+        }
+        f32::from_bits(bits)
+    }
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    {
+        libm::sqrtf(x)
+    }
+}
+
+/// Arc sine in single precision: `atan2(x, sqrt((1 - x)(1 + x)))`.
+///
+/// musl's `asinf` evaluates its polynomial in `f64`, which the M4F computes in software: about 700 instructions a
+/// call, measured under QEMU. The factored `1 - x^2` keeps its digits near `|x| = 1`; [`atan2f`] works in `f32`.
+/// Within 4e-7 of the correctly rounded value (tested); outside `[-1, 1]` the root is NaN and so is the result.
+pub(super) fn asinf(x: f32) -> f32 {
+    atan2f(x, sqrtf((1.0 - x) * (1.0 + x)))
+}
+
+/// Four-quadrant arctangent of `y / x` in single precision.
+///
+/// musl's `atan2f` is correct but takes about 90 instructions a call on the M4F (with its `atanf`), and IK needs one
+/// per chain. This reduces to `atan(t)` with `0 <= t <= 1` (the smaller of `|x|`, `|y|` over the larger), then
+/// Cephes' `atanf` (S. L. Moshier): `t > tan(pi/8)` maps to `pi/4 + atan((t - 1) / (t + 1))`, and a degree-9
+/// odd polynomial covers `|t| <= tan(pi/8)`. Within 3e-7 of the correctly rounded value (tested; an ulp at pi is
+/// 2.4e-7). Zeros, infinities and NaN go to `libm` (their signed-zero and infinite quadrant rules).
+pub(super) fn atan2f(y: f32, x: f32) -> f32 {
+    const TAN_PI_8: f32 = 0.414_213_57;
+    const FRAC_PI_4: f32 = core::f32::consts::FRAC_PI_4;
+    const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
+    const PI: f32 = core::f32::consts::PI;
+    let (ax, ay) = (libm::fabsf(x), libm::fabsf(y));
+    // Also false for NaN: both must be finite and one of them non-zero.
+    if !(ax < f32::INFINITY && ay < f32::INFINITY && (ax > 0.0 || ay > 0.0)) {
+        return libm::atan2f(y, x);
+    }
+    let swapped = ay > ax;
+    let t = if swapped { ax / ay } else { ay / ax };
+    let (base, t) = if t > TAN_PI_8 {
+        (FRAC_PI_4, (t - 1.0) / (t + 1.0))
+    } else {
+        (0.0, t)
+    };
+    let z = t * t;
+    let poly = (((8.053_744_5e-2 * z - 1.387_768_6e-1) * z + 1.997_771_1e-1) * z - 3.333_295e-1) * z * t + t;
+    let mut angle = base + poly;
+    if swapped {
+        angle = FRAC_PI_2 - angle;
+    }
+    if x < 0.0 {
+        angle = PI - angle;
+    }
+    if y.is_sign_negative() {
+        -angle
+    } else {
+        angle
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn single_precision_arc_sine_matches_libm() {
+        let mut worst = 0.0f64;
+        for i in -1_000_000..=1_000_000 {
+            let x = i as f32 * 1e-6;
+            worst = worst.max((f64::from(asinf(x)) - libm::asin(f64::from(x))).abs());
+        }
+        assert!(worst < 4e-7, "worst error {worst:e}");
+        assert_eq!(asinf(1.0), core::f32::consts::FRAC_PI_2);
+        assert_eq!(asinf(-1.0), -core::f32::consts::FRAC_PI_2);
+        assert_eq!(asinf(0.0), 0.0);
+        assert!(asinf(1.0 + f32::EPSILON).is_nan() && asinf(f32::NAN).is_nan());
+    }
+
+    #[test]
+    fn single_precision_sine_and_cosine_match_libm() {
+        // Every 1/1000 rad over +-30 rad and a sweep up to the reduction's limit: within 2e-7 absolute of the
+        // correctly rounded values (an f32 ulp at 1 is 1.2e-7).
+        let mut worst = 0.0f64;
+        let mut x = -30.0f64;
+        while x < 30.0 {
+            let (s, c) = sincosf(x as f32);
+            let xf = f64::from(x as f32);
+            worst = worst
+                .max((f64::from(s) - libm::sin(xf)).abs())
+                .max((f64::from(c) - libm::cos(xf)).abs());
+            x += 1e-3;
+        }
+        let mut x = 30.0f64;
+        while x < 8192.0 {
+            let (s, c) = sincosf(x as f32);
+            let xf = f64::from(x as f32);
+            worst = worst
+                .max((f64::from(s) - libm::sin(xf)).abs())
+                .max((f64::from(c) - libm::cos(xf)).abs());
+            x *= 1.001;
+        }
+        assert!(worst < 2e-7, "worst error {worst:e}");
+        let (s, c) = sincosf(f32::NAN);
+        assert!(s.is_nan() && c.is_nan());
+        assert_eq!(sincosf(0.0), (0.0, 1.0));
+        assert_eq!(sincosf(1e6), (libm::sinf(1e6), libm::cosf(1e6)));
+    }
+
+    #[test]
+    fn rounding_to_an_integer_matches_libm() {
+        use crate::Real;
+        let mut x = -3.0e9f32;
+        let mut k = 0u32;
+        while x < 3.0e9 {
+            for v in [x, x + 0.5, x - 0.5, x + 0.499_999_97, -x] {
+                assert_eq!(v.round_to_i64(), libm::roundf(v) as i64, "{v}");
+            }
+            x = x * 0.999 + 0.37 * (k % 7) as f32 - 1.3;
+            x = if x.abs() < 1.0 { x + 7.0 } else { x };
+            k += 1;
+            if k > 200_000 {
+                break;
+            }
+        }
+        for v in [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            0.499_999_97,
+            -0.499_999_97,
+            8_388_609.0,
+            2.0e9,
+            -2.2e9,
+        ] {
+            assert_eq!(v.round_to_i64(), libm::roundf(v) as i64, "{v}");
+        }
+        for v in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e30, -1e30] {
+            assert_eq!(v.round_to_i64(), libm::roundf(v) as i64, "{v}");
+        }
+    }
+
+    #[test]
+    fn single_precision_arc_tangent_matches_libm() {
+        // Every direction on circles of several radii, and ratios near 0, 1 and tan(pi/8) where the reduction
+        // switches: within 3e-7 of the correctly rounded angle.
+        let mut worst = 0.0f64;
+        for r in [1e-20f64, 1e-3, 0.2, 1.0, 7.5, 1e20] {
+            for i in 0..200_000 {
+                let a = (i as f64 / 100_000.0 - 1.0) * core::f64::consts::PI;
+                let (y, x) = ((r * a.sin()) as f32, (r * a.cos()) as f32);
+                let exact = libm::atan2(f64::from(y), f64::from(x));
+                worst = worst.max((f64::from(atan2f(y, x)) - exact).abs());
+            }
+        }
+        for k in -2_000..2_000 {
+            let t = 0.414_213_57f32 + k as f32 * 1e-7;
+            worst = worst.max((f64::from(atan2f(t, 1.0)) - libm::atan2(f64::from(t), 1.0)).abs());
+        }
+        assert!(worst < 3e-7, "worst error {worst:e}");
+        assert_eq!(atan2f(0.0, 1.0), 0.0);
+        assert!(atan2f(-0.0, 1.0).is_sign_negative());
+        assert_eq!(atan2f(1.0, 0.0), core::f32::consts::FRAC_PI_2);
+        assert_eq!(atan2f(0.0, -1.0), libm::atan2f(0.0, -1.0));
+        assert_eq!(atan2f(-0.0, -0.0), libm::atan2f(-0.0, -0.0));
+        assert_eq!(atan2f(f32::INFINITY, 1.0), libm::atan2f(f32::INFINITY, 1.0));
+        assert!(atan2f(f32::NAN, 1.0).is_nan() && atan2f(1.0, f32::NAN).is_nan());
+    }
+}
