@@ -38,8 +38,8 @@ impl<T: Real> MultiTurn<T> {
                 let nxt = wrap_pi(nxt);
                 let delta = wrap_pi(nxt - cur);
                 // cur + delta equals nxt up to a whole turn: that turn is the crossing of +-pi.
-                let crossed = ((cur + delta - nxt) / two_pi).round_();
-                self.turns[i] = self.turns[i].saturating_add(crossed.to_i64().clamp(-1, 1) as i32);
+                let crossed = ((cur + delta - nxt) / two_pi).round_to_i64().clamp(-1, 1) as i32;
+                self.turns[i] = self.turns[i].saturating_add(crossed);
                 self.within.0[i] = nxt;
             } else {
                 self.within.0[i] = nxt;

@@ -263,6 +263,7 @@ pub struct Pipeline<M: Mechanism<f32>> {
     held: u32,
 }
 
+#[inline]
 fn delta(axis: usize, to: f32, from: f32) -> f32 {
     if axis == 5 {
         wrap_pi(to - from)

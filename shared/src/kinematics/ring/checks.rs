@@ -15,6 +15,7 @@ use crate::real::{length, wrap_once, wrap_pi};
 use crate::Real;
 
 /// Where everything of one pose is: computed once for all the checks (and for the statics).
+#[derive(Debug, Clone, Copy)]
 pub(super) struct Configuration<T: Real> {
     /// The actuators.
     pub q: Actuators<T>,

@@ -21,8 +21,6 @@
 //! are evaluated, and the guard starts again from there. Tested against full evaluation on random walks
 //! (`shared/tests/guard.rs`).
 
-use nalgebra::Vector3;
-
 use super::checks::{Configuration, SlowMargins};
 use super::RingPlatform;
 use crate::kinematics::ChainKind;
@@ -32,19 +30,22 @@ use crate::Real;
 /// Room kept for rounding: `f32` evaluations of the margins differ from the true values by a few 1e-7.
 const SLACK: f64 = 1e-5;
 
-/// Where the slow checks were last evaluated, and what they gave.
-#[derive(Debug, Clone, Copy, Default)]
-pub struct SlowCheckGuard<T> {
-    at: Option<Reference<T>>,
+/// Where the slow checks were last evaluated and what they gave, and the configuration being checked now (kept
+/// here so that a control loop fills the same memory every tick instead of clearing a new one).
+#[derive(Debug, Clone, Copy)]
+pub struct SlowCheckGuard<T: Real> {
+    /// The configuration of the pose being checked.
+    pub(super) scratch: Configuration<T>,
+    at: Option<(Configuration<T>, SlowMargins<T>)>,
 }
 
-#[derive(Debug, Clone, Copy)]
-struct Reference<T> {
-    dirs: [Vector3<T>; 6],
-    carriages: [Vector3<T>; 6],
-    joints: [Vector3<T>; 6],
-    normal: Vector3<T>,
-    slow: SlowMargins<T>,
+impl<T: Real> Default for SlowCheckGuard<T> {
+    fn default() -> Self {
+        Self {
+            scratch: Configuration::zeroed(),
+            at: None,
+        }
+    }
 }
 
 impl<T: Real> SlowCheckGuard<T> {
@@ -55,11 +56,12 @@ impl<T: Real> SlowCheckGuard<T> {
 }
 
 impl<T: Real> RingPlatform<T> {
-    /// The slow margins of `c`: proved from the guard's reference when its bounds allow, else evaluated (and the
-    /// reference moved here). Returns whether they were evaluated.
-    pub(super) fn slow_margins(&self, c: &Configuration<T>, guard: &mut SlowCheckGuard<T>) -> (SlowMargins<T>, bool) {
-        if let Some(reference) = &guard.at {
-            if let Some(proved) = self.proved(reference, c) {
+    /// The slow margins of the guard's scratch configuration: proved from its reference when the bounds allow,
+    /// else evaluated (and the reference moved there). Returns whether they were evaluated.
+    pub(super) fn slow_margins(&self, guard: &mut SlowCheckGuard<T>) -> (SlowMargins<T>, bool) {
+        let c = &guard.scratch;
+        if let Some((reference, slow)) = &guard.at {
+            if let Some(proved) = self.proved(reference, slow, c) {
                 return (proved, false);
             }
         }
@@ -67,21 +69,15 @@ impl<T: Real> RingPlatform<T> {
             cones: self.cone_margin(c),
             index: self.singularity_of(c),
         };
-        guard.at = Some(Reference {
-            dirs: c.dirs,
-            carriages: c.carriages,
-            joints: c.joints,
-            normal: c.rotation.column(2).into_owned(),
-            slow,
-        });
+        guard.at = Some((*c, slow));
         (slow, true)
     }
 
     /// Lower bounds of the slow margins at `c` from those at the reference, if both still pass with them.
-    fn proved(&self, r: &Reference<T>, c: &Configuration<T>) -> Option<SlowMargins<T>> {
+    fn proved(&self, r: &Configuration<T>, at: &SlowMargins<T>, c: &Configuration<T>) -> Option<SlowMargins<T>> {
         let quarter_turn = T::frac_pi_2();
         let inv_rr = T::one() / self.rr;
-        let tilt = length(&(c.rotation.column(2) - r.normal));
+        let tilt = length(&(c.rotation.column(2) - r.rotation.column(2)));
         let mut turn = T::zero();
         let mut rows = T::zero();
         for i in 0..self.n {
@@ -96,9 +92,9 @@ impl<T: Real> RingPlatform<T> {
             }
         }
         let slack = T::of(SLACK);
-        let cones = r.slow.cones - quarter_turn * (turn + tilt) - slack;
+        let cones = at.cones - quarter_turn * (turn + tilt) - slack;
         // Two for each unit row moving up to twice as far as its raw row.
-        let index = r.slow.index - (rows + rows) - slack;
+        let index = at.index - (rows + rows) - slack;
         (cones >= T::zero() && index >= self.min_index).then_some(SlowMargins { cones, index })
     }
 }

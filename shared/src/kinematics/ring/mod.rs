@@ -222,11 +222,11 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         pose: &Pose<T>,
         guard: &mut SlowCheckGuard<T>,
     ) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
-        let mut c = Configuration::zeroed();
-        self.solve(pose, &mut c)?;
-        c.direct(self.n);
-        let (slow, _) = self.slow_margins(&c, guard);
-        Ok((c.q, self.report_with(pose, &c, &slow)))
+        self.solve(pose, &mut guard.scratch)?;
+        guard.scratch.direct(self.n);
+        let (slow, _) = self.slow_margins(guard);
+        let c = &guard.scratch;
+        Ok((c.q, self.report_with(pose, c, &slow)))
     }
 
     fn residuals(&self, pose: &Pose<T>, q: &Actuators<T>) -> Vector6<T> {
