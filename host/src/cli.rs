@@ -195,12 +195,18 @@ pub struct FkArgs {
     /// Six actuator values in the mechanism's order (see `ringpod ik`): angles in radians unless --degrees.
     #[arg(long, allow_hyphen_values = true)]
     pub actuators: String,
-    /// Starting pose x,y,z,alpha,beta,gamma for the iteration. Default: the preset's home pose.
+    /// Starting pose x,y,z,alpha,beta,gamma for the iteration (the platform's last known pose): the answer must be
+    /// within half a ring radius and half a radian of it. Default: the preset's home pose turned by the yaw the
+    /// carriages show, and the answer within a ring radius and a radian of that.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
     /// Maximum Newton iterations.
     #[arg(long, default_value_t = 30)]
     pub max_iterations: u8,
+    /// Also answer with a pose outside the workspace checks (the math alone; by default such a pose is an error
+    /// naming the check it fails).
+    #[arg(long)]
+    pub anywhere: bool,
 }
 
 /// Which plane `ringpod workspace` draws.

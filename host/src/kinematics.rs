@@ -4,7 +4,8 @@ use std::fmt::Write;
 
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::kinematics::{
-    AxisKind, Check, KinematicsError, Mechanism, NewtonOptions, Pose, Singularity, WorkspaceReport,
+    start_from_home, AxisKind, Check, KinematicsError, Mechanism, NewtonOptions, Pose, Singularity, WorkspaceReport,
+    FROM_HOME_DISTANCE,
 };
 use serde::Serialize;
 
@@ -159,14 +160,22 @@ fn singularity_name(s: Singularity) -> &'static str {
     }
 }
 
-fn pose_arg(common: &Common, preset: Preset, text: Option<&str>, what: &'static str) -> Result<Pose<f64>, CliError> {
+fn pose_arg(
+    common: &Common,
+    preset: Preset,
+    length: f64,
+    text: Option<&str>,
+    what: &'static str,
+) -> Result<Pose<f64>, CliError> {
     let units = Units {
         degrees: common.degrees,
     };
-    Ok(match text {
+    let pose = match text {
         Some(t) => units.pose_in(numbers::six(what, t)?),
         None => Pose::from_array(preset.home()),
-    })
+    };
+    numbers::pose_in_range(what, &pose.to_array(), length)?;
+    Ok(pose)
 }
 
 pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliError> {
@@ -175,7 +184,7 @@ pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliErr
         degrees: common.degrees,
     };
     let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
-    let pose = pose_arg(common, preset, args.pose.as_deref(), "pose")?;
+    let pose = pose_arg(common, preset, m.characteristic_length(), args.pose.as_deref(), "pose")?;
     let (q, report) = m.inverse_checked(&pose).map_err(|reason| match (&m, reason) {
         (AnyMechanism::Ring(r), KinematicsError::Unreachable { .. }) => CliError::OutOfReach {
             reason,
@@ -286,9 +295,39 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
         AxisKind::Linear => raw[i],
         AxisKind::Ring | AxisKind::Angle => units.angle_in(raw[i]),
     }));
-    let guess = pose_arg(common, preset, args.guess.as_deref(), "guess")?;
+    let length = m.characteristic_length();
+    for (i, v) in q.0.iter().enumerate() {
+        let limit = match axes[i] {
+            AxisKind::Linear => numbers::MAX_LENGTHS * length,
+            AxisKind::Ring | AxisKind::Angle => numbers::MAX_TURNING,
+        };
+        if !v.is_finite() || v.abs() > limit {
+            return Err(CliError::BadNumbers {
+                what: "actuators",
+                reason: format!(
+                    "value {} ({}) is out of range (at most {} either way)",
+                    i + 1,
+                    numbers::readable(*v),
+                    numbers::readable(limit)
+                ),
+            });
+        }
+    }
+    // Without a guess: home turned by the yaw the carriages show, accepted within a tilt range of it.
+    let (guess, max_distance) = match args.guess.as_deref() {
+        Some(_) => (
+            pose_arg(common, preset, length, args.guess.as_deref(), "guess")?,
+            NewtonOptions::<f64>::default().max_distance,
+        ),
+        None => {
+            let home = Pose::from_array(preset.home());
+            (start_from_home(&m, &q, &home), FROM_HOME_DISTANCE)
+        }
+    };
     let options = NewtonOptions {
         max_iterations: args.max_iterations,
+        max_distance,
+        inside: !args.anywhere,
         ..NewtonOptions::default()
     };
     let sol = m.forward(&q, &guess, &options)?;
@@ -352,7 +391,7 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
             reason: "must be a finite number >= 0".into(),
         });
     }
-    let pose = pose_arg(common, preset, args.pose.as_deref(), "pose")?;
+    let pose = pose_arg(common, preset, m.characteristic_length(), args.pose.as_deref(), "pose")?;
     let q = m.inverse(&pose)?;
     let wrench = ring.gravity_wrench(&pose, args.mass);
     let l = ring.loads(&pose, &q, &wrench)?;

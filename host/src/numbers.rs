@@ -18,6 +18,63 @@ pub fn six(what: &'static str, text: &str) -> Result<[f64; 6], CliError> {
     Ok(values)
 }
 
+/// Tilt (roll, pitch) beyond a whole turn either way is a mistake, not an orientation.
+pub const MAX_TILT: f64 = std::f64::consts::TAU;
+/// Yaw and ring-carriage angles up to 10,000 rad (about 1,600 turns): far beyond any session, and where an `f32`
+/// angle on the controller still resolves its steps. Beyond is a broken number (1e308 came back as 300 digits).
+pub const MAX_TURNING: f64 = 1e4;
+/// Lengths up to 100 times the mechanism's characteristic length (its ring radius).
+pub const MAX_LENGTHS: f64 = 100.0;
+
+/// A number as a person reads it: plain when modest, in exponent form when huge or tiny.
+pub fn readable(v: f64) -> String {
+    if v != 0.0 && (v.abs() >= 1e6 || v.abs() < 1e-4) {
+        format!("{v:e}")
+    } else {
+        format!("{}", (v * 1e6).round() / 1e6)
+    }
+}
+
+/// Checks a pose given on the command line (SI units) against sane ranges for a mechanism of characteristic
+/// length `length`.
+pub fn pose_in_range(what: &'static str, pose: &[f64; 6], length: f64) -> Result<(), CliError> {
+    let bad = |reason: String| Err(CliError::BadNumbers { what, reason });
+    let names = ["x", "y", "z", "alpha", "beta", "gamma"];
+    for (i, v) in pose.iter().enumerate() {
+        let (limit, unit) = match i {
+            0..=2 => (MAX_LENGTHS * length, "m"),
+            3 | 4 => (MAX_TILT, "rad"),
+            _ => (MAX_TURNING, "rad"),
+        };
+        if !v.is_finite() || v.abs() > limit {
+            return bad(format!(
+                "{} = {} {unit} is out of range (at most {} {unit} either way)",
+                names[i],
+                readable(*v),
+                readable(limit)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks one length or height given on the command line (m).
+pub fn length_in_range(what: &'static str, value: f64, length: f64) -> Result<(), CliError> {
+    let limit = MAX_LENGTHS * length;
+    if value.is_finite() && value.abs() <= limit {
+        Ok(())
+    } else {
+        Err(CliError::BadNumbers {
+            what,
+            reason: format!(
+                "{} m is out of range (a finite number, at most {} m either way)",
+                readable(value),
+                readable(limit)
+            ),
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -41,6 +98,24 @@ mod tests {
             "",
         ] {
             assert!(matches!(six("pose", text), Err(CliError::BadNumbers { .. })), "{text}");
+        }
+    }
+
+    #[test]
+    fn rejects_numbers_out_of_range() {
+        let fine = [0.01, -0.02, 0.2, 0.1, -0.1, 123.0];
+        assert!(pose_in_range("pose", &fine, 0.3).is_ok());
+        for (i, v) in [(5, 1e308), (5, -2e4), (3, 7.0), (4, -1e9), (0, 31.0), (2, -1e6)] {
+            let mut p = fine;
+            p[i] = v;
+            assert!(
+                matches!(pose_in_range("pose", &p, 0.3), Err(CliError::BadNumbers { .. })),
+                "{p:?}"
+            );
+        }
+        assert!(length_in_range("z", 0.2, 0.3).is_ok());
+        for v in [f64::NAN, f64::INFINITY, 31.0, -1e300] {
+            assert!(length_in_range("z", v, 0.3).is_err(), "{v}");
         }
     }
 }

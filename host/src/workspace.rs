@@ -63,8 +63,12 @@ pub fn run(args: &WorkspaceArgs) -> anyhow::Result<String> {
     let m = RingPlatform::<f64>::new(g);
     let home = preset.home();
     let r = g.ring_radius;
-    let n = args.cells.clamp(10, 2000);
+    let n = args.cells;
     let z0 = args.z.unwrap_or(home[2]);
+    crate::numbers::length_in_range("z", z0, r)?;
+    if !(10..=2000).contains(&args.cells) {
+        anyhow::bail!("--cells {} is out of range (10 to 2000)", args.cells);
+    }
     // Plane coordinates (u, v) -> pose.
     let (u_range, v_range) = match args.section {
         Section::Xy => ((-r, r), (-r, r)),

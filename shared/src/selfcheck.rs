@@ -147,7 +147,12 @@ fn reference_ik(d: &mut Digest) -> bool {
 
 fn round_trip(d: &mut Digest) -> bool {
     let trainer = RingPlatform::<f32>::new(&TRAINER_MODEL);
-    let options = NewtonOptions::default();
+    // The poses combine all axes at half their ranges, and not all of that box is inside the checks: FK is asked
+    // for the math here (every acceptance test but the workspace runs).
+    let options = NewtonOptions {
+        inside: false,
+        ..NewtonOptions::default()
+    };
     let mut ok = true;
     for pose in poses(64) {
         let Ok(q) = trainer.inverse(&pose) else {

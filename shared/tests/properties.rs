@@ -74,11 +74,16 @@ fn round_trip<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>, e: [f64; 6]) -> Result
     let Ok((q, report)) = m.inverse_checked(pose) else {
         return Ok(());
     };
-    // Within 2x the singularity threshold the FK may rightly refuse; elsewhere it must converge.
-    if report.singularity_index < 0.05 {
+    // Within 2x the singularity thresholds the FK may rightly refuse; elsewhere it must converge. The poses reach a
+    // little beyond the checks: FK is asked for the math, not for a pose the platform may take.
+    if report.singularity_index < 0.05 || m.jacobians(pose, &q).index_a() < 0.02 {
         return Ok(());
     }
-    let fk = m.forward(&q, &near(pose, e, m.dof()), &NewtonOptions::default());
+    let options = NewtonOptions {
+        inside: false,
+        ..NewtonOptions::default()
+    };
+    let fk = m.forward(&q, &near(pose, e, m.dof()), &options);
     let sol = fk.map_err(|err| TestCaseError::fail(format!("FK failed at {pose:?}: {err}")))?;
     prop_assert!(same_pose(&sol.pose, pose, 1e-9), "{:?} vs {:?}", sol.pose, pose);
     prop_assert!(sol.iterations <= 8, "{} iterations", sol.iterations);

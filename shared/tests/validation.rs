@@ -220,3 +220,99 @@ fn checks_fail_where_they_should() {
     let (_, r) = heavy.inverse_checked(&Pose::new(0.0, 0.0, z0, 0.0, 0.0, 0.0)).unwrap();
     assert!(r.margin(Check::Stability).unwrap() < 0.0);
 }
+
+/// With the carriage order broken, the spacing margin is measured between carriages that are neighbours around the
+/// ring (chain-order gaps stop meaning "how far outside"): checked against the gaps sorted here, on random poses
+/// whose order is broken.
+#[test]
+fn spacing_is_measured_in_ring_order_when_the_order_is_broken() {
+    let m = RingPlatform::<f64>::new(&presets::TRAINER_MODEL);
+    let limits = presets::TRAINER_MODEL.limits.carriage_spacing;
+    let mut state = 11u64;
+    let mut uniform = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let mut broken = 0;
+    for _ in 0..200_000 {
+        let pose = Pose::new(
+            uniform() * 0.08,
+            uniform() * 0.08,
+            0.227 + uniform() * 0.09,
+            uniform() * 0.4,
+            uniform() * 0.4,
+            uniform() * 3.2,
+        );
+        let Ok((q, report)) = m.inverse_checked(&pose) else {
+            continue;
+        };
+        if report.passes(Check::RodCrossing) {
+            continue;
+        }
+        broken += 1;
+        let mut angles: Vec<f64> = q.0[..4].iter().map(|a| a.rem_euclid(std::f64::consts::TAU)).collect();
+        angles.sort_by(f64::total_cmp);
+        let expected = (0..4)
+            .map(|k| {
+                let gap = (angles[(k + 1) % 4] - angles[k]).rem_euclid(std::f64::consts::TAU);
+                (gap - limits[0]).min(limits[1] - gap)
+            })
+            .fold(f64::INFINITY, f64::min);
+        let got = report.margin(Check::CarriageSpacing).unwrap();
+        assert!((got - expected).abs() < 1e-9, "{pose:?}: {got} vs {expected}");
+        assert!(got > -std::f64::consts::PI, "{got}");
+    }
+    assert!(broken > 100, "only {broken} poses with the order broken");
+    // The pose of the issue: -4.109 rad over chain-order gaps, -0.374 around the ring.
+    let pose = Pose::new(
+        0.058449912683985,
+        0.058730575477737,
+        0.147915588699746,
+        0.022745240243061,
+        -0.137177905770529,
+        1.633892256484312,
+    );
+    let (_, report) = m.inverse_checked(&pose).unwrap();
+    assert!((report.margin(Check::CarriageSpacing).unwrap() + 0.3743).abs() < 1e-3);
+}
+
+/// Each kind of singularity is measured on the way in, not only at an exact zero: along a path from a healthy pose
+/// to a singular one of the geometry, the index of that kind falls to zero and the classification follows.
+#[test]
+fn singularities_are_measured_on_the_way_in() {
+    fn path(m: &RingPlatform<f64>, zs: &[f64]) -> Vec<(f64, f64, Singularity)> {
+        zs.iter()
+            .map(|z| {
+                let p = Pose::new(0.0, 0.0, *z, 0.0, 0.0, 0.0);
+                let j = m.jacobians(&p, &m.inverse(&p).unwrap());
+                (j.index_a(), j.index_b(), j.classify(0.01))
+            })
+            .collect()
+    }
+    fn falls(values: &[f64]) -> bool {
+        values.windows(2).all(|w| w[1] < w[0])
+    }
+    let trainer = RingPlatform::<f64>::new(&presets::TRAINER_MODEL);
+    // Type 1: raising the platform until the first rod chain's carriage moves along the rod's sphere
+    // (dF1/dq1 = 3.7e-7 at z = 0.298875897118, labelled "none" before).
+    let up = path(&trainer, &[0.25, 0.298, 0.2988, 0.29887, 0.298875, 0.298875897118]);
+    assert!(falls(&up.iter().map(|s| s.1).collect::<Vec<_>>()), "{up:?}");
+    assert_eq!(up[0].2, Singularity::None);
+    assert_eq!(up[5].2, Singularity::Type1);
+    assert!(up[5].1 < 1e-5 && up.iter().all(|s| s.0 > 0.01), "{up:?}");
+    // Type 2: lowering the platform into the ring plane.
+    let down = path(&trainer, &[0.1, 0.05, 0.02, 0.01, 0.001, 1e-5]);
+    assert!(falls(&down.iter().map(|s| s.0).collect::<Vec<_>>()), "{down:?}");
+    assert_eq!(down[0].2, Singularity::None);
+    assert_eq!(down[5].2, Singularity::Type2);
+    assert!(down.iter().all(|s| s.1 > 0.4), "{down:?}");
+    // Type 3: the rotopod raised until every rod is at full stretch (labelled type 2 before).
+    let rotopod = RingPlatform::<f64>::new(&presets::ROTOPOD_CH4);
+    let both = path(&rotopod, &[0.7, 0.9, 0.95, 0.969, 0.96934, 0.969345008824996]);
+    assert!(falls(&both.iter().map(|s| s.0).collect::<Vec<_>>()), "{both:?}");
+    assert!(falls(&both.iter().map(|s| s.1).collect::<Vec<_>>()), "{both:?}");
+    assert_eq!(both[0].2, Singularity::None);
+    assert_eq!(both[5].2, Singularity::Type3);
+}

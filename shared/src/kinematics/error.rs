@@ -49,6 +49,14 @@ pub enum KinematicsError {
         /// Iterations run.
         iterations: u8,
     },
+    /// Forward kinematics converged to a pose further from the guess than the configured distance: another
+    /// solution of the same actuators, not the platform's (the guess was too far off).
+    FarFromGuess,
+    /// Forward kinematics converged to a pose whose own inverse kinematics gives other actuators (another branch
+    /// of a chain: the guess was on the wrong side of a type-1 boundary).
+    OtherBranch,
+    /// Forward kinematics converged to a pose that fails a workspace check: not a pose the platform can be in.
+    Outside(crate::kinematics::Check),
 }
 
 impl fmt::Display for Reach {
@@ -72,6 +80,9 @@ impl fmt::Display for KinematicsError {
             Self::NearSingularity => f.write_str("too close to a type-2 singularity"),
             Self::OtherAssembly => f.write_str("converged to another assembly than the auxiliary actuators show"),
             Self::NoConvergence { iterations } => write!(f, "no convergence after {iterations} iterations"),
+            Self::FarFromGuess => f.write_str("converged too far from the guess (another solution of the actuators)"),
+            Self::OtherBranch => f.write_str("converged to a pose whose chains take other branches than the actuators"),
+            Self::Outside(check) => write!(f, "converged to a pose outside the workspace ({check} fails)"),
         }
     }
 }

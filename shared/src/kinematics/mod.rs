@@ -17,7 +17,7 @@ pub mod velocity;
 pub mod workspace;
 
 pub use error::{KinematicsError, Reach};
-pub use forward::{ForwardSolution, NewtonOptions};
+pub use forward::{start_from_home, ForwardSolution, NewtonOptions, FROM_HOME_DISTANCE};
 pub use geometry::{Branch, Chain, ChainKind, GeometryError, RingGeometry, RingLimits, ToolGeometry};
 pub use multiturn::MultiTurn;
 pub use pose::{Actuators, Pose};

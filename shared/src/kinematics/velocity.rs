@@ -72,21 +72,42 @@ impl<T: Real> Jacobians<T> {
         core::array::from_fn(|r| core::array::from_fn(|c| if c < 3 { a[(r, c)] } else { a[(r, c)] / self.length }))
     }
 
-    /// Scale-free singularity index of `A` in `[0, 1]` (0 = type-2 singular); see [`hadamard_ratio`].
+    /// Type-2 index in `[0, 1]`: Hadamard's ratio of `A` (closed, angle columns divided by the characteristic
+    /// length; see [`hadamard_ratio`]). 0 where the platform gains a freedom with the actuators locked: the rows of
+    /// `A`, each with several entries, become dependent.
     pub fn index_a(&self) -> T {
         hadamard_ratio_in_place(&mut self.a_closed_scaled()).0
     }
 
-    /// Scale-free singularity index of `B` in `[0, 1]` (0 = type-1 singular).
+    /// Type-1 index in `[0, 1]`: the smallest singular value of `B` (angle columns divided by the characteristic
+    /// length) with each constraint row divided by the norm of the whole row `[A_i B_i]`. 0 where an actuator can
+    /// move without moving the platform (the platform loses a freedom: the workspace boundary). For rod chains,
+    /// whose `B` is diagonal, it is the smallest share any constraint has in its actuator.
+    ///
+    /// Not Hadamard's ratio of `B`: a rod chain's row of `B` has a single entry, so that ratio stays 1 however small
+    /// `dF/dq` gets. Not a determinant of the normalised rows either: six healthy rows at 0.4 each make 0.004.
     pub fn index_b(&self) -> T {
         let inv = T::one() / self.length;
-        let mut b = self.b;
-        for (c, kind) in self.axes.iter().enumerate() {
-            if *kind != AxisKind::Linear {
-                b.column_mut(c).scale_mut(inv);
+        let a = self.a_closed();
+        let mut rows = [[T::zero(); 6]; 6];
+        for (r, row) in rows.iter_mut().enumerate() {
+            let mut norm = T::zero();
+            for c in 0..6 {
+                let ac = if c < 3 { a[(r, c)] } else { a[(r, c)] * inv };
+                row[c] = match self.axes[c] {
+                    AxisKind::Linear => self.b[(r, c)],
+                    AxisKind::Ring | AxisKind::Angle => self.b[(r, c)] * inv,
+                };
+                norm += ac * ac + row[c] * row[c];
+            }
+            let norm = norm.sqrt_();
+            if norm > T::zero() && norm.finite() {
+                for v in row.iter_mut() {
+                    *v /= norm;
+                }
             }
         }
-        hadamard_ratio(&b)
+        smallest_singular_value(&rows)
     }
 
     /// Classifies the configuration: an index below `threshold` counts as singular.
@@ -98,6 +119,20 @@ impl<T: Real> Jacobians<T> {
             (true, true) => Singularity::Type3,
         }
     }
+}
+
+/// The smallest singular value of rows of norm at most one (so at most 1); 0 when it cannot be found (entries not
+/// finite, or the iteration does not converge). A measure of distance to singularity that a product over rows (a
+/// determinant) is not: six healthy rows at 0.4 each make a determinant of 0.004.
+fn smallest_singular_value<T: Real>(rows: &[[T; 6]; 6]) -> T {
+    if !rows.iter().flatten().all(|v| v.finite()) {
+        return T::zero();
+    }
+    let m = Matrix6::from_fn(|r, c| rows[r][c]);
+    m.try_svd(false, false, T::of(T::EPS), 200)
+        .map(|svd| svd.singular_values.iter().fold(T::one(), |s, v| s.min_(*v)))
+        .filter(|s| s.finite())
+        .unwrap_or(T::zero())
 }
 
 fn solve<T: Real>(m: &Matrix6<T>, rhs: &Vector6<T>) -> Result<Vector6<T>, KinematicsError> {

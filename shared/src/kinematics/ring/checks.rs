@@ -93,14 +93,17 @@ impl<T: Real> RingPlatform<T> {
         slow: &SlowMargins<T>,
     ) -> WorkspaceReport<T> {
         let (spacing, order) = self.ring_order_margins(&c.q);
+        // With the order broken, the chain order is no longer the order around the ring: the spacing and the
+        // support polygon are measured around the ring instead, so that they still say how far outside.
+        let ring_order = (order < T::zero()).then(|| self.ring_order(&c.q));
         WorkspaceReport::new(
             [
                 Some(self.reach_of(&c.joints)),
-                Some(spacing),
+                Some(ring_order.as_ref().map_or(spacing, |o| self.spacing_around(&c.q, o))),
                 Some(order),
                 Some(slow.cones),
                 Some(slow.index - self.min_index),
-                Some(self.stability_margin(pose, c)),
+                Some(self.stability_margin(pose, c, ring_order.as_ref())),
             ],
             slow.index,
         )
@@ -188,11 +191,50 @@ impl<T: Real> RingPlatform<T> {
         hadamard_ratio_in_place(&mut rows).0
     }
 
-    fn stability_margin(&self, pose: &Pose<T>, c: &Configuration<T>) -> T {
+    /// The chains in the order their carriages come around the ring (counter-clockwise from angle 0).
+    fn ring_order(&self, q: &Actuators<T>) -> [usize; 6] {
+        let angle = |i: usize| {
+            let a = wrap_pi(q.0[i]);
+            if a < T::zero() {
+                a + T::two_pi()
+            } else {
+                a
+            }
+        };
+        let mut order = [0, 1, 2, 3, 4, 5];
+        // Insertion sort of at most six.
+        for k in 1..self.n {
+            let mut j = k;
+            while j > 0 && angle(order[j]) < angle(order[j - 1]) {
+                order.swap(j, j - 1);
+                j -= 1;
+            }
+        }
+        order
+    }
+
+    /// The spacing margin over the gaps between carriages that are neighbours around the ring.
+    fn spacing_around(&self, q: &Actuators<T>, order: &[usize; 6]) -> T {
+        let mut spacing = T::max_value().unwrap_or(T::one());
+        for k in 0..self.n {
+            let (i, j) = (order[k], order[(k + 1) % self.n]);
+            let mut gap = wrap_pi(q.0[j] - q.0[i]);
+            if gap < T::zero() {
+                gap += T::two_pi();
+            }
+            spacing = spacing.min_(gap - self.spacing[0]).min_(self.spacing[1] - gap);
+        }
+        spacing
+    }
+
+    /// Distance of the centre of mass inside the polygon of the carriages, taken in chain order, or around the ring
+    /// when the order is broken.
+    fn stability_margin(&self, pose: &Pose<T>, c: &Configuration<T>, order: Option<&[usize; 6]>) -> T {
         let com = c.rotation * self.com + pose.position();
         let mut margin = T::max_value().unwrap_or(T::one());
-        for i in 0..self.n {
-            let (p0, p1) = (c.carriages[i], c.carriages[(i + 1) % self.n]);
+        let at = |k: usize| order.map_or(k, |o| o[k]);
+        for k in 0..self.n {
+            let (p0, p1) = (c.carriages[at(k)], c.carriages[at((k + 1) % self.n)]);
             let edge = p1 - p0;
             let len = (edge.x * edge.x + edge.y * edge.y).sqrt_();
             if len == T::zero() {
