@@ -200,8 +200,8 @@ pub struct FkArgs {
     /// carriages show, and the answer within a ring radius and a radian of that.
     #[arg(long, allow_hyphen_values = true)]
     pub guess: Option<String>,
-    /// Maximum Newton iterations.
-    #[arg(long, default_value_t = 30)]
+    /// Maximum Newton iterations (1 to 255).
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u8).range(1..))]
     pub max_iterations: u8,
     /// Also answer with a pose outside the workspace checks (the math alone; by default such a pose is an error
     /// naming the check it fails).

@@ -385,10 +385,11 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
             reason: "statics are for ring platforms".into(),
         });
     };
-    if !(args.mass.is_finite() && args.mass >= 0.0) {
+    // A payload up to a thousand tonnes: beyond that the number is a mistake, not a simulator.
+    if !(args.mass.is_finite() && (0.0..=1e6).contains(&args.mass)) {
         return Err(CliError::BadNumbers {
             what: "mass",
-            reason: "must be a finite number >= 0".into(),
+            reason: format!("{} kg is out of range (0 to 1e6 kg)", numbers::readable(args.mass)),
         });
     }
     let pose = pose_arg(common, preset, m.characteristic_length(), args.pose.as_deref(), "pose")?;
