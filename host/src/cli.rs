@@ -12,11 +12,19 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Lists the built-in geometries.
+    /// Lists the built-in geometries, or writes one as a rig file (`--export NAME > my-rig.toml`) to start your own.
     Presets {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Print this preset (a ring platform) as a rig file (TOML).
+        #[arg(long, value_name = "NAME")]
+        export: Option<String>,
+    },
+    /// Rig files: your own ring platform in TOML (`ringpod presets --export trainer-model` writes one to start from).
+    Rig {
+        #[command(subcommand)]
+        action: RigAction,
     },
     /// Inverse kinematics: the six actuator values for a pose, with every workspace check and its margin.
     /// Exits 0 whenever the pose has a solution (failing checks are reported), 1 when it has none.
@@ -50,6 +58,20 @@ pub enum Command {
         /// Serve on a pseudo-terminal (the only transport for now).
         #[arg(long)]
         pty: bool,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum RigAction {
+    /// Checks a rig file (every key, the home pose inside every check) and measures its spec coverage: each axis
+    /// over its range alone, and the share of the combined box inside. Exits 0 when the rig is valid and its spec
+    /// ranges (if given) are covered axis by axis, 3 when they are not, 1 when the file is invalid.
+    Check {
+        /// The rig file.
+        file: std::path::PathBuf,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
     },
 }
 
@@ -171,6 +193,9 @@ pub struct Common {
     /// Geometry: trainer-model, trainer-ch5, rotopod-ch4, tool5-ex (see `ringpod presets`).
     #[arg(long, short, default_value = "trainer-model")]
     pub mechanism: String,
+    /// Your own ring platform: a rig file (TOML; see `ringpod rig check`), instead of --mechanism.
+    #[arg(long, value_name = "RIG.toml")]
+    pub geometry: Option<std::path::PathBuf>,
     /// Angles in degrees, on input and output (default radians).
     #[arg(long)]
     pub degrees: bool,
@@ -223,6 +248,9 @@ pub struct WorkspaceArgs {
     /// Geometry (a ring platform).
     #[arg(long, short, default_value = "trainer-model")]
     pub mechanism: String,
+    /// Your own ring platform: a rig file (TOML), instead of --mechanism.
+    #[arg(long, value_name = "RIG.toml")]
+    pub geometry: Option<std::path::PathBuf>,
     /// The plane.
     #[arg(long, value_enum, default_value = "xy")]
     pub section: Section,

@@ -32,6 +32,9 @@ pub enum CliError {
         /// Reach margin of the pose (negative).
         margin: f64,
     },
+    /// A rig file is invalid.
+    #[error("rig file: {0}")]
+    Rig(#[from] crate::rig::RigError),
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),

@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::cli::{Common, FkArgs, LoadsArgs, PoseArgs};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
-use crate::mechanism::AnyMechanism;
+use crate::mechanism::{AnyMechanism, Selected};
 use crate::numbers;
 
 /// What a command prints and its exit code.
@@ -21,7 +21,7 @@ pub struct Outcome {
 }
 
 impl Outcome {
-    fn ok(text: String) -> Self {
+    pub fn ok(text: String) -> Self {
         Self { text, code: 0 }
     }
 }
@@ -128,7 +128,7 @@ struct CheckJson {
 
 #[derive(Serialize)]
 struct IkJson<'a> {
-    mechanism: &'static str,
+    mechanism: &'a str,
     pose: [f64; 6],
     axes: &'a [String; 6],
     units: [&'static str; 6],
@@ -162,7 +162,7 @@ fn singularity_name(s: Singularity) -> &'static str {
 
 fn pose_arg(
     common: &Common,
-    preset: Preset,
+    home: [f64; 6],
     length: f64,
     text: Option<&str>,
     what: &'static str,
@@ -172,7 +172,7 @@ fn pose_arg(
     };
     let pose = match text {
         Some(t) => units.pose_in(numbers::six(what, t)?),
-        None => Pose::from_array(preset.home()),
+        None => Pose::from_array(home),
     };
     numbers::pose_in_range(what, &pose.to_array(), length)?;
     Ok(pose)
@@ -183,8 +183,12 @@ pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliErr
     let units = Units {
         degrees: common.degrees,
     };
-    let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
-    let pose = pose_arg(common, preset, m.characteristic_length(), args.pose.as_deref(), "pose")?;
+    let Selected {
+        name,
+        home,
+        mechanism: m,
+    } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
+    let pose = pose_arg(common, home, m.characteristic_length(), args.pose.as_deref(), "pose")?;
     let (q, report) = m.inverse_checked(&pose).map_err(|reason| match (&m, reason) {
         (AnyMechanism::Ring(r), KinematicsError::Unreachable { .. }) => CliError::OutOfReach {
             reason,
@@ -203,7 +207,7 @@ pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliErr
     };
     let text = if common.json {
         let out = IkJson {
-            mechanism: preset.name(),
+            mechanism: &name,
             pose: units.pose_out(&pose),
             axes: &names,
             units: std::array::from_fn(|i| units.axis_unit(axes[i])),
@@ -220,7 +224,7 @@ pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliErr
         let _ = writeln!(
             t,
             "{} at pose x,y,z,alpha,beta,gamma = {} (m, {})",
-            preset.name(),
+            name,
             shown.join(", "),
             units.angle_unit()
         );
@@ -276,8 +280,8 @@ pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliErr
 }
 
 #[derive(Serialize)]
-struct FkJson {
-    mechanism: &'static str,
+struct FkJson<'a> {
+    mechanism: &'a str,
     pose: [f64; 6],
     iterations: u8,
     residual: f64,
@@ -288,7 +292,11 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
     let units = Units {
         degrees: common.degrees,
     };
-    let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
+    let Selected {
+        name,
+        home,
+        mechanism: m,
+    } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
     let raw = numbers::six("actuators", &args.actuators)?;
     let axes = m.axes();
     let q = ringpod_core::kinematics::Actuators(std::array::from_fn(|i| match axes[i] {
@@ -316,13 +324,10 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
     // Without a guess: home turned by the yaw the carriages show, accepted within a tilt range of it.
     let (guess, max_distance) = match args.guess.as_deref() {
         Some(_) => (
-            pose_arg(common, preset, length, args.guess.as_deref(), "guess")?,
+            pose_arg(common, home, length, args.guess.as_deref(), "guess")?,
             NewtonOptions::<f64>::default().max_distance,
         ),
-        None => {
-            let home = Pose::from_array(preset.home());
-            (start_from_home(&m, &q, &home), FROM_HOME_DISTANCE)
-        }
+        None => (start_from_home(&m, &q, &Pose::from_array(home)), FROM_HOME_DISTANCE),
     };
     let options = NewtonOptions {
         max_iterations: args.max_iterations,
@@ -334,7 +339,7 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
     let pose = units.pose_out(&sol.pose);
     let text = if common.json {
         let out = FkJson {
-            mechanism: preset.name(),
+            mechanism: &name,
             pose,
             iterations: sol.iterations,
             residual: sol.residual,
@@ -345,9 +350,7 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
         let _ = writeln!(
             t,
             "{} pose ({} Newton iterations, residual {:.1e}):",
-            preset.name(),
-            sol.iterations,
-            sol.residual
+            name, sol.iterations, sol.residual
         );
         for (name, (v, unit)) in ["x", "y", "z", "alpha", "beta", "gamma"].iter().zip(pose.iter().zip([
             "m",
@@ -366,7 +369,7 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
 
 #[derive(Serialize)]
 struct LoadsJson<'a> {
-    mechanism: &'static str,
+    mechanism: &'a str,
     mass_kg: f64,
     axes: &'a [String; 6],
     /// Carriage torque about the ring axis (N m) or linear-actuator force (N, positive = compression).
@@ -378,7 +381,11 @@ struct LoadsJson<'a> {
 
 pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
     let common = &args.common;
-    let (preset, m) = AnyMechanism::by_name(&common.mechanism)?;
+    let Selected {
+        name,
+        home,
+        mechanism: m,
+    } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
     let AnyMechanism::Ring(ring) = &m else {
         return Err(CliError::BadNumbers {
             what: "mechanism",
@@ -392,7 +399,7 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
             reason: format!("{} kg is out of range (0 to 1e6 kg)", numbers::readable(args.mass)),
         });
     }
-    let pose = pose_arg(common, preset, m.characteristic_length(), args.pose.as_deref(), "pose")?;
+    let pose = pose_arg(common, home, m.characteristic_length(), args.pose.as_deref(), "pose")?;
     let q = m.inverse(&pose)?;
     let wrench = ring.gravity_wrench(&pose, args.mass);
     let l = ring.loads(&pose, &q, &wrench)?;
@@ -401,7 +408,7 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
     let units: [&'static str; 6] = std::array::from_fn(|i| if axes[i] == AxisKind::Linear { "N" } else { "N m" });
     let text = if common.json {
         let out = LoadsJson {
-            mechanism: preset.name(),
+            mechanism: &name,
             mass_kg: args.mass,
             axes: &names,
             drives: l.drives,
@@ -411,7 +418,7 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
         serde_json::to_string_pretty(&out)? + "\n"
     } else {
         let mut t = String::new();
-        let _ = writeln!(t, "{} holding {} kg at its centre of mass:", preset.name(), args.mass);
+        let _ = writeln!(t, "{name} holding {} kg at its centre of mass:", args.mass);
         for i in 0..6 {
             let _ = writeln!(t, "  {:<4} {:>12.4} {}", names[i], l.drives[i], units[i]);
         }

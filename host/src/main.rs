@@ -9,6 +9,7 @@ mod kinematics;
 mod mechanism;
 mod numbers;
 mod pty;
+mod rig;
 mod settings;
 mod stream;
 mod table;
@@ -24,7 +25,13 @@ fn main() -> ExitCode {
     use cli::Command as C;
     let cli = cli::Cli::parse();
     let result = match &cli.command {
-        C::Presets { json } => answer(kinematics::presets(*json)),
+        C::Presets { json, export } => answer(match export {
+            Some(name) => rig::export(name),
+            None => kinematics::presets(*json),
+        }),
+        C::Rig { action } => answer(match action {
+            cli::RigAction::Check { file, json } => rig::check_command(file, *json),
+        }),
         C::Ik(args) => answer(kinematics::ik(args, false)),
         C::Check(args) => answer(kinematics::ik(args, true)),
         C::Fk(args) => answer(kinematics::fk(args)),

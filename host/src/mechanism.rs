@@ -17,6 +17,40 @@ pub enum AnyMechanism {
     Tool(ToolCarrier<f64>),
 }
 
+/// The geometry a command works on: a preset by name, or a rig file.
+pub struct Selected {
+    /// Its name, for reports.
+    pub name: String,
+    /// Its home pose.
+    pub home: [f64; 6],
+    /// The mechanism.
+    pub mechanism: AnyMechanism,
+}
+
+impl Selected {
+    /// The rig file if one is given, else the preset named.
+    pub fn of(mechanism: &str, geometry: Option<&std::path::Path>) -> Result<Self, CliError> {
+        match geometry {
+            Some(path) => {
+                let rig = crate::rig::load(path)?;
+                Ok(Self {
+                    name: rig.geometry.name.to_owned(),
+                    home: rig.home.to_array(),
+                    mechanism: AnyMechanism::Ring(Box::new(RingPlatform::new(&rig.geometry))),
+                })
+            }
+            None => {
+                let (preset, m) = AnyMechanism::by_name(mechanism)?;
+                Ok(Self {
+                    name: preset.name().to_owned(),
+                    home: preset.home(),
+                    mechanism: m,
+                })
+            }
+        }
+    }
+}
+
 impl AnyMechanism {
     /// The mechanism of a preset name.
     pub fn by_name(name: &str) -> Result<(Preset, Self), CliError> {

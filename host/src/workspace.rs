@@ -55,13 +55,23 @@ fn colour(cell: Cell) -> RGBColor {
 
 /// Runs the command; returns the text to print.
 pub fn run(args: &WorkspaceArgs) -> anyhow::Result<String> {
-    let preset =
-        Preset::from_name(&args.mechanism).ok_or_else(|| anyhow::anyhow!("unknown mechanism `{}`", args.mechanism))?;
-    let PresetGeometry::Ring(g) = preset.geometry() else {
-        anyhow::bail!("the workspace scan is for ring platforms")
+    let (geometry, home, ranges) = match &args.geometry {
+        Some(path) => {
+            let rig = crate::rig::load(path)?;
+            (rig.geometry, rig.home.to_array(), rig.ranges)
+        }
+        None => {
+            let preset = Preset::from_name(&args.mechanism)
+                .ok_or_else(|| anyhow::anyhow!("unknown mechanism `{}`", args.mechanism))?;
+            let PresetGeometry::Ring(g) = preset.geometry() else {
+                anyhow::bail!("the workspace scan is for ring platforms")
+            };
+            let ranges = (preset == Preset::TrainerModel).then_some(TRAINER_MODEL_RANGES);
+            (*g, preset.home(), ranges)
+        }
     };
+    let g = &geometry;
     let m = RingPlatform::<f64>::new(g);
-    let home = preset.home();
     let r = g.ring_radius;
     let n = args.cells;
     let z0 = args.z.unwrap_or(home[2]);
@@ -149,10 +159,13 @@ pub fn run(args: &WorkspaceArgs) -> anyhow::Result<String> {
             range.1 / DEG
         );
     }
-    if preset == Preset::TrainerModel {
-        let (inside, total) = spec_axes(&m, home);
-        text += &format!(
-            "trainer-model spec ranges (each axis over its range, every 10 deg of yaw): {inside} of {total} poses inside: {}\n",
+    if let Some(ranges) = ranges {
+        let coverage = crate::rig::coverage(&m, &Pose::from_array(home), &ranges);
+        let (inside, total) = coverage.per_axis.iter().fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        text +=
+            &format!(
+            "{} spec ranges (each axis over its range, every 10 deg of yaw): {inside} of {total} poses inside: {}\n",
+            g.name,
             if inside == total { "all inside" } else { "NOT all inside" }
         );
     }
@@ -205,25 +218,6 @@ fn angle_range(m: &RingPlatform<f64>, home: [f64; 6], axis: usize) -> (f64, f64)
 }
 
 /// Each spec axis swept over its range (41 points) at every 10 degrees of yaw: (inside, total).
-fn spec_axes(m: &RingPlatform<f64>, home: [f64; 6]) -> (usize, usize) {
-    let mut poses = Vec::new();
-    for (axis, range) in TRAINER_MODEL_RANGES.iter().enumerate() {
-        for k in 0..=40 {
-            for yaw in 0..36 {
-                let mut c = home;
-                c[axis] += -range + 2.0 * range * k as f64 / 40.0;
-                c[5] = yaw as f64 * 10.0 * DEG;
-                poses.push(Pose::from_array(c));
-            }
-        }
-    }
-    let inside = poses
-        .par_iter()
-        .filter(|p| m.inverse_checked(p).is_ok_and(|(_, r)| r.all_pass()))
-        .count();
-    (inside, poses.len())
-}
-
 fn draw(
     out: &Path,
     grid: &[Vec<Cell>],

@@ -396,3 +396,87 @@ fn cue_reports_bad_rows_and_refuses_bad_parameters_by_name() {
             .stderr(predicates::str::contains(key));
     }
 }
+
+/// A rig no preset describes (the model with a 2 % larger ring and a 1 % longer rod), from a rig file: `rig check`
+/// accepts it, `ik`, `fk` (no guess), `check` and `workspace` drive it, and its IK differs from the preset's.
+#[test]
+fn a_rig_file_drives_the_kinematics_commands() {
+    let dir = std::env::temp_dir().join(format!("ringpod-rig-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exported = ringpod()
+        .args(["presets", "--export", "trainer-model"])
+        .output()
+        .unwrap();
+    assert!(exported.status.success());
+    let text = String::from_utf8(exported.stdout).unwrap();
+    assert!(text.contains("ring_radius = 0.286"), "{text}");
+    let own = text
+        .replace("name = \"trainer-model\"", "name = \"my-rig\"")
+        .replace("ring_radius = 0.286", "ring_radius = 0.29172")
+        .replace("rod_length = 0.312", "rod_length = 0.31512");
+    let rig = dir.join("my-rig.toml");
+    std::fs::write(&rig, own).unwrap();
+    let rig = rig.to_str().unwrap();
+    ringpod()
+        .args(["rig", "check", rig])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("my-rig: valid").and(predicate::str::contains("surge")));
+    let pose = "--pose=0.02,-0.01,0.23,0.05,-0.04,1.2";
+    let ours = json(&["ik", "--geometry", rig, pose, "--json"]);
+    let preset = json(&["ik", pose, "--json"]);
+    assert_eq!(ours["mechanism"], "my-rig");
+    assert_ne!(ours["actuators"], preset["actuators"]);
+    let q: Vec<String> = ours["actuators"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.to_string())
+        .collect();
+    let fk = json(&[
+        "fk",
+        "--geometry",
+        rig,
+        &format!("--actuators={}", q.join(",")),
+        "--json",
+    ]);
+    let want = [0.02, -0.01, 0.23, 0.05, -0.04, 1.2];
+    for (g, w) in fk["pose"].as_array().unwrap().iter().zip(want) {
+        assert!((g.as_f64().unwrap() - w).abs() < 1e-6, "{fk}");
+    }
+    ringpod().args(["check", "--geometry", rig, pose]).assert().code(0);
+    ringpod()
+        .args(["check", "--geometry", rig, "--pose=0,-0.1,0.227,0,0,0"])
+        .assert()
+        .code(3);
+    let svg = dir.join("w.svg");
+    ringpod()
+        .args([
+            "workspace",
+            "--geometry",
+            rig,
+            "--cells",
+            "40",
+            "--quiet",
+            "--out",
+            svg.to_str().unwrap(),
+        ])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("my-rig spec ranges"));
+    // A broken file says which key and why.
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        text.replace("kind = \"radial\"\n", "kind = \"radial\"\nbranch = \"plus\"\n"),
+    )
+    .unwrap();
+    ringpod()
+        .args(["ik", "--geometry", bad.to_str().unwrap()])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "chains[2].branch: only rod chains have a branch",
+        ));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,144 @@
+//! `ringpod rig check` and `ringpod presets --export`.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use ringpod_core::kinematics::presets::{self, Preset, PresetGeometry};
+use ringpod_core::kinematics::RingPlatform;
+use serde::Serialize;
+
+use super::{coverage, load, RigFile};
+use crate::error::{CliError, EXIT_CHECK_FAILED};
+use crate::kinematics::Outcome;
+
+/// The axes of the spec ranges, in their order.
+const AXES: [&str; 5] = ["surge", "sway", "heave", "roll", "pitch"];
+
+/// `ringpod presets --export NAME`: the preset as a rig file, to start one's own from.
+pub fn export(name: &str) -> Result<Outcome, CliError> {
+    let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
+    let PresetGeometry::Ring(g) = preset.geometry() else {
+        return Err(CliError::BadNumbers {
+            what: "export",
+            reason: format!("{name} is not a ring platform; rig files describe ring platforms"),
+        });
+    };
+    let ranges = (preset == Preset::TrainerModel).then_some(presets::TRAINER_MODEL_RANGES);
+    let file = RigFile::of(g, preset.home(), ranges);
+    let body = toml::to_string(&file).map_err(|e| CliError::BadNumbers {
+        what: "export",
+        reason: e.to_string(),
+    })?;
+    let header = format!(
+        "# {name}: {}\n# Lengths in metres, angles of [limits] and [spec] in degrees, home = [x, y, z, roll, pitch, yaw]\n\
+         # (m, rad). Chains counter-clockwise around the ring; actuators: every carriage in chain order, then every\n\
+         # radial length. Check with `ringpod rig check FILE`, use with `--geometry FILE`.\n",
+        preset.description()
+    );
+    Ok(Outcome::ok(header + &body))
+}
+
+#[derive(Serialize)]
+struct AxisJson {
+    axis: &'static str,
+    range: f64,
+    inside: usize,
+    tried: usize,
+}
+
+#[derive(Serialize)]
+struct CheckJson<'a> {
+    name: &'a str,
+    valid: bool,
+    spec_covered: Option<bool>,
+    per_axis: Vec<AxisJson>,
+    combined_inside: Option<usize>,
+    combined_tried: Option<usize>,
+}
+
+/// `ringpod rig check FILE`: the verdict, and the spec coverage when the file gives spec ranges.
+pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
+    let rig = load(path)?;
+    let m = RingPlatform::<f64>::new(&rig.geometry);
+    let cover = rig.ranges.map(|r| (r, coverage(&m, &rig.home, &r)));
+    let covered = cover
+        .as_ref()
+        .map(|(_, c)| c.per_axis.iter().all(|(inside, tried)| inside == tried));
+    let code = if covered == Some(false) { EXIT_CHECK_FAILED } else { 0 };
+    let name = rig.geometry.name;
+    if json {
+        let out = CheckJson {
+            name,
+            valid: true,
+            spec_covered: covered,
+            per_axis: cover
+                .iter()
+                .flat_map(|(r, c)| {
+                    (0..5).map(move |i| AxisJson {
+                        axis: AXES[i],
+                        range: r[i],
+                        inside: c.per_axis[i].0,
+                        tried: c.per_axis[i].1,
+                    })
+                })
+                .collect(),
+            combined_inside: cover.as_ref().map(|(_, c)| c.combined.0),
+            combined_tried: cover.as_ref().map(|(_, c)| c.combined.1),
+        };
+        return Ok(Outcome {
+            text: serde_json::to_string_pretty(&out)? + "\n",
+            code,
+        });
+    }
+    let mut t = String::new();
+    let g = &rig.geometry;
+    let _ = writeln!(
+        t,
+        "{name}: valid ({} chains, ring radius {} m, rod {} m; the home pose is inside every check)",
+        g.chains().len(),
+        g.ring_radius,
+        g.rod_length
+    );
+    match &cover {
+        None => {
+            let _ = writeln!(t, "no [spec] ranges: add them to measure the coverage");
+        }
+        Some((r, c)) => {
+            let _ = writeln!(
+                t,
+                "spec coverage (each axis alone: 41 steps at 36 yaws; inside every check):"
+            );
+            for i in 0..5 {
+                let (inside, tried) = c.per_axis[i];
+                let range = if i < 3 {
+                    format!("+-{:.4} m", r[i])
+                } else {
+                    format!("+-{:.2} deg", r[i].to_degrees())
+                };
+                let _ = writeln!(
+                    t,
+                    "  {:<6} {:<14} {inside:>5} of {tried} ({:.1} %)",
+                    AXES[i],
+                    range,
+                    100.0 * inside as f64 / tried as f64
+                );
+            }
+            let (inside, tried) = c.combined;
+            let _ = writeln!(
+                t,
+                "  all axes at once (corners at 8 yaws, random poses at any yaw): {inside} of {tried} ({:.1} %)",
+                100.0 * inside as f64 / tried as f64
+            );
+            let _ = writeln!(
+                t,
+                "{}",
+                if covered == Some(true) {
+                    "every axis is covered over its whole range"
+                } else {
+                    "NOT covered: some axis leaves the workspace within its range"
+                }
+            );
+        }
+    }
+    Ok(Outcome { text: t, code })
+}

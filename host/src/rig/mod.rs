@@ -1,0 +1,591 @@
+//! Rig files: a ring platform of the builder's own, in TOML (the geometry and the names of KINEMATICS.md 2.1 and 2.2,
+//! joint limits, the home pose, the spec ranges), checked with an error that names the key and says why.
+//!
+//! ```toml
+//! name = "my-rig"
+//! ring_radius = 0.286          # m
+//! rod_length = 0.2             # m
+//! home = [0, 0, 0.227, 0, 0, 0]
+//!
+//! [[chains]]                   # counter-clockwise around the ring, in actuator order
+//! kind = "rod"
+//! branch = "plus"
+//! platform_point = [-0.06, -0.12, 0]
+//! ...
+//! [limits]                     # optional; the source's joint limits by default
+//! stroke = [0.160, 0.310]      # m, required with radial chains
+//! carriage_spacing_deg = [12, 120]
+//! base_cone_deg = 11
+//! platform_cone_deg = 22
+//! min_singularity_index = 0.01
+//! centre_of_mass = [0, 0, 0.02]
+//!
+//! [spec]                       # optional; +- ranges around home that `rig check` measures
+//! surge = 0.05
+//! sway = 0.05
+//! heave = 0.04
+//! roll_deg = 20
+//! pitch_deg = 20
+//! ```
+
+mod command;
+mod coverage;
+
+pub use command::{check_command, export};
+pub use coverage::coverage;
+
+use std::fmt;
+use std::path::Path;
+
+use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, RingGeometry, RingLimits, DEG};
+use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
+use serde::{Deserialize, Serialize};
+
+/// A rig file as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigFile {
+    /// Name for reports (1 to 32 characters).
+    pub name: String,
+    /// Ring radius (m).
+    pub ring_radius: f64,
+    /// Rod length of the rod chains (m).
+    pub rod_length: f64,
+    /// Home pose x, y, z (m), roll, pitch, yaw (rad): where homing leaves the platform; inside every check.
+    pub home: [f64; 6],
+    /// The chains, counter-clockwise around the ring.
+    pub chains: Vec<ChainSpec>,
+    /// Joint limits (the source's by default).
+    #[serde(default)]
+    pub limits: LimitsSpec,
+    /// Motion ranges around home that `ringpod rig check` measures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spec: Option<SpecRanges>,
+}
+
+/// One chain.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChainSpec {
+    /// Rod (one actuator: the carriage) or radial (two: the carriage and the length).
+    pub kind: KindSpec,
+    /// Which of the two solutions a rod chain takes (rod chains only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub branch: Option<BranchSpec>,
+    /// The platform joint in the platform frame (m).
+    pub platform_point: [f64; 3],
+}
+
+/// `kind` of a chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum KindSpec {
+    /// Carriage, spherical joint, rod of fixed length.
+    Rod,
+    /// Carriage, revolute joint tangent to the ring, linear actuator in the radial plane.
+    Radial,
+}
+
+/// `branch` of a rod chain: `q = theta + phi` or `theta - phi`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BranchSpec {
+    /// `q = theta + phi`.
+    Plus,
+    /// `q = theta - phi`.
+    Minus,
+}
+
+/// `[limits]`: what the workspace checks enforce. Angles in degrees, as builders measure them.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LimitsSpec {
+    /// Linear-actuator length range (m); required when there are radial chains.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stroke: Option<[f64; 2]>,
+    /// Allowed central angle between neighbouring carriages (deg).
+    pub carriage_spacing_deg: [f64; 2],
+    /// Least angle of a chain to the base plane (deg).
+    pub base_cone_deg: f64,
+    /// Least angle of a chain to the platform plane (deg).
+    pub platform_cone_deg: f64,
+    /// Least singularity index of the wrench matrix.
+    pub min_singularity_index: f64,
+    /// Centre of mass of platform and payload in the platform frame (m).
+    pub centre_of_mass: [f64; 3],
+}
+
+impl Default for LimitsSpec {
+    /// The source's joint limits: spacing 12 to 120 deg, cones 11 and 22 deg, index 0.01, centre of mass at the
+    /// platform's origin.
+    fn default() -> Self {
+        Self {
+            stroke: None,
+            carriage_spacing_deg: [12.0, 120.0],
+            base_cone_deg: 11.0,
+            platform_cone_deg: 22.0,
+            min_singularity_index: 0.01,
+            centre_of_mass: [0.0; 3],
+        }
+    }
+}
+
+/// `[spec]`: motion ranges, each plus and minus around home; yaw is continuous.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpecRanges {
+    /// Surge (m).
+    pub surge: f64,
+    /// Sway (m).
+    pub sway: f64,
+    /// Heave (m).
+    pub heave: f64,
+    /// Roll (deg).
+    pub roll_deg: f64,
+    /// Pitch (deg).
+    pub pitch_deg: f64,
+}
+
+impl SpecRanges {
+    /// `[surge, sway, heave, roll, pitch]` in m and rad.
+    pub fn si(&self) -> [f64; 5] {
+        [
+            self.surge,
+            self.sway,
+            self.heave,
+            self.roll_deg * DEG,
+            self.pitch_deg * DEG,
+        ]
+    }
+}
+
+/// Why a rig file cannot be used: the key, and what is wrong with it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigError {
+    /// The key (`chains[2].branch`, `limits.stroke`, `home`), or the file for errors of the whole.
+    pub key: String,
+    /// Why.
+    pub why: String,
+}
+
+impl fmt::Display for RigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.key, self.why)
+    }
+}
+
+impl std::error::Error for RigError {}
+
+fn err<T>(key: impl Into<String>, why: impl Into<String>) -> Result<T, RigError> {
+    Err(RigError {
+        key: key.into(),
+        why: why.into(),
+    })
+}
+
+/// A checked rig: the geometry the core drives, its home pose and spec ranges.
+#[derive(Debug, Clone, Copy)]
+pub struct Rig {
+    /// The geometry.
+    pub geometry: RingGeometry,
+    /// The home pose.
+    pub home: Pose<f64>,
+    /// The spec ranges, if the file gives them (m and rad).
+    pub ranges: Option<[f64; 5]>,
+}
+
+/// Reads and checks a rig file.
+pub fn load(path: &Path) -> Result<Rig, RigError> {
+    let text = std::fs::read_to_string(path).or_else(|e| err(path.display().to_string(), e.to_string()))?;
+    parse(&text)
+}
+
+/// Parses and checks the text of a rig file.
+pub fn parse(text: &str) -> Result<Rig, RigError> {
+    let file: RigFile = toml::from_str(text).or_else(|e| {
+        // toml names the key and the line; keep its words.
+        err("rig file", e.message().trim().to_owned() + &span_of(text, e.span()))
+    })?;
+    file.check()
+}
+
+fn span_of(text: &str, span: Option<std::ops::Range<usize>>) -> String {
+    span.map(|s| format!(" (line {})", text[..s.start.min(text.len())].matches('\n').count() + 1))
+        .unwrap_or_default()
+}
+
+/// Radians to degrees as a person writes them: 120, not 119.99999999999999.
+fn degrees(rad: f64) -> f64 {
+    (rad / DEG * 1e9).round() / 1e9
+}
+
+fn finite<const N: usize>(key: &str, v: &[f64; N]) -> Result<(), RigError> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(i) => err(key, format!("value {} is not a finite number", i + 1)),
+        None => Ok(()),
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<(), RigError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        err(key, format!("{v} is not a positive length (m)"))
+    }
+}
+
+impl RigFile {
+    /// Every rule the presets obey, and the controller's: each error names its key.
+    pub fn check(&self) -> Result<Rig, RigError> {
+        if self.name.is_empty() || self.name.chars().count() > 32 {
+            return err("name", "between 1 and 32 characters");
+        }
+        positive("ring_radius", self.ring_radius)?;
+        positive("rod_length", self.rod_length)?;
+        finite("home", &self.home)?;
+        let n = self.chains.len();
+        if !(3..=6).contains(&n) {
+            return err("chains", format!("{n} chains; a ring platform has 3 to 6"));
+        }
+        let mut chains = Vec::with_capacity(n);
+        for (i, c) in self.chains.iter().enumerate() {
+            let key = |k: &str| format!("chains[{i}].{k}");
+            finite(&key("platform_point"), &c.platform_point)?;
+            let kind = match (c.kind, c.branch) {
+                (KindSpec::Rod, Some(BranchSpec::Plus)) => ChainKind::Rod(Branch::Plus),
+                (KindSpec::Rod, Some(BranchSpec::Minus)) => ChainKind::Rod(Branch::Minus),
+                (KindSpec::Rod, None) => return err(key("branch"), "a rod chain takes \"plus\" or \"minus\""),
+                (KindSpec::Radial, None) => ChainKind::Radial,
+                (KindSpec::Radial, Some(_)) => return err(key("branch"), "only rod chains have a branch"),
+            };
+            for (j, other) in self.chains[..i].iter().enumerate() {
+                let d: f64 = (0..3)
+                    .map(|k| (other.platform_point[k] - c.platform_point[k]).powi(2))
+                    .sum();
+                if d.sqrt() < 1e-9 {
+                    return err(key("platform_point"), format!("the same point as chains[{j}]"));
+                }
+            }
+            chains.push(Chain {
+                kind,
+                platform_point: c.platform_point,
+            });
+        }
+        let radial = chains.iter().filter(|c| c.kind == ChainKind::Radial).count();
+        if n + radial != 6 {
+            return err(
+                "chains",
+                format!(
+                    "{n} carriages and {radial} radial lengths make {} actuators; a ring platform drives six",
+                    n + radial
+                ),
+            );
+        }
+        let limits = self.limits(radial)?;
+        // The core's own validation is the last word (it is what the firmware builds from).
+        let name: &'static str = Box::leak(self.name.clone().into_boxed_str());
+        let geometry = RingGeometry::new(name, self.ring_radius, self.rod_length, &chains, limits)
+            .or_else(|e| err("rig file", e.to_string()))?;
+        let home = Pose::from_array(self.home);
+        let m = RingPlatform::<f64>::new(&geometry);
+        match m.inverse_checked(&home) {
+            Err(e) => return err("home", format!("has no solution: {e}")),
+            Ok((_, report)) => {
+                if let Some(check) = report.first_failure() {
+                    let margin = report.margin(check).unwrap_or(0.0);
+                    return err(
+                        "home",
+                        format!(
+                            "fails the {check} check by {:.6} {} (home must be inside every check)",
+                            -margin,
+                            check.unit()
+                        ),
+                    );
+                }
+            }
+        }
+        let ranges = match &self.spec {
+            Some(s) => {
+                let si = s.si();
+                let names = ["surge", "sway", "heave", "roll_deg", "pitch_deg"];
+                if let Some(i) = si.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+                    return err(format!("spec.{}", names[i]), "a range is a finite number >= 0");
+                }
+                Some(si)
+            }
+            None => None,
+        };
+        Ok(Rig { geometry, home, ranges })
+    }
+
+    fn limits(&self, radial: usize) -> Result<RingLimits, RigError> {
+        let l = &self.limits;
+        let stroke = match (l.stroke, radial) {
+            (Some(s), _) => {
+                finite("limits.stroke", &s)?;
+                if !(s[0] >= 0.0 && s[0] < s[1]) {
+                    return err("limits.stroke", "[min, max] with 0 <= min < max (m)");
+                }
+                s
+            }
+            (None, 0) => [0.0, 1.0],
+            (None, _) => return err("limits.stroke", "required with radial chains: [min, max] length (m)"),
+        };
+        let [lo, hi] = l.carriage_spacing_deg;
+        if !(lo >= 0.0 && lo < hi && hi <= 360.0) {
+            return err(
+                "limits.carriage_spacing_deg",
+                "[min, max] with 0 <= min < max <= 360 (deg)",
+            );
+        }
+        for (key, v) in [
+            ("limits.base_cone_deg", l.base_cone_deg),
+            ("limits.platform_cone_deg", l.platform_cone_deg),
+        ] {
+            if !(0.0..90.0).contains(&v) {
+                return err(key, format!("{v} is not in [0, 90) deg"));
+            }
+        }
+        if !(0.0..1.0).contains(&l.min_singularity_index) {
+            return err("limits.min_singularity_index", "in [0, 1)");
+        }
+        finite("limits.centre_of_mass", &l.centre_of_mass)?;
+        Ok(RingLimits {
+            stroke,
+            carriage_spacing: [lo * DEG, hi * DEG],
+            base_cone: l.base_cone_deg * DEG,
+            platform_cone: l.platform_cone_deg * DEG,
+            min_singularity_index: l.min_singularity_index,
+            centre_of_mass: l.centre_of_mass,
+        })
+    }
+
+    /// The rig file of a geometry (what `ringpod presets --export` writes).
+    pub fn of(geometry: &RingGeometry, home: [f64; 6], ranges: Option<[f64; 5]>) -> Self {
+        let l = &geometry.limits;
+        let has_radial = geometry.chains().iter().any(|c| c.kind == ChainKind::Radial);
+        Self {
+            name: geometry.name.to_owned(),
+            ring_radius: geometry.ring_radius,
+            rod_length: geometry.rod_length,
+            home,
+            chains: geometry
+                .chains()
+                .iter()
+                .map(|c| ChainSpec {
+                    kind: match c.kind {
+                        ChainKind::Rod(_) => KindSpec::Rod,
+                        ChainKind::Radial => KindSpec::Radial,
+                    },
+                    branch: match c.kind {
+                        ChainKind::Rod(Branch::Plus) => Some(BranchSpec::Plus),
+                        ChainKind::Rod(Branch::Minus) => Some(BranchSpec::Minus),
+                        ChainKind::Radial => None,
+                    },
+                    platform_point: c.platform_point,
+                })
+                .collect(),
+            limits: LimitsSpec {
+                stroke: has_radial.then_some(l.stroke),
+                carriage_spacing_deg: l.carriage_spacing.map(degrees),
+                base_cone_deg: degrees(l.base_cone),
+                platform_cone_deg: degrees(l.platform_cone),
+                min_singularity_index: l.min_singularity_index,
+                centre_of_mass: l.centre_of_mass,
+            },
+            spec: ranges.map(|r| SpecRanges {
+                surge: r[0],
+                sway: r[1],
+                heave: r[2],
+                roll_deg: degrees(r[3]),
+                pitch_deg: degrees(r[4]),
+            }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use ringpod_core::kinematics::presets::{self, Preset};
+    use ringpod_core::kinematics::{NewtonOptions, FROM_HOME_DISTANCE};
+
+    fn trainer_file() -> RigFile {
+        RigFile::of(
+            &presets::TRAINER_MODEL,
+            Preset::TrainerModel.home(),
+            Some(presets::TRAINER_MODEL_RANGES),
+        )
+    }
+
+    #[test]
+    fn a_rig_file_round_trips_exactly() {
+        let file = trainer_file();
+        let text = toml::to_string(&file).unwrap();
+        let back: RigFile = toml::from_str(&text).unwrap();
+        assert_eq!(back, file);
+        assert_eq!(toml::to_string(&back).unwrap(), text);
+    }
+
+    #[test]
+    fn a_rig_restating_the_preset_drives_bit_identical_ik() {
+        let rig = parse(&toml::to_string(&trainer_file()).unwrap()).unwrap();
+        let (ours, preset) = (
+            RingPlatform::<f64>::new(&rig.geometry),
+            RingPlatform::<f64>::new(&presets::TRAINER_MODEL),
+        );
+        let (ours32, preset32) = (
+            RingPlatform::<f32>::new(&rig.geometry),
+            RingPlatform::<f32>::new(&presets::TRAINER_MODEL),
+        );
+        let mut state = 5u64;
+        let mut uniform = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..2_000 {
+            let p = Pose::new(
+                uniform() * 0.06,
+                uniform() * 0.06,
+                0.227 + uniform() * 0.05,
+                uniform() * 0.4,
+                uniform() * 0.4,
+                uniform() * 4.0,
+            );
+            assert_eq!(ours.inverse(&p), preset.inverse(&p));
+            assert_eq!(ours32.inverse(&p.cast()), preset32.inverse(&p.cast()));
+        }
+        assert_eq!(rig.home, Pose::from_array(Preset::TrainerModel.home()));
+        assert_eq!(rig.ranges, Some(presets::TRAINER_MODEL_RANGES));
+    }
+
+    /// Each class of mistake, and the key its error names.
+    #[test]
+    fn every_invalid_class_names_its_key() {
+        type Mistake = Box<dyn Fn(&mut RigFile)>;
+        let cases: Vec<(&str, Mistake)> = vec![
+            ("name", Box::new(|f| f.name.clear())),
+            ("ring_radius", Box::new(|f| f.ring_radius = -0.2)),
+            ("ring_radius", Box::new(|f| f.ring_radius = f64::NAN)),
+            ("rod_length", Box::new(|f| f.rod_length = 0.0)),
+            ("home", Box::new(|f| f.home[5] = f64::INFINITY)),
+            ("home", Box::new(|f| f.home[2] = 0.9)),
+            ("home", Box::new(|f| f.home[1] = 0.1)),
+            ("chains", Box::new(|f| f.chains.truncate(2))),
+            (
+                "chains",
+                Box::new(|f| {
+                    f.chains[0].kind = KindSpec::Radial;
+                    f.chains[0].branch = None;
+                }),
+            ),
+            ("chains[0].branch", Box::new(|f| f.chains[0].kind = KindSpec::Radial)),
+            ("chains[0].branch", Box::new(|f| f.chains[0].branch = None)),
+            (
+                "chains[2].branch",
+                Box::new(|f| f.chains[2].branch = Some(BranchSpec::Plus)),
+            ),
+            (
+                "chains[1].platform_point",
+                Box::new(|f| f.chains[1].platform_point = f.chains[0].platform_point),
+            ),
+            (
+                "chains[3].platform_point",
+                Box::new(|f| f.chains[3].platform_point[0] = f64::NAN),
+            ),
+            ("limits.stroke", Box::new(|f| f.limits.stroke = None)),
+            ("limits.stroke", Box::new(|f| f.limits.stroke = Some([0.3, 0.2]))),
+            (
+                "limits.carriage_spacing_deg",
+                Box::new(|f| f.limits.carriage_spacing_deg = [120.0, 12.0]),
+            ),
+            ("limits.base_cone_deg", Box::new(|f| f.limits.base_cone_deg = 95.0)),
+            (
+                "limits.platform_cone_deg",
+                Box::new(|f| f.limits.platform_cone_deg = -1.0),
+            ),
+            (
+                "limits.min_singularity_index",
+                Box::new(|f| f.limits.min_singularity_index = 1.5),
+            ),
+            (
+                "limits.centre_of_mass",
+                Box::new(|f| f.limits.centre_of_mass[2] = f64::NAN),
+            ),
+            ("spec.heave", Box::new(|f| f.spec.as_mut().unwrap().heave = -0.01)),
+        ];
+        for (key, break_it) in cases {
+            let mut f = trainer_file();
+            break_it(&mut f);
+            let e = f.check().expect_err(key);
+            assert_eq!(e.key, key, "{e}");
+            assert!(!e.why.is_empty());
+        }
+        // Syntax and unknown keys: toml's message with the line.
+        let e = parse("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
+        assert!(e.why.contains("rod_lenght") && e.why.contains("line 3"), "{e}");
+    }
+
+    fn perturbed(factors: [f64; 10]) -> RigFile {
+        let mut f = trainer_file();
+        f.ring_radius *= factors[0];
+        f.rod_length *= factors[1];
+        for (i, c) in f.chains.iter_mut().enumerate() {
+            c.platform_point[0] *= factors[2 + 2 * i];
+            c.platform_point[1] *= factors[3 + 2 * i];
+        }
+        f
+    }
+
+    /// The random rigs below are not vacuous: most of them are valid and inside the checks at the tested poses.
+    #[test]
+    fn most_perturbed_rigs_are_valid() {
+        let mut state = 17u64;
+        let mut uniform = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let valid = (0..200)
+            .filter(|_| {
+                perturbed(core::array::from_fn(|_| 1.0 + 0.05 * uniform()))
+                    .check()
+                    .is_ok()
+            })
+            .count();
+        assert!(valid > 100, "{valid} of 200 valid");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+        /// Rigs no preset describes (the model's dimensions each changed by up to 5 %): every one that is valid
+        /// passes IK -> FK round trips from no guess at poses inside its checks.
+        #[test]
+        fn random_valid_rigs_round_trip(factors in prop::array::uniform10(0.95..1.05f64), offsets in prop::array::uniform6(-1.0..1.0f64)) {
+            let Ok(rig) = perturbed(factors).check() else { return Ok(()) };
+            let m = RingPlatform::<f64>::new(&rig.geometry);
+            let h = rig.home.to_array();
+            let p = Pose::new(h[0] + offsets[0] * 0.03, h[1] + offsets[1] * 0.03, h[2] + offsets[2] * 0.02,
+                offsets[3] * 0.15, offsets[4] * 0.15, offsets[5] * 3.0);
+            let Ok((q, report)) = m.inverse_checked(&p) else { return Ok(()) };
+            if !report.all_pass() {
+                return Ok(());
+            }
+            let options = NewtonOptions { max_distance: FROM_HOME_DISTANCE, ..NewtonOptions::default() };
+            let start = ringpod_core::kinematics::start_from_home(&m, &q, &rig.home);
+            match m.forward(&q, &start, &options) {
+                Ok(fk) => {
+                    let (a, b) = (fk.pose.to_array(), p.to_array());
+                    prop_assert!((0..5).all(|i| (a[i] - b[i]).abs() < 1e-9), "{:?} vs {:?}", fk.pose, p);
+                }
+                // Refusing near a type-2 singularity is right; anything else is not.
+                Err(e) => prop_assert_eq!(e, ringpod_core::kinematics::KinematicsError::NearSingularity),
+            }
+        }
+    }
+}
