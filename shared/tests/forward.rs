@@ -14,17 +14,9 @@ fn from_home() -> NewtonOptions<f64> {
     }
 }
 
-struct Lcg(u64);
+mod common;
 
-impl Lcg {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    }
-}
+use common::Lcg;
 
 fn trainer() -> RingPlatform<f64> {
     RingPlatform::new(&presets::TRAINER_MODEL)

@@ -3,6 +3,8 @@
 // Index loops over parallel per-axis arrays read more plainly than zips here.
 #![allow(clippy::needless_range_loop)]
 
+mod common;
+
 use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, RingGeometry, ToolGeometry, DEG};
 use ringpod_core::kinematics::{
     presets, Actuators, Check, GeometryError, KinematicsError, Mechanism, NewtonOptions, Pose, RingPlatform,
@@ -228,13 +230,8 @@ fn checks_fail_where_they_should() {
 fn spacing_is_measured_in_ring_order_when_the_order_is_broken() {
     let m = RingPlatform::<f64>::new(&presets::TRAINER_MODEL);
     let limits = presets::TRAINER_MODEL.limits.carriage_spacing;
-    let mut state = 11u64;
-    let mut uniform = || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut rng = common::Lcg(11);
+    let mut uniform = || rng.uniform();
     let mut broken = 0;
     for _ in 0..200_000 {
         let pose = Pose::new(

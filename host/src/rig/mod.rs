@@ -411,6 +411,17 @@ mod tests {
     use ringpod_core::kinematics::presets::{self, Preset};
     use ringpod_core::kinematics::{NewtonOptions, FROM_HOME_DISTANCE};
 
+    /// Uniform numbers in [-1, 1) from a fixed seed (an LCG: the same on every run).
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        }
+    }
+
     fn trainer_file() -> RigFile {
         RigFile::of(
             &presets::TRAINER_MODEL,
@@ -439,13 +450,7 @@ mod tests {
             RingPlatform::<f32>::new(&rig.geometry),
             RingPlatform::<f32>::new(&presets::TRAINER_MODEL),
         );
-        let mut state = 5u64;
-        let mut uniform = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut uniform = uniform(5);
         for _ in 0..2_000 {
             let p = Pose::new(
                 uniform() * 0.06,
@@ -543,13 +548,7 @@ mod tests {
     /// The random rigs below are not vacuous: most of them are valid and inside the checks at the tested poses.
     #[test]
     fn most_perturbed_rigs_are_valid() {
-        let mut state = 17u64;
-        let mut uniform = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut uniform = uniform(17);
         let valid = (0..200)
             .filter(|_| {
                 perturbed(core::array::from_fn(|_| 1.0 + 0.05 * uniform()))
