@@ -31,6 +31,13 @@ fn main() -> ExitCode {
         }),
         C::Rig { action } => answer(match action {
             cli::RigAction::Check { file, json } => rig::check_command(file, *json),
+            cli::RigAction::Design {
+                file,
+                combined,
+                starts,
+                steps,
+                seed,
+            } => rig::design_command(file, *combined, *starts, *steps, *seed),
         }),
         C::Ik(args) => answer(kinematics::ik(args, false)),
         C::Check(args) => answer(kinematics::ik(args, true)),

@@ -7,7 +7,8 @@ use ringpod_core::kinematics::presets::{self, Preset, PresetGeometry};
 use ringpod_core::kinematics::RingPlatform;
 use serde::Serialize;
 
-use super::{coverage, load, RigFile};
+use super::design::{design, Search, Target};
+use super::{coverage, load, RigError, RigFile};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::kinematics::Outcome;
 
@@ -141,4 +142,72 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
         }
     }
     Ok(Outcome { text: t, code })
+}
+
+/// `ringpod rig design TEMPLATE`: the best dimensions found, as a rig file, with its coverage in comments.
+pub fn design_command(path: &Path, combined: bool, starts: u32, steps: u32, seed: u64) -> Result<Outcome, CliError> {
+    let text = std::fs::read_to_string(path).map_err(|e| RigError {
+        key: path.display().to_string(),
+        why: e.to_string(),
+    })?;
+    let template: RigFile = toml::from_str(&text).map_err(|e| RigError {
+        key: "rig file".into(),
+        why: e.message().trim().to_owned(),
+    })?;
+    let search = Search {
+        target: if combined { Target::Combined } else { Target::EachAxis },
+        starts,
+        steps,
+        seed,
+    };
+    let found = design(&template, &search)?;
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "# Designed by `ringpod rig design` ({} starts x {} steps, seed {seed}, covering {}): score {:.3}",
+        starts,
+        steps,
+        if combined {
+            "all spec axes at once"
+        } else {
+            "each spec axis alone"
+        },
+        found.score
+    );
+    let _ = writeln!(
+        out,
+        "# (the smallest margin over the spec poses in units of 5 mm, 0.1 rad, 0.05 index; >= 0: inside)"
+    );
+    let covers = match found.file.check() {
+        Ok(rig) => {
+            let m = RingPlatform::<f64>::new(&rig.geometry);
+            if let Some(r) = rig.ranges {
+                let c = coverage(&m, &rig.home, &r);
+                for (i, (inside, tried)) in c.per_axis.iter().enumerate() {
+                    let _ = writeln!(out, "# {:<6} {inside} of {tried} spec poses inside", AXES[i]);
+                }
+                let _ = writeln!(out, "# all at once: {} of {} inside", c.combined.0, c.combined.1);
+                let axes = c.per_axis.iter().all(|(a, b)| a == b);
+                if combined {
+                    axes && c.combined.0 == c.combined.1
+                } else {
+                    axes
+                }
+            } else {
+                false
+            }
+        }
+        Err(e) => {
+            let _ = writeln!(out, "# the best candidate is not a valid rig: {e}");
+            false
+        }
+    };
+    let body = toml::to_string(&found.file).map_err(|e| CliError::BadNumbers {
+        what: "design",
+        reason: e.to_string(),
+    })?;
+    Ok(Outcome {
+        text: out + &body,
+        code: if covers { 0 } else { EXIT_CHECK_FAILED },
+    })
 }

@@ -30,8 +30,9 @@
 
 mod command;
 mod coverage;
+mod design;
 
-pub use command::{check_command, export};
+pub use command::{check_command, design_command, export};
 pub use coverage::coverage;
 
 use std::fmt;
@@ -237,9 +238,51 @@ fn positive(key: &str, v: f64) -> Result<(), RigError> {
 impl RigFile {
     /// Every rule the presets obey, and the controller's: each error names its key.
     pub fn check(&self) -> Result<Rig, RigError> {
+        let geometry = self.geometry()?;
+        let home = Pose::from_array(self.home);
+        let m = RingPlatform::<f64>::new(&geometry);
+        match m.inverse_checked(&home) {
+            Err(e) => return err("home", format!("has no solution: {e}")),
+            Ok((_, report)) => {
+                if let Some(check) = report.first_failure() {
+                    let margin = report.margin(check).unwrap_or(0.0);
+                    return err(
+                        "home",
+                        format!(
+                            "fails the {check} check by {:.6} {} (home must be inside every check)",
+                            -margin,
+                            check.unit()
+                        ),
+                    );
+                }
+            }
+        }
+        let ranges = match &self.spec {
+            Some(s) => {
+                let si = s.si();
+                let names = ["surge", "sway", "heave", "roll_deg", "pitch_deg"];
+                if let Some(i) = si.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+                    return err(format!("spec.{}", names[i]), "a range is a finite number >= 0");
+                }
+                Some(si)
+            }
+            None => None,
+        };
+        Ok(Rig { geometry, home, ranges })
+    }
+
+    /// The geometry of the file, every key checked but the home pose.
+    pub fn geometry(&self) -> Result<RingGeometry, RigError> {
         if self.name.is_empty() || self.name.chars().count() > 32 {
             return err("name", "between 1 and 32 characters");
         }
+        // The core's geometry carries a static name; a rig is loaded once per command.
+        self.geometry_named(Box::leak(self.name.clone().into_boxed_str()))
+    }
+
+    /// [`RigFile::geometry`] under another name (a design search scores thousands of candidates whose home is not
+    /// yet inside).
+    pub fn geometry_named(&self, name: &'static str) -> Result<RingGeometry, RigError> {
         positive("ring_radius", self.ring_radius)?;
         positive("rod_length", self.rod_length)?;
         finite("home", &self.home)?;
@@ -283,39 +326,8 @@ impl RigFile {
         }
         let limits = self.limits(radial)?;
         // The core's own validation is the last word (it is what the firmware builds from).
-        let name: &'static str = Box::leak(self.name.clone().into_boxed_str());
-        let geometry = RingGeometry::new(name, self.ring_radius, self.rod_length, &chains, limits)
-            .or_else(|e| err("rig file", e.to_string()))?;
-        let home = Pose::from_array(self.home);
-        let m = RingPlatform::<f64>::new(&geometry);
-        match m.inverse_checked(&home) {
-            Err(e) => return err("home", format!("has no solution: {e}")),
-            Ok((_, report)) => {
-                if let Some(check) = report.first_failure() {
-                    let margin = report.margin(check).unwrap_or(0.0);
-                    return err(
-                        "home",
-                        format!(
-                            "fails the {check} check by {:.6} {} (home must be inside every check)",
-                            -margin,
-                            check.unit()
-                        ),
-                    );
-                }
-            }
-        }
-        let ranges = match &self.spec {
-            Some(s) => {
-                let si = s.si();
-                let names = ["surge", "sway", "heave", "roll_deg", "pitch_deg"];
-                if let Some(i) = si.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
-                    return err(format!("spec.{}", names[i]), "a range is a finite number >= 0");
-                }
-                Some(si)
-            }
-            None => None,
-        };
-        Ok(Rig { geometry, home, ranges })
+        RingGeometry::new(name, self.ring_radius, self.rod_length, &chains, limits)
+            .or_else(|e| err("rig file", e.to_string()))
     }
 
     fn limits(&self, radial: usize) -> Result<RingLimits, RigError> {
