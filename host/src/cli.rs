@@ -101,9 +101,16 @@ pub struct LoadsArgs {
     /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
     #[arg(long, allow_hyphen_values = true)]
     pub pose: Option<String>,
-    /// Payload mass (kg), at the geometry's centre of mass.
+    /// Payload mass (kg), at the geometry's centre of mass: with --input, the whole moving mass.
     #[arg(long)]
     pub mass: f64,
+    /// A motion (pose CSV as `stream --input` reads: t,x,y,z,alpha,beta,gamma): report the peak drive demand of each
+    /// axis along it (inverse dynamics: gravity and the payload's inertia; the chains massless).
+    #[arg(long, conflicts_with = "pose")]
+    pub input: Option<std::path::PathBuf>,
+    /// Payload inertia about its centre of mass, platform frame: Ixx,Iyy,Izz (kg m^2). Default: none (a point mass).
+    #[arg(long, allow_hyphen_values = true, requires = "input")]
+    pub inertia: Option<String>,
 }
 
 /// Device commands.

@@ -399,12 +399,37 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
             reason: format!("{} kg is out of range (0 to 1e6 kg)", numbers::readable(args.mass)),
         });
     }
+    let names = m.axis_names();
+    if let Some(input) = &args.input {
+        let inertia = match &args.inertia {
+            Some(text) => {
+                let v: Vec<f64> = text
+                    .split(',')
+                    .map(|s| s.trim().parse::<f64>())
+                    .collect::<Result<_, _>>()
+                    .map_err(|e| CliError::BadNumbers {
+                        what: "inertia",
+                        reason: e.to_string(),
+                    })?;
+                match v[..] {
+                    [a, b, c] if v.iter().all(|x| x.is_finite() && (0.0..=1e6).contains(x)) => [a, b, c],
+                    _ => {
+                        return Err(CliError::BadNumbers {
+                            what: "inertia",
+                            reason: "three numbers Ixx,Iyy,Izz, each 0 to 1e6 kg m^2".into(),
+                        })
+                    }
+                }
+            }
+            None => [0.0; 3],
+        };
+        return crate::demand::run(&name, ring, &names, input, args.mass, inertia, common.json);
+    }
     let pose = pose_arg(common, home, m.characteristic_length(), args.pose.as_deref(), "pose")?;
     let q = m.inverse(&pose)?;
     let wrench = ring.gravity_wrench(&pose, args.mass);
     let l = ring.loads(&pose, &q, &wrench)?;
     let axes = m.axes();
-    let names = m.axis_names();
     let units: [&'static str; 6] = std::array::from_fn(|i| if axes[i] == AxisKind::Linear { "N" } else { "N m" });
     let text = if common.json {
         let out = LoadsJson {

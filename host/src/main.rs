@@ -4,6 +4,7 @@ mod cli;
 mod client;
 mod cue;
 mod datagram;
+mod demand;
 mod error;
 mod kinematics;
 mod mechanism;

@@ -480,3 +480,72 @@ fn a_rig_file_drives_the_kinematics_commands() {
         ));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `loads --input`: along a motion the peak demand of each axis; for a motion that stands still it is the statics,
+/// and moving costs more than standing; a pose with no solution is reported with its line (exit 3).
+#[test]
+fn loads_along_a_motion_report_the_peak_demand() {
+    let dir = std::env::temp_dir().join(format!("ringpod-demand-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let still = dir.join("still.csv");
+    let mut text = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for i in 0..20 {
+        text += &format!("{},0.01,-0.02,0.23,0.1,-0.05,0.7\n", f64::from(i) * 0.01);
+    }
+    std::fs::write(&still, &text).unwrap();
+    let at_rest = json(&["loads", "--pose=0.01,-0.02,0.23,0.1,-0.05,0.7", "--mass", "2", "--json"]);
+    let along = json(&["loads", "--input", still.to_str().unwrap(), "--mass", "2", "--json"]);
+    for k in 0..6 {
+        let (a, b) = (
+            along["peak_demand"][k].as_f64().unwrap(),
+            at_rest["drives"][k].as_f64().unwrap(),
+        );
+        assert!((a - b.abs()).abs() < 1e-9, "axis {k}: {a} vs {b}");
+    }
+    // The same poses fast (2 Hz heave, 0.8 g at the extremes, yawing 1.9 rad/s) and a hundred times slower.
+    let write = |path: &std::path::Path, slow: f64| {
+        let mut text = String::from("t,x,y,z,alpha,beta,gamma\n");
+        for i in 0..1000 {
+            let t = f64::from(i) * 0.002;
+            let z = 0.227 + 0.02 * (std::f64::consts::TAU * 2.0 * t).sin();
+            text += &format!("{},0,0,{z},0,0,{}\n", t * slow, 1.9 * t);
+        }
+        std::fs::write(path, &text).unwrap();
+        text
+    };
+    let (moving, slowly) = (dir.join("moving.csv"), dir.join("slowly.csv"));
+    let mut text = write(&moving, 1.0);
+    write(&slowly, 100.0);
+    let fast = json(&[
+        "loads",
+        "--input",
+        moving.to_str().unwrap(),
+        "--mass",
+        "2",
+        "--inertia=0.02,0.02,0.04",
+        "--json",
+    ]);
+    let slow = json(&[
+        "loads",
+        "--input",
+        slowly.to_str().unwrap(),
+        "--mass",
+        "2",
+        "--inertia=0.02,0.02,0.04",
+        "--json",
+    ]);
+    let peak = |v: &serde_json::Value, k: usize| v["peak_demand"][k].as_f64().unwrap();
+    assert!((0..6).all(|k| peak(&fast, k) >= peak(&slow, k)), "{fast} vs {slow}");
+    assert!(
+        (0..6).any(|k| peak(&fast, k) > 1.3 * peak(&slow, k)),
+        "{fast} vs {slow}"
+    );
+    text += "2.0,0,0,0.9,0,0,3.8\n";
+    std::fs::write(&moving, &text).unwrap();
+    ringpod()
+        .args(["loads", "--input", moving.to_str().unwrap(), "--mass", "2"])
+        .assert()
+        .code(3)
+        .stdout(predicate::str::contains("line 1002"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,14 +1,16 @@
 //! Ring platforms: carriages on a circular guide with rod chains and radial linear-actuator chains
-//! (KINEMATICS.md 2.1 trainer, 2.2 rotopod, 3 velocities; the checks of 4 in [`checks`], the statics of 5 in
-//! [`statics`]).
+//! (KINEMATICS.md 2.1 trainer, 2.2 rotopod, 3 velocities; the checks of 4 in `checks`, the statics of 5 in
+//! `statics`, the inverse dynamics in `dynamics`).
 
 mod checks;
+mod dynamics;
 mod guard;
 mod statics;
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use self::checks::Configuration;
+pub use self::dynamics::{BodyMotion, MotionState, Payload};
 pub use self::guard::SlowCheckGuard;
 pub use self::statics::ActuatorLoads;
 use super::geometry::{Branch, ChainKind, RingGeometry};
