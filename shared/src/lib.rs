@@ -25,6 +25,7 @@ pub mod motion;
 pub mod protocol;
 mod real;
 pub mod safety;
+pub mod screws;
 pub mod selfcheck;
 pub mod sim;
 
