@@ -118,3 +118,136 @@ fn at_closure_each_derivative_is_its_joints_twist() {
     assert!((t1 - line(&Vector3::z(), &o, &o)).amax() < 1e-12, "{t1}");
     assert!((t2 - line(&Vector3::z(), &p2, &o)).amax() < 1e-12, "{t2}");
 }
+
+mod paper_003 {
+    //! The 3-DOF translational mechanism of paper 003: three chains of five revolute joints A-E, A the actuated one.
+
+    use nalgebra::{Matrix3, Vector3, Vector6};
+    use ringpod_core::screws::line;
+    use ringpod_core::screws::reactions::{actuation_wrench, constraint_wrench, reactions};
+
+    use super::DEG;
+
+    /// `det M_C = s1 s2 s3 - c1 c2 c3` (SCREWS.md 3), the determinant of the constraint couples' moments.
+    fn det_mc(theta: [f64; 3]) -> f64 {
+        let (s, c) = (theta.map(|t| t.sin()), theta.map(|t| t.cos()));
+        let m = Matrix3::new(0.0, s[0], -c[0], -c[1], 0.0, s[1], s[2], -c[2], 0.0);
+        m.determinant()
+    }
+
+    #[test]
+    fn t4_the_constraint_determinant() {
+        assert!((det_mc([30.0 * DEG, 40.0 * DEG, 50.0 * DEG]) + 0.180232).abs() < 1e-6);
+        assert!(det_mc([45.0 * DEG; 3]).abs() < 1e-15);
+    }
+
+    struct Mechanism {
+        /// Per chain: the actuated twist, the four passive twists, about F.
+        actuated: [Vector6<f64>; 3],
+        passive: [[Vector6<f64>; 4]; 3],
+        /// The closed-form constraint wrenches.
+        w_c: [Vector6<f64>; 3],
+    }
+
+    fn mechanism() -> Mechanism {
+        let f = Vector3::new(-0.25, -0.12, -0.18);
+        let theta = [-157.2695 * DEG, -175.4759 * DEG, -290.4576 * DEG];
+        let (s, c) = (theta.map(|t| t.sin()), theta.map(|t| t.cos()));
+        let e = [Vector3::x(), Vector3::y(), Vector3::z()];
+        let u = [
+            Vector3::new(0.0, c[0], s[0]),
+            Vector3::new(s[1], 0.0, c[1]),
+            Vector3::new(c[2], s[2], 0.0),
+        ];
+        let b = [
+            Vector3::new(-0.5, 0.0773, -0.1845),
+            Vector3::new(-0.1994, -0.5, 0.0158),
+            Vector3::new(-0.1874, 0.0699, -0.5),
+        ];
+        let cc = [
+            Vector3::new(-0.55, 0.0025, -0.0059),
+            Vector3::new(-0.0166, -0.42, 0.0013),
+            Vector3::new(-0.0009, 0.0004, -0.48),
+        ];
+        let d = [
+            Vector3::new(-0.55, 0.0797, -0.1903),
+            Vector3::new(-0.216, -0.42, 0.0171),
+            Vector3::new(-0.1883, 0.0703, -0.48),
+        ];
+        let a = e.map(|ei| -0.5 * ei);
+        Mechanism {
+            actuated: core::array::from_fn(|i| line(&e[i], &a[i], &f)),
+            passive: core::array::from_fn(|i| {
+                [
+                    line(&u[i], &b[i], &f),
+                    line(&u[i], &cc[i], &f),
+                    line(&e[i], &d[i], &f),
+                    line(&e[i], &(f - 0.3 * e[i]), &f),
+                ]
+            }),
+            w_c: [
+                Vector6::new(0.0, 0.0, 0.0, 0.0, s[0], -c[0]),
+                Vector6::new(0.0, 0.0, 0.0, -c[1], 0.0, s[1]),
+                Vector6::new(0.0, 0.0, 0.0, s[2], -c[2], 0.0),
+            ],
+        }
+    }
+
+    fn near(got: &[f64], want: &[f64], what: &str) {
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() <= 1e-4 * w.abs().max(1.0), "{what}: {got:?} vs {want:?}");
+        }
+    }
+
+    #[test]
+    fn t5_wrenches_of_the_chains() {
+        let m = mechanism();
+        for i in 0..3 {
+            // The kernel of the chain's twists is the closed-form couple, up to sign.
+            let all: Vec<Vector6<f64>> = core::iter::once(m.actuated[i]).chain(m.passive[i]).collect();
+            let w = constraint_wrench(&all).unwrap();
+            let closed = m.w_c[i].normalize();
+            assert!(
+                (w - closed).amax().min((w + closed).amax()) < 1e-3,
+                "chain {i}: {w} vs {closed}"
+            );
+        }
+        let w_a1 = actuation_wrench(&m.actuated[0], &m.passive[0], &m.w_c[0]).unwrap();
+        near(
+            w_a1.as_slice(),
+            &[0.60186, 5.37088, -0.27702, 0.0, -0.58207, -0.24385],
+            "w_A1",
+        );
+        let moments = Matrix3::from_fn(|r, c| m.w_c[r][3 + c]);
+        assert!(
+            (moments.determinant() + 0.29281).abs() < 1e-4,
+            "{}",
+            moments.determinant()
+        );
+    }
+
+    #[test]
+    fn t6_reactions_with_and_without_projection() {
+        let m = mechanism();
+        let w_a: Vec<Vector6<f64>> = (0..3)
+            .map(|i| actuation_wrench(&m.actuated[i], &m.passive[i], &m.w_c[i]).unwrap())
+            .collect();
+        let r = reactions(&w_a, &m.w_c, &Vector6::new(0.0, 0.0, 10.0, 0.0, 0.0, 0.0)).unwrap();
+        near(&r.actuators[..3], &[1.44913, 2.26914, 1.73180], "r_A, pure force");
+        near(&r.constraints[..3], &[0.21048, 2.80049, -2.96711], "r_C, pure force");
+        near(
+            &r.constraints_projected[..3],
+            &[0.0, 0.0, 0.0],
+            "projected r_C, pure force",
+        );
+        let p = Vector6::new(1.0, 2.0, 3.0, 0.1, -0.2, 0.3);
+        let r = reactions(&w_a, &m.w_c, &p).unwrap();
+        near(&r.actuators[..3], &[0.11628, 0.66516, -0.26431], "r_A");
+        near(&r.constraints[..3], &[0.22839, -0.07950, 0.17509], "r_C");
+        near(
+            &r.constraints_projected[..3],
+            &[0.31592, -0.10924, 0.22297],
+            "projected r_C",
+        );
+    }
+}

@@ -1,7 +1,9 @@
 //! Screws (SCREWS.md): Plücker lines, twists and wrenches as `[direction; moment]` six-vectors, their reciprocal
-//! product, and paper 002's matrix method for closed loops ([`matrix`]).
+//! product, paper 002's matrix method for closed loops ([`matrix`]) and paper 003's generalised reactions
+//! ([`reactions`]).
 
 pub mod matrix;
+pub mod reactions;
 
 use nalgebra::{Vector3, Vector6};
 
