@@ -8,7 +8,7 @@ use ringpod_core::kinematics::RingPlatform;
 use serde::Serialize;
 
 use super::design::{design, Search, Target};
-use super::{coverage, load, RigError, RigFile};
+use super::{coverage, load, read, RigFile};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::kinematics::Outcome;
 
@@ -146,14 +146,7 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
 
 /// `ringpod rig design TEMPLATE`: the best dimensions found, as a rig file, with its coverage in comments.
 pub fn design_command(path: &Path, combined: bool, starts: u32, steps: u32, seed: u64) -> Result<Outcome, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| RigError {
-        key: path.display().to_string(),
-        why: e.to_string(),
-    })?;
-    let template: RigFile = toml::from_str(&text).map_err(|e| RigError {
-        key: "rig file".into(),
-        why: e.message().trim().to_owned(),
-    })?;
+    let template = read(path)?;
     let search = Search {
         target: if combined { Target::Combined } else { Target::EachAxis },
         starts,

@@ -197,17 +197,20 @@ pub struct Rig {
 
 /// Reads and checks a rig file.
 pub fn load(path: &Path) -> Result<Rig, RigError> {
-    let text = std::fs::read_to_string(path).or_else(|e| err(path.display().to_string(), e.to_string()))?;
-    parse(&text)
+    read(path)?.check()
 }
 
-/// Parses and checks the text of a rig file.
-pub fn parse(text: &str) -> Result<Rig, RigError> {
-    let file: RigFile = toml::from_str(text).or_else(|e| {
+/// Reads a rig file without checking it (a design template need not be a valid rig yet).
+pub fn read(path: &Path) -> Result<RigFile, RigError> {
+    let text = std::fs::read_to_string(path).or_else(|e| err(path.display().to_string(), e.to_string()))?;
+    from_text(&text)
+}
+
+fn from_text(text: &str) -> Result<RigFile, RigError> {
+    toml::from_str(text).or_else(|e| {
         // toml names the key and the line; keep its words.
         err("rig file", e.message().trim().to_owned() + &span_of(text, e.span()))
-    })?;
-    file.check()
+    })
 }
 
 fn span_of(text: &str, span: Option<std::ops::Range<usize>>) -> String {
@@ -453,7 +456,9 @@ mod tests {
 
     #[test]
     fn a_rig_restating_the_preset_drives_bit_identical_ik() {
-        let rig = parse(&toml::to_string(&trainer_file()).unwrap()).unwrap();
+        let rig = from_text(&toml::to_string(&trainer_file()).unwrap())
+            .and_then(|f| f.check())
+            .unwrap();
         let (ours, preset) = (
             RingPlatform::<f64>::new(&rig.geometry),
             RingPlatform::<f64>::new(&presets::TRAINER_MODEL),
@@ -542,7 +547,7 @@ mod tests {
             assert!(!e.why.is_empty());
         }
         // Syntax and unknown keys: toml's message with the line.
-        let e = parse("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
+        let e = from_text("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
         assert!(e.why.contains("rod_lenght") && e.why.contains("line 3"), "{e}");
     }
 

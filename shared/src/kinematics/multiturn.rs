@@ -74,20 +74,14 @@ impl<T: Real> MultiTurn<T> {
     pub fn ring_steps(&self, i: usize, steps_per_turn: i64) -> i64 {
         let turns = i64::from(self.turns.get(i).copied().unwrap_or(0));
         let within = self.within.0.get(i).copied().unwrap_or(T::zero());
-        // i64 -> f64 -> T as before (the same rounding for any count), but only for counts an i32 cannot hold:
-        // the M4F converts through f64 in software.
-        let per_turn = match i32::try_from(steps_per_turn) {
-            Ok(n) => T::of_i32(n),
-            Err(_) => T::of(steps_per_turn as f64),
+        // A count that fits an i32 converts without f64 (software on the M4F), and times i32 turns it cannot
+        // overflow (one SMULL, where a saturating i64 product is a library call). Larger counts take the general
+        // way, with the same rounding (i64 -> f64 -> T).
+        let (per_turn, whole) = match i32::try_from(steps_per_turn) {
+            Ok(n) => (T::of_i32(n), turns * i64::from(n)),
+            Err(_) => (T::of(steps_per_turn as f64), turns.saturating_mul(steps_per_turn)),
         };
         let frac = (within * per_turn / T::two_pi()).round_to_i64();
-        // Mostly within the first turn; an i32 count times i32 turns cannot overflow (one SMULL on the M4F, where
-        // a saturating i64 product is a library call).
-        let whole = match i32::try_from(steps_per_turn) {
-            _ if turns == 0 => 0,
-            Ok(n) => turns * i64::from(n),
-            Err(_) => turns.saturating_mul(steps_per_turn),
-        };
         whole.saturating_add(frac)
     }
 }

@@ -87,18 +87,16 @@ impl<T: Real> Jacobians<T> {
     /// Not Hadamard's ratio of `B`: a rod chain's row of `B` has a single entry, so that ratio stays 1 however small
     /// `dF/dq` gets. Not a determinant of the normalised rows either: six healthy rows at 0.4 each make 0.004.
     pub fn index_b(&self) -> T {
-        let inv = T::one() / self.length;
-        let a = self.a_closed();
+        let a = self.a_closed_scaled();
         let mut rows = [[T::zero(); 6]; 6];
         for (r, row) in rows.iter_mut().enumerate() {
             let mut norm = T::zero();
             for c in 0..6 {
-                let ac = if c < 3 { a[(r, c)] } else { a[(r, c)] * inv };
                 row[c] = match self.axes[c] {
                     AxisKind::Linear => self.b[(r, c)],
-                    AxisKind::Ring | AxisKind::Angle => self.b[(r, c)] * inv,
+                    AxisKind::Ring | AxisKind::Angle => self.b[(r, c)] / self.length,
                 };
-                norm += ac * ac + row[c] * row[c];
+                norm += a[r][c] * a[r][c] + row[c] * row[c];
             }
             let norm = norm.sqrt_();
             if norm > T::zero() && norm.finite() {

@@ -48,13 +48,6 @@ impl<T: Real> Default for SlowCheckGuard<T> {
     }
 }
 
-impl<T: Real> SlowCheckGuard<T> {
-    /// Forgets the last evaluation: the next check evaluates everything.
-    pub fn reset(&mut self) {
-        self.at = None;
-    }
-}
-
 impl<T: Real> RingPlatform<T> {
     /// The slow margins of the guard's scratch configuration: proved from its reference when the bounds allow,
     /// else evaluated (and the reference moved there). Returns whether they were evaluated.

@@ -7,7 +7,7 @@ mod dynamics;
 mod guard;
 mod statics;
 
-use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::{Matrix6, Vector3, Vector6};
 
 use self::checks::Configuration;
 pub use self::dynamics::{BodyMotion, MotionState, Payload};
@@ -81,11 +81,7 @@ impl<T: Real> RingPlatform<T> {
 
     /// Platform joints `A_i = R a_i + p` in the base frame.
     pub fn joints(&self, pose: &Pose<T>) -> [Vector3<T>; 6] {
-        self.joints_with(&pose.rotation(), pose)
-    }
-
-    fn joints_with(&self, r: &Matrix3<T>, pose: &Pose<T>) -> [Vector3<T>; 6] {
-        let p = pose.position();
+        let (r, p) = (pose.rotation(), pose.position());
         self.points.map(|a| r * a + p)
     }
 
