@@ -4,7 +4,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use plotters::prelude::*;
+use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
 use ringpod_core::cueing::{self, CueConfig, SampleError, Telemetry, Washout};
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
 use ringpod_core::kinematics::{Pose, RingPlatform};
@@ -12,6 +12,7 @@ use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
 use crate::cli::CueArgs;
+use crate::plot::{self, Panel, Series, TimePlot};
 use crate::table::{self, InputError};
 
 /// The columns of a telemetry file.
@@ -179,15 +180,8 @@ fn delivered_forces(cued: &[Cued]) -> Vec<[f64; 3]> {
 }
 
 /// Draws the cues: per axis the specific force asked (scaled as the washout scales it) and delivered, and the
-/// angular rates asked and delivered. SVG, with labels (PNG text would need a system font library).
+/// angular rates asked and delivered (SVG or PNG).
 fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
-    if path.extension().is_none_or(|e| e != "svg") {
-        anyhow::bail!(
-            "{}: the plot is SVG (labels need text; PNG text would need a system font library)",
-            path.display()
-        );
-    }
-    let err = |e: &dyn std::fmt::Display| anyhow::anyhow!("{}: {e}", path.display());
     let delivered = delivered_forces(cued);
     let rates: Vec<[f64; 3]> = (0..cued.len())
         .map(|k| {
@@ -199,148 +193,58 @@ fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
             [(b[3] - a[3]) / h, (b[4] - a[4]) / h, (b[5] - a[5]) / h]
         })
         .collect();
-    let t0 = cued.first().map_or(0.0, |c| c.t);
-    let t1 = cued.last().map_or(1.0, |c| c.t).max(t0 + 1e-3);
-    let root = SVGBackend::new(path, (1000, 1000)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let root = root
-        .titled(
-            &format!(
-                "ringpod cue: telemetry in, platform cues out (neutral z = {:.3} m)",
-                neutral.z
-            ),
-            ("sans-serif", 20),
-        )
-        .map_err(|e| err(&e))?;
-    let panels = root.split_evenly((4, 1));
     let g = cueing::G;
-    type Series<'a> = (&'a str, Vec<(f64, f64)>, RGBColor);
-    let panel_data: [(&str, &str, Vec<Series>); 4] = [
-        (
-            "longitudinal specific force",
-            "m/s^2",
-            vec![
-                (
-                    "vehicle ax",
-                    cued.iter().map(|c| (c.t, c.input.force[0])).collect(),
-                    BLUE,
-                ),
-                (
-                    "platform delivers",
-                    cued.iter().zip(&delivered).map(|(c, d)| (c.t, d[0])).collect(),
-                    RED,
-                ),
-            ],
+    let asked = |f: &dyn Fn(&Cued) -> f64| cued.iter().map(|c| (c.t, f(c))).collect::<Vec<_>>();
+    let got = |f: &dyn Fn(&[f64; 3]) -> f64, v: &[[f64; 3]]| cued.iter().zip(v).map(|(c, d)| (c.t, f(d))).collect();
+    let panel = |title: &str, unit: &str, series: Vec<Series>| Panel {
+        title: title.into(),
+        unit: unit.into(),
+        series,
+        events: Vec::new(),
+    };
+    let plot = TimePlot {
+        title: format!(
+            "ringpod cue: telemetry in, platform cues out (neutral z = {:.3} m)",
+            neutral.z
         ),
-        (
-            "lateral specific force",
-            "m/s^2",
-            vec![
-                (
-                    "vehicle ay",
-                    cued.iter().map(|c| (c.t, c.input.force[1])).collect(),
-                    BLUE,
-                ),
-                (
-                    "platform delivers",
-                    cued.iter().zip(&delivered).map(|(c, d)| (c.t, d[1])).collect(),
-                    RED,
-                ),
-            ],
-        ),
-        (
-            "vertical specific force minus g",
-            "m/s^2",
-            vec![
-                (
-                    "vehicle az - g",
-                    cued.iter().map(|c| (c.t, c.input.force[2] - g)).collect(),
-                    BLUE,
-                ),
-                (
-                    "platform delivers - g",
-                    cued.iter().zip(&delivered).map(|(c, d)| (c.t, d[2] - g)).collect(),
-                    RED,
-                ),
-            ],
-        ),
-        (
-            "angular rates",
-            "rad/s",
-            vec![
-                (
-                    "vehicle roll rate",
-                    cued.iter().map(|c| (c.t, c.input.rate[0])).collect(),
-                    BLUE,
-                ),
-                (
-                    "platform roll rate",
-                    cued.iter().zip(&rates).map(|(c, r)| (c.t, r[0])).collect(),
-                    RED,
-                ),
-                (
-                    "vehicle pitch rate",
-                    cued.iter().map(|c| (c.t, c.input.rate[1])).collect(),
-                    CYAN,
-                ),
-                (
-                    "platform pitch rate",
-                    cued.iter().zip(&rates).map(|(c, r)| (c.t, r[1])).collect(),
-                    MAGENTA,
-                ),
-                (
-                    "vehicle yaw rate",
-                    cued.iter().map(|c| (c.t, c.input.rate[2])).collect(),
-                    GREEN,
-                ),
-                (
-                    "platform yaw rate",
-                    cued.iter().zip(&rates).map(|(c, r)| (c.t, r[2])).collect(),
-                    BLACK,
-                ),
-            ],
-        ),
-    ];
-    for (area, (title, unit, series)) in panels.iter().zip(panel_data) {
-        let (lo, hi) = series
-            .iter()
-            .flat_map(|s| s.1.iter().map(|p| p.1))
-            .filter(|v| v.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
-        let (lo, hi) = if lo.is_finite() {
-            (lo, hi.max(lo + 1e-3))
-        } else {
-            (-1.0, 1.0)
-        };
-        let pad = 0.05 * (hi - lo);
-        let mut chart = ChartBuilder::on(area)
-            .caption(title, ("sans-serif", 16))
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(60)
-            .build_cartesian_2d(t0..t1, (lo - pad)..(hi + pad))
-            .map_err(|e| err(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_desc(unit)
-            .draw()
-            .map_err(|e| err(&e))?;
-        for (name, points, colour) in series {
-            chart
-                .draw_series(LineSeries::new(points.into_iter().filter(|p| p.1.is_finite()), colour))
-                .map_err(|e| err(&e))?
-                .label(name)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| err(&e))?;
-    }
-    root.present().map_err(|e| err(&e))?;
-    Ok(())
+        panels: vec![
+            panel(
+                "longitudinal specific force",
+                "m/s^2",
+                vec![
+                    Series::new("vehicle ax", asked(&|c| c.input.force[0]), BLUE),
+                    Series::new("platform delivers", got(&|d| d[0], &delivered), RED),
+                ],
+            ),
+            panel(
+                "lateral specific force",
+                "m/s^2",
+                vec![
+                    Series::new("vehicle ay", asked(&|c| c.input.force[1]), BLUE),
+                    Series::new("platform delivers", got(&|d| d[1], &delivered), RED),
+                ],
+            ),
+            panel(
+                "vertical specific force minus g",
+                "m/s^2",
+                vec![
+                    Series::new("vehicle az - g", asked(&|c| c.input.force[2] - g), BLUE),
+                    Series::new("platform delivers - g", got(&|d| d[2] - g, &delivered), RED),
+                ],
+            ),
+            panel(
+                "angular rates",
+                "rad/s",
+                vec![
+                    Series::new("vehicle roll rate", asked(&|c| c.input.rate[0]), BLUE),
+                    Series::new("platform roll rate", got(&|r| r[0], &rates), RED),
+                    Series::new("vehicle pitch rate", asked(&|c| c.input.rate[1]), CYAN),
+                    Series::new("platform pitch rate", got(&|r| r[1], &rates), MAGENTA),
+                    Series::new("vehicle yaw rate", asked(&|c| c.input.rate[2]), GREEN),
+                    Series::new("platform yaw rate", got(&|r| r[2], &rates), BLACK),
+                ],
+            ),
+        ],
+    };
+    plot::save(path, (1000, 1000), &plot)
 }

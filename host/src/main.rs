@@ -9,6 +9,7 @@ mod error;
 mod kinematics;
 mod mechanism;
 mod numbers;
+mod plot;
 mod pty;
 mod rig;
 mod settings;

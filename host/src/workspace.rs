@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use indicatif::{ProgressBar, ProgressStyle};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use ringpod_core::kinematics::geometry::DEG;
@@ -10,6 +11,7 @@ use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RA
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 
 use crate::cli::{Section, WorkspaceArgs};
+use crate::plot::{self, Picture};
 
 /// What limits a grid point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -217,7 +219,7 @@ fn angle_range(m: &RingPlatform<f64>, home: [f64; 6], axis: usize) -> (f64, f64)
     (lo, hi)
 }
 
-/// Each spec axis swept over its range (41 points) at every 10 degrees of yaw: (inside, total).
+/// Draws the section, coloured by the first failing check, with a legend (SVG or PNG).
 fn draw(
     out: &Path,
     grid: &[Vec<Cell>],
@@ -226,67 +228,87 @@ fn draw(
     section: Section,
     name: &str,
 ) -> anyhow::Result<()> {
-    let svg = out.extension().is_some_and(|e| e == "svg");
-    let size = (760, 640);
     let plane = match section {
         Section::Xy => ("x (m)", "y (m)"),
         Section::Xz => ("x (m)", "z (m)"),
     };
-    // SVG carries text as text; PNG text would need a system font library, so PNG pictures have no labels.
-    if svg {
-        let root = SVGBackend::new(out, size).into_drawing_area();
-        paint(&root, grid, u, v, Some((name, plane)))?;
-        root.present()?;
-    } else {
-        let root = BitMapBackend::new(out, size).into_drawing_area();
-        paint(&root, grid, u, v, None)?;
-        root.present()?;
-    }
-    Ok(())
+    let picture = SectionPicture {
+        grid,
+        u,
+        v,
+        name,
+        plane,
+    };
+    plot::save(out, (860, 640), &picture)
 }
 
-fn paint<DB: DrawingBackend>(
-    root: &DrawingArea<DB, plotters::coord::Shift>,
-    grid: &[Vec<Cell>],
+/// A workspace section, coloured by the first failing check, with its legend.
+struct SectionPicture<'a> {
+    grid: &'a [Vec<Cell>],
     u: (f64, f64),
     v: (f64, f64),
-    labels: Option<(&str, (&str, &str))>,
-) -> anyhow::Result<()>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let n = grid.len().max(1);
-    let (du, dv) = ((u.1 - u.0) / n as f64, (v.1 - v.0) / n as f64);
-    let mut builder = ChartBuilder::on(root);
-    builder.margin(20);
-    if let Some((name, _)) = labels {
-        builder
+    name: &'a str,
+    plane: (&'a str, &'a str),
+}
+
+impl Picture for SectionPicture<'_> {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let fail = plot::failed(out);
+        let (grid, u, v) = (self.grid, self.u, self.v);
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let n = grid.len().max(1);
+        let (du, dv) = ((u.1 - u.0) / n as f64, (v.1 - v.0) / n as f64);
+        let (area, side) = root.split_horizontally(root.dim_in_pixel().0.saturating_sub(200));
+        let mut chart = ChartBuilder::on(&area)
+            .margin(20)
             .caption(
-                format!("{name}: workspace section (green: inside, darker = better conditioned)"),
-                ("sans-serif", 18),
+                format!("{}: workspace section (first failing check)", self.name),
+                (plot::FONT, 18),
             )
             .x_label_area_size(40)
-            .y_label_area_size(60);
-    }
-    let mut chart = builder
-        .build_cartesian_2d(u.0..u.1, v.0..v.1)
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
-    if let Some((_, (xl, yl))) = labels {
+            .y_label_area_size(64)
+            .build_cartesian_2d(u.0..u.1, v.0..v.1)
+            .map_err(|e| fail(&e))?;
         chart
             .configure_mesh()
-            .x_desc(xl)
-            .y_desc(yl)
+            .x_desc(self.plane.0)
+            .y_desc(self.plane.1)
+            .label_style((plot::FONT, 12))
+            .disable_mesh()
             .draw()
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(grid.iter().enumerate().flat_map(|(j, row)| {
+                row.iter().enumerate().map(move |(i, c)| {
+                    let (x0, y0) = (u.0 + i as f64 * du, v.0 + j as f64 * dv);
+                    Rectangle::new([(x0, y0), (x0 + du, y0 + dv)], colour(*c).filled())
+                })
+            }))
+            .map_err(|e| fail(&e))?;
+        // The legend beside the section, one entry per colour.
+        let legend = [
+            (Cell::Inside(0.3), "inside, index 0.3+"),
+            (Cell::Inside(0.0), "inside, index near limit"),
+            (Cell::Fails(Check::CarriageSpacing), "carriage spacing fails"),
+            (Cell::Fails(Check::RodCrossing), "rods cross"),
+            (Cell::Fails(Check::JointCones), "a joint cone fails"),
+            (Cell::Fails(Check::Singularity), "near a singularity"),
+            (Cell::Fails(Check::Stability), "not stable"),
+            (Cell::Fails(Check::Reach), "reach or stroke fails"),
+            (Cell::Unreachable, "no IK solution"),
+        ];
+        for (k, (cell, label)) in legend.into_iter().enumerate() {
+            let y = 70 + 24 * k as i32;
+            side.draw(&Rectangle::new([(4, y), (20, y + 16)], colour(cell).filled()))
+                .map_err(|e| fail(&e))?;
+            side.draw(&Rectangle::new([(4, y), (20, y + 16)], BLACK.stroke_width(1)))
+                .map_err(|e| fail(&e))?;
+            side.draw(&Text::new(label, (28, y + 2), (plot::FONT, 13)))
+                .map_err(|e| fail(&e))?;
+        }
+        Ok(())
     }
-    chart
-        .draw_series(grid.iter().enumerate().flat_map(|(j, row)| {
-            row.iter().enumerate().map(move |(i, c)| {
-                let (x0, y0) = (u.0 + i as f64 * du, v.0 + j as f64 * dv);
-                Rectangle::new([(x0, y0), (x0 + du, y0 + dv)], colour(*c).filled())
-            })
-        }))
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
-    Ok(())
 }

@@ -1,0 +1,260 @@
+//! Pictures: one drawing for SVG and PNG. The text font (DejaVu Sans, `host/assets/`, Bitstream Vera licence) is
+//! compiled into the binary and registered with plotters' own font rasteriser, so PNG pictures carry the same
+//! labels as SVG without a system font library.
+
+use std::path::Path;
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+
+/// The font every picture's text uses.
+pub const FONT: &str = "sans-serif";
+
+static FONT_DATA: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+
+fn register_fonts() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bytes are a valid TrueType font (checked by the test below); a failure leaves text undrawn in PNG
+        // only, never a panic.
+        let _ = register_font(FONT, FontStyle::Normal, FONT_DATA);
+    });
+}
+
+/// Maps a plotting error to one that names the picture.
+pub fn failed(out: &Path) -> impl Fn(&dyn std::fmt::Display) -> anyhow::Error + '_ {
+    move |e| anyhow::anyhow!("{}: {e}", out.display())
+}
+
+/// Something drawn on any plotters backend.
+pub trait Picture {
+    /// Draws on `root`; `fail` names the picture in errors.
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Writes `picture` to `out`: SVG when the name ends in `.svg`, PNG when it ends in `.png`.
+pub fn save(out: &Path, size: (u32, u32), picture: &impl Picture) -> anyhow::Result<()> {
+    register_fonts();
+    let fail = failed(out);
+    match out.extension().and_then(|e| e.to_str()) {
+        Some("svg") => {
+            let root = SVGBackend::new(out, size).into_drawing_area();
+            picture.paint(&root, out)?;
+            root.present().map_err(|e| fail(&e))
+        }
+        Some("png") => {
+            let root = BitMapBackend::new(out, size).into_drawing_area();
+            picture.paint(&root, out)?;
+            root.present().map_err(|e| fail(&e))
+        }
+        _ => anyhow::bail!("{}: a picture is .svg or .png", out.display()),
+    }
+}
+
+/// One line of a time panel.
+pub struct Series {
+    /// Legend text.
+    pub name: String,
+    /// `(time s, value)`; non-finite values are left out.
+    pub points: Vec<(f64, f64)>,
+    /// Line colour.
+    pub colour: RGBColor,
+}
+
+impl Series {
+    /// A series of `points`.
+    pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>, colour: RGBColor) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            colour,
+        }
+    }
+}
+
+/// A marked moment on the time axis (a limit, a refusal, a state change).
+pub struct Event {
+    /// When (s).
+    pub t: f64,
+    /// What, for the legend (events of one kind share a colour and one legend entry).
+    pub kind: String,
+    /// Marker colour.
+    pub colour: RGBColor,
+}
+
+/// One panel of a time plot: a title, the unit of its values, its lines and its events.
+pub struct Panel {
+    /// Panel caption.
+    pub title: String,
+    /// Y axis label.
+    pub unit: String,
+    /// The lines.
+    pub series: Vec<Series>,
+    /// Vertical markers.
+    pub events: Vec<Event>,
+}
+
+/// Panels stacked over one time axis, under a title.
+pub struct TimePlot {
+    /// Title of the picture.
+    pub title: String,
+    /// The panels, top to bottom.
+    pub panels: Vec<Panel>,
+}
+
+fn value_range(panel: &Panel) -> (f64, f64) {
+    let (lo, hi) = panel
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    if lo.is_finite() {
+        let hi = hi.max(lo + 1e-6);
+        let pad = 0.08 * (hi - lo);
+        (lo - pad, hi + pad)
+    } else {
+        (-1.0, 1.0)
+    }
+}
+
+impl TimePlot {
+    fn time_range(&self) -> (f64, f64) {
+        let (t0, t1) = self
+            .panels
+            .iter()
+            .flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)))
+            .filter(|t| t.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), t| (l.min(t), h.max(t)));
+        if t0.is_finite() {
+            (t0, t1.max(t0 + 1e-3))
+        } else {
+            (0.0, 1.0)
+        }
+    }
+}
+
+impl Picture for TimePlot {
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let fail = failed(out);
+        root.fill(&WHITE).map_err(|e| fail(&e))?;
+        let root = root.titled(&self.title, (FONT, 20)).map_err(|e| fail(&e))?;
+        let (t0, t1) = self.time_range();
+        let areas = root.split_evenly((self.panels.len().max(1), 1));
+        for (area, panel) in areas.iter().zip(&self.panels) {
+            let (lo, hi) = value_range(panel);
+            let mut chart = ChartBuilder::on(area)
+                .caption(&panel.title, (FONT, 15))
+                .margin(8)
+                .x_label_area_size(32)
+                .y_label_area_size(64)
+                .build_cartesian_2d(t0..t1, lo..hi)
+                .map_err(|e| fail(&e))?;
+            chart
+                .configure_mesh()
+                .x_desc("time (s)")
+                .y_desc(panel.unit.as_str())
+                .label_style((FONT, 12))
+                .draw()
+                .map_err(|e| fail(&e))?;
+            for s in &panel.series {
+                let colour = s.colour;
+                chart
+                    .draw_series(LineSeries::new(
+                        s.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()),
+                        colour,
+                    ))
+                    .map_err(|e| fail(&e))?
+                    .label(s.name.as_str())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
+            }
+            let mut kinds: Vec<(&str, RGBColor)> = Vec::new();
+            for e in &panel.events {
+                if !kinds.iter().any(|k| k.0 == e.kind) {
+                    kinds.push((&e.kind, e.colour));
+                }
+            }
+            for (kind, colour) in kinds {
+                let style = colour.mix(0.5);
+                chart
+                    .draw_series(
+                        panel
+                            .events
+                            .iter()
+                            .filter(|e| e.kind == kind && e.t.is_finite())
+                            .map(|e| PathElement::new(vec![(e.t, lo), (e.t, hi)], style)),
+                    )
+                    .map_err(|e| fail(&e))?
+                    .label(kind)
+                    .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 3, y + 5)], colour.filled()));
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperLeft)
+                .label_font((FONT, 12))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|e| fail(&e))?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plot() -> TimePlot {
+        TimePlot {
+            title: "test".into(),
+            panels: vec![Panel {
+                title: "a panel".into(),
+                unit: "m".into(),
+                series: vec![Series::new("line", vec![(0.0, 0.0), (1.0, 1.0)], BLUE)],
+                events: vec![Event {
+                    t: 0.5,
+                    kind: "limited".into(),
+                    colour: RED,
+                }],
+            }],
+        }
+    }
+
+    #[test]
+    fn the_shipped_font_is_a_font() {
+        assert!(ab_glyph::FontRef::try_from_slice(FONT_DATA).is_ok());
+    }
+
+    /// PNG text is drawn: the same plot with and without its labels differs in dark pixels (text is black on
+    /// white), and the SVG names its labels as text.
+    #[test]
+    fn png_and_svg_carry_labels() {
+        let dir = std::env::temp_dir().join(format!("ringpod-plot-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let svg = dir.join("p.svg");
+        save(&svg, (600, 300), &plot()).unwrap();
+        let text = std::fs::read_to_string(&svg).unwrap();
+        for label in ["time (s)", "a panel", "limited", "line"] {
+            assert!(text.contains(label), "{label} missing from the SVG");
+        }
+        let png = dir.join("p.png");
+        save(&png, (600, 300), &plot()).unwrap();
+        let image = image::open(&png).unwrap().to_rgb8();
+        // The title's band above the panel holds nothing but the title's text: without a font it stays white.
+        let dark = (0..image.width())
+            .flat_map(|x| (0..22).map(move |y| (x, y)))
+            .filter(|&(x, y)| image.get_pixel(x, y).0.iter().all(|c| *c < 100))
+            .count();
+        assert!(dark > 30, "only {dark} dark pixels in the title band: no text drawn");
+        assert!(save(&dir.join("p.jpg"), (10, 10), &plot()).is_err());
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
