@@ -111,6 +111,9 @@ pub struct LoadsArgs {
     /// Payload inertia about its centre of mass, platform frame: Ixx,Iyy,Izz (kg m^2). Default: none (a point mass).
     #[arg(long, allow_hyphen_values = true, requires = "input")]
     pub inertia: Option<String>,
+    /// With --input: draw each axis's demand against what its drive gives at that speed (.svg or .png).
+    #[arg(long, requires = "input", value_name = "FILE")]
+    pub plot: Option<std::path::PathBuf>,
 }
 
 /// Device commands.

@@ -1,15 +1,59 @@
-//! `ringpod loads --input motion.csv`: the drive demand along a motion, by inverse dynamics, and its peak per axis.
+//! `ringpod loads --input motion.csv`: the drive demand along a motion, by inverse dynamics, its peak per axis, and,
+//! where the rig gives motor data, what each drive gives at the speed it turns and the least margin over the motion.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use nalgebra::{Matrix3, Vector3};
-use ringpod_core::kinematics::{AxisKind, Mechanism, MotionState, Payload, Pose, RingPlatform};
+use plotters::style::colors::{BLUE, RED};
+use ringpod_core::kinematics::{AxisKind, Mechanism, MotionState, MultiTurn, Payload, Pose, RingPlatform};
 use serde::Serialize;
 
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::kinematics::Outcome;
+use crate::plot::{self, Panel, Series, TimePlot};
+use crate::rig::Drive;
 use crate::table::{self, InputError};
+
+/// What `loads --input` works on.
+pub struct Job<'a> {
+    /// Mechanism name for reports.
+    pub name: &'a str,
+    /// The platform.
+    pub ring: &'a RingPlatform<f64>,
+    /// Axis names in actuator order.
+    pub names: &'a [String; 6],
+    /// Each axis's drive, where known.
+    pub drives: &'a [Option<Drive>; 6],
+    /// The pose CSV.
+    pub input: &'a Path,
+    /// Moving mass (kg) at the geometry's centre of mass.
+    pub mass: f64,
+    /// Its inertia about the centre of mass, platform frame (kg m^2).
+    pub inertia: [f64; 3],
+    /// Where to draw demand against available, if anywhere.
+    pub plot: Option<&'a Path>,
+}
+
+/// One axis's drive against the motion: the least margin and where it happens.
+#[derive(Debug, Clone, Serialize)]
+pub struct MarginJson {
+    /// The drive, as the rig names it.
+    pub motor: String,
+    /// Least `available / demand` over the motion (below 1: the motion asks more than the motor gives, and an
+    /// open-loop stepper loses steps there).
+    pub margin: f64,
+    /// When the least margin happens (s).
+    pub margin_time_s: f64,
+    /// Demand there (axis units).
+    pub demand: f64,
+    /// What the drive gives there at that speed (axis units).
+    pub available: f64,
+    /// The motor's speed there (rpm).
+    pub motor_rpm: f64,
+    /// Rows where the demand exceeds what the drive gives.
+    pub rows_over: usize,
+}
 
 #[derive(Serialize)]
 struct DemandJson<'a> {
@@ -24,6 +68,10 @@ struct DemandJson<'a> {
     peak_time_s: [f64; 6],
     /// The drive at rest at the first pose (statics), for comparison.
     at_rest_first_pose: [f64; 6],
+    /// Each axis's drive against the motion (null where the rig gives no motor data).
+    drives: [Option<MarginJson>; 6],
+    /// Every drive with motor data keeps up (margin >= 1 on every row).
+    drives_keep_up: bool,
     rows: usize,
     /// Rows with no kinematic solution, and lines that could not be read.
     errors: Vec<InputError>,
@@ -44,16 +92,26 @@ fn derivatives(t: &[f64], v: &[f64], i: usize) -> (f64, f64) {
     (rate, accel)
 }
 
-/// Runs the command for a ring platform.
-pub fn run(
-    name: &str,
-    ring: &RingPlatform<f64>,
-    names: &[String; 6],
-    input: &Path,
-    mass: f64,
-    inertia: [f64; 3],
-    json: bool,
-) -> Result<Outcome, CliError> {
+/// The demand along a motion, row by row (rows with a solution).
+pub struct Profile {
+    /// Time of each row (s).
+    pub t: Vec<f64>,
+    /// Input line of each row.
+    pub line: Vec<usize>,
+    /// Drive demand of each row, per axis (N m or N, signed).
+    pub demand: Vec<[f64; 6]>,
+    /// Axis speed of each row (rad/s or m/s), from the unwrapped IK.
+    pub speed: Vec<[f64; 6]>,
+    /// Statics at the first pose.
+    pub at_rest: [f64; 6],
+    /// Rows without a solution, and lines that could not be read.
+    pub errors: Vec<InputError>,
+    /// Rows read.
+    pub rows: usize,
+}
+
+/// Inverse dynamics along the pose CSV at `input`.
+pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -> Result<Profile, CliError> {
     let bad = |reason: String| CliError::BadNumbers { what: "input", reason };
     let text = std::fs::read_to_string(input).map_err(|e| bad(format!("{}: {e}", input.display())))?;
     let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
@@ -61,17 +119,23 @@ pub fn run(
     if rows.len() < 3 {
         return Err(bad(format!("{} usable rows; a motion needs at least 3", rows.len())));
     }
+    if let Some(w) = rows.windows(2).find(|w| w[1].1[0] <= w[0].1[0]) {
+        return Err(bad(format!("line {}: time does not increase", w[1].0)));
+    }
     let times: Vec<f64> = rows.iter().map(|(_, r)| r[0]).collect();
     let series: Vec<Vec<f64>> = (0..6).map(|k| rows.iter().map(|(_, r)| r[k + 1]).collect()).collect();
-    let payload = Payload {
-        mass,
-        inertia: Matrix3::from_diagonal(&Vector3::from(inertia)),
-    };
     let axes = ring.axes();
-    let units: [&'static str; 6] = std::array::from_fn(|i| if axes[i] == AxisKind::Linear { "N" } else { "N m" });
-    let mut peak = [0.0f64; 6];
-    let mut peak_time = [f64::NAN; 6];
-    let mut at_rest = [f64::NAN; 6];
+    let mut out = Profile {
+        t: Vec::new(),
+        line: Vec::new(),
+        demand: Vec::new(),
+        speed: Vec::new(),
+        at_rest: [f64::NAN; 6],
+        errors: Vec::new(),
+        rows: rows.len(),
+    };
+    let mut position: Option<MultiTurn<f64>> = None;
+    let mut positions: Vec<[f64; 6]> = Vec::new();
     for (i, (line, row)) in rows.iter().enumerate() {
         let pose = Pose::from_array(std::array::from_fn(|k| row[k + 1]));
         let mut rates = [0.0; 6];
@@ -86,61 +150,220 @@ pub fn run(
         };
         let demand = ring
             .inverse(&pose)
-            .and_then(|q| Ok((q, ring.drive_demand(&state, &q, &payload)?)));
+            .and_then(|q| Ok((q, ring.drive_demand(&state, &q, payload)?)));
         match demand {
             Ok((q, d)) => {
-                if i == 0 {
-                    if let Ok(l) = ring.loads(&pose, &q, &ring.gravity_wrench(&pose, mass)) {
-                        at_rest = l.drives;
+                if out.t.is_empty() {
+                    let gravity = ring.gravity_wrench(&pose, payload.mass);
+                    if let Ok(l) = ring.loads(&pose, &q, &gravity) {
+                        out.at_rest = l.drives;
                     }
                 }
-                for k in 0..6 {
-                    if d.drives[k].abs() > peak[k] || peak_time[k].is_nan() {
-                        peak[k] = d.drives[k].abs();
-                        peak_time[k] = row[0];
-                    }
-                }
+                let p = position.get_or_insert_with(|| MultiTurn::new(q));
+                p.follow(&q, &axes);
+                positions.push(std::array::from_fn(|k| p.total(k)));
+                out.t.push(row[0]);
+                out.line.push(*line);
+                out.demand.push(d.drives);
             }
-            Err(e) => errors.push(InputError {
+            Err(e) => out.errors.push(InputError {
                 line: *line,
                 reason: e.to_string(),
             }),
         }
     }
-    let code = if errors.is_empty() { 0 } else { EXIT_CHECK_FAILED };
+    errors.append(&mut out.errors);
+    out.errors = errors;
+    let columns: Vec<Vec<f64>> = (0..6).map(|k| positions.iter().map(|q| q[k]).collect()).collect();
+    out.speed = (0..out.t.len())
+        .map(|i| std::array::from_fn(|k| derivatives(&out.t, &columns[k], i).0))
+        .collect();
+    Ok(out)
+}
+
+/// The least margin of one drive over a profile's axis `k`.
+fn margin(drive: &Drive, p: &Profile, k: usize) -> MarginJson {
+    let mut worst = MarginJson {
+        motor: drive.motor.clone(),
+        margin: f64::INFINITY,
+        margin_time_s: f64::NAN,
+        demand: 0.0,
+        available: drive.available(0.0),
+        motor_rpm: 0.0,
+        rows_over: 0,
+    };
+    for i in 0..p.t.len() {
+        let (demand, speed) = (p.demand[i][k].abs(), p.speed[i][k]);
+        let available = drive.available(speed);
+        let ratio = if demand > 0.0 {
+            available / demand
+        } else {
+            f64::INFINITY
+        };
+        if ratio < 1.0 {
+            worst.rows_over += 1;
+        }
+        if ratio < worst.margin || worst.margin_time_s.is_nan() {
+            worst = MarginJson {
+                margin: ratio,
+                margin_time_s: p.t[i],
+                demand,
+                available,
+                motor_rpm: drive.motor_rpm(speed),
+                ..worst
+            };
+        }
+    }
+    worst
+}
+
+/// Runs the command for a ring platform.
+pub fn run(job: &Job, json: bool) -> Result<Outcome, CliError> {
+    let payload = Payload {
+        mass: job.mass,
+        inertia: Matrix3::from_diagonal(&Vector3::from(job.inertia)),
+    };
+    let p = profile(job.ring, job.input, &payload)?;
+    let axes = job.ring.axes();
+    let units: [&'static str; 6] = std::array::from_fn(|i| if axes[i] == AxisKind::Linear { "N" } else { "N m" });
+    let mut peak = [0.0f64; 6];
+    let mut peak_time = [f64::NAN; 6];
+    for (i, d) in p.demand.iter().enumerate() {
+        for k in 0..6 {
+            if d[k].abs() > peak[k] || peak_time[k].is_nan() {
+                peak[k] = d[k].abs();
+                peak_time[k] = p.t[i];
+            }
+        }
+    }
+    let margins: [Option<MarginJson>; 6] = std::array::from_fn(|k| job.drives[k].as_ref().map(|d| margin(d, &p, k)));
+    let keep_up = margins.iter().flatten().all(|m| m.rows_over == 0);
+    if let Some(out) = job.plot {
+        draw(job, &p, units, out).map_err(|e| CliError::BadNumbers {
+            what: "plot",
+            reason: e.to_string(),
+        })?;
+    }
+    let code = if p.errors.is_empty() && keep_up {
+        0
+    } else {
+        EXIT_CHECK_FAILED
+    };
     let text = if json {
         let out = DemandJson {
-            mechanism: name,
-            mass_kg: mass,
-            inertia_kg_m2: inertia,
-            axes: names,
+            mechanism: job.name,
+            mass_kg: job.mass,
+            inertia_kg_m2: job.inertia,
+            axes: job.names,
             units,
             peak_demand: peak,
             peak_time_s: peak_time,
-            at_rest_first_pose: at_rest,
-            rows: rows.len(),
-            errors,
+            at_rest_first_pose: p.at_rest,
+            drives: margins,
+            drives_keep_up: keep_up,
+            rows: p.rows,
+            errors: p.errors,
         };
         serde_json::to_string_pretty(&out)? + "\n"
     } else {
         let mut t = String::new();
         let _ = writeln!(
             t,
-            "{name} moving {mass} kg (inertia {inertia:?} kg m^2) along {} ({} rows): peak demand per axis",
-            input.display(),
-            rows.len()
+            "{} moving {} kg (inertia {:?} kg m^2) along {} ({} rows): peak demand per axis",
+            job.name,
+            job.mass,
+            job.inertia,
+            job.input.display(),
+            p.rows
         );
         for k in 0..6 {
             let _ = writeln!(
                 t,
                 "  {:<4} {:>10.4} {:<4} at t = {:.3} s   (at rest at the first pose {:.4})",
-                names[k], peak[k], units[k], peak_time[k], at_rest[k]
+                job.names[k], peak[k], units[k], peak_time[k], p.at_rest[k]
             );
         }
-        for e in &errors {
+        if margins.iter().any(Option::is_some) {
+            let _ = writeln!(
+                t,
+                "drives (least available / demand over the motion; below 1 loses steps):"
+            );
+            for (k, m) in margins.iter().enumerate() {
+                let Some(m) = m else { continue };
+                let _ = writeln!(
+                    t,
+                    "  {:<4} margin {:>7.3} at t = {:.3} s: needs {:.4} {}, gives {:.4} at {:.0} rpm; {} rows over   ({})",
+                    job.names[k], m.margin, m.margin_time_s, m.demand, units[k], m.available, m.motor_rpm, m.rows_over, m.motor
+                );
+            }
+            let _ = writeln!(
+                t,
+                "{}",
+                if keep_up {
+                    "the drives keep up with this motion"
+                } else {
+                    "the motion asks more than the drives give: exit 3"
+                }
+            );
+        }
+        for e in &p.errors {
             let _ = writeln!(t, "  line {}: {}", e.line, e.reason);
         }
         t
     };
     Ok(Outcome { text, code })
+}
+
+/// Each axis's demand against what its drive gives at the speed it turns.
+fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> anyhow::Result<()> {
+    let panels = (0..6)
+        .map(|k| {
+            let mut series = vec![Series::new(
+                "demand |torque or force|",
+                p.t.iter().zip(&p.demand).map(|(t, d)| (*t, d[k].abs())).collect(),
+                RED,
+            )];
+            if let Some(d) = &job.drives[k] {
+                series.push(Series::new(
+                    format!("available: {}", d.motor),
+                    p.t.iter().zip(&p.speed).map(|(t, s)| (*t, d.available(s[k]))).collect(),
+                    BLUE,
+                ));
+            }
+            Panel {
+                title: format!("axis {} ({})", job.names[k], units[k]),
+                unit: units[k].to_owned(),
+                series,
+                events: Vec::new(),
+            }
+        })
+        .collect();
+    let plot = TimePlot {
+        title: format!(
+            "{}: drive demand for {} kg along {}",
+            job.name,
+            job.mass,
+            job.input
+                .file_name()
+                .map_or(String::new(), |f| f.to_string_lossy().into_owned())
+        ),
+        panels,
+    };
+    plot::save(out, (1000, 1300), &plot)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_point_derivatives_are_exact_for_a_parabola_on_uneven_steps() {
+        let t = [0.0, 0.1, 0.25, 0.3, 0.5];
+        let v: Vec<f64> = t.iter().map(|t| 3.0 * t * t - t + 2.0).collect();
+        for i in 1..4 {
+            let (rate, accel) = derivatives(&t, &v, i);
+            assert!((rate - (6.0 * t[i] - 1.0)).abs() < 1e-12, "{i}");
+            assert!((accel - 6.0).abs() < 1e-9, "{i}");
+        }
+    }
 }

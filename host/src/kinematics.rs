@@ -187,6 +187,7 @@ pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliErr
         name,
         home,
         mechanism: m,
+        ..
     } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
     let pose = pose_arg(common, home, m.characteristic_length(), args.pose.as_deref(), "pose")?;
     let (q, report) = m.inverse_checked(&pose).map_err(|reason| match (&m, reason) {
@@ -296,6 +297,7 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
         name,
         home,
         mechanism: m,
+        ..
     } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
     let raw = numbers::six("actuators", &args.actuators)?;
     let axes = m.axes();
@@ -385,6 +387,7 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
         name,
         home,
         mechanism: m,
+        drives,
     } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
     let AnyMechanism::Ring(ring) = &m else {
         return Err(CliError::BadNumbers {
@@ -423,7 +426,17 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
             }
             None => [0.0; 3],
         };
-        return crate::demand::run(&name, ring, &names, input, args.mass, inertia, common.json);
+        let job = crate::demand::Job {
+            name: &name,
+            ring,
+            names: &names,
+            drives: &drives,
+            input,
+            mass: args.mass,
+            inertia,
+            plot: args.plot.as_deref(),
+        };
+        return crate::demand::run(&job, common.json);
     }
     let pose = pose_arg(common, home, m.characteristic_length(), args.pose.as_deref(), "pose")?;
     let q = m.inverse(&pose)?;

@@ -8,6 +8,7 @@ use ringpod_core::kinematics::{
 };
 
 use crate::error::CliError;
+use crate::rig::Drive;
 
 /// The mechanism of a preset, in f64 for analysis.
 pub enum AnyMechanism {
@@ -25,6 +26,8 @@ pub struct Selected {
     pub home: [f64; 6],
     /// The mechanism.
     pub mechanism: AnyMechanism,
+    /// Each axis's drive, where the rig file or the preset gives one.
+    pub drives: [Option<Drive>; 6],
 }
 
 impl Selected {
@@ -37,14 +40,17 @@ impl Selected {
                     name: rig.geometry.name.to_owned(),
                     home: rig.home.to_array(),
                     mechanism: AnyMechanism::Ring(Box::new(RingPlatform::new(&rig.geometry))),
+                    drives: rig.drives,
                 })
             }
             None => {
                 let (preset, m) = AnyMechanism::by_name(mechanism)?;
+                let drives = crate::rig::drives::check(&crate::rig::drives::of_preset(preset), &m.axes())?;
                 Ok(Self {
                     name: preset.name().to_owned(),
                     home: preset.home(),
                     mechanism: m,
+                    drives,
                 })
             }
         }

@@ -494,7 +494,21 @@ fn loads_along_a_motion_report_the_peak_demand() {
     }
     std::fs::write(&still, &text).unwrap();
     let at_rest = json(&["loads", "--pose=0.01,-0.02,0.23,0.1,-0.05,0.7", "--mass", "2", "--json"]);
-    let along = json(&["loads", "--input", still.to_str().unwrap(), "--mass", "2", "--json"]);
+    // 2 kg is more than the model's FL20s hold even at rest: exit 3, with the report.
+    let with_code = |args: &[&str], code: i32| -> serde_json::Value {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(code),
+            "{}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let along = with_code(
+        &["loads", "--input", still.to_str().unwrap(), "--mass", "2", "--json"],
+        3,
+    );
     for k in 0..6 {
         let (a, b) = (
             along["peak_demand"][k].as_f64().unwrap(),
@@ -516,24 +530,44 @@ fn loads_along_a_motion_report_the_peak_demand() {
     let (moving, slowly) = (dir.join("moving.csv"), dir.join("slowly.csv"));
     let mut text = write(&moving, 1.0);
     write(&slowly, 100.0);
-    let fast = json(&[
-        "loads",
-        "--input",
-        moving.to_str().unwrap(),
-        "--mass",
-        "2",
-        "--inertia=0.02,0.02,0.04",
-        "--json",
-    ]);
-    let slow = json(&[
-        "loads",
-        "--input",
-        slowly.to_str().unwrap(),
-        "--mass",
-        "2",
-        "--inertia=0.02,0.02,0.04",
-        "--json",
-    ]);
+    // The model's FL20s cannot carry 2 kg this fast: the command says so with exit 3, and still reports.
+    let fast = with_code(
+        &[
+            "loads",
+            "--input",
+            moving.to_str().unwrap(),
+            "--mass",
+            "2",
+            "--inertia=0.02,0.02,0.04",
+            "--json",
+        ],
+        3,
+    );
+    let slow = with_code(
+        &[
+            "loads",
+            "--input",
+            slowly.to_str().unwrap(),
+            "--mass",
+            "2",
+            "--inertia=0.02,0.02,0.04",
+            "--json",
+        ],
+        3,
+    );
+    assert_eq!(fast["drives_keep_up"], false);
+    for k in 0..6 {
+        let d = &fast["drives"][k];
+        let (margin, demand, available) = (
+            d["margin"].as_f64().unwrap(),
+            d["demand"].as_f64().unwrap(),
+            d["available"].as_f64().unwrap(),
+        );
+        assert!((margin - available / demand).abs() < 1e-12, "{d}");
+        assert!(margin < 1.0 && d["rows_over"].as_u64().unwrap() > 0, "{d}");
+    }
+    // 2 mm per turn at 0.25 m/s (the heave's peak speed) is 7,500 rpm: beyond the motor's curve, nothing left.
+    assert_eq!(fast["drives"][4]["available"].as_f64(), Some(0.0));
     let peak = |v: &serde_json::Value, k: usize| v["peak_demand"][k].as_f64().unwrap();
     assert!((0..6).all(|k| peak(&fast, k) >= peak(&slow, k)), "{fast} vs {slow}");
     assert!(
@@ -547,5 +581,72 @@ fn loads_along_a_motion_report_the_peak_demand() {
         .assert()
         .code(3)
         .stdout(predicate::str::contains("line 1002"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A light payload moved gently keeps every FL20 inside its curve (exit 0); a rig file's own drives replace the
+/// preset's, and a rig without drives reports no margin.
+#[test]
+fn loads_set_the_motion_against_the_drives_of_the_rig() {
+    let dir = std::env::temp_dir().join(format!("ringpod-drives-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let gentle = dir.join("gentle.csv");
+    let mut text = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for i in 0..500 {
+        let t = f64::from(i) * 0.01;
+        let z = 0.227 + 0.01 * (std::f64::consts::TAU * 0.2 * t).sin();
+        text += &format!("{t},0,0,{z},0,0,{}\n", 0.3 * t);
+    }
+    std::fs::write(&gentle, &text).unwrap();
+    let args = |extra: &[&str]| -> Vec<String> {
+        let mut a: Vec<String> = ["loads", "--input", gentle.to_str().unwrap(), "--mass", "0.05", "--json"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a
+    };
+    let preset = json(&args(&[]).iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(preset["drives_keep_up"], true, "{preset}");
+    assert!((0..6).all(|k| preset["drives"][k]["margin"].as_f64().unwrap() >= 1.0));
+    // The same rig as a file, its drives halved: the margins halve (the demand is the same).
+    let exported = ringpod()
+        .args(["presets", "--export", "trainer-model"])
+        .output()
+        .unwrap();
+    let rig = String::from_utf8(exported.stdout).unwrap();
+    assert!(rig.contains("[[drives]]"), "{rig}");
+    let halved = rig.replace("efficiency = 0.9", "efficiency = 0.45");
+    let file = dir.join("rig.toml");
+    std::fs::write(&file, &halved).unwrap();
+    let out = ringpod()
+        .args(args(&["--geometry", file.to_str().unwrap()]))
+        .output()
+        .unwrap();
+    let own: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for k in 0..4 {
+        let (a, b) = (
+            preset["drives"][k]["margin"].as_f64().unwrap(),
+            own["drives"][k]["margin"].as_f64().unwrap(),
+        );
+        assert!((b - a / 2.0).abs() < 1e-9 * a, "axis {k}: {a} vs {b}");
+    }
+    // Without [[drives]]: peak demand only, no margin, exit 0.
+    let start = halved.find("[[drives]]").unwrap();
+    std::fs::write(&file, &halved[..start]).unwrap();
+    let bare = json(
+        &args(&["--geometry", file.to_str().unwrap()])
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!((0..6).all(|k| bare["drives"][k].is_null()), "{bare}");
+    // A drive that names a missing axis is refused with its key.
+    std::fs::write(&file, halved.replacen("axes = [5, 6]", "axes = [5, 7]", 1)).unwrap();
+    ringpod()
+        .args(args(&["--geometry", file.to_str().unwrap()]))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("drives[1].axes"));
     let _ = std::fs::remove_dir_all(&dir);
 }

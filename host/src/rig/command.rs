@@ -25,7 +25,7 @@ pub fn export(name: &str) -> Result<Outcome, CliError> {
         });
     };
     let ranges = (preset == Preset::TrainerModel).then_some(presets::TRAINER_MODEL_RANGES);
-    let file = RigFile::of(g, preset.home(), ranges);
+    let file = RigFile::of(g, preset.home(), ranges, super::drives::of_preset(preset));
     let body = toml::to_string(&file).map_err(|e| CliError::BadNumbers {
         what: "export",
         reason: e.to_string(),

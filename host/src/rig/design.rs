@@ -211,6 +211,7 @@ mod tests {
             &presets::TRAINER_MODEL,
             Preset::TrainerModel.home(),
             Some(presets::TRAINER_MODEL_RANGES),
+            Vec::new(),
         )
     }
 

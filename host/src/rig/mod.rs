@@ -31,9 +31,11 @@
 mod command;
 mod coverage;
 mod design;
+pub mod drives;
 
 pub use command::{check_command, design_command, export};
 pub use coverage::coverage;
+pub use drives::{Drive, DriveSpec};
 
 use std::fmt;
 use std::path::Path;
@@ -62,6 +64,9 @@ pub struct RigFile {
     /// Motion ranges around home that `ringpod rig check` measures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spec: Option<SpecRanges>,
+    /// Motor data per axis, for the drive margin of `ringpod loads --input` (optional).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drives: Vec<DriveSpec>,
 }
 
 /// One chain.
@@ -177,15 +182,22 @@ impl fmt::Display for RigError {
 
 impl std::error::Error for RigError {}
 
-fn err<T>(key: impl Into<String>, why: impl Into<String>) -> Result<T, RigError> {
-    Err(RigError {
-        key: key.into(),
-        why: why.into(),
-    })
+impl RigError {
+    /// An error of `key`.
+    pub fn new(key: impl Into<String>, why: impl Into<String>) -> Self {
+        Self {
+            key: key.into(),
+            why: why.into(),
+        }
+    }
 }
 
-/// A checked rig: the geometry the core drives, its home pose and spec ranges.
-#[derive(Debug, Clone, Copy)]
+fn err<T>(key: impl Into<String>, why: impl Into<String>) -> Result<T, RigError> {
+    Err(RigError::new(key, why))
+}
+
+/// A checked rig: the geometry the core drives, its home pose, spec ranges and drives.
+#[derive(Debug, Clone)]
 pub struct Rig {
     /// The geometry.
     pub geometry: RingGeometry,
@@ -193,6 +205,8 @@ pub struct Rig {
     pub home: Pose<f64>,
     /// The spec ranges, if the file gives them (m and rad).
     pub ranges: Option<[f64; 5]>,
+    /// Each axis's drive, where the file gives one.
+    pub drives: [Option<Drive>; 6],
 }
 
 /// Reads and checks a rig file.
@@ -271,7 +285,13 @@ impl RigFile {
             }
             None => None,
         };
-        Ok(Rig { geometry, home, ranges })
+        let drives = drives::check(&self.drives, &m.axes())?;
+        Ok(Rig {
+            geometry,
+            home,
+            ranges,
+            drives,
+        })
     }
 
     /// The geometry of the file, every key checked but the home pose.
@@ -376,7 +396,7 @@ impl RigFile {
     }
 
     /// The rig file of a geometry (what `ringpod presets --export` writes).
-    pub fn of(geometry: &RingGeometry, home: [f64; 6], ranges: Option<[f64; 5]>) -> Self {
+    pub fn of(geometry: &RingGeometry, home: [f64; 6], ranges: Option<[f64; 5]>, drives: Vec<DriveSpec>) -> Self {
         let l = &geometry.limits;
         let has_radial = geometry.chains().iter().any(|c| c.kind == ChainKind::Radial);
         Self {
@@ -415,6 +435,7 @@ impl RigFile {
                 roll_deg: degrees(r[3]),
                 pitch_deg: degrees(r[4]),
             }),
+            drives,
         }
     }
 }
@@ -442,6 +463,7 @@ mod tests {
             &presets::TRAINER_MODEL,
             Preset::TrainerModel.home(),
             Some(presets::TRAINER_MODEL_RANGES),
+            drives::of_preset(Preset::TrainerModel),
         )
     }
 
