@@ -255,7 +255,8 @@ mod tests {
     #[test]
     fn every_bad_drive_names_its_key() {
         let good = trainer_model();
-        let cases: [(&str, fn(&mut Vec<DriveSpec>)); 10] = [
+        type Spoil = fn(&mut Vec<DriveSpec>);
+        let cases: [(&str, Spoil); 10] = [
             ("drives[0].axes", |d| d[0].axes = vec![]),
             ("drives[0].axes", |d| d[0].axes = vec![7]),
             ("drives[1].axes", |d| d[1].axes = vec![5, 5]),
