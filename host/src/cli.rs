@@ -215,6 +215,17 @@ pub struct StreamArgs {
     /// Print one JSON report at the end.
     #[arg(long)]
     pub report_json: bool,
+    /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics, the trainer
+    /// model's FL20 data) for a payload of --mass kg; where it exceeds the motors, say where and do not stream
+    /// (exit 1).
+    #[arg(long, requires = "mass", conflicts_with_all = ["udp", "telemetry_udp"])]
+    pub check_loads: bool,
+    /// With --check-loads: the moving mass (kg) at the model's centre of mass.
+    #[arg(long, requires = "check_loads")]
+    pub mass: Option<f64>,
+    /// With --check-loads: its inertia Ixx,Iyy,Izz (kg m^2) about the centre of mass.
+    #[arg(long, allow_hyphen_values = true, requires = "check_loads")]
+    pub inertia: Option<String>,
 }
 
 #[derive(Debug, Args)]

@@ -53,6 +53,8 @@ pub struct MarginJson {
     pub motor_rpm: f64,
     /// Rows where the demand exceeds what the drive gives.
     pub rows_over: usize,
+    /// When the demand first exceeds it (s), if it does.
+    pub first_over_s: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -92,6 +94,15 @@ fn derivatives(t: &[f64], v: &[f64], i: usize) -> (f64, f64) {
     (rate, accel)
 }
 
+/// Makes a sampled angle continuous: each step is taken the short way round.
+fn unwrap(angle: &mut [f64]) {
+    use std::f64::consts::{PI, TAU};
+    for i in 1..angle.len() {
+        let step = (angle[i] - angle[i - 1] + PI).rem_euclid(TAU) - PI;
+        angle[i] = angle[i - 1] + step;
+    }
+}
+
 /// The demand along a motion, row by row (rows with a solution).
 pub struct Profile {
     /// Time of each row (s).
@@ -115,15 +126,40 @@ pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -
     let bad = |reason: String| CliError::BadNumbers { what: "input", reason };
     let text = std::fs::read_to_string(input).map_err(|e| bad(format!("{}: {e}", input.display())))?;
     let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
-    let (rows, mut errors) = table::read(&text, &columns).map_err(bad)?;
+    let (rows, errors) = table::read(&text, &columns).map_err(bad)?;
+    let rows: Vec<(usize, f64, Pose<f64>)> = rows
+        .into_iter()
+        .map(|(line, r)| (line, r[0], Pose::from_array(std::array::from_fn(|k| r[k + 1]))))
+        .collect();
+    let mut p = profile_of(ring, &rows, payload).map_err(bad)?;
+    let mut all = errors;
+    all.append(&mut p.errors);
+    all.sort_by_key(|e| e.line);
+    p.errors = all;
+    Ok(p)
+}
+
+/// Inverse dynamics along timed poses `(line, t, pose)`, times rising.
+pub fn profile_of(
+    ring: &RingPlatform<f64>,
+    rows: &[(usize, f64, Pose<f64>)],
+    payload: &Payload<f64>,
+) -> Result<Profile, String> {
     if rows.len() < 3 {
-        return Err(bad(format!("{} usable rows; a motion needs at least 3", rows.len())));
+        return Err(format!("{} usable rows; a motion needs at least 3", rows.len()));
     }
-    if let Some(w) = rows.windows(2).find(|w| w[1].1[0] <= w[0].1[0]) {
-        return Err(bad(format!("line {}: time does not increase", w[1].0)));
+    if let Some(w) = rows.windows(2).find(|w| !(w[1].1 > w[0].1)) {
+        return Err(format!("line {}: time does not increase", w[1].0));
     }
-    let times: Vec<f64> = rows.iter().map(|(_, r)| r[0]).collect();
-    let series: Vec<Vec<f64>> = (0..6).map(|k| rows.iter().map(|(_, r)| r[k + 1]).collect()).collect();
+    let times: Vec<f64> = rows.iter().map(|r| r.1).collect();
+    let mut series: Vec<Vec<f64>> = (0..6)
+        .map(|k| rows.iter().map(|r| r.2.to_array()[k]).collect())
+        .collect();
+    // An angle that jumps by more than half a turn between two samples wrapped (a yaw written in [0, 2 pi)); the
+    // motion is the short way round.
+    for angle in &mut series[3..] {
+        unwrap(angle);
+    }
     let axes = ring.axes();
     let mut out = Profile {
         t: Vec::new(),
@@ -136,8 +172,7 @@ pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -
     };
     let mut position: Option<MultiTurn<f64>> = None;
     let mut positions: Vec<[f64; 6]> = Vec::new();
-    for (i, (line, row)) in rows.iter().enumerate() {
-        let pose = Pose::from_array(std::array::from_fn(|k| row[k + 1]));
+    for (i, &(line, t, pose)) in rows.iter().enumerate() {
         let mut rates = [0.0; 6];
         let mut accelerations = [0.0; 6];
         for k in 0..6 {
@@ -162,18 +197,16 @@ pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -
                 let p = position.get_or_insert_with(|| MultiTurn::new(q));
                 p.follow(&q, &axes);
                 positions.push(std::array::from_fn(|k| p.total(k)));
-                out.t.push(row[0]);
-                out.line.push(*line);
+                out.t.push(t);
+                out.line.push(line);
                 out.demand.push(d.drives);
             }
             Err(e) => out.errors.push(InputError {
-                line: *line,
+                line,
                 reason: e.to_string(),
             }),
         }
     }
-    errors.append(&mut out.errors);
-    out.errors = errors;
     let columns: Vec<Vec<f64>> = (0..6).map(|k| positions.iter().map(|q| q[k]).collect()).collect();
     out.speed = (0..out.t.len())
         .map(|i| std::array::from_fn(|k| derivatives(&out.t, &columns[k], i).0))
@@ -191,6 +224,7 @@ fn margin(drive: &Drive, p: &Profile, k: usize) -> MarginJson {
         available: drive.available(0.0),
         motor_rpm: 0.0,
         rows_over: 0,
+        first_over_s: None,
     };
     for i in 0..p.t.len() {
         let (demand, speed) = (p.demand[i][k].abs(), p.speed[i][k]);
@@ -202,6 +236,7 @@ fn margin(drive: &Drive, p: &Profile, k: usize) -> MarginJson {
         };
         if ratio < 1.0 {
             worst.rows_over += 1;
+            worst.first_over_s.get_or_insert(p.t[i]);
         }
         if ratio < worst.margin || worst.margin_time_s.is_nan() {
             worst = MarginJson {
@@ -215,6 +250,69 @@ fn margin(drive: &Drive, p: &Profile, k: usize) -> MarginJson {
         }
     }
     worst
+}
+
+/// What `stream --check-loads` found before anything moved.
+pub struct Preflight {
+    /// Every drive with motor data keeps up along the whole motion.
+    pub keeps_up: bool,
+    /// A line per axis with motor data, and the poses that have no solution (the stream limits those).
+    pub text: String,
+}
+
+/// `stream --check-loads`: where a motion would ask more of the drives than they give, before anything moves.
+pub fn preflight(
+    ring: &RingPlatform<f64>,
+    drives: &[Option<Drive>; 6],
+    rows: &[(usize, f64, Pose<f64>)],
+    payload: &Payload<f64>,
+) -> Result<Preflight, String> {
+    let p = profile_of(ring, rows, payload)?;
+    let axes = ring.axes();
+    let mut text = String::new();
+    let mut keeps_up = true;
+    for (k, drive) in drives.iter().enumerate() {
+        let Some(drive) = drive else { continue };
+        let unit = if axes[k] == AxisKind::Linear { "N" } else { "N m" };
+        let m = margin(drive, &p, k);
+        let axis = k + 1;
+        match m.first_over_s {
+            Some(first) => {
+                keeps_up = false;
+                let _ = writeln!(
+                    text,
+                    "axis {axis}: over its drive from t = {first:.3} s, {} of {} poses; worst at t = {:.3} s: needs \
+                     {:.4} {unit}, {} gives {:.4} at {:.0} rpm (margin {:.3})",
+                    m.rows_over,
+                    p.t.len(),
+                    m.margin_time_s,
+                    m.demand,
+                    m.motor,
+                    m.available,
+                    m.motor_rpm,
+                    m.margin
+                );
+            }
+            None => {
+                let _ = writeln!(
+                    text,
+                    "axis {axis}: keeps up (least margin {:.3} at t = {:.3} s)",
+                    m.margin, m.margin_time_s
+                );
+            }
+        }
+    }
+    if drives.iter().all(Option::is_none) {
+        text += "no motor data for this geometry: nothing to check against\n";
+    }
+    if !p.errors.is_empty() {
+        let _ = writeln!(
+            text,
+            "{} poses have no solution and were left out (the stream limits them into the envelope)",
+            p.errors.len()
+        );
+    }
+    Ok(Preflight { keeps_up, text })
 }
 
 /// Runs the command for a ring platform.
@@ -355,6 +453,15 @@ fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> anyhow::Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_wrapped_yaw_is_followed_the_short_way() {
+        let mut yaw = [6.0, 6.2, 0.1, 0.3, 6.2];
+        unwrap(&mut yaw);
+        let tau = std::f64::consts::TAU;
+        let want = [6.0, 6.2, 0.1 + tau, 0.3 + tau, 6.2];
+        assert!(yaw.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12), "{yaw:?}");
+    }
 
     #[test]
     fn three_point_derivatives_are_exact_for_a_parabola_on_uneven_steps() {

@@ -395,37 +395,10 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
             reason: "statics are for ring platforms".into(),
         });
     };
-    // A payload up to a thousand tonnes: beyond that the number is a mistake, not a simulator.
-    if !(args.mass.is_finite() && (0.0..=1e6).contains(&args.mass)) {
-        return Err(CliError::BadNumbers {
-            what: "mass",
-            reason: format!("{} kg is out of range (0 to 1e6 kg)", numbers::readable(args.mass)),
-        });
-    }
+    numbers::mass(args.mass)?;
     let names = m.axis_names();
     if let Some(input) = &args.input {
-        let inertia = match &args.inertia {
-            Some(text) => {
-                let v: Vec<f64> = text
-                    .split(',')
-                    .map(|s| s.trim().parse::<f64>())
-                    .collect::<Result<_, _>>()
-                    .map_err(|e| CliError::BadNumbers {
-                        what: "inertia",
-                        reason: e.to_string(),
-                    })?;
-                match v[..] {
-                    [a, b, c] if v.iter().all(|x| x.is_finite() && (0.0..=1e6).contains(x)) => [a, b, c],
-                    _ => {
-                        return Err(CliError::BadNumbers {
-                            what: "inertia",
-                            reason: "three numbers Ixx,Iyy,Izz, each 0 to 1e6 kg m^2".into(),
-                        })
-                    }
-                }
-            }
-            None => [0.0; 3],
-        };
+        let inertia = numbers::inertia(args.inertia.as_deref())?;
         let job = crate::demand::Job {
             name: &name,
             ring,

@@ -141,6 +141,20 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
             Vec::new(),
         ),
     };
+    if args.check_loads {
+        let payload = ringpod_core::kinematics::Payload {
+            mass: numbers::mass(args.mass.unwrap_or(f64::NAN))?,
+            inertia: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::from(numbers::inertia(
+                args.inertia.as_deref(),
+            )?)),
+        };
+        let check = stream::check_loads(&source, &payload)?;
+        eprint!("{}", check.text);
+        if !check.keeps_up {
+            eprintln!("ringpod: the motion asks more than the drives give (--check-loads): not streamed");
+            return Ok(stream::exit::NOT_STARTED);
+        }
+    }
     let mut client = client::Client::new(connect(args.port.as_deref(), args.sim, !args.fast)?);
     client.cancel = Some(interrupted.clone());
     // The bar draws on stderr (and hides itself without a terminal), the report on stdout.

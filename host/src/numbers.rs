@@ -119,3 +119,33 @@ mod tests {
         }
     }
 }
+
+/// A payload mass (kg): up to a thousand tonnes; beyond that the number is a mistake, not a simulator.
+pub fn mass(kg: f64) -> Result<f64, CliError> {
+    if kg.is_finite() && (0.0..=1e6).contains(&kg) {
+        Ok(kg)
+    } else {
+        Err(CliError::BadNumbers {
+            what: "mass",
+            reason: format!("{} kg is out of range (0 to 1e6 kg)", readable(kg)),
+        })
+    }
+}
+
+/// `--inertia=Ixx,Iyy,Izz` (kg m^2, each 0 to 1e6); none is a point mass.
+pub fn inertia(text: Option<&str>) -> Result<[f64; 3], CliError> {
+    let Some(text) = text else { return Ok([0.0; 3]) };
+    let bad = |reason: String| CliError::BadNumbers {
+        what: "inertia",
+        reason,
+    };
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| bad(e.to_string()))?;
+    match v[..] {
+        [a, b, c] if v.iter().all(|x| x.is_finite() && (0.0..=1e6).contains(x)) => Ok([a, b, c]),
+        _ => Err(bad("three numbers Ixx,Iyy,Izz, each 0 to 1e6 kg m^2".into())),
+    }
+}

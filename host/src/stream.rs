@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressStyle};
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
-use ringpod_core::kinematics::{Check, Pose, RingPlatform};
+use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, MotionLimits, RejectReason, Setpoint};
 use ringpod_core::protocol::{ConfigKey, HostMessage, Status};
 use ringpod_core::safety::{FaultReason, State};
@@ -100,6 +100,37 @@ pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputE
         .map(|(line, v)| (line, v[0], Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6]))))
         .collect();
     Ok((poses, errors))
+}
+
+/// `stream --check-loads`: the drive demand of a file's or built-in motion's poses on the trainer model, against
+/// its drives, before anything moves.
+pub fn check_loads(
+    source: &Source,
+    payload: &ringpod_core::kinematics::Payload<f64>,
+) -> anyhow::Result<crate::demand::Preflight> {
+    let PresetGeometry::Ring(geometry) = Preset::TrainerModel.geometry() else {
+        anyhow::bail!("the trainer model is a ring platform");
+    };
+    let ring = RingPlatform::new(geometry);
+    let drives = crate::rig::drives::check(&crate::rig::drives::of_preset(Preset::TrainerModel), &ring.axes())?;
+    let rows: Vec<(usize, f64, Pose<f64>)> = match source {
+        Source::Poses(p) => p.clone(),
+        Source::Motion {
+            motion,
+            seconds,
+            rate_hz,
+        } => {
+            let n = (seconds * rate_hz).round() as usize;
+            (0..=n)
+                .map(|k| {
+                    let t = k as f64 / rate_hz;
+                    (k + 1, t, motion_pose(*motion, t, Preset::TrainerModel.home()))
+                })
+                .collect()
+        }
+        Source::Udp(_) => anyhow::bail!("--check-loads needs the poses beforehand (--input or --motion)"),
+    };
+    crate::demand::preflight(&ring, &drives, &rows, payload).map_err(|e| anyhow::anyhow!("--check-loads: {e}"))
 }
 
 /// Pose of a built-in motion at time `t` (s) around `home`. Every motion stays inside the envelope at any time

@@ -650,3 +650,44 @@ fn loads_set_the_motion_against_the_drives_of_the_rig() {
         .stderr(predicate::str::contains("drives[1].axes"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `stream --check-loads` predicts the drive demand before moving: a payload the FL20s cannot carry through the
+/// yaw motion is not streamed (exit 1) and the report says which axes and from when; a light one streams.
+#[test]
+fn stream_check_loads_refuses_a_motion_the_motors_cannot_carry() {
+    let run = |mass: &str| {
+        ringpod()
+            .args([
+                "stream",
+                "--sim",
+                "--fast",
+                "--motion",
+                "yaw",
+                "--duration",
+                "3",
+                "--quiet",
+            ])
+            .args(["--check-loads", "--mass", mass, "--report-json"])
+            .output()
+            .unwrap()
+    };
+    let heavy = run("0.5");
+    let said = String::from_utf8_lossy(&heavy.stderr);
+    assert_eq!(heavy.status.code(), Some(1), "{said}");
+    assert!(heavy.stdout.is_empty(), "a refused stream sends nothing");
+    for axis in 1..=4 {
+        assert!(
+            said.contains(&format!("axis {axis}: over its drive from t = 0.000 s")),
+            "{said}"
+        );
+    }
+    assert!(said.contains("not streamed"), "{said}");
+    let light = run("0.02");
+    let said = String::from_utf8_lossy(&light.stderr);
+    assert_eq!(light.status.code(), Some(0), "{said}");
+    assert_eq!(said.matches("keeps up").count(), 6, "{said}");
+    let report: serde_json::Value = serde_json::from_slice(&light.stdout).unwrap();
+    assert_eq!(report["setpoints_sent"], 3001);
+    // --mass belongs to --check-loads, and --check-loads needs it.
+    ringpod().args(["stream", "--sim", "--check-loads"]).assert().code(2);
+}

@@ -183,17 +183,18 @@ pub fn of_preset(preset: Preset) -> Vec<DriveSpec> {
 
 /// The 1:20 trainer model's FL20 drives, as far as the sources give them (see `source`).
 fn trainer_model() -> Vec<DriveSpec> {
-    // NEMA 8 (20 mm) hybrid stepper: 0.018 N m holding in the FL20STH30 size, a pull-out curve that falls to
-    // nothing near 1,800 rpm on a 24 V chopper driver. The sources give the motor family, 200 steps/rev and the
-    // ring gear (~8:1), not a torque curve: the shape is assumed from NEMA 8 catalogue curves.
+    // NEMA 8 (20 mm) hybrid stepper, FL20STH30 size: 0.018 N m holding. The sources give the motor family, 200
+    // steps/rev and the ring gear (~8:1), not a torque curve: the curve's shape is assumed from NEMA 8 catalogue
+    // curves on a 24 V chopper driver (a small, low-inductance motor: slow fall, nothing left near 3,600 rpm).
     let pull_out = vec![
         [0.0, 0.016],
-        [300.0, 0.014],
-        [600.0, 0.011],
-        [900.0, 0.008],
-        [1200.0, 0.005],
-        [1500.0, 0.0025],
-        [1800.0, 0.0],
+        [300.0, 0.015],
+        [600.0, 0.013],
+        [1200.0, 0.009],
+        [1800.0, 0.006],
+        [2400.0, 0.0035],
+        [3000.0, 0.0015],
+        [3600.0, 0.0],
     ];
     let source = "assumed: FL20STH30 size (0.018 N m holding), NEMA 8 curve shape at 24 V; measure yours".to_owned();
     vec![
@@ -235,8 +236,8 @@ mod tests {
     fn torque_interpolates_and_ends_at_the_last_speed() {
         let d = check(&trainer_model(), &TRAINER_AXES).unwrap()[0].clone().unwrap();
         assert_eq!(d.motor_torque(0.0), 0.016);
-        assert!((d.motor_torque(150.0) - 0.015).abs() < 1e-15);
-        assert_eq!(d.motor_torque(1800.0), 0.0);
+        assert!((d.motor_torque(150.0) - 0.0155).abs() < 1e-15);
+        assert_eq!(d.motor_torque(3600.0), 0.0);
         assert_eq!(d.motor_torque(5000.0), 0.0);
         // 1 rad/s at the carriage is 8 rad/s at the motor: 76.4 rpm.
         assert!((d.motor_rpm(-1.0) - 8.0 * 60.0 / TAU).abs() < 1e-12);
