@@ -148,7 +148,10 @@ pub fn profile_of(
     if rows.len() < 3 {
         return Err(format!("{} usable rows; a motion needs at least 3", rows.len()));
     }
-    if let Some(w) = rows.windows(2).find(|w| !(w[1].1 > w[0].1)) {
+    if let Some(w) = rows
+        .windows(2)
+        .find(|w| w[1].1.partial_cmp(&w[0].1) != Some(std::cmp::Ordering::Greater))
+    {
         return Err(format!("line {}: time does not increase", w[1].0));
     }
     let times: Vec<f64> = rows.iter().map(|r| r.1).collect();

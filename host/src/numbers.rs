@@ -75,6 +75,36 @@ pub fn length_in_range(what: &'static str, value: f64, length: f64) -> Result<()
     }
 }
 
+/// A payload mass (kg): up to a thousand tonnes; beyond that the number is a mistake, not a simulator.
+pub fn mass(kg: f64) -> Result<f64, CliError> {
+    if kg.is_finite() && (0.0..=1e6).contains(&kg) {
+        Ok(kg)
+    } else {
+        Err(CliError::BadNumbers {
+            what: "mass",
+            reason: format!("{} kg is out of range (0 to 1e6 kg)", readable(kg)),
+        })
+    }
+}
+
+/// `--inertia=Ixx,Iyy,Izz` (kg m^2, each 0 to 1e6); none is a point mass.
+pub fn inertia(text: Option<&str>) -> Result<[f64; 3], CliError> {
+    let Some(text) = text else { return Ok([0.0; 3]) };
+    let bad = |reason: String| CliError::BadNumbers {
+        what: "inertia",
+        reason,
+    };
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|s| s.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| bad(e.to_string()))?;
+    match v[..] {
+        [a, b, c] if v.iter().all(|x| x.is_finite() && (0.0..=1e6).contains(x)) => Ok([a, b, c]),
+        _ => Err(bad("three numbers Ixx,Iyy,Izz, each 0 to 1e6 kg m^2".into())),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -117,35 +147,5 @@ mod tests {
         for v in [f64::NAN, f64::INFINITY, 31.0, -1e300] {
             assert!(length_in_range("z", v, 0.3).is_err(), "{v}");
         }
-    }
-}
-
-/// A payload mass (kg): up to a thousand tonnes; beyond that the number is a mistake, not a simulator.
-pub fn mass(kg: f64) -> Result<f64, CliError> {
-    if kg.is_finite() && (0.0..=1e6).contains(&kg) {
-        Ok(kg)
-    } else {
-        Err(CliError::BadNumbers {
-            what: "mass",
-            reason: format!("{} kg is out of range (0 to 1e6 kg)", readable(kg)),
-        })
-    }
-}
-
-/// `--inertia=Ixx,Iyy,Izz` (kg m^2, each 0 to 1e6); none is a point mass.
-pub fn inertia(text: Option<&str>) -> Result<[f64; 3], CliError> {
-    let Some(text) = text else { return Ok([0.0; 3]) };
-    let bad = |reason: String| CliError::BadNumbers {
-        what: "inertia",
-        reason,
-    };
-    let v: Vec<f64> = text
-        .split(',')
-        .map(|s| s.trim().parse::<f64>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| bad(e.to_string()))?;
-    match v[..] {
-        [a, b, c] if v.iter().all(|x| x.is_finite() && (0.0..=1e6).contains(x)) => Ok([a, b, c]),
-        _ => Err(bad("three numbers Ixx,Iyy,Izz, each 0 to 1e6 kg m^2".into())),
     }
 }
