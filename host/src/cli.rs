@@ -45,6 +45,9 @@ pub enum Command {
     Ports,
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
     Loads(LoadsArgs),
+    /// Loads of a tool wrench on the five-DOF tool carrier (paper 003's projection method): drive forces and
+    /// torques, the X guide's bearing load, the frame pivots' forces and the constraint couple.
+    Reactions(ReactionsArgs),
     /// Scans the workspace with all checks (in parallel), draws a section coloured by the limiting check, and
     /// prints the section's area, the reachable ranges, the volume, and whether the spec ranges are inside.
     Workspace(WorkspaceArgs),
@@ -114,6 +117,18 @@ pub struct LoadsArgs {
     /// With --input: draw each axis's demand against what its drive gives at that speed (.svg or .png).
     #[arg(long, requires = "input", value_name = "FILE")]
     pub plot: Option<std::path::PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ReactionsArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees; gamma 0). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// Wrench on the tool at its point, base frame: fx,fy,fz (N),mx,my,mz (N m).
+    #[arg(long, allow_hyphen_values = true)]
+    pub wrench: String,
 }
 
 /// Device commands.

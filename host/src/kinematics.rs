@@ -160,7 +160,7 @@ fn singularity_name(s: Singularity) -> &'static str {
     }
 }
 
-fn pose_arg(
+pub(crate) fn pose_arg(
     common: &Common,
     home: [f64; 6],
     length: f64,

@@ -11,6 +11,7 @@ mod mechanism;
 mod numbers;
 mod plot;
 mod pty;
+mod reactions;
 mod rig;
 mod settings;
 mod stream;
@@ -45,6 +46,7 @@ fn main() -> ExitCode {
         C::Check(args) => answer(kinematics::ik(args, true)),
         C::Fk(args) => answer(kinematics::fk(args)),
         C::Loads(args) => answer(kinematics::loads(args)),
+        C::Reactions(args) => answer(reactions::run(args)),
         C::Stream(args) => stream_command(args),
         C::Device(args) => device_command(args),
         C::Ports => ports_command(),

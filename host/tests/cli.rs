@@ -691,3 +691,41 @@ fn stream_check_loads_refuses_a_motion_the_motors_cannot_carry() {
     // --mass belongs to --check-loads, and --check-loads needs it.
     ringpod().args(["stream", "--sim", "--check-loads"]).assert().code(2);
 }
+
+/// `reactions`: a downward load at the tool of the tool carrier at its home pose is carried half by each frame
+/// pivot, the X carriage carries the X force; ring platforms are pointed to `loads`; a bad wrench is refused.
+#[test]
+fn reactions_share_a_tool_load_between_the_pivots() {
+    let v = json(&[
+        "reactions",
+        "-m",
+        "tool5-ex",
+        "--pose=0,0,0.4,0,0,0",
+        "--wrench=7,0,-100,0,0,0",
+        "--json",
+    ]);
+    let f = |k: usize, i: usize| v["pivot_forces"][k][i].as_f64().unwrap();
+    assert!((f(0, 2) + f(1, 2) - 100.0).abs() < 1e-9, "{v}");
+    assert!((f(0, 2) - f(1, 2)).abs() < 1e-9, "{v}");
+    assert!((v["drives"][0].as_f64().unwrap() + 7.0).abs() < 1e-9, "{v}");
+    assert_eq!(v["drive_names"][4], "q5 pitch");
+    ringpod()
+        .args(["reactions", "--wrench=0,0,-1,0,0,0"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("ringpod loads"));
+    ringpod()
+        .args(["reactions", "-m", "tool5-ex", "--wrench=0,0,nan,0,0,0"])
+        .assert()
+        .code(1);
+    ringpod()
+        .args([
+            "reactions",
+            "-m",
+            "tool5-ex",
+            "--pose=0,0,0.4,0,0,0.2",
+            "--wrench=0,0,-1,0,0,0",
+        ])
+        .assert()
+        .code(1);
+}

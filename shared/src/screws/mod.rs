@@ -2,8 +2,10 @@
 //! product, paper 002's matrix method for closed loops ([`matrix`]) and paper 003's generalised reactions
 //! ([`reactions`]).
 
+pub mod chains;
 pub mod matrix;
 pub mod reactions;
+pub mod tool;
 
 use nalgebra::{Vector3, Vector6};
 

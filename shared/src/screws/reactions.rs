@@ -118,7 +118,7 @@ pub fn reactions(actuation: &[Vector6<f64>], constraints: &[Vector6<f64>], p: &V
 }
 
 /// A small fixed-capacity list of rows (at most six), so the module needs no allocator.
-mod heapless_rows {
+pub(super) mod heapless_rows {
     use nalgebra::Vector6;
 
     #[derive(Default)]
