@@ -28,5 +28,6 @@ pub mod safety;
 pub mod screws;
 pub mod selfcheck;
 pub mod sim;
+pub mod store;
 
 pub use real::Real;
