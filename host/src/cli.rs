@@ -37,8 +37,17 @@ pub enum Command {
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
     /// lines that could not be read, 4 setpoints the device refused, 5 the device stopped streaming or faulted,
-    /// 6 the link was lost, 130 interrupted.
+    /// 6 the link was lost, 7 the --record file could not be written, 130 interrupted.
     Stream(StreamArgs),
+    /// Draws a run record (`stream --record`): commanded vs followed per pose axis, the actuator positions, and
+    /// the events (limits, refusals, state changes), labelled, as PNG or SVG.
+    Plot {
+        /// The run record (CSV).
+        record: std::path::PathBuf,
+        /// The picture: .png or .svg.
+        #[arg(long)]
+        out: std::path::PathBuf,
+    },
     /// One command to the controller (--port, or a fresh simulated controller with --sim).
     Device(DeviceArgs),
     /// Lists the serial ports (a board shows up as a USB CDC port, /dev/ttyACM* on Linux).
@@ -230,6 +239,11 @@ pub struct StreamArgs {
     /// Print one JSON report at the end.
     #[arg(long)]
     pub report_json: bool,
+    /// Record the run: a CSV row per telemetry sample (every 10 ms at the default 100 Hz): host and device time,
+    /// the pose commanded, the pose followed (after limiting), the actuator steps, the state and the flags
+    /// (limited, refused, held). `ringpod plot FILE` draws it.
+    #[arg(long, value_name = "FILE.csv")]
+    pub record: Option<std::path::PathBuf>,
     /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics, the trainer
     /// model's FL20 data) for a payload of --mass kg; where it exceeds the motors, say where and do not stream
     /// (exit 1).

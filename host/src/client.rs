@@ -7,9 +7,13 @@ use std::time::Duration;
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::motion::{Accepted, RejectReason};
 use ringpod_core::protocol::{
-    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
+    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, Telemetry,
+    PROTOCOL_VERSION,
 };
 use ringpod_core::safety::FaultReason;
+
+/// Telemetry samples kept for a taker (a minute at 1 kHz); older ones are dropped and counted.
+pub const TELEMETRY_KEPT: usize = 60_000;
 
 /// A byte pipe to a controller, with its notion of time.
 pub trait Transport {
@@ -57,6 +61,10 @@ pub struct Client<T: Transport> {
     inbox: VecDeque<Response>,
     /// Faults the device reported on its own.
     pub faults: Vec<FaultReason>,
+    /// Telemetry samples not yet taken ([`Client::take_telemetry`]); the oldest go past [`TELEMETRY_KEPT`].
+    telemetry: VecDeque<Telemetry>,
+    /// Telemetry samples dropped because nobody took them.
+    pub telemetry_dropped: u64,
     /// How long to wait for an answer.
     pub timeout: Duration,
     /// Set by Ctrl-C: long waits ([`Client::wait_for`]) end with [`ClientError::Interrupted`].
@@ -72,6 +80,8 @@ impl<T: Transport> Client<T> {
             next_id: 0,
             inbox: VecDeque::new(),
             faults: Vec::new(),
+            telemetry: VecDeque::new(),
+            telemetry_dropped: 0,
             timeout: Duration::from_secs(2),
             cancel: None,
         }
@@ -93,15 +103,32 @@ impl<T: Transport> Client<T> {
                 if let Some(frame) = self.reader.push(b) {
                     // A frame that does not decode is dropped: the request it answered times out and says so.
                     if let Ok(response) = protocol::decode::<Response>(frame) {
-                        if let (0, DeviceMessage::Fault(reason)) = (response.id, response.body) {
-                            self.faults.push(reason);
-                        } else {
-                            self.inbox.push_back(response);
+                        match (response.id, response.body) {
+                            (0, DeviceMessage::Fault(reason)) => self.faults.push(reason),
+                            (0, DeviceMessage::Telemetry(sample)) => {
+                                if self.telemetry.len() >= TELEMETRY_KEPT {
+                                    self.telemetry.pop_front();
+                                    self.telemetry_dropped += 1;
+                                }
+                                self.telemetry.push_back(sample);
+                            }
+                            _ => self.inbox.push_back(response),
                         }
                     }
                 }
             }
         }
+    }
+
+    /// Asks the device for telemetry on this connection (or to stop it).
+    pub fn telemetry(&mut self, on: bool) -> Result<(), ClientError> {
+        self.ack(HostMessage::Telemetry(on))
+    }
+
+    /// The telemetry samples that arrived since the last call, oldest first (reads what the transport has).
+    pub fn take_telemetry(&mut self) -> Result<Vec<Telemetry>, ClientError> {
+        self.pump()?;
+        Ok(self.telemetry.drain(..).collect())
     }
 
     /// Sends one request without waiting; returns its id. Its response waits in the inbox for

@@ -95,7 +95,7 @@ fn derivatives(t: &[f64], v: &[f64], i: usize) -> (f64, f64) {
 }
 
 /// Makes a sampled angle continuous: each step is taken the short way round.
-fn unwrap(angle: &mut [f64]) {
+pub(crate) fn unwrap(angle: &mut [f64]) {
     use std::f64::consts::{PI, TAU};
     for i in 1..angle.len() {
         let step = (angle[i] - angle[i - 1] + PI).rem_euclid(TAU) - PI;

@@ -12,6 +12,7 @@ mod numbers;
 mod plot;
 mod pty;
 mod reactions;
+mod record;
 mod rig;
 mod settings;
 mod stream;
@@ -54,6 +55,10 @@ fn main() -> ExitCode {
         C::Cue(args) => cue::run(args).map(|(text, code)| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             code
+        }),
+        C::Plot { record, out } => record::plot_command(record, out).map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+            0
         }),
         C::Workspace(args) => workspace::run(args).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
@@ -165,9 +170,22 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         host_limits: !args.device_limits_only,
         quiet: args.quiet,
     };
-    let report = match stream::run(&mut client, source, input_errors, &options, args.fast, &|| {
-        interrupted.load(Ordering::SeqCst)
-    }) {
+    let recorder = match &args.record {
+        Some(path) => Some((
+            record::Recorder::create(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
+            path.display().to_string(),
+        )),
+        None => None,
+    };
+    let report = match stream::run(
+        &mut client,
+        source,
+        input_errors,
+        &options,
+        args.fast,
+        &|| interrupted.load(Ordering::SeqCst),
+        recorder,
+    ) {
         Ok(report) => report,
         Err(client::ClientError::Interrupted) => {
             eprintln!("ringpod: interrupted before the stream started");
@@ -199,6 +217,23 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     }
     if let Some(reason) = &report.reason {
         eprintln!("ringpod: {reason}");
+    }
+    if let Some(record) = &report.record {
+        match &record.error {
+            Some(e) => {
+                eprintln!("ringpod: the record {} could not be written: {e}", record.path);
+                if report.exit_code == stream::exit::FOLLOWED {
+                    return Ok(stream::exit::RECORD_FAILED);
+                }
+            }
+            None if !args.report_json => {
+                eprintln!(
+                    "recorded {} rows to {} ({} dropped)",
+                    record.rows, record.path, record.dropped
+                )
+            }
+            None => {}
+        }
     }
     Ok(report.exit_code)
 }

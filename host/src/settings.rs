@@ -13,6 +13,7 @@ pub fn name(key: ConfigKey) -> String {
         ConfigKey::TickHz => "tick-hz".into(),
         ConfigKey::InputActiveLow => "input-active-low".into(),
         ConfigKey::DebounceMs => "debounce-ms".into(),
+        ConfigKey::TelemetryHz => "telemetry-hz".into(),
         ConfigKey::PoseVelocity(a) => format!("pose-velocity.{a}"),
         ConfigKey::PoseAcceleration(a) => format!("pose-acceleration.{a}"),
         ConfigKey::StepsPerUnit(a) => format!("steps-per-unit.{a}"),

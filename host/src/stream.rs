@@ -17,6 +17,7 @@ use ringpod_core::safety::{FaultReason, State};
 use serde::Serialize;
 
 use crate::client::{setpoint_answer, Client, ClientError, Transport};
+use crate::record::Recorder;
 
 /// Setpoints sent ahead of their answers: 16 ms of a 1 kHz stream, far more than a USB or pty round trip.
 const IN_FLIGHT: usize = 16;
@@ -35,6 +36,8 @@ pub mod exit {
     pub const DEVICE_STOPPED: u8 = 5;
     /// The link to the device was lost.
     pub const TRANSPORT_LOST: u8 = 6;
+    /// Everything was followed but `--record` could not write its file.
+    pub const RECORD_FAILED: u8 = 7;
     /// Interrupted (Ctrl-C).
     pub const INTERRUPTED: u8 = 130;
 }
@@ -241,6 +244,21 @@ pub struct Report {
     pub last_applied_pose: Option<[f64; 6]>,
     /// The device's counters for this run agree with the host's, and every setpoint sent was answered.
     pub counts_agree: bool,
+    /// `--record`: rows written (a row per telemetry sample), or why the record failed.
+    pub record: Option<RecordReport>,
+}
+
+/// What `--record` wrote.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RecordReport {
+    /// The file.
+    pub path: String,
+    /// Rows written.
+    pub rows: u64,
+    /// Telemetry samples the client dropped before they were written (none unless the host fell behind).
+    pub dropped: u64,
+    /// Why the file could not be written, if it could not.
+    pub error: Option<String>,
 }
 
 /// Stream settings.
@@ -320,9 +338,27 @@ struct Streamer<'a, T: Transport> {
     in_flight: VecDeque<(u32, Option<usize>, Pose<f64>)>,
     refused_in_a_row: u32,
     last_refusal: Option<String>,
+    /// `--record`: the open file, and the first write error.
+    recorder: Option<Recorder>,
+    record_error: Option<String>,
 }
 
 impl<'a, T: Transport> Streamer<'a, T> {
+    /// Takes the telemetry that has arrived: written to the record with the pose sent last, or dropped when
+    /// nothing records (so the client's queue stays empty).
+    fn record(&mut self) -> Result<(), ClientError> {
+        let samples = self.client.take_telemetry()?;
+        if let (Some(r), None) = (self.recorder.as_mut(), &self.record_error) {
+            for t in &samples {
+                if let Err(e) = r.write(&self.last_sent, t) {
+                    self.record_error = Some(e.to_string());
+                    break;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Lets `dt` pass on the device's clock, in slices so that Ctrl-C is seen within 50 ms.
     fn elapse(&mut self, dt: Duration) -> Result<(), Stop> {
         let mut left = dt;
@@ -333,6 +369,8 @@ impl<'a, T: Transport> Streamer<'a, T> {
             let slice = left.min(Duration::from_millis(50));
             self.client.transport().elapse(slice);
             left -= slice;
+            // A lost transport shows at the next request; the record only misses what it could not read.
+            let _ = self.record();
         }
         self.clock_us = self.clock_us.saturating_add((dt.as_micros() as u64).max(1));
         Ok(())
@@ -403,6 +441,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             self.in_flight.pop_front();
             self.answered(setpoint_answer(answer)?, number, pose)?;
         }
+        self.record()?;
         if let Some(f) = self.client.faults.last() {
             return Err(StreamError::Stop(Stop::Device(format!(
                 "the device latched a fault: {f}"
@@ -704,10 +743,14 @@ impl From<Stop> for StreamError {
 }
 
 /// Brings the device to `Ready`: hello, power up, home if needed. Errors here mean the stream never started.
-fn prepare<T: Transport>(client: &mut Client<T>, home: bool) -> Result<Status, ClientError> {
+fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) -> Result<Status, ClientError> {
     let preset = client.hello()?;
     if preset != Preset::TrainerModel {
         eprintln!("note: the device drives {}", preset.name());
+    }
+    if telemetry {
+        // From here on: the record covers powering up and homing too.
+        client.telemetry(true)?;
     }
     let mut status = client.status()?;
     if matches!(status.state, State::Fault(..)) {
@@ -769,8 +812,13 @@ pub fn run<T: Transport>(
     options: &Options,
     fast: bool,
     interrupted: &dyn Fn() -> bool,
+    recorder: Option<(Recorder, String)>,
 ) -> Result<Report, ClientError> {
-    let baseline = prepare(client, options.home)?;
+    let (recorder, record_path) = match recorder {
+        Some((r, path)) => (Some(r), Some(path)),
+        None => (None, None),
+    };
+    let baseline = prepare(client, options.home, recorder.is_some())?;
     let (margins, stream_timeout) = device_envelope(client)?;
     let PresetGeometry::Ring(geometry) = Preset::TrainerModel.geometry() else {
         return Err(ClientError::Unexpected("the trainer model is a ring platform".into()));
@@ -822,6 +870,8 @@ pub fn run<T: Transport>(
         in_flight: VecDeque::new(),
         refused_in_a_row: 0,
         last_refusal: None,
+        recorder,
+        record_error: None,
     };
     let mut input_errors = input_errors;
     let mut datagrams = None;
@@ -877,6 +927,24 @@ pub fn run<T: Transport>(
     } else {
         None
     };
+    // The samples of the stop and the ramp to rest.
+    let _ = s.record();
+    let record = record_path.map(|path| {
+        let dropped = s.client.telemetry_dropped;
+        let (rows, error) = match (s.recorder.take(), s.record_error.take()) {
+            (Some(r), None) => {
+                let rows = r.rows;
+                (rows, r.finish().err().map(|e| e.to_string()))
+            }
+            (r, e) => (r.map_or(0, |r| r.rows), e),
+        };
+        RecordReport {
+            path,
+            rows,
+            dropped,
+            error,
+        }
+    });
     let (status, transport) = match (status, transport) {
         (Some(st), None) => (Some(st), None),
         (None, None) => (None, Some("the device did not answer after the stop".to_string())),
@@ -942,5 +1010,6 @@ pub fn run<T: Transport>(
         datagrams,
         last_applied_pose: s.last_applied.map(|p| p.to_array()),
         counts_agree,
+        record,
     })
 }

@@ -224,7 +224,8 @@ fn device_config_reads_writes_and_refuses() {
     let all = json(&["device", "config", "--sim"]);
     assert_eq!(all["tick-hz"], 1000.0);
     assert_eq!(all["steps-per-unit.0"], 25_600.0);
-    assert_eq!(all.as_object().unwrap().len(), 30);
+    assert_eq!(all.as_object().unwrap().len(), 31);
+    assert_eq!(all["telemetry-hz"], 100.0);
     assert_eq!(all["envelope-margin.reach"], 0.002);
     assert_eq!(all["gross-jump-ms"], 500.0);
     assert_eq!(all["follow-direct"], 0.0);
@@ -728,4 +729,87 @@ fn reactions_share_a_tool_load_between_the_pivots() {
         ])
         .assert()
         .code(1);
+}
+
+/// `stream --record` writes a row per telemetry sample (every 10 ms of device time), the commanded and followed
+/// poses agree at rest, limits show as flags; `plot` draws the record; an unwritable record fails the stream
+/// before it starts.
+#[test]
+fn a_recorded_run_has_a_row_every_10_ms_and_plots() {
+    let dir = std::env::temp_dir().join(format!("ringpod-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Heave beyond the model's 40 mm: limited.
+    let input = dir.join("poses.csv");
+    let mut text = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for i in 0..=300 {
+        let t = f64::from(i) * 0.01;
+        text += &format!(
+            "{t},0,0,{},0,0,0\n",
+            0.227 + 0.08 * (std::f64::consts::PI * t / 3.0).sin()
+        );
+    }
+    std::fs::write(&input, text).unwrap();
+    let record = dir.join("run.csv");
+    let out = ringpod()
+        .args([
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--report-json",
+            "--device-limits-only",
+        ])
+        .args(["--input", input.to_str().unwrap(), "--record", record.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let text = std::fs::read_to_string(&record).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 28);
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(report["record"]["rows"].as_u64(), Some(rows.len() as u64));
+    assert_eq!(report["record"]["dropped"], 0);
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let device: Vec<f64> = rows.iter().map(|r| r[col("device_s")].parse().unwrap()).collect();
+    assert!(
+        device.windows(2).all(|w| (w[1] - w[0] - 0.01).abs() < 1e-9),
+        "a row every 10 ms"
+    );
+    let states: Vec<&str> = rows.iter().map(|r| r[col("state")]).collect();
+    for s in ["LogicOn", "Homing", "Ready", "Running"] {
+        assert!(states.contains(&s), "{s} missing");
+    }
+    let limited = rows.iter().filter(|r| r[col("limited")] == "1").count();
+    assert!(limited > 0, "the heave crest was limited: flags show it");
+    let last = rows.last().unwrap();
+    assert_eq!(last[col("limited_total")], report["limited"]["device"].to_string());
+    let png = dir.join("run.png");
+    ringpod()
+        .args(["plot", record.to_str().unwrap(), "--out", png.to_str().unwrap()])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("limited stretches"));
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+    ringpod()
+        .args(["plot", input.to_str().unwrap(), "--out", png.to_str().unwrap()])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("no column"));
+    ringpod()
+        .args([
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--motion",
+            "demo",
+            "--duration",
+            "1",
+        ])
+        .args(["--record", dir.join("no/such/dir/run.csv").to_str().unwrap()])
+        .assert()
+        .code(1);
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -12,7 +12,8 @@ use crate::motion::{
     StepScheduler,
 };
 use crate::protocol::{
-    self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, Status, PROTOCOL_VERSION,
+    self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, Status, Telemetry, TelemetryFlags,
+    PROTOCOL_VERSION,
 };
 use crate::safety::debounce::InputConfig;
 use crate::safety::homing::{HomingConfig, HomingError, HomingPlan, RingHoming};
@@ -35,6 +36,8 @@ pub struct ControllerConfig {
     pub homing: HomingConfig,
     /// Input polarity and debouncing.
     pub inputs: InputConfig,
+    /// Telemetry samples per second while a host is connected (0: none).
+    pub telemetry_hz: u16,
 }
 
 /// Slot of the step generator (ns): the boards' timers emit one GPIO set/reset word per slot
@@ -103,6 +106,7 @@ impl ControllerConfig {
                 order: [4, 5, 0, 2, 1, 3],
             },
             inputs: InputConfig::default(),
+            telemetry_hz: 100,
         }
     }
 
@@ -136,6 +140,7 @@ impl ControllerConfig {
             }
             ConfigKey::InputActiveLow => f32::from(self.inputs.active_low),
             ConfigKey::DebounceMs => f32::from(self.inputs.debounce_samples),
+            ConfigKey::TelemetryHz => f32::from(self.telemetry_hz),
         })
     }
 
@@ -219,6 +224,7 @@ impl ControllerConfig {
             ConfigKey::DebounceMs if integer && (1.0..=50.0).contains(&value) => {
                 self.inputs.debounce_samples = value as u8
             }
+            ConfigKey::TelemetryHz if integer && value <= 2000.0 => self.telemetry_hz = value as u16,
             _ => return Err(ConfigError::Value),
         }
         Ok(())
@@ -275,6 +281,21 @@ pub struct Controller {
     tick_cost: u32,
     queue_depth: u16,
     pending_fault: bool,
+    telemetry: TelemetryClock,
+}
+
+/// When the next telemetry sample is due, and what the previous one counted (for its flags).
+#[derive(Debug, Clone, Copy, Default)]
+struct TelemetryClock {
+    /// Device time (us).
+    now_us: u64,
+    /// Ticks since the last sample.
+    ticks: u32,
+    /// The host asked for telemetry on this connection.
+    on: bool,
+    due: bool,
+    /// `(limited, refused, held)` at the last sample.
+    counted: (u32, u32, u32),
 }
 
 impl Controller {
@@ -325,6 +346,7 @@ impl Controller {
             tick_cost: 0,
             queue_depth: 0,
             pending_fault: false,
+            telemetry: TelemetryClock::default(),
         })
     }
 
@@ -419,6 +441,7 @@ impl Controller {
             HostMessage::Hello { version } => {
                 if version == PROTOCOL_VERSION {
                     self.connected = true;
+                    self.telemetry.on = false;
                     DeviceMessage::Hello {
                         version: PROTOCOL_VERSION,
                         preset: self.config.preset,
@@ -437,6 +460,11 @@ impl Controller {
                 Err(reason) => DeviceMessage::Nack(NackReason::Rejected(reason)),
             },
             HostMessage::GetStatus => DeviceMessage::Status(self.status()),
+            HostMessage::Telemetry(on) => {
+                self.telemetry.on = on;
+                self.telemetry.ticks = 0;
+                DeviceMessage::Ack
+            }
             HostMessage::GetConfig(key) => match self.get_config(key) {
                 Some(v) => DeviceMessage::Config(key, v),
                 None => DeviceMessage::Nack(NackReason::BadConfig),
@@ -507,18 +535,55 @@ impl Controller {
         protocol::encode(&response, out).unwrap_or(0)
     }
 
-    /// An unsolicited message to send, if one is pending (a newly latched fault).
+    /// An unsolicited message to send, if one is pending: a newly latched fault first, then a telemetry sample
+    /// when one is due.
     pub fn unsolicited(&mut self) -> Option<Response> {
-        if !self.pending_fault {
+        if self.pending_fault {
+            self.pending_fault = false;
+            if let State::Fault(reason, _) = self.supervisor.state() {
+                return Some(Response {
+                    id: 0,
+                    body: DeviceMessage::Fault(reason),
+                });
+            }
+        }
+        if !self.telemetry.due {
             return None;
         }
-        self.pending_fault = false;
-        match self.supervisor.state() {
-            State::Fault(reason, _) => Some(Response {
-                id: 0,
-                body: DeviceMessage::Fault(reason),
-            }),
-            _ => None,
+        self.telemetry.due = false;
+        Some(Response {
+            id: 0,
+            body: DeviceMessage::Telemetry(self.telemetry_sample()),
+        })
+    }
+
+    /// One telemetry sample; its flags say what happened since the previous one.
+    pub fn telemetry_sample(&mut self) -> Telemetry {
+        let limited = self.pipeline.limited().count;
+        let refused = self.pipeline.rejected().total();
+        let held = self.pipeline.held();
+        let (l0, r0, h0) = self.telemetry.counted;
+        self.telemetry.counted = (limited, refused, held);
+        let flag = |changed: bool, bit: u8| if changed { bit } else { 0 };
+        let flags = flag(limited != l0, TelemetryFlags::LIMITED)
+            | flag(refused != r0, TelemetryFlags::REFUSED)
+            | flag(held != h0, TelemetryFlags::HELD);
+        Telemetry {
+            time_us: self.telemetry.now_us,
+            state: self.supervisor.state(),
+            pose: self.pipeline.pose(),
+            target: self.pipeline.target(),
+            steps: self.scheduler.position(),
+            flags,
+            applied: self.pipeline.applied(),
+            limited,
+            refused,
+            tick_cost: self.tick_cost,
+            inputs: crate::safety::debounce::from_inputs(&self.inputs),
+            outputs: {
+                let o = self.supervisor.outputs();
+                u8::from(o.logic_relay) | u8::from(o.power_relay) << 1 | u8::from(o.driver_enable) << 2
+            },
         }
     }
 
@@ -603,6 +668,7 @@ impl Controller {
     /// One control period.
     pub fn tick(&mut self) -> TickOutput {
         let tick_us = self.pipeline.config().tick_us;
+        self.telemetry_tick(tick_us);
         self.elapsed_us = self.elapsed_us.saturating_add(tick_us);
         if self.elapsed_us >= 1000 {
             let ms = self.elapsed_us / 1000;
@@ -638,6 +704,24 @@ impl Controller {
         TickOutput {
             moves: self.scheduler.plan(&targets),
             outputs,
+        }
+    }
+
+    /// Advances device time; a telemetry sample falls due every `tick rate / telemetry rate` ticks while the
+    /// connected host asks for telemetry.
+    fn telemetry_tick(&mut self, tick_us: u32) {
+        let t = &mut self.telemetry;
+        t.now_us = t.now_us.wrapping_add(u64::from(tick_us));
+        let hz = u32::from(self.config.telemetry_hz);
+        if hz == 0 || !self.connected || !t.on {
+            t.ticks = 0;
+            return;
+        }
+        t.ticks += 1;
+        let every = (1_000_000 / tick_us.max(1) / hz).max(1);
+        if t.ticks >= every {
+            t.ticks = 0;
+            t.due = true;
         }
     }
 

@@ -107,8 +107,9 @@ fn polarity_maps_electrical_levels() {
 #[test]
 fn every_key_has_a_unique_code_that_round_trips() {
     let keys: Vec<ConfigKey> = ConfigKey::all().collect();
-    // stream timeout, gross jump, follow mode, tick rate, polarity, debounce; per axis three; per check one.
-    assert_eq!(keys.len(), 6 + 3 * 6 + 6);
+    // stream timeout, gross jump, follow mode, tick rate, polarity, debounce, telemetry rate; per axis three; per
+    // check one.
+    assert_eq!(keys.len(), 7 + 3 * 6 + 6);
     let mut codes: Vec<u8> = keys.iter().map(|k| k.code()).collect();
     codes.sort_unstable();
     codes.dedup();

@@ -7,7 +7,7 @@ use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Se
 use crate::safety::{FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly.
-pub const PROTOCOL_VERSION: u16 = 3;
+pub const PROTOCOL_VERSION: u16 = 4;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -49,6 +49,9 @@ pub enum HostMessage {
     GetConfig(ConfigKey),
     /// Write a configuration value (not while moving).
     SetConfig(ConfigKey, f32),
+    /// Send telemetry on this connection (`true`) at [`ConfigKey::TelemetryHz`], or stop (`false`). Every Hello
+    /// starts a connection without it: a host that only commands gets only answers.
+    Telemetry(bool),
 }
 
 /// A device message: the response to request `id`, or unsolicited with `id` 0.
@@ -82,6 +85,49 @@ pub enum DeviceMessage {
     Config(ConfigKey, f32),
     /// A fault was latched (unsolicited).
     Fault(FaultReason),
+    /// What the device is doing (unsolicited, at [`ConfigKey::TelemetryHz`] while the host asks for it).
+    Telemetry(Telemetry),
+}
+
+/// Telemetry: one sample of the device's state, sent unsolicited (id 0).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Telemetry {
+    /// Device time since the controller started (us, control ticks times their period).
+    pub time_us: u64,
+    /// Supervisor state.
+    pub state: StateCode,
+    /// Commanded pose (where the platform is being driven now).
+    pub pose: Pose<f32>,
+    /// Where it is heading: the last accepted setpoint as limited.
+    pub target: Pose<f32>,
+    /// Step position of every axis.
+    pub steps: [i64; 6],
+    /// What happened since the previous sample ([`TelemetryFlags`] bits).
+    pub flags: u8,
+    /// Setpoints accepted so far (limited ones included).
+    pub applied: u32,
+    /// Setpoints limited into the envelope so far.
+    pub limited: u32,
+    /// Setpoints refused so far (every reason).
+    pub refused: u32,
+    /// Cost of the last control tick (CPU cycles on the MCU, ns in the simulator).
+    pub tick_cost: u32,
+    /// Every input after debouncing and polarity, a bit per `safety::debounce::InputBit` (1: active).
+    pub inputs: u16,
+    /// The outputs: bit 0 LOGIC_EN relay, bit 1 POWER_EN relay, bit 2 driver enable.
+    pub outputs: u8,
+}
+
+/// Bits of [`Telemetry::flags`].
+pub struct TelemetryFlags;
+
+impl TelemetryFlags {
+    /// A setpoint was limited into the envelope since the previous sample.
+    pub const LIMITED: u8 = 1;
+    /// A setpoint was refused since the previous sample.
+    pub const REFUSED: u8 = 2;
+    /// The path failed a check and the platform held since the previous sample.
+    pub const HELD: u8 = 4;
 }
 
 /// Why a request was not carried out.
@@ -134,6 +180,8 @@ pub enum ConfigKey {
     InputActiveLow,
     /// Debouncing: equal samples (1 ms apart) before an input level is accepted (1-50), live.
     DebounceMs,
+    /// Telemetry samples per second while a host asks for them (0: none; at most the control rate), live.
+    TelemetryHz,
 }
 
 impl ConfigKey {
@@ -152,6 +200,7 @@ impl ConfigKey {
             ConfigKey::TickHz => 3,
             ConfigKey::InputActiveLow => 4,
             ConfigKey::DebounceMs => 5,
+            ConfigKey::TelemetryHz => 8,
             ConfigKey::PoseVelocity(a) => 16 + (a & 7),
             ConfigKey::PoseAcceleration(a) => 24 + (a & 7),
             ConfigKey::StepsPerUnit(a) => 32 + (a & 7),
@@ -168,6 +217,7 @@ impl ConfigKey {
             3 => ConfigKey::TickHz,
             4 => ConfigKey::InputActiveLow,
             5 => ConfigKey::DebounceMs,
+            8 => ConfigKey::TelemetryHz,
             16..=21 => ConfigKey::PoseVelocity(code - 16),
             24..=29 => ConfigKey::PoseAcceleration(code - 24),
             32..=37 => ConfigKey::StepsPerUnit(code - 32),

@@ -468,6 +468,41 @@ fn controller_on_m4f(t: &mut Tally) {
         "the device counted the bad frame and moved nothing",
     );
 
+    // Telemetry from the M4F: a recorded run has a row every 10 ms of device time.
+    let record = std::env::temp_dir().join(format!("ringpod-qemu-record-{}.csv", std::process::id()));
+    let recorded = ringpod_json(&[
+        "stream",
+        "--port",
+        pty,
+        "--motion",
+        "demo",
+        "--duration",
+        "2",
+        "--quiet",
+        "--report-json",
+        "--record",
+        &record.to_string_lossy(),
+    ]);
+    let rows = std::fs::read_to_string(&record).unwrap_or_default();
+    let _ = std::fs::remove_file(&record);
+    let device_s: Vec<f64> = rows
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(1)?.parse().ok())
+        .collect();
+    println!(
+        "recorded from the emulated controller: {} telemetry rows over {:.2} s of device time",
+        device_s.len(),
+        device_s.last().unwrap_or(&0.0) - device_s.first().unwrap_or(&0.0)
+    );
+    t.check(
+        recorded
+            .is_ok_and(|r| r["outcome"] == "followed" && r["record"]["rows"].as_u64() == Some(device_s.len() as u64))
+            && device_s.len() > 200
+            && device_s.windows(2).all(|w| (w[1] - w[0] - 0.01).abs() < 1e-9),
+        "the emulated controller sends telemetry: a recorded run has a row every 10 ms of device time",
+    );
+
     // Stream loss: the host dies mid-stream; the controller brakes to rest by itself.
     let streaming = Command::new(ringpod())
         .args([

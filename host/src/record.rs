@@ -1,0 +1,307 @@
+//! Run records: `stream --record run.csv` writes a row per telemetry sample (100 Hz by default: a row every 10 ms of
+//! device time), and `ringpod plot run.csv --out run.png` draws what was commanded against what the platform
+//! followed, the actuators, and the events (limits, refusals, state changes).
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+use std::time::Instant;
+
+use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
+use plotters::style::RGBColor;
+use ringpod_core::kinematics::Pose;
+use ringpod_core::protocol::{Telemetry, TelemetryFlags};
+use ringpod_core::safety::State;
+
+use crate::plot::{self, Event, Panel, Series, TimePlot};
+
+/// The record's columns.
+pub const COLUMNS: [&str; 28] = [
+    "host_s",
+    "device_s",
+    "cmd_x",
+    "cmd_y",
+    "cmd_z",
+    "cmd_alpha",
+    "cmd_beta",
+    "cmd_gamma",
+    "x",
+    "y",
+    "z",
+    "alpha",
+    "beta",
+    "gamma",
+    "steps_1",
+    "steps_2",
+    "steps_3",
+    "steps_4",
+    "steps_5",
+    "steps_6",
+    "state",
+    "limited",
+    "refused",
+    "held",
+    "applied",
+    "limited_total",
+    "refused_total",
+    "tick_cost",
+];
+
+/// A state as one CSV field: its name, and a fault's reason after a colon (no commas).
+pub fn state_name(state: State) -> String {
+    match state {
+        State::Off => "Off".into(),
+        State::LogicOn => "LogicOn".into(),
+        State::PowerOn { .. } => "PowerOn".into(),
+        State::Homing => "Homing".into(),
+        State::Ready => "Ready".into(),
+        State::Running => "Running".into(),
+        State::Stopping => "Stopping".into(),
+        State::Fault(reason, _) => format!("Fault: {reason}").replace(',', ";"),
+        State::ShuttingDown(_) => "ShuttingDown".into(),
+    }
+}
+
+/// Writes a run record.
+pub struct Recorder {
+    out: BufWriter<File>,
+    started: Instant,
+    /// Rows written.
+    pub rows: u64,
+}
+
+impl Recorder {
+    /// Creates the file and writes the header.
+    pub fn create(path: &Path) -> std::io::Result<Self> {
+        let mut out = BufWriter::new(File::create(path)?);
+        writeln!(out, "{}", COLUMNS.join(","))?;
+        Ok(Self {
+            out,
+            started: Instant::now(),
+            rows: 0,
+        })
+    }
+
+    /// One row: the pose the host commanded last, and the device's sample.
+    pub fn write(&mut self, commanded: &Pose<f64>, t: &Telemetry) -> std::io::Result<()> {
+        let mut row = format!(
+            "{:.6},{:.6}",
+            self.started.elapsed().as_secs_f64(),
+            t.time_us as f64 * 1e-6
+        );
+        for v in commanded.to_array() {
+            row += &format!(",{v}");
+        }
+        for v in t.target.to_array() {
+            row += &format!(",{v}");
+        }
+        for s in t.steps {
+            row += &format!(",{s}");
+        }
+        let flag = |bit: u8| u8::from(t.flags & bit != 0);
+        row += &format!(
+            ",{},{},{},{},{},{},{},{}",
+            state_name(t.state),
+            flag(TelemetryFlags::LIMITED),
+            flag(TelemetryFlags::REFUSED),
+            flag(TelemetryFlags::HELD),
+            t.applied,
+            t.limited,
+            t.refused,
+            t.tick_cost
+        );
+        writeln!(self.out, "{row}")?;
+        self.rows += 1;
+        Ok(())
+    }
+
+    /// Flushes the file.
+    pub fn finish(mut self) -> std::io::Result<u64> {
+        self.out.flush()?;
+        Ok(self.rows)
+    }
+}
+
+/// A record read back.
+struct Run {
+    t: Vec<f64>,
+    commanded: Vec<[f64; 6]>,
+    target: Vec<[f64; 6]>,
+    steps: Vec<[f64; 6]>,
+    state: Vec<String>,
+    limited: Vec<bool>,
+    refused: Vec<bool>,
+}
+
+fn read(path: &Path) -> anyhow::Result<Run> {
+    let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h.trim() == name)
+            .ok_or_else(|| anyhow::anyhow!("{}: no column {name:?} (is it a run record?)", path.display()))
+    };
+    let index: Vec<usize> = COLUMNS.iter().map(|c| col(c)).collect::<anyhow::Result<_>>()?;
+    let mut run = Run {
+        t: Vec::new(),
+        commanded: Vec::new(),
+        target: Vec::new(),
+        steps: Vec::new(),
+        state: Vec::new(),
+        limited: Vec::new(),
+        refused: Vec::new(),
+    };
+    for (n, line) in lines.enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').collect();
+        let number = |k: usize| -> anyhow::Result<f64> {
+            let f = fields
+                .get(index[k])
+                .ok_or_else(|| anyhow::anyhow!("line {}: too few fields", n + 2))?;
+            f.trim()
+                .parse::<f64>()
+                .map_err(|_| anyhow::anyhow!("line {}: {}: not a number: {f:?}", n + 2, COLUMNS[k]))
+        };
+        let six = |from: usize| -> anyhow::Result<[f64; 6]> {
+            let mut v = [0.0; 6];
+            for (i, slot) in v.iter_mut().enumerate() {
+                *slot = number(from + i)?;
+            }
+            Ok(v)
+        };
+        run.t.push(number(1)?);
+        run.commanded.push(six(2)?);
+        run.target.push(six(8)?);
+        run.steps.push(six(14)?);
+        run.state.push(fields.get(index[20]).unwrap_or(&"").trim().to_owned());
+        run.limited.push(number(21)? != 0.0);
+        run.refused.push(number(22)? != 0.0);
+    }
+    if run.t.is_empty() {
+        anyhow::bail!("{}: no rows", path.display());
+    }
+    // The device keeps yaw within a turn and a source may wrap it too: draw each angle continuous.
+    for series in [&mut run.commanded, &mut run.target] {
+        for k in 3..6 {
+            let mut angle: Vec<f64> = series.iter().map(|p| p[k]).collect();
+            crate::demand::unwrap(&mut angle);
+            for (p, a) in series.iter_mut().zip(angle) {
+                p[k] = a;
+            }
+        }
+    }
+    Ok(run)
+}
+
+/// A paler shade of `c` (the commanded line under the followed one).
+fn light(c: RGBColor) -> RGBColor {
+    RGBColor(c.0 / 2 + 128, c.1 / 2 + 128, c.2 / 2 + 128)
+}
+
+/// The start of each run of `true` in `flags`, as events.
+fn onsets(t: &[f64], flags: &[bool], kind: &str, colour: RGBColor) -> Vec<Event> {
+    (0..flags.len())
+        .filter(|&i| flags[i] && (i == 0 || !flags[i - 1]))
+        .map(|i| Event {
+            t: t[i],
+            kind: kind.to_owned(),
+            colour,
+        })
+        .collect()
+}
+
+/// `ringpod plot RUN.csv --out FILE`: returns the summary to print.
+pub fn plot_command(input: &Path, out: &Path) -> anyhow::Result<String> {
+    let run = read(input)?;
+    let mut events = onsets(
+        &run.t,
+        &run.limited,
+        "limited into the envelope",
+        RGBColor(240, 150, 40),
+    );
+    events.extend(onsets(&run.t, &run.refused, "setpoint refused", RED));
+    let changes: Vec<usize> = (1..run.state.len())
+        .filter(|&i| run.state[i] != run.state[i - 1])
+        .collect();
+    events.extend(changes.iter().map(|&i| Event {
+        t: run.t[i],
+        kind: "state change".into(),
+        colour: RGBColor(120, 120, 120),
+    }));
+    let colours = [BLUE, RED, GREEN, CYAN, MAGENTA, BLACK];
+    let pair = |axes: &[(usize, &str)]| -> Vec<Series> {
+        axes.iter()
+            .enumerate()
+            .flat_map(|(n, &(k, name))| {
+                let c = colours[n % colours.len()];
+                [
+                    Series::new(
+                        format!("{name} commanded"),
+                        run.t.iter().zip(&run.commanded).map(|(t, p)| (*t, p[k])).collect(),
+                        light(c),
+                    ),
+                    Series::new(
+                        format!("{name} followed"),
+                        run.t.iter().zip(&run.target).map(|(t, p)| (*t, p[k])).collect(),
+                        c,
+                    ),
+                ]
+            })
+            .collect()
+    };
+    let panel = |title: &str, unit: &str, series: Vec<Series>| Panel {
+        title: title.into(),
+        unit: unit.into(),
+        series,
+        events: events
+            .iter()
+            .map(|e| Event {
+                t: e.t,
+                kind: e.kind.clone(),
+                colour: e.colour,
+            })
+            .collect(),
+    };
+    let steps = (0..6)
+        .map(|k| {
+            Series::new(
+                format!("axis {}", k + 1),
+                run.t.iter().zip(&run.steps).map(|(t, s)| (*t, s[k])).collect(),
+                colours[k],
+            )
+        })
+        .collect();
+    let picture = TimePlot {
+        title: format!(
+            "ringpod run {}: commanded vs followed",
+            input
+                .file_name()
+                .map_or(String::new(), |f| f.to_string_lossy().into_owned())
+        ),
+        panels: vec![
+            panel(
+                "translation",
+                "m",
+                pair(&[(0, "surge x"), (1, "sway y"), (2, "heave z")]),
+            ),
+            panel("roll and pitch", "rad", pair(&[(3, "roll alpha"), (4, "pitch beta")])),
+            panel("yaw", "rad", pair(&[(5, "yaw gamma")])),
+            panel("actuator positions", "steps", steps),
+        ],
+    };
+    plot::save(out, (1100, 1200), &picture)?;
+    let limited = events.iter().filter(|e| e.kind.starts_with("limited")).count();
+    let refused = events.iter().filter(|e| e.kind.starts_with("setpoint")).count();
+    Ok(format!(
+        "{} rows over {:.3} s of device time: {limited} limited stretches, {refused} refusal stretches, {} state \
+         changes; picture: {}\n",
+        run.t.len(),
+        run.t[run.t.len() - 1] - run.t[0],
+        changes.len(),
+        out.display()
+    ))
+}
