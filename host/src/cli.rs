@@ -48,6 +48,19 @@ pub enum Command {
         #[arg(long)]
         out: std::path::PathBuf,
     },
+    /// A live terminal view of the device from its telemetry: state, supplies and outputs, every input, each
+    /// axis's position and switches, the counters and the tick cost. q, Esc or Ctrl-C ends it.
+    Monitor {
+        /// The board's serial port.
+        #[arg(long, conflicts_with = "sim")]
+        port: Option<String>,
+        /// A fresh simulated controller (ticking in real time).
+        #[arg(long)]
+        sim: bool,
+        /// End after this many redraws (ten a second), for scripts and tests.
+        #[arg(long)]
+        frames: Option<u64>,
+    },
     /// One command to the controller (--port, or a fresh simulated controller with --sim).
     Device(DeviceArgs),
     /// Lists the serial ports (a board shows up as a USB CDC port, /dev/ttyACM* on Linux).

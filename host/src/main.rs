@@ -8,6 +8,7 @@ mod demand;
 mod error;
 mod kinematics;
 mod mechanism;
+mod monitor;
 mod numbers;
 mod plot;
 mod pty;
@@ -56,6 +57,7 @@ fn main() -> ExitCode {
             let _ = std::io::stdout().write_all(text.as_bytes());
             code
         }),
+        C::Monitor { port, sim, frames } => monitor_command(port.as_deref(), *sim, *frames),
         C::Plot { record, out } => record::plot_command(record, out).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
@@ -236,6 +238,14 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         }
     }
     Ok(report.exit_code)
+}
+
+/// `ringpod monitor`.
+fn monitor_command(port: Option<&str>, sim: bool, frames: Option<u64>) -> anyhow::Result<u8> {
+    let mut client = client::Client::new(connect(port, sim, true)?);
+    let source = port.map_or_else(|| "the simulated controller".to_owned(), str::to_owned);
+    monitor::run(&mut client, &source, frames)?;
+    Ok(0)
 }
 
 /// The transport named on the command line.

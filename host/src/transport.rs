@@ -142,8 +142,9 @@ impl Transport for SimDevice {
             let cost = started.elapsed().as_nanos().min(u128::from(u32::MAX)) as u32;
             self.rig.controller.set_platform_stats(cost, 0);
             self.simulated_us += self.tick_us;
+            // After every tick, as the firmware's control task does: no sample is coalesced with the next.
+            self.flush_unsolicited();
         }
-        self.flush_unsolicited();
         if self.realtime {
             let due = self.started + Duration::from_micros(self.simulated_us);
             if let Some(wait) = due.checked_duration_since(Instant::now()) {

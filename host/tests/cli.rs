@@ -813,3 +813,64 @@ fn a_recorded_run_has_a_row_every_10_ms_and_plots() {
         .code(1);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `monitor` on a pseudo-terminal: it takes the terminal (alternate screen), draws the simulated controller's
+/// telemetry (state Off, the supplies, every axis), and gives the terminal back when it ends.
+#[test]
+fn monitor_draws_the_device_on_a_pseudo_terminal() {
+    use std::io::Read;
+    use std::os::fd::AsFd;
+    let pty = nix::pty::openpty(
+        Some(&nix::pty::Winsize {
+            ws_row: 30,
+            ws_col: 110,
+            ws_xpixel: 0,
+            ws_ypixel: 0,
+        }),
+        None,
+    )
+    .unwrap();
+    let tty = || std::process::Stdio::from(pty.slave.as_fd().try_clone_to_owned().unwrap());
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["monitor", "--sim", "--frames", "12"])
+        .stdin(tty())
+        .stdout(tty())
+        .stderr(tty())
+        .spawn()
+        .unwrap();
+    // Read the screen while the monitor runs (a full pty buffer would block it).
+    let mut master = std::fs::File::from(pty.master);
+    let reader = std::thread::spawn(move || {
+        let mut screen = Vec::new();
+        let mut buf = [0u8; 4096];
+        while let Ok(n) = master.read(&mut buf) {
+            if n == 0 {
+                break;
+            }
+            screen.extend_from_slice(&buf[..n]);
+            if screen.windows(8).any(|w| w == b"\x1b[?1049l") {
+                break; // left the alternate screen: done
+            }
+        }
+        String::from_utf8_lossy(&screen).into_owned()
+    });
+    let status = child.wait().unwrap();
+    drop(pty.slave);
+    let screen = reader.join().unwrap();
+    assert!(status.success(), "{screen}");
+    assert!(screen.contains("\x1b[?1049h"), "the monitor takes the alternate screen");
+    assert!(screen.contains("\x1b[?1049l"), "and gives it back");
+    // The terminal gets the words with cursor moves between them.
+    for want in [
+        "ringpod",
+        "monitor:",
+        " Off ",
+        "LOGIC_EN",
+        "POWER_OK",
+        "switches",
+        "telemetry",
+        "received",
+    ] {
+        assert!(screen.contains(want), "{want:?} not drawn: {screen}");
+    }
+}

@@ -1,0 +1,291 @@
+//! `ringpod monitor`: a live terminal view of the device from its telemetry: state, supplies and outputs, every
+//! input, each axis's position, the counters and the tick cost. `q`, Esc or Ctrl-C ends it.
+
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+use ratatui::backend::{Backend, CrosstermBackend};
+use ratatui::crossterm::event::{self, Event, KeyCode, KeyModifiers};
+use ratatui::crossterm::terminal::{disable_raw_mode, enable_raw_mode, EnterAlternateScreen, LeaveAlternateScreen};
+use ratatui::crossterm::ExecutableCommand;
+use ratatui::layout::{Constraint, Direction, Layout};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Borders, Paragraph, Row, Table};
+use ratatui::{Frame, Terminal};
+use ringpod_core::protocol::{Telemetry, TelemetryFlags};
+use ringpod_core::safety::debounce::InputBit;
+
+use crate::client::{Client, Transport};
+use crate::record::state_name;
+
+/// What the view shows: the newest sample and how the link is doing.
+#[derive(Debug, Clone, Default)]
+pub struct View {
+    /// The newest telemetry sample.
+    pub sample: Option<Telemetry>,
+    /// Samples received.
+    pub received: u64,
+    /// Samples per second over the last second.
+    pub rate_hz: f64,
+    /// Samples the client dropped.
+    pub dropped: u64,
+    /// Where the device is.
+    pub source: String,
+}
+
+fn lamp(on: bool, label: &str) -> Span<'static> {
+    let style = if on {
+        Style::default()
+            .fg(Color::Black)
+            .bg(Color::Green)
+            .add_modifier(Modifier::BOLD)
+    } else {
+        Style::default().fg(Color::Gray)
+    };
+    Span::styled(format!(" {label} "), style)
+}
+
+fn alarm(active: bool, label: &str) -> Span<'static> {
+    let style = if active {
+        Style::default()
+            .fg(Color::White)
+            .bg(Color::Red)
+            .add_modifier(Modifier::BOLD)
+    } else {
+        Style::default().fg(Color::Gray)
+    };
+    Span::styled(format!(" {label} "), style)
+}
+
+/// Draws the view.
+pub fn draw(frame: &mut Frame, view: &View) {
+    let rows = Layout::default()
+        .direction(Direction::Vertical)
+        .constraints([
+            Constraint::Length(3),
+            Constraint::Length(4),
+            Constraint::Length(10),
+            Constraint::Min(4),
+        ])
+        .split(frame.area());
+    let Some(t) = view.sample else {
+        let waiting = Paragraph::new(format!("waiting for telemetry from {} ...", view.source))
+            .block(Block::default().borders(Borders::ALL).title(" ringpod monitor "));
+        frame.render_widget(waiting, frame.area());
+        return;
+    };
+    let state = Paragraph::new(Line::from(vec![
+        Span::styled(
+            format!(" {} ", state_name(t.state)),
+            Style::default().add_modifier(Modifier::BOLD | Modifier::REVERSED),
+        ),
+        Span::raw(format!(
+            "   device time {:.2} s   tick {} {}   telemetry {:.0} Hz ({} received, {} dropped)",
+            t.time_us as f64 * 1e-6,
+            t.tick_cost,
+            if view.source.contains("sim") { "ns" } else { "cycles" },
+            view.rate_hz,
+            view.received,
+            view.dropped
+        )),
+    ]))
+    .block(
+        Block::default()
+            .borders(Borders::ALL)
+            .title(format!(" ringpod monitor: {} ", view.source)),
+    );
+    frame.render_widget(state, rows[0]);
+
+    let input = |bit: InputBit| t.inputs & bit.mask() != 0;
+    let supplies = Paragraph::new(vec![
+        Line::from(vec![
+            Span::raw("relays and drivers: "),
+            lamp(t.outputs & 1 != 0, "LOGIC_EN"),
+            Span::raw(" "),
+            lamp(t.outputs & 2 != 0, "POWER_EN"),
+            Span::raw(" "),
+            lamp(t.outputs & 4 != 0, "DRIVERS"),
+        ]),
+        Line::from(vec![
+            Span::raw("supply sense:       "),
+            lamp(input(InputBit::LogicOk), "LOGIC_OK"),
+            Span::raw(" "),
+            lamp(input(InputBit::PowerOk), "POWER_OK"),
+            Span::raw("   "),
+            alarm(input(InputBit::EStop), "E-STOP OPEN"),
+        ]),
+    ])
+    .block(Block::default().borders(Borders::ALL).title(" supplies "));
+    frame.render_widget(supplies, rows[1]);
+
+    let axes = Table::new(
+        (0..6u8).map(|a| {
+            Row::new(vec![
+                format!("axis {}", a + 1),
+                format!("{:>12}", t.steps[usize::from(a)]),
+                if input(InputBit::Home(a)) {
+                    "HOME".into()
+                } else {
+                    "-".into()
+                },
+                if input(InputBit::Limit(a)) {
+                    "LIMIT".into()
+                } else {
+                    "-".into()
+                },
+            ])
+        }),
+        [
+            Constraint::Length(8),
+            Constraint::Length(14),
+            Constraint::Length(6),
+            Constraint::Length(6),
+        ],
+    )
+    .header(Row::new(vec!["", "steps", "home", "end"]).style(Style::default().add_modifier(Modifier::BOLD)))
+    .block(Block::default().borders(Borders::ALL).title(" axes and switches "));
+    frame.render_widget(axes, rows[2]);
+
+    let p = t.target.to_array();
+    let flags = [
+        (TelemetryFlags::LIMITED, "limited"),
+        (TelemetryFlags::REFUSED, "refused"),
+        (TelemetryFlags::HELD, "held"),
+    ];
+    let mut counters = vec![Span::raw(format!(
+        "applied {}   limited {}   refused {}   ",
+        t.applied, t.limited, t.refused
+    ))];
+    counters.extend(flags.iter().map(|(bit, name)| alarm(t.flags & bit != 0, name)));
+    let motion = Paragraph::new(vec![
+        Line::from(counters),
+        Line::from(format!(
+            "target: x {:+.4} y {:+.4} z {:.4} m   roll {:+.2} pitch {:+.2} yaw {:+.2} deg",
+            p[0],
+            p[1],
+            p[2],
+            p[3].to_degrees(),
+            p[4].to_degrees(),
+            p[5].to_degrees()
+        )),
+    ])
+    .block(Block::default().borders(Borders::ALL).title(" motion (q: quit) "));
+    frame.render_widget(motion, rows[3]);
+}
+
+/// Runs the view until `q`, Esc or Ctrl-C, or for `frames` redraws. Draws ten times a second.
+pub fn run<T: Transport>(client: &mut Client<T>, source: &str, frames: Option<u64>) -> anyhow::Result<()> {
+    client.hello()?;
+    client.telemetry(true)?;
+    let mut out = std::io::stdout();
+    enable_raw_mode()?;
+    out.execute(EnterAlternateScreen)?;
+    let mut terminal = Terminal::new(CrosstermBackend::new(std::io::stdout()))?;
+    let result = view_loop(&mut terminal, client, source, frames);
+    let _ = disable_raw_mode();
+    let _ = out.execute(LeaveAlternateScreen);
+    let _ = out.flush();
+    let _ = client.telemetry(false);
+    result
+}
+
+fn view_loop<B: Backend, T: Transport>(
+    terminal: &mut Terminal<B>,
+    client: &mut Client<T>,
+    source: &str,
+    frames: Option<u64>,
+) -> anyhow::Result<()> {
+    let mut view = View {
+        source: source.to_owned(),
+        ..View::default()
+    };
+    let mut window: Vec<Instant> = Vec::new();
+    let mut drawn = 0u64;
+    loop {
+        client.transport().elapse(Duration::from_millis(100));
+        let samples = client.take_telemetry()?;
+        let now = Instant::now();
+        window.extend(std::iter::repeat_n(now, samples.len()));
+        window.retain(|t| now.duration_since(*t) < Duration::from_secs(1));
+        view.rate_hz = window.len() as f64;
+        view.received += samples.len() as u64;
+        view.dropped = client.telemetry_dropped;
+        if let Some(last) = samples.last() {
+            view.sample = Some(*last);
+        }
+        terminal.draw(|f| draw(f, &view))?;
+        drawn += 1;
+        if frames.is_some_and(|n| drawn >= n) {
+            return Ok(());
+        }
+        if event::poll(Duration::ZERO)? {
+            if let Event::Key(k) = event::read()? {
+                let ctrl_c = k.code == KeyCode::Char('c') && k.modifiers.contains(KeyModifiers::CONTROL);
+                if ctrl_c || matches!(k.code, KeyCode::Char('q') | KeyCode::Esc) {
+                    return Ok(());
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::backend::TestBackend;
+    use ringpod_core::kinematics::Pose;
+    use ringpod_core::safety::State;
+
+    fn text(view: &View) -> String {
+        let mut terminal = Terminal::new(TestBackend::new(100, 24)).unwrap();
+        terminal.draw(|f| draw(f, view)).unwrap();
+        let buffer = terminal.backend().buffer().clone();
+        buffer.content().iter().map(|c| c.symbol()).collect::<String>()
+    }
+
+    #[test]
+    fn the_view_shows_state_inputs_positions_and_counters() {
+        let sample = Telemetry {
+            time_us: 12_340_000,
+            state: State::Running,
+            pose: Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0),
+            target: Pose::new(0.01, 0.0, 0.227, 0.0, 0.0, 0.5),
+            steps: [101, 202, 303, 404, -505, 606],
+            flags: TelemetryFlags::LIMITED,
+            applied: 77,
+            limited: 5,
+            refused: 1,
+            tick_cost: 5600,
+            inputs: InputBit::Home(2).mask() | InputBit::LogicOk.mask() | InputBit::EStop.mask(),
+            outputs: 0b111,
+        };
+        let view = View {
+            sample: Some(sample),
+            received: 10,
+            rate_hz: 100.0,
+            dropped: 0,
+            source: "/dev/ttyACM0".into(),
+        };
+        let screen = text(&view);
+        for want in [
+            "Running",
+            "device time 12.34 s",
+            "LOGIC_EN",
+            "E-STOP OPEN",
+            "-505",
+            "HOME",
+            "applied 77",
+            "limited 5",
+            "yaw +28.65 deg",
+        ] {
+            assert!(screen.contains(want), "{want:?} missing from the screen");
+        }
+        assert_eq!(screen.matches("HOME").count(), 1, "only axis 3's home switch is active");
+        let waiting = text(&View {
+            source: "sim".into(),
+            ..View::default()
+        });
+        assert!(waiting.contains("waiting for telemetry"));
+    }
+}
