@@ -172,6 +172,8 @@ pub enum DeviceAction {
     Clear,
     /// Settings: `config` lists them all, `config get KEY`, `config set KEY VALUE` (stored in the board's flash).
     Config,
+    /// Every input: its electrical level and its debounced state (with --watch: each change as it happens).
+    Inputs,
 }
 
 #[derive(Debug, Args)]
@@ -190,6 +192,9 @@ pub struct DeviceArgs {
     /// A fresh in-process simulated controller.
     #[arg(long)]
     pub sim: bool,
+    /// With `inputs`: keep reading (every 20 ms) and print a line for each change, until Ctrl-C.
+    #[arg(long)]
+    pub watch: bool,
 }
 
 #[derive(Debug, Args)]

@@ -7,8 +7,8 @@ use std::time::Duration;
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::motion::{Accepted, RejectReason};
 use ringpod_core::protocol::{
-    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, NackReason, Request, Response, Status, Telemetry,
-    PROTOCOL_VERSION,
+    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, Status,
+    Telemetry, PROTOCOL_VERSION,
 };
 use ringpod_core::safety::FaultReason;
 
@@ -271,6 +271,15 @@ impl<T: Transport> Client<T> {
     pub fn status(&mut self) -> Result<Status, ClientError> {
         match self.request(HostMessage::GetStatus)? {
             DeviceMessage::Status(s) => Ok(s),
+            other => Err(ClientError::Unexpected(format!("{other:?}"))),
+        }
+    }
+
+    /// Every input's level and debounced state.
+    pub fn inputs(&mut self) -> Result<InputReport, ClientError> {
+        match self.request(HostMessage::GetInputs)? {
+            DeviceMessage::Inputs(r) => Ok(r),
+            DeviceMessage::Nack(reason) => Err(ClientError::Device(reason)),
             other => Err(ClientError::Unexpected(format!("{other:?}"))),
         }
     }

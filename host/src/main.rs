@@ -6,6 +6,7 @@ mod cue;
 mod datagram;
 mod demand;
 mod error;
+mod inputs;
 mod kinematics;
 mod mechanism;
 mod monitor;
@@ -240,6 +241,9 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     Ok(report.exit_code)
 }
 
+/// Set by Ctrl-C in commands that run until interrupted.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
 /// `ringpod monitor`.
 fn monitor_command(port: Option<&str>, sim: bool, frames: Option<u64>) -> anyhow::Result<u8> {
     let mut client = client::Client::new(connect(port, sim, true)?);
@@ -263,6 +267,9 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
     if args.action != A::Config && !args.config.is_empty() {
         anyhow::bail!("only `device config` takes further words");
     }
+    if args.watch && args.action != A::Inputs {
+        anyhow::bail!("--watch is for `device inputs`");
+    }
     let mut client = client::Client::new(connect(args.port.as_deref(), args.sim, false)?);
     client.hello()?;
     match args.action {
@@ -278,6 +285,14 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
         A::Start => client.start()?,
         A::Stop => client.stop()?,
         A::Clear => client.clear()?,
+        A::Inputs => {
+            let stop = || INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst);
+            if args.watch {
+                ctrlc::set_handler(|| INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst))?;
+            }
+            inputs::run(&mut client, args.watch, &stop)?;
+            return Ok(0);
+        }
         A::Config => {
             let json = settings::run(&mut client, &args.config)?;
             let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&json)?);

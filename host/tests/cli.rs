@@ -874,3 +874,20 @@ fn monitor_draws_the_device_on_a_pseudo_terminal() {
         assert!(screen.contains(want), "{want:?} not drawn: {screen}");
     }
 }
+
+/// `device inputs` lists every input with its pin level, polarity and state.
+#[test]
+fn device_inputs_lists_every_input() {
+    let out = ringpod().args(["device", "inputs", "--sim"]).output().unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.lines().count(), 16, "{text}");
+    for name in ["e-stop", "home 1", "home 6", "end 6", "LOGIC_OK", "POWER_OK"] {
+        assert!(text.contains(name), "{name} missing: {text}");
+    }
+    ringpod()
+        .args(["device", "status", "--watch", "--sim"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("--watch is for `device inputs`"));
+}

@@ -12,8 +12,8 @@ use crate::motion::{
     StepScheduler,
 };
 use crate::protocol::{
-    self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, Status, Telemetry, TelemetryFlags,
-    PROTOCOL_VERSION,
+    self, ConfigKey, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, Status, Telemetry,
+    TelemetryFlags, PROTOCOL_VERSION,
 };
 use crate::safety::debounce::InputConfig;
 use crate::safety::homing::{HomingConfig, HomingError, HomingPlan, RingHoming};
@@ -282,6 +282,8 @@ pub struct Controller {
     queue_depth: u16,
     pending_fault: bool,
     telemetry: TelemetryClock,
+    /// Electrical input levels as the board sampled them, if it does.
+    raw_inputs: Option<u16>,
 }
 
 /// When the next telemetry sample is due, and what the previous one counted (for its flags).
@@ -347,6 +349,7 @@ impl Controller {
             queue_depth: 0,
             pending_fault: false,
             telemetry: TelemetryClock::default(),
+            raw_inputs: None,
         })
     }
 
@@ -398,6 +401,25 @@ impl Controller {
             if !was_fault {
                 self.pending_fault = true;
             }
+        }
+    }
+
+    /// The electrical levels of the input pins as the board sampled them (before debouncing and polarity), for
+    /// [`HostMessage::GetInputs`].
+    pub fn set_raw_inputs(&mut self, raw: u16) {
+        self.raw_inputs = Some(raw);
+    }
+
+    /// Every input's level and state.
+    pub fn input_report(&self) -> InputReport {
+        let active = crate::safety::debounce::from_inputs(&self.inputs);
+        let polarity = self.config.inputs.active_low;
+        InputReport {
+            raw: self.raw_inputs.unwrap_or(active ^ polarity),
+            sampled: self.raw_inputs.is_some(),
+            active,
+            active_low: polarity,
+            debounce_ms: self.config.inputs.debounce_samples,
         }
     }
 
@@ -460,6 +482,7 @@ impl Controller {
                 Err(reason) => DeviceMessage::Nack(NackReason::Rejected(reason)),
             },
             HostMessage::GetStatus => DeviceMessage::Status(self.status()),
+            HostMessage::GetInputs => DeviceMessage::Inputs(self.input_report()),
             HostMessage::Telemetry(on) => {
                 self.telemetry.on = on;
                 self.telemetry.ticks = 0;

@@ -325,3 +325,42 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
     assert_eq!(rig.controller.take_unsaved(), Some((ConfigKey::DebounceMs, 7.0)));
     assert_eq!(rig.controller.take_unsaved(), None);
 }
+
+/// `GetInputs`: the debounced state with the polarity, and the pins' levels as the board sampled them (derived
+/// from the state and the polarity where nothing samples pins).
+#[test]
+fn get_inputs_reports_levels_and_states() {
+    let mut c = connected();
+    let ask = |c: &mut Controller| match c
+        .handle(&Request {
+            id: 5,
+            body: HostMessage::GetInputs,
+        })
+        .body
+    {
+        DeviceMessage::Inputs(r) => r,
+        other => panic!("{other:?}"),
+    };
+    c.set_inputs(Inputs {
+        home: 0b100,
+        logic_ok: true,
+        ..Inputs::default()
+    });
+    let r = ask(&mut c);
+    let home3 = InputBit::Home(2).mask();
+    assert_eq!(r.active, home3 | InputBit::LogicOk.mask());
+    assert!(!r.sampled);
+    assert_eq!(r.raw, r.active ^ r.active_low, "derived through the polarity");
+    c.set_raw_inputs(0x1234);
+    let r = ask(&mut c);
+    assert!(r.sampled);
+    assert_eq!(r.raw, 0x1234);
+    assert_eq!(r.debounce_ms, ControllerConfig::trainer_model().inputs.debounce_samples);
+    // Before the handshake: refused like every other request.
+    let mut fresh = Controller::new(ControllerConfig::trainer_model()).unwrap();
+    let r = fresh.handle(&Request {
+        id: 6,
+        body: HostMessage::GetInputs,
+    });
+    assert_eq!(r.body, DeviceMessage::Nack(NackReason::NotConnected));
+}

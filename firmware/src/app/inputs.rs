@@ -17,12 +17,15 @@ pub trait InputPins {
     async fn edge(&mut self);
 }
 
-/// Debounces the inputs into `shared.inputs`, forever. Polarity and debounce length follow the controller's
+/// Debounces the inputs into `shared.inputs`, forever, and gives the controller every raw sample (for `device
+/// inputs`). Polarity and debounce length follow the controller's
 /// (live) settings.
 pub async fn run(pins: &mut impl InputPins, shared: &Shared) -> ! {
     let mut config = shared.with(|c| c.config().inputs);
-    let mut debouncer = Debouncer::new(config, pins.read());
+    let first = pins.read();
+    let mut debouncer = Debouncer::new(config, first);
     shared.inputs.store(debouncer.stable(), Ordering::Relaxed);
+    shared.with(|c| c.set_raw_inputs(first));
     loop {
         select(pins.edge(), Timer::after(Duration::from_millis(10))).await;
         loop {
@@ -31,7 +34,9 @@ pub async fn run(pins: &mut impl InputPins, shared: &Shared) -> ! {
                 config = now;
                 debouncer = Debouncer::new(config, pins.read());
             }
-            shared.inputs.store(debouncer.sample(pins.read()), Ordering::Relaxed);
+            let raw = pins.read();
+            shared.with(|c| c.set_raw_inputs(raw));
+            shared.inputs.store(debouncer.sample(raw), Ordering::Relaxed);
             if !debouncer.settling() {
                 break;
             }

@@ -49,6 +49,8 @@ pub enum HostMessage {
     GetConfig(ConfigKey),
     /// Write a configuration value (not while moving).
     SetConfig(ConfigKey, f32),
+    /// The input levels now ([`DeviceMessage::Inputs`]).
+    GetInputs,
     /// Send telemetry on this connection (`true`) at [`ConfigKey::TelemetryHz`], or stop (`false`). Every Hello
     /// starts a connection without it: a host that only commands gets only answers.
     Telemetry(bool),
@@ -85,6 +87,8 @@ pub enum DeviceMessage {
     Config(ConfigKey, f32),
     /// A fault was latched (unsolicited).
     Fault(FaultReason),
+    /// Every input's electrical level and its debounced state.
+    Inputs(InputReport),
     /// What the device is doing (unsolicited, at [`ConfigKey::TelemetryHz`] while the host asks for it).
     Telemetry(Telemetry),
 }
@@ -116,6 +120,22 @@ pub struct Telemetry {
     pub inputs: u16,
     /// The outputs: bit 0 LOGIC_EN relay, bit 1 POWER_EN relay, bit 2 driver enable.
     pub outputs: u8,
+}
+
+/// Every input, a bit per `safety::debounce::InputBit`: what a person wiring a board checks switch by switch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct InputReport {
+    /// Electrical level of each pin (1: high), as last sampled.
+    pub raw: u16,
+    /// Whether `raw` was sampled from the pins (a board), or derived from the debounced state and the polarity (a
+    /// simulated machine, which has no pins).
+    pub sampled: bool,
+    /// Debounced and polarity-corrected state (1: active: switch made, e-stop open, supply good).
+    pub active: u16,
+    /// The polarity setting: inputs active when low.
+    pub active_low: u16,
+    /// Equal samples needed before a level counts (ms).
+    pub debounce_ms: u8,
 }
 
 /// Bits of [`Telemetry::flags`].
