@@ -174,6 +174,11 @@ pub enum DeviceAction {
     Config,
     /// Every input: its electrical level and its debounced state (with --watch: each change as it happens).
     Inputs,
+    /// `jog AXIS DISTANCE`: move one axis (1-6) by degrees (carriage) or mm (linear actuator) at its slow homing
+    /// speed, stopping at its switch. Powered (`enable`), or Ready; home again afterwards.
+    Jog,
+    /// `buzz AXIS`: ten short moves back and forth of one axis (1-6): a motor that hums without turning shows.
+    Buzz,
 }
 
 #[derive(Debug, Args)]
@@ -184,7 +189,8 @@ pub struct DeviceArgs {
     /// For `config`: `get KEY` or `set KEY VALUE`. Keys: stream-timeout-ms, gross-jump-ms, follow-direct (0 or
     /// 1), tick-hz, input-active-low, debounce-ms, per axis (0-5) pose-velocity.N, pose-acceleration.N,
     /// steps-per-unit.N, and per check envelope-margin.CHECK (reach, carriage-spacing, rod-crossing, joint-cones,
-    /// singularity, stability; in the check's unit).
+    /// singularity, stability; in the check's unit), telemetry-hz. For `jog`: AXIS DISTANCE; for `buzz`: AXIS.
+    #[arg(allow_negative_numbers = true)]
     pub config: Vec<String>,
     /// Serial port of the board (USB CDC).
     #[arg(long, conflicts_with = "sim")]

@@ -178,7 +178,8 @@ impl<T: Transport> Client<T> {
         self.wait_response(id)
     }
 
-    fn ack(&mut self, body: HostMessage) -> Result<(), ClientError> {
+    /// Sends a command that answers with an Ack; a Nack is [`ClientError::Device`].
+    pub fn ack(&mut self, body: HostMessage) -> Result<(), ClientError> {
         match self.request(body)? {
             DeviceMessage::Ack => Ok(()),
             DeviceMessage::Nack(reason) => Err(ClientError::Device(reason)),

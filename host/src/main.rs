@@ -2,11 +2,11 @@
 
 mod cli;
 mod client;
+mod commission;
 mod cue;
 mod datagram;
 mod demand;
 mod error;
-mod inputs;
 mod kinematics;
 mod mechanism;
 mod monitor;
@@ -264,8 +264,8 @@ fn connect(port: Option<&str>, sim: bool, realtime: bool) -> anyhow::Result<tran
 /// `ringpod device ACTION`.
 fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
     use cli::DeviceAction as A;
-    if args.action != A::Config && !args.config.is_empty() {
-        anyhow::bail!("only `device config` takes further words");
+    if !matches!(args.action, A::Config | A::Jog | A::Buzz) && !args.config.is_empty() {
+        anyhow::bail!("only `device config`, `jog` and `buzz` take further words");
     }
     if args.watch && args.action != A::Inputs {
         anyhow::bail!("--watch is for `device inputs`");
@@ -285,12 +285,17 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
         A::Start => client.start()?,
         A::Stop => client.stop()?,
         A::Clear => client.clear()?,
+        A::Jog | A::Buzz => {
+            let line = commission::jog(&mut client, &args.config, args.action == A::Buzz)?;
+            println!("{line}");
+            return Ok(0);
+        }
         A::Inputs => {
             let stop = || INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst);
             if args.watch {
                 ctrlc::set_handler(|| INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst))?;
             }
-            inputs::run(&mut client, args.watch, &stop)?;
+            commission::inputs(&mut client, args.watch, &stop)?;
             return Ok(0);
         }
         A::Config => {

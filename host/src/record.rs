@@ -56,6 +56,7 @@ pub fn state_name(state: State) -> String {
         State::Homing => "Homing".into(),
         State::Ready => "Ready".into(),
         State::Running => "Running".into(),
+        State::Jogging => "Jogging".into(),
         State::Stopping => "Stopping".into(),
         State::Fault(reason, _) => format!("Fault: {reason}").replace(',', ";"),
         State::ShuttingDown(_) => "ShuttingDown".into(),

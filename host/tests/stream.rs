@@ -648,3 +648,43 @@ fn telemetry_over_udp_is_cued_live() {
     assert!(report["washout_sent"].as_u64().unwrap() > 10, "{report}");
     assert_eq!(report["state"], "Ready");
 }
+
+/// Commissioning over the serial transport: `device jog` is refused unpowered; powered, a linear actuator jogs
+/// 2 mm (3,200 steps) and comes back; a buzz ends where it began; a missing axis is a usage error.
+#[test]
+fn device_jog_and_buzz_move_one_axis_over_a_pty() {
+    let (mut server, path) = simulator_on_a_pty();
+    let device = |words: &[&str]| {
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .arg("device")
+            .args(words)
+            .args(["--port", &path])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr),
+        )
+    };
+    let (code, said) = device(&["jog", "5", "-2"]);
+    assert_eq!(code, Some(1), "{said}");
+    assert!(said.contains("WrongState"), "{said}");
+    assert_eq!(device(&["enable"]).0, Some(0));
+    std::thread::sleep(std::time::Duration::from_millis(600));
+    let (code, said) = device(&["jog", "5", "-2"]);
+    assert_eq!(code, Some(0), "{said}");
+    assert!(said.contains("jogged -2 mm (-3200 steps): moved -3200 steps"), "{said}");
+    let (code, said) = device(&["jog", "5", "2"]);
+    assert!(code == Some(0) && said.contains("moved 3200 steps, now at 0"), "{said}");
+    let (code, said) = device(&["buzz", "1"]);
+    assert!(code == Some(0) && said.contains("buzzed: moved 0 steps"), "{said}");
+    let (code, said) = device(&["jog", "7", "1"]);
+    assert!(code == Some(1) && said.contains("usage"), "{said}");
+    let (code, said) = device(&["jog", "1", "30"]);
+    assert!(
+        code == Some(1) && said.contains("OutOfRange"),
+        "a carriage jogs at most its back-off: {said}"
+    );
+    let _ = server.kill();
+    let _ = server.wait();
+}

@@ -6,6 +6,7 @@
 
 use crate::kinematics::presets::{Preset, PresetGeometry};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, MultiTurn, Pose, RingPlatform};
+use crate::motion::jog::Jog;
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{
     Accepted, AxisMove, AxisScale, FollowMode, Pipeline, PipelineConfig, PipelineEvent, SchedulerConfig, StepConverter,
@@ -284,6 +285,8 @@ pub struct Controller {
     telemetry: TelemetryClock,
     /// Electrical input levels as the board sampled them, if it does.
     raw_inputs: Option<u16>,
+    /// A commissioning move in progress, and whether its axis's home switch was active when it started.
+    jog: Option<(Jog, bool)>,
 }
 
 /// When the next telemetry sample is due, and what the previous one counted (for its flags).
@@ -350,6 +353,7 @@ impl Controller {
             pending_fault: false,
             telemetry: TelemetryClock::default(),
             raw_inputs: None,
+            jog: None,
         })
     }
 
@@ -393,6 +397,9 @@ impl Controller {
     }
 
     fn after_transition(&mut self, was_fault: bool) {
+        if self.supervisor.state() != State::Jogging {
+            self.jog = None;
+        }
         if matches!(self.supervisor.state(), State::Fault(..)) {
             self.pipeline.halt();
             self.homing = None;
@@ -483,6 +490,8 @@ impl Controller {
             },
             HostMessage::GetStatus => DeviceMessage::Status(self.status()),
             HostMessage::GetInputs => DeviceMessage::Inputs(self.input_report()),
+            HostMessage::Jog { axis, steps } => self.start_jog(axis, Some(steps)),
+            HostMessage::Buzz { axis } => self.start_jog(axis, None),
             HostMessage::Telemetry(on) => {
                 self.telemetry.on = on;
                 self.telemetry.ticks = 0;
@@ -504,6 +513,68 @@ impl Controller {
             HostMessage::ClearFault => self.command(Event::ClearFault),
         };
         Response { id: request.id, body }
+    }
+
+    /// Starts a jog (`Some(steps)`) or a buzz (`None`) of `axis`, if the supervisor allows it.
+    fn start_jog(&mut self, axis: u8, steps: Option<i32>) -> DeviceMessage {
+        let a = usize::from(axis);
+        let (Some(homing), Some(kind)) = (
+            self.config.homing.axes.get(a).copied(),
+            self.pipeline.mechanism().axes().get(a).copied(),
+        ) else {
+            return DeviceMessage::Nack(NackReason::OutOfRange);
+        };
+        // A carriage moves at most its homing back-off unhomed or not (never far enough to reach a neighbour on
+        // the ring); a linear actuator at most the travel its homing searches blind.
+        let longest = match kind {
+            AxisKind::Ring => homing.backoff_steps,
+            AxisKind::Linear | AxisKind::Angle => homing.search_steps,
+        };
+        if steps.is_some_and(|s| s == 0 || s.unsigned_abs() > longest) {
+            return DeviceMessage::Nack(NackReason::OutOfRange);
+        }
+        let answer = self.command(Event::Jog);
+        if answer != DeviceMessage::Ack {
+            return answer;
+        }
+        let from = self.scheduler.position()[a];
+        let jog = match steps {
+            Some(s) => Jog::one_leg(a, from, s, homing.slow_rate),
+            None => {
+                let amplitude = i32::try_from((homing.backoff_steps / 2).max(1)).unwrap_or(i32::MAX);
+                Jog::buzz(a, from, amplitude, homing.fast_rate)
+            }
+        };
+        self.jog = Some((jog, self.inputs.home & (1 << a) != 0));
+        answer
+    }
+
+    /// One tick of a jog: the axis a step further, the others where they are; done at the end of the last leg or
+    /// when the axis's home switch closes.
+    fn jog_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
+        let Some((jog, home_at_start)) = self.jog.as_mut() else {
+            self.event(Event::JogDone);
+            return position;
+        };
+        let a = jog.axis;
+        let home_now = self.inputs.home & (1 << a) != 0;
+        let next = if home_now && !*home_at_start {
+            None
+        } else {
+            jog.next(position[a], tick_us)
+        };
+        match next {
+            Some(p) => {
+                let mut targets = position;
+                targets[a] = p;
+                targets
+            }
+            None => {
+                self.jog = None;
+                self.event(Event::JogDone);
+                position
+            }
+        }
     }
 
     fn command(&mut self, e: Event) -> DeviceMessage {
@@ -716,6 +787,7 @@ impl Controller {
                 }
             }
             Motion::Homing => self.homing_tick(position, tick_us),
+            Motion::Jog => self.jog_tick(position, tick_us),
             Motion::None => position,
         };
         let outputs = self.supervisor.outputs();

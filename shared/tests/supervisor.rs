@@ -15,6 +15,8 @@ fn alphabet(c: &SupervisorConfig) -> Vec<Event> {
         Event::Start,
         Event::Stop,
         Event::ClearFault,
+        Event::Jog,
+        Event::JogDone,
         Event::LogicOk(true),
         Event::LogicOk(false),
         Event::PowerOk(true),
@@ -59,8 +61,9 @@ fn check(before: &Supervisor, event: Event, after: &Supervisor, result: Result<(
     if a.driver_enable && (!a.power_relay || matches!(after.state(), State::Fault(..))) {
         return Err("drivers enabled without power or with a fault".into());
     }
-    if b.power_relay && !b.driver_enable && a.driver_enable && !matches!(after.state(), State::Homing) {
-        return Err("drivers enabled by anything but homing".into());
+    if b.power_relay && !b.driver_enable && a.driver_enable && !matches!(after.state(), State::Homing | State::Jogging)
+    {
+        return Err("drivers enabled by anything but homing or a jog".into());
     }
     if b.power_relay && !a.power_relay && b.driver_enable && !matches!(after.state(), State::Fault(..)) {
         return Err("power cut under enabled drivers outside a fault".into());
@@ -85,6 +88,9 @@ fn check(before: &Supervisor, event: Event, after: &Supervisor, result: Result<(
     }
     if a.motion == Motion::Homing && after.state() != State::Homing {
         return Err("homing motion outside homing".into());
+    }
+    if a.motion == Motion::Jog && (after.state() != State::Jogging || after.homed()) {
+        return Err("jog motion outside a jog, or a jogged machine still counted homed".into());
     }
     if result.is_err() && before != after {
         return Err("a refused command changed the state".into());

@@ -6,7 +6,7 @@
 //! start = [-500, -400, -300, -200, 8000, 9000]   # plant positions before homing (steps from each switch)
 //! [[step]]
 //! at_ms = 0
-//! send = "enable"                # hello, enable, disable, home, start, stop, clear, status
+//! send = "enable"                # hello, enable, disable, home, start, stop, clear, status, jog A S, buzz A
 //! expect_response = "Ack"        # optional: prefix of the response's Debug text
 //! [[step]]
 //! at_ms = 5
@@ -143,6 +143,8 @@ pub struct Expect {
     pub limited_at_least: Option<u32>,
     /// Setpoints limited into the envelope, exactly.
     pub limited: Option<u32>,
+    /// The axes' step positions, exactly.
+    pub steps: Option<[i64; 6]>,
 }
 
 /// What a run did, for assertions beyond the file.
@@ -206,7 +208,21 @@ fn command(name: &str) -> Result<HostMessage, String> {
         "stop" => HostMessage::Stop,
         "clear" => HostMessage::ClearFault,
         "status" => HostMessage::GetStatus,
-        other => return Err(format!("unknown command `{other}`")),
+        other => {
+            // `jog AXIS STEPS`, `buzz AXIS` (axis 0-5).
+            let words: Vec<&str> = other.split_whitespace().collect();
+            let number = |w: &str| w.parse::<i64>().map_err(|_| format!("`{other}`: {w} is not a number"));
+            match words.as_slice() {
+                ["jog", axis, steps] => HostMessage::Jog {
+                    axis: u8::try_from(number(axis)?).map_err(|e| e.to_string())?,
+                    steps: i32::try_from(number(steps)?).map_err(|e| e.to_string())?,
+                },
+                ["buzz", axis] => HostMessage::Buzz {
+                    axis: u8::try_from(number(axis)?).map_err(|e| e.to_string())?,
+                },
+                _ => return Err(format!("unknown command `{other}`")),
+            }
+        }
     })
 }
 
@@ -375,6 +391,9 @@ fn check(rig: &Rig, host: &Host, report: &Report, e: &Expect) -> Result<(), Stri
     };
     if let Some(p) = e.at_pose {
         near(steps_of(c, &Pose::from_array(p.map(|v| v as f32))))?;
+    }
+    if e.steps.is_some_and(|want| c.steps() != want) {
+        return Err(format!("steps {:?}, expected {:?}", c.steps(), e.steps));
     }
     if e.at_last_setpoint == Some(true) {
         let pose = host.last_accepted.ok_or("no setpoint was accepted")?;

@@ -2,6 +2,7 @@
 //! steps, and the step scheduler that turns per-period step targets into timed pulses.
 
 pub mod envelope;
+pub mod jog;
 pub mod limits;
 pub mod pipeline;
 pub mod pulse;

@@ -51,6 +51,21 @@ pub enum HostMessage {
     SetConfig(ConfigKey, f32),
     /// The input levels now ([`DeviceMessage::Inputs`]).
     GetInputs,
+    /// Commissioning: move one axis (0-5) by a step count at its slow homing rate, the others holding; stops at
+    /// the axis's home switch (an end switch latches its fault). Powered and settled, or Ready; homing is void
+    /// afterwards. At most the homing back-off for a carriage, the homing search travel for a linear axis.
+    Jog {
+        /// Axis, 0-5.
+        axis: u8,
+        /// Signed steps.
+        steps: i32,
+    },
+    /// Commissioning: ten short back-and-forth moves of one axis at its fast homing rate (half its homing back-off
+    /// each way), as Klipper's STEPPER_BUZZ: a motor that hums but does not move, or moves one way only, shows.
+    Buzz {
+        /// Axis, 0-5.
+        axis: u8,
+    },
     /// Send telemetry on this connection (`true`) at [`ConfigKey::TelemetryHz`], or stop (`false`). Every Hello
     /// starts a connection without it: a host that only commands gets only answers.
     Telemetry(bool),
@@ -168,6 +183,8 @@ pub enum NackReason {
     Rejected(RejectReason),
     /// The configuration value is out of range, or cannot change now.
     BadConfig,
+    /// A command's argument is out of its range (an axis that does not exist, a jog too long).
+    OutOfRange,
     /// The frame could not be decoded (id unknown, so the response has id 0).
     Malformed,
 }

@@ -144,6 +144,8 @@ pub enum State {
     Ready,
     /// Streaming poses.
     Running,
+    /// Commissioning: one axis jogs or buzzes, the others hold (drivers enabled). Homing is void afterwards.
+    Jogging,
     /// Ramping to rest (stop command or stream loss).
     Stopping,
     /// Latched fault; the supplies it keeps.
@@ -163,6 +165,8 @@ pub enum Motion {
     Homing,
     /// The pose stream (and its stopping ramp) moves the platform.
     Stream,
+    /// One axis jogs or buzzes (commissioning).
+    Jog,
 }
 
 /// The supervisor's outputs: relays, driver enable, and what may move.
@@ -206,6 +210,10 @@ pub enum Event {
     Stop,
     /// Command: clear a latched fault.
     ClearFault,
+    /// Command: jog or buzz one axis (commissioning), from powered-and-settled or from Ready.
+    Jog,
+    /// The jog or buzz finished (or stopped at a switch).
+    JogDone,
     /// LOGIC_OK input level.
     LogicOk(bool),
     /// POWER_OK input level.
@@ -310,6 +318,7 @@ impl Supervisor {
             State::LogicOn => (true, false, false, Motion::None),
             State::PowerOn { .. } | State::ShuttingDown(Shutdown::Drivers) => (true, true, false, Motion::None),
             State::Homing => (true, true, true, Motion::Homing),
+            State::Jogging => (true, true, true, Motion::Jog),
             State::Ready => (true, true, true, Motion::None),
             State::Running | State::Stopping => (true, true, true, Motion::Stream),
             State::Fault(_, supplies) => (
@@ -409,8 +418,16 @@ impl Supervisor {
                     self.fault(FaultReason::Watchdog);
                 }
             }
+            Event::JogDone => {
+                if self.state == State::Jogging {
+                    self.go(State::PowerOn { settled: true });
+                }
+            }
             Event::MotionFault => {
-                if matches!(self.state, State::Running | State::Stopping | State::Homing) {
+                if matches!(
+                    self.state,
+                    State::Running | State::Stopping | State::Homing | State::Jogging
+                ) {
                     self.fault(FaultReason::MotionFault);
                 }
             }
@@ -436,9 +453,13 @@ impl Supervisor {
                     self.go(State::Stopping);
                 }
             }
-            Event::Enable | Event::Disable | Event::Home | Event::Start | Event::Stop | Event::ClearFault => {
-                return self.command(event)
-            }
+            Event::Enable
+            | Event::Disable
+            | Event::Home
+            | Event::Start
+            | Event::Stop
+            | Event::ClearFault
+            | Event::Jog => return self.command(event),
         }
         Ok(())
     }
@@ -470,6 +491,18 @@ impl Supervisor {
                 self.homed = false;
                 self.go(State::Homing);
             }
+            (Event::Jog, State::PowerOn { settled: true } | State::Ready) => {
+                if self.inputs.estop_open {
+                    return Err(Refusal::EStopOpen);
+                }
+                if self.inputs.limits != 0 {
+                    return Err(Refusal::LimitActive);
+                }
+                // One axis moves away from the pose homing left: the platform must be homed again to stream.
+                self.homed = false;
+                self.go(State::Jogging);
+            }
+            (Event::Stop, State::Jogging) => self.go(State::PowerOn { settled: true }),
             (Event::Start, State::Ready) => self.go(State::Running),
             (Event::Stop, State::Running) => self.go(State::Stopping),
             (Event::Stop, State::Homing) => {

@@ -1,0 +1,171 @@
+//! Commissioning a board: `ringpod device inputs [--watch]` (every input's electrical level and debounced state,
+//! to check the wiring switch by switch), `device jog AXIS DISTANCE` and `device buzz AXIS` (one motor at a time,
+//! to check its direction and its steps per unit).
+
+use std::fmt::Write as _;
+use std::time::Duration;
+
+use ringpod_core::protocol::InputReport;
+use ringpod_core::safety::debounce::InputBit;
+
+use ringpod_core::kinematics::presets::PresetGeometry;
+use ringpod_core::kinematics::{AxisKind, Mechanism, RingPlatform};
+use ringpod_core::protocol::{ConfigKey, HostMessage};
+use ringpod_core::safety::State;
+
+use crate::client::{Client, Transport};
+
+/// The inputs in bit order, with their names.
+pub fn names() -> Vec<(InputBit, String)> {
+    let mut v = vec![(InputBit::EStop, "e-stop".to_owned())];
+    v.extend((0..6u8).map(|a| (InputBit::Home(a), format!("home {}", a + 1))));
+    v.extend((0..6u8).map(|a| (InputBit::Limit(a), format!("end {}", a + 1))));
+    v.push((InputBit::LogicOk, "LOGIC_OK".into()));
+    v.push((InputBit::PowerOk, "POWER_OK".into()));
+    v
+}
+
+/// A table: one input a line, its pin level, polarity and state.
+pub fn table(r: &InputReport) -> String {
+    let mut t = format!(
+        "{:<9} {:<5} {:<12} state   (debounce {} ms{})\n",
+        "input",
+        "pin",
+        "active when",
+        r.debounce_ms,
+        if r.sampled {
+            ""
+        } else {
+            "; levels derived: a simulated machine has no pins"
+        }
+    );
+    for (bit, name) in names() {
+        let m = bit.mask();
+        let _ = writeln!(
+            t,
+            "{name:<9} {:<5} {:<12} {}",
+            if r.raw & m != 0 { "high" } else { "low" },
+            if r.active_low & m != 0 { "low" } else { "high" },
+            if r.active & m != 0 { "ACTIVE" } else { "-" }
+        );
+    }
+    t
+}
+
+/// The changes from `before` to `now`, one line each.
+pub fn changes(before: &InputReport, now: &InputReport) -> Vec<String> {
+    names()
+        .into_iter()
+        .filter_map(|(bit, name)| {
+            let m = bit.mask();
+            let (raw, active) = ((before.raw ^ now.raw) & m != 0, (before.active ^ now.active) & m != 0);
+            (raw || active).then(|| {
+                format!(
+                    "{name}: pin {}, {}",
+                    if now.raw & m != 0 { "high" } else { "low" },
+                    if now.active & m != 0 { "ACTIVE" } else { "inactive" }
+                )
+            })
+        })
+        .collect()
+}
+
+/// Prints the table, then with `watch` every change until `stop` says so.
+pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn() -> bool) -> anyhow::Result<()> {
+    let mut last = client.inputs()?;
+    print!("{}", table(&last));
+    while watch && !stop() {
+        client.transport().elapse(Duration::from_millis(20));
+        let now = client.inputs()?;
+        for line in changes(&last, &now) {
+            println!("{line}");
+        }
+        last = now;
+    }
+    Ok(())
+}
+
+/// `device jog AXIS DISTANCE` (`Some`) or `device buzz AXIS` (`None`): AXIS 1-6, DISTANCE in degrees of ring for a
+/// carriage and millimetres for a linear actuator, turned into steps with the device's own steps per unit. Waits
+/// until the move is done; returns the step positions and a line to print.
+pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -> anyhow::Result<String> {
+    let usage = if buzz {
+        "usage: ringpod device buzz AXIS (1-6)"
+    } else {
+        "usage: ringpod device jog AXIS DISTANCE (1-6; degrees for a carriage, mm for a linear actuator)"
+    };
+    let axis: u8 = match words.first().map(|w| w.parse::<u8>()) {
+        Some(Ok(a)) if (1..=6).contains(&a) => a - 1,
+        _ => anyhow::bail!(usage),
+    };
+    let preset = client.hello()?;
+    let PresetGeometry::Ring(geometry) = preset.geometry() else {
+        anyhow::bail!("the device drives {}, not a ring platform", preset.name());
+    };
+    let kind = RingPlatform::<f64>::new(geometry).axes()[usize::from(axis)];
+    let per_unit = f64::from(client.get_config(ConfigKey::StepsPerUnit(axis))?);
+    let (message, what) = if buzz {
+        if words.len() != 1 {
+            anyhow::bail!(usage);
+        }
+        (HostMessage::Buzz { axis }, "buzzed".to_owned())
+    } else {
+        let [_, distance] = words else { anyhow::bail!(usage) };
+        let d: f64 = distance
+            .parse()
+            .map_err(|_| anyhow::anyhow!("{usage}: {distance:?} is not a number"))?;
+        // Steps per carriage turn, or per metre.
+        let (steps, unit) = match kind {
+            AxisKind::Ring => (d / 360.0 * per_unit, "deg"),
+            AxisKind::Linear | AxisKind::Angle => (d / 1000.0 * per_unit, "mm"),
+        };
+        if !steps.is_finite() || steps.abs() > f64::from(i32::MAX) {
+            anyhow::bail!("{d} {unit} is out of range");
+        }
+        let steps = steps.round() as i32;
+        (
+            HostMessage::Jog { axis, steps },
+            format!("jogged {d} {unit} ({steps} steps)"),
+        )
+    };
+    let before = client.status()?.steps;
+    client.ack(message)?;
+    let status = client.wait_for(Duration::from_secs(120), |s| s.state != State::Jogging)?;
+    if let State::Fault(reason, _) = status.state {
+        anyhow::bail!("axis {} {what} into a fault: {reason}", axis + 1);
+    }
+    let moved = status.steps[usize::from(axis)] - before[usize::from(axis)];
+    Ok(format!(
+        "axis {} {what}: moved {moved} steps, now at {} (state {:?}; home again before streaming)",
+        axis + 1,
+        status.steps[usize::from(axis)],
+        status.state
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_switch_change_is_one_line_and_the_table_names_every_input() {
+        let off = InputReport {
+            raw: 0,
+            sampled: true,
+            active: 0,
+            active_low: InputBit::EStop.mask(),
+            debounce_ms: 5,
+        };
+        let table = table(&off);
+        assert_eq!(table.lines().count(), 16, "a header and 15 inputs");
+        assert!(table.contains("e-stop    low   low          -"), "{table}");
+        let home3 = InputBit::Home(2).mask();
+        let on = InputReport {
+            raw: home3,
+            active: home3,
+            ..off
+        };
+        assert_eq!(changes(&off, &on), vec!["home 3: pin high, ACTIVE".to_owned()]);
+        assert!(changes(&on, &on).is_empty());
+    }
+}
