@@ -7,7 +7,7 @@ use core::sync::atomic::Ordering;
 use embassy_time::{Duration, Ticker};
 use ringpod_core::controller::Inputs;
 use ringpod_core::motion::AxisMove;
-use ringpod_core::safety::Outputs;
+use ringpod_core::safety::pins::{writes, OutputPin};
 
 use super::Shared;
 
@@ -15,8 +15,8 @@ use super::Shared;
 pub trait Machine {
     /// The debounced inputs now.
     fn inputs(&mut self, shared: &Shared) -> Inputs;
-    /// Drives the relays and the driver enable.
-    fn outputs(&mut self, outputs: &Outputs);
+    /// Sets one output pin (`true`: relay closed, drivers enabled).
+    fn write(&mut self, pin: OutputPin, on: bool);
     /// Hands one period's moves to the step generator (waits while its queue is full).
     async fn steps(&mut self, moves: &[AxisMove; 6], shared: &Shared);
     /// Periods queued for the step generator.
@@ -47,8 +47,11 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
             (out, c.unsolicited())
         });
         let cost = machine.cycles().wrapping_sub(start);
-        // Outputs first: a fault's disable reaches the drivers before anything else happens.
-        machine.outputs(&out.outputs);
+        // Outputs first: a fault's disable reaches the drivers before anything else happens; the order of the
+        // writes keeps the interlocks between them (`safety::pins`).
+        for (pin, on) in writes(&out.outputs) {
+            machine.write(pin, on);
+        }
         machine.steps(&out.moves, shared).await;
         let depth = machine.queue_depth(shared);
         shared.with(|c| c.set_platform_stats(cost, depth));

@@ -38,7 +38,7 @@ use ringpod_core::controller::{Controller, Inputs, MAX_STEP_SLOTS};
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
 use ringpod_core::motion::AxisMove;
 use ringpod_core::safety::debounce::{to_inputs, InputBit};
-use ringpod_core::safety::Outputs;
+use ringpod_core::safety::pins::OutputPin;
 use static_cell::StaticCell;
 use {defmt_rtt as _, panic_probe as _};
 
@@ -157,15 +157,12 @@ impl Machine for BlackPill {
         to_inputs(shared.inputs.load(Ordering::Relaxed))
     }
 
-    fn outputs(&mut self, o: &Outputs) {
-        // The supervisor never asks for power without logic; the order of the writes keeps it so within a tick.
-        self.driver_enable_n.set_level(Level::from(!o.driver_enable));
-        if o.logic_relay {
-            self.logic_relay.set_high();
-            self.power_relay.set_level(Level::from(o.power_relay));
-        } else {
-            self.power_relay.set_level(Level::from(o.power_relay));
-            self.logic_relay.set_low();
+    fn write(&mut self, pin: OutputPin, on: bool) {
+        match pin {
+            // ENABLE is active low on the drivers.
+            OutputPin::DriverEnable => self.driver_enable_n.set_level(Level::from(!on)),
+            OutputPin::LogicRelay => self.logic_relay.set_level(Level::from(on)),
+            OutputPin::PowerRelay => self.power_relay.set_level(Level::from(on)),
         }
     }
 

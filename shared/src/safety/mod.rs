@@ -2,6 +2,7 @@
 
 pub mod debounce;
 pub mod homing;
+pub mod pins;
 pub mod supervisor;
 
 pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};

@@ -28,6 +28,7 @@ use embassy_time_driver::Driver;
 use embassy_time_queue_utils::Queue;
 use ringpod_core::controller::{Controller, ControllerConfig, Inputs, TickOutput};
 use ringpod_core::motion::AxisMove;
+use ringpod_core::safety::pins::OutputPin;
 use ringpod_core::safety::Outputs;
 use ringpod_core::sim::{Plant, TRAINER_MODEL_PARKED};
 use ringpod_firmware::app::control::Machine;
@@ -173,8 +174,12 @@ impl Machine for VirtualMachine {
         self.plant.inputs(self.outputs.logic_relay, self.outputs.power_relay)
     }
 
-    fn outputs(&mut self, outputs: &Outputs) {
-        self.outputs = *outputs;
+    fn write(&mut self, pin: OutputPin, on: bool) {
+        match pin {
+            OutputPin::DriverEnable => self.outputs.driver_enable = on,
+            OutputPin::LogicRelay => self.outputs.logic_relay = on,
+            OutputPin::PowerRelay => self.outputs.power_relay = on,
+        }
     }
 
     async fn steps(&mut self, moves: &[AxisMove; 6], _shared: &Shared) {
