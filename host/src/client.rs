@@ -35,7 +35,7 @@ pub enum ClientError {
     #[error("no answer from the device within {0:?}")]
     Timeout(Duration),
     /// The device refused the request.
-    #[error("device refused: {0:?}")]
+    #[error("device refused: {0}")]
     Device(NackReason),
     /// Host and device speak different protocol versions.
     #[error("protocol version mismatch: host {host}, device {device}")]

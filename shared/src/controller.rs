@@ -13,8 +13,8 @@ use crate::motion::{
     StepScheduler,
 };
 use crate::protocol::{
-    self, ConfigKey, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, Status, Telemetry,
-    TelemetryFlags, PROTOCOL_VERSION,
+    self, ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, Status,
+    Telemetry, TelemetryFlags, PROTOCOL_VERSION,
 };
 use crate::safety::debounce::InputConfig;
 use crate::safety::homing::{HomingConfig, HomingError, HomingPlan, RingHoming};
@@ -64,6 +64,31 @@ pub enum ConfigError {
     StepTiming(PulseTimingError),
     /// A value is out of its key's range (or the key does not exist for this machine).
     Value,
+}
+
+impl ConfigError {
+    /// The cause as the protocol names it.
+    pub fn refusal(&self) -> ConfigRefusal {
+        match self {
+            Self::NotARingPlatform => ConfigRefusal::Geometry,
+            Self::HomePose(_) => ConfigRefusal::HomePose,
+            Self::Homing(_) => ConfigRefusal::Homing,
+            Self::Scheduler => ConfigRefusal::StepTiming,
+            Self::StepTiming(_) => ConfigRefusal::PulseSlots,
+            Self::Value => ConfigRefusal::OutOfRange,
+        }
+    }
+}
+
+impl core::fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::HomePose(e) => write!(f, "the home pose would have no solution: {e}"),
+            Self::Homing(e) => write!(f, "the homing plan would not be safe: {e}"),
+            Self::StepTiming(e) => write!(f, "step timing: {e}"),
+            other => other.refusal().fmt(f),
+        }
+    }
 }
 
 impl ControllerConfig {
@@ -499,7 +524,7 @@ impl Controller {
             }
             HostMessage::GetConfig(key) => match self.get_config(key) {
                 Some(v) => DeviceMessage::Config(key, v),
-                None => DeviceMessage::Nack(NackReason::BadConfig),
+                None => DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::OutOfRange)),
             },
             HostMessage::SetConfig(key, value) => match self.set_config(key, value) {
                 Ok(()) => DeviceMessage::Ack,
@@ -746,11 +771,12 @@ impl Controller {
             return Err(NackReason::Refused(crate::safety::Refusal::WrongState));
         }
         let mut saved = self.saved;
-        saved.set(key, value).map_err(|_| NackReason::BadConfig)?;
-        saved.validate().map_err(|_| NackReason::BadConfig)?;
+        let refused = |e: ConfigError| NackReason::BadConfig(e.refusal());
+        saved.set(key, value).map_err(refused)?;
+        saved.validate().map_err(refused)?;
         if key.is_live() {
             let mut live = self.config;
-            live.set(key, value).map_err(|_| NackReason::BadConfig)?;
+            live.set(key, value).map_err(refused)?;
             self.config = live;
             self.pipeline.set_config(live.pipeline);
         }

@@ -3,7 +3,9 @@
 
 use proptest::prelude::*;
 use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
-use ringpod_core::protocol::{ConfigKey, DeviceMessage, HostMessage, NackReason, Request, PROTOCOL_VERSION};
+use ringpod_core::protocol::{
+    ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, NackReason, Request, PROTOCOL_VERSION,
+};
 use ringpod_core::safety::debounce::{from_inputs, to_inputs, Debouncer, InputBit, InputConfig};
 
 fn config(samples: u8) -> InputConfig {
@@ -208,7 +210,7 @@ fn bad_values_are_refused_and_nothing_is_stored() {
     for (key, value) in bad {
         assert_eq!(
             set(&mut c, key, value),
-            DeviceMessage::Nack(NackReason::BadConfig),
+            DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::OutOfRange)),
             "{key:?} = {value}"
         );
     }
@@ -226,7 +228,10 @@ fn a_coarser_motor_that_breaks_the_homing_proof_is_refused() {
     let config = *c.saved_config();
     match reply {
         DeviceMessage::Ack => assert_eq!(config.scales[0].steps_per_turn, 400),
-        DeviceMessage::Nack(NackReason::BadConfig) => assert_eq!(config, ControllerConfig::trainer_model()),
+        DeviceMessage::Nack(NackReason::BadConfig(why)) => {
+            assert_eq!(why, ConfigRefusal::Homing, "the cause is named");
+            assert_eq!(config, ControllerConfig::trainer_model());
+        }
         other => panic!("unexpected {other:?}"),
     }
 }

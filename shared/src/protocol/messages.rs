@@ -137,6 +137,52 @@ pub struct Telemetry {
     pub outputs: u8,
 }
 
+impl core::fmt::Display for NackReason {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::VersionMismatch { device } => write!(f, "the device speaks protocol version {device}"),
+            Self::NotConnected => f.write_str("no handshake yet"),
+            Self::Refused(r) => write!(f, "refused: {r}"),
+            Self::Rejected(r) => write!(f, "setpoint rejected ({r:?})"),
+            Self::BadConfig(r) => write!(f, "setting refused (BadConfig): {r}"),
+            Self::OutOfRange => f.write_str("an argument is out of range (OutOfRange)"),
+            Self::Malformed => f.write_str("the frame could not be decoded"),
+        }
+    }
+}
+
+/// Why a setting was refused: the cause, named (the controller's `ConfigError`, flattened for the wire).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum ConfigRefusal {
+    /// The value is outside its key's range, or the key does not exist on this machine.
+    OutOfRange,
+    /// With it the home pose would have no solution.
+    HomePose,
+    /// With it the homing plan would be unsafe or inconsistent (searches, spacing proof).
+    Homing,
+    /// With it the step scheduler's timing would be inconsistent.
+    StepTiming,
+    /// With it the step generator's slots could not render the pulses faithfully.
+    PulseSlots,
+    /// The machine is not a ring platform.
+    Geometry,
+}
+
+impl core::fmt::Display for ConfigRefusal {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::OutOfRange => "the value is outside the setting's range",
+            Self::HomePose => "the home pose would have no solution",
+            Self::Homing => "the homing plan would no longer be safe (searches or spacing)",
+            Self::StepTiming => "the step timing would be inconsistent",
+            Self::PulseSlots => "the step generator could not render the pulses faithfully",
+            Self::Geometry => "the machine is not a ring platform",
+        })
+    }
+}
+
 /// Every input, a bit per `safety::debounce::InputBit`: what a person wiring a board checks switch by switch.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct InputReport {
@@ -181,8 +227,8 @@ pub enum NackReason {
     Refused(Refusal),
     /// The setpoint was rejected.
     Rejected(RejectReason),
-    /// The configuration value is out of range, or cannot change now.
-    BadConfig,
+    /// The setting was not taken, and why.
+    BadConfig(ConfigRefusal),
     /// A command's argument is out of its range (an axis that does not exist, a jog too long).
     OutOfRange,
     /// The frame could not be decoded (id unknown, so the response has id 0).

@@ -11,6 +11,6 @@ mod messages;
 
 pub use frame::{decode, encode, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
 pub use messages::{
-    ConfigKey, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode, Status, Telemetry,
-    TelemetryFlags, PROTOCOL_VERSION,
+    ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode,
+    Status, Telemetry, TelemetryFlags, PROTOCOL_VERSION,
 };
