@@ -211,6 +211,10 @@ pub struct StreamArgs {
     /// The in-process simulated controller (same core as the firmware, real framed bytes).
     #[arg(long)]
     pub sim: bool,
+    /// With --sim: simulate this rig file's platform (with the trainer model's drives and switches) instead of the
+    /// trainer model.
+    #[arg(long, value_name = "RIG.toml", requires = "sim")]
+    pub geometry: Option<std::path::PathBuf>,
     /// With --sim: run as fast as possible instead of in real time.
     #[arg(long, requires = "sim")]
     pub fast: bool,

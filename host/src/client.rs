@@ -25,6 +25,15 @@ pub trait Transport {
     fn elapse(&mut self, dt: Duration);
 }
 
+/// What a device says of itself in the handshake.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Device {
+    /// The preset it drives, if its geometry is one.
+    pub preset: Option<Preset>,
+    /// What each actuator coordinate measures.
+    pub axes: [ringpod_core::kinematics::AxisKind; 6],
+}
+
 /// Why a request did not produce its answer.
 #[derive(Debug, thiserror::Error)]
 pub enum ClientError {
@@ -193,7 +202,7 @@ impl<T: Transport> Client<T> {
     /// terminal whose other side is polled only now and then (QEMU's, about once a second). Hello changes nothing,
     /// so it is sent again every half second until the whole timeout (at least 5 s) has passed; the answers to
     /// earlier tries are dropped.
-    pub fn hello(&mut self) -> Result<Preset, ClientError> {
+    pub fn hello(&mut self) -> Result<Device, ClientError> {
         let patience = self.timeout.max(Duration::from_secs(5));
         let per_try = Duration::from_millis(500);
         let timeout = self.timeout;
@@ -217,7 +226,9 @@ impl<T: Transport> Client<T> {
         self.pump()?;
         self.inbox.retain(|r| !tries.contains(&r.id));
         match answer? {
-            DeviceMessage::Hello { version, preset } if version == PROTOCOL_VERSION => Ok(preset),
+            DeviceMessage::Hello { version, preset, axes } if version == PROTOCOL_VERSION => {
+                Ok(Device { preset, axes })
+            }
             DeviceMessage::Hello { version, .. }
             | DeviceMessage::Nack(NackReason::VersionMismatch { device: version }) => {
                 Err(ClientError::VersionMismatch {

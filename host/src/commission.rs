@@ -8,8 +8,7 @@ use std::time::Duration;
 use ringpod_core::protocol::InputReport;
 use ringpod_core::safety::debounce::InputBit;
 
-use ringpod_core::kinematics::presets::PresetGeometry;
-use ringpod_core::kinematics::{AxisKind, Mechanism, RingPlatform};
+use ringpod_core::kinematics::AxisKind;
 use ringpod_core::protocol::{ConfigKey, HostMessage};
 use ringpod_core::safety::State;
 
@@ -98,11 +97,7 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
         Some(Ok(a)) if (1..=6).contains(&a) => a - 1,
         _ => anyhow::bail!(usage),
     };
-    let preset = client.hello()?;
-    let PresetGeometry::Ring(geometry) = preset.geometry() else {
-        anyhow::bail!("the device drives {}, not a ring platform", preset.name());
-    };
-    let kind = RingPlatform::<f64>::new(geometry).axes()[usize::from(axis)];
+    let kind = client.hello()?.axes[usize::from(axis)];
     let per_unit = f64::from(client.get_config(ConfigKey::StepsPerUnit(axis))?);
     let (message, what) = if buzz {
         if words.len() != 1 {

@@ -165,13 +165,25 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
             return Ok(stream::exit::NOT_STARTED);
         }
     }
-    let mut client = client::Client::new(connect(args.port.as_deref(), args.sim, !args.fast)?);
+    let rig = args.geometry.as_deref().map(rig::load).transpose()?;
+    let transport = match &rig {
+        Some(r) => transport::AnyTransport::Sim(Box::new(transport::SimDevice::for_rig(!args.fast, r)?)),
+        None => connect(args.port.as_deref(), args.sim, !args.fast)?,
+    };
+    let mut client = client::Client::new(transport);
     client.cancel = Some(interrupted.clone());
     // The bar draws on stderr (and hides itself without a terminal), the report on stdout.
     let options = stream::Options {
         home: args.home,
         host_limits: !args.device_limits_only,
         quiet: args.quiet,
+        platform: match &rig {
+            Some(r) => stream::Platform {
+                geometry: r.geometry,
+                home: r.home.to_array(),
+            },
+            None => stream::Platform::trainer_model(),
+        },
     };
     let recorder = match &args.record {
         Some(path) => Some((

@@ -269,6 +269,27 @@ pub struct Options {
     pub host_limits: bool,
     /// No progress bar.
     pub quiet: bool,
+    /// The platform the device drives (the host limits into its envelope and leads in around its home pose).
+    pub platform: Platform,
+}
+
+/// A ring platform and its home pose.
+#[derive(Debug, Clone, Copy)]
+pub struct Platform {
+    /// Its geometry.
+    pub geometry: ringpod_core::kinematics::RingGeometry,
+    /// Its home pose.
+    pub home: [f64; 6],
+}
+
+impl Platform {
+    /// The 1:20 trainer model.
+    pub fn trainer_model() -> Self {
+        Self {
+            geometry: ringpod_core::kinematics::presets::TRAINER_MODEL,
+            home: Preset::TrainerModel.home(),
+        }
+    }
 }
 
 fn reason_name(r: RejectReason) -> String {
@@ -744,9 +765,12 @@ impl From<Stop> for StreamError {
 
 /// Brings the device to `Ready`: hello, power up, home if needed. Errors here mean the stream never started.
 fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) -> Result<Status, ClientError> {
-    let preset = client.hello()?;
-    if preset != Preset::TrainerModel {
-        eprintln!("note: the device drives {}", preset.name());
+    let device = client.hello()?;
+    if device.preset != Some(Preset::TrainerModel) {
+        eprintln!(
+            "note: the device drives {}",
+            device.preset.map_or("a geometry of its own", |p| p.name())
+        );
     }
     if telemetry {
         // From here on: the record covers powering up and homing too.
@@ -820,9 +844,7 @@ pub fn run<T: Transport>(
     };
     let baseline = prepare(client, options.home, recorder.is_some())?;
     let (margins, stream_timeout) = device_envelope(client)?;
-    let PresetGeometry::Ring(geometry) = Preset::TrainerModel.geometry() else {
-        return Err(ClientError::Unexpected("the trainer model is a ring platform".into()));
-    };
+    let geometry = &options.platform.geometry;
     let total = match &source {
         Source::Motion { seconds, rate_hz, .. } => (seconds * rate_hz).round() as u64 + 1,
         Source::Poses(p) => p.len() as u64,
@@ -848,7 +870,7 @@ pub fn run<T: Transport>(
         host_limits: options.host_limits,
         limits: MotionLimits::TRAINER_MODEL,
         stream_timeout,
-        centre: Pose::from_array(Preset::TrainerModel.home()),
+        centre: Pose::from_array(options.platform.home),
         last_sent: baseline.pose.cast(),
         clock_us: 0,
         seq: 0,
@@ -875,7 +897,7 @@ pub fn run<T: Transport>(
     };
     let mut input_errors = input_errors;
     let mut datagrams = None;
-    let home = Preset::TrainerModel.home();
+    let home = options.platform.home;
     let mut source = source;
     let outcome = match &mut source {
         Source::Motion {

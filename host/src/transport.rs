@@ -5,6 +5,7 @@ use std::io::{Read, Write};
 use std::time::{Duration, Instant};
 
 use ringpod_core::controller::{Controller, ControllerConfig};
+use ringpod_core::kinematics::Mechanism;
 use ringpod_core::protocol::{self, FrameReader};
 use ringpod_core::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
 
@@ -83,11 +84,31 @@ impl SimDevice {
     /// A simulated trainer model, parked near home, powered off.
     pub fn new(realtime: bool) -> Self {
         let config = ControllerConfig::trainer_model();
-        let tick_us = u64::from(config.pipeline.tick_us);
         let controller = Controller::new(config).expect("the built-in model configuration is valid");
+        Self::with(realtime, controller, Plant::trainer_model(TRAINER_MODEL_PARKED))
+    }
+
+    /// A simulated ring platform of a rig file, with the trainer model's drives, switches and timings, parked as
+    /// the model is (each axis a little before its switch), powered off.
+    pub fn for_rig(realtime: bool, rig: &crate::rig::Rig) -> anyhow::Result<Self> {
+        let config = ControllerConfig::for_rig(&rig.geometry, rig.home.to_array())
+            .map_err(|e| anyhow::anyhow!("{}: the controller cannot drive it: {e}", rig.geometry.name))?;
+        let controller = Controller::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let axes = controller.pipeline().mechanism().axes();
+        let stroke = rig.geometry.limits.stroke;
+        let far = ((stroke[1] - stroke[0] + 0.002) * 1.6e6) as i64;
+        Ok(Self::with(
+            realtime,
+            controller,
+            Plant::for_axes(&axes, TRAINER_MODEL_PARKED, far),
+        ))
+    }
+
+    fn with(realtime: bool, controller: Controller, plant: Plant) -> Self {
+        let tick_us = u64::from(controller.pipeline().config().tick_us);
         let rig = Rig {
             controller,
-            plant: Plant::trainer_model(TRAINER_MODEL_PARKED),
+            plant,
             ticks: 0,
         };
         Self {

@@ -688,3 +688,63 @@ fn device_jog_and_buzz_move_one_axis_over_a_pty() {
     let _ = server.kill();
     let _ = server.wait();
 }
+
+/// `stream --sim --geometry`: the simulated controller drives a rig no preset describes (a wider ring, longer
+/// rods), homes it with the plan built for it, follows the whole stream with the counts agreeing, and ends at other
+/// step positions than the trainer model does for the same motion.
+#[test]
+fn a_rig_of_ones_own_streams_on_the_simulator() {
+    let dir = std::env::temp_dir().join(format!("ringpod-own-rig-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exported = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["presets", "--export", "trainer-model"])
+        .output()
+        .unwrap();
+    let rig = String::from_utf8(exported.stdout)
+        .unwrap()
+        .replace("name = \"trainer-model\"", "name = \"wider-ring\"")
+        .replace("ring_radius = 0.286", "ring_radius = 0.3")
+        .replace("rod_length = 0.312", "rod_length = 0.325");
+    assert!(rig.contains("ring_radius = 0.3\n") && rig.contains("rod_length = 0.325\n"));
+    let file = dir.join("wider.toml");
+    std::fs::write(&file, rig).unwrap();
+    let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args([
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--report-json",
+            "--motion",
+            "demo",
+            "--duration",
+            "4",
+        ])
+        .args(["--geometry", file.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{said}");
+    assert!(said.contains("a geometry of its own"), "{said}");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["outcome"], "followed");
+    assert_eq!(report["counts_agree"], true);
+    // The trainer model's own stream of the same motion ends elsewhere: the rig's geometry was driven.
+    let model = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args([
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--report-json",
+            "--motion",
+            "demo",
+            "--duration",
+            "4",
+        ])
+        .output()
+        .unwrap();
+    let model: serde_json::Value = serde_json::from_slice(&model.stdout).unwrap();
+    assert_ne!(report["final_steps"], model["final_steps"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}

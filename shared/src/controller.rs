@@ -4,7 +4,8 @@
 //! input levels from the switches, one [`Controller::tick`] per control period) and drives its pins from what it
 //! returns; the host simulator and the tests call exactly the same code.
 
-use crate::kinematics::presets::{Preset, PresetGeometry};
+use crate::kinematics::presets::{self, Preset, PresetGeometry};
+use crate::kinematics::RingGeometry;
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, MultiTurn, Pose, RingPlatform};
 use crate::motion::jog::Jog;
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
@@ -23,8 +24,10 @@ use crate::safety::{Event, HomingSequencer, HomingStep, Motion, Outputs, State, 
 /// Everything the controller is configured with.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControllerConfig {
-    /// The geometry (a ring platform).
-    pub preset: Preset,
+    /// The platform it drives (a ring platform).
+    pub geometry: RingGeometry,
+    /// Where homing leaves the platform: `[x, y, z, alpha, beta, gamma]` (m, rad), inside every check.
+    pub home: [f64; 6],
     /// Supply sequencing.
     pub supervisor: SupervisorConfig,
     /// Motion pipeline.
@@ -115,7 +118,8 @@ impl ControllerConfig {
             home_position: -106_096,
         };
         Self {
-            preset: Preset::TrainerModel,
+            geometry: presets::TRAINER_MODEL,
+            home: Preset::TrainerModel.home(),
             supervisor: SupervisorConfig::default(),
             pipeline: PipelineConfig::default(),
             scheduler: SchedulerConfig::default(),
@@ -171,13 +175,55 @@ impl ControllerConfig {
     }
 
     fn axis_kind(&self, axis: u8) -> Option<AxisKind> {
-        let PresetGeometry::Ring(geometry) = self.preset.geometry() else {
-            return None;
-        };
-        RingPlatform::<f32>::new(geometry)
+        RingPlatform::<f32>::new(&self.geometry)
             .axes()
             .get(usize::from(axis))
             .copied()
+    }
+
+    /// The trainer model's drives, switches and timings on another ring platform (its own geometry and home
+    /// pose): each carriage with the model's carriage drive and index-switch homing, each linear actuator with the
+    /// model's lead screw and its lower end switch 1 mm below the stroke; linear actuators home first, then every
+    /// other carriage, then the rest (the homing plan's spacing proof decides whether that order is safe).
+    pub fn for_rig(geometry: &RingGeometry, home: [f64; 6]) -> Result<Self, ConfigError> {
+        let model = Self::trainer_model();
+        let m = RingPlatform::<f64>::new(geometry);
+        let axes = m.axes();
+        let q = m.inverse(&Pose::from_array(home)).map_err(ConfigError::HomePose)?;
+        let [carriage, linear] = [model.homing.axes[0], model.homing.axes[4]];
+        let mut config = Self {
+            geometry: *geometry,
+            home,
+            ..model
+        };
+        for (a, kind) in axes.iter().enumerate() {
+            let ring = *kind == AxisKind::Ring;
+            config.scales[a] = if ring {
+                AxisScale::MODEL_CARRIAGE
+            } else {
+                AxisScale::MODEL_LINEAR
+            };
+            config.homing.axes[a] = if ring {
+                carriage
+            } else {
+                let switch = geometry.limits.stroke[0] - 0.001;
+                let steps = libm::round((switch - q.0[a]) * f64::from(AxisScale::MODEL_LINEAR.steps_per_unit));
+                crate::safety::homing::AxisHoming {
+                    home_position: steps as i64,
+                    ..linear
+                }
+            };
+        }
+        let mut order = [0u8; 6];
+        let linear_first = (0..6u8).filter(|&a| axes[usize::from(a)] != AxisKind::Ring);
+        let even = (0..6u8).filter(|&a| axes[usize::from(a)] == AxisKind::Ring && a % 2 == 0);
+        let odd = (0..6u8).filter(|&a| axes[usize::from(a)] == AxisKind::Ring && a % 2 == 1);
+        for (slot, a) in order.iter_mut().zip(linear_first.chain(even).chain(odd)) {
+            *slot = a;
+        }
+        config.homing.order = order;
+        config.validate()?;
+        Ok(config)
     }
 
     /// Changes a setting after checking its range; the whole configuration is checked by [`Self::validate`].
@@ -331,15 +377,13 @@ struct TelemetryClock {
 impl Controller {
     /// A controller in `Off`, axes at step position zero.
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
-        let PresetGeometry::Ring(geometry) = config.preset.geometry() else {
-            return Err(ConfigError::NotARingPlatform);
-        };
+        let geometry = &config.geometry;
         if !config.scheduler.is_valid() || config.scheduler.period_ns != config.pipeline.tick_us.saturating_mul(1000) {
             return Err(ConfigError::Scheduler);
         }
         config.pulse_timing().map_err(ConfigError::StepTiming)?;
         let mechanism = RingPlatform::<f32>::new(geometry);
-        let home_pose = Pose::from_array(config.preset.home()).cast::<f32>();
+        let home_pose = Pose::from_array(config.home).cast::<f32>();
         let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;
         let n = geometry.chains().len();
         let mut home_angles = [0.0; 6];
@@ -498,7 +542,10 @@ impl Controller {
                     self.telemetry.on = false;
                     DeviceMessage::Hello {
                         version: PROTOCOL_VERSION,
-                        preset: self.config.preset,
+                        preset: Preset::ALL
+                            .into_iter()
+                            .find(|p| matches!(p.geometry(), PresetGeometry::Ring(g) if *g == self.config.geometry)),
+                        axes: self.pipeline.mechanism().axes(),
                     }
                 } else {
                     self.connected = false;

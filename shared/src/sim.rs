@@ -62,6 +62,26 @@ impl Plant {
         }
     }
 
+    /// Another ring platform parked like the trainer model: carriages with index flags, linear actuators with a
+    /// home end switch and a far end `far_limit` steps above it.
+    pub fn for_axes(axes: &[crate::kinematics::AxisKind; 6], start: [i64; 6], far_limit: i64) -> Self {
+        let model = Self::trainer_model(start);
+        let (carriage, linear) = (model.switches[0], model.switches[4]);
+        Self {
+            switches: core::array::from_fn(|a| {
+                if axes[a] == crate::kinematics::AxisKind::Ring {
+                    carriage
+                } else {
+                    AxisSwitches {
+                        far_limit: Some(far_limit),
+                        ..linear
+                    }
+                }
+            }),
+            ..model
+        }
+    }
+
     /// Switch and supply levels for the controller, given the relays of the last tick.
     pub fn inputs(&self, logic_relay: bool, power_relay: bool) -> Inputs {
         let mut home = 0u16;

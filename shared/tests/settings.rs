@@ -369,3 +369,55 @@ fn get_inputs_reports_levels_and_states() {
     });
     assert_eq!(r.body, DeviceMessage::Nack(NackReason::NotConnected));
 }
+
+/// The controller drives any ring rig: restating the trainer model through `for_rig` gives exactly the model's
+/// configuration (scales, homing distances and order, the linear switch 1 mm below the stroke), and another rig
+/// gets its own home and geometry, with the preset named in Hello only when it is one.
+#[test]
+fn a_rig_restating_the_trainer_model_configures_the_controller_exactly() {
+    use ringpod_core::kinematics::presets::{self, Preset};
+    let model = ControllerConfig::trainer_model();
+    let mut restated = ControllerConfig::for_rig(&presets::TRAINER_MODEL, Preset::TrainerModel.home()).unwrap();
+    // The model's switch offset was written from the home length rounded to 0.01 mm (231.31 - 165 mm); computed,
+    // it is 5 um (8 steps) less. Everything else is equal.
+    for a in [4, 5] {
+        let (got, written) = (
+            restated.homing.axes[a].home_position,
+            model.homing.axes[a].home_position,
+        );
+        assert!((got - written).abs() <= 10, "axis {a}: {got} vs {written}");
+        restated.homing.axes[a].home_position = written;
+    }
+    assert_eq!(restated, model);
+    let mut home = Preset::TrainerModel.home();
+    home[2] += 0.005;
+    let other = ControllerConfig::for_rig(&presets::TRAINER_MODEL, home).unwrap();
+    assert_eq!(other.home, home);
+    // The switch stays 1 mm below the stroke: a 5 mm higher home lengthens the actuators, so the switch is further
+    // below the new home length.
+    assert!(other.homing.axes[4].home_position < restated.homing.axes[4].home_position - 4_000);
+    let mut c = Controller::new(other).unwrap();
+    let hello = c.handle(&Request {
+        id: 1,
+        body: HostMessage::Hello {
+            version: PROTOCOL_VERSION,
+        },
+    });
+    match hello.body {
+        DeviceMessage::Hello { preset, axes, .. } => {
+            assert_eq!(preset, Some(Preset::TrainerModel), "same geometry: the preset is named");
+            assert_eq!(axes, model_axes());
+        }
+        other => panic!("{other:?}"),
+    }
+    // A home pose without a solution is refused with its cause.
+    assert!(matches!(
+        ControllerConfig::for_rig(&presets::TRAINER_MODEL, [0.0, 0.0, 2.0, 0.0, 0.0, 0.0]),
+        Err(ringpod_core::controller::ConfigError::HomePose(_))
+    ));
+}
+
+fn model_axes() -> [ringpod_core::kinematics::AxisKind; 6] {
+    use ringpod_core::kinematics::AxisKind::{Linear, Ring};
+    [Ring, Ring, Ring, Ring, Linear, Linear]
+}

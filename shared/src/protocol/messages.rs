@@ -87,8 +87,10 @@ pub enum DeviceMessage {
     Hello {
         /// The device's [`PROTOCOL_VERSION`].
         version: u16,
-        /// The geometry it drives.
-        preset: Preset,
+        /// The preset it drives, if its geometry is one.
+        preset: Option<Preset>,
+        /// What each of its actuator coordinates measures.
+        axes: [crate::kinematics::AxisKind; 6],
     },
     /// Done.
     Ack,
