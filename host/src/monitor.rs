@@ -34,28 +34,24 @@ pub struct View {
     pub source: String,
 }
 
-fn lamp(on: bool, label: &str) -> Span<'static> {
+/// A label lit in `(foreground, background)` when `on`, grey otherwise.
+fn lit(on: bool, label: &str, (fg, bg): (Color, Color)) -> Span<'static> {
     let style = if on {
-        Style::default()
-            .fg(Color::Black)
-            .bg(Color::Green)
-            .add_modifier(Modifier::BOLD)
+        Style::default().fg(fg).bg(bg).add_modifier(Modifier::BOLD)
     } else {
         Style::default().fg(Color::Gray)
     };
     Span::styled(format!(" {label} "), style)
 }
 
+/// A green lamp: an output or a supply that is on.
+fn lamp(on: bool, label: &str) -> Span<'static> {
+    lit(on, label, (Color::Black, Color::Green))
+}
+
+/// A red lamp: something to look at.
 fn alarm(active: bool, label: &str) -> Span<'static> {
-    let style = if active {
-        Style::default()
-            .fg(Color::White)
-            .bg(Color::Red)
-            .add_modifier(Modifier::BOLD)
-    } else {
-        Style::default().fg(Color::Gray)
-    };
-    Span::styled(format!(" {label} "), style)
+    lit(active, label, (Color::White, Color::Red))
 }
 
 /// Draws the view.

@@ -708,21 +708,16 @@ fn a_rig_of_ones_own_streams_on_the_simulator() {
     assert!(rig.contains("ring_radius = 0.3\n") && rig.contains("rod_length = 0.325\n"));
     let file = dir.join("wider.toml");
     std::fs::write(&file, rig).unwrap();
-    let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-        .args([
-            "stream",
-            "--sim",
-            "--fast",
-            "--quiet",
-            "--report-json",
-            "--motion",
-            "demo",
-            "--duration",
-            "4",
-        ])
-        .args(["--geometry", file.to_str().unwrap()])
-        .output()
-        .unwrap();
+    // A 4 s demo motion on the simulator, with further arguments.
+    let demo = |extra: &[&str]| {
+        std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(["stream", "--sim", "--fast", "--quiet", "--report-json"])
+            .args(["--motion", "demo", "--duration", "4"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = demo(&["--geometry", file.to_str().unwrap()]);
     let said = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(0), "{said}");
     assert!(said.contains("a geometry of its own"), "{said}");
@@ -730,20 +725,7 @@ fn a_rig_of_ones_own_streams_on_the_simulator() {
     assert_eq!(report["outcome"], "followed");
     assert_eq!(report["counts_agree"], true);
     // The trainer model's own stream of the same motion ends elsewhere: the rig's geometry was driven.
-    let model = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-        .args([
-            "stream",
-            "--sim",
-            "--fast",
-            "--quiet",
-            "--report-json",
-            "--motion",
-            "demo",
-            "--duration",
-            "4",
-        ])
-        .output()
-        .unwrap();
+    let model = demo(&[]);
     let model: serde_json::Value = serde_json::from_slice(&model.stdout).unwrap();
     assert_ne!(report["final_steps"], model["final_steps"]);
     let _ = std::fs::remove_dir_all(&dir);

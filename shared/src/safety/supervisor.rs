@@ -373,6 +373,18 @@ impl Supervisor {
         self.go(State::Fault(reason, supplies));
     }
 
+    /// What a command that may move something (homing, a jog, clearing a fault) needs: the e-stop chain closed and
+    /// no end switch made.
+    fn may_move(&self) -> Result<(), Refusal> {
+        if self.inputs.estop_open {
+            return Err(Refusal::EStopOpen);
+        }
+        if self.inputs.limits != 0 {
+            return Err(Refusal::LimitActive);
+        }
+        Ok(())
+    }
+
     fn is_fault(&self) -> bool {
         matches!(self.state, State::Fault(..))
     }
@@ -482,22 +494,12 @@ impl Supervisor {
                 self.go(State::ShuttingDown(Shutdown::Drivers));
             }
             (Event::Home, State::PowerOn { settled: true } | State::Ready) => {
-                if self.inputs.estop_open {
-                    return Err(Refusal::EStopOpen);
-                }
-                if self.inputs.limits != 0 {
-                    return Err(Refusal::LimitActive);
-                }
+                self.may_move()?;
                 self.homed = false;
                 self.go(State::Homing);
             }
             (Event::Jog, State::PowerOn { settled: true } | State::Ready) => {
-                if self.inputs.estop_open {
-                    return Err(Refusal::EStopOpen);
-                }
-                if self.inputs.limits != 0 {
-                    return Err(Refusal::LimitActive);
-                }
+                self.may_move()?;
                 // One axis moves away from the pose homing left: the platform must be homed again to stream.
                 self.homed = false;
                 self.go(State::Jogging);
@@ -510,12 +512,7 @@ impl Supervisor {
                 self.go(State::PowerOn { settled: true });
             }
             (Event::ClearFault, State::Fault(_, supplies)) => {
-                if self.inputs.estop_open {
-                    return Err(Refusal::EStopOpen);
-                }
-                if self.inputs.limits != 0 {
-                    return Err(Refusal::LimitActive);
-                }
+                self.may_move()?;
                 self.go(match supplies {
                     Supplies::Both => State::PowerOn { settled: true },
                     // Logic is kept, power is off: the way back up is the normal Enable sequence from Off, and
