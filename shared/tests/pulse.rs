@@ -1,6 +1,8 @@
 //! The step generator's slot buffers: random trajectories through the real step scheduler, rendered period by
 //! period, then the port replayed slot by slot as the DMA would write it. Every scheduled step is exactly one STEP
-//! pulse with the right DIR level, and the pulse width, low time and DIR setup and hold hold on the slot grid.
+//! pulse with the right DIR level, and the pulse width, low time and DIR setup and hold hold on the slot grid (the
+//! drivers' model, `sim::drivers`, which the QEMU controller's plant also moves by, is checked here against words
+//! that break each rule).
 
 // Index loops over parallel per-axis arrays read more plainly than zips here.
 #![allow(clippy::needless_range_loop)]
@@ -9,6 +11,8 @@ use proptest::prelude::*;
 use ringpod_core::controller::{ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer, PulseTiming, PulseTimingError};
 use ringpod_core::motion::{AxisMove, Direction, SchedulerConfig, StepScheduler};
+use ringpod_core::sim::drivers::{DriverInputs, TimingRule, TimingViolation};
+use ringpod_core::sim::Plant;
 
 /// The Black Pill's map: STEP on PB0-PB5, DIR on PB6-PB10 and PB12; axis 2 wired the other way round.
 const MAP: PortMap = PortMap {
@@ -17,78 +21,13 @@ const MAP: PortMap = PortMap {
     dir_forward_low: 0b000100,
 };
 
-/// The port as the DMA leaves it, with what the checks need to know about each axis.
-struct Port {
-    level: u16,
-    slot: i64,
-    /// Per axis: slot of the last DIR change, slot of the last rising STEP edge, slot of the last falling edge.
-    dir_changed: [i64; 6],
-    rose: [i64; 6],
-    fell: [i64; 6],
-    steps: [i64; 6],
-}
-
-impl Port {
-    fn new(map: &PortMap) -> Self {
-        let idle = map.idle_word();
-        Self {
-            level: (idle & 0xffff) as u16,
-            slot: 0,
-            dir_changed: [-1_000; 6],
-            rose: [-1_000; 6],
-            fell: [-1_000; 6],
-            steps: [0; 6],
-        }
-    }
-
-    /// Applies one word (BSRR: set wins over reset) and checks the timing of every edge it makes.
-    fn apply(&mut self, word: u32, map: &PortMap, timing: &PulseTiming, sched: &SchedulerConfig) -> Result<(), String> {
-        let set = (word & 0xffff) as u16;
-        let reset = (word >> 16) as u16 & !set;
-        let next = (self.level | set) & !reset;
-        let slot_ns = i64::from(timing.slot_ns);
-        for a in 0..6 {
-            let (s, d) = (1u16 << map.step[a], 1u16 << map.dir[a]);
-            if (self.level ^ next) & d != 0 {
-                if next & s != 0 || self.level & s != 0 {
-                    return Err(format!("axis {a}: DIR changed while STEP high at slot {}", self.slot));
-                }
-                if (self.slot - self.rose[a]) * slot_ns < i64::from(sched.dir_hold_ns) {
-                    return Err(format!("axis {a}: DIR hold violated at slot {}", self.slot));
-                }
-                self.dir_changed[a] = self.slot;
-            }
-            if self.level & s == 0 && next & s != 0 {
-                if (self.slot - self.dir_changed[a]) * slot_ns < i64::from(sched.dir_setup_ns) {
-                    return Err(format!("axis {a}: DIR setup violated at slot {}", self.slot));
-                }
-                if (self.slot - self.fell[a]) * slot_ns < i64::from(sched.min_spacing_ns - sched.pulse_ns) {
-                    return Err(format!("axis {a}: low time too short at slot {}", self.slot));
-                }
-                let forward = (next & d != 0) != (map.dir_forward_low & (1 << a) != 0);
-                self.steps[a] += if forward { 1 } else { -1 };
-                self.rose[a] = self.slot;
-            }
-            if self.level & s != 0 && next & s == 0 {
-                if (self.slot - self.rose[a]) * slot_ns < i64::from(sched.pulse_ns) {
-                    return Err(format!("axis {a}: pulse too short at slot {}", self.slot));
-                }
-                self.fell[a] = self.slot;
-            }
-        }
-        self.level = next;
-        self.slot += 1;
-        Ok(())
-    }
-}
-
 /// Plans `targets` period by period, renders and replays them, then two idle periods; returns the port's step
 /// counts, which must equal the scheduler's positions.
 fn replay(sched: SchedulerConfig, targets: &[[i64; 6]]) -> Result<([i64; 6], [i64; 6]), String> {
     let timing = PulseTiming::new(&sched, STEP_SLOT_NS, MAX_STEP_SLOTS).map_err(|e| format!("{e:?}"))?;
     let mut renderer = PulseRenderer::new(MAP, timing).map_err(|e| format!("{e:?}"))?;
     let mut scheduler = StepScheduler::new(sched, [0; 6]);
-    let mut port = Port::new(&MAP);
+    let mut drivers = DriverInputs::new(MAP, timing.slot_ns, sched);
     let mut buf = vec![0u32; timing.slots];
     let last = *targets.last().unwrap_or(&[0; 6]);
     for t in targets.iter().chain([last, last].iter()) {
@@ -105,15 +44,14 @@ fn replay(sched: SchedulerConfig, targets: &[[i64; 6]]) -> Result<([i64; 6], [i6
                 ));
             }
         }
-        for &w in &buf {
-            port.apply(w, &MAP, &timing, &sched)?;
+        if let Some(v) = drivers.play_all(&buf) {
+            return Err(v.to_string());
         }
     }
-    let step_mask = MAP.step.iter().fold(0u16, |m, &p| m | 1 << p);
-    if port.level & step_mask != 0 {
+    if drivers.step_high() {
         return Err("a STEP pin stayed high".into());
     }
-    Ok((port.steps, scheduler.position()))
+    Ok((drivers.position(), scheduler.position()))
 }
 
 fn trajectory() -> impl Strategy<Value = Vec<[i64; 6]>> {
@@ -251,4 +189,76 @@ fn a_short_buffer_renders_nothing() {
         period_ns: 1_000_000,
     };
     assert_eq!(renderer.render(&[idle; 6], &mut short), None);
+}
+
+/// A grid finer than the renderer's, so that hand-written words can break every rule.
+const FINE_SLOT_NS: u32 = 500;
+
+/// Plays hand-written words, one every 500 ns, into drivers held to the default timing.
+fn first_violation(words: &[u32]) -> Option<TimingViolation> {
+    let mut drivers = DriverInputs::new(MAP, FINE_SLOT_NS, SchedulerConfig::default());
+    drivers.play_all(words)
+}
+
+#[test]
+fn the_driver_model_catches_every_broken_rule() {
+    let slots = |ns: u32| ns.div_ceil(FINE_SLOT_NS) as usize;
+    let (step, dir) = (1u32, 1u32 << 6);
+    let idle = |n: usize| vec![0u32; n];
+    // A correct pulse: DIR set, setup time, STEP high for the pulse width, low again.
+    let mut good = vec![dir << 16];
+    good.extend(idle(slots(5_000)));
+    good.push(step);
+    good.extend(idle(slots(2_500) - 1));
+    good.push(step << 16);
+    assert_eq!(first_violation(&good), None);
+
+    let mut pulse = vec![dir << 16];
+    pulse.extend(idle(slots(5_000)));
+    pulse.extend([step, step << 16]);
+    assert_eq!(first_violation(&pulse).map(|v| v.rule), Some(TimingRule::PulseWidth));
+
+    let setup = vec![dir << 16, step];
+    assert_eq!(first_violation(&setup).map(|v| v.rule), Some(TimingRule::DirSetup));
+
+    let together = vec![dir << 16 | step];
+    assert_eq!(
+        first_violation(&together).map(|v| v.rule),
+        Some(TimingRule::DirWhileStepHigh)
+    );
+
+    let mut hold = good.clone();
+    hold.push(dir);
+    assert_eq!(first_violation(&hold).map(|v| v.rule), Some(TimingRule::DirHold));
+
+    let mut low = good.clone();
+    low.push(step);
+    let v = first_violation(&low).unwrap();
+    assert_eq!((v.rule, v.axis, v.slot), (TimingRule::LowTime, 0, good.len() as u64));
+}
+
+#[test]
+fn the_plant_moves_by_the_edges_the_drivers_count() {
+    let sched = SchedulerConfig::default();
+    let timing = PulseTiming::new(&sched, STEP_SLOT_NS, MAX_STEP_SLOTS).unwrap();
+    let mut renderer = PulseRenderer::new(MAP, timing).unwrap();
+    let mut scheduler = StepScheduler::new(sched, [0; 6]);
+    let mut drivers = DriverInputs::new(MAP, timing.slot_ns, sched);
+    let mut plant = Plant::trainer_model([0; 6]);
+    let mut buf = vec![0u32; timing.slots];
+    let targets = [
+        [120, -80, 0, 7, 200, -200],
+        [60, -80, 3, 0, 400, -350],
+        [60, -80, 3, 0, 400, -350],
+    ];
+    for (k, t) in targets.iter().enumerate() {
+        let moves = scheduler.plan(t);
+        renderer.render(&moves, &mut buf).unwrap();
+        // Drivers disabled in the second period: the plant still moves (as a driver would not, which is why the
+        // controller never steps then) and counts what it was sent.
+        assert_eq!(plant.play(&mut drivers, &buf, k != 1), None);
+    }
+    assert_eq!(plant.position, scheduler.position());
+    assert_eq!(plant.steps_received, [180, 80, 3, 14, 400, 350]);
+    assert_eq!(plant.steps_while_disabled, 60 + 3 + 7 + 200 + 150);
 }

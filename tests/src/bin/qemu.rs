@@ -52,10 +52,10 @@ fn build(bin: &str) -> Result<PathBuf, String> {
     Ok(qemu_dir().join("target/thumbv7em-none-eabihf/release").join(bin))
 }
 
-/// QEMU's command line for an ELF on mps2-an386 with semihosting. With `icount`, virtual time advances one
-/// nanosecond per instruction (the instruction counter of the cost table); without, it follows the host's clock,
-/// which a controller streamed in real time needs.
-fn qemu(elf: &Path, icount: bool) -> Command {
+/// QEMU's command line for an ELF on mps2-an386 with semihosting; `args` are the program's semihosting command line.
+/// With `icount`, virtual time advances one nanosecond per instruction (the instruction counter of the cost table);
+/// without, it follows the host's clock, which a controller streamed in real time needs.
+fn qemu(elf: &Path, icount: bool, args: &[&str]) -> Command {
     let mut c = Command::new("qemu-system-arm");
     c.args([
         "-machine",
@@ -66,7 +66,11 @@ fn qemu(elf: &Path, icount: bool) -> Command {
         "-monitor",
         "none",
     ])
-    .args(["-semihosting-config", "enable=on,target=native"]);
+    .arg("-semihosting-config")
+    .arg(
+        args.iter()
+            .fold("enable=on,target=native".to_string(), |c, a| c + ",arg=" + a),
+    );
     if icount {
         c.args(["-icount", "shift=0"]);
     }
@@ -76,7 +80,7 @@ fn qemu(elf: &Path, icount: bool) -> Command {
 
 /// Runs a program to its end (or the limit) and returns what it printed.
 fn run_to_end(elf: &Path) -> Result<String, String> {
-    let mut child = qemu(elf, true)
+    let mut child = qemu(elf, true, &[])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
@@ -195,6 +199,34 @@ const BUDGETS: [(&str, u64); 5] = [
 struct Emulated {
     child: std::process::Child,
     pty: String,
+    /// What the program prints over semihosting (and QEMU on its stderr), line by line.
+    lines: std::sync::mpsc::Receiver<String>,
+}
+
+impl Emulated {
+    /// Lines printed until one satisfies `done` (included), or an error with what came when `limit` passes first.
+    fn wait_for(&self, limit: Duration, done: impl Fn(&str) -> bool) -> Result<Vec<String>, String> {
+        let deadline = Instant::now() + limit;
+        let mut seen = Vec::new();
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.lines.recv_timeout(left) {
+                Ok(line) => {
+                    let last = done(&line);
+                    seen.push(line);
+                    if last {
+                        return Ok(seen);
+                    }
+                }
+                Err(_) => return Err(format!("waited {} s; printed: {seen:?}", limit.as_secs())),
+            }
+        }
+    }
+
+    /// Lines printed so far and not yet read.
+    fn printed(&self) -> Vec<String> {
+        self.lines.try_iter().collect()
+    }
 }
 
 impl Drop for Emulated {
@@ -204,9 +236,9 @@ impl Drop for Emulated {
     }
 }
 
-/// Starts the controller program and waits for its pty and its `READY`.
-fn start_controller(elf: &Path) -> Result<Emulated, String> {
-    let mut child = qemu(elf, false)
+/// Starts the controller program with the semihosting command line `args` and waits for its pty and its `READY`.
+fn start_controller(elf: &Path, args: &[&str]) -> Result<Emulated, String> {
+    let mut child = qemu(elf, false, args)
         .args(["-serial", "pty"])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -231,12 +263,14 @@ fn start_controller(elf: &Path) -> Result<Emulated, String> {
     let mut emulated = Emulated {
         child,
         pty: String::new(),
+        lines: rx,
     };
     let deadline = Instant::now() + Duration::from_secs(30);
     let mut ready = false;
     while !ready || emulated.pty.is_empty() {
         let left = deadline.saturating_duration_since(Instant::now());
-        let line = rx
+        let line = emulated
+            .lines
             .recv_timeout(left)
             .map_err(|_| "the controller did not come up in 30 s".to_string())?;
         if let Some(at) = line.find("/dev/pts/") {
@@ -359,7 +393,7 @@ fn controller_on_m4f(t: &mut Tally) {
         t.check(false, "the host CLI builds");
         return;
     }
-    let emulated = match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf)) {
+    let emulated = match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf, &[])) {
         Ok(e) => e,
         Err(e) => {
             eprintln!("{e}");
@@ -537,6 +571,96 @@ fn controller_on_m4f(t: &mut Tally) {
     if let Ok(s) = &after {
         println!("after the stream loss: state {}, steps {}", s["state"], s["steps"]);
     }
+
+    // The plant moved only by the STEP edges of the step generator's words: they kept the drivers' timing, and no
+    // step came while the drivers were disabled (the board module prints the first of either).
+    let problems: Vec<String> = emulated
+        .printed()
+        .into_iter()
+        .filter(|l| l.starts_with("TIMING") || l.starts_with("DISABLED") || l.starts_with("ERROR"))
+        .collect();
+    for p in &problems {
+        eprintln!("qemu: {p}");
+    }
+    t.check(
+        problems.is_empty(),
+        "every run above moved the plant by its STEP edges only, within the drivers' timing, drivers enabled",
+    );
+    drop(emulated);
+}
+
+/// Runs the CLI; its exit status and what it printed on stdout.
+fn ringpod_text(args: &[&str]) -> (bool, String) {
+    Command::new(ringpod())
+        .args(args)
+        .stdin(Stdio::null())
+        .stderr(Stdio::null())
+        .output()
+        .map(|o| (o.status.success(), String::from_utf8_lossy(&o.stdout).into_owned()))
+        .unwrap_or((false, String::new()))
+}
+
+/// The watchdog: the control loop hangs once the platform is homed (the program's `stall-when-homed`); the CMSDK
+/// watchdog resets the emulated MCU, which comes back with its supplies off, the `Watchdog` fault latched, homing
+/// lost and the setting stored before the reset restored from its flash; cleared, it powers and homes again.
+fn watchdog_on_m4f(t: &mut Tally) {
+    println!("== the watchdog on the emulated Cortex-M4F: a stalled control loop");
+    let emulated = match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf, &["stall-when-homed"]))
+    {
+        Ok(e) => e,
+        Err(e) => {
+            eprintln!("{e}");
+            t.check(false, "the controller starts on the emulated Cortex-M4F");
+            return;
+        }
+    };
+    let pty = emulated.pty.as_str();
+    let port = ["--port", pty];
+    let stored = ringpod_text(&[&["device", "config", "set", "telemetry-hz", "50"][..], &port].concat()).0;
+    // The settings task stores a change within 100 ms while the supplies are off.
+    std::thread::sleep(Duration::from_millis(500));
+    let enabled = ringpod_text(&[&["device", "enable"][..], &port].concat()).0;
+    // Homing ends in the stall: the command gets no answer and fails.
+    let _ = ringpod_text(&[&["device", "home"][..], &port].concat());
+    let reset = emulated.wait_for(Duration::from_secs(20), |l| l.trim() == "READY");
+    println!("printed over the stall: {reset:?}");
+    let lines = reset.unwrap_or_default();
+    t.check(
+        stored && enabled && lines.iter().any(|l| l == "STALL") && lines.iter().any(|l| l == "RESET watchdog"),
+        "a control loop stalled with the platform homed is reset by the watchdog",
+    );
+    let status = ringpod_json(&[&["device", "status"][..], &port].concat());
+    let (_, inputs) = ringpod_text(&[&["device", "inputs"][..], &port].concat());
+    let sense_off = ["LOGIC_OK", "POWER_OK"].iter().all(|name| {
+        inputs
+            .lines()
+            .find(|l| l.starts_with(name))
+            .and_then(|l| l.split_whitespace().last())
+            == Some("-")
+    });
+    if let Ok(s) = &status {
+        println!("after the reset: state {}, homed {}", s["state"], s["homed"]);
+    }
+    t.check(
+        status
+            .as_ref()
+            .is_ok_and(|s| s["state"] == serde_json::json!({"Fault": ["Watchdog", "None"]}) && s["homed"] == false)
+            && sense_off,
+        "it comes back with the Watchdog fault reported, both supplies off (sensed), homing lost",
+    );
+    let setting = ringpod_json(&[&["device", "config", "get", "telemetry-hz"][..], &port].concat());
+    t.check(
+        setting.is_ok_and(|s| s["value"] == 50.0) && lines.iter().any(|l| l.starts_with("SETTINGS 1 restored")),
+        "the setting stored before the reset is restored from flash by the settings task",
+    );
+    let cleared = ringpod_text(&[&["device", "clear"][..], &port].concat()).0
+        && ringpod_text(&[&["device", "enable"][..], &port].concat()).0
+        && ringpod_text(&[&["device", "home"][..], &port].concat()).0;
+    let again = ringpod_json(&[&["device", "status"][..], &port].concat());
+    t.check(
+        cleared && again.is_ok_and(|s| s["state"] == "Ready" && s["homed"] == true),
+        "cleared, it powers up and homes again (no second stall: the last reset was the watchdog's)",
+    );
     drop(emulated);
 }
 
@@ -603,6 +727,7 @@ fn main() -> ExitCode {
     let mut t = Tally { passed: 0, failed: 0 };
     core_on_m4f(&mut t);
     controller_on_m4f(&mut t);
+    watchdog_on_m4f(&mut t);
     println!("{} passed, {} failed", t.passed, t.failed);
     if t.failed == 0 {
         ExitCode::SUCCESS

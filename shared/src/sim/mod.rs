@@ -2,7 +2,10 @@
 //! supplies whose sense lines follow the relays. The host's simulator and the end-to-end tests drive the controller
 //! with it when no board is attached.
 
+pub mod drivers;
+
 use crate::controller::{Controller, Inputs, TickOutput};
+use drivers::{DriverInputs, TimingViolation};
 
 /// Where the switches of one axis are (physical steps).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,6 +119,22 @@ impl Plant {
             self.position[a] += m.signed();
             self.steps_received[a] += u64::from(m.count);
         }
+    }
+
+    /// Plays one buffer of the step generator's port words into the drivers and moves each axis by the STEP edges
+    /// they counted (what a board's DMA would make the motors do). The first timing rule the words break, if any.
+    pub fn play(&mut self, drivers: &mut DriverInputs, words: &[u32], driver_enable: bool) -> Option<TimingViolation> {
+        let (position, edges) = (drivers.position(), drivers.edges());
+        let broken = drivers.play_all(words);
+        for a in 0..6 {
+            let n = drivers.edges()[a] - edges[a];
+            if n > 0 && !driver_enable {
+                self.steps_while_disabled += n;
+            }
+            self.position[a] += drivers.position()[a] - position[a];
+            self.steps_received[a] += n;
+        }
+        broken
     }
 }
 

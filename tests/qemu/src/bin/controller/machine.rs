@@ -1,0 +1,181 @@
+//! The emulated machine behind the board's pins: the simulated plant of `ringpod_core::sim` (axes, switches at
+//! their positions, supply sense following the relays) driven the way a board drives the real one:
+//!
+//! - the relays and the driver enable are set pin by pin by the control task;
+//! - the switch and supply-sense pins are electrical levels, wired as `InputConfig::default()` expects, read and
+//!   debounced by the inputs task; a change of the plant wakes it as an EXTI edge would;
+//! - the steps task's rendered port words are played, one buffer per control period, into the drivers' model
+//!   (`sim::drivers`), and the axes move by the STEP edges it counts; a word that breaks the drivers' timing, or a
+//!   step while the drivers are disabled, is reported over semihosting (the QEMU runner fails on it).
+
+use core::cell::RefCell;
+use core::sync::atomic::Ordering;
+
+use cortex_m_semihosting::hprintln;
+use embassy_sync::blocking_mutex::raw::{CriticalSectionRawMutex, ThreadModeRawMutex};
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::signal::Signal;
+use embassy_time::{Duration, Instant, Timer};
+use ringpod_core::controller::Inputs;
+use ringpod_core::motion::AxisMove;
+use ringpod_core::safety::debounce::{self, InputConfig};
+use ringpod_core::safety::pins::OutputPin;
+use ringpod_core::safety::{Outputs, State};
+use ringpod_core::sim::drivers::DriverInputs;
+use ringpod_core::sim::Plant;
+use ringpod_firmware::app::control::Machine;
+use ringpod_firmware::app::inputs::InputPins;
+use ringpod_firmware::app::steps::{Overrun, PortOutput};
+use ringpod_firmware::app::Shared;
+
+use crate::{time, watchdog};
+
+/// The plant and everything wired to it.
+pub struct World {
+    plant: Plant,
+    outputs: Outputs,
+    drivers: DriverInputs,
+    /// Each problem is reported once: the first occurrence is the one to look at.
+    timing_reported: bool,
+    disabled_reported: bool,
+}
+
+/// The world as the tasks share it (all of them run in thread mode here).
+pub type WorldCell = Mutex<ThreadModeRawMutex, RefCell<World>>;
+
+/// The plant changed (a relay, a step): the inputs task's "EXTI edge".
+static CHANGED: Signal<CriticalSectionRawMutex, ()> = Signal::new();
+
+impl World {
+    /// `plant` with its relays open and its drivers' inputs at the port's idle levels.
+    pub fn new(plant: Plant, drivers: DriverInputs) -> Self {
+        Self {
+            plant,
+            outputs: Outputs::OFF,
+            drivers,
+            timing_reported: false,
+            disabled_reported: false,
+        }
+    }
+
+    /// Electrical levels of the input pins, in the `safety::debounce::InputBit` layout.
+    fn levels(&self) -> u16 {
+        let inputs = self.plant.inputs(self.outputs.logic_relay, self.outputs.power_relay);
+        debounce::from_inputs(&inputs) ^ InputConfig::default().active_low
+    }
+}
+
+/// The control loop's side: relays, driver enable, the step queue, the watchdog.
+pub struct Controls {
+    pub world: &'static WorldCell,
+    /// The stall test (`stall-when-homed` on the command line): the control loop hangs in the first tick that
+    /// finds the platform homed and at rest, and the watchdog has to bring the board back.
+    pub stall_when_homed: bool,
+}
+
+impl Machine for Controls {
+    fn inputs(&mut self, shared: &Shared) -> Inputs {
+        debounce::to_inputs(shared.inputs.load(Ordering::Relaxed))
+    }
+
+    fn write(&mut self, pin: OutputPin, on: bool) {
+        self.world.lock(|w| {
+            let mut w = w.borrow_mut();
+            match pin {
+                OutputPin::DriverEnable => w.outputs.driver_enable = on,
+                OutputPin::LogicRelay => w.outputs.logic_relay = on,
+                OutputPin::PowerRelay => w.outputs.power_relay = on,
+            }
+        });
+        CHANGED.signal(());
+    }
+
+    async fn steps(&mut self, moves: &[AxisMove; 6], shared: &Shared) {
+        if self.stall_when_homed && shared.with(|c| c.supervisor().state() == State::Ready) {
+            hprintln!("STALL");
+            // A control loop caught in an endless computation: interrupts still run, the loop never comes back.
+            loop {
+                cortex_m::asm::nop();
+            }
+        }
+        shared.steps.send(*moves).await;
+    }
+
+    fn queue_depth(&self, shared: &Shared) -> u16 {
+        shared.steps.len() as u16
+    }
+
+    fn cycles(&self) -> u32 {
+        // No DWT cycle counter in QEMU: microseconds of SysTick time, in 25 MHz cycles.
+        (time::now_us() * 25) as u32
+    }
+
+    fn feed_watchdog(&mut self) {
+        watchdog::feed();
+    }
+}
+
+/// The input pins, wired to the plant.
+pub struct Pins {
+    pub world: &'static WorldCell,
+    /// What the inputs task last read: an "edge" is a difference from it.
+    pub last: u16,
+}
+
+impl InputPins for Pins {
+    fn read(&mut self) -> u16 {
+        self.last = self.world.lock(|w| w.borrow().levels());
+        self.last
+    }
+
+    async fn edge(&mut self) {
+        loop {
+            CHANGED.wait().await;
+            if self.world.lock(|w| w.borrow().levels()) != self.last {
+                return;
+            }
+        }
+    }
+}
+
+/// The step port: each buffer plays over one control period, after the one before it.
+pub struct Port {
+    pub world: &'static WorldCell,
+    pub period: Duration,
+    /// When the buffer being played ends.
+    pub busy_until: Instant,
+}
+
+impl PortOutput for Port {
+    async fn write(&mut self, words: &[u32]) -> Result<(), Overrun> {
+        // A board's DMA takes the buffer when the previous one has played out. Should the emulator have been held
+        // up for longer than the queue covers, start afresh rather than play a burst (a board would have underrun).
+        Timer::at(self.busy_until).await;
+        let now = Instant::now();
+        self.busy_until = if now > self.busy_until + self.period * 4 {
+            now + self.period
+        } else {
+            self.busy_until + self.period
+        };
+        self.world.lock(|w| {
+            let w = &mut *w.borrow_mut();
+            let enabled = w.outputs.driver_enable;
+            let before = w.plant.steps_while_disabled;
+            if let Some(v) = w.plant.play(&mut w.drivers, words, enabled) {
+                if !w.timing_reported {
+                    w.timing_reported = true;
+                    hprintln!("TIMING {}", v);
+                }
+            }
+            if w.plant.steps_while_disabled > before && !w.disabled_reported {
+                w.disabled_reported = true;
+                hprintln!(
+                    "DISABLED {} steps with the drivers disabled",
+                    w.plant.steps_while_disabled - before
+                );
+            }
+        });
+        CHANGED.signal(());
+        Ok(())
+    }
+}
