@@ -6,7 +6,7 @@
 //! level of an input only after it has been read the same `samples` times in a row, so a bouncing contact
 //! changes nothing until it settles, and a single spike never latches a fault.
 
-use crate::controller::Inputs;
+use super::Inputs;
 
 /// Position of each input in the raw and logical words.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -7,3 +7,18 @@ pub mod supervisor;
 
 pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};
 pub use supervisor::{Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig, Supplies};
+
+/// Switch and supply levels, as read from the pins (after debouncing and polarity).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Inputs {
+    /// E-stop chain open.
+    pub estop_open: bool,
+    /// Home switch of each axis (bit per axis): the carriage index switches and the linear actuators' home ends.
+    pub home: u16,
+    /// End-of-travel switch at the far end of each linear actuator (bit per axis).
+    pub limits: u16,
+    /// LOGIC_OK.
+    pub logic_ok: bool,
+    /// POWER_OK.
+    pub power_ok: bool,
+}

@@ -1,0 +1,154 @@
+//! Protocol dispatch: every request gets exactly one response, a frame that does not decode is counted and never
+//! executed.
+
+use super::Controller;
+use crate::kinematics::presets::{Preset, PresetGeometry};
+use crate::kinematics::{AxisKind, Mechanism};
+use crate::motion::jog::Jog;
+use crate::motion::Accepted;
+use crate::protocol::{
+    self, ConfigRefusal, DeviceMessage, HostMessage, NackReason, Request, Response, PROTOCOL_VERSION,
+};
+use crate::safety::{Event, HomingSequencer, State};
+
+impl Controller {
+    /// Handles one request; always exactly one response.
+    pub fn handle(&mut self, request: &Request) -> Response {
+        let body = match request.body {
+            HostMessage::Hello { version } => {
+                if version == PROTOCOL_VERSION {
+                    self.connected = true;
+                    self.telemetry.on = false;
+                    DeviceMessage::Hello {
+                        version: PROTOCOL_VERSION,
+                        preset: Preset::ALL
+                            .into_iter()
+                            .find(|p| matches!(p.geometry(), PresetGeometry::Ring(g) if *g == self.config.geometry)),
+                        axes: self.pipeline.mechanism().axes(),
+                    }
+                } else {
+                    self.connected = false;
+                    DeviceMessage::Nack(NackReason::VersionMismatch {
+                        device: PROTOCOL_VERSION,
+                    })
+                }
+            }
+            _ if !self.connected => DeviceMessage::Nack(NackReason::NotConnected),
+            HostMessage::Setpoint(sp) => match self.pipeline.submit(&sp) {
+                Ok(Accepted::Applied) => DeviceMessage::Ack,
+                Ok(Accepted::Limited(report)) => DeviceMessage::Limited(report),
+                Err(reason) => DeviceMessage::Nack(NackReason::Rejected(reason)),
+            },
+            HostMessage::GetStatus => DeviceMessage::Status(self.status()),
+            HostMessage::GetInputs => DeviceMessage::Inputs(self.input_report()),
+            HostMessage::Jog { axis, steps } => self.start_jog(axis, Some(steps)),
+            HostMessage::Buzz { axis } => self.start_jog(axis, None),
+            HostMessage::Telemetry(on) => {
+                self.telemetry.on = on;
+                self.telemetry.ticks = 0;
+                DeviceMessage::Ack
+            }
+            HostMessage::GetConfig(key) => match self.get_config(key) {
+                Some(v) => DeviceMessage::Config(key, v),
+                None => DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::OutOfRange)),
+            },
+            HostMessage::SetConfig(key, value) => match self.set_config(key, value) {
+                Ok(()) => DeviceMessage::Ack,
+                Err(r) => DeviceMessage::Nack(r),
+            },
+            HostMessage::Enable => self.command(Event::Enable),
+            HostMessage::Disable => self.command(Event::Disable),
+            HostMessage::Home => self.command(Event::Home),
+            HostMessage::Start => self.command(Event::Start),
+            HostMessage::Stop => self.command(Event::Stop),
+            HostMessage::ClearFault => self.command(Event::ClearFault),
+        };
+        Response { id: request.id, body }
+    }
+
+    /// Starts a jog (`Some(steps)`) or a buzz (`None`) of `axis`, if the supervisor allows it.
+    pub(super) fn start_jog(&mut self, axis: u8, steps: Option<i32>) -> DeviceMessage {
+        let a = usize::from(axis);
+        let (Some(homing), Some(kind)) = (
+            self.config.homing.axes.get(a).copied(),
+            self.pipeline.mechanism().axes().get(a).copied(),
+        ) else {
+            return DeviceMessage::Nack(NackReason::OutOfRange);
+        };
+        // A carriage moves at most its homing back-off unhomed or not (never far enough to reach a neighbour on
+        // the ring); a linear actuator at most the travel its homing searches blind.
+        let longest = match kind {
+            AxisKind::Ring => homing.backoff_steps,
+            AxisKind::Linear | AxisKind::Angle => homing.search_steps,
+        };
+        if steps.is_some_and(|s| s == 0 || s.unsigned_abs() > longest) {
+            return DeviceMessage::Nack(NackReason::OutOfRange);
+        }
+        let answer = self.command(Event::Jog);
+        if answer != DeviceMessage::Ack {
+            return answer;
+        }
+        let from = self.scheduler.position()[a];
+        let jog = match steps {
+            Some(s) => Jog::one_leg(a, from, s, homing.slow_rate),
+            None => {
+                let amplitude = i32::try_from((homing.backoff_steps / 2).max(1)).unwrap_or(i32::MAX);
+                Jog::buzz(a, from, amplitude, homing.fast_rate)
+            }
+        };
+        self.jog = Some((jog, self.inputs.home & (1 << a) != 0));
+        answer
+    }
+
+    pub(super) fn command(&mut self, e: Event) -> DeviceMessage {
+        let was_fault = matches!(self.supervisor.state(), State::Fault(..));
+        let was_homed = self.supervisor.homed() && self.supervisor.state() == State::Ready;
+        let result = self.supervisor.handle(e);
+        self.after_transition(was_fault);
+        if let Err(r) = result {
+            return DeviceMessage::Nack(NackReason::Refused(r));
+        }
+        match e {
+            Event::Home => {
+                self.homing_carry = 0;
+                self.returning_home = false;
+                // A homed machine knows where its switches are: it first moves, under the normal limits and
+                // checks, to where the first homing started (each axis a little before its switch), so that
+                // every search is as short as the first one was. The home pose is often further from a linear
+                // actuator's end switch than its search travel.
+                self.parking = was_homed
+                    && self
+                        .parking_pose()
+                        .is_ok_and(|pose| self.pipeline.move_to(pose).is_ok());
+                self.homing = (!self.parking).then(|| HomingSequencer::new(self.plan, &self.scheduler.position()));
+            }
+            Event::Start => self.pipeline.start(),
+            Event::Stop => {
+                self.pipeline.stop();
+                if self.homing.take().is_some() || self.returning_home || self.parking {
+                    self.pipeline.halt();
+                    self.returning_home = false;
+                    self.parking = false;
+                }
+            }
+            _ => {}
+        }
+        DeviceMessage::Ack
+    }
+
+    /// Decodes a frame, handles it and encodes the response into `out`; returns the response length. A frame that
+    /// does not decode is counted and answered with a `Malformed` nack (id 0): it is never executed.
+    pub fn handle_frame(&mut self, frame: &[u8], out: &mut [u8]) -> usize {
+        let response = match protocol::decode::<Request>(frame) {
+            Ok(request) => self.handle(&request),
+            Err(_) => {
+                self.bad_frames = self.bad_frames.saturating_add(1);
+                Response {
+                    id: 0,
+                    body: DeviceMessage::Nack(NackReason::Malformed),
+                }
+            }
+        };
+        protocol::encode(&response, out).unwrap_or(0)
+    }
+}

@@ -1,0 +1,143 @@
+//! Homing and jogging: the axes moved one at a time by the homing sequencer or a commissioning jog, and the
+//! platform's pose found again from the axes' positions afterwards.
+
+use super::Controller;
+use crate::kinematics::{KinematicsError, Mechanism, MultiTurn, Pose};
+use crate::motion::PipelineEvent;
+use crate::safety::{Event, HomingSequencer, HomingStep};
+
+impl Controller {
+    /// One tick of a jog: the axis a step further, the others where they are; done at the end of the last leg or
+    /// when the axis's home switch closes.
+    pub(super) fn jog_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
+        let Some((jog, home_at_start)) = self.jog.as_mut() else {
+            self.event(Event::JogDone);
+            return position;
+        };
+        let a = jog.axis;
+        let home_now = self.inputs.home & (1 << a) != 0;
+        let next = if home_now && !*home_at_start {
+            None
+        } else {
+            jog.next(position[a], tick_us)
+        };
+        match next {
+            Some(p) => {
+                let mut targets = position;
+                targets[a] = p;
+                targets
+            }
+            None => {
+                self.jog = None;
+                self.event(Event::JogDone);
+                position
+            }
+        }
+    }
+
+    /// After homing each axis's origin is known: step 0 is its value at the home pose, and its switch is at step
+    /// `home_position`. Sets the converter's origins and finds the platform's pose at the axes' current positions
+    /// by forward kinematics.
+    pub(super) fn pose_after_homing(&mut self) -> Result<Pose<f32>, KinematicsError> {
+        let mechanism = *self.pipeline.mechanism();
+        let home = MultiTurn::new(mechanism.inverse(&self.home_pose)?);
+        let converter = self.pipeline.converter_mut();
+        for a in 0..6 {
+            converter.set_home(a, &home, 0);
+        }
+        self.pose_at_steps(&self.scheduler.position())
+    }
+
+    /// Where re-homing starts: every axis two back-off distances before its switch (homed coordinates), found
+    /// by forward kinematics.
+    pub(super) fn parking_pose(&self) -> Result<Pose<f32>, KinematicsError> {
+        let axes = &self.config.homing.axes;
+        let steps = core::array::from_fn(|a| {
+            let h = &axes[a];
+            h.home_position - i64::from(h.toward) * 2 * i64::from(h.backoff_steps)
+        });
+        self.pose_at_steps(&steps)
+    }
+
+    /// The pose at motor step positions in homed coordinates (step 0 of each axis at the home pose).
+    pub(super) fn pose_at_steps(&self, position: &[i64; 6]) -> Result<Pose<f32>, KinematicsError> {
+        let mechanism = *self.pipeline.mechanism();
+        let home = MultiTurn::new(mechanism.inverse(&self.home_pose)?);
+        let axes = mechanism.axes();
+        let q = crate::kinematics::Actuators(core::array::from_fn(|a| {
+            let scale = &self.config.scales[a];
+            let per_unit = scale.per_unit(axes[a]) * if scale.invert { -1.0 } else { 1.0 };
+            home.within.0[a] + position[a] as f32 / per_unit
+        }));
+        let options = crate::kinematics::NewtonOptions::default();
+        Ok(mechanism.forward(&q, &self.home_pose, &options)?.pose)
+    }
+
+    pub(super) fn homing_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
+        if self.parking {
+            let (targets, event) = self.pipeline.tick();
+            match event {
+                Some(PipelineEvent::AtRest) => {
+                    self.parking = false;
+                    self.homing = Some(HomingSequencer::new(self.plan, &targets));
+                }
+                Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
+                _ => {}
+            }
+            return targets;
+        }
+        if self.returning_home {
+            let (targets, event) = self.pipeline.tick();
+            match event {
+                Some(PipelineEvent::AtRest) => {
+                    self.returning_home = false;
+                    self.event(Event::HomingDone);
+                }
+                Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
+                _ => {}
+            }
+            return targets;
+        }
+        let Some(homing) = self.homing.as_mut() else {
+            return position;
+        };
+        match homing.update(&position, self.inputs.home) {
+            HomingStep::Move { axis, rate } => {
+                // Steps this period at `rate`, the fraction carried so that the average rate is exact.
+                let total = i64::from(rate) * i64::from(tick_us) + self.homing_carry;
+                let steps = total / 1_000_000;
+                self.homing_carry = total % 1_000_000;
+                let mut t = position;
+                t[usize::from(axis % 6)] += steps;
+                t
+            }
+            HomingStep::Homed { axis, .. } => {
+                // The switch defines this axis's origin: here it is at step `home_position`.
+                let a = usize::from(axis % 6);
+                let mut p = position;
+                p[a] = self.config.homing.axes[a].home_position;
+                self.scheduler.set_position(p);
+                self.homing_carry = 0;
+                p
+            }
+            HomingStep::Done => {
+                self.homing = None;
+                let started = self
+                    .pose_after_homing()
+                    .ok()
+                    .and_then(|pose| self.pipeline.reset(pose).ok());
+                if started.is_some() && self.pipeline.move_to(self.home_pose).is_ok() {
+                    self.returning_home = true;
+                } else {
+                    self.event(Event::HomingFailed);
+                }
+                self.scheduler.position()
+            }
+            HomingStep::Failed(_) => {
+                self.homing = None;
+                self.event(Event::HomingFailed);
+                position
+            }
+        }
+    }
+}

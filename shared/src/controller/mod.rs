@@ -1,0 +1,369 @@
+//! The controller: protocol dispatch, supervisor, homing, motion pipeline and step scheduler wired together.
+//!
+//! This is the whole decision-making of the device. The firmware calls it from its tasks (frames from USB,
+//! input levels from the switches, one [`Controller::tick`] per control period) and drives its pins from what it
+//! returns; the host simulator and the tests call exactly the same code.
+
+mod config;
+mod dispatch;
+mod homing;
+mod settings;
+
+/// The inputs the controller reads (they belong to the safety layer, which debounces them).
+pub use crate::safety::Inputs;
+pub use config::{ConfigError, ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
+
+use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
+use crate::motion::jog::Jog;
+use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
+use crate::protocol::{DeviceMessage, InputReport, Response, Status, Telemetry, TelemetryFlags};
+use crate::safety::homing::{HomingPlan, RingHoming};
+use crate::safety::{Event, HomingSequencer, Motion, Outputs, State, Supervisor};
+
+/// What the firmware does in one control period.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TickOutput {
+    /// Pulses of each axis for this period.
+    pub moves: [AxisMove; 6],
+    /// Relays, driver enable.
+    pub outputs: Outputs,
+}
+
+/// The controller.
+pub struct Controller {
+    /// The configuration running now.
+    config: ControllerConfig,
+    /// The configuration as stored: equal to `config` but for settings that take effect at the next start.
+    saved: ControllerConfig,
+    /// Settings changed since the firmware last took them for storing (bit per [`ConfigKey::code`]).
+    unsaved: u64,
+    home_pose: Pose<f32>,
+    supervisor: Supervisor,
+    pipeline: Pipeline<RingPlatform<f32>>,
+    scheduler: StepScheduler,
+    plan: HomingPlan,
+    homing: Option<HomingSequencer>,
+    homing_carry: i64,
+    /// Homing found every switch; the platform is on its way to the home pose.
+    returning_home: bool,
+    /// Re-homing a homed machine: the platform is on its way to the parking pose near the switches first.
+    parking: bool,
+    connected: bool,
+    inputs: Inputs,
+    elapsed_us: u32,
+    bad_frames: u32,
+    tick_cost: u32,
+    queue_depth: u16,
+    pending_fault: bool,
+    telemetry: TelemetryClock,
+    /// Electrical input levels as the board sampled them, if it does.
+    raw_inputs: Option<u16>,
+    /// A commissioning move in progress, and whether its axis's home switch was active when it started.
+    jog: Option<(Jog, bool)>,
+}
+
+/// When the next telemetry sample is due, and what the previous one counted (for its flags).
+#[derive(Debug, Clone, Copy, Default)]
+struct TelemetryClock {
+    /// Device time (us).
+    now_us: u64,
+    /// Ticks since the last sample.
+    ticks: u32,
+    /// The host asked for telemetry on this connection.
+    on: bool,
+    due: bool,
+    /// `(limited, refused, held)` at the last sample.
+    counted: (u32, u32, u32),
+}
+
+impl Controller {
+    /// A controller in `Off`, axes at step position zero.
+    pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
+        let geometry = &config.geometry;
+        if !config.scheduler.is_valid() || config.scheduler.period_ns != config.pipeline.tick_us.saturating_mul(1000) {
+            return Err(ConfigError::Scheduler);
+        }
+        config.pulse_timing().map_err(ConfigError::StepTiming)?;
+        let mechanism = RingPlatform::<f32>::new(geometry);
+        let home_pose = Pose::from_array(config.home).cast::<f32>();
+        let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;
+        let n = geometry.chains().len();
+        let mut home_angles = [0.0; 6];
+        for (i, a) in home_angles.iter_mut().enumerate().take(n) {
+            *a = f64::from(home_q.0[i]);
+        }
+        let ring = RingHoming {
+            carriages: n,
+            home_angles,
+            min_spacing: geometry.limits.carriage_spacing[0],
+            steps_per_rad: config.scales[0].steps_per_turn as f64 / core::f64::consts::TAU,
+        };
+        let plan = HomingPlan::new(config.homing, &ring).map_err(ConfigError::Homing)?;
+        let converter = StepConverter::new(config.scales, mechanism.axes());
+        let pipeline =
+            Pipeline::new(mechanism, config.pipeline, converter, home_pose).map_err(ConfigError::HomePose)?;
+        Ok(Self {
+            config,
+            saved: config,
+            unsaved: 0,
+            home_pose,
+            supervisor: Supervisor::new(config.supervisor),
+            pipeline,
+            scheduler: StepScheduler::new(config.scheduler, [0; 6]),
+            plan,
+            homing: None,
+            homing_carry: 0,
+            returning_home: false,
+            parking: false,
+            connected: false,
+            inputs: Inputs::default(),
+            elapsed_us: 0,
+            bad_frames: 0,
+            tick_cost: 0,
+            queue_depth: 0,
+            pending_fault: false,
+            telemetry: TelemetryClock::default(),
+            raw_inputs: None,
+            jog: None,
+        })
+    }
+
+    /// The supervisor (state, outputs).
+    pub fn supervisor(&self) -> &Supervisor {
+        &self.supervisor
+    }
+
+    /// The motion pipeline.
+    pub fn pipeline(&self) -> &Pipeline<RingPlatform<f32>> {
+        &self.pipeline
+    }
+
+    /// Step position of every axis (what has been scheduled).
+    pub fn steps(&self) -> [i64; 6] {
+        self.scheduler.position()
+    }
+
+    /// The firmware reports the cost of its last tick and its step-queue depth for the status.
+    pub fn set_platform_stats(&mut self, tick_cost: u32, queue_depth: u16) {
+        self.tick_cost = tick_cost;
+        self.queue_depth = queue_depth;
+    }
+
+    /// Reports a watchdog reset (once, at boot).
+    pub fn watchdog_reset(&mut self) {
+        self.event(Event::WatchdogReset);
+    }
+
+    /// The step generator could not keep its output buffer ahead of the hardware: steps may have been played out
+    /// of order, so the position is no longer known. Latches a motion fault (drivers off, homing needed).
+    pub fn step_generator_fault(&mut self) {
+        self.event(Event::MotionFault);
+    }
+
+    fn event(&mut self, e: Event) {
+        let was_fault = matches!(self.supervisor.state(), State::Fault(..));
+        // Inputs and time always apply; refusals only concern commands.
+        let _ = self.supervisor.handle(e);
+        self.after_transition(was_fault);
+    }
+
+    fn after_transition(&mut self, was_fault: bool) {
+        if self.supervisor.state() != State::Jogging {
+            self.jog = None;
+        }
+        if matches!(self.supervisor.state(), State::Fault(..)) {
+            self.pipeline.halt();
+            self.homing = None;
+            self.returning_home = false;
+            self.parking = false;
+            if !was_fault {
+                self.pending_fault = true;
+            }
+        }
+    }
+
+    /// The electrical levels of the input pins as the board sampled them (before debouncing and polarity), for
+    /// [`HostMessage::GetInputs`].
+    pub fn set_raw_inputs(&mut self, raw: u16) {
+        self.raw_inputs = Some(raw);
+    }
+
+    /// Every input's level and state.
+    pub fn input_report(&self) -> InputReport {
+        let active = crate::safety::debounce::from_inputs(&self.inputs);
+        let polarity = self.config.inputs.active_low;
+        InputReport {
+            raw: self.raw_inputs.unwrap_or(active ^ polarity),
+            sampled: self.raw_inputs.is_some(),
+            active,
+            active_low: polarity,
+            debounce_ms: self.config.inputs.debounce_samples,
+        }
+    }
+
+    /// New input levels: changes become supervisor events. A linear actuator's home end is also an
+    /// end-of-travel limit outside homing; a carriage passes its index switch every turn, which is no fault.
+    pub fn set_inputs(&mut self, inputs: Inputs) {
+        let old = self.inputs;
+        self.inputs = inputs;
+        if inputs.estop_open != old.estop_open {
+            self.event(Event::EStop(inputs.estop_open));
+        }
+        if inputs.logic_ok != old.logic_ok {
+            self.event(Event::LogicOk(inputs.logic_ok));
+        }
+        if inputs.power_ok != old.power_ok {
+            self.event(Event::PowerOk(inputs.power_ok));
+        }
+        let homing_axis = self.homing.as_ref().and_then(|h| h.current_axis());
+        let axes = self.pipeline.mechanism().axes();
+        let limit_bits = |i: &Inputs| {
+            let mut bits = i.limits;
+            for (a, kind) in axes.iter().enumerate() {
+                if *kind == AxisKind::Linear && homing_axis != Some(a as u8) {
+                    bits |= i.home & (1 << a);
+                }
+            }
+            bits
+        };
+        let (was, now) = (limit_bits(&old), limit_bits(&inputs));
+        for a in 0..6u8 {
+            let bit = 1u16 << a;
+            if (was ^ now) & bit != 0 {
+                self.event(Event::Limit(a, now & bit != 0));
+            }
+        }
+    }
+
+    /// An unsolicited message to send, if one is pending: a newly latched fault first, then a telemetry sample
+    /// when one is due.
+    pub fn unsolicited(&mut self) -> Option<Response> {
+        if self.pending_fault {
+            self.pending_fault = false;
+            if let State::Fault(reason, _) = self.supervisor.state() {
+                return Some(Response {
+                    id: 0,
+                    body: DeviceMessage::Fault(reason),
+                });
+            }
+        }
+        if !self.telemetry.due {
+            return None;
+        }
+        self.telemetry.due = false;
+        Some(Response {
+            id: 0,
+            body: DeviceMessage::Telemetry(self.telemetry_sample()),
+        })
+    }
+
+    /// One telemetry sample; its flags say what happened since the previous one.
+    pub fn telemetry_sample(&mut self) -> Telemetry {
+        let limited = self.pipeline.limited().count;
+        let refused = self.pipeline.rejected().total();
+        let held = self.pipeline.held();
+        let (l0, r0, h0) = self.telemetry.counted;
+        self.telemetry.counted = (limited, refused, held);
+        let flag = |changed: bool, bit: u8| if changed { bit } else { 0 };
+        let flags = flag(limited != l0, TelemetryFlags::LIMITED)
+            | flag(refused != r0, TelemetryFlags::REFUSED)
+            | flag(held != h0, TelemetryFlags::HELD);
+        Telemetry {
+            time_us: self.telemetry.now_us,
+            state: self.supervisor.state(),
+            pose: self.pipeline.pose(),
+            target: self.pipeline.target(),
+            steps: self.scheduler.position(),
+            flags,
+            applied: self.pipeline.applied(),
+            limited,
+            refused,
+            tick_cost: self.tick_cost,
+            inputs: crate::safety::debounce::from_inputs(&self.inputs),
+            outputs: {
+                let o = self.supervisor.outputs();
+                u8::from(o.logic_relay) | u8::from(o.power_relay) << 1 | u8::from(o.driver_enable) << 2
+            },
+        }
+    }
+
+    /// The status report.
+    pub fn status(&self) -> Status {
+        Status {
+            state: self.supervisor.state(),
+            homed: self.supervisor.homed(),
+            steps: self.scheduler.position(),
+            pose: self.pipeline.pose(),
+            target: self.pipeline.target(),
+            applied: self.pipeline.applied(),
+            limited: *self.pipeline.limited(),
+            rejected: *self.pipeline.rejected(),
+            held: self.pipeline.held(),
+            carried: self.scheduler.carried(),
+            bad_frames: self.bad_frames,
+            tick_cost: self.tick_cost,
+            queue_depth: self.queue_depth,
+        }
+    }
+
+    /// One control period.
+    pub fn tick(&mut self) -> TickOutput {
+        let tick_us = self.pipeline.config().tick_us;
+        self.telemetry_tick(tick_us);
+        self.elapsed_us = self.elapsed_us.saturating_add(tick_us);
+        if self.elapsed_us >= 1000 {
+            let ms = self.elapsed_us / 1000;
+            self.elapsed_us %= 1000;
+            self.event(Event::Elapsed(ms));
+        }
+        let position = self.scheduler.position();
+        let outputs = self.supervisor.outputs();
+        let targets = match outputs.motion {
+            Motion::Stream => {
+                let (targets, event) = self.pipeline.tick();
+                match event {
+                    Some(PipelineEvent::StreamLost) => self.event(Event::StreamLost),
+                    Some(PipelineEvent::AtRest) => self.event(Event::AtRest),
+                    Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
+                    None => {}
+                }
+                if self.supervisor.outputs().motion == Motion::Stream {
+                    targets
+                } else {
+                    position
+                }
+            }
+            Motion::Homing => self.homing_tick(position, tick_us),
+            Motion::Jog => self.jog_tick(position, tick_us),
+            Motion::None => position,
+        };
+        let outputs = self.supervisor.outputs();
+        let targets = if outputs.driver_enable {
+            targets
+        } else {
+            self.scheduler.position()
+        };
+        TickOutput {
+            moves: self.scheduler.plan(&targets),
+            outputs,
+        }
+    }
+
+    /// Advances device time; a telemetry sample falls due every `tick rate / telemetry rate` ticks while the
+    /// connected host asks for telemetry.
+    fn telemetry_tick(&mut self, tick_us: u32) {
+        let t = &mut self.telemetry;
+        t.now_us = t.now_us.wrapping_add(u64::from(tick_us));
+        let hz = u32::from(self.config.telemetry_hz);
+        if hz == 0 || !self.connected || !t.on {
+            t.ticks = 0;
+            return;
+        }
+        t.ticks += 1;
+        let every = (1_000_000 / tick_us.max(1) / hz).max(1);
+        if t.ticks >= every {
+            t.ticks = 0;
+            t.due = true;
+        }
+    }
+}
