@@ -179,6 +179,11 @@ pub enum DeviceAction {
     Jog,
     /// `buzz AXIS`: ten short moves back and forth of one axis (1-6): a motor that hums without turning shows.
     Buzz,
+    /// `rig load RIG.toml`: check a rig file and store it on the device for its next start (supplies off);
+    /// `rig show`: the rig it runs, as a rig file.
+    Rig,
+    /// Restart the controller (supplies off) once it has stored everything: a loaded rig or setting runs.
+    Restart,
 }
 
 #[derive(Debug, Args)]

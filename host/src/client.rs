@@ -7,8 +7,8 @@ use std::time::Duration;
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::motion::{Accepted, RejectReason};
 use ringpod_core::protocol::{
-    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, Status,
-    Telemetry, PROTOCOL_VERSION,
+    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, RigRecord,
+    RigSource, Status, Telemetry, PROTOCOL_VERSION,
 };
 use ringpod_core::safety::FaultReason;
 
@@ -277,6 +277,26 @@ impl<T: Transport> Client<T> {
     /// Changes a setting (refused while anything may move, or out of range).
     pub fn set_config(&mut self, key: ConfigKey, value: f32) -> Result<(), ClientError> {
         self.ack(HostMessage::SetConfig(key, value))
+    }
+
+    /// The rig the device runs, where it came from, and whether another waits for the next start.
+    pub fn rig(&mut self) -> Result<(RigRecord, RigSource, bool), ClientError> {
+        match self.request(HostMessage::GetRig)? {
+            DeviceMessage::Rig { rig, source, pending } => Ok((rig, source, pending)),
+            DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
+            other => Err(ClientError::Unexpected(format!("{other:?}"))),
+        }
+    }
+
+    /// Stores a rig for the next start (refused unless `Off`, or with the cause the checks give).
+    pub fn set_rig(&mut self, rig: RigRecord) -> Result<(), ClientError> {
+        self.ack(HostMessage::SetRig(rig))
+    }
+
+    /// Restarts the controller once everything is stored (refused unless `Off`). The device is gone for a moment:
+    /// a new connection starts with `hello`.
+    pub fn restart(&mut self) -> Result<(), ClientError> {
+        self.ack(HostMessage::Restart)
     }
 
     /// The device's status.

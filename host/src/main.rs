@@ -177,13 +177,6 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         home: args.home,
         host_limits: !args.device_limits_only,
         quiet: args.quiet,
-        platform: match &rig {
-            Some(r) => stream::Platform {
-                geometry: r.geometry,
-                home: r.home.to_array(),
-            },
-            None => stream::Platform::trainer_model(),
-        },
     };
     let recorder = match &args.record {
         Some(path) => Some((
@@ -276,8 +269,8 @@ fn connect(port: Option<&str>, sim: bool, realtime: bool) -> anyhow::Result<tran
 /// `ringpod device ACTION`.
 fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
     use cli::DeviceAction as A;
-    if !matches!(args.action, A::Config | A::Jog | A::Buzz) && !args.config.is_empty() {
-        anyhow::bail!("only `device config`, `jog` and `buzz` take further words");
+    if !matches!(args.action, A::Config | A::Jog | A::Buzz | A::Rig) && !args.config.is_empty() {
+        anyhow::bail!("only `device config`, `jog`, `buzz` and `rig` take further words");
     }
     if args.watch && args.action != A::Inputs {
         anyhow::bail!("--watch is for `device inputs`");
@@ -308,6 +301,21 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
                 ctrlc::set_handler(|| INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst))?;
             }
             commission::inputs(&mut client, args.watch, &stop)?;
+            return Ok(0);
+        }
+        A::Rig => {
+            let words: Vec<&str> = args.config.iter().map(String::as_str).collect();
+            let text = match words.as_slice() {
+                ["load", file] => rig::device::load(&mut client, std::path::Path::new(file))?,
+                ["show"] => rig::device::show(&mut client)?,
+                _ => anyhow::bail!("`device rig load RIG.toml` or `device rig show`"),
+            };
+            let _ = writeln!(std::io::stdout(), "{text}");
+            return Ok(0);
+        }
+        A::Restart => {
+            let line = rig::device::restart(&mut client)?;
+            let _ = writeln!(std::io::stdout(), "{line}");
             return Ok(0);
         }
         A::Config => {

@@ -269,27 +269,15 @@ pub struct Options {
     pub host_limits: bool,
     /// No progress bar.
     pub quiet: bool,
-    /// The platform the device drives (the host limits into its envelope and leads in around its home pose).
-    pub platform: Platform,
 }
 
 /// A ring platform and its home pose.
 #[derive(Debug, Clone, Copy)]
-pub struct Platform {
+struct Platform {
     /// Its geometry.
-    pub geometry: ringpod_core::kinematics::RingGeometry,
+    geometry: ringpod_core::kinematics::RingGeometry,
     /// Its home pose.
-    pub home: [f64; 6],
-}
-
-impl Platform {
-    /// The 1:20 trainer model.
-    pub fn trainer_model() -> Self {
-        Self {
-            geometry: ringpod_core::kinematics::presets::TRAINER_MODEL,
-            home: Preset::TrainerModel.home(),
-        }
-    }
+    home: [f64; 6],
 }
 
 fn reason_name(r: RejectReason) -> String {
@@ -817,14 +805,41 @@ fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) ->
 }
 
 /// The device's envelope margins and stream timeout (the host limits with the same margins, a rounding more).
-fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<(EnvelopeMargins, Duration), ClientError> {
+/// What the device limits with and where it leads in, as the device says: its rig (geometry and home pose), its
+/// envelope margins, stream timeout and pose limits. The host limits into exactly these, so that what it sends
+/// passes there, whatever rig and settings the device runs.
+struct DeviceEnvelope {
+    platform: Platform,
+    margins: EnvelopeMargins,
+    stream_timeout: Duration,
+    limits: MotionLimits,
+}
+
+fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelope, ClientError> {
+    let (rig, _, _) = client.rig()?;
+    let geometry = rig
+        .geometry()
+        .map_err(|e| ClientError::Unexpected(format!("the device's rig does not check: {e}")))?;
     let mut margins = EnvelopeMargins::default();
     for (i, m) in margins.0.iter_mut().enumerate() {
         // f32 on the device: 1e-6 of each unit more, so a pose the host passed passes there too.
         *m = client.get_config(ConfigKey::EnvelopeMargin(i as u8))? + 1e-6;
     }
     let timeout_ms = client.get_config(ConfigKey::StreamTimeoutMs)?;
-    Ok((margins, Duration::from_secs_f64(f64::from(timeout_ms) / 1000.0)))
+    let mut limits = MotionLimits::TRAINER_MODEL;
+    for i in 0..6u8 {
+        limits.pose_velocity[usize::from(i)] = client.get_config(ConfigKey::PoseVelocity(i))?;
+        limits.pose_acceleration[usize::from(i)] = client.get_config(ConfigKey::PoseAcceleration(i))?;
+    }
+    Ok(DeviceEnvelope {
+        platform: Platform {
+            geometry,
+            home: rig.home,
+        },
+        margins,
+        stream_timeout: Duration::from_secs_f64(f64::from(timeout_ms) / 1000.0),
+        limits,
+    })
 }
 
 /// Streams a source and returns the report (also for runs that ended early: its outcome says how). `Err` only
@@ -843,8 +858,13 @@ pub fn run<T: Transport>(
         None => (None, None),
     };
     let baseline = prepare(client, options.home, recorder.is_some())?;
-    let (margins, stream_timeout) = device_envelope(client)?;
-    let geometry = &options.platform.geometry;
+    let DeviceEnvelope {
+        platform,
+        margins,
+        stream_timeout,
+        limits,
+    } = device_envelope(client)?;
+    let geometry = &platform.geometry;
     let total = match &source {
         Source::Motion { seconds, rate_hz, .. } => (seconds * rate_hz).round() as u64 + 1,
         Source::Poses(p) => p.len() as u64,
@@ -868,9 +888,9 @@ pub fn run<T: Transport>(
         mechanism: RingPlatform::new(geometry),
         margins,
         host_limits: options.host_limits,
-        limits: MotionLimits::TRAINER_MODEL,
+        limits,
         stream_timeout,
-        centre: Pose::from_array(options.platform.home),
+        centre: Pose::from_array(platform.home),
         last_sent: baseline.pose.cast(),
         clock_us: 0,
         seq: 0,
@@ -897,7 +917,7 @@ pub fn run<T: Transport>(
     };
     let mut input_errors = input_errors;
     let mut datagrams = None;
-    let home = options.platform.home;
+    let home = platform.home;
     let mut source = source;
     let outcome = match &mut source {
         Source::Motion {

@@ -4,10 +4,12 @@ use std::collections::VecDeque;
 use std::io::{Read, Write};
 use std::time::{Duration, Instant};
 
+use embassy_futures::block_on;
 use ringpod_core::controller::{Controller, ControllerConfig};
-use ringpod_core::kinematics::Mechanism;
+use ringpod_core::protocol::RigSource;
 use ringpod_core::protocol::{self, FrameReader};
 use ringpod_core::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
+use ringpod_core::store::{self, RamFlash};
 
 use crate::client::Transport;
 
@@ -66,11 +68,18 @@ impl Transport for Serial {
     }
 }
 
+/// Erase page of the simulator's settings flash.
+const SIM_FLASH_PAGE: usize = 2048;
+/// Size of the simulator's settings flash (as the QEMU controller's).
+const SIM_FLASH_SIZE: usize = 4 * SIM_FLASH_PAGE;
+
 /// The simulated controller: the same controller core as the firmware (dispatch, supervisor, pipeline, step
 /// scheduler) with a simulated plant, behind the real framed bytes. Time passes only through [`Transport::elapse`]:
 /// in real time (sleeping to keep pace with the wall clock) or as fast as the machine can compute.
 pub struct SimDevice {
     rig: Rig,
+    /// Its settings flash, written and read as the firmware's settings task does.
+    flash: RamFlash<'static, SIM_FLASH_PAGE>,
     reader: FrameReader,
     outbox: VecDeque<u8>,
     tick_us: u64,
@@ -94,13 +103,10 @@ impl SimDevice {
         let config = ControllerConfig::for_rig(&rig.geometry, rig.home.to_array())
             .map_err(|e| anyhow::anyhow!("{}: the controller cannot drive it: {e}", rig.geometry.name))?;
         let controller = Controller::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let axes = controller.pipeline().mechanism().axes();
-        let stroke = rig.geometry.limits.stroke;
-        let far = ((stroke[1] - stroke[0] + 0.002) * 1.6e6) as i64;
         Ok(Self::with(
             realtime,
             controller,
-            Plant::for_axes(&axes, TRAINER_MODEL_PARKED, far),
+            Plant::for_config(&config, TRAINER_MODEL_PARKED),
         ))
     }
 
@@ -111,8 +117,11 @@ impl SimDevice {
             plant,
             ticks: 0,
         };
+        // One flash per simulated device, for the life of the program (a few KiB).
+        let bytes: &'static mut [u8] = Box::leak(vec![0xff; SIM_FLASH_SIZE].into_boxed_slice());
         Self {
             rig,
+            flash: RamFlash::new(bytes),
             reader: FrameReader::default(),
             outbox: VecDeque::new(),
             tick_us,
@@ -120,6 +129,43 @@ impl SimDevice {
             realtime,
             started: Instant::now(),
             simulated_us: 0,
+        }
+    }
+
+    /// What the firmware's settings task does: stores a loaded rig and changed settings (the controller hands them
+    /// out only with the supplies off), and restarts when the host asked for it, restoring from the flash as a
+    /// board's start does (the plant is the stored rig's machine, parked near its switches).
+    fn settings_task(&mut self) {
+        let range = self.flash.range();
+        let c = &mut self.rig.controller;
+        if let Some(rig) = c.take_unsaved_rig() {
+            // A RAM flash only fails when full; the device then runs on and the next start finds the old record.
+            let _ = block_on(store::store_rig(&mut self.flash, range.clone(), &rig));
+        }
+        while let Some((key, value)) = c.take_unsaved() {
+            let _ = block_on(store::store(&mut self.flash, range.clone(), key, value));
+        }
+        if c.restart_due() {
+            let (config, restored) = block_on(store::restore(
+                &mut self.flash,
+                range,
+                ControllerConfig::trainer_model(),
+            ));
+            let Ok(mut controller) = Controller::new(config) else {
+                return;
+            };
+            controller.set_rig_source(restored.rig);
+            let plant = match restored.rig {
+                RigSource::Stored => Plant::for_config(&config, TRAINER_MODEL_PARKED),
+                _ => Plant::trainer_model(TRAINER_MODEL_PARKED),
+            };
+            self.tick_us = u64::from(config.pipeline.tick_us);
+            self.rig = Rig {
+                controller,
+                plant,
+                ticks: 0,
+            };
+            self.reader = FrameReader::default();
         }
     }
 
@@ -163,6 +209,9 @@ impl Transport for SimDevice {
             let cost = started.elapsed().as_nanos().min(u128::from(u32::MAX)) as u32;
             self.rig.controller.set_platform_stats(cost, 0);
             self.simulated_us += self.tick_us;
+            if self.rig.ticks.is_multiple_of(100) {
+                self.settings_task();
+            }
             // After every tick, as the firmware's control task does: no sample is coalesced with the next.
             self.flush_unsolicited();
         }

@@ -1,5 +1,6 @@
-//! The settings task: the controller's changed settings stored in flash through the core's power-loss-safe store
-//! (`ringpod_core::store`, tested there with a power cut at every byte of a save), and restored at boot.
+//! The settings task: the controller's changed settings and a loaded rig stored in flash through the core's
+//! power-loss-safe store (`ringpod_core::store`, tested there with a power cut at every byte of a save), restored at
+//! boot, and the restart the host asked for once everything is stored.
 //!
 //! Flash is only written while the supplies are off: erasing a page stalls the CPU's flash reads (on the F411 a
 //! 128 KiB sector takes 1-2 s), which must never happen while steps are being generated.
@@ -10,30 +11,55 @@ use embassy_time::{Duration, Timer};
 use embedded_storage_async::nor_flash::NorFlash;
 use ringpod_core::controller::ControllerConfig;
 pub use ringpod_core::store::Restored;
-use ringpod_core::store::{self, store};
+use ringpod_core::store::{self, store, store_rig};
 
 use super::Shared;
 
-/// The compiled-in defaults with every stored setting replayed over them.
+/// What the settings task needs of the board besides its flash.
+pub trait Board {
+    /// Lengthens the watchdog over a write that may erase a page (`true`), and back (`false`).
+    fn widen_watchdog(&mut self, wide: bool);
+    /// Resets the MCU (the next start restores what was stored).
+    fn restart(&mut self) -> !;
+}
+
+/// The compiled-in defaults, or the stored rig, with every stored setting replayed over them.
 pub async fn restore<F: NorFlash>(flash: &mut F, range: Range<u32>) -> (ControllerConfig, Restored) {
     store::restore(flash, range, ControllerConfig::trainer_model()).await
 }
 
-/// Stores the controller's unsaved settings, one at a time, as it hands them out (only with the supplies off). `widen` is called
-/// around each write with `true` and then `false`, for the board to lengthen its watchdog over a possible erase.
-pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared, mut widen: impl FnMut(bool)) -> ! {
+/// Stores the controller's loaded rig and unsaved settings, one at a time, as it hands them out (only with the
+/// supplies off); restarts when the host asked for it and nothing waits to be stored.
+pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared, board: &mut impl Board) -> ! {
     loop {
         Timer::after(Duration::from_millis(100)).await;
-        // The controller hands settings out only while the supplies are off.
-        let next = shared.with(|c| c.take_unsaved());
-        let Some((key, value)) = next else { continue };
-        widen(true);
-        let result = store(flash, range.clone(), key, value).await;
-        widen(false);
-        match result {
-            Ok(()) => defmt::info!("stored {} = {}", key, value),
-            // The running value stays; the next boot uses the last stored one. Said, not hidden.
-            Err(_) => defmt::error!("could not store {} = {}", key, value),
+        // The controller hands them out only while the supplies are off.
+        if let Some(rig) = shared.with(|c| c.take_unsaved_rig()) {
+            board.widen_watchdog(true);
+            let result = store_rig(flash, range.clone(), &rig).await;
+            board.widen_watchdog(false);
+            match result {
+                Ok(()) => defmt::info!("stored the rig {}", rig.name()),
+                // The next start runs the rig stored before (or the compiled-in one). Said, not hidden.
+                Err(_) => defmt::error!("could not store the rig {}", rig.name()),
+            }
+            continue;
+        }
+        if let Some((key, value)) = shared.with(|c| c.take_unsaved()) {
+            board.widen_watchdog(true);
+            let result = store(flash, range.clone(), key, value).await;
+            board.widen_watchdog(false);
+            match result {
+                Ok(()) => defmt::info!("stored {} = {}", key, value),
+                // The running value stays; the next boot uses the last stored one. Said, not hidden.
+                Err(_) => defmt::error!("could not store {} = {}", key, value),
+            }
+            continue;
+        }
+        if shared.with(|c| c.restart_due()) {
+            defmt::info!("restarting, as the host asked");
+            Timer::after(Duration::from_millis(20)).await; // the Ack on its way out
+            board.restart();
         }
     }
 }

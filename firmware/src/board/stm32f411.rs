@@ -37,6 +37,7 @@ use embassy_usb::{Builder, UsbDevice};
 use ringpod_core::controller::{Controller, Inputs, MAX_STEP_SLOTS};
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
 use ringpod_core::motion::AxisMove;
+use ringpod_core::protocol::RigSource;
 use ringpod_core::safety::debounce::{to_inputs, InputBit};
 use ringpod_core::safety::pins::OutputPin;
 use static_cell::StaticCell;
@@ -291,10 +292,20 @@ async fn steps_task(mut port: DmaPort, renderer: PulseRenderer, shared: &'static
 
 #[embassy_executor::task]
 async fn settings_task(mut flash: BlockingAsync<Flash<'static, Blocking>>, shared: &'static Shared) -> ! {
-    app::settings::run(&mut flash, SETTINGS, shared, |wide| {
+    app::settings::run(&mut flash, SETTINGS, shared, &mut SettingsBoard).await
+}
+
+/// The watchdog and the reset, for the settings task.
+struct SettingsBoard;
+
+impl app::settings::Board for SettingsBoard {
+    fn widen_watchdog(&mut self, wide: bool) {
         watchdog::set_timeout(if wide { WATCHDOG_FLASH_US } else { WATCHDOG_US })
-    })
-    .await
+    }
+
+    fn restart(&mut self) -> ! {
+        cortex_m::peripheral::SCB::sys_reset()
+    }
 }
 
 /// Brings the board up and spawns the tasks.
@@ -334,6 +345,9 @@ pub async fn start(spawner: Spawner) {
     let mut flash = BlockingAsync::new(Flash::new_blocking(p.FLASH));
     let (config, restored) = app::settings::restore(&mut flash, SETTINGS).await;
     defmt::info!("settings: {}", restored);
+    if matches!(restored.rig, RigSource::Refused(_) | RigSource::Unreadable) {
+        defmt::error!("the stored rig cannot run ({}): the compiled-in rig runs", restored.rig);
+    }
     let controller = match Controller::new(config) {
         Ok(c) => c,
         Err(e) => defmt::panic!("the compiled-in configuration cannot run: {}", e),
@@ -363,6 +377,7 @@ pub async fn start(spawner: Spawner) {
         let raw = switches.read();
         raw ^ config.inputs.active_low
     }));
+    shared.with(|c| c.set_rig_source(restored.rig));
     if watchdog_reset {
         defmt::error!("the last reset was the watchdog's");
         shared.with(|c| c.watchdog_reset());

@@ -31,6 +31,7 @@
 mod command;
 mod coverage;
 mod design;
+pub mod device;
 pub mod drives;
 
 pub use command::{check_command, design_command, export};

@@ -3,11 +3,11 @@
 
 use super::Controller;
 use crate::kinematics::presets::{self, Preset};
-use crate::kinematics::RingGeometry;
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, Pose, RingPlatform};
+use crate::kinematics::{GeometryError, RingGeometry};
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{AxisScale, FollowMode, PipelineConfig, SchedulerConfig};
-use crate::protocol::{ConfigKey, ConfigRefusal};
+use crate::protocol::{ConfigKey, ConfigRefusal, RigRecord, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
 use crate::safety::homing::{HomingConfig, HomingError};
 use crate::safety::SupervisorConfig;
@@ -33,6 +33,8 @@ pub struct ControllerConfig {
     pub inputs: InputConfig,
     /// Telemetry samples per second while a host is connected (0: none).
     pub telemetry_hz: u16,
+    /// The rig's name (UTF-8, zero-padded), as `device rig show` reports it.
+    pub rig_name: [u8; RIG_NAME_LEN],
 }
 
 /// Slot of the step generator (ns): the boards' timers emit one GPIO set/reset word per slot
@@ -48,6 +50,8 @@ pub const MAX_STEP_SLOTS: usize = 800;
 pub enum ConfigError {
     /// The preset is not a ring platform.
     NotARingPlatform,
+    /// The geometry fails its checks (lengths, chains, joint limits).
+    Geometry(GeometryError),
     /// The home pose has no IK solution.
     HomePose(KinematicsError),
     /// The homing plan is unsafe or inconsistent.
@@ -64,7 +68,7 @@ impl ConfigError {
     /// The cause as the protocol names it.
     pub fn refusal(&self) -> ConfigRefusal {
         match self {
-            Self::NotARingPlatform => ConfigRefusal::Geometry,
+            Self::NotARingPlatform | Self::Geometry(_) => ConfigRefusal::Geometry,
             Self::HomePose(_) => ConfigRefusal::HomePose,
             Self::Homing(_) => ConfigRefusal::Homing,
             Self::Scheduler => ConfigRefusal::StepTiming,
@@ -80,6 +84,7 @@ impl core::fmt::Display for ConfigError {
             Self::HomePose(e) => write!(f, "the home pose would have no solution: {e}"),
             Self::Homing(e) => write!(f, "the homing plan would not be safe: {e}"),
             Self::StepTiming(e) => write!(f, "step timing: {e}"),
+            Self::Geometry(e) => write!(f, "the geometry is not a valid ring platform: {e}"),
             other => other.refusal().fmt(f),
         }
     }
@@ -128,6 +133,12 @@ impl ControllerConfig {
             },
             inputs: InputConfig::default(),
             telemetry_hz: 100,
+            rig_name: RigRecord::new(
+                presets::TRAINER_MODEL.name,
+                &presets::TRAINER_MODEL,
+                Preset::TrainerModel.home(),
+            )
+            .name,
         }
     }
 
@@ -185,6 +196,7 @@ impl ControllerConfig {
         let mut config = Self {
             geometry: *geometry,
             home,
+            rig_name: RigRecord::new(geometry.name, geometry, home).name,
             ..model
         };
         for (a, kind) in axes.iter().enumerate() {
@@ -215,6 +227,23 @@ impl ControllerConfig {
         config.homing.order = order;
         config.validate()?;
         Ok(config)
+    }
+
+    /// A stored or loaded rig with the trainer model's drives, switches and timings ([`Self::for_rig`]), under
+    /// its own name.
+    pub fn from_record(record: &RigRecord) -> Result<Self, ConfigError> {
+        let geometry = record.geometry().map_err(ConfigError::Geometry)?;
+        let mut config = Self::for_rig(&geometry, record.home)?;
+        config.rig_name = record.name;
+        Ok(config)
+    }
+
+    /// The rig this configuration drives, as a record.
+    pub fn rig(&self) -> RigRecord {
+        RigRecord {
+            name: self.rig_name,
+            ..RigRecord::new("", &self.geometry, self.home)
+        }
     }
 
     /// Changes a setting after checking its range; the whole configuration is checked by [`Self::validate`].

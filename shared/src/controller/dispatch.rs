@@ -56,6 +56,15 @@ impl Controller {
                 Ok(()) => DeviceMessage::Ack,
                 Err(r) => DeviceMessage::Nack(r),
             },
+            HostMessage::GetRig => self.rig_report(),
+            HostMessage::SetRig(record) => match self.set_rig(&record) {
+                Ok(()) => DeviceMessage::Ack,
+                Err(r) => DeviceMessage::Nack(r),
+            },
+            HostMessage::Restart => match self.request_restart() {
+                Ok(()) => DeviceMessage::Ack,
+                Err(r) => DeviceMessage::Nack(r),
+            },
             HostMessage::Enable => self.command(Event::Enable),
             HostMessage::Disable => self.command(Event::Disable),
             HostMessage::Home => self.command(Event::Home),

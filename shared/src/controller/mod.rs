@@ -16,7 +16,7 @@ pub use config::{ConfigError, ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;
 use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
-use crate::protocol::{DeviceMessage, InputReport, Response, Status, Telemetry, TelemetryFlags};
+use crate::protocol::{DeviceMessage, InputReport, Response, RigRecord, RigSource, Status, Telemetry, TelemetryFlags};
 use crate::safety::homing::{HomingPlan, RingHoming};
 use crate::safety::{Event, HomingSequencer, Motion, Outputs, State, Supervisor};
 
@@ -60,6 +60,14 @@ pub struct Controller {
     raw_inputs: Option<u16>,
     /// A commissioning move in progress, and whether its axis's home switch was active when it started.
     jog: Option<(Jog, bool)>,
+    /// Where the running rig came from (the board says so at boot).
+    rig_source: RigSource,
+    /// A rig loaded over the protocol that the firmware has not stored yet.
+    unsaved_rig: Option<RigRecord>,
+    /// A rig was loaded since the start: the next start runs it.
+    rig_pending: bool,
+    /// The host asked for a restart.
+    restart: bool,
 }
 
 /// When the next telemetry sample is due, and what the previous one counted (for its flags).
@@ -125,6 +133,10 @@ impl Controller {
             telemetry: TelemetryClock::default(),
             raw_inputs: None,
             jog: None,
+            rig_source: RigSource::Compiled,
+            unsaved_rig: None,
+            rig_pending: false,
+            restart: false,
         })
     }
 

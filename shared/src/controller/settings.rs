@@ -2,8 +2,8 @@
 //! changes the firmware has yet to store.
 
 use super::{ConfigError, Controller, ControllerConfig};
-use crate::protocol::{ConfigKey, NackReason};
-use crate::safety::Motion;
+use crate::protocol::{ConfigKey, DeviceMessage, NackReason, RigRecord, RigSource};
+use crate::safety::{Motion, Refusal, State};
 
 impl Controller {
     /// The configuration running now.
@@ -64,5 +64,56 @@ impl Controller {
         self.saved = saved;
         self.unsaved |= 1u64 << key.code();
         Ok(())
+    }
+
+    /// The board says where the running rig came from (at boot, from what its settings store restored).
+    pub fn set_rig_source(&mut self, source: RigSource) {
+        self.rig_source = source;
+    }
+
+    /// The running rig, where it came from, and whether another waits for the next start.
+    pub fn rig_report(&self) -> DeviceMessage {
+        DeviceMessage::Rig {
+            rig: self.config.rig(),
+            source: self.rig_source,
+            pending: self.rig_pending,
+        }
+    }
+
+    /// Takes a rig for the next start, after the checks that will restore it. Only in `Off`: a new geometry voids
+    /// everything the platform knows.
+    pub(super) fn set_rig(&mut self, record: &RigRecord) -> Result<(), NackReason> {
+        if self.supervisor.state() != State::Off {
+            return Err(NackReason::Refused(Refusal::WrongState));
+        }
+        let refused = |e: ConfigError| NackReason::BadConfig(e.refusal());
+        ControllerConfig::from_record(record).map_err(refused)?;
+        self.unsaved_rig = Some(*record);
+        self.rig_pending = true;
+        Ok(())
+    }
+
+    /// A loaded rig the firmware has not stored yet; handed out once, only with the supplies off (as
+    /// [`Self::take_unsaved`]).
+    pub fn take_unsaved_rig(&mut self) -> Option<RigRecord> {
+        let o = self.supervisor.outputs();
+        if o.power_relay || o.driver_enable {
+            return None;
+        }
+        self.unsaved_rig.take()
+    }
+
+    /// Asks for a restart (only in `Off`): the firmware restarts once everything is stored.
+    pub(super) fn request_restart(&mut self) -> Result<(), NackReason> {
+        if self.supervisor.state() != State::Off {
+            return Err(NackReason::Refused(Refusal::WrongState));
+        }
+        self.restart = true;
+        Ok(())
+    }
+
+    /// The host asked for a restart and every setting and rig is stored: the board resets now.
+    pub fn restart_due(&self) -> bool {
+        self.restart && self.unsaved == 0 && self.unsaved_rig.is_none() && self.supervisor.state() == State::Off
     }
 }

@@ -3,11 +3,13 @@
 
 use crate::kinematics::presets::Preset;
 use crate::kinematics::Pose;
+
+use super::rig::{RigRecord, RigSource};
 use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 use crate::safety::{FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly.
-pub const PROTOCOL_VERSION: u16 = 4;
+pub const PROTOCOL_VERSION: u16 = 5;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -22,6 +24,9 @@ pub struct Request {
 }
 
 /// What the host asks of the device.
+// A rig record (about 330 bytes) makes `SetRig` the largest variant by far. No heap to box it in; a request lives on
+// the stack for one dispatch, and the measured cost of a setpoint frame stays within its budget (README).
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum HostMessage {
     /// Version handshake; must come first.
@@ -69,6 +74,13 @@ pub enum HostMessage {
     /// Send telemetry on this connection (`true`) at [`ConfigKey::TelemetryHz`], or stop (`false`). Every Hello
     /// starts a connection without it: a host that only commands gets only answers.
     Telemetry(bool),
+    /// The rig it runs ([`DeviceMessage::Rig`]).
+    GetRig,
+    /// Store this rig for the next start (state `Off` only): checked by the same code that restores it, refused
+    /// with its cause ([`NackReason::BadConfig`]); [`HostMessage::Restart`] then runs it.
+    SetRig(RigRecord),
+    /// Restart the controller once every setting and rig is stored (state `Off` only): a board resets its MCU.
+    Restart,
 }
 
 /// A device message: the response to request `id`, or unsolicited with `id` 0.
@@ -108,6 +120,15 @@ pub enum DeviceMessage {
     Inputs(InputReport),
     /// What the device is doing (unsolicited, at [`ConfigKey::TelemetryHz`] while the host asks for it).
     Telemetry(Telemetry),
+    /// The rig it runs, where that came from, and whether another one is stored for the next start.
+    Rig {
+        /// The rig running now.
+        rig: RigRecord,
+        /// Where it came from.
+        source: RigSource,
+        /// A rig loaded since the start waits for a restart.
+        pending: bool,
+    },
 }
 
 /// Telemetry: one sample of the device's state, sent unsolicited (id 0).
@@ -168,7 +189,7 @@ pub enum ConfigRefusal {
     StepTiming,
     /// With it the step generator's slots could not render the pulses faithfully.
     PulseSlots,
-    /// The machine is not a ring platform.
+    /// The geometry is not a valid ring platform (lengths, chains, joint limits).
     Geometry,
 }
 
@@ -180,7 +201,7 @@ impl core::fmt::Display for ConfigRefusal {
             Self::Homing => "the homing plan would no longer be safe (searches or spacing)",
             Self::StepTiming => "the step timing would be inconsistent",
             Self::PulseSlots => "the step generator could not render the pulses faithfully",
-            Self::Geometry => "the machine is not a ring platform",
+            Self::Geometry => "the geometry is not a valid ring platform",
         })
     }
 }

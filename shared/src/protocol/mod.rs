@@ -8,9 +8,11 @@
 
 mod frame;
 mod messages;
+mod rig;
 
 pub use frame::{decode, encode, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
 pub use messages::{
     ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode,
     Status, Telemetry, TelemetryFlags, PROTOCOL_VERSION,
 };
+pub use rig::{RigRecord, RigSource, RIG_NAME_LEN};

@@ -85,6 +85,21 @@ impl Plant {
         }
     }
 
+    /// The machine a configuration describes, parked at `start` (steps from each switch): carriages with index
+    /// flags, linear actuators with a home end switch and a far end switch 2 mm past their stroke.
+    pub fn for_config(config: &crate::controller::ControllerConfig, start: [i64; 6]) -> Self {
+        use crate::kinematics::Mechanism;
+        let axes = crate::kinematics::RingPlatform::<f64>::new(&config.geometry).axes();
+        let stroke = config.geometry.limits.stroke;
+        let per_m = axes
+            .iter()
+            .zip(&config.scales)
+            .find(|(k, _)| **k != crate::kinematics::AxisKind::Ring)
+            .map_or(0.0, |(_, s)| f64::from(s.steps_per_unit));
+        let far = ((stroke[1] - stroke[0] + 0.002) * per_m) as i64;
+        Self::for_axes(&axes, start, far)
+    }
+
     /// Switch and supply levels for the controller, given the relays of the last tick.
     pub fn inputs(&self, logic_relay: bool, power_relay: bool) -> Inputs {
         let mut home = 0u16;

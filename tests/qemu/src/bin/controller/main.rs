@@ -32,6 +32,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Duration, Instant};
 use ringpod_core::controller::{Controller, STEP_SLOT_NS};
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
+use ringpod_core::protocol::RigSource;
 use ringpod_core::sim::drivers::DriverInputs;
 use ringpod_core::sim::{Plant, TRAINER_MODEL_PARKED};
 use ringpod_firmware::app::{self, Shared};
@@ -95,8 +96,21 @@ async fn steps_task(mut port: Port, renderer: PulseRenderer, shared: &'static Sh
 
 #[embassy_executor::task]
 async fn settings_task(mut flash: RetainedFlash, shared: &'static Shared) -> ! {
-    // No flash erase stalls the emulated CPU: the watchdog needs no widening.
-    app::settings::run(&mut flash, SETTINGS, shared, |_| {}).await
+    app::settings::run(&mut flash, SETTINGS, shared, &mut SettingsBoard).await
+}
+
+/// The reset, for the settings task.
+struct SettingsBoard;
+
+impl app::settings::Board for SettingsBoard {
+    fn widen_watchdog(&mut self, _wide: bool) {
+        // No flash erase stalls the emulated CPU: the watchdog needs no widening.
+    }
+
+    fn restart(&mut self) -> ! {
+        // SYSRESETREQ: QEMU resets the machine; the retained RAM (settings flash) stays.
+        cortex_m::peripheral::SCB::sys_reset()
+    }
 }
 
 static SHARED: StaticCell<Shared> = StaticCell::new();
@@ -127,21 +141,27 @@ async fn main(spawner: Spawner) {
     unsafe { NVIC::unmask(Irq(uart::RX_IRQ)) };
 
     // Settings as the STM32 board restores them: the compiled-in defaults with what flash holds replayed over them.
-    let mut flash = RetainedFlash::take();
+    let mut flash = retained::flash();
     let (config, restored) = app::settings::restore(&mut flash, SETTINGS).await;
     let controller = Controller::new(config).unwrap_or_else(|_| fail("configuration"));
     let timing = config.pulse_timing().unwrap_or_else(|_| fail("step timing"));
     let renderer = PulseRenderer::new(PORT_MAP, timing).unwrap_or_else(|_| fail("pin map"));
 
-    // The host simulator's machine: the same parking positions, so that the same input ends at the same steps.
     let drivers = DriverInputs::new(PORT_MAP, STEP_SLOT_NS, config.scheduler);
-    let world: &'static WorldCell = WORLD.init(Mutex::new(RefCell::new(World::new(
-        Plant::trainer_model(TRAINER_MODEL_PARKED),
-        drivers,
-    ))));
+    // The machine of the rig that runs (the trainer model unless another was stored), parked where the host
+    // simulator parks it, so that the same input ends at the same steps.
+    let plant = match restored.rig {
+        RigSource::Stored => Plant::for_config(&config, TRAINER_MODEL_PARKED),
+        _ => Plant::trainer_model(TRAINER_MODEL_PARKED),
+    };
+    let world: &'static WorldCell = WORLD.init(Mutex::new(RefCell::new(World::new(plant, drivers))));
     let mut pins = Pins { world, last: 0 };
     let first = ringpod_firmware::app::inputs::InputPins::read(&mut pins);
     let shared: &'static Shared = SHARED.init(Shared::new(controller, first ^ config.inputs.active_low));
+    shared.with(|c| c.set_rig_source(restored.rig));
+    if restored.rig != RigSource::Compiled {
+        hprintln!("RIG {} ({:?})", config.rig().name(), restored.rig);
+    }
     if watchdog_reset {
         hprintln!("RESET watchdog");
         shared.with(|c| c.watchdog_reset());

@@ -6,7 +6,7 @@
 use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 
-use embedded_storage_async::nor_flash::{ErrorType, NorFlash, NorFlashErrorKind, ReadNorFlash};
+use ringpod_core::store::RamFlash;
 
 /// Size of the emulated settings flash: four 2 KiB erase pages.
 pub const FLASH_SIZE: usize = 8 * 1024;
@@ -55,70 +55,12 @@ pub fn mark_watchdog_reset() {
     unsafe { addr_of_mut!((*retained()).cause).write_volatile(CAUSE_WATCHDOG) };
 }
 
-/// The settings flash in retained RAM, with NOR semantics: erase sets a page to 0xFF, a write can only clear bits
-/// (so that the store's sequential-storage log meets what it meets on a board's flash).
-pub struct RetainedFlash(());
+/// The settings flash: the core's NOR model over the retained RAM.
+pub type RetainedFlash = RamFlash<'static, PAGE>;
 
-impl RetainedFlash {
-    /// The one flash; [`take_watchdog_reset`] must have run.
-    pub fn take() -> Self {
-        Self(())
-    }
-
-    fn bytes(&mut self) -> &mut [u8; FLASH_SIZE] {
-        // SAFETY: one `RetainedFlash` exists (the settings task owns it), and the NMI handler never touches `flash`.
-        unsafe { &mut *addr_of_mut!((*retained()).flash) }
-    }
-}
-
-fn range(offset: u32, len: usize) -> Result<core::ops::Range<usize>, NorFlashErrorKind> {
-    let start = offset as usize;
-    let end = start.checked_add(len).ok_or(NorFlashErrorKind::OutOfBounds)?;
-    if end > FLASH_SIZE {
-        return Err(NorFlashErrorKind::OutOfBounds);
-    }
-    Ok(start..end)
-}
-
-impl ErrorType for RetainedFlash {
-    type Error = NorFlashErrorKind;
-}
-
-impl ReadNorFlash for RetainedFlash {
-    const READ_SIZE: usize = 1;
-
-    async fn read(&mut self, offset: u32, bytes: &mut [u8]) -> Result<(), Self::Error> {
-        let r = range(offset, bytes.len())?;
-        bytes.copy_from_slice(&self.bytes()[r]);
-        Ok(())
-    }
-
-    fn capacity(&self) -> usize {
-        FLASH_SIZE
-    }
-}
-
-impl NorFlash for RetainedFlash {
-    const WRITE_SIZE: usize = 4;
-    const ERASE_SIZE: usize = PAGE;
-
-    async fn erase(&mut self, from: u32, to: u32) -> Result<(), Self::Error> {
-        if !(from as usize).is_multiple_of(PAGE) || !(to as usize).is_multiple_of(PAGE) || to < from {
-            return Err(NorFlashErrorKind::NotAligned);
-        }
-        let r = range(from, (to - from) as usize)?;
-        self.bytes()[r].fill(0xff);
-        Ok(())
-    }
-
-    async fn write(&mut self, offset: u32, bytes: &[u8]) -> Result<(), Self::Error> {
-        if !(offset as usize).is_multiple_of(Self::WRITE_SIZE) || !bytes.len().is_multiple_of(Self::WRITE_SIZE) {
-            return Err(NorFlashErrorKind::NotAligned);
-        }
-        let r = range(offset, bytes.len())?;
-        for (cell, b) in self.bytes()[r].iter_mut().zip(bytes) {
-            *cell &= *b;
-        }
-        Ok(())
-    }
+/// The one settings flash; [`take_watchdog_reset`] must have run, and this is called once (the settings task owns
+/// it; the NMI handler never touches `flash`).
+pub fn flash() -> RetainedFlash {
+    // SAFETY: called once, so this is the only reference to `flash`.
+    RamFlash::new(unsafe { &mut *addr_of_mut!((*retained()).flash) })
 }

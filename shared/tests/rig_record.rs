@@ -1,0 +1,220 @@
+//! A rig on the device: the record travels in one frame, is checked by the controller as a start will check it,
+//! is stored as one versioned flash item, and comes back exactly; a record the checks refuse or cannot read leaves
+//! the compiled-in rig running with the cause reported; a save cut at any byte leaves the old rig or the new one.
+
+use embassy_futures::block_on;
+use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
+use ringpod_core::kinematics::presets::{Preset, TRAINER_MODEL};
+use ringpod_core::kinematics::RingGeometry;
+use ringpod_core::protocol::{
+    self, ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, NackReason, Request, RigRecord, RigSource, MAX_PAYLOAD,
+    PROTOCOL_VERSION,
+};
+use ringpod_core::safety::Refusal;
+use ringpod_core::store::{restore, store, store_rig, RIG_KEY, RIG_RECORD_VERSION};
+use sequential_storage::cache::NoCache;
+use sequential_storage::map::store_item;
+use sequential_storage::mock_flash::{MockFlashBase, WriteCountCheck};
+
+/// Four pages of 2 KiB (the QEMU controller's and the simulator's layout): a rig record fits a page several times.
+type Flash = MockFlashBase<4, 4, 512>;
+
+fn flash() -> Flash {
+    Flash::new(WriteCountCheck::OnceOnly, None, true)
+}
+
+/// The trainer model's chains on a wider ring with longer rods: no preset describes it.
+fn wider(ring_radius: f64, rod_length: f64) -> RigRecord {
+    let g = RingGeometry::new(
+        "wider",
+        ring_radius,
+        rod_length,
+        TRAINER_MODEL.chains(),
+        TRAINER_MODEL.limits,
+    )
+    .unwrap();
+    RigRecord::new("wider-ring", &g, Preset::TrainerModel.home())
+}
+
+#[test]
+fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
+    let rig = wider(0.3, 0.325);
+    // The wire: one frame, under the payload limit, decoded to the same bits.
+    let mut frame = [0u8; protocol::MAX_FRAME];
+    let n = protocol::encode(
+        &Request {
+            id: 7,
+            body: HostMessage::SetRig(rig),
+        },
+        &mut frame,
+    )
+    .unwrap();
+    let mut raw = [0u8; 1024];
+    let payload = postcard::to_slice(&HostMessage::SetRig(rig), &mut raw).unwrap();
+    assert!(payload.len() <= MAX_PAYLOAD, "{} bytes", payload.len());
+    let back: Request = protocol::decode(&frame[..n - 1]).unwrap();
+    assert_eq!(back.body, HostMessage::SetRig(rig));
+
+    // Flash: stored with a setting before and after it, restored as the running rig with both settings.
+    let defaults = ControllerConfig::trainer_model();
+    let mut f = flash();
+    let range = Flash::FULL_FLASH_RANGE;
+    block_on(store(&mut f, range.clone(), ConfigKey::StreamTimeoutMs, 150.0)).unwrap();
+    block_on(store_rig(&mut f, range.clone(), &rig)).unwrap();
+    block_on(store(&mut f, range.clone(), ConfigKey::TelemetryHz, 50.0)).unwrap();
+    let (config, report) = block_on(restore(&mut f, range, defaults));
+    assert_eq!(report.rig, RigSource::Stored);
+    assert_eq!(
+        (report.applied, report.refused, report.unreadable, report.fell_back),
+        (2, 0, false, false)
+    );
+    assert_eq!(config.rig(), rig);
+    assert_eq!(config.rig().name(), "wider-ring");
+    assert_eq!(config.get(ConfigKey::StreamTimeoutMs), Some(150.0));
+    assert_eq!(config.get(ConfigKey::TelemetryHz), Some(50.0));
+    let mut expected = ControllerConfig::from_record(&rig).unwrap();
+    expected.set(ConfigKey::StreamTimeoutMs, 150.0).unwrap();
+    expected.set(ConfigKey::TelemetryHz, 50.0).unwrap();
+    assert_eq!(config, expected);
+}
+
+#[test]
+fn a_stored_rig_that_cannot_run_leaves_the_compiled_rig_and_says_why() {
+    let defaults = ControllerConfig::trainer_model();
+    let range = Flash::FULL_FLASH_RANGE;
+    // Stored by an older firmware whose checks let it through: a home pose 5 m up has no solution.
+    let mut unreachable = wider(0.3, 0.325);
+    unreachable.home[2] = 5.0;
+    let mut f = flash();
+    block_on(store_rig(&mut f, range.clone(), &unreachable)).unwrap();
+    let (config, report) = block_on(restore(&mut f, range.clone(), defaults));
+    assert_eq!(report.rig, RigSource::Refused(ConfigRefusal::HomePose));
+    assert_eq!(config, defaults);
+
+    // A negative ring radius fails the geometry's own checks.
+    let mut negative = wider(0.3, 0.325);
+    negative.ring_radius = -0.3;
+    let mut f = flash();
+    block_on(store_rig(&mut f, range.clone(), &negative)).unwrap();
+    assert_eq!(
+        block_on(restore(&mut f, range.clone(), defaults)).1.rig,
+        RigSource::Refused(ConfigRefusal::Geometry)
+    );
+
+    // A record of another layout version, and bytes that are no record at all.
+    let mut raw = [0u8; 512];
+    let next_version: &[u8] = postcard::to_slice(&(RIG_RECORD_VERSION + 1, wider(0.3, 0.325)), &mut raw).unwrap();
+    for bytes in [next_version, &[1, 2, 3]] {
+        let mut f = flash();
+        let mut buf = [0u8; 512];
+        block_on(store_item(
+            &mut f,
+            range.clone(),
+            &mut NoCache::new(),
+            &mut buf,
+            &RIG_KEY,
+            &bytes,
+        ))
+        .unwrap();
+        let (config, report) = block_on(restore(&mut f, range.clone(), defaults));
+        assert_eq!((report.rig, config), (RigSource::Unreadable, defaults));
+    }
+}
+
+/// A history of rig saves (so that pages fill and a save must erase one), each cut at every byte it writes or
+/// erases: a restore then runs the old rig or the new one, nothing else, and the next save lands.
+#[test]
+fn a_rig_save_cut_at_any_byte_restores_the_old_or_the_new_rig() {
+    let defaults = ControllerConfig::trainer_model();
+    let range = Flash::FULL_FLASH_RANGE;
+    let mut live = flash();
+    let mut held = defaults.rig();
+    let mut cuts = 0;
+    for i in 0..24 {
+        let new = wider(0.29 + 0.001 * f64::from(i % 12), 0.32 + 0.0005 * f64::from(i));
+        for budget in 0u32.. {
+            let mut f = live.clone();
+            f.bytes_until_shutoff = Some(budget);
+            let done = block_on(store_rig(&mut f, range.clone(), &new)).is_ok();
+            f.bytes_until_shutoff = None;
+            let (config, _) = block_on(restore(&mut f, range.clone(), defaults));
+            let got = config.rig();
+            assert!(got == held || got == new, "save {i} cut after {budget} bytes: {got:?}");
+            if done {
+                assert_eq!(got, new, "save {i} completed");
+                break;
+            }
+            cuts += 1;
+        }
+        block_on(store_rig(&mut live, range.clone(), &new)).unwrap();
+        held = new;
+    }
+    assert!(cuts > 24 * 100, "only {cuts} cut points");
+}
+
+fn connected() -> Controller {
+    let mut c = Controller::new(ControllerConfig::trainer_model()).unwrap();
+    let hello = c.handle(&Request {
+        id: 1,
+        body: HostMessage::Hello {
+            version: PROTOCOL_VERSION,
+        },
+    });
+    assert!(matches!(hello.body, DeviceMessage::Hello { .. }));
+    c
+}
+
+fn ask(c: &mut Controller, body: HostMessage) -> DeviceMessage {
+    c.handle(&Request { id: 2, body }).body
+}
+
+#[test]
+fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
+    let mut c = connected();
+    let rig = wider(0.3, 0.325);
+    let mut bad = rig;
+    bad.home[2] = 5.0;
+    assert_eq!(
+        ask(&mut c, HostMessage::SetRig(bad)),
+        DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::HomePose))
+    );
+    assert_eq!(c.take_unsaved_rig(), None, "a refused rig is not stored");
+
+    // Powered: refused, nothing stored, no restart.
+    c.set_inputs(Inputs {
+        logic_ok: true,
+        power_ok: true,
+        ..Inputs::default()
+    });
+    assert_eq!(ask(&mut c, HostMessage::Enable), DeviceMessage::Ack);
+    c.tick();
+    let wrong_state = DeviceMessage::Nack(NackReason::Refused(Refusal::WrongState));
+    assert_eq!(ask(&mut c, HostMessage::SetRig(rig)), wrong_state);
+    assert_eq!(ask(&mut c, HostMessage::Restart), wrong_state);
+    assert_eq!(ask(&mut c, HostMessage::Disable), DeviceMessage::Ack);
+    for _ in 0..3_000 {
+        c.tick();
+    }
+    assert_eq!(c.supervisor().state(), ringpod_core::safety::State::Off);
+
+    // Off: taken, reported as pending, handed out once for storing; the restart waits for it.
+    assert_eq!(ask(&mut c, HostMessage::SetRig(rig)), DeviceMessage::Ack);
+    assert_eq!(ask(&mut c, HostMessage::Restart), DeviceMessage::Ack);
+    assert!(!c.restart_due(), "the rig is not stored yet");
+    match ask(&mut c, HostMessage::GetRig) {
+        DeviceMessage::Rig {
+            rig: running,
+            source,
+            pending,
+        } => {
+            assert_eq!(
+                (running, source, pending),
+                (ControllerConfig::trainer_model().rig(), RigSource::Compiled, true)
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(c.take_unsaved_rig(), Some(rig));
+    assert_eq!(c.take_unsaved_rig(), None);
+    assert!(c.restart_due());
+}
