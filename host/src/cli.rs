@@ -83,6 +83,10 @@ pub enum Command {
         /// Serve on a pseudo-terminal (the only transport for now).
         #[arg(long)]
         pty: bool,
+        /// Simulate this rig file's platform (with the trainer model's drives and switches) instead of the trainer
+        /// model.
+        #[arg(long, value_name = "RIG.toml")]
+        geometry: Option<std::path::PathBuf>,
     },
 }
 

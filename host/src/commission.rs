@@ -98,7 +98,9 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
         _ => anyhow::bail!(usage),
     };
     let kind = client.hello()?.axes[usize::from(axis)];
-    let per_unit = f64::from(client.get_config(ConfigKey::StepsPerUnit(axis))?);
+    // Motor steps per unit, signed: a reversed motor steps the other way for the same distance.
+    let reverse = client.get_config(ConfigKey::Reverse(axis))? == 1.0;
+    let per_unit = f64::from(client.get_config(ConfigKey::StepsPerUnit(axis))?) * if reverse { -1.0 } else { 1.0 };
     let (message, what) = if buzz {
         if words.len() != 1 {
             anyhow::bail!(usage);

@@ -53,7 +53,7 @@ fn main() -> ExitCode {
         C::Stream(args) => stream_command(args),
         C::Device(args) => device_command(args),
         C::Ports => ports_command(),
-        C::Simulate { pty } => simulate_command(*pty),
+        C::Simulate { pty, geometry } => simulate_command(*pty, geometry.as_deref()),
         C::Cue(args) => cue::run(args).map(|(text, code)| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             code
@@ -329,12 +329,16 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
     Ok(0)
 }
 
-/// `ringpod simulate --pty`.
-fn simulate_command(pty: bool) -> anyhow::Result<u8> {
+/// `ringpod simulate --pty [--geometry RIG.toml]`.
+fn simulate_command(pty: bool, geometry: Option<&std::path::Path>) -> anyhow::Result<u8> {
     if !pty {
         anyhow::bail!("say how to serve the simulator: --pty");
     }
-    pty::serve()?;
+    let device = match geometry {
+        Some(path) => transport::SimDevice::for_rig(true, &rig::load(path)?)?,
+        None => transport::SimDevice::new(true),
+    };
+    pty::serve(device)?;
     Ok(0)
 }
 

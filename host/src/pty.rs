@@ -14,7 +14,7 @@ use crate::transport::SimDevice;
 
 /// Opens a pseudo-terminal, prints the path of its device side, and runs the simulated controller behind it in
 /// real time (1 ms steps) until the process is interrupted.
-pub fn serve() -> anyhow::Result<()> {
+pub fn serve(mut device: SimDevice) -> anyhow::Result<()> {
     let pty = openpty(None, None)?;
     // Raw mode on the device side: no echo, no line editing, no newline translation of the framed bytes.
     let mut termios = tcgetattr(&pty.slave)?;
@@ -28,7 +28,6 @@ pub fn serve() -> anyhow::Result<()> {
     let _slave = pty.slave;
     println!("{}", path.display());
     std::io::stdout().flush()?;
-    let mut device = SimDevice::new(true);
     let mut buf = [0u8; 1024];
     loop {
         match master.read(&mut buf) {

@@ -17,6 +17,7 @@ pub fn name(key: ConfigKey) -> String {
         ConfigKey::PoseVelocity(a) => format!("pose-velocity.{a}"),
         ConfigKey::PoseAcceleration(a) => format!("pose-acceleration.{a}"),
         ConfigKey::StepsPerUnit(a) => format!("steps-per-unit.{a}"),
+        ConfigKey::Reverse(a) => format!("reverse.{a}"),
         ConfigKey::EnvelopeMargin(c) => format!(
             "envelope-margin.{}",
             ringpod_core::kinematics::Check::ALL

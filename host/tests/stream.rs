@@ -730,3 +730,76 @@ fn a_rig_of_ones_own_streams_on_the_simulator() {
     assert_ne!(report["final_steps"], model["final_steps"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A rig on the device: loaded into the simulator over its pseudo-terminal (checked there), stored in its flash,
+/// running after `device restart`, and shown back as a rig file that describes the same machine to the last bit
+/// (IK through the shown file equals IK through the loaded one); `simulate --geometry` starts with a rig.
+#[test]
+fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let run = |args: &[&str]| std::process::Command::new(&exe).args(args).output().unwrap();
+    let dir = std::env::temp_dir().join(format!("ringpod-device-rig-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = String::from_utf8(run(&["presets", "--export", "trainer-model"]).stdout).unwrap();
+    let wider = model
+        .replace("name = \"trainer-model\"", "name = \"wider-ring\"")
+        .replace("ring_radius = 0.286", "ring_radius = 0.3")
+        .replace("rod_length = 0.312", "rod_length = 0.325");
+    let file = dir.join("wider.toml");
+    std::fs::write(&file, wider).unwrap();
+    let file = file.to_str().unwrap();
+    let (mut server, pty) = simulator_on_a_pty();
+    let port = ["--port", pty.as_str()];
+
+    let loaded = run(&[&["device", "rig", "load", file][..], &port].concat());
+    assert!(loaded.status.success(), "{}", String::from_utf8_lossy(&loaded.stderr));
+    let before = String::from_utf8(run(&[&["device", "rig", "show"][..], &port].concat()).stdout).unwrap();
+    assert!(
+        before.starts_with("# running on the device: trainer-model (compiled in)\n# another rig is stored"),
+        "{before}"
+    );
+    let restarted = run(&[&["device", "restart"][..], &port].concat());
+    assert_eq!(
+        String::from_utf8_lossy(&restarted.stdout).trim(),
+        "restarted: running wider-ring (stored)"
+    );
+    let shown = run(&[&["device", "rig", "show"][..], &port].concat());
+    let shown = String::from_utf8(shown.stdout).unwrap();
+    assert!(
+        shown.starts_with("# running on the device: wider-ring (stored)\n"),
+        "{shown}"
+    );
+    // Loading refuses while powered.
+    assert!(run(&[&["device", "enable"][..], &port].concat()).status.success());
+    let refused = run(&[&["device", "rig", "load", file][..], &port].concat());
+    assert_eq!(refused.status.code(), Some(1));
+    let _ = server.kill();
+    let _ = server.wait();
+
+    let back = dir.join("shown.toml");
+    std::fs::write(&back, &shown).unwrap();
+    let back = back.to_str().unwrap();
+    assert!(run(&["rig", "check", back])
+        .status
+        .code()
+        .is_some_and(|c| c == 0 || c == 3));
+    let pose = "--pose=0.01,-0.005,0.23,0.03,-0.02,0.4";
+    let ik = |geometry: &str| run(&["ik", "--geometry", geometry, pose]).stdout;
+    assert!(!ik(file).is_empty());
+    assert_eq!(ik(back), ik(file), "the shown rig is the loaded one, bit for bit");
+
+    // The simulator can also start with a rig.
+    let mut server = std::process::Command::new(&exe)
+        .args(["simulate", "--pty", "--geometry", file])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut path = String::new();
+    std::io::BufRead::read_line(&mut std::io::BufReader::new(server.stdout.take().unwrap()), &mut path).unwrap();
+    let shown = run(&["device", "rig", "show", "--port", path.trim()]);
+    let _ = server.kill();
+    let _ = server.wait();
+    let shown = String::from_utf8(shown.stdout).unwrap();
+    assert!(shown.contains("ring_radius = 0.3\n"), "{shown}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -109,9 +109,9 @@ fn polarity_maps_electrical_levels() {
 #[test]
 fn every_key_has_a_unique_code_that_round_trips() {
     let keys: Vec<ConfigKey> = ConfigKey::all().collect();
-    // stream timeout, gross jump, follow mode, tick rate, polarity, debounce, telemetry rate; per axis three; per
-    // check one.
-    assert_eq!(keys.len(), 7 + 3 * 6 + 6);
+    // stream timeout, gross jump, follow mode, tick rate, polarity, debounce, telemetry rate; per axis four (pose
+    // velocity and acceleration, steps per unit, reverse); per check one.
+    assert_eq!(keys.len(), 7 + 4 * 6 + 6);
     let mut codes: Vec<u8> = keys.iter().map(|k| k.code()).collect();
     codes.sort_unstable();
     codes.dedup();
@@ -420,4 +420,85 @@ fn a_rig_restating_the_trainer_model_configures_the_controller_exactly() {
 fn model_axes() -> [ringpod_core::kinematics::AxisKind; 6] {
     use ringpod_core::kinematics::AxisKind::{Linear, Ring};
     [Ring, Ring, Ring, Ring, Linear, Linear]
+}
+
+/// Runs `rig` until it is Ready or faulted (at most 60 s of ticks) after a Home.
+fn home(rig: &mut ringpod_core::sim::Rig) -> ringpod_core::safety::State {
+    use ringpod_core::safety::State;
+    for body in [HostMessage::Enable, HostMessage::Home] {
+        for _ in 0..5_000 {
+            if matches!(
+                rig.controller.supervisor().state(),
+                State::PowerOn { settled: true } | State::Ready
+            ) {
+                break;
+            }
+            rig.tick();
+        }
+        assert_eq!(rig.controller.handle(&Request { id: 9, body }).body, DeviceMessage::Ack);
+    }
+    for _ in 0..60_000 {
+        match rig.controller.supervisor().state() {
+            s @ (State::Ready | State::Fault(..)) => return s,
+            _ => {
+                rig.tick();
+            }
+        }
+    }
+    rig.controller.supervisor().state()
+}
+
+/// A motor wired the other way round: homing drives its axis away from the switch and fails; `reverse.N` (taken at
+/// the next start) mirrors its steps, homing direction and switch position, and the machine homes to the same
+/// physical place as one wired right.
+#[test]
+fn reverse_corrects_a_motor_wired_the_other_way_round() {
+    use ringpod_core::safety::{FaultReason, State};
+    use ringpod_core::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
+    let rig_with = |config: ControllerConfig, reversed: u8| {
+        let mut plant = Plant::trainer_model(TRAINER_MODEL_PARKED);
+        plant.reversed = reversed;
+        let mut controller = Controller::new(config).unwrap();
+        let hello = controller.handle(&Request {
+            id: 1,
+            body: HostMessage::Hello {
+                version: PROTOCOL_VERSION,
+            },
+        });
+        assert!(matches!(hello.body, DeviceMessage::Hello { .. }));
+        Rig {
+            controller,
+            plant,
+            ticks: 0,
+        }
+    };
+    let model = ControllerConfig::trainer_model();
+    let mut right = rig_with(model, 0);
+    assert_eq!(home(&mut right), State::Ready);
+
+    // Carriage 2 and linear actuator 5 wired the other way round.
+    let reversed = 0b01_0010;
+    let mut wrong = rig_with(model, reversed);
+    assert!(matches!(home(&mut wrong), State::Fault(FaultReason::HomingFailed, _)));
+
+    let mut config = model;
+    for a in [1u8, 4] {
+        config.set(ConfigKey::Reverse(a), 1.0).unwrap();
+        assert_eq!(config.get(ConfigKey::Reverse(a)), Some(1.0));
+    }
+    assert!(!ConfigKey::Reverse(1).is_live());
+    assert_eq!(
+        config.set(ConfigKey::Reverse(1), 0.5),
+        Err(ringpod_core::controller::ConfigError::Value)
+    );
+    let mut fixed = rig_with(config, reversed);
+    assert_eq!(home(&mut fixed), State::Ready);
+    // The same physical place: every axis where the correctly wired machine's is; the reversed axes count their
+    // motor steps the other way.
+    assert_eq!(fixed.plant.position, right.plant.position);
+    let (r, f) = (right.controller.steps(), fixed.controller.steps());
+    for a in 0..6 {
+        let sign = if reversed & (1 << a) != 0 { -1 } else { 1 };
+        assert_eq!(f[a], sign * r[a], "axis {a}");
+    }
 }

@@ -173,6 +173,7 @@ impl ControllerConfig {
             ConfigKey::InputActiveLow => f32::from(self.inputs.active_low),
             ConfigKey::DebounceMs => f32::from(self.inputs.debounce_samples),
             ConfigKey::TelemetryHz => f32::from(self.telemetry_hz),
+            ConfigKey::Reverse(a) => f32::from(u8::from(self.scales.get(usize::from(a))?.invert)),
         })
     }
 
@@ -287,6 +288,19 @@ impl ControllerConfig {
                 let tick_us = (1e6 / value) as u32;
                 c.tick_us = tick_us;
                 self.scheduler.period_ns = tick_us * 1000;
+            }
+            ConfigKey::Reverse(a) if value == 0.0 || value == 1.0 => {
+                let i = usize::from(a);
+                let (Some(scale), Some(h)) = (self.scales.get_mut(i), self.homing.axes.get_mut(i)) else {
+                    return Err(ConfigError::Value);
+                };
+                let reverse = value == 1.0;
+                if scale.invert != reverse {
+                    // Homing works in motor steps: the switch is now the other way, at the mirrored position.
+                    scale.invert = reverse;
+                    h.toward = -h.toward;
+                    h.home_position = -h.home_position;
+                }
             }
             ConfigKey::StepsPerUnit(a) if integer && (1.0..=16_777_216.0).contains(&value) => {
                 let kind = self.axis_kind(a).ok_or(ConfigError::Value)?;

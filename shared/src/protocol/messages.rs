@@ -288,6 +288,9 @@ pub enum ConfigKey {
     DebounceMs,
     /// Telemetry samples per second while a host asks for them (0: none; at most the control rate), live.
     TelemetryHz,
+    /// The axis's motor turns the other way (1) or not (0): its steps, homing direction and switch position are
+    /// mirrored, for a motor wired or mounted the other way round; at the next start.
+    Reverse(u8),
 }
 
 impl ConfigKey {
@@ -311,6 +314,7 @@ impl ConfigKey {
             ConfigKey::PoseAcceleration(a) => 24 + (a & 7),
             ConfigKey::StepsPerUnit(a) => 32 + (a & 7),
             ConfigKey::EnvelopeMargin(c) => 40 + (c & 7),
+            ConfigKey::Reverse(a) => 48 + (a & 7),
         }
     }
 
@@ -328,13 +332,17 @@ impl ConfigKey {
             24..=29 => ConfigKey::PoseAcceleration(code - 24),
             32..=37 => ConfigKey::StepsPerUnit(code - 32),
             40..=45 => ConfigKey::EnvelopeMargin(code - 40),
+            48..=53 => ConfigKey::Reverse(code - 48),
             _ => return None,
         })
     }
 
     /// Whether a new value takes effect at once (otherwise at the next start).
     pub const fn is_live(self) -> bool {
-        !matches!(self, ConfigKey::TickHz | ConfigKey::StepsPerUnit(_))
+        !matches!(
+            self,
+            ConfigKey::TickHz | ConfigKey::StepsPerUnit(_) | ConfigKey::Reverse(_)
+        )
     }
 }
 

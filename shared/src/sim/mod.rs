@@ -39,6 +39,9 @@ pub struct Plant {
     pub steps_while_disabled: u64,
     /// Total steps received per axis.
     pub steps_received: [u64; 6],
+    /// Bit per axis: its motor is wired or mounted the other way round, so a forward step moves the axis back
+    /// (what `ConfigKey::Reverse` corrects).
+    pub reversed: u8,
 }
 
 impl Plant {
@@ -62,6 +65,7 @@ impl Plant {
             supply_dead: false,
             steps_while_disabled: 0,
             steps_received: [0; 6],
+            reversed: 0,
         }
     }
 
@@ -131,8 +135,17 @@ impl Plant {
             if m.count > 0 && !out.outputs.driver_enable {
                 self.steps_while_disabled += u64::from(m.count);
             }
-            self.position[a] += m.signed();
+            self.position[a] += self.direction(a) * m.signed();
             self.steps_received[a] += u64::from(m.count);
+        }
+    }
+
+    /// +1, or -1 for a reversed motor.
+    fn direction(&self, axis: usize) -> i64 {
+        if self.reversed & (1 << axis) != 0 {
+            -1
+        } else {
+            1
         }
     }
 
@@ -146,7 +159,7 @@ impl Plant {
             if n > 0 && !driver_enable {
                 self.steps_while_disabled += n;
             }
-            self.position[a] += drivers.position()[a] - position[a];
+            self.position[a] += self.direction(a) * (drivers.position()[a] - position[a]);
             self.steps_received[a] += n;
         }
         broken
