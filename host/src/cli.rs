@@ -197,8 +197,9 @@ pub struct DeviceArgs {
     pub action: DeviceAction,
     /// For `config`: `get KEY` or `set KEY VALUE`. Keys: stream-timeout-ms, gross-jump-ms, follow-direct (0 or
     /// 1), tick-hz, input-active-low, debounce-ms, per axis (0-5) pose-velocity.N, pose-acceleration.N,
-    /// steps-per-unit.N, and per check envelope-margin.CHECK (reach, carriage-spacing, rod-crossing, joint-cones,
-    /// singularity, stability; in the check's unit), telemetry-hz. For `jog`: AXIS DISTANCE; for `buzz`: AXIS.
+    /// steps-per-unit.N, reverse.N (0 or 1), and per check envelope-margin.CHECK (reach, carriage-spacing,
+    /// rod-crossing, joint-cones, singularity, stability; in the check's unit), telemetry-hz. For `jog`: AXIS
+    /// DISTANCE; for `buzz`: AXIS; for `rig`: `load RIG.toml` or `show`.
     #[arg(allow_negative_numbers = true)]
     pub config: Vec<String>,
     /// Serial port of the board (USB CDC).
