@@ -100,8 +100,9 @@ impl SimDevice {
     /// A simulated ring platform of a rig file, with the trainer model's drives, switches and timings, parked as
     /// the model is (each axis a little before its switch), powered off.
     pub fn for_rig(realtime: bool, rig: &crate::rig::Rig) -> anyhow::Result<Self> {
-        let config = ControllerConfig::for_rig(&rig.geometry, rig.home.to_array())
-            .map_err(|e| anyhow::anyhow!("{}: the controller cannot drive it: {e}", rig.geometry.name))?;
+        // The record a board would store: geometry, home, axes, pose limits and inputs, through the same code.
+        let config = ControllerConfig::from_record(&rig.record)
+            .map_err(|e| anyhow::anyhow!("{}: the controller cannot drive it: {e}", rig.record.name()))?;
         let controller = Controller::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
         Ok(Self::with(
             realtime,

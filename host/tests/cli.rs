@@ -224,7 +224,8 @@ fn device_config_reads_writes_and_refuses() {
     let all = json(&["device", "config", "--sim"]);
     assert_eq!(all["tick-hz"], 1000.0);
     assert_eq!(all["steps-per-unit.0"], 25_600.0);
-    assert_eq!(all.as_object().unwrap().len(), 31);
+    assert_eq!(all.as_object().unwrap().len(), 37);
+    assert_eq!(all["reverse.0"], 0.0);
     assert_eq!(all["telemetry-hz"], 100.0);
     assert_eq!(all["envelope-margin.reach"], 0.002);
     assert_eq!(all["gross-jump-ms"], 500.0);

@@ -745,6 +745,22 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
         .replace("name = \"trainer-model\"", "name = \"wider-ring\"")
         .replace("ring_radius = 0.286", "ring_radius = 0.3")
         .replace("rod_length = 0.312", "rod_length = 0.325");
+    // With the controller sections too: a reversed motor, other pose limits, other input wiring.
+    let mut axes = String::new();
+    for (steps, reverse) in [
+        (25_600, false),
+        (25_600, true),
+        (25_600, false),
+        (25_600, false),
+        (1_600_000, false),
+        (1_600_000, false),
+    ] {
+        axes += &format!("\n[[axes]]\nsteps_per_unit = {steps}\nreverse = {reverse}\n");
+    }
+    let wider = wider
+        + &axes
+        + "\n[motion]\npose_velocity = [0.04, 0.04, 0.04, 1.0, 1.0, 1.5]\npose_acceleration = [1, 1, 1, 20, 20, 20]\n"
+        + "\n[inputs]\nactive_low = [\"home1\", \"home2\", \"home3\", \"home4\", \"end5\", \"end6\"]\ndebounce_ms = 4\n";
     let file = dir.join("wider.toml");
     std::fs::write(&file, wider).unwrap();
     let file = file.to_str().unwrap();
@@ -769,6 +785,16 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
         shown.starts_with("# running on the device: wider-ring (stored)\n"),
         "{shown}"
     );
+    assert!(
+        shown.contains("reverse = true") && shown.contains("debounce_ms = 4"),
+        "{shown}"
+    );
+    assert!(
+        shown.contains("pose_velocity = [0.04, 0.04, 0.04, 1.0, 1.0, 1.5]"),
+        "{shown}"
+    );
+    let config = run(&[&["device", "config", "get", "reverse.1"][..], &port].concat());
+    assert!(String::from_utf8_lossy(&config.stdout).contains("\"value\": 1.0"));
     // Loading refuses while powered.
     assert!(run(&[&["device", "enable"][..], &port].concat()).status.success());
     let refused = run(&[&["device", "rig", "load", file][..], &port].concat());

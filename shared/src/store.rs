@@ -22,8 +22,8 @@ pub const RIG_KEY: u8 = 0xf0;
 /// Layout of the stored rig record; a record of another version is not read (the compiled-in rig runs and the
 /// host sees [`RigSource::Unreadable`]).
 pub const RIG_RECORD_VERSION: u16 = 1;
-/// Room for the stored rig record: its postcard bytes (under 340) and the crate's header.
-const RIG_BUFFER: usize = 400;
+/// Room for the stored rig record: its postcard bytes (under 480) and the crate's header.
+const RIG_BUFFER: usize = 600;
 
 /// The stored rig record as flash holds it.
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -49,7 +49,7 @@ pub struct Restored {
 }
 
 /// Room for any stored item with the crate's header: reading or moving items passes every item through this buffer,
-/// the rig record (under 340 bytes) included.
+/// the rig record (under 480 bytes) included.
 const ITEM_BUFFER: usize = RIG_BUFFER;
 
 /// `defaults` with every stored setting replayed over them, and what was found.

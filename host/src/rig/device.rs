@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use ringpod_core::protocol::{DeviceMessage, HostMessage, NackReason, RigRecord, RigSource};
+use ringpod_core::protocol::{DeviceMessage, HostMessage, NackReason, RigSource};
 
 use super::RigFile;
 use crate::client::{Client, ClientError, Transport};
@@ -13,8 +13,7 @@ use crate::client::{Client, ClientError, Transport};
 /// it for the next start. Returns what to print.
 pub fn load<T: Transport>(client: &mut Client<T>, path: &Path) -> anyhow::Result<String> {
     let file = super::read(path)?;
-    let rig = file.check()?;
-    let record = RigRecord::new(&file.name, &rig.geometry, rig.home.to_array());
+    let record = file.check()?.record;
     if record.name() != file.name {
         eprintln!(
             "note: the device keeps the name's first {} bytes: {}",
@@ -36,7 +35,7 @@ pub fn show<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
     let geometry = record
         .geometry()
         .map_err(|e| anyhow::anyhow!("the device's rig: {e}"))?;
-    let mut file = RigFile::of(&geometry, record.home, None, Vec::new());
+    let mut file = RigFile::of(&geometry, record.home, None, Vec::new()).with_sections(&record);
     file.name = record.name().to_owned();
     let mut header = format!("# running on the device: {} ({source})\n", record.name());
     if pending {

@@ -33,6 +33,7 @@ mod coverage;
 mod design;
 pub mod device;
 pub mod drives;
+mod settings;
 
 pub use command::{check_command, design_command, export};
 pub use coverage::coverage;
@@ -68,6 +69,15 @@ pub struct RigFile {
     /// Motor data per axis, for the drive margin of `ringpod loads --input` (optional).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub drives: Vec<DriveSpec>,
+    /// Each motor's steps per unit and direction, in actuator order (optional: the trainer model's drives).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub axes: Vec<settings::AxisSpec>,
+    /// Pose limits (optional: the trainer model's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<settings::MotionSpec>,
+    /// Input wiring (optional: switches to ground with pull-ups, a normally closed e-stop chain, 3 ms debouncing).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inputs: Option<settings::InputsSpec>,
 }
 
 /// One chain.
@@ -208,6 +218,8 @@ pub struct Rig {
     pub ranges: Option<[f64; 5]>,
     /// Each axis's drive, where the file gives one.
     pub drives: [Option<Drive>; 6],
+    /// What a device stores and runs: the geometry, home pose, axes, pose limits and inputs.
+    pub record: ringpod_core::protocol::RigRecord,
 }
 
 /// Reads and checks a rig file.
@@ -287,11 +299,13 @@ impl RigFile {
             None => None,
         };
         let drives = drives::check(&self.drives, &m.axes())?;
+        let record = self.record(ringpod_core::protocol::RigRecord::new(&self.name, &geometry, self.home))?;
         Ok(Rig {
             geometry,
             home,
             ranges,
             drives,
+            record,
         })
     }
 
@@ -437,6 +451,9 @@ impl RigFile {
                 pitch_deg: degrees(r[4]),
             }),
             drives,
+            axes: Vec::new(),
+            motion: None,
+            inputs: None,
         }
     }
 }

@@ -230,12 +230,28 @@ impl ControllerConfig {
         Ok(config)
     }
 
-    /// A stored or loaded rig with the trainer model's drives, switches and timings ([`Self::for_rig`]), under
-    /// its own name.
+    /// A stored or loaded rig: its geometry and home pose with the trainer model's switches and timings
+    /// ([`Self::for_rig`]), then its axes, pose limits and inputs through the same checks as the settings of those
+    /// names (so that steps per unit and direction scale and mirror the homing distances as a setting does).
     pub fn from_record(record: &RigRecord) -> Result<Self, ConfigError> {
         let geometry = record.geometry().map_err(ConfigError::Geometry)?;
         let mut config = Self::for_rig(&geometry, record.home)?;
         config.rig_name = record.name;
+        let axes = RingPlatform::<f64>::new(&geometry).axes();
+        for (a, (kind, scale)) in (0u8..).zip(axes.iter().zip(&record.scales)) {
+            let per_unit = match kind {
+                AxisKind::Ring => scale.steps_per_turn as f32,
+                AxisKind::Linear | AxisKind::Angle => scale.steps_per_unit,
+            };
+            let i = usize::from(a);
+            config.set(ConfigKey::StepsPerUnit(a), per_unit)?;
+            config.set(ConfigKey::Reverse(a), f32::from(u8::from(scale.invert)))?;
+            config.set(ConfigKey::PoseVelocity(a), record.pose_velocity[i])?;
+            config.set(ConfigKey::PoseAcceleration(a), record.pose_acceleration[i])?;
+        }
+        config.set(ConfigKey::InputActiveLow, f32::from(record.inputs.active_low))?;
+        config.set(ConfigKey::DebounceMs, f32::from(record.inputs.debounce_samples))?;
+        config.validate()?;
         Ok(config)
     }
 
@@ -243,6 +259,10 @@ impl ControllerConfig {
     pub fn rig(&self) -> RigRecord {
         RigRecord {
             name: self.rig_name,
+            scales: self.scales,
+            pose_velocity: self.pipeline.limits.pose_velocity,
+            pose_acceleration: self.pipeline.limits.pose_acceleration,
+            inputs: self.inputs,
             ..RigRecord::new("", &self.geometry, self.home)
         }
     }

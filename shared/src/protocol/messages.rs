@@ -93,6 +93,8 @@ pub struct Response {
 }
 
 /// What the device says.
+// `Rig` carries a rig record (under 480 bytes), the largest variant by far; as with `HostMessage`, no heap to box it.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum DeviceMessage {
     /// Handshake answer.

@@ -1,14 +1,17 @@
 //! A ring platform as it travels to a device and lives in its flash: the rig file's geometry (KINEMATICS.md 2.1 and
 //! 2.2: ring radius, rod length, chains in actuator order, joint limits) and home pose, in the units of
 //! `kinematics` (m, rad), `f64` as the host computes them, so that a rig file, its record on the wire and its record
-//! in flash are the same numbers bit for bit.
+//! in flash are the same numbers bit for bit; and its axes (motor steps, direction), pose limits and input wiring,
+//! in the controller's own types.
 
-use crate::kinematics::{Chain, ChainKind, GeometryError, RingGeometry, RingLimits};
+use crate::kinematics::{AxisKind, Chain, ChainKind, GeometryError, Mechanism, RingGeometry, RingLimits, RingPlatform};
+use crate::motion::{AxisScale, MotionLimits};
+use crate::safety::debounce::InputConfig;
 
 use super::ConfigRefusal;
 
 /// Longest rig name kept (bytes of UTF-8).
-pub const RIG_NAME_LEN: usize = 24;
+pub const RIG_NAME_LEN: usize = 32;
 
 /// A ring platform and where homing leaves it.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -27,10 +30,19 @@ pub struct RigRecord {
     pub limits: RingLimits,
     /// Home pose `[x, y, z, alpha, beta, gamma]` (m, rad).
     pub home: [f64; 6],
+    /// Each axis's motor in actuator order: steps per carriage turn or per metre, and direction.
+    pub scales: [AxisScale; 6],
+    /// Pose velocity limit per pose axis (m/s, rad/s).
+    pub pose_velocity: [f32; 6],
+    /// Pose acceleration limit per pose axis (m/s^2, rad/s^2).
+    pub pose_acceleration: [f32; 6],
+    /// Input polarity and debouncing.
+    pub inputs: InputConfig,
 }
 
 impl RigRecord {
-    /// The record of `geometry` homed at `home`, named `name`.
+    /// The record of `geometry` homed at `home`, named `name`, with the trainer model's axes (its carriage drive on
+    /// every ring axis, its lead screw on every linear one), pose limits and input wiring.
     pub fn new(name: &str, geometry: &RingGeometry, home: [f64; 6]) -> Self {
         let mut chains = [Chain {
             kind: ChainKind::Radial,
@@ -53,6 +65,13 @@ impl RigRecord {
             chain_count: geometry.chains().len() as u8,
             limits: geometry.limits,
             home,
+            scales: RingPlatform::<f64>::new(geometry).axes().map(|k| match k {
+                AxisKind::Ring => AxisScale::MODEL_CARRIAGE,
+                AxisKind::Linear | AxisKind::Angle => AxisScale::MODEL_LINEAR,
+            }),
+            pose_velocity: MotionLimits::TRAINER_MODEL.pose_velocity,
+            pose_acceleration: MotionLimits::TRAINER_MODEL.pose_acceleration,
+            inputs: InputConfig::default(),
         }
     }
 
