@@ -78,6 +78,9 @@ pub struct RigFile {
     /// Input wiring (optional: switches to ground with pull-ups, a normally closed e-stop chain, 3 ms debouncing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inputs: Option<settings::InputsSpec>,
+    /// Supply sensing and sequencing (optional: both supplies sensed, the firmware's default delays).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub supervisor: Option<settings::SupervisorSpec>,
 }
 
 /// One chain.
@@ -454,6 +457,7 @@ impl RigFile {
             axes: Vec::new(),
             motion: None,
             inputs: None,
+            supervisor: None,
         }
     }
 }

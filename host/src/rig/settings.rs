@@ -1,11 +1,13 @@
 //! The rig file's controller sections: `[[axes]]` (each motor's steps per unit and direction, in actuator order),
-//! `[motion]` (pose limits) and `[inputs]` (which inputs are active low, debouncing). Each is optional and takes the
+//! `[motion]` (pose limits), `[inputs]` (which inputs are active low, debouncing) and `[supervisor]` (supply
+//! sensing and sequencing delays). Each is optional and takes the
 //! trainer model's values when omitted; together with the geometry they make the [`RigRecord`] a device stores.
 
 use ringpod_core::controller::ControllerConfig;
 use ringpod_core::kinematics::{AxisKind, Mechanism, RingPlatform};
 use ringpod_core::protocol::RigRecord;
 use ringpod_core::safety::debounce::InputBit;
+use ringpod_core::safety::SupervisorConfig;
 use serde::{Deserialize, Serialize};
 
 use super::{err, RigError, RigFile};
@@ -39,6 +41,26 @@ pub struct InputsSpec {
     pub active_low: Vec<String>,
     /// Equal samples, 1 ms apart, before a level counts (1-50).
     pub debounce_ms: u8,
+}
+
+/// Supply sensing and sequencing (FIRMWARE.md "Safety supervisor").
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupervisorSpec {
+    /// The board has a LOGIC_OK input (without it, the delays alone sequence).
+    pub logic_sense: bool,
+    /// The board has a POWER_OK input.
+    pub power_sense: bool,
+    /// After the logic relay closes (and LOGIC_OK), before the power relay may close (ms).
+    pub logic_settle_ms: u32,
+    /// After the power relay closes (and POWER_OK), before the drivers may be enabled (ms).
+    pub power_settle_ms: u32,
+    /// A sensed supply not up this long after its relay closed is a fault (ms).
+    pub supply_timeout_ms: u32,
+    /// Drivers disabled this long before the power relay opens (ms).
+    pub driver_off_ms: u32,
+    /// Power supply discharge before the logic relay opens (ms).
+    pub discharge_ms: u32,
 }
 
 /// Every input by its name in the file.
@@ -120,6 +142,27 @@ impl RigFile {
             record.inputs.active_low = mask;
             record.inputs.debounce_samples = spec.debounce_ms;
         }
+        if let Some(spec) = &self.supervisor {
+            let s = SupervisorConfig {
+                logic_sense: spec.logic_sense,
+                power_sense: spec.power_sense,
+                logic_settle_ms: spec.logic_settle_ms,
+                power_settle_ms: spec.power_settle_ms,
+                supply_timeout_ms: spec.supply_timeout_ms,
+                driver_off_ms: spec.driver_off_ms,
+                discharge_ms: spec.discharge_ms,
+            };
+            if !s.is_valid() {
+                return err(
+                    "supervisor",
+                    format!(
+                        "every delay at most {} ms, and supply_timeout_ms above 0 with a sensed supply",
+                        SupervisorConfig::LONGEST_MS
+                    ),
+                );
+            }
+            record.supervisor = s;
+        }
         ControllerConfig::from_record(&record)
             .or_else(|e| err("rig", format!("the controller cannot drive it: {e}")))?;
         Ok(record)
@@ -156,6 +199,16 @@ impl RigFile {
                 .collect(),
             debounce_ms: record.inputs.debounce_samples,
         });
+        let s = record.supervisor;
+        self.supervisor = Some(SupervisorSpec {
+            logic_sense: s.logic_sense,
+            power_sense: s.power_sense,
+            logic_settle_ms: s.logic_settle_ms,
+            power_settle_ms: s.power_settle_ms,
+            supply_timeout_ms: s.supply_timeout_ms,
+            driver_off_ms: s.driver_off_ms,
+            discharge_ms: s.discharge_ms,
+        });
         self
     }
 }
@@ -183,6 +236,9 @@ mod tests {
         text += "\n[[axes]]\nsteps_per_unit = 3200000\n\n[[axes]]\nsteps_per_unit = 1600000\nreverse = true\n";
         text += "\n[motion]\npose_velocity = [0.04, 0.04, 0.03, 0.8, 0.8, 1.5]\npose_acceleration = [1, 1, 1, 10, 10, 10]\n";
         text += "\n[inputs]\nactive_low = [\"home1\", \"home2\", \"home3\", \"home4\", \"end5\", \"end6\"]\ndebounce_ms = 5\n";
+        text +=
+            "\n[supervisor]\nlogic_sense = true\npower_sense = false\nlogic_settle_ms = 150\npower_settle_ms = 400\n";
+        text += "supply_timeout_ms = 2000\ndriver_off_ms = 30\ndischarge_ms = 1500\n";
         text
     }
 
@@ -196,6 +252,8 @@ mod tests {
         assert_eq!(record.pose_velocity[5], 1.5);
         assert_eq!(record.inputs.debounce_samples, 5);
         assert_eq!(record.inputs.active_low, 0b1_1000_0001_1110);
+        assert!(!record.supervisor.power_sense);
+        assert_eq!(record.supervisor.discharge_ms, 1_500);
 
         let mut bytes = vec![0xff; 8 * 1024];
         let mut flash = RamFlash::<2048>::new(&mut bytes);
@@ -233,6 +291,7 @@ mod tests {
             ("0.8, 0.8, 1.5]", "0.8, 0.8, -1.5]", "motion.pose_velocity"),
             ("\"end6\"]", "\"end7\"]", "inputs.active_low"),
             ("debounce_ms = 5", "debounce_ms = 0", "inputs.debounce_ms"),
+            ("discharge_ms = 1500", "discharge_ms = 600000", "supervisor"),
         ];
         for (from, to, key) in cases {
             assert!(good.contains(from), "{from}");

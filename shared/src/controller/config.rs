@@ -251,6 +251,7 @@ impl ControllerConfig {
         }
         config.set(ConfigKey::InputActiveLow, f32::from(record.inputs.active_low))?;
         config.set(ConfigKey::DebounceMs, f32::from(record.inputs.debounce_samples))?;
+        config.supervisor = record.supervisor;
         config.validate()?;
         Ok(config)
     }
@@ -263,6 +264,7 @@ impl ControllerConfig {
             pose_velocity: self.pipeline.limits.pose_velocity,
             pose_acceleration: self.pipeline.limits.pose_acceleration,
             inputs: self.inputs,
+            supervisor: self.supervisor,
             ..RigRecord::new("", &self.geometry, self.home)
         }
     }

@@ -92,6 +92,9 @@ impl Controller {
             return Err(ConfigError::Scheduler);
         }
         config.pulse_timing().map_err(ConfigError::StepTiming)?;
+        if !config.supervisor.is_valid() {
+            return Err(ConfigError::Value);
+        }
         let mechanism = RingPlatform::<f32>::new(geometry);
         let home_pose = Pose::from_array(config.home).cast::<f32>();
         let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;

@@ -2,11 +2,12 @@
 //! 2.2: ring radius, rod length, chains in actuator order, joint limits) and home pose, in the units of
 //! `kinematics` (m, rad), `f64` as the host computes them, so that a rig file, its record on the wire and its record
 //! in flash are the same numbers bit for bit; and its axes (motor steps, direction), pose limits and input wiring,
-//! in the controller's own types.
+//! supply sequencing, in the controller's own types.
 
 use crate::kinematics::{AxisKind, Chain, ChainKind, GeometryError, Mechanism, RingGeometry, RingLimits, RingPlatform};
 use crate::motion::{AxisScale, MotionLimits};
 use crate::safety::debounce::InputConfig;
+use crate::safety::SupervisorConfig;
 
 use super::ConfigRefusal;
 
@@ -38,11 +39,13 @@ pub struct RigRecord {
     pub pose_acceleration: [f32; 6],
     /// Input polarity and debouncing.
     pub inputs: InputConfig,
+    /// Supply sensing and sequencing delays.
+    pub supervisor: SupervisorConfig,
 }
 
 impl RigRecord {
     /// The record of `geometry` homed at `home`, named `name`, with the trainer model's axes (its carriage drive on
-    /// every ring axis, its lead screw on every linear one), pose limits and input wiring.
+    /// every ring axis, its lead screw on every linear one), pose limits, input wiring and supply sequencing.
     pub fn new(name: &str, geometry: &RingGeometry, home: [f64; 6]) -> Self {
         let mut chains = [Chain {
             kind: ChainKind::Radial,
@@ -72,6 +75,7 @@ impl RigRecord {
             pose_velocity: MotionLimits::TRAINER_MODEL.pose_velocity,
             pose_acceleration: MotionLimits::TRAINER_MODEL.pose_acceleration,
             inputs: InputConfig::default(),
+            supervisor: SupervisorConfig::default(),
         }
     }
 

@@ -52,6 +52,23 @@ impl Default for SupervisorConfig {
 }
 
 impl SupervisorConfig {
+    /// Longest delay a configuration may set (ms): a supply that takes longer to come up or discharge is not one
+    /// this controller should sequence blind.
+    pub const LONGEST_MS: u32 = 60_000;
+
+    /// Every delay at most [`Self::LONGEST_MS`], and a sensed supply given time to come up.
+    pub fn is_valid(&self) -> bool {
+        let delays = [
+            self.logic_settle_ms,
+            self.power_settle_ms,
+            self.supply_timeout_ms,
+            self.driver_off_ms,
+            self.discharge_ms,
+        ];
+        delays.iter().all(|d| *d <= Self::LONGEST_MS)
+            && (self.supply_timeout_ms > 0 || !(self.logic_sense || self.power_sense))
+    }
+
     fn timer_cap(&self) -> u32 {
         let longest = self
             .logic_settle_ms
