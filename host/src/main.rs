@@ -282,6 +282,14 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
         A::Enable => client.enable()?,
         A::Disable => client.disable()?,
         A::Home => {
+            // Right after `device enable` the supplies may still be coming up: wait for them, as `stream` does,
+            // instead of being refused for the state.
+            client.wait_for(std::time::Duration::from_secs(5), |s| {
+                !matches!(
+                    s.state,
+                    ringpod_core::safety::State::LogicOn | ringpod_core::safety::State::PowerOn { settled: false }
+                )
+            })?;
             client.home()?;
             client.wait_for(std::time::Duration::from_secs(120), |s| {
                 !matches!(s.state, ringpod_core::safety::State::Homing)

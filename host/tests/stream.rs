@@ -689,13 +689,8 @@ fn device_jog_and_buzz_move_one_axis_over_a_pty() {
     let _ = server.wait();
 }
 
-/// `stream --sim --geometry`: the simulated controller drives a rig no preset describes (a wider ring, longer
-/// rods), homes it with the plan built for it, follows the whole stream with the counts agreeing, and ends at other
-/// step positions than the trainer model does for the same motion.
-#[test]
-fn a_rig_of_ones_own_streams_on_the_simulator() {
-    let dir = std::env::temp_dir().join(format!("ringpod-own-rig-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+/// The trainer model's rig file (`presets --export`) on a wider ring with longer rods: no preset describes it.
+fn wider_ring() -> String {
     let exported = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
         .args(["presets", "--export", "trainer-model"])
         .output()
@@ -706,6 +701,17 @@ fn a_rig_of_ones_own_streams_on_the_simulator() {
         .replace("ring_radius = 0.286", "ring_radius = 0.3")
         .replace("rod_length = 0.312", "rod_length = 0.325");
     assert!(rig.contains("ring_radius = 0.3\n") && rig.contains("rod_length = 0.325\n"));
+    rig
+}
+
+/// `stream --sim --geometry`: the simulated controller drives a rig no preset describes (a wider ring, longer
+/// rods), homes it with the plan built for it, follows the whole stream with the counts agreeing, and ends at other
+/// step positions than the trainer model does for the same motion.
+#[test]
+fn a_rig_of_ones_own_streams_on_the_simulator() {
+    let dir = std::env::temp_dir().join(format!("ringpod-own-rig-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rig = wider_ring();
     let file = dir.join("wider.toml");
     std::fs::write(&file, rig).unwrap();
     // A 4 s demo motion on the simulator, with further arguments.
@@ -740,11 +746,7 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
     let run = |args: &[&str]| std::process::Command::new(&exe).args(args).output().unwrap();
     let dir = std::env::temp_dir().join(format!("ringpod-device-rig-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let model = String::from_utf8(run(&["presets", "--export", "trainer-model"]).stdout).unwrap();
-    let wider = model
-        .replace("name = \"trainer-model\"", "name = \"wider-ring\"")
-        .replace("ring_radius = 0.286", "ring_radius = 0.3")
-        .replace("rod_length = 0.312", "rod_length = 0.325");
+    let wider = wider_ring();
     // With the controller sections too: a reversed motor, other pose limits, other input wiring.
     let mut axes = String::new();
     for (steps, reverse) in [

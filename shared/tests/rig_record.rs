@@ -2,13 +2,15 @@
 //! is stored as one versioned flash item, and comes back exactly; a record the checks refuse or cannot read leaves
 //! the compiled-in rig running with the cause reported; a save cut at any byte leaves the old rig or the new one.
 
+#[path = "common/device.rs"]
+mod device;
+
 use embassy_futures::block_on;
 use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
 use ringpod_core::kinematics::presets::{Preset, TRAINER_MODEL};
 use ringpod_core::kinematics::RingGeometry;
 use ringpod_core::protocol::{
     self, ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, NackReason, Request, RigRecord, RigSource, MAX_PAYLOAD,
-    PROTOCOL_VERSION,
 };
 use ringpod_core::safety::Refusal;
 use ringpod_core::store::{restore, store, store_rig, RIG_KEY, RIG_RECORD_VERSION};
@@ -154,25 +156,13 @@ fn a_rig_save_cut_at_any_byte_restores_the_old_or_the_new_rig() {
     assert!(cuts > 24 * 100, "only {cuts} cut points");
 }
 
-fn connected() -> Controller {
-    let mut c = Controller::new(ControllerConfig::trainer_model()).unwrap();
-    let hello = c.handle(&Request {
-        id: 1,
-        body: HostMessage::Hello {
-            version: PROTOCOL_VERSION,
-        },
-    });
-    assert!(matches!(hello.body, DeviceMessage::Hello { .. }));
-    c
-}
-
 fn ask(c: &mut Controller, body: HostMessage) -> DeviceMessage {
     c.handle(&Request { id: 2, body }).body
 }
 
 #[test]
 fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
-    let mut c = connected();
+    let mut c = device::connected();
     let rig = wider(0.3, 0.325);
     let mut bad = rig;
     bad.home[2] = 5.0;

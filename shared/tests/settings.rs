@@ -1,6 +1,9 @@
 //! Input debouncing and the device settings: keys and their flash codes, live and next-start settings, the set of
 //! unsaved changes the firmware stores, and the restore at boot that replays them.
 
+#[path = "common/device.rs"]
+mod device;
+
 use proptest::prelude::*;
 use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
 use ringpod_core::protocol::{
@@ -126,18 +129,6 @@ fn every_key_has_a_unique_code_that_round_trips() {
     }
 }
 
-fn connected() -> Controller {
-    let mut c = Controller::new(ControllerConfig::trainer_model()).unwrap();
-    let hello = c.handle(&Request {
-        id: 1,
-        body: HostMessage::Hello {
-            version: PROTOCOL_VERSION,
-        },
-    });
-    assert!(matches!(hello.body, DeviceMessage::Hello { .. }));
-    c
-}
-
 fn set(c: &mut Controller, key: ConfigKey, value: f32) -> DeviceMessage {
     c.handle(&Request {
         id: 7,
@@ -156,7 +147,7 @@ fn get(c: &mut Controller, key: ConfigKey) -> DeviceMessage {
 
 #[test]
 fn live_settings_apply_at_once_and_next_start_settings_are_stored() {
-    let mut c = connected();
+    let mut c = device::connected();
     assert_eq!(set(&mut c, ConfigKey::PoseVelocity(2), 0.02), DeviceMessage::Ack);
     assert_eq!(c.pipeline().config().limits.pose_velocity[2], 0.02);
     assert_eq!(
@@ -186,7 +177,7 @@ fn live_settings_apply_at_once_and_next_start_settings_are_stored() {
 
 #[test]
 fn bad_values_are_refused_and_nothing_is_stored() {
-    let mut c = connected();
+    let mut c = device::connected();
     let bad = [
         (ConfigKey::TickHz, 1_500.0),
         (ConfigKey::TickHz, 4_000.0),
@@ -223,7 +214,7 @@ fn bad_values_are_refused_and_nothing_is_stored() {
 fn a_coarser_motor_that_breaks_the_homing_proof_is_refused() {
     // 400 steps per carriage turn: the homing search of 20 degrees becomes 22 steps, and the scaled back-off
     // rounds to 2; the plan must still validate or be refused as a whole, never half-applied.
-    let mut c = connected();
+    let mut c = device::connected();
     let reply = set(&mut c, ConfigKey::StepsPerUnit(0), 400.0);
     let config = *c.saved_config();
     match reply {
@@ -252,7 +243,7 @@ fn steps_per_unit_keeps_homing_distances_physical() {
 
 #[test]
 fn unsaved_changes_are_handed_out_once_with_their_last_value_and_restore_at_boot() {
-    let mut c = connected();
+    let mut c = device::connected();
     assert_eq!(set(&mut c, ConfigKey::StreamTimeoutMs, 250.0), DeviceMessage::Ack);
     assert_eq!(set(&mut c, ConfigKey::StreamTimeoutMs, 300.0), DeviceMessage::Ack);
     assert_eq!(set(&mut c, ConfigKey::TickHz, 500.0), DeviceMessage::Ack);
@@ -287,7 +278,7 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
     use ringpod_core::safety::State;
     use ringpod_core::sim::{Plant, Rig};
     let mut rig = Rig {
-        controller: connected(),
+        controller: device::connected(),
         plant: Plant::trainer_model([0; 6]),
         ticks: 0,
     };
@@ -335,7 +326,7 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
 /// from the state and the polarity where nothing samples pins).
 #[test]
 fn get_inputs_reports_levels_and_states() {
-    let mut c = connected();
+    let mut c = device::connected();
     let ask = |c: &mut Controller| match c
         .handle(&Request {
             id: 5,

@@ -80,7 +80,7 @@ pub struct RigFile {
     pub inputs: Option<settings::InputsSpec>,
     /// Supply sensing and sequencing (optional: both supplies sensed, the firmware's default delays).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub supervisor: Option<settings::SupervisorSpec>,
+    pub supervisor: Option<ringpod_core::safety::SupervisorConfig>,
 }
 
 /// One chain.

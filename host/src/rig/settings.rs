@@ -1,6 +1,6 @@
 //! The rig file's controller sections: `[[axes]]` (each motor's steps per unit and direction, in actuator order),
 //! `[motion]` (pose limits), `[inputs]` (which inputs are active low, debouncing) and `[supervisor]` (supply
-//! sensing and sequencing delays). Each is optional and takes the
+//! sensing and sequencing delays, the core's `SupervisorConfig` by its field names). Each is optional and takes the
 //! trainer model's values when omitted; together with the geometry they make the [`RigRecord`] a device stores.
 
 use ringpod_core::controller::ControllerConfig;
@@ -41,26 +41,6 @@ pub struct InputsSpec {
     pub active_low: Vec<String>,
     /// Equal samples, 1 ms apart, before a level counts (1-50).
     pub debounce_ms: u8,
-}
-
-/// Supply sensing and sequencing (FIRMWARE.md "Safety supervisor").
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SupervisorSpec {
-    /// The board has a LOGIC_OK input (without it, the delays alone sequence).
-    pub logic_sense: bool,
-    /// The board has a POWER_OK input.
-    pub power_sense: bool,
-    /// After the logic relay closes (and LOGIC_OK), before the power relay may close (ms).
-    pub logic_settle_ms: u32,
-    /// After the power relay closes (and POWER_OK), before the drivers may be enabled (ms).
-    pub power_settle_ms: u32,
-    /// A sensed supply not up this long after its relay closed is a fault (ms).
-    pub supply_timeout_ms: u32,
-    /// Drivers disabled this long before the power relay opens (ms).
-    pub driver_off_ms: u32,
-    /// Power supply discharge before the logic relay opens (ms).
-    pub discharge_ms: u32,
 }
 
 /// Every input by its name in the file.
@@ -142,16 +122,7 @@ impl RigFile {
             record.inputs.active_low = mask;
             record.inputs.debounce_samples = spec.debounce_ms;
         }
-        if let Some(spec) = &self.supervisor {
-            let s = SupervisorConfig {
-                logic_sense: spec.logic_sense,
-                power_sense: spec.power_sense,
-                logic_settle_ms: spec.logic_settle_ms,
-                power_settle_ms: spec.power_settle_ms,
-                supply_timeout_ms: spec.supply_timeout_ms,
-                driver_off_ms: spec.driver_off_ms,
-                discharge_ms: spec.discharge_ms,
-            };
+        if let Some(s) = self.supervisor {
             if !s.is_valid() {
                 return err(
                     "supervisor",
@@ -199,16 +170,7 @@ impl RigFile {
                 .collect(),
             debounce_ms: record.inputs.debounce_samples,
         });
-        let s = record.supervisor;
-        self.supervisor = Some(SupervisorSpec {
-            logic_sense: s.logic_sense,
-            power_sense: s.power_sense,
-            logic_settle_ms: s.logic_settle_ms,
-            power_settle_ms: s.power_settle_ms,
-            supply_timeout_ms: s.supply_timeout_ms,
-            driver_off_ms: s.driver_off_ms,
-            discharge_ms: s.discharge_ms,
-        });
+        self.supervisor = Some(record.supervisor);
         self
     }
 }

@@ -16,10 +16,12 @@
 
 use core::fmt;
 
-/// Supply sequencing and sensing.
+/// Supply sequencing and sensing. A rig file's `[supervisor]` section is this type, by its field names (an unknown
+/// key is an error there; postcard, which has no names, is not affected).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct SupervisorConfig {
     /// The board has a LOGIC_OK input; without it, timing alone sequences.
     pub logic_sense: bool,

@@ -236,6 +236,18 @@ impl Drop for Emulated {
     }
 }
 
+/// Builds and starts the controller program with `args`; a failure is reported and counted.
+fn start_or_fail(t: &mut Tally, args: &[&str]) -> Option<Emulated> {
+    match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf, args)) {
+        Ok(e) => Some(e),
+        Err(e) => {
+            eprintln!("{e}");
+            t.check(false, "the controller starts on the emulated Cortex-M4F");
+            None
+        }
+    }
+}
+
 /// Starts the controller program with the semihosting command line `args` and waits for its pty and its `READY`.
 fn start_controller(elf: &Path, args: &[&str]) -> Result<Emulated, String> {
     let mut child = qemu(elf, false, args)
@@ -393,13 +405,8 @@ fn controller_on_m4f(t: &mut Tally) {
         t.check(false, "the host CLI builds");
         return;
     }
-    let emulated = match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf, &[])) {
-        Ok(e) => e,
-        Err(e) => {
-            eprintln!("{e}");
-            t.check(false, "the controller starts on the emulated Cortex-M4F");
-            return;
-        }
+    let Some(emulated) = start_or_fail(t, &[]) else {
+        return;
     };
     let pty = emulated.pty.as_str();
     println!("controller on {pty}");
@@ -605,14 +612,8 @@ fn ringpod_text(args: &[&str]) -> (bool, String) {
 /// lost and the setting stored before the reset restored from its flash; cleared, it powers and homes again.
 fn watchdog_on_m4f(t: &mut Tally) {
     println!("== the watchdog on the emulated Cortex-M4F: a stalled control loop");
-    let emulated = match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf, &["stall-when-homed"]))
-    {
-        Ok(e) => e,
-        Err(e) => {
-            eprintln!("{e}");
-            t.check(false, "the controller starts on the emulated Cortex-M4F");
-            return;
-        }
+    let Some(emulated) = start_or_fail(t, &["stall-when-homed"]) else {
+        return;
     };
     let pty = emulated.pty.as_str();
     let port = ["--port", pty];
@@ -681,13 +682,8 @@ fn rig_on_m4f(t: &mut Tally) {
         t.check(false, "the rig file and the input are written");
         return;
     }
-    let emulated = match build("ringpod-qemu-controller").and_then(|elf| start_controller(&elf, &[])) {
-        Ok(e) => e,
-        Err(e) => {
-            eprintln!("{e}");
-            t.check(false, "the controller starts on the emulated Cortex-M4F");
-            return;
-        }
+    let Some(emulated) = start_or_fail(t, &[]) else {
+        return;
     };
     let pty = emulated.pty.as_str();
     let (rig_file, input_file) = (rig.to_string_lossy().to_string(), input.to_string_lossy().to_string());
