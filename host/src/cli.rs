@@ -174,7 +174,8 @@ pub enum DeviceAction {
     Stop,
     /// Clear a latched fault.
     Clear,
-    /// Settings: `config` lists them all, `config get KEY`, `config set KEY VALUE` (stored in the board's flash).
+    /// Settings sections: `config` lists them all, `config get SECTION[.PATH]`, `config set SECTION.PATH VALUE`
+    /// (`stream.timeout_ms 250`, `axes.2.reverse true`; stored in the board's flash).
     Config,
     /// Every input: its electrical level and its debounced state (with --watch: each change as it happens).
     Inputs,

@@ -7,8 +7,8 @@ use std::time::Duration;
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::motion::{Accepted, RejectReason};
 use ringpod_core::protocol::{
-    self, ConfigKey, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, RigRecord,
-    RigSource, Status, Telemetry, PROTOCOL_VERSION,
+    self, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, RigRecord, RigSource,
+    Settings, SettingsKind, Status, Telemetry, PROTOCOL_VERSION,
 };
 use ringpod_core::safety::FaultReason;
 
@@ -265,18 +265,19 @@ impl<T: Transport> Client<T> {
         self.ack(HostMessage::ClearFault)
     }
 
-    /// A setting's value on the device (as stored: effective now for live keys, after a restart for the others).
-    pub fn get_config(&mut self, key: ConfigKey) -> Result<f32, ClientError> {
-        match self.request(HostMessage::GetConfig(key))? {
-            DeviceMessage::Config(k, v) if k == key => Ok(v),
+    /// A section of settings on the device as the next start runs it (what runs now, for a live section), and
+    /// whether that differs from what runs now.
+    pub fn settings(&mut self, kind: SettingsKind) -> Result<(Settings, bool), ClientError> {
+        match self.request(HostMessage::GetSettings(kind))? {
+            DeviceMessage::Settings { settings, pending } if settings.kind() == kind => Ok((settings, pending)),
             DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
             other => Err(ClientError::Unexpected(format!("{other:?}"))),
         }
     }
 
-    /// Changes a setting (refused while anything may move, or out of range).
-    pub fn set_config(&mut self, key: ConfigKey, value: f32) -> Result<(), ClientError> {
-        self.ack(HostMessage::SetConfig(key, value))
+    /// Changes a section (refused while anything may move, or with the cause the device names).
+    pub fn set_settings(&mut self, settings: Settings) -> Result<(), ClientError> {
+        self.ack(HostMessage::SetSettings(settings))
     }
 
     /// The rig the device runs, where it came from, and whether another waits for the next start.

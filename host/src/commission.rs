@@ -9,7 +9,7 @@ use ringpod_core::protocol::InputReport;
 use ringpod_core::safety::debounce::InputBit;
 
 use ringpod_core::kinematics::AxisKind;
-use ringpod_core::protocol::{ConfigKey, HostMessage};
+use ringpod_core::protocol::{HostMessage, Settings, SettingsKind};
 use ringpod_core::safety::State;
 
 use crate::client::{Client, Transport};
@@ -99,8 +99,11 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
     };
     let kind = client.hello()?.axes[usize::from(axis)];
     // Motor steps per unit, signed: a reversed motor steps the other way for the same distance.
-    let reverse = client.get_config(ConfigKey::Reverse(axis))? == 1.0;
-    let per_unit = f64::from(client.get_config(ConfigKey::StepsPerUnit(axis))?) * if reverse { -1.0 } else { 1.0 };
+    let (Settings::Axes(axes), _) = client.settings(SettingsKind::Axes)? else {
+        anyhow::bail!("the device answered with another section");
+    };
+    let motor = axes[usize::from(axis)];
+    let per_unit = f64::from(motor.steps_per_unit) * if motor.reverse { -1.0 } else { 1.0 };
     let (message, what) = if buzz {
         if words.len() != 1 {
             anyhow::bail!(usage);

@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, MotionLimits, RejectReason, Setpoint};
-use ringpod_core::protocol::{ConfigKey, HostMessage, Status};
+use ringpod_core::protocol::{HostMessage, Settings, SettingsKind, Status};
 use ringpod_core::safety::{FaultReason, State};
 use serde::Serialize;
 
@@ -820,17 +820,20 @@ fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelop
     let geometry = rig
         .geometry()
         .map_err(|e| ClientError::Unexpected(format!("the device's rig does not check: {e}")))?;
-    let mut margins = EnvelopeMargins::default();
-    for (i, m) in margins.0.iter_mut().enumerate() {
-        // f32 on the device: 1e-6 of each unit more, so a pose the host passed passes there too.
-        *m = client.get_config(ConfigKey::EnvelopeMargin(i as u8))? + 1e-6;
-    }
-    let timeout_ms = client.get_config(ConfigKey::StreamTimeoutMs)?;
-    let mut limits = MotionLimits::TRAINER_MODEL;
-    for i in 0..6u8 {
-        limits.pose_velocity[usize::from(i)] = client.get_config(ConfigKey::PoseVelocity(i))?;
-        limits.pose_acceleration[usize::from(i)] = client.get_config(ConfigKey::PoseAcceleration(i))?;
-    }
+    let (Settings::Stream(stream), _) = client.settings(SettingsKind::Stream)? else {
+        return Err(ClientError::Unexpected(
+            "the device answered with another section".into(),
+        ));
+    };
+    // f32 on the device: 1e-6 of each unit more, so a pose the host passed passes there too.
+    let margins = EnvelopeMargins(stream.margins.map(|m| m + 1e-6));
+    let timeout_ms = stream.timeout_ms;
+    // The running rig's pose limits (a live section: what the device limits to now).
+    let limits = MotionLimits {
+        pose_velocity: rig.machine.motion.pose_velocity,
+        pose_acceleration: rig.machine.motion.pose_acceleration,
+        ..MotionLimits::TRAINER_MODEL
+    };
     Ok(DeviceEnvelope {
         platform: Platform {
             geometry,

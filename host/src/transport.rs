@@ -143,8 +143,8 @@ impl SimDevice {
             // A RAM flash only fails when full; the device then runs on and the next start finds the old record.
             let _ = block_on(store::store_rig(&mut self.flash, range.clone(), &rig));
         }
-        while let Some((key, value)) = c.take_unsaved() {
-            let _ = block_on(store::store(&mut self.flash, range.clone(), key, value));
+        while let Some(settings) = c.take_unsaved() {
+            let _ = block_on(store::store(&mut self.flash, range.clone(), &settings));
         }
         if c.restart_due() {
             let (config, restored) = block_on(store::restore(

@@ -220,40 +220,63 @@ fn workspace_scan_draws_and_reports() {
 
 #[test]
 fn device_config_reads_writes_and_refuses() {
-    // Every setting is listed with its value.
+    // Every section is listed with its values, by the rig file's names.
     let all = json(&["device", "config", "--sim"]);
-    assert_eq!(all["tick-hz"], 1000.0);
-    assert_eq!(all["steps-per-unit.0"], 25_600.0);
-    assert_eq!(all.as_object().unwrap().len(), 37);
-    assert_eq!(all["reverse.0"], 0.0);
-    assert_eq!(all["telemetry-hz"], 100.0);
-    assert_eq!(all["envelope-margin.reach"], 0.002);
-    assert_eq!(all["gross-jump-ms"], 500.0);
-    assert_eq!(all["follow-direct"], 0.0);
-    // A set answers with the value read back from the device; a next-start key says it is not live.
-    let set = json(&["device", "config", "set", "pose-velocity.2", "0.02", "--sim"]);
-    assert_eq!(set["value"], 0.02);
-    assert_eq!(set["live"], true);
-    let tick = json(&["device", "config", "set", "tick-hz", "2000", "--sim"]);
+    assert_eq!(all["control"]["tick_hz"], 1000);
+    assert_eq!(all["axes"][0]["steps_per_unit"], 25_600.0);
+    assert_eq!(all["axes"][4]["steps_per_unit"], 1_600_000.0);
+    assert_eq!(all["axes"][0]["reverse"], false);
+    assert_eq!(all["stream"]["telemetry_hz"], 100);
+    assert_eq!(all["stream"]["margins"][0], 0.002);
+    assert_eq!(all["stream"]["gross_jump_ms"], 500);
+    assert_eq!(all["stream"]["follow"], "interpolate");
+    assert_eq!(all["homing"]["order"], serde_json::json!([4, 5, 0, 2, 1, 3]));
+    assert_eq!(all["homing"]["axes"][4]["toward"], "minus");
+    assert!(all["inputs"]["active_low"]
+        .as_array()
+        .unwrap()
+        .contains(&serde_json::json!("home1")));
+    assert_eq!(all["pending"], serde_json::json!([]));
+    // A set answers with the section read back from the device; a next-start section says it is not live, and
+    // pending until the next start.
+    let set = json(&["device", "config", "set", "motion.pose_velocity.2", "0.02", "--sim"]);
+    assert_eq!(set["value"]["pose_velocity"][2], 0.02);
     assert_eq!(
-        (tick["value"].as_f64(), tick["live"].as_bool()),
-        (Some(2000.0), Some(false))
+        (set["live"].as_bool(), set["pending"].as_bool()),
+        (Some(true), Some(false))
     );
+    let tick = json(&["device", "config", "set", "control.tick_hz", "2000", "--sim"]);
+    assert_eq!(
+        (
+            tick["value"]["tick_hz"].as_u64(),
+            tick["live"].as_bool(),
+            tick["pending"].as_bool()
+        ),
+        (Some(2000), Some(false), Some(true))
+    );
+    let follow = json(&["device", "config", "set", "stream.follow", "direct", "--sim"]);
+    assert_eq!(follow["value"]["follow"], "direct");
+    let one = json(&["device", "config", "get", "axes.1.reverse", "--sim"]);
+    assert_eq!(one["value"], false);
     // Out of range, unknown, malformed, or extra words: an error, exit 1.
     for args in [
-        &["device", "config", "set", "tick-hz", "1500", "--sim"][..],
-        &["device", "config", "set", "debounce-ms", "0", "--sim"],
-        &["device", "config", "get", "no-such-key", "--sim"],
-        &["device", "config", "set", "gross-jump-ms", "lots", "--sim"],
-        &["device", "config", "set", "follow-direct", "2", "--sim"],
-        &["device", "config", "set", "envelope-margin.reach", "0.5", "--sim"],
-        &["device", "config", "fetch", "tick-hz", "--sim"],
-        &["device", "status", "tick-hz", "--sim"],
+        &["device", "config", "set", "control.tick_hz", "1500", "--sim"][..],
+        &["device", "config", "set", "inputs.debounce_ms", "0", "--sim"],
+        &["device", "config", "set", "inputs.active_low", "[\"home7\"]", "--sim"],
+        &["device", "config", "get", "no-such-section", "--sim"],
+        &["device", "config", "get", "stream.no_such_key", "--sim"],
+        &["device", "config", "set", "stream.gross_jump_ms", "lots", "--sim"],
+        &["device", "config", "set", "stream.follow", "sideways", "--sim"],
+        &["device", "config", "set", "stream.margins.0", "0.5", "--sim"],
+        &["device", "config", "set", "homing.order", "[0, 0, 1, 2, 3, 4]", "--sim"],
+        &["device", "config", "set", "stream", "1", "--sim"],
+        &["device", "config", "fetch", "control.tick_hz", "--sim"],
+        &["device", "status", "control", "--sim"],
     ] {
         ringpod().args(args).assert().code(1);
     }
     ringpod()
-        .args(["device", "config", "set", "tick-hz", "1500", "--sim"])
+        .args(["device", "config", "set", "control.tick_hz", "1500", "--sim"])
         .assert()
         .stderr(predicates::str::contains("BadConfig"));
 }

@@ -795,8 +795,8 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
         shown.contains("pose_velocity = [0.04, 0.04, 0.04, 1.0, 1.0, 1.5]"),
         "{shown}"
     );
-    let config = run(&[&["device", "config", "get", "reverse.1"][..], &port].concat());
-    assert!(String::from_utf8_lossy(&config.stdout).contains("\"value\": 1.0"));
+    let config = run(&[&["device", "config", "get", "axes.1.reverse"][..], &port].concat());
+    assert!(String::from_utf8_lossy(&config.stdout).contains("\"value\": true"));
     // Loading refuses while powered.
     assert!(run(&[&["device", "enable"][..], &port].concat()).status.success());
     let refused = run(&[&["device", "rig", "load", file][..], &port].concat());

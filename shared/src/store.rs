@@ -1,8 +1,8 @@
-//! Settings in flash: every [`ConfigKey`] changed over the protocol is stored under its code with
-//! `sequential-storage` (a log of key/value items over two or more erase pages), and replayed over the compiled-in
-//! defaults at boot through the same checks as `SetConfig`. A rig loaded over the protocol is one more item: a
-//! versioned record ([`RIG_RECORD_VERSION`], postcard) under [`RIG_KEY`], restored first, through the same checks as
-//! `SetRig`; the settings are then replayed over it.
+//! Settings in flash, with `sequential-storage` (a log of key/value items over two or more erase pages). The rig
+//! (geometry, home pose and the sections that describe the machine) is one versioned record
+//! ([`RIG_RECORD_VERSION`], postcard) under [`RIG_KEY`], restored first through the same checks as `SetRig`; every
+//! other section (stream, control) is a versioned item of its own ([`SETTINGS_VERSION`]) under
+//! [`SETTINGS_KEY`] plus its code, applied over the rig through the same checks as `SetSettings`.
 //!
 //! Power loss: a save cut at any byte of its writes or erases leaves the previous value readable (the crate's
 //! guarantee, tested here by cutting a save at every byte on the crate's mock flash). Restoring is generic over the
@@ -15,15 +15,27 @@ use sequential_storage::cache::NoCache;
 use sequential_storage::map::{fetch_item, store_item};
 
 use crate::controller::ControllerConfig;
-use crate::protocol::{ConfigKey, RigRecord, RigSource};
+use crate::protocol::{RigRecord, RigSource, Settings, SettingsKind};
 
-/// The rig record's key in flash (setting codes stay below 64).
+/// The rig record's key in flash.
 pub const RIG_KEY: u8 = 0xf0;
 /// Layout of the stored rig record; a record of another version is not read (the compiled-in rig runs and the
-/// host sees [`RigSource::Unreadable`]).
-pub const RIG_RECORD_VERSION: u16 = 1;
-/// Room for the stored rig record: its postcard bytes (under 480) and the crate's header.
-const RIG_BUFFER: usize = 600;
+/// host sees [`RigSource::Unreadable`]). Version 2 carries the homing section and the motors as settings sections.
+pub const RIG_RECORD_VERSION: u16 = 2;
+/// Key of the first section stored on its own; a section's key adds its [`SettingsKind::code`]. (Keys 1-53 held
+/// the single `f32` settings of protocol versions up to 5: they are never read.)
+pub const SETTINGS_KEY: u8 = 0x80;
+/// Layout of a stored section; one of another version is not read (its defaults run, counted as refused).
+pub const SETTINGS_VERSION: u16 = 1;
+/// Room for the stored rig record: its postcard bytes (under 640) and the crate's header.
+const RIG_BUFFER: usize = 768;
+
+/// A section as flash holds it.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct StoredSettings {
+    version: u16,
+    settings: Settings,
+}
 
 /// The stored rig record as flash holds it.
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -36,9 +48,9 @@ struct StoredRig {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Restored {
-    /// Stored values applied.
+    /// Stored sections applied.
     pub applied: u8,
-    /// Stored values refused by the checks (left at their defaults).
+    /// Stored sections refused by the checks, or of another layout (left at their defaults).
     pub refused: u8,
     /// The stored values together did not make a runnable configuration: the defaults run.
     pub fell_back: bool,
@@ -49,7 +61,7 @@ pub struct Restored {
 }
 
 /// Room for any stored item with the crate's header: reading or moving items passes every item through this buffer,
-/// the rig record (under 480 bytes) included.
+/// the rig record included.
 const ITEM_BUFFER: usize = RIG_BUFFER;
 
 /// `defaults` with every stored setting replayed over them, and what was found.
@@ -63,11 +75,18 @@ pub async fn restore<F: NorFlash>(
     report.rig = rig;
     let mut config = base;
     let mut buf = [0u8; ITEM_BUFFER];
-    for key in ConfigKey::all() {
-        match fetch_item::<u8, f32, _>(flash, range.clone(), &mut NoCache::new(), &mut buf, &key.code()).await {
-            Ok(Some(value)) => match config.set(key, value) {
-                Ok(()) => report.applied += 1,
-                Err(_) => report.refused += 1,
+    for kind in SettingsKind::ALL.into_iter().filter(|k| !k.in_rig()) {
+        let key = SETTINGS_KEY + kind.code();
+        match fetch_item::<u8, &[u8], _>(flash, range.clone(), &mut NoCache::new(), &mut buf, &key).await {
+            Ok(Some(bytes)) => match postcard::from_bytes::<StoredSettings>(bytes) {
+                Ok(s)
+                    if s.version == SETTINGS_VERSION
+                        && s.settings.kind() == kind
+                        && config.apply(&s.settings).is_ok() =>
+                {
+                    report.applied += 1
+                }
+                _ => report.refused += 1,
             },
             Ok(None) => {}
             Err(_) => report.unreadable = true,
@@ -119,16 +138,25 @@ pub async fn store_rig<F: NorFlash>(
     store_item(flash, range, &mut NoCache::new(), &mut buf, &RIG_KEY, &encoded).await
 }
 
-/// Stores one setting. On an error (flash fault, power loss) the previously stored value stays the one a restore
-/// finds.
+/// Stores one section (one a rig does not carry; the others are stored as part of the rig). On an error (flash
+/// fault, power loss) the previously stored section stays the one a restore finds.
 pub async fn store<F: NorFlash>(
     flash: &mut F,
     range: Range<u32>,
-    key: ConfigKey,
-    value: f32,
+    settings: &Settings,
 ) -> Result<(), sequential_storage::Error<F::Error>> {
+    let mut bytes = [0u8; RIG_BUFFER];
+    let item = StoredSettings {
+        version: SETTINGS_VERSION,
+        settings: *settings,
+    };
+    let Ok(encoded) = postcard::to_slice(&item, &mut bytes) else {
+        return Err(sequential_storage::Error::ItemTooBig);
+    };
+    let encoded: &[u8] = encoded;
     let mut buf = [0u8; ITEM_BUFFER];
-    store_item(flash, range, &mut NoCache::new(), &mut buf, &key.code(), &value).await
+    let key = SETTINGS_KEY + settings.kind().code();
+    store_item(flash, range, &mut NoCache::new(), &mut buf, &key, &encoded).await
 }
 
 /// Flash in RAM with NOR semantics: erase sets a page of `PAGE` bytes to 0xFF, a write can only clear bits. The QEMU

@@ -82,7 +82,9 @@ proptest! {
     #[test]
     fn other_rates_render_faithfully(targets in trajectory(), hz in prop::sample::select(vec![500u32, 2_000])) {
         let mut config = ControllerConfig::trainer_model();
-        config.set(ringpod_core::protocol::ConfigKey::TickHz, hz as f32).unwrap();
+        config
+            .apply(&ringpod_core::protocol::Settings::Control(ringpod_core::protocol::ControlSettings { tick_hz: hz as u16 }))
+            .unwrap();
         let (port, scheduled) = replay(config.scheduler, &targets).map_err(TestCaseError::fail)?;
         prop_assert_eq!(port, scheduled);
     }

@@ -10,7 +10,8 @@ use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
 use ringpod_core::kinematics::presets::{Preset, TRAINER_MODEL};
 use ringpod_core::kinematics::RingGeometry;
 use ringpod_core::protocol::{
-    self, ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, NackReason, Request, RigRecord, RigSource, MAX_PAYLOAD,
+    self, ConfigRefusal, ControlSettings, DeviceMessage, HostMessage, NackReason, Request, RigRecord, RigSource,
+    Settings, SettingsKind, StreamSettings, MAX_PAYLOAD,
 };
 use ringpod_core::safety::Refusal;
 use ringpod_core::store::{restore, store, store_rig, RIG_KEY, RIG_RECORD_VERSION};
@@ -35,7 +36,7 @@ fn wider(ring_radius: f64, rod_length: f64) -> RigRecord {
         TRAINER_MODEL.limits,
     )
     .unwrap();
-    RigRecord::new("wider-ring", &g, Preset::TrainerModel.home())
+    ControllerConfig::default_record("wider-ring", &g, Preset::TrainerModel.home())
 }
 
 #[test]
@@ -57,13 +58,22 @@ fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
     let back: Request = protocol::decode(&frame[..n - 1]).unwrap();
     assert_eq!(back.body, HostMessage::SetRig(rig));
 
-    // Flash: stored with a setting before and after it, restored as the running rig with both settings.
+    // Flash: stored with a section before and after it, restored as the running rig with both sections.
     let defaults = ControllerConfig::trainer_model();
+    let Settings::Stream(stream) = defaults.settings(SettingsKind::Stream) else {
+        panic!()
+    };
+    let stream = Settings::Stream(StreamSettings {
+        timeout_ms: 150,
+        telemetry_hz: 50,
+        ..stream
+    });
+    let control = Settings::Control(ControlSettings { tick_hz: 2_000 });
     let mut f = flash();
     let range = Flash::FULL_FLASH_RANGE;
-    block_on(store(&mut f, range.clone(), ConfigKey::StreamTimeoutMs, 150.0)).unwrap();
+    block_on(store(&mut f, range.clone(), &stream)).unwrap();
     block_on(store_rig(&mut f, range.clone(), &rig)).unwrap();
-    block_on(store(&mut f, range.clone(), ConfigKey::TelemetryHz, 50.0)).unwrap();
+    block_on(store(&mut f, range.clone(), &control)).unwrap();
     let (config, report) = block_on(restore(&mut f, range, defaults));
     assert_eq!(report.rig, RigSource::Stored);
     assert_eq!(
@@ -72,11 +82,11 @@ fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
     );
     assert_eq!(config.rig(), rig);
     assert_eq!(config.rig().name(), "wider-ring");
-    assert_eq!(config.get(ConfigKey::StreamTimeoutMs), Some(150.0));
-    assert_eq!(config.get(ConfigKey::TelemetryHz), Some(50.0));
+    assert_eq!(config.settings(SettingsKind::Stream), stream);
+    assert_eq!(config.settings(SettingsKind::Control), control);
     let mut expected = ControllerConfig::from_record(&rig).unwrap();
-    expected.set(ConfigKey::StreamTimeoutMs, 150.0).unwrap();
-    expected.set(ConfigKey::TelemetryHz, 50.0).unwrap();
+    expected.apply(&stream).unwrap();
+    expected.apply(&control).unwrap();
     assert_eq!(config, expected);
 }
 
@@ -104,7 +114,7 @@ fn a_stored_rig_that_cannot_run_leaves_the_compiled_rig_and_says_why() {
     );
 
     // A record of another layout version, and bytes that are no record at all.
-    let mut raw = [0u8; 512];
+    let mut raw = [0u8; 1024];
     let next_version: &[u8] = postcard::to_slice(&(RIG_RECORD_VERSION + 1, wider(0.3, 0.325)), &mut raw).unwrap();
     for bytes in [next_version, &[1, 2, 3]] {
         let mut f = flash();

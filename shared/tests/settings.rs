@@ -1,5 +1,5 @@
-//! Input debouncing and the device settings: keys and their flash codes, live and next-start settings, the set of
-//! unsaved changes the firmware stores, and the restore at boot that replays them.
+//! Input debouncing and the device settings: sections and their codes, live and next-start sections, every bad
+//! value refused with its cause, the changes the firmware stores, and the restore at boot that replays them.
 
 #[path = "common/device.rs"]
 mod device;
@@ -7,9 +7,11 @@ mod device;
 use proptest::prelude::*;
 use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
 use ringpod_core::protocol::{
-    ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, NackReason, Request, PROTOCOL_VERSION,
+    AxisSettings, ConfigRefusal, ControlSettings, DeviceMessage, HomingSettings, HostMessage, MotionSettings,
+    NackReason, Request, Settings, SettingsKind, StreamSettings, PROTOCOL_VERSION,
 };
 use ringpod_core::safety::debounce::{from_inputs, to_inputs, Debouncer, InputBit, InputConfig};
+use ringpod_core::safety::SupervisorConfig;
 
 fn config(samples: u8) -> InputConfig {
     InputConfig {
@@ -110,52 +112,108 @@ fn polarity_maps_electrical_levels() {
 }
 
 #[test]
-fn every_key_has_a_unique_code_that_round_trips() {
-    let keys: Vec<ConfigKey> = ConfigKey::all().collect();
-    // stream timeout, gross jump, follow mode, tick rate, polarity, debounce, telemetry rate; per axis four (pose
-    // velocity and acceleration, steps per unit, reverse); per check one.
-    assert_eq!(keys.len(), 7 + 4 * 6 + 6);
-    let mut codes: Vec<u8> = keys.iter().map(|k| k.code()).collect();
+fn every_section_has_a_unique_code_and_answers_with_its_kind() {
+    let mut codes: Vec<u8> = SettingsKind::ALL.iter().map(|k| k.code()).collect();
     codes.sort_unstable();
     codes.dedup();
-    assert_eq!(codes.len(), keys.len());
-    for k in &keys {
-        assert_eq!(ConfigKey::from_code(k.code()), Some(*k));
-        assert!(k.code() < 64, "the unsaved set is a 64-bit mask");
-    }
+    assert_eq!(codes.len(), SettingsKind::ALL.len());
+    assert!(codes.iter().all(|c| *c < 8), "the unsaved set is an 8-bit mask");
     let defaults = ControllerConfig::trainer_model();
-    for k in &keys {
-        assert!(defaults.get(*k).is_some(), "{k:?} has a value");
+    for kind in SettingsKind::ALL {
+        assert_eq!(defaults.settings(kind).kind(), kind);
+        let mut again = defaults;
+        again.apply(&defaults.settings(kind)).unwrap();
+        assert_eq!(again, defaults, "{kind:?} read and written back changes nothing");
     }
 }
 
-fn set(c: &mut Controller, key: ConfigKey, value: f32) -> DeviceMessage {
+/// The trainer model's homing, given in each axis's own units, is the step counts of FIRMWARE.md.
+#[test]
+fn the_trainer_models_homing_in_units_is_its_step_counts() {
+    let h = ControllerConfig::trainer_model().homing;
+    for a in 0..4 {
+        let c = h.axes[a];
+        let expected = (1, 1_422, 142, 4_000, 500, 0);
+        let got = (
+            c.toward,
+            c.search_steps,
+            c.backoff_steps,
+            c.fast_rate,
+            c.slow_rate,
+            c.home_position,
+        );
+        assert_eq!(got, expected, "carriage {a}");
+    }
+    for a in [4, 5] {
+        let c = h.axes[a];
+        let expected = (-1, 64_000, 3_200, 32_000, 4_000, -106_096);
+        let got = (
+            c.toward,
+            c.search_steps,
+            c.backoff_steps,
+            c.fast_rate,
+            c.slow_rate,
+            c.home_position,
+        );
+        assert_eq!(got, expected, "linear actuator {a}");
+    }
+    assert_eq!(h.order, [4, 5, 0, 2, 1, 3]);
+}
+
+fn set(c: &mut Controller, settings: Settings) -> DeviceMessage {
     c.handle(&Request {
         id: 7,
-        body: HostMessage::SetConfig(key, value),
+        body: HostMessage::SetSettings(settings),
     })
     .body
 }
 
-fn get(c: &mut Controller, key: ConfigKey) -> DeviceMessage {
+fn get(c: &mut Controller, kind: SettingsKind) -> DeviceMessage {
     c.handle(&Request {
         id: 8,
-        body: HostMessage::GetConfig(key),
+        body: HostMessage::GetSettings(kind),
     })
     .body
+}
+
+fn stream(c: &Controller) -> StreamSettings {
+    match c.saved_config().settings(SettingsKind::Stream) {
+        Settings::Stream(s) => s,
+        other => panic!("{other:?}"),
+    }
+}
+
+fn motion(c: &Controller) -> MotionSettings {
+    match c.saved_config().settings(SettingsKind::Motion) {
+        Settings::Motion(s) => s,
+        other => panic!("{other:?}"),
+    }
+}
+
+fn axes(c: &Controller) -> [AxisSettings; 6] {
+    match c.saved_config().settings(SettingsKind::Axes) {
+        Settings::Axes(s) => s,
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]
-fn live_settings_apply_at_once_and_next_start_settings_are_stored() {
+fn live_sections_apply_at_once_and_next_start_sections_are_stored() {
     let mut c = device::connected();
-    assert_eq!(set(&mut c, ConfigKey::PoseVelocity(2), 0.02), DeviceMessage::Ack);
+    let mut m = motion(&c);
+    m.pose_velocity[2] = 0.02;
+    assert_eq!(set(&mut c, Settings::Motion(m)), DeviceMessage::Ack);
     assert_eq!(c.pipeline().config().limits.pose_velocity[2], 0.02);
     assert_eq!(
-        get(&mut c, ConfigKey::PoseVelocity(2)),
-        DeviceMessage::Config(ConfigKey::PoseVelocity(2), 0.02)
+        get(&mut c, SettingsKind::Motion),
+        DeviceMessage::Settings {
+            settings: Settings::Motion(m),
+            pending: false
+        }
     );
 
-    assert_eq!(set(&mut c, ConfigKey::TickHz, 2_000.0), DeviceMessage::Ack);
+    let fast = Settings::Control(ControlSettings { tick_hz: 2_000 });
+    assert_eq!(set(&mut c, fast), DeviceMessage::Ack);
     assert_eq!(
         c.pipeline().config().tick_us,
         1_000,
@@ -164,58 +222,125 @@ fn live_settings_apply_at_once_and_next_start_settings_are_stored() {
     assert_eq!(c.saved_config().pipeline.tick_us, 500);
     assert_eq!(c.saved_config().scheduler.period_ns, 500_000);
     assert_eq!(
-        get(&mut c, ConfigKey::TickHz),
-        DeviceMessage::Config(ConfigKey::TickHz, 2_000.0)
+        get(&mut c, SettingsKind::Control),
+        DeviceMessage::Settings {
+            settings: fast,
+            pending: true
+        }
     );
 
-    assert_eq!(
-        set(&mut c, ConfigKey::InputActiveLow, 0x0001 as f32),
-        DeviceMessage::Ack
-    );
+    let inputs = InputConfig {
+        active_low: 1,
+        ..c.config().inputs
+    };
+    assert_eq!(set(&mut c, Settings::Inputs(inputs)), DeviceMessage::Ack);
     assert_eq!(c.config().inputs.active_low, 1);
 }
 
 #[test]
-fn bad_values_are_refused_and_nothing_is_stored() {
+fn bad_sections_are_refused_and_nothing_is_stored() {
     let mut c = device::connected();
-    let bad = [
-        (ConfigKey::TickHz, 1_500.0),
-        (ConfigKey::TickHz, 4_000.0),
-        (ConfigKey::PoseVelocity(6), 1.0),
-        (ConfigKey::PoseVelocity(0), 0.0),
-        (ConfigKey::PoseAcceleration(1), f32::NAN),
-        (ConfigKey::StreamTimeoutMs, f32::INFINITY),
-        (ConfigKey::StreamTimeoutMs, 0.5),
-        (ConfigKey::StepsPerUnit(0), 25_600.5),
-        (ConfigKey::StepsPerUnit(4), -1.0),
-        (ConfigKey::StepsPerUnit(7), 1_000.0),
-        (ConfigKey::InputActiveLow, 70_000.0),
-        (ConfigKey::DebounceMs, 0.0),
-        (ConfigKey::DebounceMs, 51.0),
-        (ConfigKey::GrossJumpMs, 5.0),
-        (ConfigKey::FollowDirect, 0.5),
-        (ConfigKey::EnvelopeMargin(0), 0.2),
-        (ConfigKey::EnvelopeMargin(6), 0.001),
+    let s = stream(&c);
+    let m = motion(&c);
+    let a = axes(&c);
+    let inputs = c.config().inputs;
+    let homing = c.config().switches;
+    let supervisor = c.config().supervisor;
+    let mut bad = vec![
+        Settings::Control(ControlSettings { tick_hz: 1_500 }),
+        Settings::Control(ControlSettings { tick_hz: 4_000 }),
+        Settings::Stream(StreamSettings { timeout_ms: 0, ..s }),
+        Settings::Stream(StreamSettings {
+            timeout_ms: 10_001,
+            ..s
+        }),
+        Settings::Stream(StreamSettings { gross_jump_ms: 5, ..s }),
+        Settings::Stream(StreamSettings {
+            telemetry_hz: 2_001,
+            ..s
+        }),
+        Settings::Inputs(InputConfig {
+            debounce_samples: 0,
+            ..inputs
+        }),
+        Settings::Inputs(InputConfig {
+            debounce_samples: 51,
+            ..inputs
+        }),
+        Settings::Supervisor(SupervisorConfig {
+            discharge_ms: 600_000,
+            ..supervisor
+        }),
     ];
+    for (i, v) in [0.2, -0.001, f32::NAN].into_iter().enumerate() {
+        let mut margins = s.margins;
+        margins[i] = v;
+        bad.push(Settings::Stream(StreamSettings { margins, ..s }));
+    }
+    for v in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+        let mut velocity = m;
+        velocity.pose_velocity[0] = v;
+        let mut acceleration = m;
+        acceleration.pose_acceleration[5] = v;
+        bad.extend([Settings::Motion(velocity), Settings::Motion(acceleration)]);
+    }
+    for (axis, v) in [(0, 25_600.5), (4, -1.0), (4, 0.5), (1, 2e7), (2, f32::NAN)] {
+        let mut x = a;
+        x[axis].steps_per_unit = v;
+        bad.push(Settings::Axes(x));
+    }
+    for order in [[0, 0, 1, 2, 3, 4], [0, 1, 2, 3, 4, 6]] {
+        bad.push(Settings::Homing(HomingSettings { order, ..homing }));
+    }
+    for v in [0.0, -0.1, f32::NAN] {
+        let mut h = homing;
+        h.axes[3].search = v;
+        bad.push(Settings::Homing(h));
+        let mut h = homing;
+        h.axes[4].slow = v;
+        bad.push(Settings::Homing(h));
+    }
+    let mut h = homing;
+    h.axes[0].switch = f32::INFINITY;
+    bad.push(Settings::Homing(h));
     let before = *c.saved_config();
-    for (key, value) in bad {
+    for settings in bad {
         assert_eq!(
-            set(&mut c, key, value),
+            set(&mut c, settings),
             DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::OutOfRange)),
-            "{key:?} = {value}"
+            "{settings:?}"
         );
     }
     assert_eq!(*c.saved_config(), before);
     assert!(!c.has_unsaved());
     assert_eq!(c.take_unsaved(), None);
+    assert_eq!(c.take_unsaved_rig(), None);
+}
+
+#[test]
+fn a_homing_section_that_breaks_the_spacing_proof_is_refused_with_its_cause() {
+    // Carriages that back off 40 degrees before their slow approach would meet their neighbours.
+    let mut c = device::connected();
+    let mut h = c.config().switches;
+    for a in 0..4 {
+        h.axes[a].backoff = 40f32.to_radians();
+        h.axes[a].search = 60f32.to_radians();
+    }
+    assert_eq!(
+        set(&mut c, Settings::Homing(h)),
+        DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::Homing))
+    );
+    assert_eq!(*c.saved_config(), ControllerConfig::trainer_model());
 }
 
 #[test]
 fn a_coarser_motor_that_breaks_the_homing_proof_is_refused() {
-    // 400 steps per carriage turn: the homing search of 20 degrees becomes 22 steps, and the scaled back-off
-    // rounds to 2; the plan must still validate or be refused as a whole, never half-applied.
+    // 400 steps per carriage turn: the homing search of 20 degrees becomes 22 steps, and the back-off 2; the plan
+    // must still validate or be refused as a whole, never half-applied.
     let mut c = device::connected();
-    let reply = set(&mut c, ConfigKey::StepsPerUnit(0), 400.0);
+    let mut a = axes(&c);
+    a[0].steps_per_unit = 400.0;
+    let reply = set(&mut c, Settings::Axes(a));
     let config = *c.saved_config();
     match reply {
         DeviceMessage::Ack => assert_eq!(config.scales[0].steps_per_turn, 400),
@@ -231,42 +356,55 @@ fn a_coarser_motor_that_breaks_the_homing_proof_is_refused() {
 fn steps_per_unit_keeps_homing_distances_physical() {
     let mut config = ControllerConfig::trainer_model();
     let before = config.homing.axes[4];
-    config.set(ConfigKey::StepsPerUnit(4), 3.2e6).unwrap();
+    let Settings::Axes(mut a) = config.settings(SettingsKind::Axes) else {
+        panic!()
+    };
+    a[4].steps_per_unit = 3.2e6;
+    config.apply(&Settings::Axes(a)).unwrap();
     let after = config.homing.axes[4];
     assert_eq!(after.search_steps, before.search_steps * 2);
     assert_eq!(after.home_position, before.home_position * 2);
     assert_eq!(after.fast_rate, before.fast_rate * 2);
-    assert_eq!(config.get(ConfigKey::StepsPerUnit(4)), Some(3.2e6));
-    assert_eq!(config.get(ConfigKey::StepsPerUnit(0)), Some(25_600.0));
+    assert_eq!(config.settings(SettingsKind::Axes), Settings::Axes(a));
+    assert_eq!(config.scales[0].steps_per_turn, 25_600);
     config.validate().unwrap();
 }
 
 #[test]
 fn unsaved_changes_are_handed_out_once_with_their_last_value_and_restore_at_boot() {
     let mut c = device::connected();
-    assert_eq!(set(&mut c, ConfigKey::StreamTimeoutMs, 250.0), DeviceMessage::Ack);
-    assert_eq!(set(&mut c, ConfigKey::StreamTimeoutMs, 300.0), DeviceMessage::Ack);
-    assert_eq!(set(&mut c, ConfigKey::TickHz, 500.0), DeviceMessage::Ack);
-    assert_eq!(set(&mut c, ConfigKey::StepsPerUnit(5), 3.2e6), DeviceMessage::Ack);
-    assert_eq!(set(&mut c, ConfigKey::DebounceMs, 5.0), DeviceMessage::Ack);
-    let mut stored = Vec::new();
-    while let Some(kv) = c.take_unsaved() {
-        stored.push(kv);
-    }
+    let s = stream(&c);
+    let later = StreamSettings { timeout_ms: 300, ..s };
     assert_eq!(
-        stored,
-        vec![
-            (ConfigKey::StreamTimeoutMs, 300.0),
-            (ConfigKey::TickHz, 500.0),
-            (ConfigKey::DebounceMs, 5.0),
-            (ConfigKey::StepsPerUnit(5), 3.2e6),
-        ]
+        set(&mut c, Settings::Stream(StreamSettings { timeout_ms: 250, ..s })),
+        DeviceMessage::Ack
     );
+    assert_eq!(set(&mut c, Settings::Stream(later)), DeviceMessage::Ack);
+    let slow = Settings::Control(ControlSettings { tick_hz: 500 });
+    assert_eq!(set(&mut c, slow), DeviceMessage::Ack);
+    let mut a = axes(&c);
+    a[5].steps_per_unit = 3.2e6;
+    assert_eq!(set(&mut c, Settings::Axes(a)), DeviceMessage::Ack);
+    let inputs = InputConfig {
+        debounce_samples: 5,
+        ..c.config().inputs
+    };
+    assert_eq!(set(&mut c, Settings::Inputs(inputs)), DeviceMessage::Ack);
+    let mut stored = Vec::new();
+    while let Some(s) = c.take_unsaved() {
+        stored.push(s);
+    }
+    assert_eq!(stored, vec![Settings::Stream(later), slow]);
+    // The machine's sections travel as the whole rig, once, with their last values.
+    let rig = c.take_unsaved_rig().expect("the rig with its changed sections");
+    assert_eq!(c.take_unsaved_rig(), None);
+    assert_eq!(rig.machine.axes, a);
+    assert_eq!(rig.machine.inputs, inputs);
     assert!(!c.has_unsaved());
-    // Boot: the defaults, then every stored pair replayed through the same checks.
-    let mut boot = ControllerConfig::trainer_model();
-    for (k, v) in &stored {
-        boot.set(*k, *v).unwrap();
+    // Boot: the stored rig, then every stored section through the same checks.
+    let mut boot = ControllerConfig::from_record(&rig).unwrap();
+    for s in &stored {
+        boot.apply(s).unwrap();
     }
     assert_eq!(boot, *c.saved_config());
     let restarted = Controller::new(boot).unwrap();
@@ -298,10 +436,20 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
         rig.tick();
     }
     assert!(rig.controller.supervisor().outputs().power_relay);
-    // Nothing moves in PowerOn, so the setting is taken, but it is not handed out for flash while power is on.
-    assert_eq!(set(&mut rig.controller, ConfigKey::DebounceMs, 7.0), DeviceMessage::Ack);
+    // Nothing moves in PowerOn, so the section is taken, but it is not handed out for flash while power is on.
+    let s = StreamSettings {
+        gross_jump_ms: 700,
+        ..stream(&rig.controller)
+    };
+    assert_eq!(set(&mut rig.controller, Settings::Stream(s)), DeviceMessage::Ack);
+    let inputs = InputConfig {
+        debounce_samples: 7,
+        ..rig.controller.config().inputs
+    };
+    assert_eq!(set(&mut rig.controller, Settings::Inputs(inputs)), DeviceMessage::Ack);
     assert!(rig.controller.has_unsaved());
     assert_eq!(rig.controller.take_unsaved(), None);
+    assert_eq!(rig.controller.take_unsaved_rig(), None);
     assert_eq!(
         rig.controller
             .handle(&Request {
@@ -318,8 +466,12 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
         rig.tick();
     }
     assert_eq!(rig.controller.supervisor().state(), State::Off);
-    assert_eq!(rig.controller.take_unsaved(), Some((ConfigKey::DebounceMs, 7.0)));
+    assert_eq!(rig.controller.take_unsaved(), Some(Settings::Stream(s)));
     assert_eq!(rig.controller.take_unsaved(), None);
+    assert_eq!(
+        rig.controller.take_unsaved_rig().map(|r| r.machine.inputs),
+        Some(inputs)
+    );
 }
 
 /// `GetInputs`: the debounced state with the polarity, and the pins' levels as the board sampled them (derived
@@ -378,6 +530,7 @@ fn a_rig_restating_the_trainer_model_configures_the_controller_exactly() {
         );
         assert!((got - written).abs() <= 10, "axis {a}: {got} vs {written}");
         restated.homing.axes[a].home_position = written;
+        restated.switches.axes[a].switch = model.switches.axes[a].switch;
     }
     assert_eq!(restated, model);
     let mut home = Preset::TrainerModel.home();
@@ -439,11 +592,11 @@ fn home(rig: &mut ringpod_core::sim::Rig) -> ringpod_core::safety::State {
     rig.controller.supervisor().state()
 }
 
-/// A motor wired the other way round: homing drives its axis away from the switch and fails; `reverse.N` (taken at
+/// A motor wired the other way round: homing drives its axis away from the switch and fails; the axes section's `reverse` (taken at
 /// the next start) mirrors its steps, homing direction and switch position, and the machine homes to the same
 /// physical place as one wired right.
 #[test]
-fn reverse_corrects_a_motor_wired_the_other_way_round() {
+fn an_axis_reversed_corrects_a_motor_wired_the_other_way_round() {
     use ringpod_core::safety::{FaultReason, State};
     use ringpod_core::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
     let rig_with = |config: ControllerConfig, reversed: u8| {
@@ -473,15 +626,13 @@ fn reverse_corrects_a_motor_wired_the_other_way_round() {
     assert!(matches!(home(&mut wrong), State::Fault(FaultReason::HomingFailed, _)));
 
     let mut config = model;
-    for a in [1u8, 4] {
-        config.set(ConfigKey::Reverse(a), 1.0).unwrap();
-        assert_eq!(config.get(ConfigKey::Reverse(a)), Some(1.0));
-    }
-    assert!(!ConfigKey::Reverse(1).is_live());
-    assert_eq!(
-        config.set(ConfigKey::Reverse(1), 0.5),
-        Err(ringpod_core::controller::ConfigError::Value)
-    );
+    let Settings::Axes(mut a) = config.settings(SettingsKind::Axes) else {
+        panic!()
+    };
+    a[1].reverse = true;
+    a[4].reverse = true;
+    config.apply(&Settings::Axes(a)).unwrap();
+    assert!(!SettingsKind::Axes.is_live());
     let mut fixed = rig_with(config, reversed);
     assert_eq!(home(&mut fixed), State::Ready);
     // The same physical place: every axis where the correctly wired machine's is; the reversed axes count their

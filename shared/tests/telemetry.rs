@@ -5,7 +5,7 @@ use ringpod_core::controller::{Controller, ControllerConfig};
 use ringpod_core::kinematics::Pose;
 use ringpod_core::motion::Setpoint;
 use ringpod_core::protocol::{
-    self, ConfigKey, DeviceMessage, HostMessage, Request, Response, Telemetry, TelemetryFlags, MAX_FRAME,
+    self, DeviceMessage, HostMessage, Request, Response, Settings, SettingsKind, Telemetry, TelemetryFlags, MAX_FRAME,
     PROTOCOL_VERSION,
 };
 use ringpod_core::safety::{FaultReason, State, Supplies};
@@ -56,20 +56,23 @@ fn samples_come_at_the_configured_rate_only_while_connected() {
         assert_eq!(w[1].time_us - w[0].time_us, 10_000);
     }
     assert_eq!(samples[0].state, State::Off);
-    let set = |c: &mut Controller, hz: f32| {
+    let set = |c: &mut Controller, hz: u16| {
+        let Settings::Stream(mut s) = c.config().settings(SettingsKind::Stream) else {
+            panic!("not the stream section")
+        };
+        s.telemetry_hz = hz;
         c.handle(&Request {
             id: 2,
-            body: HostMessage::SetConfig(ConfigKey::TelemetryHz, hz),
+            body: HostMessage::SetSettings(Settings::Stream(s)),
         })
         .body
     };
-    assert_eq!(set(&mut c, 250.0), DeviceMessage::Ack);
+    assert_eq!(set(&mut c, 250), DeviceMessage::Ack);
     assert_eq!(run(&mut c, 1000).len(), 250);
-    assert_eq!(set(&mut c, 0.0), DeviceMessage::Ack);
+    assert_eq!(set(&mut c, 0), DeviceMessage::Ack);
     assert!(run(&mut c, 1000).is_empty());
-    assert!(matches!(set(&mut c, 2500.0), DeviceMessage::Nack(_)));
-    assert!(matches!(set(&mut c, 10.5), DeviceMessage::Nack(_)));
-    assert_eq!(set(&mut c, 100.0), DeviceMessage::Ack);
+    assert!(matches!(set(&mut c, 2500), DeviceMessage::Nack(_)));
+    assert_eq!(set(&mut c, 100), DeviceMessage::Ack);
     assert_eq!(run(&mut c, 100).len(), 10);
     subscribe(&mut c, false);
     assert!(run(&mut c, 1000).is_empty(), "unsubscribed");

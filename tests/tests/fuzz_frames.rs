@@ -3,9 +3,11 @@
 
 use ringpod_core::controller::{Controller, ControllerConfig};
 use ringpod_core::kinematics::Pose;
+use ringpod_core::motion::FollowMode;
 use ringpod_core::motion::Setpoint;
 use ringpod_core::protocol::{
-    self, ConfigKey, DeviceMessage, HostMessage, NackReason, Request, Response, PROTOCOL_VERSION,
+    self, DeviceMessage, HostMessage, NackReason, Request, Response, Settings, SettingsKind, StreamSettings,
+    PROTOCOL_VERSION,
 };
 use ringpod_tests::plant::{Plant, Rig, TRAINER_MODEL_PARKED};
 
@@ -46,8 +48,14 @@ fn random_request(rng: &mut Rng, seq: &mut u32) -> Request {
         5 => HostMessage::Stop,
         6 => HostMessage::ClearFault,
         7 => HostMessage::GetStatus,
-        8 => HostMessage::GetConfig(ConfigKey::PoseVelocity(rng.below(8) as u8)),
-        9 => HostMessage::SetConfig(ConfigKey::StreamTimeoutMs, rng.f32()),
+        8 => HostMessage::GetSettings(SettingsKind::ALL[rng.below(7) as usize]),
+        9 => HostMessage::SetSettings(Settings::Stream(StreamSettings {
+            timeout_ms: rng.below(20_000) as u16,
+            gross_jump_ms: rng.below(20_000) as u16,
+            follow: FollowMode::Interpolate,
+            margins: [rng.f32(); 6],
+            telemetry_hz: rng.below(4_000) as u16,
+        })),
         _ => {
             *seq = seq.wrapping_add(if rng.below(10) == 0 { rng.next() as u32 } else { 1 });
             let home = [0.0, 0.0, 0.227, 0.0, 0.0, 0.0];

@@ -1,4 +1,4 @@
-//! The settings task: the controller's changed settings and a loaded rig stored in flash through the core's
+//! The settings task: the controller's changed settings sections and its loaded or changed rig stored in flash through the core's
 //! power-loss-safe store (`ringpod_core::store`, tested there with a power cut at every byte of a save), restored at
 //! boot, and the restart the host asked for once everything is stored.
 //!
@@ -45,14 +45,15 @@ pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared,
             }
             continue;
         }
-        if let Some((key, value)) = shared.with(|c| c.take_unsaved()) {
+        if let Some(settings) = shared.with(|c| c.take_unsaved()) {
             board.widen_watchdog(true);
-            let result = store(flash, range.clone(), key, value).await;
+            let result = store(flash, range.clone(), &settings).await;
             board.widen_watchdog(false);
+            let kind = settings.kind();
             match result {
-                Ok(()) => defmt::info!("stored {} = {}", key, value),
+                Ok(()) => defmt::info!("stored the {} section", kind.name()),
                 // The running value stays; the next boot uses the last stored one. Said, not hidden.
-                Err(_) => defmt::error!("could not store {} = {}", key, value),
+                Err(_) => defmt::error!("could not store the {} section", kind.name()),
             }
             continue;
         }

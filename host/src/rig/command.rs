@@ -26,7 +26,7 @@ pub fn export(name: &str) -> Result<Outcome, CliError> {
     };
     let ranges = (preset == Preset::TrainerModel).then_some(presets::TRAINER_MODEL_RANGES);
     let file = RigFile::of(g, preset.home(), ranges, super::drives::of_preset(preset));
-    let body = toml::to_string(&file).map_err(|e| CliError::BadNumbers {
+    let body = file.to_toml().map_err(|e| CliError::BadNumbers {
         what: "export",
         reason: e.to_string(),
     })?;
@@ -195,7 +195,7 @@ pub fn design_command(path: &Path, combined: bool, starts: u32, steps: u32, seed
             false
         }
     };
-    let body = toml::to_string(&found.file).map_err(|e| CliError::BadNumbers {
+    let body = found.file.to_toml().map_err(|e| CliError::BadNumbers {
         what: "design",
         reason: e.to_string(),
     })?;

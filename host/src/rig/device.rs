@@ -44,7 +44,7 @@ pub fn show<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
     if let RigSource::Refused(_) | RigSource::Unreadable = source {
         eprintln!("warning: {source}");
     }
-    Ok(header + &toml::to_string(&file)?)
+    Ok(header + &file.to_toml()?)
 }
 
 /// `device restart`: the device stores everything, then resets; waits until it answers as a new start (a

@@ -38,12 +38,15 @@ mod settings;
 pub use command::{check_command, design_command, export};
 pub use coverage::coverage;
 pub use drives::{Drive, DriveSpec};
+pub use settings::{names as input_names, InputsSpec};
 
 use std::fmt;
 use std::path::Path;
 
+use ringpod_core::controller::ControllerConfig;
 use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, RingGeometry, RingLimits, DEG};
 use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
+use ringpod_core::protocol::{AxisSettings, HomingSettings, MotionSettings};
 use serde::{Deserialize, Serialize};
 
 /// A rig file as written.
@@ -71,16 +74,21 @@ pub struct RigFile {
     pub drives: Vec<DriveSpec>,
     /// Each motor's steps per unit and direction, in actuator order (optional: the trainer model's drives).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub axes: Vec<settings::AxisSpec>,
+    pub axes: Vec<AxisSettings>,
     /// Pose limits (optional: the trainer model's).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub motion: Option<settings::MotionSpec>,
+    pub motion: Option<MotionSettings>,
     /// Input wiring (optional: switches to ground with pull-ups, a normally closed e-stop chain, 3 ms debouncing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inputs: Option<settings::InputsSpec>,
     /// Supply sensing and sequencing (optional: both supplies sensed, the firmware's default delays).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub supervisor: Option<ringpod_core::safety::SupervisorConfig>,
+    /// Every axis's home switch and its search, in the axis's units (optional: the trainer model's switches on
+    /// this rig: index flags at the carriages' home angles, linear actuators' lower end switches 1 mm below the
+    /// stroke).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub homing: Option<HomingSettings>,
 }
 
 /// One chain.
@@ -302,7 +310,7 @@ impl RigFile {
             None => None,
         };
         let drives = drives::check(&self.drives, &m.axes())?;
-        let record = self.record(ringpod_core::protocol::RigRecord::new(&self.name, &geometry, self.home))?;
+        let record = self.record(ControllerConfig::default_record(&self.name, &geometry, self.home))?;
         Ok(Rig {
             geometry,
             home,
@@ -458,7 +466,27 @@ impl RigFile {
             motion: None,
             inputs: None,
             supervisor: None,
+            homing: None,
         }
+    }
+
+    /// The file as TOML text, every number as written: the device's `f32` values by their shortest decimal (0.05,
+    /// not 0.05000000074505806), keys in the order of the types.
+    pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
+        /// A float that is exactly an `f32` is one of the device's values: its shortest `f32` decimal.
+        fn tidy(v: &mut toml::Value) {
+            match v {
+                toml::Value::Float(f) if f64::from(*f as f32) == *f => {
+                    *f = (*f as f32).to_string().parse().unwrap_or(*f);
+                }
+                toml::Value::Array(a) => a.iter_mut().for_each(tidy),
+                toml::Value::Table(t) => t.iter_mut().for_each(|(_, v)| tidy(v)),
+                _ => {}
+            }
+        }
+        let mut value = toml::Value::try_from(self)?;
+        tidy(&mut value);
+        toml::to_string(&value)
     }
 }
 
@@ -492,15 +520,15 @@ mod tests {
     #[test]
     fn a_rig_file_round_trips_exactly() {
         let file = trainer_file();
-        let text = toml::to_string(&file).unwrap();
+        let text = file.to_toml().unwrap();
         let back: RigFile = toml::from_str(&text).unwrap();
         assert_eq!(back, file);
-        assert_eq!(toml::to_string(&back).unwrap(), text);
+        assert_eq!(back.to_toml().unwrap(), text);
     }
 
     #[test]
     fn a_rig_restating_the_preset_drives_bit_identical_ik() {
-        let rig = from_text(&toml::to_string(&trainer_file()).unwrap())
+        let rig = from_text(&trainer_file().to_toml().unwrap())
             .and_then(|f| f.check())
             .unwrap();
         let (ours, preset) = (

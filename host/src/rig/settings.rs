@@ -1,37 +1,17 @@
-//! The rig file's controller sections: `[[axes]]` (each motor's steps per unit and direction, in actuator order),
-//! `[motion]` (pose limits), `[inputs]` (which inputs are active low, debouncing) and `[supervisor]` (supply
-//! sensing and sequencing delays, the core's `SupervisorConfig` by its field names). Each is optional and takes the
-//! trainer model's values when omitted; together with the geometry they make the [`RigRecord`] a device stores.
+//! The rig file's controller sections, the device's own settings sections by their field names: `[[axes]]` (each
+//! motor's steps per unit and direction, in actuator order), `[motion]` (pose limits), `[inputs]` (which inputs are
+//! active low, by name, and debouncing), `[supervisor]` (supply sensing and sequencing delays) and `[homing]` (each
+//! axis's switch and search in the axis's units, and the order). Each is optional and takes the trainer model's
+//! values on this rig when omitted; together with the geometry they make the [`RigRecord`] a device stores.
 
 use ringpod_core::controller::ControllerConfig;
 use ringpod_core::kinematics::{AxisKind, Mechanism, RingPlatform};
 use ringpod_core::protocol::RigRecord;
-use ringpod_core::safety::debounce::InputBit;
+use ringpod_core::safety::debounce::{InputBit, InputConfig};
 use ringpod_core::safety::SupervisorConfig;
 use serde::{Deserialize, Serialize};
 
 use super::{err, RigError, RigFile};
-
-/// One motor.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct AxisSpec {
-    /// Motor steps per carriage turn (ring axes, an integer) or per metre (linear axes).
-    pub steps_per_unit: f64,
-    /// The motor turns the other way round (its steps, homing direction and switch position are mirrored).
-    #[serde(default)]
-    pub reverse: bool,
-}
-
-/// Pose limits.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct MotionSpec {
-    /// Velocity limit per pose axis x, y, z (m/s), roll, pitch, yaw (rad/s); the device holds them as `f32`.
-    pub pose_velocity: [f64; 6],
-    /// Acceleration limit per pose axis (m/s^2, rad/s^2).
-    pub pose_acceleration: [f64; 6],
-}
 
 /// Input wiring.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -44,7 +24,7 @@ pub struct InputsSpec {
 }
 
 /// Every input by its name in the file.
-fn inputs() -> impl Iterator<Item = (String, InputBit)> {
+pub fn names() -> impl Iterator<Item = (String, InputBit)> {
     let axes = (0..6u8).flat_map(|a| {
         [
             (format!("home{}", a + 1), InputBit::Home(a)),
@@ -70,24 +50,16 @@ impl RigFile {
                 format!("{} entries: one per actuator (6), or none", self.axes.len()),
             );
         }
-        for (i, (spec, kind)) in self.axes.iter().zip(kinds).enumerate() {
+        for (i, (axis, kind)) in self.axes.iter().zip(kinds).enumerate() {
             let key = format!("axes[{i}].steps_per_unit");
-            let v = spec.steps_per_unit;
+            let v = axis.steps_per_unit;
             if !(v.is_finite() && (1.0..=16_777_216.0).contains(&v)) {
                 return err(key, format!("{v} is not a step count from 1 to 16,777,216"));
             }
-            let scale = &mut record.scales[i];
-            match kind {
-                AxisKind::Ring if v.fract() != 0.0 => {
-                    return err(key, "steps per carriage turn are a whole number");
-                }
-                AxisKind::Ring => {
-                    scale.steps_per_turn = v as i64;
-                    scale.steps_per_unit = v as f32 / core::f32::consts::TAU;
-                }
-                AxisKind::Linear | AxisKind::Angle => scale.steps_per_unit = v as f32,
+            if kind == AxisKind::Ring && v.fract() != 0.0 {
+                return err(key, "steps per carriage turn are a whole number");
             }
-            scale.invert = spec.reverse;
+            record.machine.axes[i] = *axis;
         }
         if let Some(m) = &self.motion {
             for (name, values) in [
@@ -101,17 +73,16 @@ impl RigFile {
                     );
                 }
             }
-            record.pose_velocity = m.pose_velocity.map(|v| v as f32);
-            record.pose_acceleration = m.pose_acceleration.map(|v| v as f32);
+            record.machine.motion = *m;
         }
         if let Some(spec) = &self.inputs {
             let mut mask = 0u16;
             for name in &spec.active_low {
-                let Some((_, bit)) = inputs().find(|(n, _)| n == name) else {
-                    let names: Vec<String> = inputs().map(|(n, _)| n).collect();
+                let Some((_, bit)) = names().find(|(n, _)| n == name) else {
+                    let all: Vec<String> = names().map(|(n, _)| n).collect();
                     return err(
                         "inputs.active_low",
-                        format!("no input {name:?}; inputs: {}", names.join(", ")),
+                        format!("no input {name:?}; inputs: {}", all.join(", ")),
                     );
                 };
                 mask |= bit.mask();
@@ -119,8 +90,10 @@ impl RigFile {
             if !(1..=50).contains(&spec.debounce_ms) {
                 return err("inputs.debounce_ms", format!("{} is not 1 to 50 ms", spec.debounce_ms));
             }
-            record.inputs.active_low = mask;
-            record.inputs.debounce_samples = spec.debounce_ms;
+            record.machine.inputs = InputConfig {
+                active_low: mask,
+                debounce_samples: spec.debounce_ms,
+            };
         }
         if let Some(s) = self.supervisor {
             if !s.is_valid() {
@@ -132,7 +105,29 @@ impl RigFile {
                     ),
                 );
             }
-            record.supervisor = s;
+            record.machine.supervisor = s;
+        }
+        if let Some(h) = &self.homing {
+            let mut sorted = h.order;
+            sorted.sort_unstable();
+            if sorted != [0, 1, 2, 3, 4, 5] {
+                return err("homing.order", "every axis 0 to 5 once");
+            }
+            for (i, a) in h.axes.iter().enumerate() {
+                let fields = [
+                    ("search", a.search),
+                    ("backoff", a.backoff),
+                    ("fast", a.fast),
+                    ("slow", a.slow),
+                ];
+                if let Some((name, v)) = fields.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+                    return err(format!("homing.axes[{i}].{name}"), format!("{v} is not above 0"));
+                }
+                if !a.switch.is_finite() {
+                    return err(format!("homing.axes[{i}].switch"), "not a number");
+                }
+            }
+            record.machine.homing = *h;
         }
         ControllerConfig::from_record(&record)
             .or_else(|e| err("rig", format!("the controller cannot drive it: {e}")))?;
@@ -141,37 +136,26 @@ impl RigFile {
 
     /// This file with the sections of `record` written out (what `device rig show` prints).
     pub fn with_sections(mut self, record: &RigRecord) -> Self {
-        let kinds = record
-            .geometry()
-            .map(|g| RingPlatform::<f64>::new(&g).axes())
-            .unwrap_or([AxisKind::Ring; 6]);
-        self.axes = record
-            .scales
-            .iter()
-            .zip(kinds)
-            .map(|(s, k)| AxisSpec {
-                steps_per_unit: match k {
-                    AxisKind::Ring => s.steps_per_turn as f64,
-                    AxisKind::Linear | AxisKind::Angle => f64::from(s.steps_per_unit),
-                },
-                reverse: s.invert,
-            })
-            .collect();
-        // The f32's shortest decimal: 0.05, not 0.05000000074505806.
-        let decimal = |v: f32| v.to_string().parse::<f64>().unwrap_or(f64::from(v));
-        self.motion = Some(MotionSpec {
-            pose_velocity: record.pose_velocity.map(decimal),
-            pose_acceleration: record.pose_acceleration.map(decimal),
-        });
-        self.inputs = Some(InputsSpec {
-            active_low: inputs()
-                .filter(|(_, b)| record.inputs.active_low & b.mask() != 0)
+        let m = &record.machine;
+        self.axes = m.axes.to_vec();
+        self.motion = Some(m.motion);
+        self.inputs = Some(InputsSpec::of(&m.inputs));
+        self.supervisor = Some(m.supervisor);
+        self.homing = Some(m.homing);
+        self
+    }
+}
+
+impl InputsSpec {
+    /// The inputs section by names.
+    pub fn of(inputs: &InputConfig) -> Self {
+        Self {
+            active_low: names()
+                .filter(|(_, b)| inputs.active_low & b.mask() != 0)
                 .map(|(n, _)| n)
                 .collect(),
-            debounce_ms: record.inputs.debounce_samples,
-        });
-        self.supervisor = Some(record.supervisor);
-        self
+            debounce_ms: inputs.debounce_samples,
+        }
     }
 }
 
@@ -191,7 +175,7 @@ mod tests {
             None,
             Vec::new(),
         );
-        let mut text = toml::to_string(&model).unwrap();
+        let mut text = model.to_toml().unwrap();
         for (steps, reverse) in [(25_600, false), (12_800, true), (25_600, false), (25_600, false)] {
             text += &format!("\n[[axes]]\nsteps_per_unit = {steps}\nreverse = {reverse}\n");
         }
@@ -201,6 +185,17 @@ mod tests {
         text +=
             "\n[supervisor]\nlogic_sense = true\npower_sense = false\nlogic_settle_ms = 150\npower_settle_ms = 400\n";
         text += "supply_timeout_ms = 2000\ndriver_off_ms = 30\ndischarge_ms = 1500\n";
+        text += "\n[homing]\norder = [5, 4, 0, 2, 1, 3]\n";
+        for a in 0..6 {
+            let (toward, switch, search) = if a < 4 {
+                ("plus", 0.01, 0.35)
+            } else {
+                ("minus", -0.05, 0.04)
+            };
+            text += &format!(
+                "\n[[homing.axes]]\ntoward = \"{toward}\"\nswitch = {switch}\nsearch = {search}\nbackoff = 0.002\nfast = 0.02\nslow = 0.0025\n"
+            );
+        }
         text
     }
 
@@ -208,14 +203,18 @@ mod tests {
     #[test]
     fn a_rig_file_round_trips_through_the_device_record_exactly() {
         let record = from_text(&with_sections()).unwrap().check().unwrap().record;
-        assert_eq!(record.scales[1].steps_per_turn, 12_800);
-        assert!(record.scales[1].invert && record.scales[5].invert && !record.scales[0].invert);
-        assert_eq!(record.scales[4].steps_per_unit, 3.2e6);
-        assert_eq!(record.pose_velocity[5], 1.5);
-        assert_eq!(record.inputs.debounce_samples, 5);
-        assert_eq!(record.inputs.active_low, 0b1_1000_0001_1110);
-        assert!(!record.supervisor.power_sense);
-        assert_eq!(record.supervisor.discharge_ms, 1_500);
+        let m = &record.machine;
+        assert_eq!(m.axes[1].steps_per_unit, 12_800.0);
+        assert!(m.axes[1].reverse && m.axes[5].reverse && !m.axes[0].reverse);
+        assert_eq!(m.axes[4].steps_per_unit, 3.2e6);
+        assert_eq!(m.motion.pose_velocity[5], 1.5);
+        assert_eq!(m.inputs.debounce_samples, 5);
+        assert_eq!(m.inputs.active_low, 0b1_1000_0001_1110);
+        assert!(!m.supervisor.power_sense);
+        assert_eq!(m.supervisor.discharge_ms, 1_500);
+        assert_eq!(m.homing.order, [5, 4, 0, 2, 1, 3]);
+        assert_eq!(m.homing.axes[4].switch, -0.05);
+        assert_eq!(m.homing.axes[0].toward, ringpod_core::protocol::Toward::Plus);
 
         let mut bytes = vec![0xff; 8 * 1024];
         let mut flash = RamFlash::<2048>::new(&mut bytes);
@@ -228,11 +227,12 @@ mod tests {
         let geometry = record.geometry().unwrap();
         let mut shown = RigFile::of(&geometry, record.home, None, Vec::new()).with_sections(&record);
         shown.name = record.name().to_owned();
-        let again = from_text(&toml::to_string(&shown).unwrap())
-            .unwrap()
-            .check()
-            .unwrap()
-            .record;
+        let text = shown.to_toml().unwrap();
+        assert!(
+            text.contains("pose_velocity = [0.04, 0.04, 0.03, 0.8, 0.8, 1.5]"),
+            "{text}"
+        );
+        let again = from_text(&text).unwrap().check().unwrap().record;
         assert_eq!(again, record);
     }
 
@@ -254,6 +254,13 @@ mod tests {
             ("\"end6\"]", "\"end7\"]", "inputs.active_low"),
             ("debounce_ms = 5", "debounce_ms = 0", "inputs.debounce_ms"),
             ("discharge_ms = 1500", "discharge_ms = 600000", "supervisor"),
+            (
+                "order = [5, 4, 0, 2, 1, 3]",
+                "order = [5, 4, 0, 2, 1, 1]",
+                "homing.order",
+            ),
+            ("search = 0.35", "search = 0", "homing.axes[0].search"),
+            ("slow = 0.0025", "slow = -1", "homing.axes[0].slow"),
         ];
         for (from, to, key) in cases {
             assert!(good.contains(from), "{from}");

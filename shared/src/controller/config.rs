@@ -6,10 +6,10 @@ use crate::kinematics::presets::{self, Preset};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, Pose, RingPlatform};
 use crate::kinematics::{GeometryError, RingGeometry};
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
-use crate::motion::{AxisScale, FollowMode, PipelineConfig, SchedulerConfig};
-use crate::protocol::{ConfigKey, ConfigRefusal, RigRecord, RIG_NAME_LEN};
+use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
+use crate::protocol::{ConfigRefusal, HomingSettings, RigRecord, Settings, SwitchSettings, Toward, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
-use crate::safety::homing::{HomingConfig, HomingError};
+use crate::safety::homing::{AxisHoming, HomingConfig, HomingError};
 use crate::safety::SupervisorConfig;
 
 /// Everything the controller is configured with.
@@ -27,7 +27,9 @@ pub struct ControllerConfig {
     pub scheduler: SchedulerConfig,
     /// Motor scale of every axis.
     pub scales: [AxisScale; 6],
-    /// Homing of every axis.
+    /// Homing of every axis in its own units, as the homing section gives it.
+    pub switches: HomingSettings,
+    /// Homing of every axis in motor steps: `switches` with the axes' scales and directions.
     pub homing: HomingConfig,
     /// Input polarity and debouncing.
     pub inputs: InputConfig,
@@ -60,7 +62,7 @@ pub enum ConfigError {
     Scheduler,
     /// The step generator's slot grid cannot render the step timing faithfully.
     StepTiming(PulseTimingError),
-    /// A value is out of its key's range (or the key does not exist for this machine).
+    /// A value is out of its range.
     Value,
 }
 
@@ -95,25 +97,7 @@ impl ControllerConfig {
     /// two linear actuators, searching up to 20 degrees of ring (linear actuators up to 40 mm); then the platform
     /// moves to the home pose under the normal limits.
     pub fn trainer_model() -> Self {
-        let carriage = crate::safety::homing::AxisHoming {
-            toward: 1,
-            search_steps: 1_422, // 20 degrees at 25,600 steps per turn
-            backoff_steps: 142,  // 2 degrees
-            fast_rate: 4_000,
-            slow_rate: 500,
-            home_position: 0, // the index flags sit at the carriages' home-pose angles
-        };
-        let linear = crate::safety::homing::AxisHoming {
-            toward: -1,
-            search_steps: 64_000, // 40 mm at 1.6 M steps/m: the platform parks within 40 mm of the switches
-            backoff_steps: 3_200, // 2 mm
-            fast_rate: 32_000,
-            slow_rate: 4_000,
-            // The lower end switch is at 165 mm, below the 173 mm the spec ranges use and above the 160 mm stroke
-            // minimum: 231.31 - 165 = 66.31 mm = 106,096 steps below the home-pose length. The platform parks low.
-            home_position: -106_096,
-        };
-        Self {
+        let mut config = Self {
             geometry: presets::TRAINER_MODEL,
             home: Preset::TrainerModel.home(),
             supervisor: SupervisorConfig::default(),
@@ -127,19 +111,44 @@ impl ControllerConfig {
                 AxisScale::MODEL_LINEAR,
                 AxisScale::MODEL_LINEAR,
             ],
-            homing: HomingConfig {
-                axes: [carriage, carriage, carriage, carriage, linear, linear],
+            switches: HomingSettings {
+                axes: [
+                    MODEL_CARRIAGE_HOMING,
+                    MODEL_CARRIAGE_HOMING,
+                    MODEL_CARRIAGE_HOMING,
+                    MODEL_CARRIAGE_HOMING,
+                    MODEL_LINEAR_HOMING,
+                    MODEL_LINEAR_HOMING,
+                ],
                 order: [4, 5, 0, 2, 1, 3],
+            },
+            homing: HomingConfig {
+                axes: [AxisHoming {
+                    toward: 1,
+                    search_steps: 0,
+                    backoff_steps: 0,
+                    fast_rate: 0,
+                    slow_rate: 0,
+                    home_position: 0,
+                }; 6],
+                order: [0; 6],
             },
             inputs: InputConfig::default(),
             telemetry_hz: 100,
-            rig_name: RigRecord::new(
-                presets::TRAINER_MODEL.name,
-                &presets::TRAINER_MODEL,
-                Preset::TrainerModel.home(),
-            )
-            .name,
+            rig_name: [0; RIG_NAME_LEN],
+        };
+        config.rig_name = RigRecord::new(
+            presets::TRAINER_MODEL.name,
+            &config.geometry,
+            config.home,
+            config.machine(),
+        )
+        .name;
+        // Finite, positive values in range: the conversion cannot fail (a test holds it to the steps of FIRMWARE.md).
+        if let Ok(homing) = config.homing_steps() {
+            config.homing = homing;
         }
+        config
     }
 
     /// The step generator's slot grid for this configuration.
@@ -152,71 +161,35 @@ impl ControllerConfig {
         Controller::new(*self).map(|_| ())
     }
 
-    /// The value of a setting.
-    pub fn get(&self, key: ConfigKey) -> Option<f32> {
-        let c = &self.pipeline;
-        Some(match key {
-            ConfigKey::StreamTimeoutMs => c.stream_timeout_us as f32 / 1000.0,
-            ConfigKey::PoseVelocity(a) => *c.limits.pose_velocity.get(usize::from(a))?,
-            ConfigKey::PoseAcceleration(a) => *c.limits.pose_acceleration.get(usize::from(a))?,
-            ConfigKey::GrossJumpMs => c.gross_jump_us as f32 / 1000.0,
-            ConfigKey::FollowDirect => f32::from(u8::from(c.follow == FollowMode::Direct)),
-            ConfigKey::EnvelopeMargin(i) => *c.margins.0.get(usize::from(i))?,
-            ConfigKey::TickHz => 1e6 / c.tick_us as f32,
-            ConfigKey::StepsPerUnit(a) => {
-                let scale = self.scales.get(usize::from(a))?;
-                match self.axis_kind(a)? {
-                    AxisKind::Ring => scale.steps_per_turn as f32,
-                    AxisKind::Linear | AxisKind::Angle => scale.steps_per_unit,
-                }
-            }
-            ConfigKey::InputActiveLow => f32::from(self.inputs.active_low),
-            ConfigKey::DebounceMs => f32::from(self.inputs.debounce_samples),
-            ConfigKey::TelemetryHz => f32::from(self.telemetry_hz),
-            ConfigKey::Reverse(a) => f32::from(u8::from(self.scales.get(usize::from(a))?.invert)),
-        })
-    }
-
-    pub(super) fn axis_kind(&self, axis: u8) -> Option<AxisKind> {
-        RingPlatform::<f32>::new(&self.geometry)
-            .axes()
-            .get(usize::from(axis))
-            .copied()
-    }
-
     /// The trainer model's drives, switches and timings on another ring platform (its own geometry and home
     /// pose): each carriage with the model's carriage drive and index-switch homing, each linear actuator with the
     /// model's lead screw and its lower end switch 1 mm below the stroke; linear actuators home first, then every
     /// other carriage, then the rest (the homing plan's spacing proof decides whether that order is safe).
     pub fn for_rig(geometry: &RingGeometry, home: [f64; 6]) -> Result<Self, ConfigError> {
+        Self::from_record(&Self::default_record(geometry.name, geometry, home))
+    }
+
+    /// The record [`Self::for_rig`] runs: `geometry` homed at `home` with the trainer model's machine sections.
+    /// A home pose without a solution leaves the linear switches at the home pose (the record is then refused by
+    /// its home-pose check).
+    pub fn default_record(name: &str, geometry: &RingGeometry, home: [f64; 6]) -> RigRecord {
         let model = Self::trainer_model();
         let m = RingPlatform::<f64>::new(geometry);
         let axes = m.axes();
-        let q = m.inverse(&Pose::from_array(home)).map_err(ConfigError::HomePose)?;
-        let [carriage, linear] = [model.homing.axes[0], model.homing.axes[4]];
-        let mut config = Self {
-            geometry: *geometry,
-            home,
-            rig_name: RigRecord::new(geometry.name, geometry, home).name,
-            ..model
-        };
+        let q = m.inverse(&Pose::from_array(home)).map(|q| q.0).unwrap_or([0.0; 6]);
+        let mut machine = model.machine();
         for (a, kind) in axes.iter().enumerate() {
-            let ring = *kind == AxisKind::Ring;
-            config.scales[a] = if ring {
-                AxisScale::MODEL_CARRIAGE
+            if *kind == AxisKind::Ring {
+                machine.axes[a].steps_per_unit = AxisScale::MODEL_CARRIAGE.steps_per_turn as f32;
+                machine.homing.axes[a] = MODEL_CARRIAGE_HOMING;
             } else {
-                AxisScale::MODEL_LINEAR
-            };
-            config.homing.axes[a] = if ring {
-                carriage
-            } else {
-                let switch = geometry.limits.stroke[0] - 0.001;
-                let steps = libm::round((switch - q.0[a]) * f64::from(AxisScale::MODEL_LINEAR.steps_per_unit));
-                crate::safety::homing::AxisHoming {
-                    home_position: steps as i64,
-                    ..linear
-                }
-            };
+                machine.axes[a].steps_per_unit = AxisScale::MODEL_LINEAR.steps_per_unit;
+                let switch = geometry.limits.stroke[0] - 0.001 - q[a];
+                machine.homing.axes[a] = SwitchSettings {
+                    switch: switch as f32,
+                    ..MODEL_LINEAR_HOMING
+                };
+            }
         }
         let mut order = [0u8; 6];
         let linear_first = (0..6u8).filter(|&a| axes[usize::from(a)] != AxisKind::Ring);
@@ -225,33 +198,31 @@ impl ControllerConfig {
         for (slot, a) in order.iter_mut().zip(linear_first.chain(even).chain(odd)) {
             *slot = a;
         }
-        config.homing.order = order;
-        config.validate()?;
-        Ok(config)
+        machine.homing.order = order;
+        RigRecord::new(name, geometry, home, machine)
     }
 
-    /// A stored or loaded rig: its geometry and home pose with the trainer model's switches and timings
-    /// ([`Self::for_rig`]), then its axes, pose limits and inputs through the same checks as the settings of those
-    /// names (so that steps per unit and direction scale and mirror the homing distances as a setting does).
+    /// A stored or loaded rig: its geometry and home pose, and its machine sections through the same checks as
+    /// `SetSettings` of those sections; the sections a rig does not carry (stream, control) are the trainer
+    /// model's.
     pub fn from_record(record: &RigRecord) -> Result<Self, ConfigError> {
         let geometry = record.geometry().map_err(ConfigError::Geometry)?;
-        let mut config = Self::for_rig(&geometry, record.home)?;
-        config.rig_name = record.name;
-        let axes = RingPlatform::<f64>::new(&geometry).axes();
-        for (a, (kind, scale)) in (0u8..).zip(axes.iter().zip(&record.scales)) {
-            let per_unit = match kind {
-                AxisKind::Ring => scale.steps_per_turn as f32,
-                AxisKind::Linear | AxisKind::Angle => scale.steps_per_unit,
-            };
-            let i = usize::from(a);
-            config.set(ConfigKey::StepsPerUnit(a), per_unit)?;
-            config.set(ConfigKey::Reverse(a), f32::from(u8::from(scale.invert)))?;
-            config.set(ConfigKey::PoseVelocity(a), record.pose_velocity[i])?;
-            config.set(ConfigKey::PoseAcceleration(a), record.pose_acceleration[i])?;
+        let mut config = Self {
+            geometry,
+            home: record.home,
+            rig_name: record.name,
+            ..Self::trainer_model()
+        };
+        let m = &record.machine;
+        for section in [
+            Settings::Axes(m.axes),
+            Settings::Motion(m.motion),
+            Settings::Inputs(m.inputs),
+            Settings::Supervisor(m.supervisor),
+            Settings::Homing(m.homing),
+        ] {
+            config.apply(&section)?;
         }
-        config.set(ConfigKey::InputActiveLow, f32::from(record.inputs.active_low))?;
-        config.set(ConfigKey::DebounceMs, f32::from(record.inputs.debounce_samples))?;
-        config.supervisor = record.supervisor;
         config.validate()?;
         Ok(config)
     }
@@ -260,101 +231,31 @@ impl ControllerConfig {
     pub fn rig(&self) -> RigRecord {
         RigRecord {
             name: self.rig_name,
-            scales: self.scales,
-            pose_velocity: self.pipeline.limits.pose_velocity,
-            pose_acceleration: self.pipeline.limits.pose_acceleration,
-            inputs: self.inputs,
-            supervisor: self.supervisor,
-            ..RigRecord::new("", &self.geometry, self.home)
+            ..RigRecord::new("", &self.geometry, self.home, self.machine())
         }
-    }
-
-    /// Changes a setting after checking its range; the whole configuration is checked by [`Self::validate`].
-    /// Changing an axis's steps per unit scales its homing distances and rates with it, so that they stay the
-    /// same physical lengths and speeds.
-    pub fn set(&mut self, key: ConfigKey, value: f32) -> Result<(), ConfigError> {
-        if !value.is_finite() || value < 0.0 {
-            return Err(ConfigError::Value);
-        }
-        let integer = value == libm::floorf(value);
-        let c = &mut self.pipeline;
-        match key {
-            ConfigKey::StreamTimeoutMs if (1.0..=10_000.0).contains(&value) => {
-                c.stream_timeout_us = (value * 1000.0) as u32
-            }
-            ConfigKey::PoseVelocity(a) if value > 0.0 => {
-                *c.limits
-                    .pose_velocity
-                    .get_mut(usize::from(a))
-                    .ok_or(ConfigError::Value)? = value
-            }
-            ConfigKey::PoseAcceleration(a) if value > 0.0 => {
-                *c.limits
-                    .pose_acceleration
-                    .get_mut(usize::from(a))
-                    .ok_or(ConfigError::Value)? = value
-            }
-            ConfigKey::GrossJumpMs if (10.0..=10_000.0).contains(&value) => c.gross_jump_us = (value * 1000.0) as u32,
-            ConfigKey::FollowDirect if value == 0.0 || value == 1.0 => {
-                c.follow = if value == 1.0 {
-                    FollowMode::Direct
-                } else {
-                    FollowMode::Interpolate
-                }
-            }
-            // No margin may take more than a tenth of the check's natural scale (0.1 m, 0.1 rad, 0.1 of the index).
-            ConfigKey::EnvelopeMargin(i) if value <= 0.1 => {
-                *c.margins.0.get_mut(usize::from(i)).ok_or(ConfigError::Value)? = value
-            }
-            ConfigKey::TickHz if value == 500.0 || value == 1000.0 || value == 2000.0 => {
-                let tick_us = (1e6 / value) as u32;
-                c.tick_us = tick_us;
-                self.scheduler.period_ns = tick_us * 1000;
-            }
-            ConfigKey::Reverse(a) if value == 0.0 || value == 1.0 => {
-                let i = usize::from(a);
-                let (Some(scale), Some(h)) = (self.scales.get_mut(i), self.homing.axes.get_mut(i)) else {
-                    return Err(ConfigError::Value);
-                };
-                let reverse = value == 1.0;
-                if scale.invert != reverse {
-                    // Homing works in motor steps: the switch is now the other way, at the mirrored position.
-                    scale.invert = reverse;
-                    h.toward = -h.toward;
-                    h.home_position = -h.home_position;
-                }
-            }
-            ConfigKey::StepsPerUnit(a) if integer && (1.0..=16_777_216.0).contains(&value) => {
-                let kind = self.axis_kind(a).ok_or(ConfigError::Value)?;
-                let i = usize::from(a);
-                let scale = &mut self.scales[i];
-                let old = f64::from(scale.per_unit(kind));
-                match kind {
-                    AxisKind::Ring => {
-                        scale.steps_per_turn = value as i64;
-                        scale.steps_per_unit = value / core::f32::consts::TAU;
-                    }
-                    AxisKind::Linear | AxisKind::Angle => scale.steps_per_unit = value,
-                }
-                let ratio = f64::from(scale.per_unit(kind)) / old;
-                let h = &mut self.homing.axes[i];
-                let steps = |v: i64| libm::round(v as f64 * ratio) as i64;
-                let rate = |v: u32| libm::round(f64::from(v) * ratio).clamp(1.0, f64::from(u32::MAX)) as u32;
-                h.search_steps = rate(h.search_steps);
-                h.backoff_steps = rate(h.backoff_steps);
-                h.home_position = steps(h.home_position);
-                h.fast_rate = rate(h.fast_rate);
-                h.slow_rate = rate(h.slow_rate);
-            }
-            ConfigKey::InputActiveLow if integer && value <= f32::from(u16::MAX) => {
-                self.inputs.active_low = value as u16
-            }
-            ConfigKey::DebounceMs if integer && (1.0..=50.0).contains(&value) => {
-                self.inputs.debounce_samples = value as u8
-            }
-            ConfigKey::TelemetryHz if integer && value <= 2000.0 => self.telemetry_hz = value as u16,
-            _ => return Err(ConfigError::Value),
-        }
-        Ok(())
     }
 }
+
+/// The trainer model's carriage homing: the index flags sit at the carriages' home-pose angles; searched up to 20
+/// degrees of ring at 4,000 steps/s of its 25,600 per turn, backed off 2 degrees, approached at 500 steps/s.
+const MODEL_CARRIAGE_HOMING: SwitchSettings = SwitchSettings {
+    toward: Toward::Plus,
+    switch: 0.0,
+    search: 20.0 * core::f32::consts::PI / 180.0,
+    backoff: 2.0 * core::f32::consts::PI / 180.0,
+    fast: 4_000.0 * core::f32::consts::TAU / 25_600.0,
+    slow: 500.0 * core::f32::consts::TAU / 25_600.0,
+};
+
+/// The trainer model's linear-actuator homing: the lower end switch at 165 mm, below the 173 mm the spec ranges use
+/// and above the 160 mm stroke minimum, 66.31 mm below the home-pose length of 231.31 mm (the platform parks low);
+/// searched up to 40 mm (the platform parks within 40 mm of the switches) at 20 mm/s, backed off 2 mm, approached
+/// at 2.5 mm/s.
+const MODEL_LINEAR_HOMING: SwitchSettings = SwitchSettings {
+    toward: Toward::Minus,
+    switch: -0.066_31,
+    search: 0.040,
+    backoff: 0.002,
+    fast: 0.020,
+    slow: 0.0025,
+};

@@ -6,9 +6,7 @@ use crate::kinematics::presets::{Preset, PresetGeometry};
 use crate::kinematics::{AxisKind, Mechanism};
 use crate::motion::jog::Jog;
 use crate::motion::Accepted;
-use crate::protocol::{
-    self, ConfigRefusal, DeviceMessage, HostMessage, NackReason, Request, Response, PROTOCOL_VERSION,
-};
+use crate::protocol::{self, DeviceMessage, HostMessage, NackReason, Request, Response, PROTOCOL_VERSION};
 use crate::safety::{Event, HomingSequencer, State};
 
 impl Controller {
@@ -48,11 +46,8 @@ impl Controller {
                 self.telemetry.ticks = 0;
                 DeviceMessage::Ack
             }
-            HostMessage::GetConfig(key) => match self.get_config(key) {
-                Some(v) => DeviceMessage::Config(key, v),
-                None => DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::OutOfRange)),
-            },
-            HostMessage::SetConfig(key, value) => match self.set_config(key, value) {
+            HostMessage::GetSettings(kind) => self.settings_report(kind),
+            HostMessage::SetSettings(settings) => match self.set_settings(&settings) {
                 Ok(()) => DeviceMessage::Ack,
                 Err(r) => DeviceMessage::Nack(r),
             },

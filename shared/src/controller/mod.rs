@@ -7,6 +7,7 @@
 mod config;
 mod dispatch;
 mod homing;
+mod sections;
 mod settings;
 
 /// The inputs the controller reads (they belong to the safety layer, which debounces them).
@@ -35,8 +36,9 @@ pub struct Controller {
     config: ControllerConfig,
     /// The configuration as stored: equal to `config` but for settings that take effect at the next start.
     saved: ControllerConfig,
-    /// Settings changed since the firmware last took them for storing (bit per [`ConfigKey::code`]).
-    unsaved: u64,
+    /// Sections stored on their own changed since the firmware last took them for storing (bit per
+    /// [`crate::protocol::SettingsKind::code`]).
+    unsaved: u8,
     home_pose: Pose<f32>,
     supervisor: Supervisor,
     pipeline: Pipeline<RingPlatform<f32>>,
@@ -62,10 +64,8 @@ pub struct Controller {
     jog: Option<(Jog, bool)>,
     /// Where the running rig came from (the board says so at boot).
     rig_source: RigSource,
-    /// A rig loaded over the protocol that the firmware has not stored yet.
+    /// A rig loaded, or a section of the stored rig changed, over the protocol that the firmware has not stored yet.
     unsaved_rig: Option<RigRecord>,
-    /// A rig was loaded since the start: the next start runs it.
-    rig_pending: bool,
     /// The host asked for a restart.
     restart: bool,
 }
@@ -138,7 +138,6 @@ impl Controller {
             jog: None,
             rig_source: RigSource::Compiled,
             unsaved_rig: None,
-            rig_pending: false,
             restart: false,
         })
     }

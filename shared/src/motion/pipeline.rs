@@ -160,6 +160,7 @@ pub enum Accepted {
 
 /// How the reference moves toward a new setpoint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum FollowMode {
     /// Linearly over the setpoint's own interval: a smooth path, one interval behind the source.

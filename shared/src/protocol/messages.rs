@@ -5,11 +5,12 @@ use crate::kinematics::presets::Preset;
 use crate::kinematics::Pose;
 
 use super::rig::{RigRecord, RigSource};
+use super::settings::{Settings, SettingsKind};
 use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 use crate::safety::{FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly.
-pub const PROTOCOL_VERSION: u16 = 5;
+pub const PROTOCOL_VERSION: u16 = 6;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -50,10 +51,11 @@ pub enum HostMessage {
     Setpoint(Setpoint),
     /// Ask for the status.
     GetStatus,
-    /// Read a configuration value.
-    GetConfig(ConfigKey),
-    /// Write a configuration value (not while moving).
-    SetConfig(ConfigKey, f32),
+    /// Read a section of settings: the value the next start runs ([`DeviceMessage::Settings`]).
+    GetSettings(SettingsKind),
+    /// Write a section of settings (not while moving): checked whole with the rest of the configuration, refused
+    /// with its cause ([`NackReason::BadConfig`]); a live section takes effect at once, every section is stored.
+    SetSettings(Settings),
     /// The input levels now ([`DeviceMessage::Inputs`]).
     GetInputs,
     /// Commissioning: move one axis (0-5) by a step count at its slow homing rate, the others holding; stops at
@@ -71,7 +73,7 @@ pub enum HostMessage {
         /// Axis, 0-5.
         axis: u8,
     },
-    /// Send telemetry on this connection (`true`) at [`ConfigKey::TelemetryHz`], or stop (`false`). Every Hello
+    /// Send telemetry on this connection (`true`) at the stream settings' `telemetry_hz`, or stop (`false`). Every Hello
     /// starts a connection without it: a host that only commands gets only answers.
     Telemetry(bool),
     /// The rig it runs ([`DeviceMessage::Rig`]).
@@ -114,13 +116,18 @@ pub enum DeviceMessage {
     Nack(NackReason),
     /// Status and telemetry.
     Status(Status),
-    /// A configuration value.
-    Config(ConfigKey, f32),
+    /// A section of settings as the next start runs it.
+    Settings {
+        /// The section.
+        settings: Settings,
+        /// It differs from what runs now (a section that takes effect at the next start was changed).
+        pending: bool,
+    },
     /// A fault was latched (unsolicited).
     Fault(FaultReason),
     /// Every input's electrical level and its debounced state.
     Inputs(InputReport),
-    /// What the device is doing (unsolicited, at [`ConfigKey::TelemetryHz`] while the host asks for it).
+    /// What the device is doing (unsolicited, at the stream settings' `telemetry_hz` while the host asks for it).
     Telemetry(Telemetry),
     /// The rig it runs, where that came from, and whether another one is stored for the next start.
     Rig {
@@ -181,7 +188,7 @@ impl core::fmt::Display for NackReason {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum ConfigRefusal {
-    /// The value is outside its key's range, or the key does not exist on this machine.
+    /// A value is outside its range (the section's documentation gives each one).
     OutOfRange,
     /// With it the home pose would have no solution.
     HomePose,
@@ -198,7 +205,7 @@ pub enum ConfigRefusal {
 impl core::fmt::Display for ConfigRefusal {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(match self {
-            Self::OutOfRange => "the value is outside the setting's range",
+            Self::OutOfRange => "a value is outside its range",
             Self::HomePose => "the home pose would have no solution",
             Self::Homing => "the homing plan would no longer be safe (searches or spacing)",
             Self::StepTiming => "the step timing would be inconsistent",
@@ -258,94 +265,6 @@ pub enum NackReason {
     OutOfRange,
     /// The frame could not be decoded (id unknown, so the response has id 0).
     Malformed,
-}
-
-/// Configuration values that can be read and written. Values are `f32`; integers (rates, step counts, masks) are
-/// exact up to 2^24. Keys marked *live* take effect at once; the others are stored and take effect at the next
-/// start of the controller (a reset of the board). [`ConfigKey::code`] is the key's number in the device's flash.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum ConfigKey {
-    /// Stream timeout (ms), live.
-    StreamTimeoutMs,
-    /// Velocity limit of a pose axis (m/s or rad/s), live.
-    PoseVelocity(u8),
-    /// Acceleration limit of a pose axis, live.
-    PoseAcceleration(u8),
-    /// Gross-jump window (ms): a setpoint further from the previous one than any axis travels at its velocity
-    /// limit in this time is refused as a broken source, live.
-    GrossJumpMs,
-    /// Follow mode: 0 interpolates over each setpoint's interval, 1 heads for each setpoint at once, live.
-    FollowDirect,
-    /// Room a limited setpoint leaves inside a workspace check (in the check's unit), by check in the order of
-    /// `Check::ALL`, live.
-    EnvelopeMargin(u8),
-    /// Control rate (Hz): 500, 1,000 or 2,000; at the next start.
-    TickHz,
-    /// Motor steps per carriage turn (ring axes, an integer) or per metre (linear axes); at the next start.
-    StepsPerUnit(u8),
-    /// Inputs active when low, a bit per input in the order of `safety::debounce::InputBit`, live.
-    InputActiveLow,
-    /// Debouncing: equal samples (1 ms apart) before an input level is accepted (1-50), live.
-    DebounceMs,
-    /// Telemetry samples per second while a host asks for them (0: none; at most the control rate), live.
-    TelemetryHz,
-    /// The axis's motor turns the other way (1) or not (0): its steps, homing direction and switch position are
-    /// mirrored, for a motor wired or mounted the other way round; at the next start.
-    Reverse(u8),
-}
-
-impl ConfigKey {
-    /// Every key, in code order.
-    pub fn all() -> impl Iterator<Item = ConfigKey> {
-        (0..=u8::MAX).filter_map(ConfigKey::from_code)
-    }
-
-    /// The key's stable number (its key in flash): never reuse or renumber one.
-    pub const fn code(self) -> u8 {
-        match self {
-            ConfigKey::StreamTimeoutMs => 1,
-            // 2 was the jump tolerance of protocol version 2: never reuse it.
-            ConfigKey::GrossJumpMs => 6,
-            ConfigKey::FollowDirect => 7,
-            ConfigKey::TickHz => 3,
-            ConfigKey::InputActiveLow => 4,
-            ConfigKey::DebounceMs => 5,
-            ConfigKey::TelemetryHz => 8,
-            ConfigKey::PoseVelocity(a) => 16 + (a & 7),
-            ConfigKey::PoseAcceleration(a) => 24 + (a & 7),
-            ConfigKey::StepsPerUnit(a) => 32 + (a & 7),
-            ConfigKey::EnvelopeMargin(c) => 40 + (c & 7),
-            ConfigKey::Reverse(a) => 48 + (a & 7),
-        }
-    }
-
-    /// The key with this code (axes 0-5 only).
-    pub const fn from_code(code: u8) -> Option<ConfigKey> {
-        Some(match code {
-            1 => ConfigKey::StreamTimeoutMs,
-            6 => ConfigKey::GrossJumpMs,
-            7 => ConfigKey::FollowDirect,
-            3 => ConfigKey::TickHz,
-            4 => ConfigKey::InputActiveLow,
-            5 => ConfigKey::DebounceMs,
-            8 => ConfigKey::TelemetryHz,
-            16..=21 => ConfigKey::PoseVelocity(code - 16),
-            24..=29 => ConfigKey::PoseAcceleration(code - 24),
-            32..=37 => ConfigKey::StepsPerUnit(code - 32),
-            40..=45 => ConfigKey::EnvelopeMargin(code - 40),
-            48..=53 => ConfigKey::Reverse(code - 48),
-            _ => return None,
-        })
-    }
-
-    /// Whether a new value takes effect at once (otherwise at the next start).
-    pub const fn is_live(self) -> bool {
-        !matches!(
-            self,
-            ConfigKey::TickHz | ConfigKey::StepsPerUnit(_) | ConfigKey::Reverse(_)
-        )
-    }
 }
 
 /// Status and telemetry.

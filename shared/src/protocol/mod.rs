@@ -9,10 +9,15 @@
 mod frame;
 mod messages;
 mod rig;
+mod settings;
 
 pub use frame::{decode, encode, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
 pub use messages::{
-    ConfigKey, ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode,
-    Status, Telemetry, TelemetryFlags, PROTOCOL_VERSION,
+    ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode, Status,
+    Telemetry, TelemetryFlags, PROTOCOL_VERSION,
 };
 pub use rig::{RigRecord, RigSource, RIG_NAME_LEN};
+pub use settings::{
+    AxisSettings, ControlSettings, HomingSettings, MachineSettings, MotionSettings, Settings, SettingsKind,
+    StreamSettings, SwitchSettings, Toward,
+};

@@ -1,15 +1,13 @@
 //! A ring platform as it travels to a device and lives in its flash: the rig file's geometry (KINEMATICS.md 2.1 and
 //! 2.2: ring radius, rod length, chains in actuator order, joint limits) and home pose, in the units of
 //! `kinematics` (m, rad), `f64` as the host computes them, so that a rig file, its record on the wire and its record
-//! in flash are the same numbers bit for bit; and its axes (motor steps, direction), pose limits and input wiring,
-//! supply sequencing, in the controller's own types.
+//! in flash are the same numbers bit for bit; and the settings sections that describe the machine (motors, pose
+//! limits, inputs, supply sequencing, homing: [`MachineSettings`]), as they travel on their own.
 
-use crate::kinematics::{AxisKind, Chain, ChainKind, GeometryError, Mechanism, RingGeometry, RingLimits, RingPlatform};
-use crate::motion::{AxisScale, MotionLimits};
-use crate::safety::debounce::InputConfig;
-use crate::safety::SupervisorConfig;
+use crate::kinematics::presets::{Preset, PresetGeometry};
+use crate::kinematics::{Chain, ChainKind, GeometryError, RingGeometry, RingLimits};
 
-use super::ConfigRefusal;
+use super::{ConfigRefusal, MachineSettings};
 
 /// Longest rig name kept (bytes of UTF-8).
 pub const RIG_NAME_LEN: usize = 32;
@@ -31,22 +29,14 @@ pub struct RigRecord {
     pub limits: RingLimits,
     /// Home pose `[x, y, z, alpha, beta, gamma]` (m, rad).
     pub home: [f64; 6],
-    /// Each axis's motor in actuator order: steps per carriage turn or per metre, and direction.
-    pub scales: [AxisScale; 6],
-    /// Pose velocity limit per pose axis (m/s, rad/s).
-    pub pose_velocity: [f32; 6],
-    /// Pose acceleration limit per pose axis (m/s^2, rad/s^2).
-    pub pose_acceleration: [f32; 6],
-    /// Input polarity and debouncing.
-    pub inputs: InputConfig,
-    /// Supply sensing and sequencing delays.
-    pub supervisor: SupervisorConfig,
+    /// Its motors, pose limits, inputs, supply sequencing and homing.
+    pub machine: MachineSettings,
 }
 
 impl RigRecord {
-    /// The record of `geometry` homed at `home`, named `name`, with the trainer model's axes (its carriage drive on
-    /// every ring axis, its lead screw on every linear one), pose limits, input wiring and supply sequencing.
-    pub fn new(name: &str, geometry: &RingGeometry, home: [f64; 6]) -> Self {
+    /// The record of `geometry` homed at `home`, named `name` (cut to [`RIG_NAME_LEN`] bytes at a character
+    /// boundary), with the sections of `machine`.
+    pub fn new(name: &str, geometry: &RingGeometry, home: [f64; 6], machine: MachineSettings) -> Self {
         let mut chains = [Chain {
             kind: ChainKind::Radial,
             platform_point: [0.0; 3],
@@ -68,14 +58,7 @@ impl RigRecord {
             chain_count: geometry.chains().len() as u8,
             limits: geometry.limits,
             home,
-            scales: RingPlatform::<f64>::new(geometry).axes().map(|k| match k {
-                AxisKind::Ring => AxisScale::MODEL_CARRIAGE,
-                AxisKind::Linear | AxisKind::Angle => AxisScale::MODEL_LINEAR,
-            }),
-            pose_velocity: MotionLimits::TRAINER_MODEL.pose_velocity,
-            pose_acceleration: MotionLimits::TRAINER_MODEL.pose_acceleration,
-            inputs: InputConfig::default(),
-            supervisor: SupervisorConfig::default(),
+            machine,
         }
     }
 
@@ -85,10 +68,20 @@ impl RigRecord {
         core::str::from_utf8(&self.name[..len]).unwrap_or("?")
     }
 
-    /// The geometry, through every check of `RingGeometry::new` (reports name it "rig").
+    /// The geometry, through every check of `RingGeometry::new`; named as the preset it restates, if it restates
+    /// one exactly, and "rig" otherwise.
     pub fn geometry(&self) -> Result<RingGeometry, GeometryError> {
         let n = usize::from(self.chain_count).min(6);
-        RingGeometry::new("rig", self.ring_radius, self.rod_length, &self.chains[..n], self.limits)
+        let geometry = RingGeometry::new("rig", self.ring_radius, self.rod_length, &self.chains[..n], self.limits)?;
+        let preset = Preset::ALL.into_iter().find_map(|p| match p.geometry() {
+            PresetGeometry::Ring(g) => {
+                let mut renamed = *g;
+                renamed.name = "rig";
+                (renamed == geometry).then_some(*g)
+            }
+            _ => None,
+        });
+        Ok(preset.unwrap_or(geometry))
     }
 }
 

@@ -40,7 +40,7 @@ pub struct Plant {
     /// Total steps received per axis.
     pub steps_received: [u64; 6],
     /// Bit per axis: its motor is wired or mounted the other way round, so a forward step moves the axis back
-    /// (what `ConfigKey::Reverse` corrects).
+    /// (what the axes section's `reverse` corrects).
     pub reversed: u8,
 }
 

@@ -20,7 +20,7 @@ use ringpod_core::kinematics::presets::{TRAINER_MODEL, TRAINER_MODEL_HOME_Z};
 use ringpod_core::kinematics::{Mechanism, NewtonOptions, Pose, RingPlatform};
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer, PulseTiming};
 use ringpod_core::motion::{envelope, PipelineConfig, SchedulerConfig, Setpoint, StepScheduler};
-use ringpod_core::protocol::{self, ConfigKey, HostMessage, Request};
+use ringpod_core::protocol::{self, ControlSettings, HostMessage, Request, Settings};
 use ringpod_core::selfcheck::{self, Digest, CHECKS};
 use ringpod_qemu::{fail, halt};
 
@@ -164,8 +164,11 @@ fn main() -> ! {
         n,
     );
     let mut fast = ControllerConfig::trainer_model();
-    if fast.set(ConfigKey::TickHz, 2_000.0).is_err() {
-        fail("tick-hz 2000");
+    if fast
+        .apply(&Settings::Control(ControlSettings { tick_hz: 2_000 }))
+        .is_err()
+    {
+        fail("control.tick_hz 2000");
     }
     let (tick, _, n) = stream_costs(fast, 2_000);
     report("control tick at 2 kHz (the same work, half the period)", tick, n);

@@ -617,7 +617,7 @@ fn watchdog_on_m4f(t: &mut Tally) {
     };
     let pty = emulated.pty.as_str();
     let port = ["--port", pty];
-    let stored = ringpod_text(&[&["device", "config", "set", "telemetry-hz", "50"][..], &port].concat()).0;
+    let stored = ringpod_text(&[&["device", "config", "set", "stream.telemetry_hz", "50"][..], &port].concat()).0;
     // The settings task stores a change within 100 ms while the supplies are off.
     std::thread::sleep(Duration::from_millis(500));
     let enabled = ringpod_text(&[&["device", "enable"][..], &port].concat()).0;
@@ -649,9 +649,9 @@ fn watchdog_on_m4f(t: &mut Tally) {
             && sense_off,
         "it comes back with the Watchdog fault reported, both supplies off (sensed), homing lost",
     );
-    let setting = ringpod_json(&[&["device", "config", "get", "telemetry-hz"][..], &port].concat());
+    let setting = ringpod_json(&[&["device", "config", "get", "stream.telemetry_hz"][..], &port].concat());
     t.check(
-        setting.is_ok_and(|s| s["value"] == 50.0) && lines.iter().any(|l| l.starts_with("SETTINGS 1 restored")),
+        setting.is_ok_and(|s| s["value"] == 50) && lines.iter().any(|l| l.starts_with("SETTINGS 1 restored")),
         "the setting stored before the reset is restored from flash by the settings task",
     );
     let cleared = ringpod_text(&[&["device", "clear"][..], &port].concat()).0

@@ -1,0 +1,215 @@
+//! The configuration as typed sections ([`Settings`]): each read whole from the running configuration and changed
+//! whole, after checking its values' ranges; the checks of the whole configuration (home pose, homing plan, step
+//! timing) are [`ControllerConfig::validate`]'s. Homing is kept in the axes' own units and turned into steps here,
+//! so that a motor's steps per unit or direction changes its homing with it.
+
+use super::{ConfigError, ControllerConfig};
+use crate::kinematics::{AxisKind, Mechanism, RingPlatform};
+use crate::motion::AxisScale;
+use crate::protocol::{
+    AxisSettings, ControlSettings, MachineSettings, MotionSettings, Settings, SettingsKind, StreamSettings,
+    SwitchSettings, Toward,
+};
+use crate::safety::homing::{AxisHoming, HomingConfig};
+
+/// Most steps a count or rate may take (they are `u32` in the step scheduler; 2^31 leaves room to add).
+const MOST_STEPS: f64 = 2_147_483_647.0;
+
+impl ControllerConfig {
+    /// A section as this configuration has it.
+    pub fn settings(&self, kind: SettingsKind) -> Settings {
+        let c = &self.pipeline;
+        match kind {
+            SettingsKind::Stream => Settings::Stream(StreamSettings {
+                timeout_ms: (c.stream_timeout_us / 1000) as u16,
+                gross_jump_ms: (c.gross_jump_us / 1000) as u16,
+                follow: c.follow,
+                margins: c.margins.0,
+                telemetry_hz: self.telemetry_hz,
+            }),
+            SettingsKind::Control => Settings::Control(ControlSettings {
+                tick_hz: (1_000_000 / c.tick_us.max(1)) as u16,
+            }),
+            SettingsKind::Motion => Settings::Motion(self.motion()),
+            SettingsKind::Inputs => Settings::Inputs(self.inputs),
+            SettingsKind::Axes => Settings::Axes(self.axes()),
+            SettingsKind::Homing => Settings::Homing(self.switches),
+            SettingsKind::Supervisor => Settings::Supervisor(self.supervisor),
+        }
+    }
+
+    /// The sections a rig record carries.
+    pub fn machine(&self) -> MachineSettings {
+        MachineSettings {
+            axes: self.axes(),
+            motion: self.motion(),
+            inputs: self.inputs,
+            supervisor: self.supervisor,
+            homing: self.switches,
+        }
+    }
+
+    fn axes(&self) -> [AxisSettings; 6] {
+        let kinds = self.axis_kinds();
+        core::array::from_fn(|a| {
+            let s = &self.scales[a];
+            AxisSettings {
+                steps_per_unit: match kinds[a] {
+                    AxisKind::Ring => s.steps_per_turn as f32,
+                    AxisKind::Linear | AxisKind::Angle => s.steps_per_unit,
+                },
+                reverse: s.invert,
+            }
+        })
+    }
+
+    fn motion(&self) -> MotionSettings {
+        MotionSettings {
+            pose_velocity: self.pipeline.limits.pose_velocity,
+            pose_acceleration: self.pipeline.limits.pose_acceleration,
+        }
+    }
+
+    /// Changes a section after checking its values' ranges (each section documents them); the configuration as a
+    /// whole is checked by [`Self::validate`]. On an error nothing has changed.
+    pub fn apply(&mut self, settings: &Settings) -> Result<(), ConfigError> {
+        let mut next = *self;
+        let c = &mut next.pipeline;
+        match *settings {
+            Settings::Stream(s) => {
+                let margins_ok = s.margins.iter().all(|m| (0.0..=0.1).contains(m));
+                if !(1..=10_000).contains(&s.timeout_ms)
+                    || !(10..=10_000).contains(&s.gross_jump_ms)
+                    || !margins_ok
+                    || s.telemetry_hz > 2_000
+                {
+                    return Err(ConfigError::Value);
+                }
+                c.stream_timeout_us = u32::from(s.timeout_ms) * 1000;
+                c.gross_jump_us = u32::from(s.gross_jump_ms) * 1000;
+                c.follow = s.follow;
+                c.margins.0 = s.margins;
+                next.telemetry_hz = s.telemetry_hz;
+            }
+            Settings::Control(s) => {
+                if !matches!(s.tick_hz, 500 | 1_000 | 2_000) {
+                    return Err(ConfigError::Value);
+                }
+                c.tick_us = 1_000_000 / u32::from(s.tick_hz);
+                next.scheduler.period_ns = c.tick_us * 1000;
+            }
+            Settings::Motion(s) => {
+                let positive = |v: &[f32; 6]| v.iter().all(|x| x.is_finite() && *x > 0.0);
+                if !positive(&s.pose_velocity) || !positive(&s.pose_acceleration) {
+                    return Err(ConfigError::Value);
+                }
+                c.limits.pose_velocity = s.pose_velocity;
+                c.limits.pose_acceleration = s.pose_acceleration;
+            }
+            Settings::Inputs(s) => {
+                if !(1..=50).contains(&s.debounce_samples) {
+                    return Err(ConfigError::Value);
+                }
+                next.inputs = s;
+            }
+            Settings::Axes(axes) => {
+                let kinds = next.axis_kinds();
+                for ((scale, axis), kind) in next.scales.iter_mut().zip(&axes).zip(kinds) {
+                    *scale = axis_scale(axis, kind)?;
+                }
+            }
+            Settings::Homing(h) => {
+                let mut seen = [false; 6];
+                for a in h.order {
+                    let slot = seen.get_mut(usize::from(a)).ok_or(ConfigError::Value)?;
+                    if core::mem::replace(slot, true) {
+                        return Err(ConfigError::Value);
+                    }
+                }
+                let positive = |s: &SwitchSettings| {
+                    [s.search, s.backoff, s.fast, s.slow]
+                        .iter()
+                        .all(|x| x.is_finite() && *x > 0.0)
+                        && s.switch.is_finite()
+                };
+                if !h.axes.iter().all(positive) {
+                    return Err(ConfigError::Value);
+                }
+                next.switches = h;
+            }
+            Settings::Supervisor(s) => {
+                if !s.is_valid() {
+                    return Err(ConfigError::Value);
+                }
+                next.supervisor = s;
+            }
+        }
+        if matches!(settings.kind(), SettingsKind::Axes | SettingsKind::Homing) {
+            next.homing = next.homing_steps()?;
+        }
+        *self = next;
+        Ok(())
+    }
+
+    /// The homing sections in motor steps, with each axis's steps per unit and direction.
+    pub(super) fn homing_steps(&self) -> Result<HomingConfig, ConfigError> {
+        let kinds = self.axis_kinds();
+        let mut axes = [self.homing.axes[0]; 6];
+        for (a, slot) in axes.iter_mut().enumerate() {
+            let s = &self.switches.axes[a];
+            let scale = &self.scales[a];
+            let per_unit = f64::from(scale.per_unit(kinds[a]));
+            let steps = |v: f32| {
+                let n = libm::round(f64::from(v) * per_unit);
+                if n.is_finite() && libm::fabs(n) <= MOST_STEPS {
+                    Ok(n)
+                } else {
+                    Err(ConfigError::Value)
+                }
+            };
+            let sign: i8 = if scale.invert { -1 } else { 1 };
+            *slot = AxisHoming {
+                toward: sign
+                    * match s.toward {
+                        Toward::Plus => 1,
+                        Toward::Minus => -1,
+                    },
+                search_steps: steps(s.search)? as u32,
+                backoff_steps: steps(s.backoff)? as u32,
+                fast_rate: steps(s.fast)?.max(1.0) as u32,
+                slow_rate: steps(s.slow)?.max(1.0) as u32,
+                home_position: i64::from(sign) * steps(s.switch)? as i64,
+            };
+        }
+        Ok(HomingConfig {
+            axes,
+            order: self.switches.order,
+        })
+    }
+
+    /// What each actuator coordinate measures, in chain order.
+    pub(super) fn axis_kinds(&self) -> [AxisKind; 6] {
+        RingPlatform::<f32>::new(&self.geometry).axes()
+    }
+}
+
+/// A motor's scale, checked: 1 to 2^24 steps per unit, whole steps per carriage turn on the ring.
+fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Result<AxisScale, ConfigError> {
+    let v = axis.steps_per_unit;
+    if !(v.is_finite() && (1.0..=16_777_216.0).contains(&v)) {
+        return Err(ConfigError::Value);
+    }
+    Ok(match kind {
+        AxisKind::Ring if v != libm::floorf(v) => return Err(ConfigError::Value),
+        AxisKind::Ring => AxisScale {
+            steps_per_turn: v as i64,
+            steps_per_unit: v / core::f32::consts::TAU,
+            invert: axis.reverse,
+        },
+        AxisKind::Linear | AxisKind::Angle => AxisScale {
+            steps_per_turn: 0,
+            steps_per_unit: v,
+            invert: axis.reverse,
+        },
+    })
+}
