@@ -220,3 +220,39 @@ fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
     assert_eq!(c.take_unsaved_rig(), None);
     assert!(c.restart_due());
 }
+
+/// The stream's hot path reads a setpoint request straight from its payload: the same request as the full
+/// decode, for every setpoint; any other request is left to it.
+#[test]
+fn a_setpoint_request_read_on_its_own_is_the_request_decoded_whole() {
+    use ringpod_core::kinematics::Pose;
+    use ringpod_core::motion::Setpoint;
+    let setpoint = Setpoint {
+        seq: 0x1234_5678,
+        time_us: 987_654_321,
+        pose: Pose::from_array([0.01, -0.02, 0.23, 0.1, -0.2, 3.0]),
+    };
+    for id in [0, 1, 300, u32::MAX] {
+        let mut raw = [0u8; 128];
+        let payload = postcard::to_slice(
+            &Request {
+                id,
+                body: HostMessage::Setpoint(setpoint),
+            },
+            &mut raw,
+        )
+        .unwrap();
+        assert_eq!(protocol::setpoint_request(payload), Some((id, setpoint)));
+        // A byte more or less is no setpoint request.
+        assert_eq!(protocol::setpoint_request(&payload[..payload.len() - 1]), None);
+    }
+    for body in [
+        HostMessage::GetStatus,
+        HostMessage::Stop,
+        HostMessage::SetRig(wider(0.3, 0.325)),
+    ] {
+        let mut raw = [0u8; 1024];
+        let payload = postcard::to_slice(&Request { id: 9, body }, &mut raw).unwrap();
+        assert_eq!(protocol::setpoint_request(payload), None);
+    }
+}

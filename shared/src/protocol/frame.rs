@@ -44,12 +44,27 @@ impl fmt::Display for FrameError {
 
 impl core::error::Error for FrameError {}
 
+/// Most payload bytes an answer to a setpoint takes (ack, limited, nack): such a message is serialized through a
+/// buffer of this size, not one of [`MAX_PAYLOAD`], whose zeroing alone would cost the stream's hot path hundreds
+/// of instructions.
+const SMALL_PAYLOAD: usize = 96;
+
 /// Encodes `message` into `out` as one frame, delimiter included; returns its length.
 pub fn encode<M: Serialize>(message: &M, out: &mut [u8]) -> Result<usize, FrameError> {
+    let mut small = [0u8; SMALL_PAYLOAD + 4];
+    if let Ok(payload) = postcard::to_slice(message, &mut small[..SMALL_PAYLOAD]) {
+        let len = payload.len();
+        return seal(&mut small, len, out);
+    }
     let mut raw = [0u8; MAX_PAYLOAD + 4];
     let len = postcard::to_slice(message, &mut raw[..MAX_PAYLOAD])
         .map_err(|_| FrameError::TooLong)?
         .len();
+    seal(&mut raw, len, out)
+}
+
+/// Appends the CRC to the payload `raw[..len]` and writes it COBS-encoded with its delimiter into `out`.
+fn seal(raw: &mut [u8], len: usize, out: &mut [u8]) -> Result<usize, FrameError> {
     let crc = CRC.checksum(&raw[..len]).to_le_bytes();
     raw[len..len + 4].copy_from_slice(&crc);
     let n = cobs::try_encode(&raw[..len + 4], out).map_err(|_| FrameError::TooLong)?;
@@ -61,18 +76,29 @@ pub fn encode<M: Serialize>(message: &M, out: &mut [u8]) -> Result<usize, FrameE
 /// Decodes one frame (its bytes up to, not including, the delimiter).
 pub fn decode<M: DeserializeOwned>(frame: &[u8]) -> Result<M, FrameError> {
     let mut raw = [0u8; MAX_FRAME];
+    parse(unframe(frame, &mut raw)?)
+}
+
+/// The checked payload of one frame (its bytes up to, not including, the delimiter), COBS-decoded into `scratch`
+/// (at least as long as the frame).
+pub fn unframe<'a>(frame: &[u8], scratch: &'a mut [u8]) -> Result<&'a [u8], FrameError> {
     if frame.is_empty() || frame.len() > MAX_FRAME {
         return Err(FrameError::Cobs);
     }
-    let report = cobs::decode(frame, &mut raw).map_err(|_| FrameError::Cobs)?;
+    let report = cobs::decode(frame, scratch).map_err(|_| FrameError::Cobs)?;
     let len = report.frame_size();
     if len < 5 {
         return Err(FrameError::TooShort);
     }
-    let (payload, crc) = raw[..len].split_at(len - 4);
+    let (payload, crc) = scratch[..len].split_at(len - 4);
     if CRC.checksum(payload).to_le_bytes() != crc {
         return Err(FrameError::Checksum);
     }
+    Ok(payload)
+}
+
+/// A message from a whole payload (no bytes left over).
+pub fn parse<M: DeserializeOwned>(payload: &[u8]) -> Result<M, FrameError> {
     match postcard::take_from_bytes::<M>(payload) {
         Ok((message, [])) => Ok(message),
         _ => Err(FrameError::Payload),

@@ -85,6 +85,24 @@ pub enum HostMessage {
     Restart,
 }
 
+/// The position of [`HostMessage::Setpoint`] among the variants: its tag on the wire.
+const SETPOINT_TAG: u32 = 7;
+
+/// A setpoint request read straight from its payload, `(id, setpoint)`, or `None` for any other request. The
+/// stream's hot path: a [`Request`] holds room for the largest request (a rig record, over 600 bytes), which a
+/// setpoint of 40 bytes need not be decoded into and moved through.
+pub fn setpoint_request(payload: &[u8]) -> Option<(u32, Setpoint)> {
+    let (id, rest) = postcard::take_from_bytes::<u32>(payload).ok()?;
+    let (tag, rest) = postcard::take_from_bytes::<u32>(rest).ok()?;
+    if tag != SETPOINT_TAG {
+        return None;
+    }
+    match postcard::take_from_bytes::<Setpoint>(rest) {
+        Ok((setpoint, [])) => Some((id, setpoint)),
+        _ => None,
+    }
+}
+
 /// A device message: the response to request `id`, or unsolicited with `id` 0.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Response {

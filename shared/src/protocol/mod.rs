@@ -11,10 +11,10 @@ mod messages;
 mod rig;
 mod settings;
 
-pub use frame::{decode, encode, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
+pub use frame::{decode, encode, parse, unframe, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
 pub use messages::{
-    ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode, Status,
-    Telemetry, TelemetryFlags, PROTOCOL_VERSION,
+    setpoint_request, ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode,
+    Status, Telemetry, TelemetryFlags, PROTOCOL_VERSION,
 };
 pub use rig::{RigRecord, RigSource, RIG_NAME_LEN};
 pub use settings::{
