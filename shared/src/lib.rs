@@ -21,6 +21,7 @@
 pub mod controller;
 pub mod cueing;
 pub mod kinematics;
+pub mod model;
 pub mod motion;
 pub mod protocol;
 mod real;

@@ -2,14 +2,14 @@
 //! rig file's, and the checks that decide whether a configuration can run.
 
 use super::Controller;
-use crate::kinematics::presets::{self, Preset};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, Pose, RingPlatform};
 use crate::kinematics::{GeometryError, RingGeometry};
+use crate::model::{CARRIAGE_HOMING, LINEAR_HOMING};
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
-use crate::protocol::{ConfigRefusal, HomingSettings, RigRecord, Settings, SwitchSettings, Toward, RIG_NAME_LEN};
+use crate::protocol::{ConfigRefusal, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
-use crate::safety::homing::{AxisHoming, HomingConfig, HomingError};
+use crate::safety::homing::{HomingConfig, HomingError};
 use crate::safety::SupervisorConfig;
 
 /// Everything the controller is configured with.
@@ -93,64 +93,6 @@ impl core::fmt::Display for ConfigError {
 }
 
 impl ControllerConfig {
-    /// The 1:20 trainer model with the FL20 drives of FIRMWARE.md: carriages home in the order 1, 3, 2, 4 after the
-    /// two linear actuators, searching up to 20 degrees of ring (linear actuators up to 40 mm); then the platform
-    /// moves to the home pose under the normal limits.
-    pub fn trainer_model() -> Self {
-        let mut config = Self {
-            geometry: presets::TRAINER_MODEL,
-            home: Preset::TrainerModel.home(),
-            supervisor: SupervisorConfig::default(),
-            pipeline: PipelineConfig::default(),
-            scheduler: SchedulerConfig::default(),
-            scales: [
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_LINEAR,
-                AxisScale::MODEL_LINEAR,
-            ],
-            switches: HomingSettings {
-                axes: [
-                    MODEL_CARRIAGE_HOMING,
-                    MODEL_CARRIAGE_HOMING,
-                    MODEL_CARRIAGE_HOMING,
-                    MODEL_CARRIAGE_HOMING,
-                    MODEL_LINEAR_HOMING,
-                    MODEL_LINEAR_HOMING,
-                ],
-                order: [4, 5, 0, 2, 1, 3],
-            },
-            homing: HomingConfig {
-                axes: [AxisHoming {
-                    toward: 1,
-                    search_steps: 0,
-                    backoff_steps: 0,
-                    fast_rate: 0,
-                    slow_rate: 0,
-                    home_position: 0,
-                }; 6],
-                order: [0; 6],
-            },
-            inputs: InputConfig::default(),
-            telemetry_hz: 100,
-            rig_name: [0; RIG_NAME_LEN],
-        };
-        config.rig_name = RigRecord::new(
-            presets::TRAINER_MODEL.name,
-            &config.geometry,
-            config.home,
-            config.machine(),
-        )
-        .name;
-        // Finite, positive values in range: the conversion cannot fail (a test holds it to the steps of FIRMWARE.md).
-        if let Ok(homing) = config.homing_steps() {
-            config.homing = homing;
-        }
-        config
-    }
-
     /// The step generator's slot grid for this configuration.
     pub fn pulse_timing(&self) -> Result<PulseTiming, PulseTimingError> {
         PulseTiming::new(&self.scheduler, STEP_SLOT_NS, MAX_STEP_SLOTS)
@@ -181,13 +123,13 @@ impl ControllerConfig {
         for (a, kind) in axes.iter().enumerate() {
             if *kind == AxisKind::Ring {
                 machine.axes[a].steps_per_unit = AxisScale::MODEL_CARRIAGE.steps_per_turn as f32;
-                machine.homing.axes[a] = MODEL_CARRIAGE_HOMING;
+                machine.homing.axes[a] = CARRIAGE_HOMING;
             } else {
                 machine.axes[a].steps_per_unit = AxisScale::MODEL_LINEAR.steps_per_unit;
                 let switch = geometry.limits.stroke[0] - 0.001 - q[a];
                 machine.homing.axes[a] = SwitchSettings {
                     switch: switch as f32,
-                    ..MODEL_LINEAR_HOMING
+                    ..LINEAR_HOMING
                 };
             }
         }
@@ -235,27 +177,3 @@ impl ControllerConfig {
         }
     }
 }
-
-/// The trainer model's carriage homing: the index flags sit at the carriages' home-pose angles; searched up to 20
-/// degrees of ring at 4,000 steps/s of its 25,600 per turn, backed off 2 degrees, approached at 500 steps/s.
-const MODEL_CARRIAGE_HOMING: SwitchSettings = SwitchSettings {
-    toward: Toward::Plus,
-    switch: 0.0,
-    search: 20.0 * core::f32::consts::PI / 180.0,
-    backoff: 2.0 * core::f32::consts::PI / 180.0,
-    fast: 4_000.0 * core::f32::consts::TAU / 25_600.0,
-    slow: 500.0 * core::f32::consts::TAU / 25_600.0,
-};
-
-/// The trainer model's linear-actuator homing: the lower end switch at 165 mm, below the 173 mm the spec ranges use
-/// and above the 160 mm stroke minimum, 66.31 mm below the home-pose length of 231.31 mm (the platform parks low);
-/// searched up to 40 mm (the platform parks within 40 mm of the switches) at 20 mm/s, backed off 2 mm, approached
-/// at 2.5 mm/s.
-const MODEL_LINEAR_HOMING: SwitchSettings = SwitchSettings {
-    toward: Toward::Minus,
-    switch: -0.066_31,
-    search: 0.040,
-    backoff: 0.002,
-    fast: 0.020,
-    slow: 0.0025,
-};

@@ -197,7 +197,7 @@ impl Controller {
     }
 
     /// The electrical levels of the input pins as the board sampled them (before debouncing and polarity), for
-    /// [`HostMessage::GetInputs`].
+    /// [`crate::protocol::HostMessage::GetInputs`].
     pub fn set_raw_inputs(&mut self, raw: u16) {
         self.raw_inputs = Some(raw);
     }

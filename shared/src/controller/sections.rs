@@ -152,7 +152,7 @@ impl ControllerConfig {
     }
 
     /// The homing sections in motor steps, with each axis's steps per unit and direction.
-    pub(super) fn homing_steps(&self) -> Result<HomingConfig, ConfigError> {
+    pub(crate) fn homing_steps(&self) -> Result<HomingConfig, ConfigError> {
         let kinds = self.axis_kinds();
         let mut axes = [self.homing.axes[0]; 6];
         for (a, slot) in axes.iter_mut().enumerate() {

@@ -16,21 +16,6 @@ pub struct MotionLimits {
     pub actuator_acceleration: [f32; 6],
 }
 
-impl MotionLimits {
-    /// The 1:20 trainer model: 0.05 m/s (spec table), 1.9 rad/s of yaw (its test motion) and 1 rad/s of tilt;
-    /// accelerations of 1 m/s^2 and 20 rad/s^2 let the 50 Hz vibration tests run at small amplitude. Actuators:
-    /// 2.4 rad/s on the carriages (9.8 k steps/s) and 0.06 m/s on the linear actuators (96 k steps/s), inside the
-    /// 100 k steps/s the step generator sustains. Actuator accelerations (100 rad/s^2, 5 m/s^2) are above what the
-    /// pose limits ask through the Jacobian over the workspace, so they bind only near singularities, where the
-    /// motion is slowed to keep the steppers from losing steps.
-    pub const TRAINER_MODEL: MotionLimits = MotionLimits {
-        pose_velocity: [0.05, 0.05, 0.05, 1.0, 1.0, 1.9],
-        pose_acceleration: [1.0, 1.0, 1.0, 20.0, 20.0, 20.0],
-        actuator_velocity: [2.4, 2.4, 2.4, 2.4, 0.06, 0.06],
-        actuator_acceleration: [100.0, 100.0, 100.0, 100.0, 5.0, 5.0],
-    };
-}
-
 /// One axis following a reference under a velocity and an acceleration limit, in discrete time.
 ///
 /// The speed it commands toward the reference is never more than it can brake from, a tick at a time, before the

@@ -15,19 +15,6 @@ pub struct AxisScale {
 }
 
 impl AxisScale {
-    /// FL20 (200 full steps) at 1/16 microstepping on an 8:1 ring gear: 25,600 steps per carriage turn.
-    pub const MODEL_CARRIAGE: AxisScale = AxisScale {
-        steps_per_turn: 25_600,
-        steps_per_unit: 25_600.0 / core::f32::consts::TAU,
-        invert: false,
-    };
-    /// FL20 at 1/16 on a 2 mm lead screw: 1.6 M steps per metre.
-    pub const MODEL_LINEAR: AxisScale = AxisScale {
-        steps_per_turn: 0,
-        steps_per_unit: 1.6e6,
-        invert: false,
-    };
-
     /// Steps per unit of the actuator coordinate (per radian for ring axes).
     pub fn per_unit(&self, kind: AxisKind) -> f32 {
         match kind {

@@ -19,10 +19,7 @@ pub struct AxisSwitches {
     pub far_limit: Option<i64>,
 }
 
-/// Where the simulator parks the trainer model (steps from each axis's switch): carriages a few degrees before
-/// their index flags, linear actuators 5-6 mm above their home ends. The host simulator, the QEMU controller and the
-/// tests start here, so that the same input ends at the same step positions on each of them.
-pub const TRAINER_MODEL_PARKED: [i64; 6] = [-500, -400, -300, -200, 8_000, 9_000];
+pub use crate::model::TRAINER_MODEL_PARKED;
 
 /// The simulated plant.
 #[derive(Debug, Clone)]

@@ -1,0 +1,133 @@
+//! The 1:20 trainer model of FIRMWARE.md, every number of it in this one file: its motors, pose and actuator limits,
+//! homing, the configuration the firmware compiles in, and where the simulator parks it. Its geometry and home pose
+//! are a preset among the source's mechanisms (`kinematics::presets::TRAINER_MODEL`, `Preset::TrainerModel`) and
+//! its spec ranges are there too; its motors' torque curves are host data (`ringpod presets --export`). Another rig
+//! takes its own numbers from its rig file and starts from these where the file says nothing
+//! ([`ControllerConfig::default_record`]).
+
+use crate::controller::ControllerConfig;
+use crate::kinematics::presets::{self, Preset};
+use crate::motion::{AxisScale, MotionLimits, PipelineConfig, SchedulerConfig};
+use crate::protocol::{HomingSettings, RigRecord, SwitchSettings, Toward, RIG_NAME_LEN};
+use crate::safety::debounce::InputConfig;
+use crate::safety::homing::{AxisHoming, HomingConfig};
+use crate::safety::SupervisorConfig;
+
+impl MotionLimits {
+    /// The 1:20 trainer model: 0.05 m/s (spec table), 1.9 rad/s of yaw (its test motion) and 1 rad/s of tilt;
+    /// accelerations of 1 m/s^2 and 20 rad/s^2 let the 50 Hz vibration tests run at small amplitude. Actuators:
+    /// 2.4 rad/s on the carriages (9.8 k steps/s) and 0.06 m/s on the linear actuators (96 k steps/s), inside the
+    /// 100 k steps/s the step generator sustains. Actuator accelerations (100 rad/s^2, 5 m/s^2) are above what the
+    /// pose limits ask through the Jacobian over the workspace, so they bind only near singularities, where the
+    /// motion is slowed to keep the steppers from losing steps.
+    pub const TRAINER_MODEL: MotionLimits = MotionLimits {
+        pose_velocity: [0.05, 0.05, 0.05, 1.0, 1.0, 1.9],
+        pose_acceleration: [1.0, 1.0, 1.0, 20.0, 20.0, 20.0],
+        actuator_velocity: [2.4, 2.4, 2.4, 2.4, 0.06, 0.06],
+        actuator_acceleration: [100.0, 100.0, 100.0, 100.0, 5.0, 5.0],
+    };
+}
+
+impl AxisScale {
+    /// FL20 (200 full steps) at 1/16 microstepping on an 8:1 ring gear: 25,600 steps per carriage turn.
+    pub const MODEL_CARRIAGE: AxisScale = AxisScale {
+        steps_per_turn: 25_600,
+        steps_per_unit: 25_600.0 / core::f32::consts::TAU,
+        invert: false,
+    };
+    /// FL20 at 1/16 on a 2 mm lead screw: 1.6 M steps per metre.
+    pub const MODEL_LINEAR: AxisScale = AxisScale {
+        steps_per_turn: 0,
+        steps_per_unit: 1.6e6,
+        invert: false,
+    };
+}
+
+impl ControllerConfig {
+    /// The 1:20 trainer model with the FL20 drives of FIRMWARE.md: carriages home in the order 1, 3, 2, 4 after the
+    /// two linear actuators, searching up to 20 degrees of ring (linear actuators up to 40 mm); then the platform
+    /// moves to the home pose under the normal limits.
+    pub fn trainer_model() -> Self {
+        let mut config = Self {
+            geometry: presets::TRAINER_MODEL,
+            home: Preset::TrainerModel.home(),
+            supervisor: SupervisorConfig::default(),
+            pipeline: PipelineConfig::default(),
+            scheduler: SchedulerConfig::default(),
+            scales: [
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_CARRIAGE,
+                AxisScale::MODEL_LINEAR,
+                AxisScale::MODEL_LINEAR,
+            ],
+            switches: HomingSettings {
+                axes: [
+                    CARRIAGE_HOMING,
+                    CARRIAGE_HOMING,
+                    CARRIAGE_HOMING,
+                    CARRIAGE_HOMING,
+                    LINEAR_HOMING,
+                    LINEAR_HOMING,
+                ],
+                order: [4, 5, 0, 2, 1, 3],
+            },
+            homing: HomingConfig {
+                axes: [AxisHoming {
+                    toward: 1,
+                    search_steps: 0,
+                    backoff_steps: 0,
+                    fast_rate: 0,
+                    slow_rate: 0,
+                    home_position: 0,
+                }; 6],
+                order: [0; 6],
+            },
+            inputs: InputConfig::default(),
+            telemetry_hz: 100,
+            rig_name: [0; RIG_NAME_LEN],
+        };
+        config.rig_name = RigRecord::new(
+            presets::TRAINER_MODEL.name,
+            &config.geometry,
+            config.home,
+            config.machine(),
+        )
+        .name;
+        // Finite, positive values in range: the conversion cannot fail (a test holds it to the steps of FIRMWARE.md).
+        if let Ok(homing) = config.homing_steps() {
+            config.homing = homing;
+        }
+        config
+    }
+}
+
+/// The trainer model's carriage homing: the index flags sit at the carriages' home-pose angles; searched up to 20
+/// degrees of ring at 4,000 steps/s of its 25,600 per turn, backed off 2 degrees, approached at 500 steps/s.
+pub const CARRIAGE_HOMING: SwitchSettings = SwitchSettings {
+    toward: Toward::Plus,
+    switch: 0.0,
+    search: 20.0 * core::f32::consts::PI / 180.0,
+    backoff: 2.0 * core::f32::consts::PI / 180.0,
+    fast: 4_000.0 * core::f32::consts::TAU / 25_600.0,
+    slow: 500.0 * core::f32::consts::TAU / 25_600.0,
+};
+
+/// The trainer model's linear-actuator homing: the lower end switch at 165 mm, below the 173 mm the spec ranges use
+/// and above the 160 mm stroke minimum, 66.31 mm below the home-pose length of 231.31 mm (the platform parks low);
+/// searched up to 40 mm (the platform parks within 40 mm of the switches) at 20 mm/s, backed off 2 mm, approached
+/// at 2.5 mm/s.
+pub const LINEAR_HOMING: SwitchSettings = SwitchSettings {
+    toward: Toward::Minus,
+    switch: -0.066_31,
+    search: 0.040,
+    backoff: 0.002,
+    fast: 0.020,
+    slow: 0.0025,
+};
+
+/// Where the simulator parks the trainer model (steps from each axis's switch): carriages a few degrees before
+/// their index flags, linear actuators 5-6 mm above their home ends. The host simulator, the QEMU controller and the
+/// tests start here, so that the same input ends at the same step positions on each of them.
+pub const TRAINER_MODEL_PARKED: [i64; 6] = [-500, -400, -300, -200, 8_000, 9_000];
