@@ -12,7 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, MotionLimits, RejectReason, Setpoint};
-use ringpod_core::protocol::{HostMessage, Settings, SettingsKind, Status};
+use ringpod_core::protocol::{HostMessage, RigSource, Settings, SettingsKind, Status};
 use ringpod_core::safety::{FaultReason, State};
 use serde::Serialize;
 
@@ -816,7 +816,11 @@ struct DeviceEnvelope {
 }
 
 fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelope, ClientError> {
-    let (rig, _, _) = client.rig()?;
+    let (rig, source, _) = client.rig()?;
+    if let RigSource::Refused(_) | RigSource::Unreadable = source {
+        // The board runs its compiled-in rig: said before anything moves, not found out from the motion.
+        eprintln!("warning: {source}");
+    }
     let geometry = rig
         .geometry()
         .map_err(|e| ClientError::Unexpected(format!("the device's rig does not check: {e}")))?;

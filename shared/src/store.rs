@@ -27,7 +27,7 @@ pub const RIG_RECORD_VERSION: u16 = 2;
 pub const SETTINGS_KEY: u8 = 0x80;
 /// Layout of a stored section; one of another version is not read (its defaults run, counted as refused).
 pub const SETTINGS_VERSION: u16 = 1;
-/// Room for the stored rig record: its postcard bytes (under 640) and the crate's header.
+/// Room for the stored rig record: its postcard bytes (about 560) and the crate's header.
 const RIG_BUFFER: usize = 768;
 
 /// A section as flash holds it.

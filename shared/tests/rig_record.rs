@@ -55,6 +55,7 @@ fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
     let mut raw = [0u8; 1024];
     let payload = postcard::to_slice(&HostMessage::SetRig(rig), &mut raw).unwrap();
     assert!(payload.len() <= MAX_PAYLOAD, "{} bytes", payload.len());
+    eprintln!("a rig record with six chains: {} payload bytes", payload.len());
     let back: Request = protocol::decode(&frame[..n - 1]).unwrap();
     assert_eq!(back.body, HostMessage::SetRig(rig));
 

@@ -25,8 +25,8 @@ pub struct Request {
 }
 
 /// What the host asks of the device.
-// A rig record (about 330 bytes) makes `SetRig` the largest variant by far. No heap to box it in; a request lives on
-// the stack for one dispatch, and the measured cost of a setpoint frame stays within its budget (README).
+// A rig record (about 560 bytes) makes `SetRig` the largest variant by far. No heap to box it in: a request lives on
+// the stack for one dispatch, and the stream's setpoints are read without it ([`setpoint_request`]).
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum HostMessage {
@@ -113,7 +113,7 @@ pub struct Response {
 }
 
 /// What the device says.
-// `Rig` carries a rig record (under 480 bytes), the largest variant by far; as with `HostMessage`, no heap to box it.
+// `Rig` carries a rig record (about 560 bytes), the largest variant by far; as with `HostMessage`, no heap to box it.
 #[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum DeviceMessage {
