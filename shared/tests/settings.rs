@@ -644,3 +644,127 @@ fn an_axis_reversed_corrects_a_motor_wired_the_other_way_round() {
         assert_eq!(f[a], sign * r[a], "axis {a}");
     }
 }
+
+/// A value for an `f32` field: near the defaults (mostly), anything at all, or not a number.
+fn real() -> impl Strategy<Value = f32> {
+    prop_oneof![
+        6 => 0.0f32..0.5,
+        2 => -1.0e9f32..1.0e9,
+        1 => Just(f32::NAN),
+        1 => Just(f32::INFINITY),
+        1 => any::<f32>(),
+    ]
+}
+
+/// A section of any kind with values in and out of every range.
+fn any_settings() -> impl Strategy<Value = Settings> {
+    use ringpod_core::motion::FollowMode;
+    use ringpod_core::protocol::{SwitchSettings, Toward};
+    let stream = (
+        0u16..12_000,
+        0u16..12_000,
+        any::<bool>(),
+        prop::array::uniform6(real()),
+        0u16..3_000,
+    )
+        .prop_map(|(timeout_ms, gross_jump_ms, direct, margins, telemetry_hz)| {
+            Settings::Stream(StreamSettings {
+                timeout_ms,
+                gross_jump_ms,
+                follow: if direct {
+                    FollowMode::Direct
+                } else {
+                    FollowMode::Interpolate
+                },
+                margins: margins.map(|m| m * 0.25),
+                telemetry_hz,
+            })
+        });
+    let control = prop::sample::select(vec![0u16, 500, 999, 1_000, 1_500, 2_000, 4_000])
+        .prop_map(|tick_hz| Settings::Control(ControlSettings { tick_hz }));
+    let motion = (prop::array::uniform6(real()), prop::array::uniform6(real())).prop_map(|(v, a)| {
+        Settings::Motion(MotionSettings {
+            pose_velocity: v,
+            pose_acceleration: a.map(|x| x * 40.0),
+        })
+    });
+    let inputs = (any::<u16>(), 0u8..60).prop_map(|(active_low, debounce_samples)| {
+        Settings::Inputs(InputConfig {
+            active_low,
+            debounce_samples,
+        })
+    });
+    let axes = prop::array::uniform6((
+        prop::sample::select(vec![
+            0.0f32,
+            400.0,
+            12_800.0,
+            25_600.0,
+            25_600.5,
+            1.6e6,
+            3.2e6,
+            2e7,
+            f32::NAN,
+        ]),
+        any::<bool>(),
+    ))
+    .prop_map(|a| {
+        Settings::Axes(a.map(|(steps_per_unit, reverse)| AxisSettings {
+            steps_per_unit,
+            reverse,
+        }))
+    });
+    let switch = (any::<bool>(), real(), real(), real(), real(), real()).prop_map(
+        |(plus, switch, search, backoff, fast, slow)| SwitchSettings {
+            toward: if plus { Toward::Plus } else { Toward::Minus },
+            switch: switch * 0.2,
+            search,
+            backoff: backoff * 0.1,
+            fast,
+            slow: slow * 0.1,
+        },
+    );
+    let homing = (prop::array::uniform6(0u8..7), prop::array::uniform6(switch))
+        .prop_map(|(order, axes)| Settings::Homing(HomingSettings { order, axes }));
+    let supervisor = (any::<bool>(), any::<bool>(), prop::array::uniform5(0u32..80_000)).prop_map(|(l, p, ms)| {
+        Settings::Supervisor(SupervisorConfig {
+            logic_sense: l,
+            power_sense: p,
+            logic_settle_ms: ms[0],
+            power_settle_ms: ms[1],
+            supply_timeout_ms: ms[2],
+            driver_off_ms: ms[3],
+            discharge_ms: ms[4],
+        })
+    });
+    prop_oneof![stream, control, motion, inputs, axes, homing, supervisor]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3_000))]
+
+    /// Any section, sensible or not: the controller never panics; what it takes it reports back exactly as sent,
+    /// still runs (its stored configuration builds a controller) and hands out for storing; what it refuses
+    /// changes nothing.
+    #[test]
+    fn any_section_is_taken_exactly_or_refused_with_nothing_changed(settings in any_settings()) {
+        let mut c = device::connected();
+        let before = *c.saved_config();
+        let kind = settings.kind();
+        match set(&mut c, settings) {
+            DeviceMessage::Ack => {
+                match get(&mut c, kind) {
+                    DeviceMessage::Settings { settings: back, .. } => prop_assert_eq!(back, settings),
+                    other => prop_assert!(false, "{:?}", other),
+                }
+                prop_assert!(c.saved_config().validate().is_ok());
+                prop_assert!(c.has_unsaved());
+            }
+            DeviceMessage::Nack(NackReason::BadConfig(_)) => {
+                prop_assert_eq!(*c.saved_config(), before);
+                prop_assert!(!c.has_unsaved());
+            }
+            other => prop_assert!(false, "{:?}", other),
+        }
+    }
+}
