@@ -1,0 +1,110 @@
+//! What a stream reports at its end (`--report-json`), and the names it gives the device's refusals.
+
+use std::collections::BTreeMap;
+
+use ringpod_core::motion::RejectReason;
+use serde::Serialize;
+
+use super::InputError;
+
+/// How much was limited into the envelope.
+#[derive(Debug, Default, Serialize)]
+pub struct LimitedReport {
+    /// Input poses the host limited before sending.
+    pub host: u32,
+    /// Setpoints the device limited (of those this run sent).
+    pub device: u32,
+    /// Per check that bound them (host and device).
+    pub by_check: BTreeMap<String, u32>,
+    /// The largest translation taken off a pose (mm).
+    pub largest_mm: f64,
+    /// The largest roll or pitch taken off a pose (deg).
+    pub largest_deg: f64,
+}
+
+/// What came over UDP.
+#[derive(Debug, Default, Serialize)]
+pub struct DatagramReport {
+    /// Datagrams received from the source.
+    pub received: u32,
+    /// Datagrams that did not parse (also in `input_errors`).
+    pub unreadable: u32,
+    /// Datagrams from other senders than `--udp-from`, ignored.
+    pub other_senders: u32,
+    /// Times the source paused longer than the stream timeout and the stream was led in and started again.
+    pub resumed: u32,
+    /// Telemetry: pauses of more than a second after which the washout started again at neutral.
+    pub telemetry_gaps: u32,
+}
+
+/// The end-of-run report (`--report-json`).
+#[derive(Debug, Serialize)]
+pub struct Report {
+    /// `followed`, `input_errors`, `refused`, `device_stopped`, `transport_lost` or `interrupted`.
+    pub outcome: &'static str,
+    /// Why the run ended as it did, when not simply followed.
+    pub reason: Option<String>,
+    /// The exit code (see [`exit`]).
+    pub exit_code: u8,
+    /// Final device state.
+    pub state: String,
+    /// Input setpoints sent (lead-in and settle not included).
+    pub setpoints_sent: u32,
+    /// Of those, accepted by the device (limited ones included).
+    pub setpoints_applied: u32,
+    /// Limiting into the envelope.
+    pub limited: LimitedReport,
+    /// Of the input setpoints, refused by the device, by reason.
+    pub rejected: BTreeMap<String, u32>,
+    /// Each refused input setpoint: its line (or datagram number) and the reason.
+    pub refusals: Vec<InputError>,
+    /// Lead-in setpoints (from where the platform was to the first pose, and after each restart).
+    pub lead_in_sent: u32,
+    /// Settle setpoints (the last pose held at the end).
+    pub settle_sent: u32,
+    /// Telemetry: setpoints of the washout to neutral while the source paused.
+    pub washout_sent: u32,
+    /// Times a gap in the input longer than the stream timeout let the platform come to rest and the stream was
+    /// started again.
+    pub restarts: u32,
+    /// Step position of each axis at the end.
+    pub final_steps: [i64; 6],
+    /// Faults the device reported.
+    pub faults: Vec<String>,
+    /// Input lines or datagrams that could not be used (never sent).
+    pub input_errors: Vec<InputError>,
+    /// UDP sources: what arrived.
+    pub datagrams: Option<DatagramReport>,
+    /// The last input pose the device accepted, as sent (after host limiting).
+    pub last_applied_pose: Option<[f64; 6]>,
+    /// The device's counters for this run agree with the host's, and every setpoint sent was answered.
+    pub counts_agree: bool,
+    /// `--record`: rows written (a row per telemetry sample), or why the record failed.
+    pub record: Option<RecordReport>,
+}
+
+/// What `--record` wrote.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RecordReport {
+    /// The file.
+    pub path: String,
+    /// Rows written.
+    pub rows: u64,
+    /// Telemetry samples the client dropped before they were written (none unless the host fell behind).
+    pub dropped: u64,
+    /// Why the file could not be written, if it could not.
+    pub error: Option<String>,
+}
+
+/// A refusal's name in the report.
+pub(super) fn reason_name(r: RejectReason) -> String {
+    match r {
+        RejectReason::NonFinite => "non_finite".into(),
+        RejectReason::Unreachable => "unreachable".into(),
+        RejectReason::GrossJump { outside: None } => "gross_jump".into(),
+        RejectReason::GrossJump { outside: Some(c) } => format!("gross_jump+outside:{}", c.name()),
+        RejectReason::Stale => "stale".into(),
+        RejectReason::NotStreaming => "not_streaming".into(),
+        other => format!("{other:?}").to_lowercase(),
+    }
+}

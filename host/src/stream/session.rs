@@ -1,0 +1,478 @@
+//! One run of a stream: setpoints sent ahead of their answers, the host's limiting into the device's envelope, the
+//! lead-in, settle and washout setpoints, and everything counted for the report.
+
+use std::collections::{BTreeMap, VecDeque};
+use std::time::{Duration, Instant};
+
+use indicatif::ProgressBar;
+use ringpod_core::kinematics::{Check, Pose, RingPlatform};
+use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, MotionLimits, RejectReason, Setpoint};
+use ringpod_core::protocol::{HostMessage, Status};
+use ringpod_core::safety::State;
+
+use super::report::{reason_name, DatagramReport, LimitedReport};
+use super::{InputError, UdpSource};
+use crate::client::{setpoint_answer, Client, ClientError, Transport};
+use crate::record::Recorder;
+
+/// Setpoints sent ahead of their answers: 16 ms of a 1 kHz stream, far more than a USB or pty round trip.
+const IN_FLIGHT: usize = 16;
+
+/// Why streaming ended early.
+pub(super) enum Stop {
+    /// The device stopped streaming or faulted: the reason.
+    Device(String),
+    /// Ctrl-C.
+    Interrupted,
+}
+
+/// What a setpoint is for.
+#[derive(Clone, Copy, PartialEq)]
+pub(super) enum Kind {
+    /// An input pose, with its line or datagram number.
+    Input(Option<usize>),
+    LeadIn,
+    Settle,
+    /// A telemetry source paused: the washout of a vehicle at rest.
+    Washout,
+}
+
+/// One run: the client, the host's clock and envelope, and everything counted.
+pub(super) struct Streamer<'a, T: Transport> {
+    pub(super) client: &'a mut Client<T>,
+    pub(super) interrupted: &'a dyn Fn() -> bool,
+    pub(super) bar: ProgressBar,
+    pub(super) mechanism: RingPlatform<f64>,
+    pub(super) margins: EnvelopeMargins,
+    pub(super) host_limits: bool,
+    pub(super) limits: MotionLimits,
+    pub(super) stream_timeout: Duration,
+    /// The middle of the workspace, from which poses are limited (the home pose).
+    pub(super) centre: Pose<f64>,
+    /// The last pose sent (limited).
+    pub(super) last_sent: Pose<f64>,
+    pub(super) clock_us: u64,
+    pub(super) seq: u32,
+    pub(super) baseline: Status,
+    // Counts.
+    pub(super) sent_all: u32,
+    pub(super) applied_all: u32,
+    pub(super) rejected_all: u32,
+    pub(super) device_limited: u32,
+    pub(super) input_sent: u32,
+    pub(super) input_applied: u32,
+    pub(super) lead_in: u32,
+    pub(super) settle: u32,
+    pub(super) washout: u32,
+    pub(super) restarts: u32,
+    pub(super) rejected: BTreeMap<String, u32>,
+    pub(super) refusals: Vec<InputError>,
+    pub(super) limited: LimitedReport,
+    pub(super) last_applied: Option<Pose<f64>>,
+    /// Setpoints sent and not yet answered: request id, input line or datagram number, pose.
+    pub(super) in_flight: VecDeque<(u32, Option<usize>, Pose<f64>)>,
+    pub(super) refused_in_a_row: u32,
+    pub(super) last_refusal: Option<String>,
+    /// `--record`: the open file, and the first write error.
+    pub(super) recorder: Option<Recorder>,
+    pub(super) record_error: Option<String>,
+}
+
+impl<'a, T: Transport> Streamer<'a, T> {
+    /// Takes the telemetry that has arrived: written to the record with the pose sent last, or dropped when
+    /// nothing records (so the client's queue stays empty).
+    pub(super) fn record(&mut self) -> Result<(), ClientError> {
+        let samples = self.client.take_telemetry()?;
+        if let (Some(r), None) = (self.recorder.as_mut(), &self.record_error) {
+            for t in &samples {
+                if let Err(e) = r.write(&self.last_sent, t) {
+                    self.record_error = Some(e.to_string());
+                    break;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Lets `dt` pass on the device's clock, in slices so that Ctrl-C is seen within 50 ms.
+    fn elapse(&mut self, dt: Duration) -> Result<(), Stop> {
+        let mut left = dt;
+        while !left.is_zero() {
+            if (self.interrupted)() {
+                return Err(Stop::Interrupted);
+            }
+            let slice = left.min(Duration::from_millis(50));
+            self.client.transport().elapse(slice);
+            left -= slice;
+            // A lost transport shows at the next request; the record only misses what it could not read.
+            let _ = self.record();
+        }
+        self.clock_us = self.clock_us.saturating_add((dt.as_micros() as u64).max(1));
+        Ok(())
+    }
+
+    /// Limits a pose into the envelope (host side, f64) on the ray from the centre, as the device does.
+    fn limit(&mut self, pose: Pose<f64>) -> Pose<f64> {
+        if !self.host_limits || !pose.to_array().iter().all(|c| c.is_finite()) {
+            // Garbage goes to the device as it is, to be refused with its reason.
+            return pose;
+        }
+        let limited = envelope::limit(&self.mechanism, &self.centre, &pose, &self.margins, 16);
+        if let Some(check) = limited.bound_by {
+            let (mm, rad) = envelope::correction(&pose, &limited.pose);
+            self.limited.host += 1;
+            self.count_limit(check, mm, rad);
+        }
+        limited.pose
+    }
+
+    fn count_limit(&mut self, check: Check, translation_m: f64, rotation_rad: f64) {
+        *self.limited.by_check.entry(check.name().to_string()).or_default() += 1;
+        self.limited.largest_mm = self.limited.largest_mm.max(translation_m * 1e3);
+        self.limited.largest_deg = self.limited.largest_deg.max(rotation_rad.to_degrees());
+    }
+
+    /// Sends one setpoint without waiting for its answer (a round trip per setpoint would cap the rate at one
+    /// per round trip: 1 kHz needs them in flight), then counts the answers that have arrived, waiting while more
+    /// than [`IN_FLIGHT`] are outstanding. A device that stops streaming ends the run.
+    fn send(&mut self, pose: Pose<f64>, kind: Kind) -> Result<(), StreamError> {
+        self.seq = self.seq.wrapping_add(1);
+        self.sent_all += 1;
+        if let Kind::Input(_) = kind {
+            self.input_sent += 1;
+        }
+        let id = self.client.send(HostMessage::Setpoint(Setpoint {
+            seq: self.seq,
+            time_us: self.clock_us,
+            pose: pose.cast(),
+        }))?;
+        if pose.to_array().iter().all(|c| c.is_finite()) {
+            self.last_sent = pose;
+        }
+        let number = match kind {
+            Kind::Input(line) => Some(line.unwrap_or(self.input_sent as usize)),
+            _ => None,
+        };
+        self.in_flight.push_back((id, number, pose));
+        self.collect(IN_FLIGHT)
+    }
+
+    /// Counts the answers to setpoints in flight, in order, until at most `keep` are outstanding.
+    pub(super) fn collect(&mut self, keep: usize) -> Result<(), StreamError> {
+        let step = Duration::from_micros(200);
+        let mut waited = Duration::ZERO;
+        while let Some(&(id, number, pose)) = self.in_flight.front() {
+            let Some(answer) = self.client.take_response(id)? else {
+                if self.in_flight.len() <= keep {
+                    break;
+                }
+                if waited >= self.client.timeout {
+                    return Err(ClientError::Timeout(self.client.timeout).into());
+                }
+                self.client.transport().elapse(step);
+                waited += step;
+                continue;
+            };
+            self.in_flight.pop_front();
+            self.answered(setpoint_answer(answer)?, number, pose)?;
+        }
+        self.record()?;
+        if let Some(f) = self.client.faults.last() {
+            return Err(StreamError::Stop(Stop::Device(format!(
+                "the device latched a fault: {f}"
+            ))));
+        }
+        Ok(())
+    }
+
+    /// Counts one answer; `number` is an input setpoint's line or datagram number (`None`: lead-in or settle).
+    fn answered(
+        &mut self,
+        answer: Result<Accepted, RejectReason>,
+        number: Option<usize>,
+        pose: Pose<f64>,
+    ) -> Result<(), StreamError> {
+        match answer {
+            Ok(accepted) => {
+                self.applied_all += 1;
+                self.refused_in_a_row = 0;
+                if let Accepted::Limited(r) = accepted {
+                    self.device_limited += 1;
+                    self.count_limit(r.check, f64::from(r.translation), f64::from(r.rotation));
+                }
+                if number.is_some() {
+                    self.input_applied += 1;
+                    self.last_applied = Some(pose);
+                }
+            }
+            Err(reason) => {
+                self.rejected_all += 1;
+                let name = reason_name(reason);
+                if let Some(number) = number {
+                    *self.rejected.entry(name.clone()).or_default() += 1;
+                    self.bar
+                        .suspend(|| eprintln!("line {number}: refused by the device: {name}"));
+                    self.refusals.push(InputError {
+                        line: number,
+                        reason: name.clone(),
+                    });
+                }
+                if reason == RejectReason::NotStreaming {
+                    let status = self.client.status()?;
+                    let fault = self
+                        .client
+                        .faults
+                        .last()
+                        .map_or(String::new(), |f| format!(": fault {f}"));
+                    let before = match &self.last_refusal {
+                        Some(last) if self.refused_in_a_row > 0 => format!(
+                            ", after {} refused setpoints in a row (the last: {last})",
+                            self.refused_in_a_row
+                        ),
+                        _ => String::new(),
+                    };
+                    return Err(StreamError::Stop(Stop::Device(format!(
+                        "the device stopped streaming ({:?}){fault}{before}",
+                        status.state
+                    ))));
+                }
+                self.refused_in_a_row += 1;
+                self.last_refusal = Some(name);
+            }
+        }
+        Ok(())
+    }
+
+    /// Starts the stream (the device must be `Ready`) and leads the platform from where it is to `first` at a
+    /// quarter of the speed limits, at 100 Hz. Returns `first` as limited.
+    fn start_and_lead_in(&mut self, first: Pose<f64>) -> Result<Pose<f64>, StreamError> {
+        self.collect(0)?;
+        let status = self.client.wait_for(Duration::from_secs(10), |s| {
+            !matches!(s.state, State::Running | State::Stopping)
+        })?;
+        if status.state != State::Ready {
+            return Err(StreamError::Stop(Stop::Device(format!(
+                "the device is in {:?}, not ready to stream",
+                status.state
+            ))));
+        }
+        self.client.start()?;
+        let now = status.pose.cast::<f64>();
+        self.last_sent = now;
+        let first = self.limit(first);
+        let (a, b) = (now.to_array(), first.to_array());
+        // The way from here to the first pose; yaw the short way round.
+        let way: [f64; 6] = std::array::from_fn(|i| {
+            let d = b[i] - a[i];
+            if i == 5 {
+                (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+            } else {
+                d
+            }
+        });
+        let seconds = (0..6).fold(0.0f64, |m, i| {
+            m.max(way[i].abs() / (0.25 * f64::from(self.limits.pose_velocity[i])))
+        });
+        let n = (seconds * 100.0).ceil() as usize;
+        for k in 1..=n {
+            let f = k as f64 / n as f64;
+            let pose = Pose::from_array(std::array::from_fn(|i| a[i] + way[i] * f));
+            self.elapse(Duration::from_millis(10))?;
+            let pose = self.limit(pose);
+            self.send(pose, Kind::LeadIn)?;
+            self.lead_in += 1;
+        }
+        // The first pose follows the lead-in by one of its intervals.
+        self.elapse(Duration::from_millis(10))?;
+        Ok(first)
+    }
+
+    /// Holds the last pose until the platform has arrived there (the device's commanded pose equals its target),
+    /// at least 250 ms and at most 10 s: a platform slowed by its limits can be far behind its source when the
+    /// source ends, and stopping before it arrives would leave it wherever braking ends.
+    fn settle(&mut self) -> Result<(), StreamError> {
+        let last = self.last_sent;
+        for k in 1..=1000u32 {
+            self.elapse(Duration::from_millis(10))?;
+            self.send(last, Kind::Settle)?;
+            self.settle += 1;
+            if k >= 25 && k % 5 == 0 {
+                self.collect(0)?;
+                let s = self.client.status()?;
+                let (p, t) = (s.pose.to_array(), s.target.to_array());
+                let arrived = (0..6).all(|i| {
+                    let d = t[i] - p[i];
+                    let d = if i == 5 { d.sin().atan2(d.cos()) } else { d };
+                    d.abs() <= 2e-6
+                });
+                if arrived {
+                    break;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Streams timed poses (a file or a motion): each at its own time; a gap longer than the stream timeout
+    /// lets the platform come to rest, and the stream is led in and started again at the next pose.
+    pub(super) fn timed(
+        &mut self,
+        poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>)>,
+        fast: bool,
+    ) -> Result<(), StreamError> {
+        let mut last_t: Option<f64> = None;
+        for (line, t, pose) in poses {
+            if (self.interrupted)() {
+                return Err(StreamError::Stop(Stop::Interrupted));
+            }
+            let gap = last_t.map_or(0.0, |l| (t - l).max(0.0));
+            let pose = match last_t {
+                None => self.start_and_lead_in(pose)?,
+                Some(_) if gap > self.stream_timeout.as_secs_f64() => {
+                    // The device brakes to rest by itself; nothing happens after that, so a fast run does not
+                    // compute the rest of the gap.
+                    let wait = if fast { gap.min(3.0) } else { gap };
+                    self.elapse(Duration::from_secs_f64(wait))?;
+                    self.restarts += 1;
+                    self.bar
+                        .suspend(|| eprintln!("{gap:.3} s gap in the input: the platform rests, then leads in again"));
+                    self.start_and_lead_in(pose)?
+                }
+                Some(_) => {
+                    self.elapse(Duration::from_secs_f64(gap))?;
+                    self.limit(pose)
+                }
+            };
+            last_t = Some(t);
+            self.send(pose, Kind::Input(line))?;
+            self.bar.inc(1);
+        }
+        if last_t.is_some() {
+            self.settle()?;
+        }
+        self.collect(0)
+    }
+
+    /// Streams datagrams as they arrive: the platform waits where it is for the first one, leads in and starts;
+    /// a pause longer than the stream timeout brakes it to rest, and the next datagram leads in and starts again;
+    /// `idle` without a datagram ends the session.
+    pub(super) fn live(
+        &mut self,
+        source: &mut UdpSource,
+        report: &mut DatagramReport,
+        errors: &mut Vec<InputError>,
+    ) -> Result<(), StreamError> {
+        source
+            .socket
+            .set_read_timeout(Some(Duration::from_millis(1)))
+            .map_err(ClientError::Io)?;
+        self.bar.suspend(|| {
+            eprintln!(
+                "streaming: send datagrams to {}",
+                source.socket.local_addr().map_or("?".into(), |a| a.to_string())
+            )
+        });
+        // The largest UDP payload: no datagram is ever cut.
+        let mut buf = vec![0u8; 65_536];
+        let mut wall = Instant::now();
+        let mut last_datagram = Instant::now();
+        let mut last_idle = Instant::now();
+        let mut streaming = false;
+        loop {
+            if (self.interrupted)() {
+                return Err(StreamError::Stop(Stop::Interrupted));
+            }
+            let got = source.socket.recv_from(&mut buf);
+            let now = Instant::now();
+            self.elapse(now - wall)?;
+            wall = now;
+            let (n, from) = match got {
+                Ok(got) => got,
+                // A signal (Ctrl-C) interrupts the wait: nothing arrived, and the loop then sees the flag.
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                    ) =>
+                {
+                    let quiet = now - last_datagram;
+                    // Telemetry that pauses washes out: the vehicle at rest, through the washout, every 10 ms
+                    // from half the stream timeout on, so the platform glides back to neutral.
+                    if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= Duration::from_millis(10) {
+                        let dt = (now - last_idle).min(Duration::from_millis(20)).as_secs_f64();
+                        last_idle = now;
+                        if let Some(pose) = source.decoder.idle(dt, now) {
+                            let pose = self.limit(pose);
+                            self.send(pose, Kind::Washout)?;
+                            self.washout += 1;
+                            continue;
+                        }
+                    }
+                    if streaming && quiet > self.stream_timeout && !source.decoder.washes_out() {
+                        // The source paused (a game's menu): the device brakes to rest by itself.
+                        streaming = false;
+                        if self.last_applied.is_some() {
+                            self.bar.suspend(|| eprintln!("the source paused: the platform rests"));
+                        }
+                    }
+                    if quiet >= source.idle {
+                        return self.collect(0);
+                    }
+                    continue;
+                }
+                Err(e) => return Err(ClientError::Io(e).into()),
+            };
+            if source.from.is_some_and(|ip| ip != from.ip()) {
+                report.other_senders += 1;
+                continue;
+            }
+            last_datagram = now;
+            last_idle = now;
+            report.received += 1;
+            let number = report.received as usize;
+            let pose = match source.decoder.decode(&buf[..n], now) {
+                Ok(pose) => pose,
+                Err(reason) => {
+                    report.unreadable += 1;
+                    self.bar.suspend(|| eprintln!("datagram {number}: {reason}"));
+                    errors.push(InputError { line: number, reason });
+                    continue;
+                }
+            };
+            let pose = if streaming {
+                self.limit(pose)
+            } else {
+                if self.last_applied.is_some() {
+                    report.resumed += 1;
+                }
+                streaming = true;
+                self.start_and_lead_in(pose)?
+            };
+            self.send(pose, Kind::Input(Some(number)))?;
+            self.bar.inc(1);
+            // The lead-in let its own time pass: the device's clock is already there.
+            wall = Instant::now();
+        }
+    }
+}
+
+/// How a stream ended early.
+pub(super) enum StreamError {
+    Stop(Stop),
+    Client(ClientError),
+}
+
+impl From<ClientError> for StreamError {
+    fn from(e: ClientError) -> Self {
+        match e {
+            ClientError::Interrupted => StreamError::Stop(Stop::Interrupted),
+            other => StreamError::Client(other),
+        }
+    }
+}
+
+impl From<Stop> for StreamError {
+    fn from(s: Stop) -> Self {
+        StreamError::Stop(s)
+    }
+}

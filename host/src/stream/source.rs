@@ -1,0 +1,137 @@
+//! Where a stream's poses come from: a built-in motion, a pose file, or UDP datagrams from simulator software.
+
+use std::time::Duration;
+
+use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
+use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
+use ringpod_core::motion::MotionLimits;
+
+use super::InputError;
+
+/// Built-in motions (trainer-model ranges and the test motions of the physical model).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Motion {
+    /// All six axes at once within a third of their ranges, yaw turning at 0.5 rad/s.
+    Demo,
+    /// Vertical vibration sweep 1 -> 50 Hz, amplitude limited to stay inside the speed and acceleration limits.
+    Vibration,
+    /// Continuous yaw at 1.9 rad/s.
+    Yaw,
+    /// Heave sine, 10 mm at 0.5 Hz.
+    Heave,
+}
+
+/// A pose of an input file: its line number, its time (s) and the pose.
+pub type TimedPose = (usize, f64, Pose<f64>);
+
+/// Where poses come from.
+pub enum Source {
+    /// A motion, sampled at `rate_hz` for `seconds` (generated as it is sent).
+    Motion {
+        /// Which.
+        motion: Motion,
+        /// How long (s).
+        seconds: f64,
+        /// Setpoints per second.
+        rate_hz: f64,
+    },
+    /// Timed poses from a CSV file.
+    Poses(Vec<TimedPose>),
+    /// Poses from UDP datagrams, sent as they arrive.
+    Udp(UdpSource),
+}
+
+/// A live source of poses: simulator software sending one datagram per pose or per telemetry sample.
+pub struct UdpSource {
+    /// The bound socket.
+    pub socket: std::net::UdpSocket,
+    /// What a datagram means.
+    pub decoder: crate::datagram::Decoder,
+    /// End after this long without a datagram.
+    pub idle: Duration,
+    /// Take datagrams from this address only.
+    pub from: Option<std::net::IpAddr>,
+}
+
+/// The columns of a pose file.
+pub const POSE_COLUMNS: [&str; 7] = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
+
+/// Reads a pose file: `t,x,y,z,alpha,beta,gamma` named in its header in any order (seconds, metres, radians or
+/// degrees; [`crate::table::read`]). NaN and infinity in a pose are passed on: the device refuses them with a
+/// reason, which is the point.
+pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputError>), String> {
+    let (rows, errors) = crate::table::read(text, &POSE_COLUMNS)?;
+    let a = |x: f64| if degrees { x.to_radians() } else { x };
+    let poses = rows
+        .into_iter()
+        .map(|(line, v)| (line, v[0], Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6]))))
+        .collect();
+    Ok((poses, errors))
+}
+
+/// `stream --check-loads`: the drive demand of a file's or built-in motion's poses on the trainer model, against
+/// its drives, before anything moves.
+pub fn check_loads(
+    source: &Source,
+    payload: &ringpod_core::kinematics::Payload<f64>,
+) -> anyhow::Result<crate::demand::Preflight> {
+    let PresetGeometry::Ring(geometry) = Preset::TrainerModel.geometry() else {
+        anyhow::bail!("the trainer model is a ring platform");
+    };
+    let ring = RingPlatform::new(geometry);
+    let drives = crate::rig::drives::check(&crate::rig::drives::of_preset(Preset::TrainerModel), &ring.axes())?;
+    let rows: Vec<(usize, f64, Pose<f64>)> = match source {
+        Source::Poses(p) => p.clone(),
+        Source::Motion {
+            motion,
+            seconds,
+            rate_hz,
+        } => {
+            let n = (seconds * rate_hz).round() as usize;
+            (0..=n)
+                .map(|k| {
+                    let t = k as f64 / rate_hz;
+                    (k + 1, t, motion_pose(*motion, t, Preset::TrainerModel.home()))
+                })
+                .collect()
+        }
+        Source::Udp(_) => anyhow::bail!("--check-loads needs the poses beforehand (--input or --motion)"),
+    };
+    crate::demand::preflight(&ring, &drives, &rows, payload).map_err(|e| anyhow::anyhow!("--check-loads: {e}"))
+}
+
+/// Pose of a built-in motion at time `t` (s) around `home`. Every motion stays inside the envelope at any time
+/// and yaw (tested for 120 s each), so host limiting leaves it unchanged.
+pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6]) -> Pose<f64> {
+    let mut p = home;
+    let tau = std::f64::consts::TAU;
+    let limits = MotionLimits::TRAINER_MODEL;
+    match motion {
+        Motion::Demo => {
+            // A third of each range (the combined extremes of half the ranges leave the envelope at some yaws),
+            // frequencies low enough for the 0.05 m/s and 1 rad/s limits; the motion starts at home and eases in
+            // over the first two seconds.
+            let ease = (t / 2.0).min(1.0);
+            for (i, f) in [0.2, 0.15, 0.25, 0.3, 0.22].iter().enumerate() {
+                p[i] += ease * TRAINER_MODEL_RANGES[i] / 3.0 * (tau * f * t).sin();
+            }
+            p[5] = (0.5 * t * ease).rem_euclid(tau);
+        }
+        Motion::Vibration => {
+            // Sweep the frequency linearly from 1 to 50 Hz over 20 s; the amplitude is the largest that keeps the
+            // speed and acceleration inside the limits at the current frequency, capped at 1 mm.
+            let f = 1.0 + 49.0 * (t / 20.0).min(1.0);
+            let w = tau * f;
+            let amp = 0.001f64
+                .min(0.8 * f64::from(limits.pose_velocity[2]) / w)
+                .min(0.8 * f64::from(limits.pose_acceleration[2]) / (w * w));
+            // Phase of the linear chirp: the integral of f over time.
+            let s = t.min(20.0);
+            let phase = tau * (s + 49.0 * s * s / 40.0 + 50.0 * (t - s));
+            p[2] += amp * phase.sin();
+        }
+        Motion::Yaw => p[5] = (1.9 * t.min(1.0).powi(2) * 0.5 + 1.9 * (t - 1.0).max(0.0)).rem_euclid(tau),
+        Motion::Heave => p[2] += 0.010 * (tau * 0.5 * t).sin(),
+    }
+    Pose::from_array(p)
+}
