@@ -250,7 +250,7 @@ pub fn run<T: Transport>(
             let n = (seconds * rate_hz).round() as u64;
             let mut poses = (0..=n).map(|k| {
                 let t = k as f64 / rate_hz;
-                (None, t, motion_pose(motion, t, home))
+                (None, t, motion_pose(motion, t, home, &limits))
             });
             s.timed(&mut poses, fast)
         }

@@ -91,7 +91,11 @@ pub fn check_loads(
             (0..=n)
                 .map(|k| {
                     let t = k as f64 / rate_hz;
-                    (k + 1, t, motion_pose(*motion, t, Preset::TrainerModel.home()))
+                    (
+                        k + 1,
+                        t,
+                        motion_pose(*motion, t, Preset::TrainerModel.home(), &MotionLimits::TRAINER_MODEL),
+                    )
                 })
                 .collect()
         }
@@ -100,12 +104,12 @@ pub fn check_loads(
     crate::demand::preflight(&ring, &drives, &rows, payload).map_err(|e| anyhow::anyhow!("--check-loads: {e}"))
 }
 
-/// Pose of a built-in motion at time `t` (s) around `home`. Every motion stays inside the envelope at any time
-/// and yaw (tested for 120 s each), so host limiting leaves it unchanged.
-pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6]) -> Pose<f64> {
+/// Pose of a built-in motion at time `t` (s) around `home`; the vibration sweep scales its amplitude to `limits` (the
+/// device's pose limits). On the trainer model every motion stays inside the envelope at any time and yaw (tested for
+/// 120 s each), so host limiting leaves it unchanged.
+pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6], limits: &MotionLimits) -> Pose<f64> {
     let mut p = home;
     let tau = std::f64::consts::TAU;
-    let limits = MotionLimits::TRAINER_MODEL;
     match motion {
         Motion::Demo => {
             // A third of each range (the combined extremes of half the ranges leave the envelope at some yaws),
