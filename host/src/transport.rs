@@ -133,18 +133,15 @@ impl SimDevice {
         }
     }
 
-    /// What the firmware's settings task does: stores a loaded rig and changed settings (the controller hands them
-    /// out only with the supplies off), and restarts when the host asked for it, restoring from the flash as a
+    /// What the firmware's settings task does: stores the changed configuration (the controller hands it out only
+    /// with the supplies off), and restarts when the host asked for it, restoring from the flash as a
     /// board's start does (the plant is the stored rig's machine, parked near its switches).
     fn settings_task(&mut self) {
         let range = self.flash.range();
         let c = &mut self.rig.controller;
-        if let Some(rig) = c.take_unsaved_rig() {
+        if let Some(config) = c.take_unsaved() {
             // A RAM flash only fails when full; the device then runs on and the next start finds the old record.
-            let _ = block_on(store::store_rig(&mut self.flash, range.clone(), &rig));
-        }
-        while let Some(settings) = c.take_unsaved() {
-            let _ = block_on(store::store(&mut self.flash, range.clone(), &settings));
+            let _ = block_on(store::store(&mut self.flash, range.clone(), &config));
         }
         if c.restart_due() {
             let (config, restored) = block_on(store::restore(

@@ -1,12 +1,13 @@
-//! Settings in flash, with `sequential-storage` (a log of key/value items over two or more erase pages). The rig
-//! (geometry, home pose and the sections that describe the machine) is one versioned record
-//! ([`RIG_RECORD_VERSION`], postcard) under [`RIG_KEY`], restored first through the same checks as `SetRig`; every
-//! other section (stream, control) is a versioned item of its own ([`SETTINGS_VERSION`]) under
-//! [`SETTINGS_KEY`] plus its code, applied over the rig through the same checks as `SetSettings`.
+//! The configuration in flash: one versioned record ([`RECORD_VERSION`], postcard) under [`CONFIG_KEY`] with
+//! `sequential-storage` (a log of key/value items over two or more erase pages): the rig (geometry, home pose and the
+//! settings sections that describe the machine) and the sections stored with it (stream, control). At boot the rig
+//! is restored through the same checks as `SetRig`, then the sections through the same checks as `SetSettings`; a
+//! record that cannot run leaves the compiled-in defaults running, and says why.
 //!
-//! Power loss: a save cut at any byte of its writes or erases leaves the previous value readable (the crate's
-//! guarantee, tested here by cutting a save at every byte on the crate's mock flash). Restoring is generic over the
-//! flash so that the firmware's settings task and the host tests run this same code.
+//! One record, so that a save is all or nothing: a save cut at any byte of its writes or erases leaves the previous
+//! record readable (the crate's guarantee, tested here by cutting saves at every byte on the crate's mock flash),
+//! never a rig of one save with sections of another. Restoring is generic over the flash so that the firmware's
+//! settings task, the simulator and the host tests run this same code.
 
 use core::ops::Range;
 
@@ -15,44 +16,36 @@ use sequential_storage::cache::NoCache;
 use sequential_storage::map::{fetch_item, store_item};
 
 use crate::controller::ControllerConfig;
-use crate::protocol::{RigRecord, RigSource, Settings, SettingsKind};
+use crate::protocol::{ControlSettings, RigRecord, RigSource, Settings, StreamSettings};
 
-/// The rig record's key in flash.
-pub const RIG_KEY: u8 = 0xf0;
-/// Layout of the stored rig record; a record of another version is not read (the compiled-in rig runs and the
-/// host sees [`RigSource::Unreadable`]). Version 2 carries the homing section and the motors as settings sections.
-pub const RIG_RECORD_VERSION: u16 = 2;
-/// Key of the first section stored on its own; a section's key adds its [`SettingsKind::code`]. (Keys 1-53 held
-/// the single `f32` settings of protocol versions up to 5: they are never read.)
-pub const SETTINGS_KEY: u8 = 0x80;
-/// Layout of a stored section; one of another version is not read (its defaults run, counted as refused).
-pub const SETTINGS_VERSION: u16 = 1;
-/// Room for the stored rig record: its postcard bytes (about 560) and the crate's header.
-const RIG_BUFFER: usize = 768;
+/// The record's key in flash. (Keys 1-53 held the single `f32` settings of protocol versions up to 5: never read.)
+pub const CONFIG_KEY: u8 = 0xf0;
+/// Layout of the stored record; a record of another version is not read (the compiled-in defaults run and the host
+/// sees [`RigSource::Unreadable`]). Version 1 held the rig alone; 2 adds the machine's settings sections (homing
+/// among them) and the stream and control sections.
+pub const RECORD_VERSION: u16 = 2;
+/// Room for the record's postcard bytes (about 590) and the crate's header; every item read or moved passes through
+/// a buffer of this size.
+const RECORD_BUFFER: usize = 768;
 
-/// A section as flash holds it.
+/// The record as flash holds it.
 #[derive(serde::Serialize, serde::Deserialize)]
-struct StoredSettings {
-    version: u16,
-    settings: Settings,
-}
-
-/// The stored rig record as flash holds it.
-#[derive(serde::Serialize, serde::Deserialize)]
-struct StoredRig {
+struct Record {
     version: u16,
     rig: RigRecord,
+    stream: StreamSettings,
+    control: ControlSettings,
 }
 
 /// What boot found in flash.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Restored {
-    /// Stored sections applied.
+    /// Stored sections besides the rig applied (stream, control).
     pub applied: u8,
-    /// Stored sections refused by the checks, or of another layout (left at their defaults).
+    /// Stored sections refused by the checks (left at their defaults).
     pub refused: u8,
-    /// The stored values together did not make a runnable configuration: the defaults run.
+    /// The stored rig and sections together did not make a runnable configuration: the stored rig runs alone.
     pub fell_back: bool,
     /// Flash could not be read.
     pub unreadable: bool,
@@ -60,36 +53,42 @@ pub struct Restored {
     pub rig: RigSource,
 }
 
-/// Room for any stored item with the crate's header: reading or moving items passes every item through this buffer,
-/// the rig record included.
-const ITEM_BUFFER: usize = RIG_BUFFER;
-
-/// `defaults` with every stored setting replayed over them, and what was found.
+/// `defaults`, or the stored configuration, and what was found.
 pub async fn restore<F: NorFlash>(
     flash: &mut F,
     range: Range<u32>,
     defaults: ControllerConfig,
 ) -> (ControllerConfig, Restored) {
     let mut report = Restored::default();
-    let (base, rig) = restore_rig(flash, range.clone(), defaults).await;
-    report.rig = rig;
+    let mut buf = [0u8; RECORD_BUFFER];
+    let record = match fetch_item::<u8, &[u8], _>(flash, range, &mut NoCache::new(), &mut buf, &CONFIG_KEY).await {
+        Ok(None) => return (defaults, report),
+        Ok(Some(bytes)) => match postcard::from_bytes::<Record>(bytes) {
+            Ok(record) if record.version == RECORD_VERSION => record,
+            _ => {
+                report.rig = RigSource::Unreadable;
+                return (defaults, report);
+            }
+        },
+        Err(_) => {
+            report.unreadable = true;
+            report.rig = RigSource::Unreadable;
+            return (defaults, report);
+        }
+    };
+    let base = match ControllerConfig::from_record(&record.rig) {
+        Ok(config) => config,
+        Err(e) => {
+            report.rig = RigSource::Refused(e.refusal());
+            return (defaults, report);
+        }
+    };
+    report.rig = RigSource::Stored;
     let mut config = base;
-    let mut buf = [0u8; ITEM_BUFFER];
-    for kind in SettingsKind::ALL.into_iter().filter(|k| !k.in_rig()) {
-        let key = SETTINGS_KEY + kind.code();
-        match fetch_item::<u8, &[u8], _>(flash, range.clone(), &mut NoCache::new(), &mut buf, &key).await {
-            Ok(Some(bytes)) => match postcard::from_bytes::<StoredSettings>(bytes) {
-                Ok(s)
-                    if s.version == SETTINGS_VERSION
-                        && s.settings.kind() == kind
-                        && config.apply(&s.settings).is_ok() =>
-                {
-                    report.applied += 1
-                }
-                _ => report.refused += 1,
-            },
-            Ok(None) => {}
-            Err(_) => report.unreadable = true,
+    for section in [Settings::Stream(record.stream), Settings::Control(record.control)] {
+        match config.apply(&section) {
+            Ok(()) => report.applied += 1,
+            Err(_) => report.refused += 1,
         }
     }
     if config.validate().is_err() {
@@ -99,64 +98,26 @@ pub async fn restore<F: NorFlash>(
     (config, report)
 }
 
-/// The stored rig with the compiled-in drives and timings, or `defaults` when there is none or it cannot run.
-async fn restore_rig<F: NorFlash>(
+/// Stores `config` (what the next start is to run) as the record. On an error the previously stored record (or
+/// none) stays the one a restore finds.
+pub async fn store<F: NorFlash>(
     flash: &mut F,
     range: Range<u32>,
-    defaults: ControllerConfig,
-) -> (ControllerConfig, RigSource) {
-    let mut buf = [0u8; RIG_BUFFER];
-    match fetch_item::<u8, &[u8], _>(flash, range, &mut NoCache::new(), &mut buf, &RIG_KEY).await {
-        Ok(None) => (defaults, RigSource::Compiled),
-        Ok(Some(bytes)) => match postcard::from_bytes::<StoredRig>(bytes) {
-            Ok(stored) if stored.version == RIG_RECORD_VERSION => match ControllerConfig::from_record(&stored.rig) {
-                Ok(config) => (config, RigSource::Stored),
-                Err(e) => (defaults, RigSource::Refused(e.refusal())),
-            },
-            _ => (defaults, RigSource::Unreadable),
-        },
-        Err(_) => (defaults, RigSource::Unreadable),
-    }
-}
-
-/// Stores a rig for the next start. On an error the previously stored rig (or none) stays the one a restore finds.
-pub async fn store_rig<F: NorFlash>(
-    flash: &mut F,
-    range: Range<u32>,
-    rig: &RigRecord,
+    config: &ControllerConfig,
 ) -> Result<(), sequential_storage::Error<F::Error>> {
-    let mut bytes = [0u8; RIG_BUFFER];
-    let record = StoredRig {
-        version: RIG_RECORD_VERSION,
-        rig: *rig,
+    let record = Record {
+        version: RECORD_VERSION,
+        rig: config.rig(),
+        stream: config.stream(),
+        control: config.control(),
     };
+    let mut bytes = [0u8; RECORD_BUFFER];
     let Ok(encoded) = postcard::to_slice(&record, &mut bytes) else {
         return Err(sequential_storage::Error::ItemTooBig);
     };
     let encoded: &[u8] = encoded;
-    let mut buf = [0u8; RIG_BUFFER];
-    store_item(flash, range, &mut NoCache::new(), &mut buf, &RIG_KEY, &encoded).await
-}
-
-/// Stores one section (one a rig does not carry; the others are stored as part of the rig). On an error (flash
-/// fault, power loss) the previously stored section stays the one a restore finds.
-pub async fn store<F: NorFlash>(
-    flash: &mut F,
-    range: Range<u32>,
-    settings: &Settings,
-) -> Result<(), sequential_storage::Error<F::Error>> {
-    let mut bytes = [0u8; RIG_BUFFER];
-    let item = StoredSettings {
-        version: SETTINGS_VERSION,
-        settings: *settings,
-    };
-    let Ok(encoded) = postcard::to_slice(&item, &mut bytes) else {
-        return Err(sequential_storage::Error::ItemTooBig);
-    };
-    let encoded: &[u8] = encoded;
-    let mut buf = [0u8; ITEM_BUFFER];
-    let key = SETTINGS_KEY + settings.kind().code();
-    store_item(flash, range, &mut NoCache::new(), &mut buf, &key, &encoded).await
+    let mut buf = [0u8; RECORD_BUFFER];
+    store_item(flash, range, &mut NoCache::new(), &mut buf, &CONFIG_KEY, &encoded).await
 }
 
 /// Flash in RAM with NOR semantics: erase sets a page of `PAGE` bytes to 0xFF, a write can only clear bits. The QEMU

@@ -14,7 +14,7 @@ use ringpod_core::protocol::{
     Settings, SettingsKind, StreamSettings, MAX_PAYLOAD,
 };
 use ringpod_core::safety::Refusal;
-use ringpod_core::store::{restore, store, store_rig, RIG_KEY, RIG_RECORD_VERSION};
+use ringpod_core::store::{restore, store, CONFIG_KEY, RECORD_VERSION};
 use sequential_storage::cache::NoCache;
 use sequential_storage::map::store_item;
 use sequential_storage::mock_flash::{MockFlashBase, WriteCountCheck};
@@ -59,22 +59,20 @@ fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
     let back: Request = protocol::decode(&frame[..n - 1]).unwrap();
     assert_eq!(back.body, HostMessage::SetRig(rig));
 
-    // Flash: stored with a section before and after it, restored as the running rig with both sections.
+    // Flash: stored with the stream and control sections as one record, restored as the running configuration.
     let defaults = ControllerConfig::trainer_model();
-    let Settings::Stream(stream) = defaults.settings(SettingsKind::Stream) else {
-        panic!()
-    };
     let stream = Settings::Stream(StreamSettings {
         timeout_ms: 150,
         telemetry_hz: 50,
-        ..stream
+        ..defaults.stream()
     });
     let control = Settings::Control(ControlSettings { tick_hz: 2_000 });
+    let mut expected = ControllerConfig::from_record(&rig).unwrap();
+    expected.apply(&stream).unwrap();
+    expected.apply(&control).unwrap();
     let mut f = flash();
     let range = Flash::FULL_FLASH_RANGE;
-    block_on(store(&mut f, range.clone(), &stream)).unwrap();
-    block_on(store_rig(&mut f, range.clone(), &rig)).unwrap();
-    block_on(store(&mut f, range.clone(), &control)).unwrap();
+    block_on(store(&mut f, range.clone(), &expected)).unwrap();
     let (config, report) = block_on(restore(&mut f, range, defaults));
     assert_eq!(report.rig, RigSource::Stored);
     assert_eq!(
@@ -85,10 +83,28 @@ fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
     assert_eq!(config.rig().name(), "wider-ring");
     assert_eq!(config.settings(SettingsKind::Stream), stream);
     assert_eq!(config.settings(SettingsKind::Control), control);
-    let mut expected = ControllerConfig::from_record(&rig).unwrap();
-    expected.apply(&stream).unwrap();
-    expected.apply(&control).unwrap();
     assert_eq!(config, expected);
+}
+
+/// A record as an older or other firmware may have written it: the rig and sections in the record's layout.
+fn raw_record(version: u16, rig: &RigRecord) -> Vec<u8> {
+    let defaults = ControllerConfig::trainer_model();
+    let mut raw = [0u8; 1024];
+    let bytes = postcard::to_slice(&(version, rig, defaults.stream(), defaults.control()), &mut raw).unwrap();
+    bytes.to_vec()
+}
+
+fn store_raw(f: &mut Flash, bytes: &[u8]) {
+    let mut buf = [0u8; 1024];
+    block_on(store_item(
+        f,
+        Flash::FULL_FLASH_RANGE,
+        &mut NoCache::new(),
+        &mut buf,
+        &CONFIG_KEY,
+        &bytes,
+    ))
+    .unwrap();
 }
 
 #[test]
@@ -99,7 +115,7 @@ fn a_stored_rig_that_cannot_run_leaves_the_compiled_rig_and_says_why() {
     let mut unreachable = wider(0.3, 0.325);
     unreachable.home[2] = 5.0;
     let mut f = flash();
-    block_on(store_rig(&mut f, range.clone(), &unreachable)).unwrap();
+    store_raw(&mut f, &raw_record(RECORD_VERSION, &unreachable));
     let (config, report) = block_on(restore(&mut f, range.clone(), defaults));
     assert_eq!(report.rig, RigSource::Refused(ConfigRefusal::HomePose));
     assert_eq!(config, defaults);
@@ -108,27 +124,24 @@ fn a_stored_rig_that_cannot_run_leaves_the_compiled_rig_and_says_why() {
     let mut negative = wider(0.3, 0.325);
     negative.ring_radius = -0.3;
     let mut f = flash();
-    block_on(store_rig(&mut f, range.clone(), &negative)).unwrap();
+    store_raw(&mut f, &raw_record(RECORD_VERSION, &negative));
     assert_eq!(
         block_on(restore(&mut f, range.clone(), defaults)).1.rig,
         RigSource::Refused(ConfigRefusal::Geometry)
     );
 
+    // The raw layout is the record's: the same bytes with a good rig restore it.
+    let mut f = flash();
+    store_raw(&mut f, &raw_record(RECORD_VERSION, &wider(0.3, 0.325)));
+    assert_eq!(
+        block_on(restore(&mut f, range.clone(), defaults)).1.rig,
+        RigSource::Stored
+    );
+
     // A record of another layout version, and bytes that are no record at all.
-    let mut raw = [0u8; 1024];
-    let next_version: &[u8] = postcard::to_slice(&(RIG_RECORD_VERSION + 1, wider(0.3, 0.325)), &mut raw).unwrap();
-    for bytes in [next_version, &[1, 2, 3]] {
+    for bytes in [raw_record(RECORD_VERSION + 1, &wider(0.3, 0.325)), vec![1, 2, 3]] {
         let mut f = flash();
-        let mut buf = [0u8; 1024];
-        block_on(store_item(
-            &mut f,
-            range.clone(),
-            &mut NoCache::new(),
-            &mut buf,
-            &RIG_KEY,
-            &bytes,
-        ))
-        .unwrap();
+        store_raw(&mut f, &bytes);
         let (config, report) = block_on(restore(&mut f, range.clone(), defaults));
         assert_eq!((report.rig, config), (RigSource::Unreadable, defaults));
     }
@@ -145,12 +158,13 @@ fn a_rig_save_cut_at_any_byte_restores_the_old_or_the_new_rig() {
     let mut cuts = 0;
     for i in 0..24 {
         let new = wider(0.29 + 0.001 * f64::from(i % 12), 0.32 + 0.0005 * f64::from(i));
+        let new_config = ControllerConfig::from_record(&new).unwrap();
         // A save writes far fewer bytes than this: a save that never completes fails the test, not hangs it.
         for budget in 0u32..=20_000 {
             assert!(budget < 20_000, "save {i} never completed");
             let mut f = live.clone();
             f.bytes_until_shutoff = Some(budget);
-            let done = block_on(store_rig(&mut f, range.clone(), &new)).is_ok();
+            let done = block_on(store(&mut f, range.clone(), &new_config)).is_ok();
             f.bytes_until_shutoff = None;
             let (config, _) = block_on(restore(&mut f, range.clone(), defaults));
             let got = config.rig();
@@ -161,7 +175,7 @@ fn a_rig_save_cut_at_any_byte_restores_the_old_or_the_new_rig() {
             }
             cuts += 1;
         }
-        block_on(store_rig(&mut live, range.clone(), &new)).unwrap();
+        block_on(store(&mut live, range.clone(), &new_config)).unwrap();
         held = new;
     }
     assert!(cuts > 24 * 100, "only {cuts} cut points");
@@ -181,7 +195,7 @@ fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
         ask(&mut c, HostMessage::SetRig(bad)),
         DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::HomePose))
     );
-    assert_eq!(c.take_unsaved_rig(), None, "a refused rig is not stored");
+    assert_eq!(c.take_unsaved(), None, "a refused rig is not stored");
 
     // Powered: refused, nothing stored, no restart.
     c.set_inputs(Inputs {
@@ -217,8 +231,8 @@ fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
         }
         other => panic!("{other:?}"),
     }
-    assert_eq!(c.take_unsaved_rig(), Some(rig));
-    assert_eq!(c.take_unsaved_rig(), None);
+    assert_eq!(c.take_unsaved().map(|config| config.rig()), Some(rig));
+    assert_eq!(c.take_unsaved(), None);
     assert!(c.restart_due());
 }
 

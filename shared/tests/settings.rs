@@ -112,12 +112,11 @@ fn polarity_maps_electrical_levels() {
 }
 
 #[test]
-fn every_section_has_a_unique_code_and_answers_with_its_kind() {
-    let mut codes: Vec<u8> = SettingsKind::ALL.iter().map(|k| k.code()).collect();
-    codes.sort_unstable();
-    codes.dedup();
-    assert_eq!(codes.len(), SettingsKind::ALL.len());
-    assert!(codes.iter().all(|c| *c < 8), "the unsaved set is an 8-bit mask");
+fn every_section_has_a_unique_name_and_answers_with_its_kind() {
+    let mut names: Vec<&str> = SettingsKind::ALL.iter().map(|k| k.name()).collect();
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names.len(), SettingsKind::ALL.len());
     let defaults = ControllerConfig::trainer_model();
     for kind in SettingsKind::ALL {
         assert_eq!(defaults.settings(kind).kind(), kind);
@@ -314,7 +313,6 @@ fn bad_sections_are_refused_and_nothing_is_stored() {
     assert_eq!(*c.saved_config(), before);
     assert!(!c.has_unsaved());
     assert_eq!(c.take_unsaved(), None);
-    assert_eq!(c.take_unsaved_rig(), None);
 }
 
 #[test]
@@ -390,22 +388,19 @@ fn unsaved_changes_are_handed_out_once_with_their_last_value_and_restore_at_boot
         ..c.config().inputs
     };
     assert_eq!(set(&mut c, Settings::Inputs(inputs)), DeviceMessage::Ack);
-    let mut stored = Vec::new();
-    while let Some(s) = c.take_unsaved() {
-        stored.push(s);
-    }
-    assert_eq!(stored, vec![Settings::Stream(later), slow]);
-    // The machine's sections travel as the whole rig, once, with their last values.
-    let rig = c.take_unsaved_rig().expect("the rig with its changed sections");
-    assert_eq!(c.take_unsaved_rig(), None);
+    // Everything changed is in the one configuration handed out, once, with its last values.
+    let stored = c.take_unsaved().expect("the changed configuration");
+    assert_eq!(c.take_unsaved(), None);
+    assert!(!c.has_unsaved());
+    assert_eq!(stored.stream(), later);
+    assert_eq!(stored.settings(SettingsKind::Control), slow);
+    let rig = stored.rig();
     assert_eq!(rig.machine.axes, a);
     assert_eq!(rig.machine.inputs, inputs);
-    assert!(!c.has_unsaved());
-    // Boot: the stored rig, then every stored section through the same checks.
+    // Boot: the stored rig, then the stored sections through the same checks.
     let mut boot = ControllerConfig::from_record(&rig).unwrap();
-    for s in &stored {
-        boot.apply(s).unwrap();
-    }
+    boot.apply(&Settings::Stream(stored.stream())).unwrap();
+    boot.apply(&Settings::Control(stored.control())).unwrap();
     assert_eq!(boot, *c.saved_config());
     let restarted = Controller::new(boot).unwrap();
     assert_eq!(restarted.pipeline().config().tick_us, 2_000);
@@ -449,7 +444,6 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
     assert_eq!(set(&mut rig.controller, Settings::Inputs(inputs)), DeviceMessage::Ack);
     assert!(rig.controller.has_unsaved());
     assert_eq!(rig.controller.take_unsaved(), None);
-    assert_eq!(rig.controller.take_unsaved_rig(), None);
     assert_eq!(
         rig.controller
             .handle(&Request {
@@ -466,12 +460,9 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
         rig.tick();
     }
     assert_eq!(rig.controller.supervisor().state(), State::Off);
-    assert_eq!(rig.controller.take_unsaved(), Some(Settings::Stream(s)));
+    let stored = rig.controller.take_unsaved().expect("handed out with the supplies off");
+    assert_eq!((stored.stream(), stored.inputs), (s, inputs));
     assert_eq!(rig.controller.take_unsaved(), None);
-    assert_eq!(
-        rig.controller.take_unsaved_rig().map(|r| r.machine.inputs),
-        Some(inputs)
-    );
 }
 
 /// `GetInputs`: the debounced state with the polarity, and the pins' levels as the board sampled them (derived

@@ -1,6 +1,6 @@
-//! The settings task: the controller's changed settings sections and its loaded or changed rig stored in flash through the core's
-//! power-loss-safe store (`ringpod_core::store`, tested there with a power cut at every byte of a save), restored at
-//! boot, and the restart the host asked for once everything is stored.
+//! The settings task: the controller's changed configuration (settings sections, a loaded rig) stored in flash as
+//! one record through the core's power-loss-safe store (`ringpod_core::store`, tested there with a power cut at
+//! every byte of a save), restored at boot, and the restart the host asked for once everything is stored.
 //!
 //! Flash is only written while the supplies are off: erasing a page stalls the CPU's flash reads (on the F411 a
 //! 128 KiB sector takes 1-2 s), which must never happen while steps are being generated.
@@ -11,7 +11,7 @@ use embassy_time::{Duration, Timer};
 use embedded_storage_async::nor_flash::NorFlash;
 use ringpod_core::controller::ControllerConfig;
 pub use ringpod_core::store::Restored;
-use ringpod_core::store::{self, store, store_rig};
+use ringpod_core::store::{self, store};
 
 use super::Shared;
 
@@ -28,32 +28,21 @@ pub async fn restore<F: NorFlash>(flash: &mut F, range: Range<u32>) -> (Controll
     store::restore(flash, range, ControllerConfig::trainer_model()).await
 }
 
-/// Stores the controller's loaded rig and unsaved settings, one at a time, as it hands them out (only with the
-/// supplies off); restarts when the host asked for it and nothing waits to be stored.
+/// Stores the controller's changed configuration as it hands it out (only with the supplies off); restarts when the
+/// host asked for it and nothing waits to be stored.
 pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared, board: &mut impl Board) -> ! {
     loop {
         Timer::after(Duration::from_millis(100)).await;
-        // The controller hands them out only while the supplies are off.
-        if let Some(rig) = shared.with(|c| c.take_unsaved_rig()) {
+        // The controller hands it out only while the supplies are off.
+        if let Some(config) = shared.with(|c| c.take_unsaved()) {
             board.widen_watchdog(true);
-            let result = store_rig(flash, range.clone(), &rig).await;
+            let result = store(flash, range.clone(), &config).await;
             board.widen_watchdog(false);
+            let rig = config.rig();
             match result {
-                Ok(()) => defmt::info!("stored the rig {}", rig.name()),
-                // The next start runs the rig stored before (or the compiled-in one). Said, not hidden.
-                Err(_) => defmt::error!("could not store the rig {}", rig.name()),
-            }
-            continue;
-        }
-        if let Some(settings) = shared.with(|c| c.take_unsaved()) {
-            board.widen_watchdog(true);
-            let result = store(flash, range.clone(), &settings).await;
-            board.widen_watchdog(false);
-            let kind = settings.kind();
-            match result {
-                Ok(()) => defmt::info!("stored the {} section", kind.name()),
-                // The running value stays; the next boot uses the last stored one. Said, not hidden.
-                Err(_) => defmt::error!("could not store the {} section", kind.name()),
+                Ok(()) => defmt::info!("stored the configuration (rig {})", rig.name()),
+                // The running configuration stays; the next start finds the record stored before. Said, not hidden.
+                Err(_) => defmt::error!("could not store the configuration (rig {})", rig.name()),
             }
             continue;
         }

@@ -162,7 +162,7 @@ impl InputsSpec {
 #[cfg(test)]
 mod tests {
     use embassy_futures::block_on;
-    use ringpod_core::store::{restore, store_rig, RamFlash};
+    use ringpod_core::store::{restore, store, RamFlash};
 
     use super::super::{from_text, RigFile};
     use super::*;
@@ -219,7 +219,8 @@ mod tests {
         let mut bytes = vec![0xff; 8 * 1024];
         let mut flash = RamFlash::<2048>::new(&mut bytes);
         let range = flash.range();
-        block_on(store_rig(&mut flash, range.clone(), &record)).unwrap();
+        let config = ControllerConfig::from_record(&record).unwrap();
+        block_on(store(&mut flash, range.clone(), &config)).unwrap();
         let (config, report) = block_on(restore(&mut flash, range, ControllerConfig::trainer_model()));
         assert_eq!(report.rig, ringpod_core::protocol::RigSource::Stored);
         assert_eq!(config.rig(), record);

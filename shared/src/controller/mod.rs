@@ -17,7 +17,7 @@ pub use config::{ConfigError, ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;
 use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
-use crate::protocol::{DeviceMessage, InputReport, Response, RigRecord, RigSource, Status, Telemetry, TelemetryFlags};
+use crate::protocol::{DeviceMessage, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
 use crate::safety::homing::{HomingPlan, RingHoming};
 use crate::safety::{Event, HomingSequencer, Motion, Outputs, State, Supervisor};
 
@@ -36,9 +36,8 @@ pub struct Controller {
     config: ControllerConfig,
     /// The configuration as stored: equal to `config` but for settings that take effect at the next start.
     saved: ControllerConfig,
-    /// Sections stored on their own changed since the firmware last took them for storing (bit per
-    /// [`crate::protocol::SettingsKind::code`]).
-    unsaved: u8,
+    /// The stored configuration changed since the firmware last took it for storing.
+    unsaved: bool,
     home_pose: Pose<f32>,
     supervisor: Supervisor,
     pipeline: Pipeline<RingPlatform<f32>>,
@@ -64,8 +63,6 @@ pub struct Controller {
     jog: Option<(Jog, bool)>,
     /// Where the running rig came from (the board says so at boot).
     rig_source: RigSource,
-    /// A rig loaded, or a section of the stored rig changed, over the protocol that the firmware has not stored yet.
-    unsaved_rig: Option<RigRecord>,
     /// The host asked for a restart.
     restart: bool,
 }
@@ -116,7 +113,7 @@ impl Controller {
         Ok(Self {
             config,
             saved: config,
-            unsaved: 0,
+            unsaved: false,
             home_pose,
             supervisor: Supervisor::new(config.supervisor),
             pipeline,
@@ -137,7 +134,6 @@ impl Controller {
             raw_inputs: None,
             jog: None,
             rig_source: RigSource::Compiled,
-            unsaved_rig: None,
             restart: false,
         })
     }

@@ -18,23 +18,33 @@ const MOST_STEPS: f64 = 2_147_483_647.0;
 impl ControllerConfig {
     /// A section as this configuration has it.
     pub fn settings(&self, kind: SettingsKind) -> Settings {
-        let c = &self.pipeline;
         match kind {
-            SettingsKind::Stream => Settings::Stream(StreamSettings {
-                timeout_ms: (c.stream_timeout_us / 1000) as u16,
-                gross_jump_ms: (c.gross_jump_us / 1000) as u16,
-                follow: c.follow,
-                margins: c.margins.0,
-                telemetry_hz: self.telemetry_hz,
-            }),
-            SettingsKind::Control => Settings::Control(ControlSettings {
-                tick_hz: (1_000_000 / c.tick_us.max(1)) as u16,
-            }),
+            SettingsKind::Stream => Settings::Stream(self.stream()),
+            SettingsKind::Control => Settings::Control(self.control()),
             SettingsKind::Motion => Settings::Motion(self.motion()),
             SettingsKind::Inputs => Settings::Inputs(self.inputs),
             SettingsKind::Axes => Settings::Axes(self.axes()),
             SettingsKind::Homing => Settings::Homing(self.switches),
             SettingsKind::Supervisor => Settings::Supervisor(self.supervisor),
+        }
+    }
+
+    /// The stream section.
+    pub fn stream(&self) -> StreamSettings {
+        let c = &self.pipeline;
+        StreamSettings {
+            timeout_ms: (c.stream_timeout_us / 1000) as u16,
+            gross_jump_ms: (c.gross_jump_us / 1000) as u16,
+            follow: c.follow,
+            margins: c.margins.0,
+            telemetry_hz: self.telemetry_hz,
+        }
+    }
+
+    /// The control section.
+    pub fn control(&self) -> ControlSettings {
+        ControlSettings {
+            tick_hz: (1_000_000 / self.pipeline.tick_us.max(1)) as u16,
         }
     }
 

@@ -1,5 +1,5 @@
 //! Settings over the protocol: the running configuration, the stored one (what the next start runs), and the
-//! sections and rig the firmware has yet to store.
+//! changes the firmware has yet to store.
 
 use super::{ConfigError, Controller, ControllerConfig};
 use crate::protocol::{DeviceMessage, NackReason, RigRecord, RigSource, Settings, SettingsKind};
@@ -16,27 +16,23 @@ impl Controller {
         &self.saved
     }
 
-    /// A section stored on its own (one a rig does not carry) changed over the protocol that the firmware has not
-    /// stored yet, as the next start is to run it; each change is handed out once. Nothing is lost: a section
-    /// changed twice before it is taken is stored once, with its last value. Changes to the sections a rig carries
-    /// are handed out as the whole rig ([`Self::take_unsaved_rig`]).
+    /// The configuration the next start is to run, when it changed since it was last handed out (a section set,
+    /// a rig loaded): the firmware stores it as one record. Nothing is lost: changes made before it is taken are
+    /// in it, and a change made after is handed out again.
     ///
     /// Only while the power relay and the drivers are off: writing flash can stall the CPU (a sector erase on an
     /// STM32F4 for up to 2 s), which must never happen while anything could move.
-    pub fn take_unsaved(&mut self) -> Option<Settings> {
-        if self.moving_possible() {
+    pub fn take_unsaved(&mut self) -> Option<ControllerConfig> {
+        if self.moving_possible() || !self.unsaved {
             return None;
         }
-        let kind = SettingsKind::ALL
-            .into_iter()
-            .find(|k| self.unsaved & (1 << k.code()) != 0)?;
-        self.unsaved &= !(1 << kind.code());
-        Some(self.saved.settings(kind))
+        self.unsaved = false;
+        Some(self.saved)
     }
 
-    /// Whether settings or a rig wait to be stored.
+    /// Whether a change waits to be stored.
     pub fn has_unsaved(&self) -> bool {
-        self.unsaved != 0 || self.unsaved_rig.is_some()
+        self.unsaved
     }
 
     /// The power relay or the drivers are on: flash must not be written.
@@ -55,8 +51,7 @@ impl Controller {
     }
 
     /// Changes a section (not while anything moves): checked whole with the configuration it joins; a live
-    /// section changes the running configuration too. Every change is stored: a section a rig carries as part of
-    /// the stored rig.
+    /// section changes the running configuration too. Every change is stored.
     pub(super) fn set_settings(&mut self, settings: &Settings) -> Result<(), NackReason> {
         if !matches!(self.supervisor.outputs().motion, Motion::None) {
             return Err(NackReason::Refused(Refusal::WrongState));
@@ -74,11 +69,7 @@ impl Controller {
             self.pipeline.set_config(live.pipeline);
         }
         self.saved = saved;
-        if kind.in_rig() {
-            self.unsaved_rig = Some(saved.rig());
-        } else {
-            self.unsaved |= 1 << kind.code();
-        }
+        self.unsaved = true;
         Ok(())
     }
 
@@ -107,25 +98,14 @@ impl Controller {
         let mut saved = ControllerConfig::from_record(record).map_err(refused)?;
         for kind in SettingsKind::ALL.into_iter().filter(|k| !k.in_rig()) {
             let mut kept = saved;
+            // A section the new rig cannot run with takes its default.
             if kept.apply(&self.saved.settings(kind)).is_ok() && kept.validate().is_ok() {
                 saved = kept;
-            } else {
-                // The new rig runs this section's defaults: stored, so that flash says what runs.
-                self.unsaved |= 1 << kind.code();
             }
         }
         self.saved = saved;
-        self.unsaved_rig = Some(*record);
+        self.unsaved = true;
         Ok(())
-    }
-
-    /// A loaded or changed rig the firmware has not stored yet; handed out once, only with the supplies off (as
-    /// [`Self::take_unsaved`]).
-    pub fn take_unsaved_rig(&mut self) -> Option<RigRecord> {
-        if self.moving_possible() {
-            return None;
-        }
-        self.unsaved_rig.take()
     }
 
     /// Asks for a restart (only in `Off`): the firmware restarts once everything is stored.
@@ -139,6 +119,6 @@ impl Controller {
 
     /// The host asked for a restart and every setting and rig is stored: the board resets now.
     pub fn restart_due(&self) -> bool {
-        self.restart && self.unsaved == 0 && self.unsaved_rig.is_none() && self.supervisor.state() == State::Off
+        self.restart && !self.unsaved && self.supervisor.state() == State::Off
     }
 }

@@ -3,8 +3,8 @@
 //! the same thing in a TOML file, on the wire and in flash.
 //!
 //! Sections marked *live* take effect at once; the others are stored and take effect at the next start (a reset of
-//! the board). Sections that describe the machine ([`SettingsKind::in_rig`]) are part of the [`super::RigRecord`] a
-//! device stores; the others are stored on their own.
+//! the board). Sections that describe the machine ([`SettingsKind::in_rig`]) are part of the [`super::RigRecord`];
+//! a device stores the rig and the other sections together, as one record.
 
 use crate::motion::FollowMode;
 use crate::safety::debounce::InputConfig;
@@ -169,19 +169,6 @@ impl SettingsKind {
             Self::Axes => "axes",
             Self::Homing => "homing",
             Self::Supervisor => "supervisor",
-        }
-    }
-
-    /// The section's stable number (its key in flash is derived from it): never reuse or renumber one.
-    pub const fn code(self) -> u8 {
-        match self {
-            Self::Stream => 0,
-            Self::Control => 1,
-            Self::Motion => 2,
-            Self::Inputs => 3,
-            Self::Axes => 4,
-            Self::Homing => 5,
-            Self::Supervisor => 6,
         }
     }
 }
