@@ -1,5 +1,6 @@
-//! Motion: setpoint validation and interpolation, velocity/acceleration limits, IK per tick, conversion to motor
-//! steps, and the step scheduler that turns per-period step targets into timed pulses.
+//! Motion: setpoints and their answers (`setpoint`), their validation and interpolation (`pipeline`),
+//! velocity/acceleration limits, IK per tick, conversion to motor steps, and the step scheduler that turns
+//! per-period step targets into timed pulses.
 
 pub mod envelope;
 pub mod jog;
@@ -7,13 +8,12 @@ pub mod limits;
 pub mod pipeline;
 pub mod pulse;
 pub mod scheduler;
+pub mod setpoint;
 pub mod steps;
 
 pub use envelope::{EnvelopeMargins, Limited};
 pub use limits::{AxisTracker, MotionLimits};
-pub use pipeline::{
-    Accepted, FollowMode, LimitCounters, LimitReport, Pipeline, PipelineConfig, PipelineEvent, RejectCounters,
-    RejectReason, Setpoint,
-};
+pub use pipeline::{FollowMode, Pipeline, PipelineConfig, PipelineEvent};
 pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler, StepTimes};
+pub use setpoint::{Accepted, LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 pub use steps::{AxisScale, StepConverter};

@@ -193,7 +193,7 @@ impl core::fmt::Display for NackReason {
             Self::VersionMismatch { device } => write!(f, "the device speaks protocol version {device}"),
             Self::NotConnected => f.write_str("no handshake yet"),
             Self::Refused(r) => write!(f, "refused: {r}"),
-            Self::Rejected(r) => write!(f, "setpoint rejected ({r:?})"),
+            Self::Rejected(r) => write!(f, "setpoint rejected: {r}"),
             Self::BadConfig(r) => write!(f, "setting refused (BadConfig): {r}"),
             Self::OutOfRange => f.write_str("an argument is out of range (OutOfRange)"),
             Self::Malformed => f.write_str("the frame could not be decoded"),
