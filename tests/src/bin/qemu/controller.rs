@@ -1,0 +1,212 @@
+//! The controller's firmware tasks on the emulated MCU, streamed through its UART as a board is over USB.
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+use crate::emulator::start_or_fail;
+use crate::host_cli::{ringpod, ringpod_json, send_garbage, write_beyond_envelope, write_input};
+use crate::Tally;
+
+/// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
+pub(crate) fn controller_on_m4f(t: &mut Tally) {
+    println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let cli = Command::new(&cargo)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .args(["build", "--release", "-p", "ringpod"])
+        .status();
+    if !cli.is_ok_and(|s| s.success()) {
+        t.check(false, "the host CLI builds");
+        return;
+    }
+    let Some(emulated) = start_or_fail(t, &[]) else {
+        return;
+    };
+    let pty = emulated.pty.as_str();
+    println!("controller on {pty}");
+    let input = std::env::temp_dir().join(format!("ringpod-qemu-{}.csv", std::process::id()));
+    if write_input(&input).is_err() {
+        t.check(false, "the input file is written");
+        return;
+    }
+    let file = input.to_string_lossy().to_string();
+    let emu = ringpod_json(&["stream", "--port", pty, "--input", &file, "--quiet", "--report-json"]);
+    let sim = ringpod_json(&[
+        "stream",
+        "--sim",
+        "--fast",
+        "--input",
+        &file,
+        "--quiet",
+        "--report-json",
+    ]);
+    let _ = std::fs::remove_file(&input);
+    match (&emu, &sim) {
+        (Ok(e), Ok(s)) => {
+            println!(
+                "emulated: final steps {}, simulator: {}",
+                e["final_steps"], s["final_steps"]
+            );
+            t.check(
+                e["state"] == "Ready" && e["counts_agree"] == true && e["rejected"] == serde_json::json!({}),
+                "stream a CSV: homed, every setpoint applied, back at rest, the counts add up",
+            );
+            t.check(
+                e["final_steps"] == s["final_steps"] && e["setpoints_applied"] == s["setpoints_applied"],
+                "the emulated controller ends at the host simulator's step positions",
+            );
+        }
+        (Err(e), _) | (_, Err(e)) => {
+            eprintln!("{e}");
+            t.check(false, "stream a CSV into the emulated controller and the simulator");
+        }
+    }
+
+    // Beyond the envelope and the limits, limited by the device itself (no host limiting): every setpoint
+    // applied, many limited on the M4F, none refused, and the same end as the simulator's.
+    let beyond = std::env::temp_dir().join(format!("ringpod-qemu-beyond-{}.csv", std::process::id()));
+    if write_beyond_envelope(&beyond).is_err() {
+        t.check(false, "the input file is written");
+        return;
+    }
+    let file = beyond.to_string_lossy().to_string();
+    let args = ["--input", &file, "--device-limits-only", "--quiet", "--report-json"];
+    let emu = ringpod_json(&[&["stream", "--port", pty][..], &args].concat());
+    let sim = ringpod_json(&[&["stream", "--sim", "--fast"][..], &args].concat());
+    let _ = std::fs::remove_file(&beyond);
+    match (&emu, &sim) {
+        (Ok(e), Ok(s)) => {
+            println!(
+                "beyond the envelope: {} of {} limited on the emulated device, final steps {} (simulator {})",
+                e["limited"]["device"], e["setpoints_sent"], e["final_steps"], s["final_steps"]
+            );
+            t.check(
+                e["outcome"] == "followed"
+                    && e["state"] == "Ready"
+                    && e["counts_agree"] == true
+                    && e["rejected"] == serde_json::json!({})
+                    && e["limited"]["device"].as_u64().unwrap_or(0) > 50,
+                "a stream beyond the envelope and the limits flows: every setpoint applied, limited on the M4F",
+            );
+            t.check(
+                e["final_steps"] == s["final_steps"] && e["limited"]["device"] == s["limited"]["device"],
+                "the emulated controller limits as the host simulator does and ends at its step positions",
+            );
+        }
+        (Err(e), _) | (_, Err(e)) => {
+            eprintln!("{e}");
+            t.check(
+                false,
+                "stream beyond the envelope into the emulated controller and the simulator",
+            );
+        }
+    }
+
+    // A frame of garbage: answered with a Malformed nack (id 0), counted, never executed.
+    let garbage = [0x05, 0x11, 0x22, 0x33, 0x44, 0x55, 0x00];
+    let malformed = send_garbage(pty, &garbage).ok().and_then(|bytes| {
+        let frame = bytes.split(|b| *b == 0).next()?.to_vec();
+        ringpod_core::protocol::decode::<ringpod_core::protocol::Response>(&frame).ok()
+    });
+    t.check(
+        malformed.is_some_and(|r| {
+            r.id == 0
+                && r.body == ringpod_core::protocol::DeviceMessage::Nack(ringpod_core::protocol::NackReason::Malformed)
+        }),
+        "a corrupted frame is answered with a Malformed nack",
+    );
+    let status = ringpod_json(&["device", "status", "--port", pty]);
+    t.check(
+        status
+            .as_ref()
+            .is_ok_and(|s| s["bad_frames"] == 1 && s["state"] == "Ready"),
+        "the device counted the bad frame and moved nothing",
+    );
+
+    // Telemetry from the M4F: a recorded run has a row every 10 ms of device time.
+    let record = std::env::temp_dir().join(format!("ringpod-qemu-record-{}.csv", std::process::id()));
+    let recorded = ringpod_json(&[
+        "stream",
+        "--port",
+        pty,
+        "--motion",
+        "demo",
+        "--duration",
+        "2",
+        "--quiet",
+        "--report-json",
+        "--record",
+        &record.to_string_lossy(),
+    ]);
+    let rows = std::fs::read_to_string(&record).unwrap_or_default();
+    let _ = std::fs::remove_file(&record);
+    let device_s: Vec<f64> = rows
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(1)?.parse().ok())
+        .collect();
+    println!(
+        "recorded from the emulated controller: {} telemetry rows over {:.2} s of device time",
+        device_s.len(),
+        device_s.last().unwrap_or(&0.0) - device_s.first().unwrap_or(&0.0)
+    );
+    t.check(
+        recorded
+            .is_ok_and(|r| r["outcome"] == "followed" && r["record"]["rows"].as_u64() == Some(device_s.len() as u64))
+            && device_s.len() > 200
+            && device_s.windows(2).all(|w| (w[1] - w[0] - 0.01).abs() < 1e-9),
+        "the emulated controller sends telemetry: a recorded run has a row every 10 ms of device time",
+    );
+
+    // Stream loss: the host dies mid-stream; the controller brakes to rest by itself.
+    let streaming = Command::new(ringpod())
+        .args([
+            "stream",
+            "--port",
+            pty,
+            "--motion",
+            "demo",
+            "--duration",
+            "30",
+            "--quiet",
+        ])
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn();
+    let Ok(mut streaming) = streaming else {
+        t.check(false, "a stream starts");
+        return;
+    };
+    std::thread::sleep(Duration::from_secs(4));
+    let _ = streaming.kill();
+    let _ = streaming.wait();
+    std::thread::sleep(Duration::from_millis(1_500));
+    let after = ringpod_json(&["device", "status", "--port", pty]);
+    t.check(
+        after
+            .as_ref()
+            .is_ok_and(|s| s["state"] == "Ready" && s["applied"].as_u64().unwrap_or(0) > 0),
+        "a host killed mid-stream leaves the platform braked to rest (Ready)",
+    );
+    if let Ok(s) = &after {
+        println!("after the stream loss: state {}, steps {}", s["state"], s["steps"]);
+    }
+
+    // The plant moved only by the STEP edges of the step generator's words: they kept the drivers' timing, and no
+    // step came while the drivers were disabled (the board module prints the first of either).
+    let problems: Vec<String> = emulated
+        .printed()
+        .into_iter()
+        .filter(|l| l.starts_with("TIMING") || l.starts_with("DISABLED") || l.starts_with("ERROR"))
+        .collect();
+    for p in &problems {
+        eprintln!("qemu: {p}");
+    }
+    t.check(
+        problems.is_empty(),
+        "every run above moved the plant by its STEP edges only, within the drivers' timing, drivers enabled",
+    );
+    drop(emulated);
+}

@@ -1,0 +1,61 @@
+//! `cargo run -p ringpod-tests --bin qemu`: builds the Cortex-M4F programs of `tests/qemu`, runs them in
+//! `qemu-system-arm -machine mps2-an386` with a time limit, checks what they report, and prints
+//! `N passed, N failed` as its last line (exit status 1 when anything failed).
+//!
+//! 1. `self_check`: the core's self-check on the emulated MCU: every check passes, and the digest of its output
+//!    bits equals the digest the same code computes on this host (bit identity of the f32 math); the cost of the
+//!    control path in instructions (`-icount shift=0`), printed as a table with the budget.
+//! 2. `controller`: the controller's firmware tasks on the emulated MCU, streamed through its UART.
+//! 3. `watchdog`: a stalled control loop reset by the watchdog. 4. `rig`: a rig of one's own loaded and run.
+//!
+//! `emulator` starts QEMU and the programs; `host_cli` drives the `ringpod` CLI against them.
+
+mod controller;
+mod emulator;
+mod host_cli;
+mod rig;
+mod self_check;
+mod watchdog;
+
+use std::process::ExitCode;
+
+use crate::controller::controller_on_m4f;
+use crate::emulator::ensure_qemu;
+use crate::rig::rig_on_m4f;
+use crate::self_check::core_on_m4f;
+use crate::watchdog::watchdog_on_m4f;
+
+pub(crate) struct Tally {
+    passed: u32,
+    failed: u32,
+}
+
+impl Tally {
+    pub(crate) fn check(&mut self, ok: bool, what: &str) {
+        println!("{} {what}", if ok { "PASS" } else { "FAIL" });
+        if ok {
+            self.passed += 1;
+        } else {
+            self.failed += 1;
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    if let Err(e) = ensure_qemu() {
+        eprintln!("{e}");
+        println!("0 passed, 1 failed");
+        return ExitCode::FAILURE;
+    }
+    let mut t = Tally { passed: 0, failed: 0 };
+    core_on_m4f(&mut t);
+    controller_on_m4f(&mut t);
+    watchdog_on_m4f(&mut t);
+    rig_on_m4f(&mut t);
+    println!("{} passed, {} failed", t.passed, t.failed);
+    if t.failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}

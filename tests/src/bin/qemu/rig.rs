@@ -1,0 +1,71 @@
+//! A rig of the builder's own on the emulated MCU: loaded, stored, restarted into, streamed.
+
+use std::time::Duration;
+
+use crate::emulator::start_or_fail;
+use crate::host_cli::{ringpod_json, ringpod_text, write_input};
+use crate::Tally;
+
+/// A rig no preset describes, on the device: loaded over the UART (checked by the M4F), stored in its flash,
+/// restored at the restart the host asks for, shown back as a rig file, and driven end to end: a CSV streamed into
+/// it ends at exactly the steps the host simulator reaches with `--geometry` of the same file.
+pub(crate) fn rig_on_m4f(t: &mut Tally) {
+    println!("== a rig of its own on the emulated Cortex-M4F: load, restart, stream");
+    let dir = std::env::temp_dir().join(format!("ringpod-qemu-rig-{}", std::process::id()));
+    let _ = std::fs::create_dir_all(&dir);
+    let (rig, input) = (dir.join("wider.toml"), dir.join("input.csv"));
+    let (exported, model) = ringpod_text(&["presets", "--export", "trainer-model"]);
+    let wider = model
+        .replace("name = \"trainer-model\"", "name = \"wider-ring\"")
+        .replace("ring_radius = 0.286", "ring_radius = 0.3")
+        .replace("rod_length = 0.312", "rod_length = 0.325");
+    if !exported || wider == model || std::fs::write(&rig, wider).is_err() || write_input(&input).is_err() {
+        t.check(false, "the rig file and the input are written");
+        return;
+    }
+    let Some(emulated) = start_or_fail(t, &[]) else {
+        return;
+    };
+    let pty = emulated.pty.as_str();
+    let (rig_file, input_file) = (rig.to_string_lossy().to_string(), input.to_string_lossy().to_string());
+    let loaded = ringpod_text(&["device", "rig", "load", &rig_file, "--port", pty]).0;
+    let (restarted, said) = ringpod_text(&["device", "restart", "--port", pty]);
+    let printed = emulated.wait_for(Duration::from_secs(10), |l| l.trim() == "READY");
+    println!("restart: {} / {printed:?}", said.trim());
+    let (_, shown) = ringpod_text(&["device", "rig", "show", "--port", pty]);
+    t.check(
+        loaded
+            && restarted
+            && said.contains("running wider-ring (stored)")
+            && printed.is_ok_and(|l| l.iter().any(|l| l == "RIG wider-ring (Stored)"))
+            && shown.contains("name = \"wider-ring\"")
+            && shown.contains("ring_radius = 0.3\n")
+            && shown.contains("rod_length = 0.325\n"),
+        "a rig file loaded into the emulated controller is stored and runs after a restart",
+    );
+    let args = ["--input", &input_file, "--quiet", "--report-json"];
+    let emu = ringpod_json(&[&["stream", "--port", pty][..], &args].concat());
+    let sim = ringpod_json(&[&["stream", "--sim", "--fast", "--geometry", &rig_file][..], &args].concat());
+    let model = ringpod_json(&[&["stream", "--sim", "--fast"][..], &args].concat());
+    let _ = std::fs::remove_dir_all(&dir);
+    match (&emu, &sim, &model) {
+        (Ok(e), Ok(s), Ok(m)) => {
+            println!(
+                "wider ring: emulated final steps {}, simulator {}, the trainer model {}",
+                e["final_steps"], s["final_steps"], m["final_steps"]
+            );
+            t.check(
+                e["state"] == "Ready"
+                    && e["counts_agree"] == true
+                    && e["final_steps"] == s["final_steps"]
+                    && e["final_steps"] != m["final_steps"],
+                "the emulated controller drives the stored rig to the simulator's steps for it (not the model's)",
+            );
+        }
+        _ => {
+            eprintln!("{emu:?} {sim:?} {model:?}");
+            t.check(false, "stream into the emulated controller's rig and the simulator's");
+        }
+    }
+    drop(emulated);
+}
