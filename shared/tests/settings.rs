@@ -130,9 +130,14 @@ fn every_section_has_a_unique_name_and_answers_with_its_kind() {
 #[test]
 fn the_trainer_models_homing_in_units_is_its_step_counts() {
     let h = ControllerConfig::trainer_model().homing;
-    for a in 0..4 {
+    // (toward, search, back-off, fast rate, slow rate, position at the switch) in steps.
+    let carriage = (1, 1_422, 142, 4_000, 500, 0);
+    let linear = (-1, 64_000, 3_200, 32_000, 4_000, -106_096);
+    for (a, expected) in [carriage, carriage, carriage, carriage, linear, linear]
+        .into_iter()
+        .enumerate()
+    {
         let c = h.axes[a];
-        let expected = (1, 1_422, 142, 4_000, 500, 0);
         let got = (
             c.toward,
             c.search_steps,
@@ -141,20 +146,7 @@ fn the_trainer_models_homing_in_units_is_its_step_counts() {
             c.slow_rate,
             c.home_position,
         );
-        assert_eq!(got, expected, "carriage {a}");
-    }
-    for a in [4, 5] {
-        let c = h.axes[a];
-        let expected = (-1, 64_000, 3_200, 32_000, 4_000, -106_096);
-        let got = (
-            c.toward,
-            c.search_steps,
-            c.backoff_steps,
-            c.fast_rate,
-            c.slow_rate,
-            c.home_position,
-        );
-        assert_eq!(got, expected, "linear actuator {a}");
+        assert_eq!(got, expected, "axis {a}");
     }
     assert_eq!(h.order, [4, 5, 0, 2, 1, 3]);
 }
