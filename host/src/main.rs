@@ -332,8 +332,15 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
             return Ok(0);
         }
     }
+    // The status, and the rig the board runs: where it came from and whether another waits for the next start.
     let status = client.status()?;
-    let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&status)?);
+    let (rig, source, pending) = client.rig()?;
+    if let ringpod_core::protocol::RigSource::Refused(_) | ringpod_core::protocol::RigSource::Unreadable = source {
+        eprintln!("warning: {source}");
+    }
+    let mut json = serde_json::to_value(status)?;
+    json["rig"] = serde_json::json!({ "name": rig.name(), "source": source.to_string(), "pending": pending });
+    let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&json)?);
     Ok(0)
 }
 

@@ -771,6 +771,12 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
 
     let loaded = run(&[&["device", "rig", "load", file][..], &port].concat());
     assert!(loaded.status.success(), "{}", String::from_utf8_lossy(&loaded.stderr));
+    let status = run(&[&["device", "status"][..], &port].concat());
+    let status: serde_json::Value = serde_json::from_slice(&status.stdout).unwrap();
+    assert_eq!(
+        status["rig"],
+        serde_json::json!({ "name": "trainer-model", "source": "compiled in", "pending": true })
+    );
     let before = String::from_utf8(run(&[&["device", "rig", "show"][..], &port].concat()).stdout).unwrap();
     assert!(
         before.starts_with("# running on the device: trainer-model (compiled in)\n# another rig is stored"),
@@ -780,6 +786,12 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
     assert_eq!(
         String::from_utf8_lossy(&restarted.stdout).trim(),
         "restarted: running wider-ring (stored)"
+    );
+    let status = run(&[&["device", "status"][..], &port].concat());
+    let status: serde_json::Value = serde_json::from_slice(&status.stdout).unwrap();
+    assert_eq!(
+        status["rig"],
+        serde_json::json!({ "name": "wider-ring", "source": "stored", "pending": false })
     );
     let shown = run(&[&["device", "rig", "show"][..], &port].concat());
     let shown = String::from_utf8(shown.stdout).unwrap();
