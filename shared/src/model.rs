@@ -10,7 +10,6 @@ use crate::kinematics::presets::{self, Preset};
 use crate::motion::{AxisScale, MotionLimits, PipelineConfig, SchedulerConfig};
 use crate::protocol::{HomingSettings, RigRecord, SwitchSettings, Toward, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
-use crate::safety::homing::{AxisHoming, HomingConfig};
 use crate::safety::SupervisorConfig;
 
 impl MotionLimits {
@@ -73,17 +72,6 @@ impl ControllerConfig {
                 ],
                 order: [4, 5, 0, 2, 1, 3],
             },
-            homing: HomingConfig {
-                axes: [AxisHoming {
-                    toward: 1,
-                    search_steps: 0,
-                    backoff_steps: 0,
-                    fast_rate: 0,
-                    slow_rate: 0,
-                    home_position: 0,
-                }; 6],
-                order: [0; 6],
-            },
             inputs: InputConfig::default(),
             telemetry_hz: 100,
             rig_name: [0; RIG_NAME_LEN],
@@ -95,10 +83,6 @@ impl ControllerConfig {
             config.machine(),
         )
         .name;
-        // Finite, positive values in range: the conversion cannot fail (a test holds it to the steps of FIRMWARE.md).
-        if let Ok(homing) = config.homing_steps() {
-            config.homing = homing;
-        }
         config
     }
 }

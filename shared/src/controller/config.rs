@@ -9,7 +9,7 @@ use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
 use crate::protocol::{ConfigRefusal, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
-use crate::safety::homing::{HomingConfig, HomingError};
+use crate::safety::homing::HomingError;
 use crate::safety::SupervisorConfig;
 
 /// Everything the controller is configured with.
@@ -27,10 +27,9 @@ pub struct ControllerConfig {
     pub scheduler: SchedulerConfig,
     /// Motor scale of every axis.
     pub scales: [AxisScale; 6],
-    /// Homing of every axis in its own units, as the homing section gives it.
+    /// Homing of every axis in its own units, as the homing section gives it (in motor steps:
+    /// [`Self::homing`]).
     pub switches: HomingSettings,
-    /// Homing of every axis in motor steps: `switches` with the axes' scales and directions.
-    pub homing: HomingConfig,
     /// Input polarity and debouncing.
     pub inputs: InputConfig,
     /// Telemetry samples per second while a host is connected (0: none).

@@ -79,7 +79,7 @@ impl Controller {
     pub(super) fn start_jog(&mut self, axis: u8, steps: Option<i32>) -> DeviceMessage {
         let a = usize::from(axis);
         let (Some(homing), Some(kind)) = (
-            self.config.homing.axes.get(a).copied(),
+            self.plan.config().axes.get(a).copied(),
             self.pipeline.mechanism().axes().get(a).copied(),
         ) else {
             return DeviceMessage::Nack(NackReason::OutOfRange);

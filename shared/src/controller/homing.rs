@@ -51,7 +51,7 @@ impl Controller {
     /// Where re-homing starts: every axis two back-off distances before its switch (homed coordinates), found
     /// by forward kinematics.
     pub(super) fn parking_pose(&self) -> Result<Pose<f32>, KinematicsError> {
-        let axes = &self.config.homing.axes;
+        let axes = &self.plan.config().axes;
         let steps = core::array::from_fn(|a| {
             let h = &axes[a];
             h.home_position - i64::from(h.toward) * 2 * i64::from(h.backoff_steps)
@@ -115,7 +115,7 @@ impl Controller {
                 // The switch defines this axis's origin: here it is at step `home_position`.
                 let a = usize::from(axis % 6);
                 let mut p = position;
-                p[a] = self.config.homing.axes[a].home_position;
+                p[a] = self.plan.config().axes[a].home_position;
                 self.scheduler.set_position(p);
                 self.homing_carry = 0;
                 p

@@ -106,7 +106,7 @@ impl Controller {
             min_spacing: geometry.limits.carriage_spacing[0],
             steps_per_rad: config.scales[0].steps_per_turn as f64 / core::f64::consts::TAU,
         };
-        let plan = HomingPlan::new(config.homing, &ring).map_err(ConfigError::Homing)?;
+        let plan = HomingPlan::new(config.homing()?, &ring).map_err(ConfigError::Homing)?;
         let converter = StepConverter::new(config.scales, mechanism.axes());
         let pipeline =
             Pipeline::new(mechanism, config.pipeline, converter, home_pose).map_err(ConfigError::HomePose)?;

@@ -155,16 +155,24 @@ impl ControllerConfig {
             }
         }
         if matches!(settings.kind(), SettingsKind::Axes | SettingsKind::Homing) {
-            next.homing = next.homing_steps()?;
+            // A step count out of range is a value out of range.
+            next.homing()?;
         }
         *self = next;
         Ok(())
     }
 
-    /// The homing sections in motor steps, with each axis's steps per unit and direction.
-    pub(crate) fn homing_steps(&self) -> Result<HomingConfig, ConfigError> {
+    /// Homing of every axis in motor steps: the homing section with each axis's steps per unit and direction.
+    pub fn homing(&self) -> Result<HomingConfig, ConfigError> {
         let kinds = self.axis_kinds();
-        let mut axes = [self.homing.axes[0]; 6];
+        let mut axes = [AxisHoming {
+            toward: 1,
+            search_steps: 0,
+            backoff_steps: 0,
+            fast_rate: 0,
+            slow_rate: 0,
+            home_position: 0,
+        }; 6];
         for (a, slot) in axes.iter_mut().enumerate() {
             let s = &self.switches.axes[a];
             let scale = &self.scales[a];
