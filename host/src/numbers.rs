@@ -1,6 +1,16 @@
-//! Reading lists of six numbers from the command line.
+//! Numbers on the command line and in what the CLI writes: lists of six, ranges, and the device's `f32` values.
 
 use crate::error::CliError;
+
+/// A float that is exactly an `f32` is one of the device's values: its shortest `f32` decimal (0.05, not
+/// 0.05000000074505806), so that files and JSON show the number as written; any other float as it is.
+pub fn as_written(f: f64) -> f64 {
+    if f64::from(f as f32) == f {
+        (f as f32).to_string().parse().unwrap_or(f)
+    } else {
+        f
+    }
+}
 
 /// Parses `a,b,c,d,e,f` into six finite numbers.
 pub fn six(what: &'static str, text: &str) -> Result<[f64; 6], CliError> {

@@ -4,7 +4,6 @@
 //! it with the rest of its configuration and says why when it refuses.
 
 use ringpod_core::protocol::{Settings, SettingsKind};
-use ringpod_core::safety::debounce::InputConfig;
 use serde_json::Value;
 
 use crate::client::{Client, Transport};
@@ -15,16 +14,9 @@ fn to_json(settings: &Settings) -> anyhow::Result<Value> {
     fn tidy(v: &mut Value) {
         match v {
             Value::Number(n) if n.is_f64() => {
-                let f = n.as_f64().unwrap_or_default();
-                if f64::from(f as f32) == f {
-                    if let Some(short) = (f as f32)
-                        .to_string()
-                        .parse()
-                        .ok()
-                        .and_then(serde_json::Number::from_f64)
-                    {
-                        *n = short;
-                    }
+                let written = n.as_f64().map(crate::numbers::as_written);
+                if let Some(short) = written.and_then(serde_json::Number::from_f64) {
+                    *n = short;
                 }
             }
             Value::Array(a) => a.iter_mut().for_each(tidy),
@@ -54,27 +46,11 @@ fn from_json(kind: SettingsKind, value: Value) -> anyhow::Result<Settings> {
         SettingsKind::Motion => Settings::Motion(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Inputs => {
             let spec: InputsSpec = serde_json::from_value(value).map_err(bad)?;
-            Settings::Inputs(input_config(&spec)?)
+            Settings::Inputs(spec.config().map_err(|e| anyhow::anyhow!("{e}"))?)
         }
         SettingsKind::Axes => Settings::Axes(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Homing => Settings::Homing(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Supervisor => Settings::Supervisor(serde_json::from_value(value).map_err(bad)?),
-    })
-}
-
-/// The inputs section from its names.
-fn input_config(spec: &InputsSpec) -> anyhow::Result<InputConfig> {
-    let mut mask = 0u16;
-    for name in &spec.active_low {
-        let Some((_, bit)) = crate::rig::input_names().find(|(n, _)| n == name) else {
-            let all: Vec<String> = crate::rig::input_names().map(|(n, _)| n).collect();
-            anyhow::bail!("inputs.active_low: no input {name:?}; inputs: {}", all.join(", "));
-        };
-        mask |= bit.mask();
-    }
-    Ok(InputConfig {
-        active_low: mask,
-        debounce_samples: spec.debounce_ms,
     })
 }
 

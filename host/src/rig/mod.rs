@@ -38,7 +38,7 @@ mod settings;
 pub use command::{check_command, design_command, export};
 pub use coverage::coverage;
 pub use drives::{Drive, DriveSpec};
-pub use settings::{names as input_names, InputsSpec};
+pub use settings::InputsSpec;
 
 use std::fmt;
 use std::path::Path;
@@ -473,12 +473,9 @@ impl RigFile {
     /// The file as TOML text, every number as written: the device's `f32` values by their shortest decimal (0.05,
     /// not 0.05000000074505806), keys in the order of the types.
     pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
-        /// A float that is exactly an `f32` is one of the device's values: its shortest `f32` decimal.
         fn tidy(v: &mut toml::Value) {
             match v {
-                toml::Value::Float(f) if f64::from(*f as f32) == *f => {
-                    *f = (*f as f32).to_string().parse().unwrap_or(*f);
-                }
+                toml::Value::Float(f) => *f = crate::numbers::as_written(*f),
                 toml::Value::Array(a) => a.iter_mut().for_each(tidy),
                 toml::Value::Table(t) => t.iter_mut().for_each(|(_, v)| tidy(v)),
                 _ => {}

@@ -24,7 +24,7 @@ pub struct InputsSpec {
 }
 
 /// Every input by its name in the file.
-pub fn names() -> impl Iterator<Item = (String, InputBit)> {
+fn names() -> impl Iterator<Item = (String, InputBit)> {
     let axes = (0..6u8).flat_map(|a| {
         [
             (format!("home{}", a + 1), InputBit::Home(a)),
@@ -76,24 +76,10 @@ impl RigFile {
             record.machine.motion = *m;
         }
         if let Some(spec) = &self.inputs {
-            let mut mask = 0u16;
-            for name in &spec.active_low {
-                let Some((_, bit)) = names().find(|(n, _)| n == name) else {
-                    let all: Vec<String> = names().map(|(n, _)| n).collect();
-                    return err(
-                        "inputs.active_low",
-                        format!("no input {name:?}; inputs: {}", all.join(", ")),
-                    );
-                };
-                mask |= bit.mask();
-            }
             if !(1..=50).contains(&spec.debounce_ms) {
                 return err("inputs.debounce_ms", format!("{} is not 1 to 50 ms", spec.debounce_ms));
             }
-            record.machine.inputs = InputConfig {
-                active_low: mask,
-                debounce_samples: spec.debounce_ms,
-            };
+            record.machine.inputs = spec.config()?;
         }
         if let Some(s) = self.supervisor {
             if !s.is_valid() {
@@ -147,6 +133,25 @@ impl RigFile {
 }
 
 impl InputsSpec {
+    /// The inputs section these names make (the device checks the debouncing).
+    pub fn config(&self) -> Result<InputConfig, RigError> {
+        let mut mask = 0u16;
+        for name in &self.active_low {
+            let Some((_, bit)) = names().find(|(n, _)| n == name) else {
+                let all: Vec<String> = names().map(|(n, _)| n).collect();
+                return err(
+                    "inputs.active_low",
+                    format!("no input {name:?}; inputs: {}", all.join(", ")),
+                );
+            };
+            mask |= bit.mask();
+        }
+        Ok(InputConfig {
+            active_low: mask,
+            debounce_samples: self.debounce_ms,
+        })
+    }
+
     /// The inputs section by names.
     pub fn of(inputs: &InputConfig) -> Self {
         Self {
