@@ -32,8 +32,8 @@ pub enum CliError {
         /// Reach margin of the pose (negative).
         margin: f64,
     },
-    /// A rig file is invalid.
-    #[error("rig file: {0}")]
+    /// A rig file is invalid (the error names the file and the key).
+    #[error(transparent)]
     Rig(#[from] crate::rig::RigError),
     /// JSON output failed.
     #[error("JSON output: {0}")]

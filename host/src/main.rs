@@ -17,6 +17,7 @@ mod reactions;
 mod record;
 mod rig;
 mod settings;
+mod signals;
 mod stream;
 mod table;
 mod transport;
@@ -87,12 +88,7 @@ fn answer(outcome: Result<kinematics::Outcome, error::CliError>) -> anyhow::Resu
 
 /// `ringpod stream`: the exit codes of [`stream::exit`].
 fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
-    use std::sync::atomic::{AtomicBool, Ordering};
-    use std::sync::Arc;
-
-    let interrupted = Arc::new(AtomicBool::new(false));
-    let flag = interrupted.clone();
-    ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))?;
+    let signals = signals::Signals::install()?;
     let positive = |name: &str, v: f64, max: f64| {
         if v.is_finite() && v > 0.0 && v <= max {
             Ok(v)
@@ -171,7 +167,7 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         None => connect(args.port.as_deref(), args.sim, !args.fast)?,
     };
     let mut client = client::Client::new(transport);
-    client.cancel = Some(interrupted.clone());
+    client.cancel = Some(signals.flag());
     // The bar draws on stderr (and hides itself without a terminal), the report on stdout.
     let options = stream::Options {
         home: args.home,
@@ -191,13 +187,19 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         input_errors,
         &options,
         args.fast,
-        &|| interrupted.load(Ordering::SeqCst),
+        &|| signals.received(),
         recorder,
     ) {
-        Ok(report) => report,
+        Ok(mut report) => {
+            if report.exit_code == stream::exit::INTERRUPTED {
+                report.exit_code = signals.exit_code();
+                report.reason = Some(format!("interrupted by {}", signals.name()));
+            }
+            report
+        }
         Err(client::ClientError::Interrupted) => {
-            eprintln!("ringpod: interrupted before the stream started");
-            return Ok(stream::exit::INTERRUPTED);
+            eprintln!("ringpod: interrupted by {} before the stream started", signals.name());
+            return Ok(signals.exit_code());
         }
         Err(e) => {
             eprintln!("ringpod: the stream could not start: {e}");
@@ -245,9 +247,6 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     }
     Ok(report.exit_code)
 }
-
-/// Set by Ctrl-C in commands that run until interrupted.
-static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
 
 /// `ringpod monitor`.
 fn monitor_command(port: Option<&str>, sim: bool, frames: Option<u64>) -> anyhow::Result<u8> {
@@ -303,12 +302,14 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
             println!("{line}");
             return Ok(0);
         }
+        A::Inputs if args.watch => {
+            // Watched until a signal, which is its normal end: 128 + the signal, as a shell reports it.
+            let signals = signals::Signals::install()?;
+            commission::inputs(&mut client, true, &|| signals.received())?;
+            return Ok(signals.exit_code());
+        }
         A::Inputs => {
-            let stop = || INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst);
-            if args.watch {
-                ctrlc::set_handler(|| INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst))?;
-            }
-            commission::inputs(&mut client, args.watch, &stop)?;
+            commission::inputs(&mut client, false, &|| false)?;
             return Ok(0);
         }
         A::Rig => {
@@ -353,8 +354,10 @@ fn simulate_command(pty: bool, geometry: Option<&std::path::Path>) -> anyhow::Re
         Some(path) => transport::SimDevice::for_rig(true, &rig::load(path)?)?,
         None => transport::SimDevice::new(true),
     };
-    pty::serve(device)?;
-    Ok(0)
+    let signals = signals::Signals::install()?;
+    pty::serve(device, &|| signals.received())?;
+    eprintln!("ringpod: simulator stopped by {}", signals.name());
+    Ok(signals.exit_code())
 }
 
 /// `ringpod ports`.

@@ -13,8 +13,8 @@ use crate::client::Transport;
 use crate::transport::SimDevice;
 
 /// Opens a pseudo-terminal, prints the path of its device side, and runs the simulated controller behind it in
-/// real time (1 ms steps) until the process is interrupted.
-pub fn serve(mut device: SimDevice) -> anyhow::Result<()> {
+/// real time (1 ms steps) until `stop` says so (a signal); returning closes the pseudo-terminal.
+pub fn serve(mut device: SimDevice, stop: &dyn Fn() -> bool) -> anyhow::Result<()> {
     let pty = openpty(None, None)?;
     // Raw mode on the device side: no echo, no line editing, no newline translation of the framed bytes.
     let mut termios = tcgetattr(&pty.slave)?;
@@ -29,7 +29,7 @@ pub fn serve(mut device: SimDevice) -> anyhow::Result<()> {
     println!("{}", path.display());
     std::io::stdout().flush()?;
     let mut buf = [0u8; 1024];
-    loop {
+    while !stop() {
         match master.read(&mut buf) {
             Ok(n) if n > 0 => device.send(&buf[..n])?,
             Ok(_) => {}
@@ -47,4 +47,5 @@ pub fn serve(mut device: SimDevice) -> anyhow::Result<()> {
             master.write_all(&buf[..n])?;
         }
     }
+    Ok(())
 }

@@ -28,13 +28,14 @@ impl MotionLimits {
 }
 
 impl AxisScale {
-    /// FL20 (200 full steps) at 1/16 microstepping on an 8:1 ring gear: 25,600 steps per carriage turn.
+    /// FL20 (200 full steps) at 1/16 microstepping on an 8:1 ring gear: 25,600 steps per carriage turn. The source
+    /// gives the FL20 and no gearing: the 8:1 ratio is the specification's assumption (FIRMWARE.md, "Step rates").
     pub const MODEL_CARRIAGE: AxisScale = AxisScale {
         steps_per_turn: 25_600,
         steps_per_unit: 25_600.0 / core::f32::consts::TAU,
         invert: false,
     };
-    /// FL20 at 1/16 on a 2 mm lead screw: 1.6 M steps per metre.
+    /// FL20 at 1/16 on a 2 mm lead screw: 1.6 M steps per metre (the lead, too, is the specification's assumption).
     pub const MODEL_LINEAR: AxisScale = AxisScale {
         steps_per_turn: 0,
         steps_per_unit: 1.6e6,

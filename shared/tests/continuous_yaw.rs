@@ -5,7 +5,8 @@
 
 use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
 
-/// 200 full steps x 16 microsteps x 8:1 ring gear = 25,600 steps per carriage revolution (about 4,074 steps/rad).
+/// 200 full steps x 16 microsteps x 8:1 ring gear (assumed: the source gives no gearing) = 25,600 steps per carriage
+/// revolution (about 4,074 steps/rad).
 const STEPS_PER_TURN: i64 = 25_600;
 
 /// The commanded pose at tick k: yaw advances by `dyaw` a tick while heave and tilt wobble inside the spec ranges.

@@ -183,9 +183,10 @@ pub fn of_preset(preset: Preset) -> Vec<DriveSpec> {
 
 /// The 1:20 trainer model's FL20 drives, as far as the sources give them (see `source`).
 fn trainer_model() -> Vec<DriveSpec> {
-    // NEMA 8 (20 mm) hybrid stepper, FL20STH30 size: 0.018 N m holding. The sources give the motor family, 200
-    // steps/rev and the ring gear (~8:1), not a torque curve: the curve's shape is assumed from NEMA 8 catalogue
-    // curves on a 24 V chopper driver (a small, low-inductance motor: slow fall, nothing left near 3,600 rpm).
+    // NEMA 8 (20 mm) hybrid stepper, FL20STH30 size: 0.018 N m holding. The sources give the motor family and its
+    // 200 steps/rev, no gearing and no torque curve: the 8:1 ring gear and the 2 mm lead are the specification's
+    // assumptions (FIRMWARE.md, "Step rates"), and the curve's shape is assumed from NEMA 8 catalogue curves on a
+    // 24 V chopper driver (a small, low-inductance motor: slow fall, nothing left near 3,600 rpm).
     let pull_out = vec![
         [0.0, 0.016],
         [300.0, 0.015],
@@ -196,7 +197,10 @@ fn trainer_model() -> Vec<DriveSpec> {
         [3000.0, 0.0015],
         [3600.0, 0.0],
     ];
-    let source = "assumed: FL20STH30 size (0.018 N m holding), NEMA 8 curve shape at 24 V; measure yours".to_owned();
+    let source =
+        "assumed: FL20STH30 size (0.018 N m holding), NEMA 8 curve shape at 24 V, 8:1 ring gear and 2 mm lead \
+                  (the sources give no gearing); measure yours"
+            .to_owned();
     vec![
         DriveSpec {
             axes: vec![1, 2, 3, 4],

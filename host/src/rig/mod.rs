@@ -190,7 +190,8 @@ impl SpecRanges {
 /// Why a rig file cannot be used: the key, and what is wrong with it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RigError {
-    /// The key (`chains[2].branch`, `limits.stroke`, `home`), or the file for errors of the whole.
+    /// The key (`chains[2].branch`, `limits.stroke`, `home`), prefixed with the file's path once read from one;
+    /// empty for errors of the whole text (its syntax, the core's check of the geometry).
     pub key: String,
     /// Why.
     pub why: String,
@@ -198,7 +199,11 @@ pub struct RigError {
 
 impl fmt::Display for RigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.key, self.why)
+        if self.key.is_empty() {
+            f.write_str(&self.why)
+        } else {
+            write!(f, "{}: {}", self.key, self.why)
+        }
     }
 }
 
@@ -211,6 +216,15 @@ impl RigError {
             key: key.into(),
             why: why.into(),
         }
+    }
+
+    /// The same error, said of the file at `path` (once: the path goes in front of the key).
+    fn in_file(self, path: &Path) -> Self {
+        let key = match self.key.is_empty() {
+            true => path.display().to_string(),
+            false => format!("{}: {}", path.display(), self.key),
+        };
+        Self { key, why: self.why }
     }
 }
 
@@ -235,19 +249,19 @@ pub struct Rig {
 
 /// Reads and checks a rig file.
 pub fn load(path: &Path) -> Result<Rig, RigError> {
-    read(path)?.check()
+    read(path)?.check().map_err(|e| e.in_file(path))
 }
 
 /// Reads a rig file without checking it (a design template need not be a valid rig yet).
 pub fn read(path: &Path) -> Result<RigFile, RigError> {
     let text = std::fs::read_to_string(path).or_else(|e| err(path.display().to_string(), e.to_string()))?;
-    from_text(&text)
+    from_text(&text).map_err(|e| e.in_file(path))
 }
 
 fn from_text(text: &str) -> Result<RigFile, RigError> {
     toml::from_str(text).or_else(|e| {
         // toml names the key and the line; keep its words.
-        err("rig file", e.message().trim().to_owned() + &span_of(text, e.span()))
+        err("", e.message().trim().to_owned() + &span_of(text, e.span()))
     })
 }
 
@@ -375,8 +389,7 @@ impl RigFile {
         }
         let limits = self.limits(radial)?;
         // The core's own validation is the last word (it is what the firmware builds from).
-        RingGeometry::new(name, self.ring_radius, self.rod_length, &chains, limits)
-            .or_else(|e| err("rig file", e.to_string()))
+        RingGeometry::new(name, self.ring_radius, self.rod_length, &chains, limits).or_else(|e| err("", e.to_string()))
     }
 
     fn limits(&self, radial: usize) -> Result<RingLimits, RigError> {

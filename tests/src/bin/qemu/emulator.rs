@@ -1,4 +1,4 @@
-//! QEMU itself: installing it when missing, building the Cortex-M4F programs of `tests/qemu`, running one to its
+//! QEMU itself: building the Cortex-M4F programs of `tests/qemu`, running one to its
 //! end under a time limit, or starting the controller program with its UART on a pseudo-terminal.
 
 use std::io::{BufRead, BufReader, Read};
@@ -187,58 +187,4 @@ pub(crate) fn start_controller(elf: &Path, args: &[&str]) -> Result<Emulated, St
         }
     }
     Ok(emulated)
-}
-
-/// Makes sure `qemu-system-arm` is there: on a fresh Debian or Ubuntu machine it installs it (as root, or through
-/// `sudo` without a password), as the README's test command promises; otherwise it says what to install.
-pub(crate) fn ensure_qemu() -> Result<(), String> {
-    let present = || {
-        Command::new("qemu-system-arm")
-            .arg("--version")
-            .stdout(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success())
-    };
-    if present() {
-        return Ok(());
-    }
-    let root = Command::new("id")
-        .arg("-u")
-        .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
-    let sudo = !root
-        && Command::new("sudo")
-            .args(["-n", "true"])
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
-    let apt = Command::new("apt-get")
-        .arg("--version")
-        .stdout(Stdio::null())
-        .status()
-        .is_ok();
-    let help = "qemu-system-arm is missing: install it (Debian and Ubuntu: apt-get install qemu-system-arm)";
-    if !apt || !(root || sudo) {
-        return Err(help.into());
-    }
-    println!("== qemu-system-arm is missing: installing it with apt-get");
-    let apt_get = |args: &[&str]| {
-        let mut c = if root {
-            Command::new("apt-get")
-        } else {
-            Command::new("sudo")
-        };
-        if !root {
-            c.arg("apt-get");
-        }
-        c.args(args)
-            .env("DEBIAN_FRONTEND", "noninteractive")
-            .status()
-            .is_ok_and(|s| s.success())
-    };
-    if apt_get(&["update"]) && apt_get(&["install", "-y", "qemu-system-arm"]) && present() {
-        Ok(())
-    } else {
-        Err(help.into())
-    }
 }

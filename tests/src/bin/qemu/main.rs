@@ -8,21 +8,24 @@
 //! 2. `controller`: the controller's firmware tasks on the emulated MCU, streamed through its UART.
 //! 3. `watchdog`: a stalled control loop reset by the watchdog. 4. `rig`: a rig of one's own loaded and run.
 //!
-//! `emulator` starts QEMU and the programs; `host_cli` drives the `ringpod` CLI against them.
+//! `setup` installs what the suite needs first (the target's standard library, QEMU) or says how;
+//! `cargo run -p ringpod-tests --bin qemu -- --preflight` runs only that. `emulator` starts QEMU and the programs;
+//! `host_cli` drives the `ringpod` CLI against them.
 
 mod controller;
 mod emulator;
 mod host_cli;
 mod rig;
 mod self_check;
+mod setup;
 mod watchdog;
 
 use std::process::ExitCode;
 
 use crate::controller::controller_on_m4f;
-use crate::emulator::ensure_qemu;
 use crate::rig::rig_on_m4f;
 use crate::self_check::core_on_m4f;
+use crate::setup::preflight;
 use crate::watchdog::watchdog_on_m4f;
 
 pub(crate) struct Tally {
@@ -42,10 +45,26 @@ impl Tally {
 }
 
 fn main() -> ExitCode {
-    if let Err(e) = ensure_qemu() {
-        eprintln!("{e}");
+    let only_preflight = match std::env::args().nth(1).as_deref() {
+        None => false,
+        Some("--preflight") => true,
+        Some(other) => {
+            eprintln!("qemu: unknown argument {other:?} (the only one is --preflight)");
+            return ExitCode::from(2);
+        }
+    };
+    // Nothing is built before this passes: a missing piece is one line naming its command, not a compiler error.
+    if let Err(e) = preflight() {
+        eprintln!("qemu: {e}");
         println!("0 passed, 1 failed");
         return ExitCode::FAILURE;
+    }
+    if only_preflight {
+        println!(
+            "preflight: the {} standard library and qemu-system-arm are installed",
+            setup::TARGET
+        );
+        return ExitCode::SUCCESS;
     }
     let mut t = Tally { passed: 0, failed: 0 };
     core_on_m4f(&mut t);
