@@ -1,6 +1,7 @@
 //! `ringpod stream` against the simulated controller: the same core as the firmware behind the real framed bytes.
 
 use assert_cmd::Command;
+use nix::sys::signal::Signal;
 use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
 use ringpod_core::motion::{AxisScale, StepConverter};
 
@@ -507,31 +508,78 @@ fn stream_from_udp_datagrams() {
     }
 }
 
-/// Ctrl-C (SIGINT) in the middle of a stream ends it with a stop and a wait for rest, and still reports.
+/// Ctrl-C (SIGINT) or SIGTERM in the middle of a stream ends it with a stop and a wait for rest, still reports, and
+/// exits with 128 + the signal (130, 143) as a shell or a service manager expects.
 #[test]
-fn ctrl_c_stops_and_reports() {
-    // UDP source: the stream is then certainly running (it announces itself) when the signal comes.
-    let (child, mut stderr, addr) = spawn_udp_stream(&["--udp-idle", "60"]);
-    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-    for k in 0..20 {
-        socket
-            .send_to(format!("0 0 {} 0 0 0", 0.227 + 0.0001 * f64::from(k)).as_bytes(), &addr)
-            .unwrap();
-        std::thread::sleep(std::time::Duration::from_millis(10));
+fn a_signal_stops_and_reports() {
+    for (signal, code) in [(Signal::SIGINT, 130), (Signal::SIGTERM, 143)] {
+        // UDP source: the stream is then certainly running (it announces itself) when the signal comes.
+        let (child, mut stderr, addr) = spawn_udp_stream(&["--udp-idle", "60"]);
+        let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+        for k in 0..20 {
+            socket
+                .send_to(format!("0 0 {} 0 0 0", 0.227 + 0.0001 * f64::from(k)).as_bytes(), &addr)
+                .unwrap();
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        nix::sys::signal::kill(nix::unistd::Pid::from_raw(child.id() as i32), signal).unwrap();
+        let out = child.wait_with_output().unwrap();
+        let mut rest = String::new();
+        let _ = std::io::Read::read_to_string(&mut stderr, &mut rest);
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout)
+            .unwrap_or_else(|e| panic!("{e}; status {:?}; stderr: {rest}", out.status));
+        assert_eq!(report["state"], "Ready", "stopped and at rest");
+        assert!(report["setpoints_applied"].as_u64().unwrap() >= 1);
+        assert_eq!(report["counts_agree"], true);
+        assert_eq!(report["outcome"], "interrupted");
+        assert_eq!(out.status.code(), Some(code), "{signal}: {rest}");
+        assert!(rest.contains("interrupted by"), "{rest}");
     }
-    nix::sys::signal::kill(
-        nix::unistd::Pid::from_raw(child.id() as i32),
-        nix::sys::signal::Signal::SIGINT,
-    )
-    .unwrap();
-    let out = child.wait_with_output().unwrap();
-    let mut rest = String::new();
-    let _ = std::io::Read::read_to_string(&mut stderr, &mut rest);
-    let report: serde_json::Value =
-        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; stderr: {rest}", out.status));
-    assert_eq!(report["state"], "Ready", "stopped and at rest");
-    assert!(report["setpoints_applied"].as_u64().unwrap() >= 1);
-    assert_eq!(report["counts_agree"], true);
+}
+
+/// `simulate --pty` started the way a script starts it (`ringpod simulate --pty &`, where the shell sets SIGINT to
+/// ignored): SIGINT and SIGTERM still stop it, and it exits with 128 + the signal, closing its pseudo-terminal.
+#[test]
+fn the_simulator_stops_on_sigint_and_sigterm_even_started_with_sigint_ignored() {
+    use std::io::BufRead;
+    use std::os::unix::process::CommandExt;
+    for (signal, code) in [(Signal::SIGINT, 130), (Signal::SIGTERM, 143)] {
+        let mut command = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"));
+        command
+            .args(["simulate", "--pty"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped());
+        // SAFETY: between fork and exec only `signal`, which is async-signal-safe, runs.
+        unsafe {
+            command.pre_exec(|| {
+                nix::sys::signal::signal(Signal::SIGINT, nix::sys::signal::SigHandler::SigIgn)
+                    .map(|_| ())
+                    .map_err(std::io::Error::from)
+            });
+        }
+        let mut server = command.spawn().unwrap();
+        let mut path = String::new();
+        std::io::BufReader::new(server.stdout.take().unwrap())
+            .read_line(&mut path)
+            .unwrap();
+        assert!(path.starts_with("/dev/pts/"), "{path}");
+        nix::sys::signal::kill(nix::unistd::Pid::from_raw(server.id() as i32), signal).unwrap();
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+        let status = loop {
+            if let Some(status) = server.try_wait().unwrap() {
+                break status;
+            }
+            if std::time::Instant::now() > deadline {
+                let _ = server.kill();
+                panic!("the simulator still runs 10 s after {signal}");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        assert_eq!(status.code(), Some(code), "{signal}");
+        let mut said = String::new();
+        let _ = std::io::Read::read_to_string(&mut server.stderr.take().unwrap(), &mut said);
+        assert!(said.contains("simulator stopped by"), "{said}");
+    }
 }
 
 /// A live session as a user has it: ringpod starts first, the game later; the game pauses (a menu) longer than
