@@ -283,12 +283,12 @@ pub struct StreamArgs {
     /// (limited, refused, held). `ringpod plot FILE` draws it.
     #[arg(long, value_name = "FILE.csv")]
     pub record: Option<std::path::PathBuf>,
-    /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics, the trainer
-    /// model's FL20 data) for a payload of --mass kg; where it exceeds the motors, say where and do not stream
-    /// (exit 1).
+    /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics) on the platform
+    /// the device runs, against its drives (the --geometry file's `[[drives]]`, or the preset's motor data) for a
+    /// payload of --mass kg; where it exceeds the motors, say where and do not stream (exit 1).
     #[arg(long, requires = "mass", conflicts_with_all = ["udp", "telemetry_udp"])]
     pub check_loads: bool,
-    /// With --check-loads: the moving mass (kg) at the model's centre of mass.
+    /// With --check-loads: the moving mass (kg) at the platform's centre of mass.
     #[arg(long, requires = "check_loads")]
     pub mass: Option<f64>,
     /// With --check-loads: its inertia Ixx,Iyy,Izz (kg m^2) about the centre of mass.
@@ -391,6 +391,12 @@ pub struct CueArgs {
     /// A plot of the cues (SVG): per axis the specific force asked and delivered, and the angular rates.
     #[arg(long)]
     pub plot: Option<std::path::PathBuf>,
+    /// The platform cued for (a ring platform): its home is the neutral pose, its envelope limits the cues.
+    #[arg(long, short, default_value = "trainer-model")]
+    pub mechanism: String,
+    /// Your own ring platform: a rig file (TOML), instead of --mechanism.
+    #[arg(long, value_name = "RIG.toml")]
+    pub geometry: Option<std::path::PathBuf>,
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,

@@ -6,12 +6,12 @@ use std::path::Path;
 
 use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
 use ringpod_core::cueing::{self, CueConfig, SampleError, Telemetry, Washout};
-use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
-use ringpod_core::kinematics::{Pose, RingPlatform};
+use ringpod_core::kinematics::Pose;
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
 use crate::cli::CueArgs;
+use crate::mechanism::{AnyMechanism, Selected};
 use crate::plot::{self, Panel, Series, TimePlot};
 use crate::table::{self, InputError};
 
@@ -61,12 +61,11 @@ pub fn run(args: &CueArgs) -> anyhow::Result<(String, u8)> {
     let text = std::fs::read_to_string(&args.input).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
     let (rows, mut errors) =
         table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
-    let preset = Preset::TrainerModel;
-    let PresetGeometry::Ring(geometry) = preset.geometry() else {
-        anyhow::bail!("the trainer model is a ring platform");
+    let selected = Selected::of(&args.mechanism, args.geometry.as_deref())?;
+    let AnyMechanism::Ring(mechanism) = selected.mechanism else {
+        anyhow::bail!("cueing moves a ring platform; {} is not one", selected.name);
     };
-    let mechanism = RingPlatform::<f64>::new(geometry);
-    let neutral = Pose::from_array(preset.home());
+    let neutral = Pose::from_array(selected.home);
     let margins = EnvelopeMargins::default();
     let mut washout = Washout::<f64>::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
@@ -88,7 +87,7 @@ pub fn run(args: &CueArgs) -> anyhow::Result<(String, u8)> {
         let pose = match offset {
             Ok(offset) => {
                 let wanted = cueing::pose(&neutral, &offset);
-                let l = envelope::limit(&mechanism, &neutral, &wanted, &margins, 16);
+                let l = envelope::limit(&*mechanism, &neutral, &wanted, &margins, 16);
                 limited += usize::from(l.is_limited());
                 l.pose
             }

@@ -29,8 +29,9 @@ pub enum Decoder {
         format: TelemetryFormat,
         /// The washout.
         washout: Box<Washout<f64>>,
-        /// The platform's neutral pose.
-        neutral: Pose<f64>,
+        /// The platform's neutral pose: the home pose of the rig the device runs, set by the stream once it knows it
+        /// ([`Decoder::centre_on`]), before the first datagram is read.
+        neutral: Option<Pose<f64>>,
         /// Time of the last sample: its own (s) or its arrival.
         last: Option<(Option<f64>, Instant)>,
         /// Gaps of more than a second after which the washout started again at neutral.
@@ -152,6 +153,7 @@ impl Decoder {
                 last,
                 gaps,
             } => {
+                let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
                 let (t, sample) = match format {
                     TelemetryFormat::Text => parse_telemetry(bytes)?,
                     TelemetryFormat::Outsim => outsim::parse(bytes).map(|(t, s)| (Some(t), s))?,
@@ -175,7 +177,7 @@ impl Decoder {
                 };
                 let offset = offset?;
                 *last = Some((t, now));
-                Ok(cueing::pose(neutral, &offset))
+                Ok(cueing::pose(&neutral, &offset))
             }
         }
     }
@@ -195,8 +197,15 @@ impl Decoder {
                     rate: [0.0; 3],
                 };
                 let offset = washout.step(&rest, dt).ok()?;
-                Some(cueing::pose(neutral, &offset))
+                Some(cueing::pose(&(*neutral)?, &offset))
             }
+        }
+    }
+
+    /// Cues around `home` (the home pose of the rig the device runs); a pose source has no neutral.
+    pub fn centre_on(&mut self, home: Pose<f64>) {
+        if let Decoder::Telemetry { neutral, .. } = self {
+            *neutral = Some(home);
         }
     }
 
@@ -287,7 +296,7 @@ mod tests {
         let mut d = Decoder::Telemetry {
             format: TelemetryFormat::Text,
             washout: Box::new(washout),
-            neutral,
+            neutral: Some(neutral),
             last: None,
             gaps: 0,
         };

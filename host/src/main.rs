@@ -105,13 +105,11 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
                 (None, Some(addr)) => {
                     let config = cue::load_config(args.cue_config.as_deref())?;
                     let washout = ringpod_core::cueing::Washout::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
-                    let neutral = ringpod_core::kinematics::Pose::from_array(
-                        ringpod_core::kinematics::presets::Preset::TrainerModel.home(),
-                    );
                     let decoder = datagram::Decoder::Telemetry {
                         format: args.telemetry_format,
                         washout: Box::new(washout),
-                        neutral,
+                        // The device's home pose, once the stream has asked for its rig.
+                        neutral: None,
                         last: None,
                         gaps: 0,
                     };
@@ -147,20 +145,6 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
             Vec::new(),
         ),
     };
-    if args.check_loads {
-        let payload = ringpod_core::kinematics::Payload {
-            mass: numbers::mass(args.mass.unwrap_or(f64::NAN))?,
-            inertia: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::from(numbers::inertia(
-                args.inertia.as_deref(),
-            )?)),
-        };
-        let check = stream::check_loads(&source, &payload)?;
-        eprint!("{}", check.text);
-        if !check.keeps_up {
-            eprintln!("ringpod: the motion asks more than the drives give (--check-loads): not streamed");
-            return Ok(stream::exit::NOT_STARTED);
-        }
-    }
     let rig = args.geometry.as_deref().map(rig::load).transpose()?;
     let transport = match &rig {
         Some(r) => transport::AnyTransport::Sim(Box::new(transport::SimDevice::for_rig(!args.fast, r)?)),
@@ -168,6 +152,22 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
     };
     let mut client = client::Client::new(transport);
     client.cancel = Some(signals.flag());
+    // Checked on the platform the device runs, before it powers up.
+    if args.check_loads {
+        let payload = ringpod_core::kinematics::Payload {
+            mass: numbers::mass(args.mass.unwrap_or(f64::NAN))?,
+            inertia: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::from(numbers::inertia(
+                args.inertia.as_deref(),
+            )?)),
+        };
+        let platform = stream::loads_platform(&mut client, rig.as_ref())?;
+        let check = stream::check_loads(&source, &payload, &platform)?;
+        eprint!("{}", check.text);
+        if !check.keeps_up {
+            eprintln!("ringpod: the motion asks more than the drives give (--check-loads): not streamed");
+            return Ok(stream::exit::NOT_STARTED);
+        }
+    }
     // The bar draws on stderr (and hides itself without a terminal), the report on stdout.
     let options = stream::Options {
         home: args.home,

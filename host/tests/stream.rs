@@ -785,6 +785,76 @@ fn a_rig_of_ones_own_streams_on_the_simulator() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `cue --geometry` and `stream --check-loads --geometry` work on the rig given, not on the trainer model: the cues
+/// centre on its home pose (another height) and the drive margins are those of its geometry, so both answers differ
+/// from the trainer model's for the same input.
+#[test]
+fn cue_and_check_loads_take_the_platform_of_the_rig() {
+    let dir = std::env::temp_dir().join(format!("ringpod-rig-cue-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("wider.toml");
+    // A wider ring with longer rods, homed 1 cm higher: no preset describes it.
+    let rig = wider_ring().replacen("0.227", "0.237", 1);
+    std::fs::write(&file, &rig).unwrap();
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let run = |args: &[&str]| std::process::Command::new(&exe).args(args).output().unwrap();
+    let mut drive = String::from("t,ax,ay,az,wx,wy,wz\n");
+    for k in 0..200 {
+        drive += &format!("{},2.0,0,9.81,0,0,0.3\n", f64::from(k) * 0.01);
+    }
+    let input = dir.join("drive.csv");
+    std::fs::write(&input, drive).unwrap();
+    let cue = |name: &str, extra: &[&str]| {
+        let out = dir.join(name);
+        let o = run(&[
+            &[
+                "cue",
+                "--input",
+                input.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            extra,
+        ]
+        .concat());
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read_to_string(out).unwrap()
+    };
+    let model = cue("model.csv", &[]);
+    let own = cue("own.csv", &["--geometry", file.to_str().unwrap()]);
+    let z_at_start = |csv: &str| -> f64 { csv.lines().nth(1).unwrap().split(',').nth(3).unwrap().parse().unwrap() };
+    assert!((z_at_start(&model) - 0.227).abs() < 1e-9, "{model:.200}");
+    assert!((z_at_start(&own) - 0.237).abs() < 1e-9, "the rig's neutral: {own:.200}");
+    // The drive margins of a yaw motion on each platform (the rig file carries the model's drives).
+    let loads = |extra: &[&str]| {
+        let o = run(&[
+            &[
+                "stream",
+                "--sim",
+                "--fast",
+                "--quiet",
+                "--motion",
+                "yaw",
+                "--duration",
+                "2",
+            ][..],
+            &["--check-loads", "--mass", "0.02"],
+            extra,
+        ]
+        .concat());
+        assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let on_model = loads(&[]);
+    let on_rig = loads(&["--geometry", file.to_str().unwrap()]);
+    assert!(
+        on_model.contains("keeps up") && on_rig.contains("keeps up"),
+        "{on_model}\n{on_rig}"
+    );
+    assert_ne!(on_model, on_rig, "the margins are the rig's");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A rig on the device: loaded into the simulator over its pseudo-terminal (checked there), stored in its flash,
 /// running after `device restart`, and shown back as a rig file that describes the same machine to the last bit
 /// (IK through the shown file equals IK through the loaded one); `simulate --geometry` starts with a rig.

@@ -5,6 +5,7 @@
 //! and refuses only garbage. The run ends with a stop, a wait for rest and a report whose outcome and exit code say
 //! whether the input was followed.
 
+mod loads;
 mod report;
 mod session;
 mod source;
@@ -15,13 +16,14 @@ use std::time::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::kinematics::{Pose, RingPlatform};
-use ringpod_core::motion::{EnvelopeMargins, MotionLimits};
-use ringpod_core::protocol::{RigSource, Settings, SettingsKind, Status};
+use ringpod_core::motion::EnvelopeMargins;
+use ringpod_core::protocol::{MotionSettings, RigSource, Settings, SettingsKind, Status};
 use ringpod_core::safety::{FaultReason, State};
 
+pub use loads::{check_loads, platform as loads_platform};
 pub use report::{DatagramReport, LimitedReport, RecordReport, Report};
 use session::{Stop, StreamError, Streamer};
-pub use source::{check_loads, motion_pose, read_csv, Motion, Source, UdpSource};
+pub use source::{motion_pose, read_csv, Motion, Source, UdpSource};
 
 use crate::client::{Client, ClientError, Transport};
 use crate::record::Recorder;
@@ -126,7 +128,7 @@ struct DeviceEnvelope {
     platform: Platform,
     margins: EnvelopeMargins,
     stream_timeout: Duration,
-    limits: MotionLimits,
+    limits: MotionSettings,
 }
 
 fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelope, ClientError> {
@@ -147,11 +149,7 @@ fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelop
     let margins = EnvelopeMargins(stream.margins.map(|m| m + 1e-6));
     let timeout_ms = stream.timeout_ms;
     // The running rig's pose limits (a live section: what the device limits to now).
-    let limits = MotionLimits {
-        pose_velocity: rig.machine.motion.pose_velocity,
-        pose_acceleration: rig.machine.motion.pose_acceleration,
-        ..MotionLimits::TRAINER_MODEL
-    };
+    let limits = rig.machine.motion;
     Ok(DeviceEnvelope {
         platform: Platform {
             geometry,
@@ -186,6 +184,10 @@ pub fn run<T: Transport>(
         limits,
     } = device_envelope(client)?;
     let geometry = &platform.geometry;
+    let mut source = source;
+    if let Source::Udp(udp) = &mut source {
+        udp.decoder.centre_on(Pose::from_array(platform.home));
+    }
     let total = match &source {
         Source::Motion { seconds, rate_hz, .. } => (seconds * rate_hz).round() as u64 + 1,
         Source::Poses(p) => p.len() as u64,

@@ -6,8 +6,8 @@ use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
 use ringpod_core::kinematics::{Check, Pose, RingPlatform};
-use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, MotionLimits, RejectReason, Setpoint};
-use ringpod_core::protocol::{HostMessage, Status};
+use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, RejectReason, Setpoint};
+use ringpod_core::protocol::{HostMessage, MotionSettings, Status};
 use ringpod_core::safety::State;
 
 use super::report::{reason_name, DatagramReport, LimitedReport};
@@ -45,7 +45,7 @@ pub(super) struct Streamer<'a, T: Transport> {
     pub(super) mechanism: RingPlatform<f64>,
     pub(super) margins: EnvelopeMargins,
     pub(super) host_limits: bool,
-    pub(super) limits: MotionLimits,
+    pub(super) limits: MotionSettings,
     pub(super) stream_timeout: Duration,
     /// The middle of the workspace, from which poses are limited (the home pose).
     pub(super) centre: Pose<f64>,

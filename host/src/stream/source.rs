@@ -2,9 +2,9 @@
 
 use std::time::Duration;
 
-use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
-use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
-use ringpod_core::motion::MotionLimits;
+use ringpod_core::kinematics::presets::TRAINER_MODEL_RANGES;
+use ringpod_core::kinematics::Pose;
+use ringpod_core::protocol::MotionSettings;
 
 use super::InputError;
 
@@ -69,45 +69,10 @@ pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputE
     Ok((poses, errors))
 }
 
-/// `stream --check-loads`: the drive demand of a file's or built-in motion's poses on the trainer model, against
-/// its drives, before anything moves.
-pub fn check_loads(
-    source: &Source,
-    payload: &ringpod_core::kinematics::Payload<f64>,
-) -> anyhow::Result<crate::demand::Preflight> {
-    let PresetGeometry::Ring(geometry) = Preset::TrainerModel.geometry() else {
-        anyhow::bail!("the trainer model is a ring platform");
-    };
-    let ring = RingPlatform::new(geometry);
-    let drives = crate::rig::drives::check(&crate::rig::drives::of_preset(Preset::TrainerModel), &ring.axes())?;
-    let rows: Vec<(usize, f64, Pose<f64>)> = match source {
-        Source::Poses(p) => p.clone(),
-        Source::Motion {
-            motion,
-            seconds,
-            rate_hz,
-        } => {
-            let n = (seconds * rate_hz).round() as usize;
-            (0..=n)
-                .map(|k| {
-                    let t = k as f64 / rate_hz;
-                    (
-                        k + 1,
-                        t,
-                        motion_pose(*motion, t, Preset::TrainerModel.home(), &MotionLimits::TRAINER_MODEL),
-                    )
-                })
-                .collect()
-        }
-        Source::Udp(_) => anyhow::bail!("--check-loads needs the poses beforehand (--input or --motion)"),
-    };
-    crate::demand::preflight(&ring, &drives, &rows, payload).map_err(|e| anyhow::anyhow!("--check-loads: {e}"))
-}
-
 /// Pose of a built-in motion at time `t` (s) around `home`; the vibration sweep scales its amplitude to `limits` (the
 /// device's pose limits). On the trainer model every motion stays inside the envelope at any time and yaw (tested for
 /// 120 s each), so host limiting leaves it unchanged.
-pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6], limits: &MotionLimits) -> Pose<f64> {
+pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6], limits: &MotionSettings) -> Pose<f64> {
     let mut p = home;
     let tau = std::f64::consts::TAU;
     match motion {

@@ -1,0 +1,74 @@
+//! `stream --check-loads`: the drive demand of a file's or built-in motion's poses on the platform the device runs,
+//! against that platform's drives, before anything moves.
+
+use ringpod_core::kinematics::{Mechanism, Payload, Pose, RingPlatform};
+use ringpod_core::protocol::MotionSettings;
+
+use super::source::{motion_pose, Source};
+use crate::client::{Client, ClientError, Transport};
+use crate::rig::{Drive, Rig};
+
+/// The platform whose drives are checked: the device's rig, with motor data from the rig file or the preset.
+pub struct LoadPlatform {
+    /// The geometry and home pose the device runs.
+    ring: RingPlatform<f64>,
+    home: [f64; 6],
+    /// The device's pose limits (the built-in motions scale to them).
+    limits: MotionSettings,
+    /// Motor data per axis.
+    drives: [Option<Drive>; 6],
+}
+
+/// The platform the device runs (`GetRig`), with the drives of `rig` (the file given with `--geometry`, which the
+/// simulated device then runs) or, where the device runs a preset, the preset's. A rig of the device's own whose
+/// drives the host does not know cannot be checked: the error says to give its file.
+pub fn platform<T: Transport>(client: &mut Client<T>, rig: Option<&Rig>) -> anyhow::Result<LoadPlatform> {
+    let device = client.hello()?;
+    let (record, _, _) = client.rig()?;
+    let geometry = record
+        .geometry()
+        .map_err(|e| ClientError::Unexpected(format!("the device's rig does not check: {e}")))?;
+    let ring = RingPlatform::new(&geometry);
+    let drives = match (rig, device.preset) {
+        (Some(rig), _) => rig.drives.clone(),
+        (None, Some(preset)) => crate::rig::drives::check(&crate::rig::drives::of_preset(preset), &ring.axes())?,
+        (None, None) => anyhow::bail!(
+            "--check-loads: the device runs {}, whose drives this host does not know: give its rig file with \
+             --geometry",
+            record.name()
+        ),
+    };
+    Ok(LoadPlatform {
+        ring,
+        home: record.home,
+        limits: record.machine.motion,
+        drives,
+    })
+}
+
+/// The demand of `source`'s poses on `platform` for `payload`.
+pub fn check_loads(
+    source: &Source,
+    payload: &Payload<f64>,
+    platform: &LoadPlatform,
+) -> anyhow::Result<crate::demand::Preflight> {
+    let rows: Vec<(usize, f64, Pose<f64>)> = match source {
+        Source::Poses(p) => p.clone(),
+        Source::Motion {
+            motion,
+            seconds,
+            rate_hz,
+        } => {
+            let n = (seconds * rate_hz).round() as usize;
+            (0..=n)
+                .map(|k| {
+                    let t = k as f64 / rate_hz;
+                    (k + 1, t, motion_pose(*motion, t, platform.home, &platform.limits))
+                })
+                .collect()
+        }
+        Source::Udp(_) => anyhow::bail!("--check-loads needs the poses beforehand (--input or --motion)"),
+    };
+    crate::demand::preflight(&platform.ring, &platform.drives, &rows, payload)
+        .map_err(|e| anyhow::anyhow!("--check-loads: {e}"))
+}
