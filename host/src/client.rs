@@ -10,7 +10,7 @@ use ringpod_core::protocol::{
     self, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, RigRecord, RigSource,
     Settings, SettingsKind, Status, Telemetry, PROTOCOL_VERSION,
 };
-use ringpod_core::safety::FaultReason;
+use ringpod_core::safety::{Command, FaultReason};
 
 /// Telemetry samples kept for a taker (a minute at 1 kHz); older ones are dropped and counted.
 pub const TELEMETRY_KEPT: usize = 60_000;
@@ -242,27 +242,27 @@ impl<T: Transport> Client<T> {
 
     /// Power up (logic, then power).
     pub fn enable(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Enable)
+        self.ack(HostMessage::Command(Command::Enable))
     }
     /// Shut down.
     pub fn disable(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Disable)
+        self.ack(HostMessage::Command(Command::Disable))
     }
     /// Home all axes.
     pub fn home(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Home)
+        self.ack(HostMessage::Command(Command::Home))
     }
     /// Start taking setpoints.
     pub fn start(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Start)
+        self.ack(HostMessage::Command(Command::Start))
     }
     /// Ramp to rest.
     pub fn stop(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Stop)
+        self.ack(HostMessage::Command(Command::Stop))
     }
     /// Clear a latched fault.
     pub fn clear(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::ClearFault)
+        self.ack(HostMessage::Command(Command::ClearFault))
     }
 
     /// A section of settings on the device as the next start runs it (what runs now, for a live section), and

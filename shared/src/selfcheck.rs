@@ -10,7 +10,7 @@ use crate::kinematics::presets::{self, ROTOPOD_CH4, TRAINER_MODEL};
 use crate::kinematics::{Mechanism, NewtonOptions, Pose, RingPlatform};
 use crate::motion::{SchedulerConfig, Setpoint, StepScheduler};
 use crate::protocol::{self, DeviceMessage, HostMessage, Request, Response, PROTOCOL_VERSION};
-use crate::safety::State;
+use crate::safety::{Command, State};
 use crate::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
 
 /// FNV-1a over the bits of everything the workload computes.
@@ -274,15 +274,15 @@ pub fn running_rig_with(d: &mut Digest, config: ControllerConfig) -> Option<Rig>
             version: PROTOCOL_VERSION,
         },
     );
-    if !matches!(hello, DeviceMessage::Hello { .. }) || !ack(ask(&mut rig, HostMessage::Enable)) {
+    if !matches!(hello, DeviceMessage::Hello { .. }) || !ack(ask(&mut rig, HostMessage::Command(Command::Enable))) {
         return None;
     }
     until(&mut rig, d, 5_000, |s| matches!(s, State::PowerOn { settled: true }))?;
-    if !ack(ask(&mut rig, HostMessage::Home)) {
+    if !ack(ask(&mut rig, HostMessage::Command(Command::Home))) {
         return None;
     }
     until(&mut rig, d, 40_000, |s| s == State::Ready)?;
-    ack(ask(&mut rig, HostMessage::Start)).then_some(rig)
+    ack(ask(&mut rig, HostMessage::Command(Command::Start))).then_some(rig)
 }
 
 /// Ticks until the state satisfies `done`, at most `limit` ticks.

@@ -13,7 +13,7 @@ use ringpod_core::protocol::{
     self, ConfigRefusal, ControlSettings, DeviceMessage, HostMessage, NackReason, Request, RigRecord, RigSource,
     Settings, SettingsKind, StreamSettings, MAX_PAYLOAD,
 };
-use ringpod_core::safety::Refusal;
+use ringpod_core::safety::{Command, Refusal};
 use ringpod_core::store::{restore, store, CONFIG_KEY, RECORD_VERSION};
 use sequential_storage::cache::NoCache;
 use sequential_storage::map::store_item;
@@ -203,12 +203,12 @@ fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
         power_ok: true,
         ..Inputs::default()
     });
-    assert_eq!(ask(&mut c, HostMessage::Enable), DeviceMessage::Ack);
+    assert_eq!(ask(&mut c, HostMessage::Command(Command::Enable)), DeviceMessage::Ack);
     c.tick();
     let wrong_state = DeviceMessage::Nack(NackReason::Refused(Refusal::WrongState));
     assert_eq!(ask(&mut c, HostMessage::SetRig(rig)), wrong_state);
     assert_eq!(ask(&mut c, HostMessage::Restart), wrong_state);
-    assert_eq!(ask(&mut c, HostMessage::Disable), DeviceMessage::Ack);
+    assert_eq!(ask(&mut c, HostMessage::Command(Command::Disable)), DeviceMessage::Ack);
     for _ in 0..3_000 {
         c.tick();
     }
@@ -263,7 +263,7 @@ fn a_setpoint_request_read_on_its_own_is_the_request_decoded_whole() {
     }
     for body in [
         HostMessage::GetStatus,
-        HostMessage::Stop,
+        HostMessage::Command(Command::Stop),
         HostMessage::SetRig(wider(0.3, 0.325)),
     ] {
         let mut raw = [0u8; 1024];

@@ -11,7 +11,7 @@ use ringpod_core::protocol::{
     NackReason, Request, Settings, SettingsKind, StreamSettings, PROTOCOL_VERSION,
 };
 use ringpod_core::safety::debounce::{from_inputs, to_inputs, Debouncer, InputBit, InputConfig};
-use ringpod_core::safety::SupervisorConfig;
+use ringpod_core::safety::{Command, SupervisorConfig};
 
 fn config(samples: u8) -> InputConfig {
     InputConfig {
@@ -411,7 +411,7 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
         rig.controller
             .handle(&Request {
                 id: 2,
-                body: HostMessage::Enable
+                body: HostMessage::Command(Command::Enable)
             })
             .body,
         DeviceMessage::Ack
@@ -440,7 +440,7 @@ fn settings_are_handed_out_for_storing_only_with_the_supplies_off() {
         rig.controller
             .handle(&Request {
                 id: 3,
-                body: HostMessage::Disable
+                body: HostMessage::Command(Command::Disable)
             })
             .body,
         DeviceMessage::Ack
@@ -551,7 +551,10 @@ fn model_axes() -> [ringpod_core::kinematics::AxisKind; 6] {
 /// Runs `rig` until it is Ready or faulted (at most 60 s of ticks) after a Home.
 fn home(rig: &mut ringpod_core::sim::Rig) -> ringpod_core::safety::State {
     use ringpod_core::safety::State;
-    for body in [HostMessage::Enable, HostMessage::Home] {
+    for body in [
+        HostMessage::Command(Command::Enable),
+        HostMessage::Command(Command::Home),
+    ] {
         for _ in 0..5_000 {
             if matches!(
                 rig.controller.supervisor().state(),

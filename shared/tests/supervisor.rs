@@ -4,17 +4,19 @@
 use std::collections::{HashMap, HashSet};
 
 use proptest::prelude::*;
-use ringpod_core::safety::{Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig};
+use ringpod_core::safety::{
+    Command, Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig,
+};
 
 /// Every event the supervisor knows, with the time steps that matter (1 ms and each configured delay).
 fn alphabet(c: &SupervisorConfig) -> Vec<Event> {
     let mut events = vec![
-        Event::Enable,
-        Event::Disable,
-        Event::Home,
-        Event::Start,
-        Event::Stop,
-        Event::ClearFault,
+        Event::Command(Command::Enable),
+        Event::Command(Command::Disable),
+        Event::Command(Command::Home),
+        Event::Command(Command::Start),
+        Event::Command(Command::Stop),
+        Event::Command(Command::ClearFault),
         Event::Jog,
         Event::JogDone,
         Event::LogicOk(true),
@@ -69,7 +71,7 @@ fn check(before: &Supervisor, event: Event, after: &Supervisor, result: Result<(
         return Err("power cut under enabled drivers outside a fault".into());
     }
     if let State::Fault(..) = before.state() {
-        if !matches!(after.state(), State::Fault(..)) && event != Event::ClearFault {
+        if !matches!(after.state(), State::Fault(..)) && event != Event::Command(Command::ClearFault) {
             return Err("fault left without ClearFault".into());
         }
         if a.driver_enable || a.motion != Motion::None {
@@ -209,7 +211,7 @@ fn run(s: &mut Supervisor, events: &[Event]) {
 fn power_up_home_run_stop_shut_down() {
     let c = SupervisorConfig::default();
     let mut s = Supervisor::new(c);
-    run(&mut s, &[Event::Enable]);
+    run(&mut s, &[Event::Command(Command::Enable)]);
     assert_eq!(s.state(), State::LogicOn);
     assert_eq!(
         s.outputs(),
@@ -227,15 +229,22 @@ fn power_up_home_run_stop_shut_down() {
     run(&mut s, &[Event::PowerOk(true), Event::Elapsed(c.power_settle_ms)]);
     assert_eq!(s.state(), State::PowerOn { settled: true });
     assert_eq!(
-        s.handle(Event::Start),
+        s.handle(Event::Command(Command::Start)),
         Err(Refusal::WrongState),
         "no streaming before homing"
     );
-    run(&mut s, &[Event::Home, Event::HomingDone, Event::Start]);
+    run(
+        &mut s,
+        &[
+            Event::Command(Command::Home),
+            Event::HomingDone,
+            Event::Command(Command::Start),
+        ],
+    );
     assert_eq!(s.outputs().motion, Motion::Stream);
     run(&mut s, &[Event::StreamLost]);
     assert_eq!(s.state(), State::Stopping);
-    run(&mut s, &[Event::AtRest, Event::Disable]);
+    run(&mut s, &[Event::AtRest, Event::Command(Command::Disable)]);
     assert!(
         s.outputs().power_relay && !s.outputs().driver_enable,
         "drivers off first"
@@ -259,12 +268,12 @@ fn estop_latches_until_cleared_and_released() {
     run(
         &mut s,
         &[
-            Event::Enable,
+            Event::Command(Command::Enable),
             Event::Elapsed(1000),
             Event::Elapsed(1000),
-            Event::Home,
+            Event::Command(Command::Home),
             Event::HomingDone,
-            Event::Start,
+            Event::Command(Command::Start),
         ],
     );
     s.handle(Event::EStop(true)).unwrap();
@@ -273,9 +282,9 @@ fn estop_latches_until_cleared_and_released() {
         State::Fault(FaultReason::EStop, ringpod_core::safety::Supplies::Logic)
     );
     assert!(!s.outputs().power_relay && !s.outputs().driver_enable);
-    assert_eq!(s.handle(Event::ClearFault), Err(Refusal::EStopOpen));
-    assert_eq!(s.handle(Event::Home), Err(Refusal::Faulted));
-    run(&mut s, &[Event::EStop(false), Event::ClearFault]);
+    assert_eq!(s.handle(Event::Command(Command::ClearFault)), Err(Refusal::EStopOpen));
+    assert_eq!(s.handle(Event::Command(Command::Home)), Err(Refusal::Faulted));
+    run(&mut s, &[Event::EStop(false), Event::Command(Command::ClearFault)]);
     assert_eq!(s.state(), State::Off);
     assert!(!s.homed(), "homing is lost with the drivers");
 }
@@ -284,13 +293,16 @@ fn estop_latches_until_cleared_and_released() {
 fn supply_timeout_and_loss() {
     let c = SupervisorConfig::default();
     let mut s = Supervisor::new(c);
-    run(&mut s, &[Event::Enable, Event::Elapsed(c.supply_timeout_ms)]);
+    run(
+        &mut s,
+        &[Event::Command(Command::Enable), Event::Elapsed(c.supply_timeout_ms)],
+    );
     assert!(matches!(s.state(), State::Fault(FaultReason::SupplyTimeout, _)));
     let mut s = Supervisor::new(c);
     run(
         &mut s,
         &[
-            Event::Enable,
+            Event::Command(Command::Enable),
             Event::LogicOk(true),
             Event::Elapsed(c.logic_settle_ms),
             Event::PowerOk(true),

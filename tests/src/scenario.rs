@@ -28,6 +28,7 @@ use ringpod_core::controller::{Controller, ControllerConfig};
 use ringpod_core::kinematics::{presets, Pose};
 use ringpod_core::motion::Setpoint;
 use ringpod_core::protocol::{self, DeviceMessage, HostMessage, Request, Response, PROTOCOL_VERSION};
+use ringpod_core::safety::Command;
 use serde::Deserialize;
 
 use crate::plant::{Plant, Rig};
@@ -201,12 +202,12 @@ fn command(name: &str) -> Result<HostMessage, String> {
             version: PROTOCOL_VERSION,
         },
         "hello-v0" => HostMessage::Hello { version: 0 },
-        "enable" => HostMessage::Enable,
-        "disable" => HostMessage::Disable,
-        "home" => HostMessage::Home,
-        "start" => HostMessage::Start,
-        "stop" => HostMessage::Stop,
-        "clear" => HostMessage::ClearFault,
+        "enable" => HostMessage::Command(Command::Enable),
+        "disable" => HostMessage::Command(Command::Disable),
+        "home" => HostMessage::Command(Command::Home),
+        "start" => HostMessage::Command(Command::Start),
+        "stop" => HostMessage::Command(Command::Stop),
+        "clear" => HostMessage::Command(Command::ClearFault),
         "status" => HostMessage::GetStatus,
         other => {
             // `jog AXIS STEPS`, `buzz AXIS` (axis 0-5).

@@ -9,6 +9,7 @@ use ringpod_core::protocol::{
     self, DeviceMessage, HostMessage, NackReason, Request, Response, Settings, SettingsKind, StreamSettings,
     PROTOCOL_VERSION,
 };
+use ringpod_core::safety::Command;
 use ringpod_tests::plant::{Plant, Rig, TRAINER_MODEL_PARKED};
 
 /// xorshift64*: fast and repeatable.
@@ -41,12 +42,12 @@ fn random_request(rng: &mut Rng, seq: &mut u32) -> Request {
                 PROTOCOL_VERSION
             },
         },
-        1 => HostMessage::Enable,
-        2 => HostMessage::Disable,
-        3 => HostMessage::Home,
-        4 => HostMessage::Start,
-        5 => HostMessage::Stop,
-        6 => HostMessage::ClearFault,
+        1 => HostMessage::Command(Command::Enable),
+        2 => HostMessage::Command(Command::Disable),
+        3 => HostMessage::Command(Command::Home),
+        4 => HostMessage::Command(Command::Start),
+        5 => HostMessage::Command(Command::Stop),
+        6 => HostMessage::Command(Command::ClearFault),
         7 => HostMessage::GetStatus,
         8 => HostMessage::GetSettings(SettingsKind::ALL[rng.below(7) as usize]),
         9 => HostMessage::SetSettings(Settings::Stream(StreamSettings {

@@ -7,7 +7,7 @@ use crate::kinematics::{AxisKind, Mechanism};
 use crate::motion::jog::Jog;
 use crate::motion::{Accepted, Setpoint};
 use crate::protocol::{self, DeviceMessage, HostMessage, NackReason, Request, Response, PROTOCOL_VERSION};
-use crate::safety::{Event, HomingSequencer, State};
+use crate::safety::{Command, Event, HomingSequencer, State};
 
 impl Controller {
     /// Handles one request; always exactly one response.
@@ -56,12 +56,7 @@ impl Controller {
                 Ok(()) => DeviceMessage::Ack,
                 Err(r) => DeviceMessage::Nack(r),
             },
-            HostMessage::Enable => self.command(Event::Enable),
-            HostMessage::Disable => self.command(Event::Disable),
-            HostMessage::Home => self.command(Event::Home),
-            HostMessage::Start => self.command(Event::Start),
-            HostMessage::Stop => self.command(Event::Stop),
-            HostMessage::ClearFault => self.command(Event::ClearFault),
+            HostMessage::Command(command) => self.command(Event::Command(command)),
         };
         Response { id: request.id, body }
     }
@@ -118,7 +113,7 @@ impl Controller {
             return DeviceMessage::Nack(NackReason::Refused(r));
         }
         match e {
-            Event::Home => {
+            Event::Command(Command::Home) => {
                 self.homing_carry = 0;
                 self.returning_home = false;
                 // A homed machine knows where its switches are: it first moves, under the normal limits and
@@ -131,8 +126,8 @@ impl Controller {
                         .is_ok_and(|pose| self.pipeline.move_to(pose).is_ok());
                 self.homing = (!self.parking).then(|| HomingSequencer::new(self.plan, &self.scheduler.position()));
             }
-            Event::Start => self.pipeline.start(),
-            Event::Stop => {
+            Event::Command(Command::Start) => self.pipeline.start(),
+            Event::Command(Command::Stop) => {
                 self.pipeline.stop();
                 if self.homing.take().is_some() || self.returning_home || self.parking {
                     self.pipeline.halt();

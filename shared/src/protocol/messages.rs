@@ -7,10 +7,10 @@ use crate::kinematics::Pose;
 use super::rig::{RigRecord, RigSource};
 use super::settings::{Settings, SettingsKind};
 use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
-use crate::safety::{FaultReason, Refusal, State};
+use crate::safety::{Command, FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly.
-pub const PROTOCOL_VERSION: u16 = 6;
+pub const PROTOCOL_VERSION: u16 = 7;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -35,18 +35,9 @@ pub enum HostMessage {
         /// The host's [`PROTOCOL_VERSION`].
         version: u16,
     },
-    /// Bring up logic, then power.
-    Enable,
-    /// Shut down: drivers, power, logic.
-    Disable,
-    /// Home all axes.
-    Home,
-    /// Start taking pose setpoints.
-    Start,
-    /// Ramp to rest (or abort homing).
-    Stop,
-    /// Clear a latched fault.
-    ClearFault,
+    /// A command to the supervisor (enable, disable, home, start, stop, clear a fault): acknowledged, or refused
+    /// with the supervisor's reason.
+    Command(Command),
     /// A pose setpoint.
     Setpoint(Setpoint),
     /// Ask for the status.
@@ -86,7 +77,7 @@ pub enum HostMessage {
 }
 
 /// The position of [`HostMessage::Setpoint`] among the variants: its tag on the wire.
-const SETPOINT_TAG: u32 = 7;
+const SETPOINT_TAG: u32 = 2;
 
 /// A setpoint request read straight from its payload, `(id, setpoint)`, or `None` for any other request. The
 /// stream's hot path: a [`Request`] holds room for the largest request (a rig record, over 600 bytes), which a

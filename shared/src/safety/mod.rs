@@ -6,7 +6,9 @@ pub mod pins;
 pub mod supervisor;
 
 pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};
-pub use supervisor::{Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig, Supplies};
+pub use supervisor::{
+    Command, Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig, Supplies,
+};
 
 /// Switch and supply levels, as read from the pins (after debouncing and polarity).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

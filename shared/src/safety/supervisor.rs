@@ -213,22 +213,43 @@ impl Outputs {
     };
 }
 
+/// What an operator asks of the supervisor: one type for the wire ([`crate::protocol::HostMessage::Command`]) and
+/// for the state machine ([`Event::Command`]), so the two cannot drift apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Command {
+    /// Bring up logic, then power.
+    Enable,
+    /// Shut down: drivers, power, then logic.
+    Disable,
+    /// Home the axes.
+    Home,
+    /// Start taking the pose stream.
+    Start,
+    /// Ramp to rest (or abort homing).
+    Stop,
+    /// Clear a latched fault.
+    ClearFault,
+}
+
+impl Command {
+    /// Every command, in wire order.
+    pub const ALL: [Command; 6] = [
+        Command::Enable,
+        Command::Disable,
+        Command::Home,
+        Command::Start,
+        Command::Stop,
+        Command::ClearFault,
+    ];
+}
+
 /// An event the supervisor reacts to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum Event {
-    /// Command: bring up logic, then power.
-    Enable,
-    /// Command: shut down (drivers, power, then logic).
-    Disable,
-    /// Command: home the axes.
-    Home,
-    /// Command: start taking the pose stream.
-    Start,
-    /// Command: ramp to rest (or abort homing).
-    Stop,
-    /// Command: clear a latched fault.
-    ClearFault,
+    /// An operator's command.
+    Command(Command),
     /// Command: jog or buzz one axis (commissioning), from powered-and-settled or from Ready.
     Jog,
     /// The jog or buzz finished (or stopped at a switch).
@@ -484,35 +505,35 @@ impl Supervisor {
                     self.go(State::Stopping);
                 }
             }
-            Event::Enable
-            | Event::Disable
-            | Event::Home
-            | Event::Start
-            | Event::Stop
-            | Event::ClearFault
+            Event::Command(Command::Enable)
+            | Event::Command(Command::Disable)
+            | Event::Command(Command::Home)
+            | Event::Command(Command::Start)
+            | Event::Command(Command::Stop)
+            | Event::Command(Command::ClearFault)
             | Event::Jog => return self.command(event),
         }
         Ok(())
     }
 
     fn command(&mut self, command: Event) -> Result<(), Refusal> {
-        if self.is_fault() && command != Event::ClearFault {
+        if self.is_fault() && command != Event::Command(Command::ClearFault) {
             return Err(Refusal::Faulted);
         }
         match (command, self.state) {
-            (Event::Enable, State::Off) => {
+            (Event::Command(Command::Enable), State::Off) => {
                 if self.inputs.estop_open {
                     return Err(Refusal::EStopOpen);
                 }
                 self.go(State::LogicOn);
             }
-            (Event::Disable, State::LogicOn | State::PowerOn { .. } | State::Ready) => {
+            (Event::Command(Command::Disable), State::LogicOn | State::PowerOn { .. } | State::Ready) => {
                 // Without drive current the steppers hold nothing: the axes may be moved by hand or by gravity,
                 // so the positions homing found are no longer known.
                 self.homed = false;
                 self.go(State::ShuttingDown(Shutdown::Drivers));
             }
-            (Event::Home, State::PowerOn { settled: true } | State::Ready) => {
+            (Event::Command(Command::Home), State::PowerOn { settled: true } | State::Ready) => {
                 self.may_move()?;
                 self.homed = false;
                 self.go(State::Homing);
@@ -523,14 +544,14 @@ impl Supervisor {
                 self.homed = false;
                 self.go(State::Jogging);
             }
-            (Event::Stop, State::Jogging) => self.go(State::PowerOn { settled: true }),
-            (Event::Start, State::Ready) => self.go(State::Running),
-            (Event::Stop, State::Running) => self.go(State::Stopping),
-            (Event::Stop, State::Homing) => {
+            (Event::Command(Command::Stop), State::Jogging) => self.go(State::PowerOn { settled: true }),
+            (Event::Command(Command::Start), State::Ready) => self.go(State::Running),
+            (Event::Command(Command::Stop), State::Running) => self.go(State::Stopping),
+            (Event::Command(Command::Stop), State::Homing) => {
                 self.homed = false;
                 self.go(State::PowerOn { settled: true });
             }
-            (Event::ClearFault, State::Fault(_, supplies)) => {
+            (Event::Command(Command::ClearFault), State::Fault(_, supplies)) => {
                 self.may_move()?;
                 self.go(match supplies {
                     Supplies::Both => State::PowerOn { settled: true },
