@@ -196,11 +196,11 @@ pub struct DeviceArgs {
     /// What to do.
     #[arg(value_enum)]
     pub action: DeviceAction,
-    /// For `config`: `get KEY` or `set KEY VALUE`. Keys: stream-timeout-ms, gross-jump-ms, follow-direct (0 or
-    /// 1), tick-hz, input-active-low, debounce-ms, per axis (0-5) pose-velocity.N, pose-acceleration.N,
-    /// steps-per-unit.N, reverse.N (0 or 1), and per check envelope-margin.CHECK (reach, carriage-spacing,
-    /// rod-crossing, joint-cones, singularity, stability; in the check's unit), telemetry-hz. For `jog`: AXIS
-    /// DISTANCE; for `buzz`: AXIS; for `rig`: `load RIG.toml` or `show`.
+    /// For `config`: nothing (every section), `get SECTION[.PATH]` or `set SECTION.PATH VALUE` (VALUE in JSON).
+    /// Sections: stream (timeout_ms, gross_jump_ms, follow, margins.N, telemetry_hz), control (tick_hz), motion
+    /// (pose_velocity.N, pose_acceleration.N), inputs (active_low, debounce_ms), axes.N (steps_per_unit, reverse),
+    /// homing, supervisor; N counts from 0, e.g. `set axes.4.reverse true`, `set stream.timeout_ms 200`. For
+    /// `jog`: AXIS DISTANCE; for `buzz`: AXIS; for `rig`: `load RIG.toml` or `show`.
     #[arg(allow_negative_numbers = true)]
     pub config: Vec<String>,
     /// Serial port of the board (USB CDC).
@@ -251,12 +251,13 @@ pub struct StreamArgs {
     #[arg(long, value_enum, default_value = "text")]
     pub telemetry_format: crate::datagram::TelemetryFormat,
     /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`).
-    #[arg(long)]
+    #[arg(long, requires = "telemetry_udp", conflicts_with_all = ["udp", "input", "motion"])]
     pub cue_config: Option<std::path::PathBuf>,
     /// With --udp or --telemetry-udp: take datagrams from this sender only (others are counted and ignored).
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["input", "motion"])]
     pub udp_from: Option<std::net::IpAddr>,
-    /// With --udp or --telemetry-udp: end the stream after this many seconds without a datagram.
+    /// With --udp or --telemetry-udp: end the stream after this many seconds without a readable datagram (a source
+    /// that sends only what cannot be read is as good as none).
     #[arg(long, default_value_t = 2.0)]
     pub udp_idle: f64,
     /// Angles of --input or --udp in degrees.

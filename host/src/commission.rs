@@ -71,13 +71,20 @@ pub fn changes(before: &InputReport, now: &InputReport) -> Vec<String> {
 
 /// Prints the table, then with `watch` every change until `stop` says so.
 pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn() -> bool) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout();
     let mut last = client.inputs()?;
-    print!("{}", table(&last));
+    // A reader that went away (`| head`) ends the watch, as it ends any filter.
+    if write!(out, "{}", table(&last)).and_then(|()| out.flush()).is_err() {
+        return Ok(());
+    }
     while watch && !stop() {
         client.transport().elapse(Duration::from_millis(20));
         let now = client.inputs()?;
         for line in changes(&last, &now) {
-            println!("{line}");
+            if writeln!(out, "{line}").and_then(|()| out.flush()).is_err() {
+                return Ok(());
+            }
         }
         last = now;
     }

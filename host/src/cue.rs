@@ -40,7 +40,8 @@ pub fn load_config(path: Option<&Path>) -> anyhow::Result<CueConfig> {
     let Some(path) = path else {
         return Ok(CueConfig::default());
     };
-    let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let text = crate::files::read_text(path, crate::files::CONFIG_LIMIT)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let config: CueConfig = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     config
         .validate()
@@ -58,7 +59,8 @@ struct Cued {
 /// Runs the command; returns the summary as text and the exit code.
 pub fn run(args: &CueArgs) -> anyhow::Result<(String, u8)> {
     let config = load_config(args.config.as_deref())?;
-    let text = std::fs::read_to_string(&args.input).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
+    let text = crate::files::read_text(&args.input, crate::files::DATA_LIMIT)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
     let (rows, mut errors) =
         table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
     let selected = Selected::of(&args.mechanism, args.geometry.as_deref())?;
@@ -145,19 +147,20 @@ pub fn run(args: &CueArgs) -> anyhow::Result<(String, u8)> {
 }
 
 fn write_poses(path: &Path, cued: &[Cued]) -> anyhow::Result<()> {
-    let mut out =
-        std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?);
-    writeln!(out, "t,x,y,z,alpha,beta,gamma")?;
-    for c in cued {
-        let p = c.pose.to_array();
-        writeln!(
-            out,
-            "{},{:.7},{:.7},{:.7},{:.7},{:.7},{:.7}",
-            c.t, p[0], p[1], p[2], p[3], p[4], p[5]
-        )?;
-    }
-    out.flush()?;
-    Ok(())
+    let write = || -> std::io::Result<()> {
+        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        writeln!(out, "t,x,y,z,alpha,beta,gamma")?;
+        for c in cued {
+            let p = c.pose.to_array();
+            writeln!(
+                out,
+                "{},{:.7},{:.7},{:.7},{:.7},{:.7},{:.7}",
+                c.t, p[0], p[1], p[2], p[3], p[4], p[5]
+            )?;
+        }
+        out.flush()
+    };
+    write().map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 /// The specific force the platform delivers at each sample (platform axes): its acceleration by central

@@ -55,7 +55,20 @@ pub fn parse_pose(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
         return Err(format!("expected 6 numbers, got {}", v.len()));
     }
     let a = |x: f64| if degrees { x.to_radians() } else { x };
-    Ok(Pose::new(v[0], v[1], v[2], a(v[3]), a(v[4]), a(v[5])))
+    let pose = [v[0], v[1], v[2], a(v[3]), a(v[4]), a(v[5])];
+    // Garbage is not sent: a live source's datagram that no device could follow is unreadable, like a wrong one,
+    // and the session goes on (a file's bad row is the device's to refuse, with its reason).
+    if let Some(i) = pose.iter().position(|x| !(*x as f32).is_finite()) {
+        return Err(format!("value {} is not a finite number (in single precision)", i + 1));
+    }
+    if pose[5].abs() > crate::numbers::MAX_TURNING {
+        return Err(format!(
+            "a yaw of {} rad is beyond {} rad either way",
+            crate::numbers::readable(pose[5]),
+            crate::numbers::readable(crate::numbers::MAX_TURNING)
+        ));
+    }
+    Ok(Pose::from_array(pose))
 }
 
 /// Parses a text telemetry datagram: `[t] ax ay az wx wy wz`.
@@ -66,6 +79,17 @@ pub fn parse_telemetry(bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), St
         6 => (None, &v[..]),
         n => return Err(format!("expected 6 or 7 numbers, got {n}")),
     };
+    // A time that is not a time would become the reference of every later sample's interval, and a value that is
+    // not finite would reach the filters on a first sample: both are unreadable.
+    if t.is_some_and(|t| !t.is_finite() || t.abs() > crate::table::MAX_TIME_S) {
+        return Err(format!(
+            "its time is not a time (a finite number of seconds, at most {} either way)",
+            crate::numbers::readable(crate::table::MAX_TIME_S)
+        ));
+    }
+    if v.iter().any(|x| !x.is_finite()) {
+        return Err("a value is not finite".into());
+    }
     Ok((
         t,
         Telemetry {

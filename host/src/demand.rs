@@ -124,7 +124,8 @@ pub struct Profile {
 /// Inverse dynamics along the pose CSV at `input`.
 pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -> Result<Profile, CliError> {
     let bad = |reason: String| CliError::BadNumbers { what: "input", reason };
-    let text = std::fs::read_to_string(input).map_err(|e| bad(format!("{}: {e}", input.display())))?;
+    let text = crate::files::read_text(input, crate::files::DATA_LIMIT)
+        .map_err(|e| bad(format!("{}: {e}", input.display())))?;
     let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
     let (rows, errors) = table::read(&text, &columns).map_err(bad)?;
     let rows: Vec<(usize, f64, Pose<f64>)> = rows
@@ -141,6 +142,33 @@ pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -
 
 /// Inverse dynamics along timed poses `(line, t, pose)`, times rising.
 pub fn profile_of(
+    ring: &RingPlatform<f64>,
+    rows: &[(usize, f64, Pose<f64>)],
+    payload: &Payload<f64>,
+) -> Result<Profile, String> {
+    // A pose that is not a number has no demand and would poison the unwrapping and the differences of every row
+    // after it: it is reported by its line and left out.
+    let (rows, garbage): (Vec<_>, Vec<_>) = rows.iter().cloned().partition(|r| {
+        r.2.to_array()
+            .iter()
+            .all(|c| c.is_finite() && c.abs() <= crate::numbers::MAX_TURNING)
+    });
+    let garbage: Vec<InputError> = garbage
+        .into_iter()
+        .map(|r| InputError {
+            line: r.0,
+            reason: "a coordinate is not a finite number in range: left out".into(),
+        })
+        .collect();
+    let mut profile = profile_of_finite(ring, &rows, payload)?;
+    // Rows read: the left-out ones too.
+    profile.rows += garbage.len();
+    profile.errors.extend(garbage);
+    profile.errors.sort_by_key(|e| e.line);
+    Ok(profile)
+}
+
+fn profile_of_finite(
     ring: &RingPlatform<f64>,
     rows: &[(usize, f64, Pose<f64>)],
     payload: &Payload<f64>,

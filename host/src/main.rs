@@ -7,6 +7,7 @@ mod cue;
 mod datagram;
 mod demand;
 mod error;
+mod files;
 mod kinematics;
 mod mechanism;
 mod monitor;
@@ -94,7 +95,8 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
             Ok(v)
         } else {
             Err(anyhow::anyhow!(
-                "--{name} {v}: must be a number of at most {max:e}, above 0"
+                "--{name} {}: must be a number of at most {max:e}, above 0",
+                numbers::readable(v)
             ))
         }
     };
@@ -128,7 +130,8 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
             (stream::Source::Udp(source), Vec::new())
         }
         (Some(path), _) => {
-            let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let text =
+                files::read_text(path, files::DATA_LIMIT).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             let (poses, errors) =
                 stream::read_csv(&text, args.degrees).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
             for e in &errors {
@@ -210,7 +213,10 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
         let _ = writeln!(std::io::stdout(), "{}", serde_json::to_string_pretty(&report)?);
     } else {
         let rejected: u32 = report.rejected.values().sum();
-        println!(
+        // A closed stdout (`| head -c1`) loses the summary, not the run's exit code.
+        let mut out = std::io::stdout();
+        let _ = writeln!(
+            out,
             "{}: {} setpoints sent, {} applied ({} limited on the host, {} on the device), {} refused; final state {}; steps {:?}",
             report.outcome,
             report.setpoints_sent,
@@ -222,7 +228,7 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
             report.final_steps
         );
         for (reason, n) in &report.rejected {
-            println!("  refused {reason}: {n}");
+            let _ = writeln!(out, "  refused {reason}: {n}");
         }
     }
     if let Some(reason) = &report.reason {
@@ -252,8 +258,9 @@ fn stream_command(args: &cli::StreamArgs) -> anyhow::Result<u8> {
 fn monitor_command(port: Option<&str>, sim: bool, frames: Option<u64>) -> anyhow::Result<u8> {
     let mut client = client::Client::new(connect(port, sim, true)?);
     let source = port.map_or_else(|| "the simulated controller".to_owned(), str::to_owned);
-    monitor::run(&mut client, &source, frames)?;
-    Ok(0)
+    let signals = signals::Signals::install()?;
+    monitor::run(&mut client, &source, frames, &|| signals.received())?;
+    Ok(if signals.received() { signals.exit_code() } else { 0 })
 }
 
 /// The transport named on the command line.
@@ -299,7 +306,7 @@ fn device_command(args: &cli::DeviceArgs) -> anyhow::Result<u8> {
         A::Clear => client.clear()?,
         A::Jog | A::Buzz => {
             let line = commission::jog(&mut client, &args.config, args.action == A::Buzz)?;
-            println!("{line}");
+            let _ = writeln!(std::io::stdout(), "{line}");
             return Ok(0);
         }
         A::Inputs if args.watch => {

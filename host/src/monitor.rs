@@ -171,14 +171,24 @@ pub fn draw(frame: &mut Frame, view: &View) {
 }
 
 /// Runs the view until `q`, Esc or Ctrl-C, or for `frames` redraws. Draws ten times a second.
-pub fn run<T: Transport>(client: &mut Client<T>, source: &str, frames: Option<u64>) -> anyhow::Result<()> {
+pub fn run<T: Transport>(
+    client: &mut Client<T>,
+    source: &str,
+    frames: Option<u64>,
+    stop: &dyn Fn() -> bool,
+) -> anyhow::Result<()> {
+    use std::io::IsTerminal;
+    if !std::io::stdout().is_terminal() {
+        anyhow::bail!("monitor draws on a terminal, and its output is not one (`device status` or `stream --record` give the same data as text)");
+    }
     client.hello()?;
     client.telemetry(true)?;
     let mut out = std::io::stdout();
     enable_raw_mode()?;
     out.execute(EnterAlternateScreen)?;
     let mut terminal = Terminal::new(CrosstermBackend::new(std::io::stdout()))?;
-    let result = view_loop(&mut terminal, client, source, frames);
+    // Whatever ends the view (q, a signal, an error), the terminal is given back as it was.
+    let result = view_loop(&mut terminal, client, source, frames, stop);
     let _ = disable_raw_mode();
     let _ = out.execute(LeaveAlternateScreen);
     let _ = out.flush();
@@ -191,6 +201,7 @@ fn view_loop<B: Backend, T: Transport>(
     client: &mut Client<T>,
     source: &str,
     frames: Option<u64>,
+    stop: &dyn Fn() -> bool,
 ) -> anyhow::Result<()> {
     let mut view = View {
         source: source.to_owned(),
@@ -198,7 +209,7 @@ fn view_loop<B: Backend, T: Transport>(
     };
     let mut window: Vec<Instant> = Vec::new();
     let mut drawn = 0u64;
-    loop {
+    while !stop() {
         client.transport().elapse(Duration::from_millis(100));
         let samples = client.take_telemetry()?;
         let now = Instant::now();
@@ -224,6 +235,7 @@ fn view_loop<B: Backend, T: Transport>(
             }
         }
     }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -106,6 +106,9 @@ pub struct TimePlot {
     pub panels: Vec<Panel>,
 }
 
+/// The largest value an axis reaches either way.
+const AXIS_LIMIT: f64 = 1e300;
+
 fn value_range(panel: &Panel) -> (f64, f64) {
     let (lo, hi) = panel
         .series
@@ -113,13 +116,28 @@ fn value_range(panel: &Panel) -> (f64, f64) {
         .flat_map(|s| s.points.iter().map(|p| p.1))
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
-    if lo.is_finite() {
-        let hi = hi.max(lo + 1e-6);
-        let pad = 0.08 * (hi - lo);
-        (lo - pad, hi + pad)
-    } else {
-        (-1.0, 1.0)
+    match widened(lo, hi, 1e-6) {
+        // 8 % of the span each way; half-spans, so that values near f64's limits do not overflow to infinity
+        // (an infinite axis made the tick loop endless).
+        Some((lo, hi)) => {
+            let pad = 0.16 * (hi / 2.0 - lo / 2.0);
+            // plotters computes the axis's width: it must stay finite, so values beyond 1e300 (garbage in a record)
+            // are drawn at the edge.
+            ((lo - pad).max(-AXIS_LIMIT), (hi + pad).min(AXIS_LIMIT))
+        }
+        None => (-1.0, 1.0),
     }
+}
+
+/// `lo..hi` made at least `least` wide (relative to the values' size, so that it is wider at 1e300 too), or `None`
+/// when there are no finite values.
+fn widened(lo: f64, hi: f64, least: f64) -> Option<(f64, f64)> {
+    if !lo.is_finite() || !hi.is_finite() {
+        return None;
+    }
+    let (lo, hi) = (lo.clamp(-AXIS_LIMIT, AXIS_LIMIT), hi.clamp(-AXIS_LIMIT, AXIS_LIMIT));
+    let least = least * lo.abs().max(hi.abs()).max(1.0);
+    Some((lo, hi.max(lo + least)))
 }
 
 impl TimePlot {
@@ -130,11 +148,7 @@ impl TimePlot {
             .flat_map(|p| p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0)))
             .filter(|t| t.is_finite())
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), t| (l.min(t), h.max(t)));
-        if t0.is_finite() {
-            (t0, t1.max(t0 + 1e-3))
-        } else {
-            (0.0, 1.0)
-        }
+        widened(t0, t1, 1e-3).unwrap_or((0.0, 1.0))
     }
 }
 
@@ -168,7 +182,12 @@ impl Picture for TimePlot {
                 let colour = s.colour;
                 chart
                     .draw_series(LineSeries::new(
-                        s.points.iter().copied().filter(|p| p.0.is_finite() && p.1.is_finite()),
+                        // Within the axes: plotters turns every point into pixels, which values near f64's
+                        // limits overflow.
+                        s.points
+                            .iter()
+                            .filter(|p| p.0.is_finite() && p.1.is_finite())
+                            .map(|p| (p.0.clamp(t0, t1), p.1.clamp(lo, hi))),
                         colour,
                     ))
                     .map_err(|e| fail(&e))?
@@ -188,7 +207,7 @@ impl Picture for TimePlot {
                         panel
                             .events
                             .iter()
-                            .filter(|e| e.kind == kind && e.t.is_finite())
+                            .filter(|e| e.kind == kind && (t0..=t1).contains(&e.t))
                             .map(|e| PathElement::new(vec![(e.t, lo), (e.t, hi)], style)),
                     )
                     .map_err(|e| fail(&e))?

@@ -26,8 +26,9 @@ pub fn serve(mut device: SimDevice, stop: &dyn Fn() -> bool) -> anyhow::Result<(
     let mut master = std::fs::File::from(pty.master);
     // Keep the device side open so that the terminal survives clients that come and go.
     let _slave = pty.slave;
-    println!("{}", path.display());
-    std::io::stdout().flush()?;
+    // A reader that went away (`| head -1`) does not stop the simulator: the path is known to whoever took it.
+    let mut out = std::io::stdout();
+    let _ = writeln!(out, "{}", path.display()).and_then(|()| out.flush());
     let mut buf = [0u8; 1024];
     while !stop() {
         match master.read(&mut buf) {

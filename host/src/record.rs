@@ -135,7 +135,8 @@ struct Run {
 }
 
 fn read(path: &Path) -> anyhow::Result<Run> {
-    let text = std::fs::read_to_string(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let text = crate::files::read_text(path, crate::files::DATA_LIMIT)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
     let col = |name: &str| {

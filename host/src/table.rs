@@ -22,6 +22,8 @@ pub type Row = (usize, Vec<f64>);
 /// must increase from row to row. Bad rows are returned with their line numbers, not fatal; a missing or wrong
 /// header is.
 pub fn read(text: &str, columns: &[&str]) -> Result<(Vec<Row>, Vec<InputError>), String> {
+    // A byte-order mark is how spreadsheets ("CSV UTF-8") start a file: not part of the first column's name.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let text = text.replace("\r\n", "\n").replace('\r', "\n");
     let mut rows = Vec::new();
     let mut errors = Vec::new();
@@ -42,10 +44,13 @@ pub fn read(text: &str, columns: &[&str]) -> Result<(Vec<Row>, Vec<InputError>),
             match found {
                 Some(found) if fields.len() == columns.len() => order = Some(found),
                 _ => {
+                    // At most a line's worth of what was found: a header of megabytes is not echoed.
+                    let found: String = raw.chars().take(80).collect();
+                    let more = if found.len() < raw.len() { "..." } else { "" };
                     return Err(format!(
-                        "line {line}: the header must name the columns {} (in any order), found `{raw}`",
+                        "line {line}: the header must name the columns {} (in any order), found `{found}{more}`",
                         columns.join(",")
-                    ))
+                    ));
                 }
             }
             continue;

@@ -76,6 +76,9 @@ pub fn run(args: &WorkspaceArgs) -> anyhow::Result<String> {
     let m = RingPlatform::<f64>::new(g);
     let r = g.ring_radius;
     let n = args.cells;
+    if args.z.is_some() && args.section != Section::Xy {
+        anyhow::bail!("--z is the height of the xy section; the xz section is vertical and spans every height");
+    }
     let z0 = args.z.unwrap_or(home[2]);
     crate::numbers::length_in_range("z", z0, r)?;
     if !(10..=2000).contains(&args.cells) {

@@ -99,3 +99,260 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
         }
     }
 }
+
+/// Class: files that are not what a command reads (`/dev/zero`, binary bytes, a folder, missing) end at once with
+/// the file named and what is wrong, never by reading without end: every command that reads a file.
+#[test]
+fn a_file_that_is_not_a_text_file_is_refused_at_once() {
+    let dir = scratch("files");
+    let binary = dir.join("binary.csv");
+    std::fs::write(&binary, [0xff, 0xfe, 0x00, 0x80, 0x13, 0x37, 0x0a]).unwrap();
+    let out = dir.join("out.csv").display().to_string();
+    let picture = dir.join("out.svg").display().to_string();
+    let folder = dir.display().to_string();
+    let binary = binary.display().to_string();
+    for (file, cause) in [
+        ("/dev/zero", "larger than"),
+        (binary.as_str(), "not UTF-8"),
+        (folder.as_str(), "directory"),
+        ("/nonexistent/poses.csv", "No such file"),
+    ] {
+        for args in [
+            vec!["stream", "--sim", "--fast", "--quiet", "--input", file],
+            vec!["cue", "--input", file, "--out", &out],
+            vec![
+                "cue",
+                "--input",
+                "docs/drive-telemetry.csv",
+                "--config",
+                file,
+                "--out",
+                &out,
+            ],
+            vec!["plot", file, "--out", &picture],
+            vec!["loads", "--mass", "0.1", "--input", file],
+            vec!["rig", "check", file],
+        ] {
+            let started = std::time::Instant::now();
+            let (code, _, stderr) = run(&args);
+            assert_eq!(code, 1, "{args:?}: {stderr}");
+            assert!(stderr.contains(file) && stderr.contains(cause), "{args:?}: {stderr}");
+            assert!(
+                started.elapsed() < std::time::Duration::from_secs(20),
+                "{args:?} took {:?}",
+                started.elapsed()
+            );
+        }
+    }
+}
+
+/// Class: numbers at the ends of f64 in a run record (a position of 1e308 on one row and -1e308 on the next, times
+/// of 1e300): the record is still drawn, as SVG and as PNG, instead of hanging in the axis ticks.
+#[test]
+fn a_record_with_extreme_values_is_still_drawn() {
+    let dir = scratch("plot");
+    let record = dir.join("run.csv");
+    let (code, _, stderr) = run(&[
+        "stream",
+        "--sim",
+        "--fast",
+        "--quiet",
+        "--motion",
+        "heave",
+        "--duration",
+        "1",
+        "--record",
+        record.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let text = std::fs::read_to_string(&record).unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    // Column 9 is the followed x; the first column the host's time.
+    for (row, value) in [(5, "1e308"), (6, "-1e308"), (7, "1e300")] {
+        let mut fields: Vec<String> = lines[row].split(',').map(str::to_owned).collect();
+        fields[8] = value.to_owned();
+        if row == 7 {
+            fields[0] = value.to_owned();
+        }
+        lines[row] = fields.join(",");
+    }
+    let extreme = dir.join("extreme.csv");
+    std::fs::write(&extreme, lines.join("\n") + "\n").unwrap();
+    for picture in ["extreme.svg", "extreme.png"] {
+        let out = dir.join(picture);
+        let (code, _, stderr) = run(&["plot", extreme.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        assert_eq!(code, 0, "{picture}: {stderr}");
+        assert!(std::fs::metadata(&out).unwrap().len() > 1000, "{picture} drawn");
+    }
+}
+
+/// Class: a reader that goes away (`| head -c1`: stdout a closed pipe) never makes a command panic; the run still
+/// ends with its own exit code.
+#[test]
+fn a_closed_stdout_is_not_a_panic() {
+    for args in [
+        vec!["stream", "--sim", "--fast", "--motion", "heave", "--duration", "1"],
+        vec![
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--report-json",
+            "--motion",
+            "heave",
+            "--duration",
+            "1",
+        ],
+        vec!["device", "inputs", "--sim"],
+        vec!["device", "jog", "5", "1", "--sim"],
+        vec!["presets"],
+        vec!["ik", "--pose", "0,0,0.227,0,0,0"],
+    ] {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(&args)
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Close the reading end before anything is written.
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_ne!(out.status.code(), Some(101), "{args:?}: {stderr}");
+    }
+}
+
+/// Class: a job too large to hold (a built-in motion of 1e5 s at 10 kHz checked for loads: a billion poses) is
+/// refused with its size and what to change, instead of an allocation that aborts the process.
+#[test]
+fn a_load_check_too_large_to_hold_is_refused() {
+    let (code, _, stderr) = run(&[
+        "stream",
+        "--sim",
+        "--fast",
+        "--quiet",
+        "--motion",
+        "heave",
+        "--duration",
+        "1e5",
+        "--rate",
+        "1e4",
+        "--check-loads",
+        "--mass",
+        "1",
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("1e9 poses") && stderr.contains("--duration"),
+        "{stderr}"
+    );
+}
+
+/// Class: a pose that is not a number in a motion file given to `loads --input` is reported by its line and left
+/// out; the rows before and after it are computed as without it (the unwrapping and differences are not poisoned).
+#[test]
+fn a_non_finite_row_of_a_load_input_is_left_out_by_line() {
+    let dir = scratch("loads");
+    let rows = |bad: Option<usize>| {
+        let mut csv = String::from("t,x,y,z,alpha,beta,gamma\n");
+        for k in 0..100 {
+            let alpha = if Some(k) == bad {
+                "nan".to_string()
+            } else {
+                format!("{}", 0.001 * k as f64)
+            };
+            csv += &format!("{},0,0,0.227,{alpha},0,0\n", k as f64 * 0.01);
+        }
+        csv
+    };
+    let with = dir.join("with.csv");
+    std::fs::write(&with, rows(Some(0))).unwrap();
+    let (code, stdout, stderr) = run(&["loads", "--mass", "0.01", "--input", with.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 3, "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let errors = json["errors"].as_array().unwrap_or_else(|| panic!("{json}"));
+    assert_eq!(errors.len(), 1, "{json}");
+    assert_eq!(errors[0]["line"], 2);
+    assert!(stdout.contains("drives_keep_up") && !stdout.contains("NaN"), "{stdout}");
+}
+
+/// Class: options that would do nothing with the others given are refused, not silently ignored.
+#[test]
+fn an_option_that_would_be_ignored_is_refused() {
+    for (args, code) in [
+        (
+            vec!["stream", "--sim", "--udp", "127.0.0.1:0", "--cue-config", "x.toml"],
+            2,
+        ),
+        (
+            vec!["stream", "--sim", "--input", "x.csv", "--udp-from", "127.0.0.1"],
+            2,
+        ),
+        (
+            vec!["stream", "--sim", "--motion", "demo", "--udp-from", "127.0.0.1"],
+            2,
+        ),
+        (
+            vec!["workspace", "--section", "xz", "--z", "0.1", "--out", "/tmp/x.svg"],
+            1,
+        ),
+    ] {
+        let (got, _, stderr) = run(&args);
+        assert_eq!(got, code, "{args:?}: {stderr}");
+    }
+}
+
+/// Class: numbers at the ends of f64 in messages are written as a person reads them, not as 300 digits.
+#[test]
+fn huge_and_tiny_numbers_are_said_readably() {
+    for args in [
+        vec!["stream", "--sim", "--duration=1e308"],
+        vec!["stream", "--sim", "--rate=1e308"],
+        vec!["stream", "--sim", "--duration=-1e-320"],
+        vec!["stream", "--sim", "--udp", "127.0.0.1:0", "--udp-idle=1e308"],
+    ] {
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        assert!(stderr.len() < 200 && !stderr.contains("00000000"), "{args:?}: {stderr}");
+    }
+}
+
+/// Class: a CSV as spreadsheets write it (a UTF-8 byte-order mark before the header) is read; a header that is not
+/// one is quoted in a line's worth, however long it is.
+#[test]
+fn a_spreadsheets_csv_is_read_and_a_wrong_header_is_quoted_briefly() {
+    let dir = scratch("csv");
+    let bom = dir.join("bom.csv");
+    std::fs::write(
+        &bom,
+        "\u{feff}t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n0.01,0,0,0.2271,0,0,0\n",
+    )
+    .unwrap();
+    let (code, _, stderr) = run(&["stream", "--sim", "--fast", "--quiet", "--input", bom.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stderr}");
+    let long = dir.join("long.csv");
+    std::fs::write(&long, "x".repeat(1 << 20) + "\n0,0,0,0.227,0,0,0\n").unwrap();
+    let (code, _, stderr) = run(&[
+        "stream",
+        "--sim",
+        "--fast",
+        "--quiet",
+        "--input",
+        long.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains("header") && stderr.len() < 400,
+        "{}",
+        &stderr[..400.min(stderr.len())]
+    );
+}
+
+/// Class: `monitor` with no terminal to draw on says so instead of an OS error number.
+#[test]
+fn the_monitor_without_a_terminal_says_so() {
+    let (code, _, stderr) = run(&["monitor", "--sim", "--frames", "3"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("draws on a terminal"), "{stderr}");
+}

@@ -582,6 +582,81 @@ fn the_simulator_stops_on_sigint_and_sigterm_even_started_with_sigint_ignored() 
     }
 }
 
+/// Class (adversary): a live source's garbage is unreadable, never sent, and never ends the session. A pose
+/// datagram that is not finite (NaN, infinity, 1e400, a yaw of 1e300 that f32 makes infinite), one of 65,000 digits,
+/// a telemetry datagram whose time is NaN or 1e300, and three seconds of nothing but garbage after a good start
+/// (longer than the stream timeout): every later good datagram is applied, the garbage is counted by number, and
+/// the exit code says input was unreadable (3).
+#[test]
+fn a_live_sources_garbage_is_unreadable_and_the_session_goes_on() {
+    let sleep = |ms| std::thread::sleep(std::time::Duration::from_millis(ms));
+    let long_number = "1".repeat(65_000);
+    // Poses: garbage first, then good datagrams, then a long spell of garbage only, then good ones again.
+    let (child, mut stderr, addr) = spawn_udp_stream(&["--udp-idle", "4"]);
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let garbage = [
+        "nan 0 0.227 0 0 0".to_string(),
+        "0 inf 0.227 0 0 0".into(),
+        "0 0 1e400 0 0 0".into(),
+        "0 0 0.227 0 0 1e300".into(),
+        format!("0 0 0.227 0 0 {long_number}"),
+    ];
+    for g in &garbage {
+        socket.send_to(g.as_bytes(), &addr).unwrap();
+    }
+    let good = |k: u32| format!("0 0 {} 0 0 0", 0.227 + 0.0001 * f64::from(k % 10));
+    for k in 0..20 {
+        socket.send_to(good(k).as_bytes(), &addr).unwrap();
+        sleep(10);
+    }
+    // 3 s of garbage every 10 ms: the device's stream timeout passes, the platform rests, the session goes on.
+    for _ in 0..300 {
+        socket.send_to(b"garbage", &addr).unwrap();
+        sleep(10);
+    }
+    for k in 0..20 {
+        socket.send_to(good(k).as_bytes(), &addr).unwrap();
+        sleep(10);
+    }
+    let out = child.wait_with_output().unwrap();
+    let mut said = String::new();
+    let _ = std::io::Read::read_to_string(&mut stderr, &mut said);
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; {said}", out.status));
+    assert_eq!(out.status.code(), Some(3), "{said}");
+    assert_eq!(report["datagrams"]["unreadable"], 305, "{said}");
+    assert_eq!(report["setpoints_applied"], report["setpoints_sent"], "{said}");
+    assert!(
+        report["rejected"].as_object().unwrap().is_empty(),
+        "nothing refused: {said}"
+    );
+    assert_eq!(report["datagrams"]["resumed"], 1, "{said}");
+    assert!(said.contains("datagram 1: value 1 is not a finite number"), "{said}");
+    assert!(said.contains("datagram 4: value 6 is not a finite number"), "{said}");
+
+    // Telemetry whose first time is garbage: the samples after it are cued.
+    let (child, mut stderr, addr) = spawn_live_stream(&["--telemetry-udp", "127.0.0.1:0", "--udp-idle", "0.5"]);
+    for first in ["nan 0 0 9.81 0 0 0", "1e300 0 0 9.81 0 0 0", "0.0 nan 0 9.81 0 0 0"] {
+        socket.send_to(first.as_bytes(), &addr).unwrap();
+    }
+    for k in 0..50 {
+        let t = f64::from(k) * 0.01;
+        socket
+            .send_to(format!("{t} 0.5 0 9.81 0 0 0").as_bytes(), &addr)
+            .unwrap();
+        sleep(10);
+    }
+    let out = child.wait_with_output().unwrap();
+    let mut said = String::new();
+    let _ = std::io::Read::read_to_string(&mut stderr, &mut said);
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; {said}", out.status));
+    assert_eq!(out.status.code(), Some(3), "{said}");
+    assert_eq!(report["datagrams"]["unreadable"], 3, "{said}");
+    assert!(report["setpoints_applied"].as_u64().unwrap() >= 50, "{said}");
+    assert!(report["rejected"].as_object().unwrap().is_empty(), "{said}");
+}
+
 /// A live session as a user has it: ringpod starts first, the game later; the game pauses (a menu) longer than
 /// the stream timeout and resumes. The platform waits, leads in, rests in the pause, leads in again: every
 /// datagram is applied. Datagrams of any size are read whole; other senders are ignored with `--udp-from`.

@@ -254,7 +254,8 @@ pub fn load(path: &Path) -> Result<Rig, RigError> {
 
 /// Reads a rig file without checking it (a design template need not be a valid rig yet).
 pub fn read(path: &Path) -> Result<RigFile, RigError> {
-    let text = std::fs::read_to_string(path).or_else(|e| err(path.display().to_string(), e.to_string()))?;
+    let text =
+        crate::files::read_text(path, crate::files::CONFIG_LIMIT).or_else(|e| err(path.display().to_string(), e))?;
     from_text(&text).map_err(|e| e.in_file(path))
 }
 

@@ -375,7 +375,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
         // The largest UDP payload: no datagram is ever cut.
         let mut buf = vec![0u8; 65_536];
         let mut wall = Instant::now();
-        let mut last_datagram = Instant::now();
+        let mut last_pose = Instant::now();
         let mut last_idle = Instant::now();
         let mut streaming = false;
         loop {
@@ -386,8 +386,8 @@ impl<'a, T: Transport> Streamer<'a, T> {
             let now = Instant::now();
             self.elapse(now - wall)?;
             wall = now;
-            let (n, from) = match got {
-                Ok(got) => got,
+            let datagram = match got {
+                Ok(got) => Some(got),
                 // A signal (Ctrl-C) interrupts the wait: nothing arrived, and the loop then sees the flag.
                 Err(e)
                     if matches!(
@@ -395,50 +395,42 @@ impl<'a, T: Transport> Streamer<'a, T> {
                         std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
                     ) =>
                 {
-                    let quiet = now - last_datagram;
-                    // Telemetry that pauses washes out: the vehicle at rest, through the washout, every 10 ms
-                    // from half the stream timeout on, so the platform glides back to neutral.
-                    if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= Duration::from_millis(10) {
-                        let dt = (now - last_idle).min(Duration::from_millis(20)).as_secs_f64();
-                        last_idle = now;
-                        if let Some(pose) = source.decoder.idle(dt, now) {
-                            let pose = self.limit(pose);
-                            self.send(pose, Kind::Washout)?;
-                            self.washout += 1;
-                            continue;
-                        }
-                    }
-                    if streaming && quiet > self.stream_timeout && !source.decoder.washes_out() {
-                        // The source paused (a game's menu): the device brakes to rest by itself.
-                        streaming = false;
-                        if self.last_applied.is_some() {
-                            self.bar.suspend(|| eprintln!("the source paused: the platform rests"));
-                        }
-                    }
-                    if quiet >= source.idle {
-                        return self.collect(0);
-                    }
-                    continue;
+                    None
                 }
                 Err(e) => return Err(ClientError::Io(e).into()),
             };
-            if source.from.is_some_and(|ip| ip != from.ip()) {
-                report.other_senders += 1;
-                continue;
-            }
-            last_datagram = now;
-            last_idle = now;
-            report.received += 1;
-            let number = report.received as usize;
-            let pose = match source.decoder.decode(&buf[..n], now) {
-                Ok(pose) => pose,
-                Err(reason) => {
-                    report.unreadable += 1;
-                    self.bar.suspend(|| eprintln!("datagram {number}: {reason}"));
-                    errors.push(InputError { line: number, reason });
-                    continue;
+            // Only a readable datagram of the source counts as the source being there: a stranger's datagrams and
+            // unreadable ones (a flood of them included) leave the pause logic below running.
+            let Some((number, pose)) =
+                datagram.and_then(|(n, from)| read(source, &buf[..n], from, now, report, errors, &self.bar))
+            else {
+                let quiet = now - last_pose;
+                // Telemetry that pauses washes out: the vehicle at rest, through the washout, every 10 ms
+                // from half the stream timeout on, so the platform glides back to neutral.
+                if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= Duration::from_millis(10) {
+                    let dt = (now - last_idle).min(Duration::from_millis(20)).as_secs_f64();
+                    last_idle = now;
+                    if let Some(pose) = source.decoder.idle(dt, now) {
+                        let pose = self.limit(pose);
+                        self.send(pose, Kind::Washout)?;
+                        self.washout += 1;
+                        continue;
+                    }
                 }
+                if streaming && quiet > self.stream_timeout && !source.decoder.washes_out() {
+                    // The source paused (a game's menu): the device brakes to rest by itself.
+                    streaming = false;
+                    if self.last_applied.is_some() {
+                        self.bar.suspend(|| eprintln!("the source paused: the platform rests"));
+                    }
+                }
+                if quiet >= source.idle {
+                    return self.collect(0);
+                }
+                continue;
             };
+            last_pose = now;
+            last_idle = now;
             let pose = if streaming {
                 self.limit(pose)
             } else {
@@ -452,6 +444,34 @@ impl<'a, T: Transport> Streamer<'a, T> {
             self.bar.inc(1);
             // The lead-in let its own time pass: the device's clock is already there.
             wall = Instant::now();
+        }
+    }
+}
+
+/// One datagram of the UDP source: counted, and decoded into its number and pose, or reported as unreadable (or
+/// ignored as a stranger's) with `None`.
+fn read(
+    source: &mut UdpSource,
+    bytes: &[u8],
+    from: std::net::SocketAddr,
+    now: Instant,
+    report: &mut DatagramReport,
+    errors: &mut Vec<InputError>,
+    bar: &ProgressBar,
+) -> Option<(usize, ringpod_core::kinematics::Pose<f64>)> {
+    if source.from.is_some_and(|ip| ip != from.ip()) {
+        report.other_senders += 1;
+        return None;
+    }
+    report.received += 1;
+    let number = report.received as usize;
+    match source.decoder.decode(bytes, now) {
+        Ok(pose) => Some((number, pose)),
+        Err(reason) => {
+            report.unreadable += 1;
+            bar.suspend(|| eprintln!("datagram {number}: {reason}"));
+            errors.push(InputError { line: number, reason });
+            None
         }
     }
 }

@@ -1,0 +1,31 @@
+//! Reading the text files a user names: bounded, so that `/dev/zero`, a log grown for a month or a disk image given
+//! by mistake is an error in a second instead of gigabytes of memory and the kernel's out-of-memory killer.
+
+use std::io::Read;
+use std::path::Path;
+
+/// The most a data file (poses, telemetry, a run record) may hold: about 3 hours of 1 kHz poses with room to spare.
+pub const DATA_LIMIT: u64 = 256 << 20;
+/// The most a settings file (a rig, a washout configuration) may hold: a rig file is a few kilobytes.
+pub const CONFIG_LIMIT: u64 = 1 << 20;
+
+/// The text of the file at `path`, at most `limit` bytes, or why not, without the path: the callers name the file
+/// in their own way (a rig error's key, a command's option).
+pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    if file.metadata().is_ok_and(|m| m.is_dir()) {
+        return Err("is a directory, not a file".into());
+    }
+    let mut bytes = Vec::new();
+    // One byte more than allowed tells "too large" from "exactly the limit".
+    file.take(limit + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(format!(
+            "larger than {} MiB: not a file of this kind (or split it)",
+            limit >> 20
+        ));
+    }
+    String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (byte {} is not)", e.utf8_error().valid_up_to() + 1))
+}
