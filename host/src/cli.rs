@@ -37,7 +37,7 @@ pub enum Command {
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
     /// lines that could not be read, 4 setpoints the device refused, 5 the device stopped streaming or faulted,
-    /// 6 the link was lost, 7 the --record file could not be written, 130 interrupted.
+    /// 6 the link was lost, 7 the --record file could not be written, 128 + the signal when stopped by one (130 Ctrl-C, 143 SIGTERM).
     Stream(StreamArgs),
     /// Draws a run record (`stream --record`): commanded vs followed per pose axis, the actuator positions, and
     /// the events (limits, refusals, state changes), labelled, as PNG or SVG.
