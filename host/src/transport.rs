@@ -8,8 +8,9 @@ use embassy_futures::block_on;
 use ringpod_core::controller::{Controller, ControllerConfig};
 use ringpod_core::protocol::RigSource;
 use ringpod_core::protocol::{self, FrameReader};
+use ringpod_core::sim::RamFlash;
 use ringpod_core::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
-use ringpod_core::store::{self, RamFlash};
+use ringpod_core::store;
 
 use crate::client::Transport;
 

@@ -27,7 +27,9 @@ pub mod protocol;
 mod real;
 pub mod safety;
 pub mod screws;
+#[cfg(feature = "sim")]
 pub mod selfcheck;
+#[cfg(feature = "sim")]
 pub mod sim;
 pub mod store;
 

@@ -167,7 +167,8 @@ impl InputsSpec {
 #[cfg(test)]
 mod tests {
     use embassy_futures::block_on;
-    use ringpod_core::store::{restore, store, RamFlash};
+    use ringpod_core::sim::RamFlash;
+    use ringpod_core::store::{restore, store};
 
     use super::super::{from_text, RigFile};
     use super::*;

@@ -3,6 +3,7 @@
 //! with it when no board is attached.
 
 pub mod drivers;
+mod flash;
 
 use crate::controller::{Controller, Inputs, TickOutput};
 use drivers::{DriverInputs, TimingViolation};
@@ -20,6 +21,7 @@ pub struct AxisSwitches {
 }
 
 pub use crate::model::TRAINER_MODEL_PARKED;
+pub use flash::RamFlash;
 
 /// The simulated plant.
 #[derive(Debug, Clone)]

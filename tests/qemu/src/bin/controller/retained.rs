@@ -6,7 +6,7 @@
 use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
 
-use ringpod_core::store::RamFlash;
+use ringpod_core::sim::RamFlash;
 
 /// Size of the emulated settings flash: four 2 KiB erase pages.
 pub const FLASH_SIZE: usize = 8 * 1024;
