@@ -237,70 +237,110 @@ fn bad_sections_are_refused_and_nothing_is_stored() {
     let inputs = c.config().inputs;
     let homing = c.config().switches;
     let supervisor = c.config().supervisor;
-    let mut bad = vec![
-        Settings::Control(ControlSettings { tick_hz: 1_500 }),
-        Settings::Control(ControlSettings { tick_hz: 4_000 }),
-        Settings::Stream(StreamSettings { timeout_ms: 0, ..s }),
-        Settings::Stream(StreamSettings {
-            timeout_ms: 10_001,
-            ..s
-        }),
-        Settings::Stream(StreamSettings { gross_jump_ms: 5, ..s }),
-        Settings::Stream(StreamSettings {
-            telemetry_hz: 2_001,
-            ..s
-        }),
-        Settings::Inputs(InputConfig {
-            debounce_samples: 0,
-            ..inputs
-        }),
-        Settings::Inputs(InputConfig {
-            debounce_samples: 51,
-            ..inputs
-        }),
-        Settings::Supervisor(SupervisorConfig {
-            discharge_ms: 600_000,
-            ..supervisor
-        }),
+    // Each bad value with the field the refusal must name.
+    let mut bad: Vec<(Settings, String)> = vec![
+        (
+            Settings::Control(ControlSettings { tick_hz: 1_500 }),
+            "control.tick_hz".into(),
+        ),
+        (
+            Settings::Control(ControlSettings { tick_hz: 4_000 }),
+            "control.tick_hz".into(),
+        ),
+        (
+            Settings::Stream(StreamSettings { timeout_ms: 0, ..s }),
+            "stream.timeout_ms".into(),
+        ),
+        (
+            Settings::Stream(StreamSettings {
+                timeout_ms: 10_001,
+                ..s
+            }),
+            "stream.timeout_ms".into(),
+        ),
+        (
+            Settings::Stream(StreamSettings { gross_jump_ms: 5, ..s }),
+            "stream.gross_jump_ms".into(),
+        ),
+        (
+            Settings::Stream(StreamSettings {
+                telemetry_hz: 2_001,
+                ..s
+            }),
+            "stream.telemetry_hz".into(),
+        ),
+        (
+            Settings::Inputs(InputConfig {
+                debounce_samples: 0,
+                ..inputs
+            }),
+            "inputs.debounce_ms".into(),
+        ),
+        (
+            Settings::Inputs(InputConfig {
+                debounce_samples: 51,
+                ..inputs
+            }),
+            "inputs.debounce_ms".into(),
+        ),
+        (
+            Settings::Supervisor(SupervisorConfig {
+                discharge_ms: 600_000,
+                ..supervisor
+            }),
+            "supervisor.discharge_ms".into(),
+        ),
     ];
     for (i, v) in [0.2, -0.001, f32::NAN].into_iter().enumerate() {
         let mut margins = s.margins;
         margins[i] = v;
-        bad.push(Settings::Stream(StreamSettings { margins, ..s }));
+        bad.push((
+            Settings::Stream(StreamSettings { margins, ..s }),
+            format!("stream.margins[{i}]"),
+        ));
     }
     for v in [0.0, -1.0, f32::NAN, f32::INFINITY] {
         let mut velocity = m;
         velocity.pose_velocity[0] = v;
         let mut acceleration = m;
         acceleration.pose_acceleration[5] = v;
-        bad.extend([Settings::Motion(velocity), Settings::Motion(acceleration)]);
+        bad.push((Settings::Motion(velocity), "motion.pose_velocity[0]".into()));
+        bad.push((Settings::Motion(acceleration), "motion.pose_acceleration[5]".into()));
     }
     for (axis, v) in [(0, 25_600.5), (4, -1.0), (4, 0.5), (1, 2e7), (2, f32::NAN)] {
         let mut x = a;
         x[axis].steps_per_unit = v;
-        bad.push(Settings::Axes(x));
+        bad.push((Settings::Axes(x), format!("axes[{axis}].steps_per_unit")));
     }
     for order in [[0, 0, 1, 2, 3, 4], [0, 1, 2, 3, 4, 6]] {
-        bad.push(Settings::Homing(HomingSettings { order, ..homing }));
+        bad.push((
+            Settings::Homing(HomingSettings { order, ..homing }),
+            "homing.order".into(),
+        ));
     }
     for v in [0.0, -0.1, f32::NAN] {
         let mut h = homing;
         h.axes[3].search = v;
-        bad.push(Settings::Homing(h));
+        bad.push((Settings::Homing(h), "homing.axes[3].search".into()));
         let mut h = homing;
         h.axes[4].slow = v;
-        bad.push(Settings::Homing(h));
+        bad.push((Settings::Homing(h), "homing.axes[4].slow".into()));
     }
     let mut h = homing;
     h.axes[0].switch = f32::INFINITY;
-    bad.push(Settings::Homing(h));
+    bad.push((Settings::Homing(h), "homing.axes[0].switch".into()));
     let before = *c.saved_config();
-    for settings in bad {
-        assert_eq!(
-            set(&mut c, settings),
-            DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::OutOfRange)),
-            "{settings:?}"
-        );
+    for (settings, field) in bad {
+        match set(&mut c, settings) {
+            DeviceMessage::Nack(NackReason::BadConfig(refusal @ ConfigRefusal::OutOfRange(named))) => {
+                assert_eq!(named.to_string(), field, "{settings:?}");
+                assert!(
+                    refusal.to_string().starts_with(&format!("{field}: must be ")),
+                    "{refusal}"
+                );
+            }
+            other => panic!("{settings:?}: {other:?}"),
+        }
     }
     assert_eq!(*c.saved_config(), before);
     assert!(!c.has_unsaved());

@@ -4,11 +4,9 @@
 //! axis's switch and search in the axis's units, and the order). Each is optional and takes the trainer model's
 //! values on this rig when omitted; together with the geometry they make the [`RigRecord`] a device stores.
 
-use ringpod_core::controller::ControllerConfig;
-use ringpod_core::kinematics::{AxisKind, Mechanism, RingPlatform};
+use ringpod_core::controller::{ConfigError, ControllerConfig};
 use ringpod_core::protocol::RigRecord;
 use ringpod_core::safety::debounce::{InputBit, InputConfig};
-use ringpod_core::safety::SupervisorConfig;
 use serde::{Deserialize, Serialize};
 
 use super::{err, RigError, RigFile};
@@ -42,81 +40,33 @@ impl RigFile {
     /// the controller's own code; each error names its key.
     pub(super) fn record(&self, record: RigRecord) -> Result<RigRecord, RigError> {
         let mut record = record;
-        let geometry = record.geometry().or_else(|e| err("rig", e.to_string()))?;
-        let kinds = RingPlatform::<f64>::new(&geometry).axes();
+        record.geometry().or_else(|e| err("rig", e.to_string()))?;
         if !self.axes.is_empty() && self.axes.len() != 6 {
             return err(
                 "axes",
                 format!("{} entries: one per actuator (6), or none", self.axes.len()),
             );
         }
-        for (i, (axis, kind)) in self.axes.iter().zip(kinds).enumerate() {
-            let key = format!("axes[{i}].steps_per_unit");
-            let v = axis.steps_per_unit;
-            if !(v.is_finite() && (1.0..=16_777_216.0).contains(&v)) {
-                return err(key, format!("{v} is not a step count from 1 to 16,777,216"));
-            }
-            if kind == AxisKind::Ring && v.fract() != 0.0 {
-                return err(key, "steps per carriage turn are a whole number");
-            }
-            record.machine.axes[i] = *axis;
+        for (slot, axis) in record.machine.axes.iter_mut().zip(&self.axes) {
+            *slot = *axis;
         }
         if let Some(m) = &self.motion {
-            for (name, values) in [
-                ("pose_velocity", &m.pose_velocity),
-                ("pose_acceleration", &m.pose_acceleration),
-            ] {
-                if let Some(i) = values.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-                    return err(
-                        format!("motion.{name}"),
-                        format!("value {} is not a positive number", i + 1),
-                    );
-                }
-            }
             record.machine.motion = *m;
         }
         if let Some(spec) = &self.inputs {
-            if !(1..=50).contains(&spec.debounce_ms) {
-                return err("inputs.debounce_ms", format!("{} is not 1 to 50 ms", spec.debounce_ms));
-            }
             record.machine.inputs = spec.config()?;
         }
         if let Some(s) = self.supervisor {
-            if !s.is_valid() {
-                return err(
-                    "supervisor",
-                    format!(
-                        "every delay at most {} ms, and supply_timeout_ms above 0 with a sensed supply",
-                        SupervisorConfig::LONGEST_MS
-                    ),
-                );
-            }
             record.machine.supervisor = s;
         }
         if let Some(h) = &self.homing {
-            let mut sorted = h.order;
-            sorted.sort_unstable();
-            if sorted != [0, 1, 2, 3, 4, 5] {
-                return err("homing.order", "every axis 0 to 5 once");
-            }
-            for (i, a) in h.axes.iter().enumerate() {
-                let fields = [
-                    ("search", a.search),
-                    ("backoff", a.backoff),
-                    ("fast", a.fast),
-                    ("slow", a.slow),
-                ];
-                if let Some((name, v)) = fields.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
-                    return err(format!("homing.axes[{i}].{name}"), format!("{v} is not above 0"));
-                }
-                if !a.switch.is_finite() {
-                    return err(format!("homing.axes[{i}].switch"), "not a number");
-                }
-            }
             record.machine.homing = *h;
         }
-        ControllerConfig::from_record(&record)
-            .or_else(|e| err("rig", format!("the controller cannot drive it: {e}")))?;
+        // The device's checks are the only ones: a field out of range is named by the core, by the file's key.
+        ControllerConfig::from_record(&record).map_err(|e| match e {
+            ConfigError::Value(field) => RigError::new(field.to_string(), format!("must be {}", field.must())),
+            other => RigError::new("rig", format!("the controller cannot drive it: {other}")),
+        })?;
         Ok(record)
     }
 

@@ -1,15 +1,16 @@
 //! The controller's configuration: the platform, its drives, homing, inputs and timings; the trainer model's, a
 //! rig file's, and the checks that decide whether a configuration can run.
 
+#[cfg(doc)]
 use super::Controller;
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, Pose, RingPlatform};
 use crate::kinematics::{GeometryError, RingGeometry};
 use crate::model::{CARRIAGE_HOMING, LINEAR_HOMING};
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
-use crate::protocol::{ConfigRefusal, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
+use crate::protocol::{ConfigRefusal, Field, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
-use crate::safety::homing::HomingError;
+use crate::safety::homing::{HomingError, HomingPlan, RingHoming};
 use crate::safety::SupervisorConfig;
 
 /// Everything the controller is configured with.
@@ -38,6 +39,18 @@ pub struct ControllerConfig {
     pub rig_name: [u8; RIG_NAME_LEN],
 }
 
+/// What [`ControllerConfig::check`] found a configuration to be: its mechanism, its home pose (solved) and its
+/// proven homing plan.
+#[derive(Debug, Clone, Copy)]
+pub struct Checked {
+    /// The mechanism in `f32`, as the controller computes it.
+    pub mechanism: RingPlatform<f32>,
+    /// The home pose in `f32`.
+    pub home_pose: Pose<f32>,
+    /// The homing plan, its spacing proven.
+    pub plan: HomingPlan,
+}
+
 /// Slot of the step generator (ns): the boards' timers emit one GPIO set/reset word per slot
 /// ([`crate::motion::pulse`]). 2.5 us is the shortest STEP pulse of FIRMWARE.md.
 pub const STEP_SLOT_NS: u32 = 2_500;
@@ -61,8 +74,8 @@ pub enum ConfigError {
     Scheduler,
     /// The step generator's slot grid cannot render the step timing faithfully.
     StepTiming(PulseTimingError),
-    /// A value is out of its range.
-    Value,
+    /// A field is out of its range.
+    Value(Field),
 }
 
 impl ConfigError {
@@ -74,7 +87,7 @@ impl ConfigError {
             Self::Homing(_) => ConfigRefusal::Homing,
             Self::Scheduler => ConfigRefusal::StepTiming,
             Self::StepTiming(_) => ConfigRefusal::PulseSlots,
-            Self::Value => ConfigRefusal::OutOfRange,
+            Self::Value(field) => ConfigRefusal::OutOfRange(*field),
         }
     }
 }
@@ -99,7 +112,39 @@ impl ControllerConfig {
 
     /// Whether a controller can run this configuration (what [`Controller::new`] checks).
     pub fn validate(&self) -> Result<(), ConfigError> {
-        Controller::new(*self).map(|_| ())
+        self.check().map(|_| ())
+    }
+
+    /// Every check of the whole configuration, once, with what they compute and a controller needs: the step
+    /// timing and its slot grid, the supervisor's delays, the home pose's solution, the homing plan's proof. The
+    /// sections' own ranges were checked as they were applied ([`Self::apply`]).
+    pub fn check(&self) -> Result<Checked, ConfigError> {
+        let geometry = &self.geometry;
+        if !self.scheduler.is_valid() || self.scheduler.period_ns != self.pipeline.tick_us.saturating_mul(1000) {
+            return Err(ConfigError::Scheduler);
+        }
+        self.pulse_timing().map_err(ConfigError::StepTiming)?;
+        super::sections::supervisor_fields(&self.supervisor)?;
+        let mechanism = RingPlatform::<f32>::new(geometry);
+        let home_pose = Pose::from_array(self.home).cast::<f32>();
+        let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;
+        let n = geometry.chains().len();
+        let mut home_angles = [0.0; 6];
+        for (i, a) in home_angles.iter_mut().enumerate().take(n) {
+            *a = f64::from(home_q.0[i]);
+        }
+        let ring = RingHoming {
+            carriages: n,
+            home_angles,
+            min_spacing: geometry.limits.carriage_spacing[0],
+            steps_per_rad: self.scales[0].steps_per_turn as f64 / core::f64::consts::TAU,
+        };
+        let plan = HomingPlan::new(self.homing()?, &ring).map_err(ConfigError::Homing)?;
+        Ok(Checked {
+            mechanism,
+            home_pose,
+            plan,
+        })
     }
 
     /// The trainer model's drives, switches and timings on another ring platform (its own geometry and home

@@ -12,13 +12,13 @@ mod settings;
 
 /// The inputs the controller reads (they belong to the safety layer, which debounces them).
 pub use crate::safety::Inputs;
-pub use config::{ConfigError, ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
+pub use config::{Checked, ConfigError, ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
 
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;
 use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
 use crate::protocol::{DeviceMessage, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
-use crate::safety::homing::{HomingPlan, RingHoming};
+use crate::safety::homing::HomingPlan;
 use crate::safety::{Event, HomingSequencer, Motion, Outputs, State, Supervisor};
 
 /// What the firmware does in one control period.
@@ -84,29 +84,11 @@ struct TelemetryClock {
 impl Controller {
     /// A controller in `Off`, axes at step position zero.
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
-        let geometry = &config.geometry;
-        if !config.scheduler.is_valid() || config.scheduler.period_ns != config.pipeline.tick_us.saturating_mul(1000) {
-            return Err(ConfigError::Scheduler);
-        }
-        config.pulse_timing().map_err(ConfigError::StepTiming)?;
-        if !config.supervisor.is_valid() {
-            return Err(ConfigError::Value);
-        }
-        let mechanism = RingPlatform::<f32>::new(geometry);
-        let home_pose = Pose::from_array(config.home).cast::<f32>();
-        let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;
-        let n = geometry.chains().len();
-        let mut home_angles = [0.0; 6];
-        for (i, a) in home_angles.iter_mut().enumerate().take(n) {
-            *a = f64::from(home_q.0[i]);
-        }
-        let ring = RingHoming {
-            carriages: n,
-            home_angles,
-            min_spacing: geometry.limits.carriage_spacing[0],
-            steps_per_rad: config.scales[0].steps_per_turn as f64 / core::f64::consts::TAU,
-        };
-        let plan = HomingPlan::new(config.homing()?, &ring).map_err(ConfigError::Homing)?;
+        let Checked {
+            mechanism,
+            home_pose,
+            plan,
+        } = config.check()?;
         let converter = StepConverter::new(config.scales, mechanism.axes());
         let pipeline =
             Pipeline::new(mechanism, config.pipeline, converter, home_pose).map_err(ConfigError::HomePose)?;

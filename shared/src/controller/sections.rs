@@ -7,10 +7,11 @@ use super::{ConfigError, ControllerConfig};
 use crate::kinematics::{AxisKind, Mechanism, RingPlatform};
 use crate::motion::AxisScale;
 use crate::protocol::{
-    AxisSettings, ControlSettings, MachineSettings, MotionSettings, Settings, SettingsKind, StreamSettings,
-    SwitchSettings, Toward,
+    AxisSettings, ControlSettings, Field, FieldName, MachineSettings, MotionSettings, Settings, SettingsKind,
+    StreamSettings, SwitchSettings, Toward,
 };
 use crate::safety::homing::{AxisHoming, HomingConfig};
+use crate::safety::SupervisorConfig;
 
 /// Most steps a count or rate may take (they are `u32` in the step scheduler; 2^31 leaves room to add).
 const MOST_STEPS: f64 = 2_147_483_647.0;
@@ -87,13 +88,22 @@ impl ControllerConfig {
         let c = &mut next.pipeline;
         match *settings {
             Settings::Stream(s) => {
-                let margins_ok = s.margins.iter().all(|m| (0.0..=0.1).contains(m));
-                if !(1..=10_000).contains(&s.timeout_ms)
-                    || !(10..=10_000).contains(&s.gross_jump_ms)
-                    || !margins_ok
-                    || s.telemetry_hz > 2_000
-                {
-                    return Err(ConfigError::Value);
+                let field = |name| ConfigError::Value(Field::of(SettingsKind::Stream, name));
+                if !(1..=10_000).contains(&s.timeout_ms) {
+                    return Err(field(FieldName::TimeoutMs));
+                }
+                if !(10..=10_000).contains(&s.gross_jump_ms) {
+                    return Err(field(FieldName::GrossJumpMs));
+                }
+                if let Some(i) = s.margins.iter().position(|m| !(0.0..=0.1).contains(m)) {
+                    return Err(ConfigError::Value(Field::at(
+                        SettingsKind::Stream,
+                        i,
+                        FieldName::Margins,
+                    )));
+                }
+                if s.telemetry_hz > 2_000 {
+                    return Err(field(FieldName::TelemetryHz));
                 }
                 c.stream_timeout_us = u32::from(s.timeout_ms) * 1000;
                 c.gross_jump_us = u32::from(s.gross_jump_ms) * 1000;
@@ -103,54 +113,60 @@ impl ControllerConfig {
             }
             Settings::Control(s) => {
                 if !matches!(s.tick_hz, 500 | 1_000 | 2_000) {
-                    return Err(ConfigError::Value);
+                    return Err(ConfigError::Value(Field::of(SettingsKind::Control, FieldName::TickHz)));
                 }
                 c.tick_us = 1_000_000 / u32::from(s.tick_hz);
                 next.scheduler.period_ns = c.tick_us * 1000;
             }
             Settings::Motion(s) => {
-                let positive = |v: &[f32; 6]| v.iter().all(|x| x.is_finite() && *x > 0.0);
-                if !positive(&s.pose_velocity) || !positive(&s.pose_acceleration) {
-                    return Err(ConfigError::Value);
+                for (values, name) in [
+                    (&s.pose_velocity, FieldName::PoseVelocity),
+                    (&s.pose_acceleration, FieldName::PoseAcceleration),
+                ] {
+                    if let Some(i) = values.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
+                        return Err(ConfigError::Value(Field::at(SettingsKind::Motion, i, name)));
+                    }
                 }
                 c.limits.pose_velocity = s.pose_velocity;
                 c.limits.pose_acceleration = s.pose_acceleration;
             }
             Settings::Inputs(s) => {
                 if !(1..=50).contains(&s.debounce_samples) {
-                    return Err(ConfigError::Value);
+                    return Err(ConfigError::Value(Field::of(
+                        SettingsKind::Inputs,
+                        FieldName::DebounceMs,
+                    )));
                 }
                 next.inputs = s;
             }
             Settings::Axes(axes) => {
                 let kinds = next.axis_kinds();
-                for ((scale, axis), kind) in next.scales.iter_mut().zip(&axes).zip(kinds) {
-                    *scale = axis_scale(axis, kind)?;
+                for (a, ((scale, axis), kind)) in next.scales.iter_mut().zip(&axes).zip(kinds).enumerate() {
+                    *scale = axis_scale(axis, kind).ok_or(ConfigError::Value(Field::at(
+                        SettingsKind::Axes,
+                        a,
+                        FieldName::StepsPerUnit,
+                    )))?;
                 }
             }
             Settings::Homing(h) => {
+                let order = ConfigError::Value(Field::of(SettingsKind::Homing, FieldName::Order));
                 let mut seen = [false; 6];
                 for a in h.order {
-                    let slot = seen.get_mut(usize::from(a)).ok_or(ConfigError::Value)?;
+                    let slot = seen.get_mut(usize::from(a)).ok_or(order)?;
                     if core::mem::replace(slot, true) {
-                        return Err(ConfigError::Value);
+                        return Err(order);
                     }
                 }
-                let positive = |s: &SwitchSettings| {
-                    [s.search, s.backoff, s.fast, s.slow]
-                        .iter()
-                        .all(|x| x.is_finite() && *x > 0.0)
-                        && s.switch.is_finite()
-                };
-                if !h.axes.iter().all(positive) {
-                    return Err(ConfigError::Value);
+                for (a, s) in h.axes.iter().enumerate() {
+                    if let Some(name) = invalid_switch(s) {
+                        return Err(ConfigError::Value(Field::at(SettingsKind::Homing, a, name)));
+                    }
                 }
                 next.switches = h;
             }
             Settings::Supervisor(s) => {
-                if !s.is_valid() {
-                    return Err(ConfigError::Value);
-                }
+                supervisor_fields(&s)?;
                 next.supervisor = s;
             }
         }
@@ -177,12 +193,12 @@ impl ControllerConfig {
             let s = &self.switches.axes[a];
             let scale = &self.scales[a];
             let per_unit = f64::from(scale.per_unit(kinds[a]));
-            let steps = |v: f32| {
+            let steps = |v: f32, name| {
                 let n = libm::round(f64::from(v) * per_unit);
                 if n.is_finite() && libm::fabs(n) <= MOST_STEPS {
                     Ok(n)
                 } else {
-                    Err(ConfigError::Value)
+                    Err(ConfigError::Value(Field::at(SettingsKind::Homing, a, name)))
                 }
             };
             let sign: i8 = if scale.invert { -1 } else { 1 };
@@ -192,11 +208,11 @@ impl ControllerConfig {
                         Toward::Plus => 1,
                         Toward::Minus => -1,
                     },
-                search_steps: steps(s.search)? as u32,
-                backoff_steps: steps(s.backoff)? as u32,
-                fast_rate: steps(s.fast)?.max(1.0) as u32,
-                slow_rate: steps(s.slow)?.max(1.0) as u32,
-                home_position: i64::from(sign) * steps(s.switch)? as i64,
+                search_steps: steps(s.search, FieldName::Search)? as u32,
+                backoff_steps: steps(s.backoff, FieldName::Backoff)? as u32,
+                fast_rate: steps(s.fast, FieldName::Fast)?.max(1.0) as u32,
+                slow_rate: steps(s.slow, FieldName::Slow)?.max(1.0) as u32,
+                home_position: i64::from(sign) * steps(s.switch, FieldName::Switch)? as i64,
             };
         }
         Ok(HomingConfig {
@@ -211,14 +227,49 @@ impl ControllerConfig {
     }
 }
 
+/// The first field of a switch's homing that is not a positive (the switch: finite) number.
+fn invalid_switch(s: &SwitchSettings) -> Option<FieldName> {
+    let positive = [
+        (s.search, FieldName::Search),
+        (s.backoff, FieldName::Backoff),
+        (s.fast, FieldName::Fast),
+        (s.slow, FieldName::Slow),
+    ];
+    match positive.iter().find(|(x, _)| !(x.is_finite() && *x > 0.0)) {
+        Some((_, name)) => Some(*name),
+        None => (!s.switch.is_finite()).then_some(FieldName::Switch),
+    }
+}
+
+/// The supervisor's delays, each at most [`SupervisorConfig::LONGEST_MS`], and a supply timeout where a supply is
+/// sensed: the first field that is not.
+pub(super) fn supervisor_fields(s: &SupervisorConfig) -> Result<(), ConfigError> {
+    let delays = [
+        (s.logic_settle_ms, FieldName::LogicSettleMs),
+        (s.power_settle_ms, FieldName::PowerSettleMs),
+        (s.supply_timeout_ms, FieldName::SupplyTimeoutMs),
+        (s.driver_off_ms, FieldName::DriverOffMs),
+        (s.discharge_ms, FieldName::DischargeMs),
+    ];
+    let sensed_without_timeout = s.supply_timeout_ms == 0 && (s.logic_sense || s.power_sense);
+    let bad = match delays.iter().find(|(ms, _)| *ms > SupervisorConfig::LONGEST_MS) {
+        Some((_, name)) => Some(*name),
+        None => sensed_without_timeout.then_some(FieldName::SupplyTimeoutMs),
+    };
+    match bad {
+        Some(name) => Err(ConfigError::Value(Field::of(SettingsKind::Supervisor, name))),
+        None => Ok(()),
+    }
+}
+
 /// A motor's scale, checked: 1 to 2^24 steps per unit, whole steps per carriage turn on the ring.
-fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Result<AxisScale, ConfigError> {
+fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Option<AxisScale> {
     let v = axis.steps_per_unit;
     if !(v.is_finite() && (1.0..=16_777_216.0).contains(&v)) {
-        return Err(ConfigError::Value);
+        return None;
     }
-    Ok(match kind {
-        AxisKind::Ring if v != libm::floorf(v) => return Err(ConfigError::Value),
+    Some(match kind {
+        AxisKind::Ring if v != libm::floorf(v) => return None,
         AxisKind::Ring => AxisScale {
             steps_per_turn: v as i64,
             steps_per_unit: v / core::f32::consts::TAU,

@@ -6,6 +6,7 @@ use crate::kinematics::Pose;
 
 use super::rig::{RigRecord, RigSource};
 use super::settings::{Settings, SettingsKind};
+use super::Field;
 use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 use crate::safety::{Command, FaultReason, Refusal, State};
 
@@ -197,8 +198,8 @@ impl core::fmt::Display for NackReason {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum ConfigRefusal {
-    /// A value is outside its range (the section's documentation gives each one).
-    OutOfRange,
+    /// A field is outside its range ([`Field::must`] says what it must be).
+    OutOfRange(Field),
     /// With it the home pose would have no solution.
     HomePose,
     /// With it the homing plan would be unsafe or inconsistent (searches, spacing proof).
@@ -214,7 +215,7 @@ pub enum ConfigRefusal {
 impl core::fmt::Display for ConfigRefusal {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(match self {
-            Self::OutOfRange => "a value is outside its range",
+            Self::OutOfRange(field) => return write!(f, "{field}: must be {}", field.must()),
             Self::HomePose => "the home pose would have no solution",
             Self::Homing => "the homing plan would no longer be safe (searches or spacing)",
             Self::StepTiming => "the step timing would be inconsistent",

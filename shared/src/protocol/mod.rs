@@ -6,11 +6,13 @@
 //! [`HostMessage::Hello`] with [`PROTOCOL_VERSION`]; a device answers any other request before a matching hello with
 //! [`NackReason::NotConnected`], and a different version with [`NackReason::VersionMismatch`].
 
+mod field;
 mod frame;
 mod messages;
 mod rig;
 mod settings;
 
+pub use field::{Field, FieldName};
 pub use frame::{decode, encode, parse, unframe, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
 pub use messages::{
     setpoint_request, ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode,

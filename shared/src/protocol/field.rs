@@ -1,0 +1,129 @@
+//! A field of a settings section, as a refused configuration names it on the wire and in words
+//! (`axes[2].steps_per_unit`, `motion.pose_velocity[4]`, `homing.axes[0].search`): the device's checks are the only
+//! ones, and a host prints their verdict instead of repeating them.
+
+use super::SettingsKind;
+
+/// One field of one section, with the element it concerns: an axis (`axes`, `homing`) or a position in an array
+/// value (`stream.margins`, the pose limits).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Field {
+    /// The section.
+    pub section: SettingsKind,
+    /// The axis or array position, from 0.
+    pub index: Option<u8>,
+    /// The field.
+    pub name: FieldName,
+}
+
+/// The fields that have a range, by their names in the settings sections and rig files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(missing_docs)] // Each is named by `as_str` and ranged by `Field::must`.
+pub enum FieldName {
+    TimeoutMs,
+    GrossJumpMs,
+    Margins,
+    TelemetryHz,
+    TickHz,
+    PoseVelocity,
+    PoseAcceleration,
+    DebounceMs,
+    StepsPerUnit,
+    Order,
+    Search,
+    Backoff,
+    Fast,
+    Slow,
+    Switch,
+    LogicSettleMs,
+    PowerSettleMs,
+    SupplyTimeoutMs,
+    DriverOffMs,
+    DischargeMs,
+}
+
+impl FieldName {
+    /// The field's name in its section.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Self::TimeoutMs => "timeout_ms",
+            Self::GrossJumpMs => "gross_jump_ms",
+            Self::Margins => "margins",
+            Self::TelemetryHz => "telemetry_hz",
+            Self::TickHz => "tick_hz",
+            Self::PoseVelocity => "pose_velocity",
+            Self::PoseAcceleration => "pose_acceleration",
+            Self::DebounceMs => "debounce_ms",
+            Self::StepsPerUnit => "steps_per_unit",
+            Self::Order => "order",
+            Self::Search => "search",
+            Self::Backoff => "backoff",
+            Self::Fast => "fast",
+            Self::Slow => "slow",
+            Self::Switch => "switch",
+            Self::LogicSettleMs => "logic_settle_ms",
+            Self::PowerSettleMs => "power_settle_ms",
+            Self::SupplyTimeoutMs => "supply_timeout_ms",
+            Self::DriverOffMs => "driver_off_ms",
+            Self::DischargeMs => "discharge_ms",
+        }
+    }
+}
+
+impl Field {
+    /// A field of `section` that concerns no single element.
+    pub const fn of(section: SettingsKind, name: FieldName) -> Self {
+        Self {
+            section,
+            index: None,
+            name,
+        }
+    }
+
+    /// A field of `section` for element `index` (an axis, or a position in an array value).
+    pub const fn at(section: SettingsKind, index: usize, name: FieldName) -> Self {
+        Self {
+            section,
+            // Every section has at most six elements.
+            index: Some(index as u8),
+            name,
+        }
+    }
+
+    /// What the field must be.
+    pub const fn must(&self) -> &'static str {
+        match self.name {
+            FieldName::TimeoutMs => "1 to 10,000 ms",
+            FieldName::GrossJumpMs => "10 to 10,000 ms",
+            FieldName::Margins => "0 to 0.1, in its check's unit",
+            FieldName::TelemetryHz => "0 to 2,000 samples a second",
+            FieldName::TickHz => "500, 1,000 or 2,000 ticks a second",
+            FieldName::PoseVelocity | FieldName::PoseAcceleration => "a positive number",
+            FieldName::DebounceMs => "1 to 50 ms",
+            FieldName::StepsPerUnit => "1 to 16,777,216 steps, and a whole number per carriage turn",
+            FieldName::Order => "every axis 0 to 5 once",
+            FieldName::Search | FieldName::Backoff | FieldName::Fast | FieldName::Slow => {
+                "a positive number, at most 2^31 motor steps"
+            }
+            FieldName::Switch => "a finite number, at most 2^31 motor steps either way",
+            FieldName::SupplyTimeoutMs => "above 0 while a supply is sensed, and at most 60,000 ms",
+            FieldName::LogicSettleMs | FieldName::PowerSettleMs | FieldName::DriverOffMs | FieldName::DischargeMs => {
+                "at most 60,000 ms"
+            }
+        }
+    }
+}
+
+impl core::fmt::Display for Field {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let (section, name) = (self.section.name(), self.name.as_str());
+        match (self.section, self.name, self.index) {
+            (SettingsKind::Homing, FieldName::Order, _) | (_, _, None) => write!(f, "{section}.{name}"),
+            (SettingsKind::Axes, _, Some(i)) => write!(f, "axes[{i}].{name}"),
+            (SettingsKind::Homing, _, Some(i)) => write!(f, "homing.axes[{i}].{name}"),
+            (_, _, Some(i)) => write!(f, "{section}.{name}[{i}]"),
+        }
+    }
+}
