@@ -10,7 +10,7 @@ use ringpod_core::kinematics::{AxisKind, Mechanism, MotionState, MultiTurn, Payl
 use serde::Serialize;
 
 use crate::error::{CliError, EXIT_CHECK_FAILED};
-use crate::kinematics::Outcome;
+use crate::out::Outcome;
 use crate::plot::{self, Panel, Series, TimePlot};
 use crate::rig::Drive;
 use crate::table::{self, InputError};

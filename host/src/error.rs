@@ -34,7 +34,10 @@ pub enum CliError {
     },
     /// A rig file is invalid (the error names the file and the key).
     #[error(transparent)]
-    Rig(#[from] crate::rig::RigError),
+    Rig(#[from] crate::rig::error::RigError),
+    /// A number on the command line cannot be used.
+    #[error(transparent)]
+    Number(#[from] crate::numbers::BadNumber),
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),

@@ -13,18 +13,7 @@ use crate::cli::{Common, FkArgs, LoadsArgs, PoseArgs};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::mechanism::{AnyMechanism, Selected};
 use crate::numbers;
-
-/// What a command prints and its exit code.
-pub struct Outcome {
-    pub text: String,
-    pub code: u8,
-}
-
-impl Outcome {
-    pub fn ok(text: String) -> Self {
-        Self { text, code: 0 }
-    }
-}
+pub use crate::out::Outcome;
 
 /// Angle conversion for `--degrees`.
 struct Units {

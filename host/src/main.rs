@@ -12,6 +12,7 @@ mod kinematics;
 mod mechanism;
 mod monitor;
 mod numbers;
+mod out;
 mod plot;
 mod pty;
 mod reactions;

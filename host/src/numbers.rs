@@ -1,7 +1,5 @@
 //! Numbers on the command line and in what the CLI writes: lists of six, ranges, and the device's `f32` values.
 
-use crate::error::CliError;
-
 /// A float that is exactly an `f32` is one of the device's values: its shortest `f32` decimal (0.05, not
 /// 0.05000000074505806), so that files and JSON show the number as written; any other float as it is.
 pub fn as_written(f: f64) -> f64 {
@@ -13,8 +11,8 @@ pub fn as_written(f: f64) -> f64 {
 }
 
 /// Parses `a,b,c,d,e,f` into six finite numbers.
-pub fn six(what: &'static str, text: &str) -> Result<[f64; 6], CliError> {
-    let bad = |reason: String| CliError::BadNumbers { what, reason };
+pub fn six(what: &'static str, text: &str) -> Result<[f64; 6], BadNumber> {
+    let bad = |reason: String| BadNumber { what, reason };
     let values: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>().map_err(|e| bad(format!("`{}`: {e}", s.trim()))))
@@ -33,6 +31,16 @@ pub const MAX_TILT: f64 = std::f64::consts::TAU;
 /// Yaw and ring-carriage angles up to 10,000 rad (about 1,600 turns): far beyond any session, and where an `f32`
 /// angle on the controller still resolves its steps. Beyond is a broken number (1e308 came back as 300 digits).
 pub const MAX_TURNING: f64 = 1e4;
+/// A number given on the command line that cannot be used: the option and why.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("--{what}: {reason}")]
+pub struct BadNumber {
+    /// The option.
+    pub what: &'static str,
+    /// What is wrong.
+    pub reason: String,
+}
+
 /// Lengths up to 100 times the mechanism's characteristic length (its ring radius).
 pub const MAX_LENGTHS: f64 = 100.0;
 
@@ -47,8 +55,8 @@ pub fn readable(v: f64) -> String {
 
 /// Checks a pose given on the command line (SI units) against sane ranges for a mechanism of characteristic
 /// length `length`.
-pub fn pose_in_range(what: &'static str, pose: &[f64; 6], length: f64) -> Result<(), CliError> {
-    let bad = |reason: String| Err(CliError::BadNumbers { what, reason });
+pub fn pose_in_range(what: &'static str, pose: &[f64; 6], length: f64) -> Result<(), BadNumber> {
+    let bad = |reason: String| Err(BadNumber { what, reason });
     let names = ["x", "y", "z", "alpha", "beta", "gamma"];
     for (i, v) in pose.iter().enumerate() {
         let (limit, unit) = match i {
@@ -69,12 +77,12 @@ pub fn pose_in_range(what: &'static str, pose: &[f64; 6], length: f64) -> Result
 }
 
 /// Checks one length or height given on the command line (m).
-pub fn length_in_range(what: &'static str, value: f64, length: f64) -> Result<(), CliError> {
+pub fn length_in_range(what: &'static str, value: f64, length: f64) -> Result<(), BadNumber> {
     let limit = MAX_LENGTHS * length;
     if value.is_finite() && value.abs() <= limit {
         Ok(())
     } else {
-        Err(CliError::BadNumbers {
+        Err(BadNumber {
             what,
             reason: format!(
                 "{} m is out of range (a finite number, at most {} m either way)",
@@ -86,11 +94,11 @@ pub fn length_in_range(what: &'static str, value: f64, length: f64) -> Result<()
 }
 
 /// A payload mass (kg): up to a thousand tonnes; beyond that the number is a mistake, not a simulator.
-pub fn mass(kg: f64) -> Result<f64, CliError> {
+pub fn mass(kg: f64) -> Result<f64, BadNumber> {
     if kg.is_finite() && (0.0..=1e6).contains(&kg) {
         Ok(kg)
     } else {
-        Err(CliError::BadNumbers {
+        Err(BadNumber {
             what: "mass",
             reason: format!("{} kg is out of range (0 to 1e6 kg)", readable(kg)),
         })
@@ -98,9 +106,9 @@ pub fn mass(kg: f64) -> Result<f64, CliError> {
 }
 
 /// `--inertia=Ixx,Iyy,Izz` (kg m^2, each 0 to 1e6); none is a point mass.
-pub fn inertia(text: Option<&str>) -> Result<[f64; 3], CliError> {
+pub fn inertia(text: Option<&str>) -> Result<[f64; 3], BadNumber> {
     let Some(text) = text else { return Ok([0.0; 3]) };
-    let bad = |reason: String| CliError::BadNumbers {
+    let bad = |reason: String| BadNumber {
         what: "inertia",
         reason,
     };
@@ -137,7 +145,7 @@ mod tests {
             "1,2,3,4,5,inf",
             "",
         ] {
-            assert!(matches!(six("pose", text), Err(CliError::BadNumbers { .. })), "{text}");
+            assert!(matches!(six("pose", text), Err(BadNumber { .. })), "{text}");
         }
     }
 
@@ -148,10 +156,7 @@ mod tests {
         for (i, v) in [(5, 1e308), (5, -2e4), (3, 7.0), (4, -1e9), (0, 31.0), (2, -1e6)] {
             let mut p = fine;
             p[i] = v;
-            assert!(
-                matches!(pose_in_range("pose", &p, 0.3), Err(CliError::BadNumbers { .. })),
-                "{p:?}"
-            );
+            assert!(matches!(pose_in_range("pose", &p, 0.3), Err(BadNumber { .. })), "{p:?}");
         }
         assert!(length_in_range("z", 0.2, 0.3).is_ok());
         for v in [f64::NAN, f64::INFINITY, 31.0, -1e300] {

@@ -1,16 +1,13 @@
 //! The 1:20 trainer model of FIRMWARE.md, every number of it in this one file: its motors, pose and actuator limits,
-//! homing, the configuration the firmware compiles in, and where the simulator parks it. Its geometry and home pose
+//! homing, and where the simulator parks it. Its geometry and home pose
 //! are a preset among the source's mechanisms (`kinematics::presets::TRAINER_MODEL`, `Preset::TrainerModel`) and
 //! its spec ranges are there too; its motors' torque curves are host data (`ringpod presets --export`). Another rig
 //! takes its own numbers from its rig file and starts from these where the file says nothing
-//! ([`ControllerConfig::default_record`]).
+//! ([`crate::controller::ControllerConfig::default_record`]); the configuration the firmware compiles in is
+//! [`crate::controller::ControllerConfig::trainer_model`], built from these.
 
-use crate::controller::ControllerConfig;
-use crate::kinematics::presets::{self, Preset};
-use crate::motion::{AxisScale, MotionLimits, PipelineConfig, SchedulerConfig};
-use crate::protocol::{HomingSettings, RigRecord, SwitchSettings, Toward, RIG_NAME_LEN};
-use crate::safety::debounce::InputConfig;
-use crate::safety::SupervisorConfig;
+use crate::motion::{AxisScale, MotionLimits};
+use crate::protocol::{HomingSettings, SwitchSettings, Toward};
 
 impl MotionLimits {
     /// The 1:20 trainer model: 0.05 m/s (spec table), 1.9 rad/s of yaw (its test motion) and 1 rad/s of tilt;
@@ -43,50 +40,32 @@ impl AxisScale {
     };
 }
 
-impl ControllerConfig {
-    /// The 1:20 trainer model with the FL20 drives of FIRMWARE.md: carriages home in the order 1, 3, 2, 4 after the
-    /// two linear actuators, searching up to 20 degrees of ring (linear actuators up to 40 mm); then the platform
-    /// moves to the home pose under the normal limits.
-    pub fn trainer_model() -> Self {
-        let mut config = Self {
-            geometry: presets::TRAINER_MODEL,
-            home: Preset::TrainerModel.home(),
-            supervisor: SupervisorConfig::default(),
-            pipeline: PipelineConfig::default(),
-            scheduler: SchedulerConfig::default(),
-            scales: [
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_CARRIAGE,
-                AxisScale::MODEL_LINEAR,
-                AxisScale::MODEL_LINEAR,
-            ],
-            switches: HomingSettings {
-                axes: [
-                    CARRIAGE_HOMING,
-                    CARRIAGE_HOMING,
-                    CARRIAGE_HOMING,
-                    CARRIAGE_HOMING,
-                    LINEAR_HOMING,
-                    LINEAR_HOMING,
-                ],
-                order: [4, 5, 0, 2, 1, 3],
-            },
-            inputs: InputConfig::default(),
-            telemetry_hz: 100,
-            rig_name: [0; RIG_NAME_LEN],
-        };
-        config.rig_name = RigRecord::new(
-            presets::TRAINER_MODEL.name,
-            &config.geometry,
-            config.home,
-            config.machine(),
-        )
-        .name;
-        config
-    }
-}
+/// The trainer model's motors in actuator order: four carriages on the ring, two linear actuators.
+pub const SCALES: [AxisScale; 6] = [
+    AxisScale::MODEL_CARRIAGE,
+    AxisScale::MODEL_CARRIAGE,
+    AxisScale::MODEL_CARRIAGE,
+    AxisScale::MODEL_CARRIAGE,
+    AxisScale::MODEL_LINEAR,
+    AxisScale::MODEL_LINEAR,
+];
+
+/// Its homing: the two linear actuators first, then the carriages in the order 1, 3, 2, 4, searching up to 20
+/// degrees of ring (linear actuators up to 40 mm); then the platform moves to the home pose under the normal limits.
+pub const HOMING: HomingSettings = HomingSettings {
+    axes: [
+        CARRIAGE_HOMING,
+        CARRIAGE_HOMING,
+        CARRIAGE_HOMING,
+        CARRIAGE_HOMING,
+        LINEAR_HOMING,
+        LINEAR_HOMING,
+    ],
+    order: [4, 5, 0, 2, 1, 3],
+};
+
+/// Telemetry samples a second while a host is connected and asks for them.
+pub const TELEMETRY_HZ: u16 = 100;
 
 /// The trainer model's carriage homing: the index flags sit at the carriages' home-pose angles; searched up to 20
 /// degrees of ring at 4,000 steps/s of its 25,600 per turn, backed off 2 degrees, approached at 500 steps/s.

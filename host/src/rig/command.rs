@@ -10,7 +10,7 @@ use serde::Serialize;
 use super::design::{design, Search, Target};
 use super::{coverage, load, read, RigFile};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
-use crate::kinematics::Outcome;
+use crate::out::Outcome;
 
 /// The axes of the spec ranges, in their order.
 const AXES: [&str; 5] = ["surge", "sway", "heave", "roll", "pitch"];

@@ -3,9 +3,10 @@
 
 #[cfg(doc)]
 use super::Controller;
+use crate::kinematics::presets::{self, Preset};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, Pose, RingPlatform};
 use crate::kinematics::{GeometryError, RingGeometry};
-use crate::model::{CARRIAGE_HOMING, LINEAR_HOMING};
+use crate::model::{self, CARRIAGE_HOMING, LINEAR_HOMING};
 use crate::motion::pulse::{PulseTiming, PulseTimingError};
 use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
 use crate::protocol::{ConfigRefusal, Field, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
@@ -145,6 +146,31 @@ impl ControllerConfig {
             home_pose,
             plan,
         })
+    }
+
+    /// The 1:20 trainer model ([`crate::model`]) with the FL20 drives of FIRMWARE.md: the configuration the firmware
+    /// compiles in and every rig starts from.
+    pub fn trainer_model() -> Self {
+        let mut config = Self {
+            geometry: presets::TRAINER_MODEL,
+            home: Preset::TrainerModel.home(),
+            supervisor: SupervisorConfig::default(),
+            pipeline: PipelineConfig::default(),
+            scheduler: SchedulerConfig::default(),
+            scales: model::SCALES,
+            switches: model::HOMING,
+            inputs: InputConfig::default(),
+            telemetry_hz: model::TELEMETRY_HZ,
+            rig_name: [0; RIG_NAME_LEN],
+        };
+        config.rig_name = RigRecord::new(
+            presets::TRAINER_MODEL.name,
+            &config.geometry,
+            config.home,
+            config.machine(),
+        )
+        .name;
+        config
     }
 
     /// The trainer model's drives, switches and timings on another ring platform (its own geometry and home
