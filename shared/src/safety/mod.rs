@@ -1,14 +1,14 @@
 //! Safety: the interlock supervisor (FIRMWARE.md "Safety supervisor") and the homing sequence.
 
 pub mod debounce;
+mod events;
 pub mod homing;
 pub mod pins;
 pub mod supervisor;
 
+pub use events::{Command, Event, Refusal};
 pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};
-pub use supervisor::{
-    Command, Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig, Supplies,
-};
+pub use supervisor::{FaultReason, Motion, Outputs, State, Supervisor, SupervisorConfig, Supplies};
 
 /// Switch and supply levels, as read from the pins (after debouncing and polarity).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -16,6 +16,8 @@
 
 use core::fmt;
 
+use super::events::{Command, Event, Refusal};
+
 /// Supply sequencing and sensing. A rig file's `[supervisor]` section is this type, by its field names (an unknown
 /// key is an error there; postcard, which has no names, is not affected).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -211,98 +213,6 @@ impl Outputs {
         driver_enable: false,
         motion: Motion::None,
     };
-}
-
-/// What an operator asks of the supervisor: one type for the wire ([`crate::protocol::HostMessage::Command`]) and
-/// for the state machine ([`Event::Command`]), so the two cannot drift apart.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Command {
-    /// Bring up logic, then power.
-    Enable,
-    /// Shut down: drivers, power, then logic.
-    Disable,
-    /// Home the axes.
-    Home,
-    /// Start taking the pose stream.
-    Start,
-    /// Ramp to rest (or abort homing).
-    Stop,
-    /// Clear a latched fault.
-    ClearFault,
-}
-
-impl Command {
-    /// Every command, in wire order.
-    pub const ALL: [Command; 6] = [
-        Command::Enable,
-        Command::Disable,
-        Command::Home,
-        Command::Start,
-        Command::Stop,
-        Command::ClearFault,
-    ];
-}
-
-/// An event the supervisor reacts to.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Event {
-    /// An operator's command.
-    Command(Command),
-    /// Command: jog or buzz one axis (commissioning), from powered-and-settled or from Ready.
-    Jog,
-    /// The jog or buzz finished (or stopped at a switch).
-    JogDone,
-    /// LOGIC_OK input level.
-    LogicOk(bool),
-    /// POWER_OK input level.
-    PowerOk(bool),
-    /// E-stop chain: `true` = open (stop).
-    EStop(bool),
-    /// End-of-travel switch of an axis: `true` = tripped.
-    Limit(u8, bool),
-    /// The homing sequence finished.
-    HomingDone,
-    /// The homing sequence failed.
-    HomingFailed,
-    /// The stopping ramp reached rest.
-    AtRest,
-    /// No valid setpoint within the stream timeout.
-    StreamLost,
-    /// The motion pipeline could not keep the platform inside its workspace.
-    MotionFault,
-    /// Reported once at boot when the reset cause was the watchdog.
-    WatchdogReset,
-    /// Time passed (ms).
-    Elapsed(u32),
-}
-
-/// Why a command was not carried out (the state is unchanged).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[derive(serde::Serialize, serde::Deserialize)]
-#[non_exhaustive]
-pub enum Refusal {
-    /// The command does not apply in the current state.
-    WrongState,
-    /// The e-stop chain is open.
-    EStopOpen,
-    /// An end-of-travel switch is tripped.
-    LimitActive,
-    /// A latched fault must be cleared first.
-    Faulted,
-}
-
-impl fmt::Display for Refusal {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::WrongState => "not possible in the current state",
-            Self::EStopOpen => "e-stop is open",
-            Self::LimitActive => "a limit switch is tripped",
-            Self::Faulted => "a fault is latched: clear it first",
-        })
-    }
 }
 
 /// Input levels the supervisor remembers.
