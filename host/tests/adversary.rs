@@ -9,11 +9,29 @@ fn ringpod() -> Command {
     Command::cargo_bin("ringpod").unwrap()
 }
 
-/// A scratch folder of this test process.
-fn scratch(name: &str) -> PathBuf {
+/// A scratch folder of this test process, removed when the test ends (also when it fails).
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn join(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+
+    fn display(&self) -> std::path::Display<'_> {
+        self.0.display()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn scratch(name: &str) -> Scratch {
     let dir = std::env::temp_dir().join(format!("ringpod-adversary-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir
+    Scratch(dir)
 }
 
 /// Runs `ringpod ARGS` and returns (exit code, stdout, stderr); a panic (exit 101) fails the test.
