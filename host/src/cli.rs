@@ -343,13 +343,73 @@ pub struct FkArgs {
     pub anywhere: bool,
 }
 
-/// Which plane `ringpod workspace` draws.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Section {
-    /// Horizontal, at height --z.
-    Xy,
-    /// Vertical through the ring axis (y = 0).
-    Xz,
+impl Common {
+    /// The options the analysis commands take.
+    pub fn on(&self) -> crate::kinematics::On<'_> {
+        crate::kinematics::On {
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+            degrees: self.degrees,
+            json: self.json,
+        }
+    }
+}
+
+impl FkArgs {
+    /// The options `fk` takes.
+    pub fn options(&self) -> crate::kinematics::FkOptions<'_> {
+        crate::kinematics::FkOptions {
+            on: self.common.on(),
+            actuators: &self.actuators,
+            guess: self.guess.as_deref(),
+            max_iterations: self.max_iterations,
+            anywhere: self.anywhere,
+        }
+    }
+}
+
+impl LoadsArgs {
+    /// The options `loads` takes.
+    pub fn options(&self) -> crate::kinematics::LoadsOptions<'_> {
+        crate::kinematics::LoadsOptions {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            mass: self.mass,
+            input: self.input.as_deref(),
+            inertia: self.inertia.as_deref(),
+            plot: self.plot.as_deref(),
+        }
+    }
+}
+
+impl WorkspaceArgs {
+    /// The options `workspace` takes.
+    pub fn options(&self) -> crate::workspace::Options<'_> {
+        crate::workspace::Options {
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+            section: self.section,
+            z: self.z,
+            cells: self.cells,
+            out: &self.out,
+            quiet: self.quiet,
+        }
+    }
+}
+
+impl CueArgs {
+    /// The options `cue` takes.
+    pub fn options(&self) -> crate::cue::Options<'_> {
+        crate::cue::Options {
+            input: &self.input,
+            out: &self.out,
+            config: self.config.as_deref(),
+            plot: self.plot.as_deref(),
+            json: self.json,
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+        }
+    }
 }
 
 #[derive(Debug, Args)]
@@ -362,7 +422,7 @@ pub struct WorkspaceArgs {
     pub geometry: Option<std::path::PathBuf>,
     /// The plane.
     #[arg(long, value_enum, default_value = "xy")]
-    pub section: Section,
+    pub section: crate::workspace::Section,
     /// Height of the xy section (m). Default: the preset's home height.
     #[arg(long)]
     pub z: Option<f64>,

@@ -10,7 +10,6 @@ use ringpod_core::kinematics::Pose;
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
-use crate::cli::CueArgs;
 use crate::mechanism::{AnyMechanism, Selected};
 use crate::plot::{self, Panel, Series, TimePlot};
 use crate::table::{self, InputError};
@@ -56,14 +55,32 @@ struct Cued {
     pose: Pose<f64>,
 }
 
+/// What `cue` is asked to do.
+pub struct Options<'a> {
+    /// The telemetry CSV.
+    pub input: &'a Path,
+    /// The pose CSV to write.
+    pub out: &'a Path,
+    /// Washout parameters (TOML); the defaults without.
+    pub config: Option<&'a Path>,
+    /// A plot of the cues (SVG).
+    pub plot: Option<&'a Path>,
+    /// The summary as JSON.
+    pub json: bool,
+    /// The platform: a preset by name...
+    pub mechanism: &'a str,
+    /// ...or a rig file.
+    pub geometry: Option<&'a Path>,
+}
+
 /// Runs the command; returns the summary as text and the exit code.
-pub fn run(args: &CueArgs) -> anyhow::Result<(String, u8)> {
-    let config = load_config(args.config.as_deref())?;
-    let text = crate::files::read_text(&args.input, crate::files::DATA_LIMIT)
+pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
+    let config = load_config(args.config)?;
+    let text = crate::files::read_text(args.input, crate::files::DATA_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
     let (rows, mut errors) =
         table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
-    let selected = Selected::of(&args.mechanism, args.geometry.as_deref())?;
+    let selected = Selected::of(args.mechanism, args.geometry)?;
     let AnyMechanism::Ring(mechanism) = selected.mechanism else {
         anyhow::bail!("cueing moves a ring platform; {} is not one", selected.name);
     };
@@ -113,7 +130,7 @@ pub fn run(args: &CueArgs) -> anyhow::Result<(String, u8)> {
         cued.push(Cued { t, input: sample, pose });
     }
     errors.sort_by_key(|e| e.line);
-    write_poses(&args.out, &cued)?;
+    write_poses(args.out, &cued)?;
     if let Some(plot) = &args.plot {
         draw(plot, &cued, &neutral)?;
     }

@@ -9,11 +9,52 @@ use ringpod_core::kinematics::{
 };
 use serde::Serialize;
 
-use crate::cli::{Common, FkArgs, LoadsArgs, PoseArgs};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::mechanism::{AnyMechanism, Selected};
 use crate::numbers;
 pub use crate::out::Outcome;
+
+/// What every analysis command is asked about: the platform (a preset by name, or a rig file) and how to answer.
+pub struct On<'a> {
+    /// A preset's name (used when no rig file is given).
+    pub mechanism: &'a str,
+    /// A rig file, instead of the preset.
+    pub geometry: Option<&'a std::path::Path>,
+    /// Angles in degrees, on input and output.
+    pub degrees: bool,
+    /// One JSON object instead of text.
+    pub json: bool,
+}
+
+/// `fk`: the actuator values and how to search.
+pub struct FkOptions<'a> {
+    /// The platform.
+    pub on: On<'a>,
+    /// Six actuator values, comma-separated.
+    pub actuators: &'a str,
+    /// A pose to start from (default: the home pose).
+    pub guess: Option<&'a str>,
+    /// Newton iterations at most.
+    pub max_iterations: u8,
+    /// Accept a solution outside the workspace checks.
+    pub anywhere: bool,
+}
+
+/// `loads`: statics at a pose, or inverse dynamics along a motion file.
+pub struct LoadsOptions<'a> {
+    /// The platform.
+    pub on: On<'a>,
+    /// The pose (default: the home pose).
+    pub pose: Option<&'a str>,
+    /// The payload (kg).
+    pub mass: f64,
+    /// A motion file (pose CSV): the demand along it.
+    pub input: Option<&'a std::path::Path>,
+    /// With `input`: the payload's inertia Ixx,Iyy,Izz.
+    pub inertia: Option<&'a str>,
+    /// With `input`: a picture of demand against what the drives give.
+    pub plot: Option<&'a std::path::Path>,
+}
 
 /// Angle conversion for `--degrees`.
 struct Units {
@@ -150,7 +191,7 @@ fn singularity_name(s: Singularity) -> &'static str {
 }
 
 pub(crate) fn pose_arg(
-    common: &Common,
+    common: &On,
     home: [f64; 6],
     length: f64,
     text: Option<&str>,
@@ -167,8 +208,7 @@ pub(crate) fn pose_arg(
     Ok(pose)
 }
 
-pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliError> {
-    let common = &args.common;
+pub fn ik(common: &On, pose: Option<&str>, exit_on_failed_check: bool) -> Result<Outcome, CliError> {
     let units = Units {
         degrees: common.degrees,
     };
@@ -177,8 +217,8 @@ pub fn ik(args: &PoseArgs, exit_on_failed_check: bool) -> Result<Outcome, CliErr
         home,
         mechanism: m,
         ..
-    } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
-    let pose = pose_arg(common, home, m.characteristic_length(), args.pose.as_deref(), "pose")?;
+    } = Selected::of(common.mechanism, common.geometry)?;
+    let pose = pose_arg(common, home, m.characteristic_length(), pose, "pose")?;
     let (q, report) = m.inverse_checked(&pose).map_err(|reason| match (&m, reason) {
         (AnyMechanism::Ring(r), KinematicsError::Unreachable { .. }) => CliError::OutOfReach {
             reason,
@@ -277,8 +317,8 @@ struct FkJson<'a> {
     residual: f64,
 }
 
-pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
-    let common = &args.common;
+pub fn fk(args: &FkOptions) -> Result<Outcome, CliError> {
+    let common = &args.on;
     let units = Units {
         degrees: common.degrees,
     };
@@ -287,8 +327,8 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
         home,
         mechanism: m,
         ..
-    } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
-    let raw = numbers::six("actuators", &args.actuators)?;
+    } = Selected::of(common.mechanism, common.geometry)?;
+    let raw = numbers::six("actuators", args.actuators)?;
     let axes = m.axes();
     let q = ringpod_core::kinematics::Actuators(std::array::from_fn(|i| match axes[i] {
         AxisKind::Linear => raw[i],
@@ -313,9 +353,9 @@ pub fn fk(args: &FkArgs) -> Result<Outcome, CliError> {
         }
     }
     // Without a guess: home turned by the yaw the carriages show, accepted within a tilt range of it.
-    let (guess, max_distance) = match args.guess.as_deref() {
+    let (guess, max_distance) = match args.guess {
         Some(_) => (
-            pose_arg(common, home, length, args.guess.as_deref(), "guess")?,
+            pose_arg(common, home, length, args.guess, "guess")?,
             NewtonOptions::<f64>::default().max_distance,
         ),
         None => (start_from_home(&m, &q, &Pose::from_array(home)), FROM_HOME_DISTANCE),
@@ -370,14 +410,14 @@ struct LoadsJson<'a> {
     line_forces: [f64; 6],
 }
 
-pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
-    let common = &args.common;
+pub fn loads(args: &LoadsOptions) -> Result<Outcome, CliError> {
+    let common = &args.on;
     let Selected {
         name,
         home,
         mechanism: m,
         drives,
-    } = Selected::of(&common.mechanism, common.geometry.as_deref())?;
+    } = Selected::of(common.mechanism, common.geometry)?;
     let AnyMechanism::Ring(ring) = &m else {
         return Err(CliError::BadNumbers {
             what: "mechanism",
@@ -386,8 +426,8 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
     };
     numbers::mass(args.mass)?;
     let names = m.axis_names();
-    if let Some(input) = &args.input {
-        let inertia = numbers::inertia(args.inertia.as_deref())?;
+    if let Some(input) = args.input {
+        let inertia = numbers::inertia(args.inertia)?;
         let job = crate::demand::Job {
             name: &name,
             ring,
@@ -396,11 +436,11 @@ pub fn loads(args: &LoadsArgs) -> Result<Outcome, CliError> {
             input,
             mass: args.mass,
             inertia,
-            plot: args.plot.as_deref(),
+            plot: args.plot,
         };
         return crate::demand::run(&job, common.json);
     }
-    let pose = pose_arg(common, home, m.characteristic_length(), args.pose.as_deref(), "pose")?;
+    let pose = pose_arg(common, home, m.characteristic_length(), args.pose, "pose")?;
     let q = m.inverse(&pose)?;
     let wrench = ring.gravity_wrench(&pose, args.mass);
     let l = ring.loads(&pose, &q, &wrench)?;

@@ -48,16 +48,16 @@ fn main() -> ExitCode {
                 seed,
             } => rig::design_command(file, *combined, *starts, *steps, *seed),
         }),
-        C::Ik(args) => answer(kinematics::ik(args, false)),
-        C::Check(args) => answer(kinematics::ik(args, true)),
-        C::Fk(args) => answer(kinematics::fk(args)),
-        C::Loads(args) => answer(kinematics::loads(args)),
-        C::Reactions(args) => answer(reactions::run(args)),
+        C::Ik(args) => answer(kinematics::ik(&args.common.on(), args.pose.as_deref(), false)),
+        C::Check(args) => answer(kinematics::ik(&args.common.on(), args.pose.as_deref(), true)),
+        C::Fk(args) => answer(kinematics::fk(&args.options())),
+        C::Loads(args) => answer(kinematics::loads(&args.options())),
+        C::Reactions(args) => answer(reactions::run(&args.common.on(), args.pose.as_deref(), &args.wrench)),
         C::Stream(args) => stream_command(args),
         C::Device(args) => device_command(args),
         C::Ports => ports_command(),
         C::Simulate { pty, geometry } => simulate_command(*pty, geometry.as_deref()),
-        C::Cue(args) => cue::run(args).map(|(text, code)| {
+        C::Cue(args) => cue::run(&args.options()).map(|(text, code)| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             code
         }),
@@ -66,7 +66,7 @@ fn main() -> ExitCode {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),
-        C::Workspace(args) => workspace::run(args).map(|text| {
+        C::Workspace(args) => workspace::run(&args.options()).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),

@@ -7,9 +7,8 @@ use std::fmt::Write as _;
 use ringpod_core::screws::tool::{tool_loads, ToolLoads};
 use serde::Serialize;
 
-use crate::cli::ReactionsArgs;
 use crate::error::CliError;
-use crate::kinematics::{pose_arg, Outcome};
+use crate::kinematics::{pose_arg, On, Outcome};
 use crate::mechanism::{AnyMechanism, Selected};
 use crate::numbers;
 
@@ -42,9 +41,9 @@ const DRIVES: [&str; 5] = [
 ];
 const UNITS: [&str; 5] = ["N", "N m", "N m", "N m", "N m"];
 
-pub fn run(args: &ReactionsArgs) -> Result<Outcome, CliError> {
-    let common = &args.common;
-    let selected = Selected::of(&common.mechanism, common.geometry.as_deref())?;
+/// `reactions` at `pose` (default: the home pose) under `wrench` (`fx,fy,fz,mx,my,mz`).
+pub fn run(common: &On, pose: Option<&str>, wrench: &str) -> Result<Outcome, CliError> {
+    let selected = Selected::of(common.mechanism, common.geometry)?;
     let AnyMechanism::Tool(carrier) = &selected.mechanism else {
         return Err(CliError::BadNumbers {
             what: "mechanism",
@@ -57,10 +56,10 @@ pub fn run(args: &ReactionsArgs) -> Result<Outcome, CliError> {
         common,
         selected.home,
         ringpod_core::kinematics::Mechanism::characteristic_length(carrier),
-        args.pose.as_deref(),
+        pose,
         "pose",
     )?;
-    let wrench = numbers::six("wrench", &args.wrench)?;
+    let wrench = numbers::six("wrench", wrench)?;
     if let Some(i) = wrench.iter().position(|v| !(v.is_finite() && v.abs() <= 1e9)) {
         return Err(CliError::BadNumbers {
             what: "wrench",

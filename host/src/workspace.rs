@@ -10,7 +10,6 @@ use ringpod_core::kinematics::geometry::DEG;
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 
-use crate::cli::{Section, WorkspaceArgs};
 use crate::plot::{self, Picture};
 
 /// What limits a grid point.
@@ -55,15 +54,42 @@ fn colour(cell: Cell) -> RGBColor {
     }
 }
 
+/// The plane of a workspace section.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Section {
+    /// Horizontal, at height --z.
+    Xy,
+    /// Vertical through the ring axis (y = 0).
+    Xz,
+}
+
+/// What `workspace` is asked to do.
+pub struct Options<'a> {
+    /// The platform: a preset by name (a ring platform)...
+    pub mechanism: &'a str,
+    /// ...or a rig file.
+    pub geometry: Option<&'a std::path::Path>,
+    /// The plane.
+    pub section: Section,
+    /// Height of the xy section (m); the home pose's height without.
+    pub z: Option<f64>,
+    /// Cells along each side of the section.
+    pub cells: usize,
+    /// The picture (SVG or PNG).
+    pub out: &'a std::path::Path,
+    /// No progress bar.
+    pub quiet: bool,
+}
+
 /// Runs the command; returns the text to print.
-pub fn run(args: &WorkspaceArgs) -> anyhow::Result<String> {
+pub fn run(args: &Options) -> anyhow::Result<String> {
     let (geometry, home, ranges) = match &args.geometry {
         Some(path) => {
             let rig = crate::rig::load(path)?;
             (rig.geometry, rig.home.to_array(), rig.ranges)
         }
         None => {
-            let preset = Preset::from_name(&args.mechanism)
+            let preset = Preset::from_name(args.mechanism)
                 .ok_or_else(|| anyhow::anyhow!("unknown mechanism `{}`", args.mechanism))?;
             let PresetGeometry::Ring(g) = preset.geometry() else {
                 anyhow::bail!("the workspace scan is for ring platforms")
@@ -116,7 +142,7 @@ pub fn run(args: &WorkspaceArgs) -> anyhow::Result<String> {
         })
         .collect();
     bar.finish_and_clear();
-    draw(&args.out, &grid, u_range, v_range, args.section, g.name)?;
+    draw(args.out, &grid, u_range, v_range, args.section, g.name)?;
 
     let mut text = String::new();
     let inside: Vec<(f64, f64)> = grid
