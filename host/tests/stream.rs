@@ -454,6 +454,18 @@ fn spawn_udp_stream(
     spawn_live_stream(&[&["--udp", "127.0.0.1:0"][..], args].concat())
 }
 
+/// Waits for a live stream to end: its output, its JSON report and what it said on stderr.
+fn ended(
+    child: std::process::Child,
+    stderr: &mut std::io::BufReader<std::process::ChildStderr>,
+) -> (std::process::Output, serde_json::Value, String) {
+    let out = child.wait_with_output().unwrap();
+    let mut said = String::new();
+    let _ = std::io::Read::read_to_string(stderr, &mut said);
+    let report = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; {said}", out.status));
+    (out, report, said)
+}
+
 /// Starts `ringpod stream --sim ARGS` with a live source and waits until it announces the address to send to.
 fn spawn_live_stream(
     args: &[&str],
@@ -618,11 +630,7 @@ fn a_live_sources_garbage_is_unreadable_and_the_session_goes_on() {
         socket.send_to(good(k).as_bytes(), &addr).unwrap();
         sleep(10);
     }
-    let out = child.wait_with_output().unwrap();
-    let mut said = String::new();
-    let _ = std::io::Read::read_to_string(&mut stderr, &mut said);
-    let report: serde_json::Value =
-        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; {said}", out.status));
+    let (out, report, said) = ended(child, &mut stderr);
     assert_eq!(out.status.code(), Some(3), "{said}");
     assert_eq!(report["datagrams"]["unreadable"], 305, "{said}");
     assert_eq!(report["setpoints_applied"], report["setpoints_sent"], "{said}");
@@ -646,11 +654,7 @@ fn a_live_sources_garbage_is_unreadable_and_the_session_goes_on() {
             .unwrap();
         sleep(10);
     }
-    let out = child.wait_with_output().unwrap();
-    let mut said = String::new();
-    let _ = std::io::Read::read_to_string(&mut stderr, &mut said);
-    let report: serde_json::Value =
-        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; {said}", out.status));
+    let (out, report, said) = ended(child, &mut stderr);
     assert_eq!(out.status.code(), Some(3), "{said}");
     assert_eq!(report["datagrams"]["unreadable"], 3, "{said}");
     assert!(report["setpoints_applied"].as_u64().unwrap() >= 50, "{said}");
