@@ -81,7 +81,7 @@ pub enum Command {
     /// (and any other program) can talk to it as to a board. Runs until interrupted.
     Simulate {
         /// Serve on a pseudo-terminal (the only transport for now).
-        #[arg(long)]
+        #[arg(long, required = true)]
         pty: bool,
         /// Simulate this rig file's platform (with the trainer model's drives and switches) instead of the trainer
         /// model.
@@ -249,7 +249,7 @@ pub struct StreamArgs {
     /// With --telemetry-udp: `text` (`[t] ax ay az wx wy wz`, the units of `ringpod cue`) or `outsim` (Live for
     /// Speed's OutSim packet, also sent by BeamNG.drive).
     #[arg(long, value_enum, default_value = "text")]
-    pub telemetry_format: crate::datagram::TelemetryFormat,
+    pub telemetry_format: crate::stream::datagram::TelemetryFormat,
     /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`).
     #[arg(long, requires = "telemetry_udp", conflicts_with_all = ["udp", "input", "motion"])]
     pub cue_config: Option<std::path::PathBuf>,
@@ -345,8 +345,8 @@ pub struct FkArgs {
 
 impl Common {
     /// The options the analysis commands take.
-    pub fn on(&self) -> crate::kinematics::On<'_> {
-        crate::kinematics::On {
+    pub fn on(&self) -> crate::analysis::kinematics::On<'_> {
+        crate::analysis::kinematics::On {
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
             degrees: self.degrees,
@@ -357,8 +357,8 @@ impl Common {
 
 impl FkArgs {
     /// The options `fk` takes.
-    pub fn options(&self) -> crate::kinematics::FkOptions<'_> {
-        crate::kinematics::FkOptions {
+    pub fn options(&self) -> crate::analysis::kinematics::FkOptions<'_> {
+        crate::analysis::kinematics::FkOptions {
             on: self.common.on(),
             actuators: &self.actuators,
             guess: self.guess.as_deref(),
@@ -370,8 +370,8 @@ impl FkArgs {
 
 impl LoadsArgs {
     /// The options `loads` takes.
-    pub fn options(&self) -> crate::kinematics::LoadsOptions<'_> {
-        crate::kinematics::LoadsOptions {
+    pub fn options(&self) -> crate::analysis::kinematics::LoadsOptions<'_> {
+        crate::analysis::kinematics::LoadsOptions {
             on: self.common.on(),
             pose: self.pose.as_deref(),
             mass: self.mass,
@@ -384,8 +384,8 @@ impl LoadsArgs {
 
 impl WorkspaceArgs {
     /// The options `workspace` takes.
-    pub fn options(&self) -> crate::workspace::Options<'_> {
-        crate::workspace::Options {
+    pub fn options(&self) -> crate::analysis::workspace::Options<'_> {
+        crate::analysis::workspace::Options {
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
             section: self.section,
@@ -399,8 +399,8 @@ impl WorkspaceArgs {
 
 impl CueArgs {
     /// The options `cue` takes.
-    pub fn options(&self) -> crate::cue::Options<'_> {
-        crate::cue::Options {
+    pub fn options(&self) -> crate::analysis::cue::Options<'_> {
+        crate::analysis::cue::Options {
             input: &self.input,
             out: &self.out,
             config: self.config.as_deref(),
@@ -422,7 +422,7 @@ pub struct WorkspaceArgs {
     pub geometry: Option<std::path::PathBuf>,
     /// The plane.
     #[arg(long, value_enum, default_value = "xy")]
-    pub section: crate::workspace::Section,
+    pub section: crate::analysis::workspace::Section,
     /// Height of the xy section (m). Default: the preset's home height.
     #[arg(long)]
     pub z: Option<f64>,
@@ -461,4 +461,93 @@ pub struct CueArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
+}
+
+impl StreamArgs {
+    /// The stream these arguments ask for (clap has already refused the combinations that make no sense).
+    pub fn job(&self) -> anyhow::Result<crate::stream::command::Job> {
+        use crate::stream::command::{Datagrams, Device, Input, Job, LoadsCheck};
+        let udp = |addr, holds| Input::Udp {
+            addr,
+            holds,
+            from: self.udp_from,
+            idle: self.udp_idle,
+        };
+        let input = match (self.udp, self.telemetry_udp, &self.input) {
+            (Some(addr), _, _) => udp(addr, Datagrams::Poses { degrees: self.degrees }),
+            (None, Some(addr), _) => udp(
+                addr,
+                Datagrams::Telemetry {
+                    format: self.telemetry_format,
+                    cue_config: self.cue_config.clone(),
+                },
+            ),
+            (None, None, Some(path)) => Input::File {
+                path: path.clone(),
+                degrees: self.degrees,
+            },
+            (None, None, None) => Input::Motion {
+                motion: self.motion.unwrap_or(crate::stream::Motion::Demo),
+                seconds: self.duration,
+                rate_hz: self.rate,
+            },
+        };
+        let device = match crate::link::Target::named(self.port.as_deref(), self.sim)? {
+            crate::link::Target::Port(port) => Device::Port(port),
+            crate::link::Target::Sim => Device::Sim {
+                fast: self.fast,
+                rig: self.geometry.clone(),
+            },
+        };
+        Ok(Job {
+            input,
+            device,
+            check_loads: self.check_loads.then(|| LoadsCheck {
+                mass: self.mass.unwrap_or(f64::NAN),
+                inertia: self.inertia.clone(),
+            }),
+            options: crate::stream::Options {
+                home: self.home,
+                host_limits: !self.device_limits_only,
+                quiet: self.quiet,
+            },
+            record: self.record.clone(),
+            report_json: self.report_json,
+        })
+    }
+}
+
+impl DeviceArgs {
+    /// The device and what to do there; words that an action does not take are refused here.
+    pub fn request(&self) -> anyhow::Result<(crate::link::Target, crate::device::Action)> {
+        use crate::device::Action;
+        use DeviceAction as A;
+        if !matches!(self.action, A::Config | A::Jog | A::Buzz | A::Rig) && !self.config.is_empty() {
+            anyhow::bail!("only `device config`, `jog`, `buzz` and `rig` take further words");
+        }
+        if self.watch && self.action != A::Inputs {
+            anyhow::bail!("--watch is for `device inputs`");
+        }
+        let words = self.config.clone();
+        let action = match self.action {
+            A::Status => Action::Status,
+            A::Enable => Action::Enable,
+            A::Disable => Action::Disable,
+            A::Home => Action::Home,
+            A::Start => Action::Start,
+            A::Stop => Action::Stop,
+            A::Clear => Action::Clear,
+            A::Config => Action::Config(words),
+            A::Inputs => Action::Inputs { watch: self.watch },
+            A::Jog => Action::Jog(words),
+            A::Buzz => Action::Buzz(words),
+            A::Rig => match words.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+                ["load", file] => Action::LoadRig(std::path::PathBuf::from(file)),
+                ["show"] => Action::ShowRig,
+                _ => anyhow::bail!("`device rig load RIG.toml` or `device rig show`"),
+            },
+            A::Restart => Action::Restart,
+        };
+        Ok((crate::link::Target::named(self.port.as_deref(), self.sim)?, action))
+    }
 }

@@ -37,7 +37,7 @@ pub enum CliError {
     Rig(#[from] crate::rig::error::RigError),
     /// A number on the command line cannot be used.
     #[error(transparent)]
-    Number(#[from] crate::numbers::BadNumber),
+    Number(#[from] crate::input::numbers::BadNumber),
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),

@@ -8,8 +8,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use proptest::prelude::*;
-use ringpod_core::controller::{ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
+use ringpod_core::controller::ControllerConfig;
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer, PulseTiming, PulseTimingError};
+use ringpod_core::motion::pulse::{MAX_STEP_SLOTS, STEP_SLOT_NS};
 use ringpod_core::motion::{AxisMove, Direction, SchedulerConfig, StepScheduler};
 use ringpod_core::sim::drivers::{DriverInputs, TimingRule, TimingViolation};
 use ringpod_core::sim::Plant;

@@ -10,7 +10,7 @@ use ringpod_core::protocol::{
     AxisSettings, ConfigRefusal, ControlSettings, DeviceMessage, HomingSettings, HostMessage, MotionSettings,
     NackReason, Request, Settings, SettingsKind, StreamSettings, PROTOCOL_VERSION,
 };
-use ringpod_core::safety::debounce::{from_inputs, to_inputs, Debouncer, InputBit, InputConfig};
+use ringpod_core::safety::debounce::{Debouncer, InputBit, InputConfig};
 use ringpod_core::safety::{Command, SupervisorConfig};
 
 fn config(samples: u8) -> InputConfig {
@@ -67,7 +67,7 @@ proptest! {
         estop in any::<bool>(), home in 0u16..64, limits in 0u16..64, logic_ok in any::<bool>(), power_ok in any::<bool>()
     ) {
         let inputs = Inputs { estop_open: estop, home, limits, logic_ok, power_ok };
-        prop_assert_eq!(to_inputs(from_inputs(&inputs)), inputs);
+        prop_assert_eq!(Inputs::from_word(inputs.word()), inputs);
     }
 }
 
@@ -94,7 +94,7 @@ fn polarity_maps_electrical_levels() {
     // At rest: switches with pull-ups read high (not pressed), the e-stop chain is closed (low), supplies down.
     let at_rest = defaults.active_low;
     let d = Debouncer::new(defaults, at_rest);
-    assert_eq!(to_inputs(d.stable()), Inputs::default());
+    assert_eq!(Inputs::from_word(d.stable()), Inputs::default());
     // A pressed home switch of axis 2 pulls its pin low.
     let mut d = Debouncer::new(
         InputConfig {
@@ -104,10 +104,10 @@ fn polarity_maps_electrical_levels() {
         at_rest,
     );
     let pressed = at_rest & !InputBit::Home(2).mask();
-    assert_eq!(to_inputs(d.sample(pressed)).home, 1 << 2);
+    assert_eq!(Inputs::from_word(d.sample(pressed)).home, 1 << 2);
     // The e-stop chain opening pulls its pin high.
     let open = pressed | InputBit::EStop.mask();
-    assert!(to_inputs(d.sample(open)).estop_open);
+    assert!(Inputs::from_word(d.sample(open)).estop_open);
     assert_eq!(InputBit::Home(6).mask(), 0, "no seventh axis");
 }
 

@@ -6,21 +6,15 @@ use core::sync::atomic::Ordering;
 
 use embassy_time::{Duration, Ticker};
 use ringpod_core::controller::Inputs;
-use ringpod_core::motion::AxisMove;
 use ringpod_core::safety::pins::{writes, OutputPin};
 
 use super::Shared;
 
-/// The board's side of the control loop.
+/// The board's side of the control loop: the hardware only. The loop itself reads the debounced inputs and owns
+/// the step queue, so every board shares that code.
 pub trait Machine {
-    /// The debounced inputs now.
-    fn inputs(&mut self, shared: &Shared) -> Inputs;
     /// Sets one output pin (`true`: relay closed, drivers enabled).
     fn write(&mut self, pin: OutputPin, on: bool);
-    /// Hands one period's moves to the step generator (waits while its queue is full).
-    async fn steps(&mut self, moves: &[AxisMove; 6], shared: &Shared);
-    /// Periods queued for the step generator.
-    fn queue_depth(&self, shared: &Shared) -> u16;
     /// A free-running cycle counter (DWT CYCCNT on a board).
     fn cycles(&self) -> u32;
     /// Reloads the independent watchdog.
@@ -35,7 +29,7 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
     let mut n = 0u32;
     loop {
         ticker.next().await;
-        let inputs = machine.inputs(shared);
+        let inputs = Inputs::from_word(shared.inputs.load(Ordering::Relaxed));
         let step_fault = shared.step_fault.swap(false, Ordering::Relaxed);
         let start = machine.cycles();
         let (out, message) = shared.with(|c| {
@@ -52,8 +46,9 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
         for (pin, on) in writes(&out.outputs) {
             machine.write(pin, on);
         }
-        machine.steps(&out.moves, shared).await;
-        let depth = machine.queue_depth(shared);
+        // Waits while the step generator's queue is full: the queue paces the loop as much as the ticker does.
+        shared.steps.send(out.moves).await;
+        let depth = shared.steps.len() as u16;
         shared.with(|c| c.set_platform_stats(cost, depth));
         if let Some(m) = message {
             // The fault stays latched in the state whether or not the message fits; the host sees it in the status.

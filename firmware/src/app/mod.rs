@@ -21,6 +21,7 @@ use embassy_sync::channel::Channel;
 use ringpod_core::controller::Controller;
 use ringpod_core::motion::AxisMove;
 use ringpod_core::protocol::Response;
+use ringpod_core::safety::debounce::Debouncer;
 
 /// Periods of step moves the control tick may run ahead of the step generator.
 pub const STEP_QUEUE: usize = 4;
@@ -43,8 +44,10 @@ pub struct Shared {
 }
 
 impl Shared {
-    /// Shares `controller`, with the inputs as the board read them at reset.
-    pub fn new(controller: Controller, inputs: u16) -> Self {
+    /// Shares `controller`, with the electrical levels of the inputs as the board read them at reset (the
+    /// debouncer applies the polarity, here as in the inputs task).
+    pub fn new(controller: Controller, levels: u16) -> Self {
+        let inputs = Debouncer::new(controller.config().inputs, levels).stable();
         Self {
             controller: Mutex::new(RefCell::new(controller)),
             outbox: Channel::new(),

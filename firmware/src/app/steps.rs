@@ -4,8 +4,8 @@
 
 use core::sync::atomic::Ordering;
 
-use ringpod_core::controller::MAX_STEP_SLOTS;
 use ringpod_core::motion::pulse::PulseRenderer;
+use ringpod_core::motion::pulse::MAX_STEP_SLOTS;
 use ringpod_core::motion::{AxisMove, Direction};
 
 use super::Shared;

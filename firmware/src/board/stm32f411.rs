@@ -17,8 +17,6 @@
 //! per update from a ring of rendered periods into `BSRR`. The CPU renders a period per millisecond; it never
 //! touches a pin per step. Inputs are on port A, lines 0-10, each on its own EXTI line.
 
-use core::sync::atomic::Ordering;
-
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::dma::{self, TransferOptions, WritableRingBuffer};
@@ -34,11 +32,11 @@ use embassy_stm32::usb::{self, Driver};
 use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config};
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embassy_usb::{Builder, UsbDevice};
-use ringpod_core::controller::{Controller, Inputs, MAX_STEP_SLOTS};
+use ringpod_core::controller::Controller;
+use ringpod_core::motion::pulse::MAX_STEP_SLOTS;
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
-use ringpod_core::motion::AxisMove;
 use ringpod_core::protocol::RigSource;
-use ringpod_core::safety::debounce::{to_inputs, InputBit};
+use ringpod_core::safety::debounce::InputBit;
 use ringpod_core::safety::pins::OutputPin;
 use static_cell::StaticCell;
 use {defmt_rtt as _, panic_probe as _};
@@ -146,7 +144,7 @@ mod watchdog {
     }
 }
 
-/// Relays, driver enable, step queue, cycle counter, watchdog: the control loop's hardware.
+/// Relays, driver enable, cycle counter, watchdog: the control loop's hardware.
 struct BlackPill {
     logic_relay: Output<'static>,
     power_relay: Output<'static>,
@@ -154,10 +152,6 @@ struct BlackPill {
 }
 
 impl Machine for BlackPill {
-    fn inputs(&mut self, shared: &Shared) -> Inputs {
-        to_inputs(shared.inputs.load(Ordering::Relaxed))
-    }
-
     fn write(&mut self, pin: OutputPin, on: bool) {
         match pin {
             // ENABLE is active low on the drivers.
@@ -165,14 +159,6 @@ impl Machine for BlackPill {
             OutputPin::LogicRelay => self.logic_relay.set_level(Level::from(on)),
             OutputPin::PowerRelay => self.power_relay.set_level(Level::from(on)),
         }
-    }
-
-    async fn steps(&mut self, moves: &[AxisMove; 6], shared: &Shared) {
-        shared.steps.send(*moves).await;
-    }
-
-    fn queue_depth(&self, shared: &Shared) -> u16 {
-        shared.steps.len() as u16
     }
 
     fn cycles(&self) -> u32 {
@@ -373,10 +359,7 @@ pub async fn start(spawner: Spawner) {
         ],
     };
     let mut switches = switches;
-    let shared: &'static Shared = SHARED.init(Shared::new(controller, {
-        let raw = switches.read();
-        raw ^ config.inputs.active_low
-    }));
+    let shared: &'static Shared = SHARED.init(Shared::new(controller, switches.read()));
     shared.with(|c| c.set_rig_source(restored.rig));
     if watchdog_reset {
         defmt::error!("the last reset was the watchdog's");
@@ -402,7 +385,7 @@ pub async fn start(spawner: Spawner) {
     ring.start();
     let timer = Timer::new(p.TIM1);
     timer.set_frequency(
-        Hertz(1_000_000_000 / ringpod_core::controller::STEP_SLOT_NS),
+        Hertz(1_000_000_000 / ringpod_core::motion::pulse::STEP_SLOT_NS),
         RoundTo::Faster,
     );
     timer.enable_update_dma(true);

@@ -4,10 +4,11 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use ringpod_core::protocol::{DeviceMessage, HostMessage, NackReason, RigSource};
+use ringpod_core::protocol::endpoints::GetStatus;
+use ringpod_core::protocol::{NackReason, RigSource};
 
 use super::RigFile;
-use crate::client::{Client, ClientError, Transport};
+use crate::link::client::{Client, ClientError, Transport};
 
 /// `device rig load FILE`: checks the file here (every error names its key), then the device checks and stores
 /// it for the next start. Returns what to print.
@@ -53,8 +54,8 @@ pub fn restart<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
     client.restart()?;
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
-        match client.request(HostMessage::GetStatus) {
-            Ok(DeviceMessage::Nack(NackReason::NotConnected)) => break,
+        match client.call(GetStatus) {
+            Err(ClientError::Device(NackReason::NotConnected)) => break,
             // A board on USB leaves: its port closes, and it comes back under the same name in a moment.
             Err(ClientError::Io(_)) => return Ok("restarting: the port closed; the board enumerates again".into()),
             _ if Instant::now() > deadline => anyhow::bail!("the device did not restart within 10 s"),

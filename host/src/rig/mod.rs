@@ -214,8 +214,8 @@ pub fn load(path: &Path) -> Result<Rig, RigError> {
 
 /// Reads a rig file without checking it (a design template need not be a valid rig yet).
 pub fn read(path: &Path) -> Result<RigFile, RigError> {
-    let text =
-        crate::files::read_text(path, crate::files::CONFIG_LIMIT).or_else(|e| err(path.display().to_string(), e))?;
+    let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
+        .or_else(|e| err(path.display().to_string(), e))?;
     from_text(&text).map_err(|e| e.in_file(path))
 }
 
@@ -449,7 +449,7 @@ impl RigFile {
     pub fn to_toml(&self) -> Result<String, toml::ser::Error> {
         fn tidy(v: &mut toml::Value) {
             match v {
-                toml::Value::Float(f) => *f = crate::numbers::as_written(*f),
+                toml::Value::Float(f) => *f = crate::input::numbers::as_written(*f),
                 toml::Value::Array(a) => a.iter_mut().for_each(tidy),
                 toml::Value::Table(t) => t.iter_mut().for_each(|(_, v)| tidy(v)),
                 _ => {}

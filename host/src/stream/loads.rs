@@ -5,7 +5,7 @@ use ringpod_core::kinematics::{Mechanism, Payload, Pose, RingPlatform};
 use ringpod_core::protocol::MotionSettings;
 
 use super::source::{motion_pose, Source};
-use crate::client::{Client, ClientError, Transport};
+use crate::link::client::{Client, ClientError, Transport};
 use crate::rig::{Drive, Rig};
 
 /// The platform whose drives are checked: the device's rig, with motor data from the rig file or the preset.
@@ -55,7 +55,7 @@ pub fn check_loads(
     source: &Source,
     payload: &Payload<f64>,
     platform: &LoadPlatform,
-) -> anyhow::Result<crate::demand::Preflight> {
+) -> anyhow::Result<crate::analysis::demand::Preflight> {
     let rows: Vec<(usize, f64, Pose<f64>)> = match source {
         Source::Poses(p) => p.clone(),
         Source::Motion {
@@ -68,9 +68,9 @@ pub fn check_loads(
                 anyhow::bail!(
                     "--check-loads: {} s at {} Hz is {} poses, more than the {MAX_POSES} it checks: shorten \
                      --duration or lower --rate",
-                    crate::numbers::readable(*seconds),
-                    crate::numbers::readable(*rate_hz),
-                    crate::numbers::readable(n)
+                    crate::input::numbers::readable(*seconds),
+                    crate::input::numbers::readable(*rate_hz),
+                    crate::input::numbers::readable(n)
                 );
             }
             let n = n as usize;
@@ -83,6 +83,6 @@ pub fn check_loads(
         }
         Source::Udp(_) => anyhow::bail!("--check-loads needs the poses beforehand (--input or --motion)"),
     };
-    crate::demand::preflight(&platform.ring, &platform.drives, &rows, payload)
+    crate::analysis::demand::preflight(&platform.ring, &platform.drives, &rows, payload)
         .map_err(|e| anyhow::anyhow!("--check-loads: {e}"))
 }

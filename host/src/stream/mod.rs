@@ -5,7 +5,10 @@
 //! and refuses only garbage. The run ends with a stop, a wait for rest and a report whose outcome and exit code say
 //! whether the input was followed.
 
+pub mod command;
+pub mod datagram;
 mod loads;
+pub mod record;
 mod report;
 mod session;
 mod source;
@@ -25,9 +28,9 @@ pub use report::{DatagramReport, LimitedReport, RecordReport, Report};
 use session::{Stop, StreamError, Streamer};
 pub use source::{motion_pose, read_csv, Motion, Source, UdpSource};
 
-use crate::client::{Client, ClientError, Transport};
-use crate::record::Recorder;
-pub use crate::table::InputError;
+pub use crate::input::table::InputError;
+use crate::link::client::{Client, ClientError, Transport};
+use crate::stream::record::Recorder;
 
 /// Exit codes of `ringpod stream` (the most serious applies).
 pub mod exit {

@@ -12,8 +12,8 @@ use ringpod_core::safety::State;
 
 use super::report::{reason_name, DatagramReport, LimitedReport};
 use super::{InputError, UdpSource};
-use crate::client::{setpoint_answer, Client, ClientError, Transport};
-use crate::record::Recorder;
+use crate::link::client::{setpoint_answer, Client, ClientError, Transport};
+use crate::stream::record::Recorder;
 
 /// Setpoints sent ahead of their answers: 16 ms of a 1 kHz stream, far more than a USB or pty round trip.
 const IN_FLIGHT: usize = 16;

@@ -46,7 +46,7 @@ pub struct UdpSource {
     /// The bound socket.
     pub socket: std::net::UdpSocket,
     /// What a datagram means.
-    pub decoder: crate::datagram::Decoder,
+    pub decoder: crate::stream::datagram::Decoder,
     /// End after this long without a datagram.
     pub idle: Duration,
     /// Take datagrams from this address only.
@@ -57,10 +57,10 @@ pub struct UdpSource {
 pub const POSE_COLUMNS: [&str; 7] = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
 
 /// Reads a pose file: `t,x,y,z,alpha,beta,gamma` named in its header in any order (seconds, metres, radians or
-/// degrees; [`crate::table::read`]). NaN and infinity in a pose are passed on: the device refuses them with a
+/// degrees; [`crate::input::table::read`]). NaN and infinity in a pose are passed on: the device refuses them with a
 /// reason, which is the point.
 pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputError>), String> {
-    let (rows, errors) = crate::table::read(text, &POSE_COLUMNS)?;
+    let (rows, errors) = crate::input::table::read(text, &POSE_COLUMNS)?;
     let a = |x: f64| if degrees { x.to_radians() } else { x };
     let poses = rows
         .into_iter()

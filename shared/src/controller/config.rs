@@ -7,7 +7,7 @@ use crate::kinematics::presets::{self, Preset};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, Pose, RingPlatform};
 use crate::kinematics::{GeometryError, RingGeometry};
 use crate::model::{self, CARRIAGE_HOMING, LINEAR_HOMING};
-use crate::motion::pulse::{PulseTiming, PulseTimingError};
+use crate::motion::pulse::{PulseTiming, PulseTimingError, MAX_STEP_SLOTS, STEP_SLOT_NS};
 use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
 use crate::protocol::{ConfigRefusal, Field, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
@@ -51,12 +51,6 @@ pub struct Checked {
     /// The homing plan, its spacing proven.
     pub plan: HomingPlan,
 }
-
-/// Slot of the step generator (ns): the boards' timers emit one GPIO set/reset word per slot
-/// ([`crate::motion::pulse`]). 2.5 us is the shortest STEP pulse of FIRMWARE.md.
-pub const STEP_SLOT_NS: u32 = 2_500;
-/// Longest step buffer a board holds (slots): one period of 2 ms at [`STEP_SLOT_NS`].
-pub const MAX_STEP_SLOTS: usize = 800;
 
 /// Why a configuration cannot run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,6 +1,7 @@
 //! Protocol dispatch: every request gets exactly one response, a frame that does not decode is counted and never
 //! executed.
 
+use super::homing::Homing;
 use super::Controller;
 use crate::kinematics::presets::{Preset, PresetGeometry};
 use crate::kinematics::{AxisKind, Mechanism};
@@ -114,25 +115,29 @@ impl Controller {
         }
         match e {
             Event::Command(Command::Home) => {
-                self.homing_carry = 0;
-                self.returning_home = false;
                 // A homed machine knows where its switches are: it first moves, under the normal limits and
                 // checks, to where the first homing started (each axis a little before its switch), so that
                 // every search is as short as the first one was. The home pose is often further from a linear
                 // actuator's end switch than its search travel.
-                self.parking = was_homed
+                let parking = was_homed
                     && self
                         .parking_pose()
                         .is_ok_and(|pose| self.pipeline.move_to(pose).is_ok());
-                self.homing = (!self.parking).then(|| HomingSequencer::new(self.plan, &self.scheduler.position()));
+                self.homing = if parking {
+                    Homing::Parking
+                } else {
+                    Homing::Searching {
+                        sequencer: HomingSequencer::new(self.plan, &self.scheduler.position()),
+                        carry: 0,
+                    }
+                };
             }
             Event::Command(Command::Start) => self.pipeline.start(),
             Event::Command(Command::Stop) => {
                 self.pipeline.stop();
-                if self.homing.take().is_some() || self.returning_home || self.parking {
+                if self.homing != Homing::Idle {
                     self.pipeline.halt();
-                    self.returning_home = false;
-                    self.parking = false;
+                    self.homing = Homing::Idle;
                 }
             }
             _ => {}

@@ -6,6 +6,34 @@ use crate::kinematics::{KinematicsError, Mechanism, MultiTurn, Pose};
 use crate::motion::PipelineEvent;
 use crate::safety::{Event, HomingSequencer, HomingStep};
 
+/// Where homing is: one phase at a time, so that no two can be under way together.
+// The sequencer holds its plan (about a hundred bytes); the controller holds one `Homing` in place and never moves
+// it, and a board has no heap to box it.
+#[allow(clippy::large_enum_variant)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Homing {
+    /// Not homing.
+    Idle,
+    /// Re-homing a homed machine: the platform on its way, through the pipeline, to the parking pose near the
+    /// switches, so that every search is as short as the first one was.
+    Parking,
+    /// The sequencer searching the switches axis by axis; `carry` is the fraction of a step (in step-microseconds)
+    /// carried between ticks so that the average rate is exact.
+    Searching { sequencer: HomingSequencer, carry: i64 },
+    /// Every switch found: the platform on its way to the home pose.
+    Returning,
+}
+
+impl Homing {
+    /// The axis whose switch is being searched.
+    pub(super) fn axis(&self) -> Option<u8> {
+        match self {
+            Homing::Searching { sequencer, .. } => sequencer.current_axis(),
+            _ => None,
+        }
+    }
+}
+
 impl Controller {
     /// One tick of a jog: the axis a step further, the others where they are; done at the end of the last leg or
     /// when the axis's home switch closes.
@@ -74,67 +102,72 @@ impl Controller {
     }
 
     pub(super) fn homing_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
-        if self.parking {
-            let (targets, event) = self.pipeline.tick();
-            match event {
-                Some(PipelineEvent::AtRest) => {
-                    self.parking = false;
-                    self.homing = Some(HomingSequencer::new(self.plan, &targets));
-                }
-                Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
-                _ => {}
-            }
-            return targets;
+        match self.homing {
+            Homing::Idle => position,
+            Homing::Parking | Homing::Returning => self.homing_move_tick(),
+            Homing::Searching { .. } => self.search_tick(position, tick_us),
         }
-        if self.returning_home {
-            let (targets, event) = self.pipeline.tick();
-            match event {
-                Some(PipelineEvent::AtRest) => {
-                    self.returning_home = false;
-                    self.event(Event::HomingDone);
-                }
-                Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
-                _ => {}
+    }
+
+    /// A tick of the pipeline's move to the parking pose or back home; its end starts the search or ends homing.
+    fn homing_move_tick(&mut self) -> [i64; 6] {
+        let (targets, event) = self.pipeline.tick();
+        match event {
+            Some(PipelineEvent::AtRest) if self.homing == Homing::Parking => {
+                self.homing = Homing::Searching {
+                    sequencer: HomingSequencer::new(self.plan, &targets),
+                    carry: 0,
+                };
             }
-            return targets;
+            Some(PipelineEvent::AtRest) => {
+                self.homing = Homing::Idle;
+                self.event(Event::HomingDone);
+            }
+            Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
+            _ => {}
         }
-        let Some(homing) = self.homing.as_mut() else {
+        targets
+    }
+
+    /// A tick of the switch search: one axis moves at its rate until its switch, which sets its origin.
+    fn search_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
+        let Homing::Searching { sequencer, carry } = &mut self.homing else {
             return position;
         };
-        match homing.update(&position, self.inputs.home) {
+        match sequencer.update(&position, self.inputs.home) {
             HomingStep::Move { axis, rate } => {
                 // Steps this period at `rate`, the fraction carried so that the average rate is exact.
-                let total = i64::from(rate) * i64::from(tick_us) + self.homing_carry;
+                let total = i64::from(rate) * i64::from(tick_us) + *carry;
                 let steps = total / 1_000_000;
-                self.homing_carry = total % 1_000_000;
+                *carry = total % 1_000_000;
                 let mut t = position;
                 t[usize::from(axis % 6)] += steps;
                 t
             }
             HomingStep::Homed { axis, .. } => {
                 // The switch defines this axis's origin: here it is at step `home_position`.
+                *carry = 0;
                 let a = usize::from(axis % 6);
                 let mut p = position;
                 p[a] = self.plan.config().axes[a].home_position;
                 self.scheduler.set_position(p);
-                self.homing_carry = 0;
                 p
             }
             HomingStep::Done => {
-                self.homing = None;
+                self.homing = Homing::Idle;
                 let started = self
                     .pose_after_homing()
                     .ok()
                     .and_then(|pose| self.pipeline.reset(pose).ok());
                 if started.is_some() && self.pipeline.move_to(self.home_pose).is_ok() {
-                    self.returning_home = true;
+                    self.homing = Homing::Returning;
                 } else {
                     self.event(Event::HomingFailed);
                 }
                 self.scheduler.position()
             }
             HomingStep::Failed(_) => {
-                self.homing = None;
+                self.homing = Homing::Idle;
                 self.event(Event::HomingFailed);
                 position
             }

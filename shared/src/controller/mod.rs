@@ -12,14 +12,15 @@ mod settings;
 
 /// The inputs the controller reads (they belong to the safety layer, which debounces them).
 pub use crate::safety::Inputs;
-pub use config::{Checked, ConfigError, ControllerConfig, MAX_STEP_SLOTS, STEP_SLOT_NS};
+pub use config::{Checked, ConfigError, ControllerConfig};
 
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;
 use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
 use crate::protocol::{DeviceMessage, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
 use crate::safety::homing::HomingPlan;
-use crate::safety::{Event, HomingSequencer, Motion, Outputs, State, Supervisor};
+use crate::safety::{Event, Motion, Outputs, State, Supervisor};
+use homing::Homing;
 
 /// What the firmware does in one control period.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,12 +44,7 @@ pub struct Controller {
     pipeline: Pipeline<RingPlatform<f32>>,
     scheduler: StepScheduler,
     plan: HomingPlan,
-    homing: Option<HomingSequencer>,
-    homing_carry: i64,
-    /// Homing found every switch; the platform is on its way to the home pose.
-    returning_home: bool,
-    /// Re-homing a homed machine: the platform is on its way to the parking pose near the switches first.
-    parking: bool,
+    homing: Homing,
     connected: bool,
     inputs: Inputs,
     elapsed_us: u32,
@@ -101,10 +97,7 @@ impl Controller {
             pipeline,
             scheduler: StepScheduler::new(config.scheduler, [0; 6]),
             plan,
-            homing: None,
-            homing_carry: 0,
-            returning_home: false,
-            parking: false,
+            homing: Homing::Idle,
             connected: false,
             inputs: Inputs::default(),
             elapsed_us: 0,
@@ -165,9 +158,7 @@ impl Controller {
         }
         if matches!(self.supervisor.state(), State::Fault(..)) {
             self.pipeline.halt();
-            self.homing = None;
-            self.returning_home = false;
-            self.parking = false;
+            self.homing = Homing::Idle;
             if !was_fault {
                 self.pending_fault = true;
             }
@@ -182,7 +173,7 @@ impl Controller {
 
     /// Every input's level and state.
     pub fn input_report(&self) -> InputReport {
-        let active = crate::safety::debounce::from_inputs(&self.inputs);
+        let active = self.inputs.word();
         let polarity = self.config.inputs.active_low;
         InputReport {
             raw: self.raw_inputs.unwrap_or(active ^ polarity),
@@ -207,7 +198,7 @@ impl Controller {
         if inputs.power_ok != old.power_ok {
             self.event(Event::PowerOk(inputs.power_ok));
         }
-        let homing_axis = self.homing.as_ref().and_then(|h| h.current_axis());
+        let homing_axis = self.homing.axis();
         let axes = self.pipeline.mechanism().axes();
         let limit_bits = |i: &Inputs| {
             let mut bits = i.limits;
@@ -271,7 +262,7 @@ impl Controller {
             limited,
             refused,
             tick_cost: self.tick_cost,
-            inputs: crate::safety::debounce::from_inputs(&self.inputs),
+            inputs: self.inputs.word(),
             outputs: {
                 let o = self.supervisor.outputs();
                 u8::from(o.logic_relay) | u8::from(o.power_relay) << 1 | u8::from(o.driver_enable) << 2

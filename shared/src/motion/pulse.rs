@@ -14,6 +14,12 @@
 
 use super::scheduler::{AxisMove, Direction, SchedulerConfig};
 
+/// Slot of the boards' step generators (ns): their timers emit one GPIO set/reset word per slot. 2.5 us is the
+/// shortest STEP pulse of FIRMWARE.md.
+pub const STEP_SLOT_NS: u32 = 2_500;
+/// Longest step buffer a board holds (slots): one period of 2 ms at [`STEP_SLOT_NS`].
+pub const MAX_STEP_SLOTS: usize = 800;
+
 /// Which pin of the port each axis's STEP and DIR signal is on (0-15), and the DIR level that means forward.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PortMap {

@@ -6,6 +6,7 @@
 //! [`HostMessage::Hello`] with [`PROTOCOL_VERSION`]; a device answers any other request before a matching hello with
 //! [`NackReason::NotConnected`], and a different version with [`NackReason::VersionMismatch`].
 
+pub mod endpoints;
 mod field;
 mod frame;
 mod messages;

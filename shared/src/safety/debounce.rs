@@ -63,48 +63,51 @@ impl Default for InputConfig {
     }
 }
 
-/// Logical input word to the controller's [`Inputs`].
-pub fn to_inputs(logical: u16) -> Inputs {
-    let mut home = 0;
-    let mut limits = 0;
-    for a in 0..6u8 {
-        if logical & InputBit::Home(a).mask() != 0 {
-            home |= 1 << a;
+impl Inputs {
+    /// The inputs of a logical input word (bits in [`InputBit`]'s layout, polarity already applied by the
+    /// [`Debouncer`]: a set bit is an active input). Inputs of axes beyond six are not the controller's.
+    pub fn from_word(logical: u16) -> Self {
+        let mut home = 0;
+        let mut limits = 0;
+        for a in 0..6u8 {
+            if logical & InputBit::Home(a).mask() != 0 {
+                home |= 1 << a;
+            }
+            if logical & InputBit::Limit(a).mask() != 0 {
+                limits |= 1 << a;
+            }
         }
-        if logical & InputBit::Limit(a).mask() != 0 {
-            limits |= 1 << a;
+        Inputs {
+            estop_open: logical & InputBit::EStop.mask() != 0,
+            home,
+            limits,
+            logic_ok: logical & InputBit::LogicOk.mask() != 0,
+            power_ok: logical & InputBit::PowerOk.mask() != 0,
         }
     }
-    Inputs {
-        estop_open: logical & InputBit::EStop.mask() != 0,
-        home,
-        limits,
-        logic_ok: logical & InputBit::LogicOk.mask() != 0,
-        power_ok: logical & InputBit::PowerOk.mask() != 0,
-    }
-}
 
-/// The controller's [`Inputs`] as a logical word (the inverse of [`to_inputs`] for axes 0-5).
-pub fn from_inputs(inputs: &Inputs) -> u16 {
-    let mut w = 0;
-    for a in 0..6u8 {
-        if inputs.home & (1 << a) != 0 {
-            w |= InputBit::Home(a).mask();
+    /// The logical input word (the inverse of [`Inputs::from_word`] for axes 0-5).
+    pub fn word(&self) -> u16 {
+        let mut w = 0;
+        for a in 0..6u8 {
+            if self.home & (1 << a) != 0 {
+                w |= InputBit::Home(a).mask();
+            }
+            if self.limits & (1 << a) != 0 {
+                w |= InputBit::Limit(a).mask();
+            }
         }
-        if inputs.limits & (1 << a) != 0 {
-            w |= InputBit::Limit(a).mask();
+        if self.estop_open {
+            w |= InputBit::EStop.mask();
         }
+        if self.logic_ok {
+            w |= InputBit::LogicOk.mask();
+        }
+        if self.power_ok {
+            w |= InputBit::PowerOk.mask();
+        }
+        w
     }
-    if inputs.estop_open {
-        w |= InputBit::EStop.mask();
-    }
-    if inputs.logic_ok {
-        w |= InputBit::LogicOk.mask();
-    }
-    if inputs.power_ok {
-        w |= InputBit::PowerOk.mask();
-    }
-    w
 }
 
 /// Per-input debouncing of sampled levels.

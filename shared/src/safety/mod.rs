@@ -10,8 +10,9 @@ pub use events::{Command, Event, Refusal};
 pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};
 pub use supervisor::{FaultReason, Motion, Outputs, State, Supervisor, SupervisorConfig, Supplies};
 
-/// Switch and supply levels, as read from the pins (after debouncing and polarity).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+/// Switch and supply levels, as read from the pins (after debouncing and polarity). The supervisor keeps the
+/// ones its events report (its `home` stays clear: homing reads the switches, the interlocks do not).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub struct Inputs {
     /// E-stop chain open.
     pub estop_open: bool,

@@ -17,6 +17,7 @@
 use core::fmt;
 
 use super::events::{Command, Event, Refusal};
+use super::Inputs;
 
 /// Supply sequencing and sensing. A rig file's `[supervisor]` section is this type, by its field names (an unknown
 /// key is an error there; postcard, which has no names, is not affected).
@@ -215,15 +216,6 @@ impl Outputs {
     };
 }
 
-/// Input levels the supervisor remembers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
-struct Inputs {
-    estop_open: bool,
-    limits: u16,
-    logic_ok: bool,
-    power_ok: bool,
-}
-
 /// The interlock state machine.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Supervisor {
@@ -231,6 +223,7 @@ pub struct Supervisor {
     state: State,
     timer_ms: u32,
     homed: bool,
+    /// The levels its events reported.
     inputs: Inputs,
 }
 

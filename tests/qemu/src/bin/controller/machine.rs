@@ -9,16 +9,13 @@
 //!   step while the drivers are disabled, is reported over semihosting (the QEMU runner fails on it).
 
 use core::cell::RefCell;
-use core::sync::atomic::Ordering;
 
 use cortex_m_semihosting::hprintln;
 use embassy_sync::blocking_mutex::raw::{CriticalSectionRawMutex, ThreadModeRawMutex};
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Timer};
-use ringpod_core::controller::Inputs;
-use ringpod_core::motion::AxisMove;
-use ringpod_core::safety::debounce::{self, InputConfig};
+use ringpod_core::safety::debounce::InputConfig;
 use ringpod_core::safety::pins::OutputPin;
 use ringpod_core::safety::{Outputs, State};
 use ringpod_core::sim::drivers::DriverInputs;
@@ -61,23 +58,21 @@ impl World {
     /// Electrical levels of the input pins, in the `safety::debounce::InputBit` layout.
     fn levels(&self) -> u16 {
         let inputs = self.plant.inputs(self.outputs.logic_relay, self.outputs.power_relay);
-        debounce::from_inputs(&inputs) ^ InputConfig::default().active_low
+        inputs.word() ^ InputConfig::default().active_low
     }
 }
 
 /// The control loop's side: relays, driver enable, the step queue, the watchdog.
 pub struct Controls {
     pub world: &'static WorldCell,
+    /// What the tasks share: the stall test looks at the supervisor's state.
+    pub shared: &'static Shared,
     /// The stall test (`stall-when-homed` on the command line): the control loop hangs in the first tick that
     /// finds the platform homed and at rest, and the watchdog has to bring the board back.
     pub stall_when_homed: bool,
 }
 
 impl Machine for Controls {
-    fn inputs(&mut self, shared: &Shared) -> Inputs {
-        debounce::to_inputs(shared.inputs.load(Ordering::Relaxed))
-    }
-
     fn write(&mut self, pin: OutputPin, on: bool) {
         self.world.lock(|w| {
             let mut w = w.borrow_mut();
@@ -90,27 +85,20 @@ impl Machine for Controls {
         CHANGED.signal(());
     }
 
-    async fn steps(&mut self, moves: &[AxisMove; 6], shared: &Shared) {
-        if self.stall_when_homed && shared.with(|c| c.supervisor().state() == State::Ready) {
-            hprintln!("STALL");
-            // A control loop caught in an endless computation: interrupts still run, the loop never comes back.
-            loop {
-                cortex_m::asm::nop();
-            }
-        }
-        shared.steps.send(*moves).await;
-    }
-
-    fn queue_depth(&self, shared: &Shared) -> u16 {
-        shared.steps.len() as u16
-    }
-
     fn cycles(&self) -> u32 {
         // No DWT cycle counter in QEMU: microseconds of SysTick time, in 25 MHz cycles.
         (time::now_us() * 25) as u32
     }
 
     fn feed_watchdog(&mut self) {
+        if self.stall_when_homed && self.shared.with(|c| c.supervisor().state() == State::Ready) {
+            hprintln!("STALL");
+            // A control loop caught in an endless computation before the end of its tick: interrupts still run,
+            // the loop never comes back to feed the watchdog.
+            loop {
+                cortex_m::asm::nop();
+            }
+        }
         watchdog::feed();
     }
 }

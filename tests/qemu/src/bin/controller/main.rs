@@ -30,7 +30,8 @@ use cortex_m_semihosting::hprintln;
 use embassy_executor::Spawner;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Duration, Instant};
-use ringpod_core::controller::{Controller, STEP_SLOT_NS};
+use ringpod_core::controller::Controller;
+use ringpod_core::motion::pulse::STEP_SLOT_NS;
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
 use ringpod_core::protocol::RigSource;
 use ringpod_core::sim::drivers::DriverInputs;
@@ -157,7 +158,7 @@ async fn main(spawner: Spawner) {
     let world: &'static WorldCell = WORLD.init(Mutex::new(RefCell::new(World::new(plant, drivers))));
     let mut pins = Pins { world, last: 0 };
     let first = ringpod_firmware::app::inputs::InputPins::read(&mut pins);
-    let shared: &'static Shared = SHARED.init(Shared::new(controller, first ^ config.inputs.active_low));
+    let shared: &'static Shared = SHARED.init(Shared::new(controller, first));
     shared.with(|c| c.set_rig_source(restored.rig));
     if restored.rig != RigSource::Compiled {
         hprintln!("RIG {} ({:?})", config.rig().name(), restored.rig);
@@ -183,6 +184,7 @@ async fn main(spawner: Spawner) {
     };
     let controls = Controls {
         world,
+        shared,
         stall_when_homed: command_line_has(b"stall-when-homed") && !watchdog_reset,
     };
     watchdog::start(WATCHDOG_US);

@@ -7,10 +7,10 @@ use std::fmt::Write as _;
 use ringpod_core::screws::tool::{tool_loads, ToolLoads};
 use serde::Serialize;
 
+use crate::analysis::kinematics::{pose_arg, On, Outcome};
+use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::CliError;
-use crate::kinematics::{pose_arg, On, Outcome};
-use crate::mechanism::{AnyMechanism, Selected};
-use crate::numbers;
+use crate::input::numbers;
 
 #[derive(Serialize)]
 struct ReactionsJson<'a> {

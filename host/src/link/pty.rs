@@ -9,8 +9,8 @@ use nix::fcntl::{fcntl, FcntlArg, OFlag};
 use nix::pty::openpty;
 use nix::sys::termios::{cfmakeraw, tcgetattr, tcsetattr, SetArg};
 
-use crate::client::Transport;
-use crate::transport::SimDevice;
+use crate::link::client::Transport;
+use crate::link::transport::SimDevice;
 
 /// Opens a pseudo-terminal, prints the path of its device side, and runs the simulated controller behind it in
 /// real time (1 ms steps) until `stop` says so (a signal); returning closes the pseudo-terminal.

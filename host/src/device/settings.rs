@@ -6,7 +6,7 @@
 use ringpod_core::protocol::{Settings, SettingsKind};
 use serde_json::Value;
 
-use crate::client::{Client, Transport};
+use crate::link::client::{Client, Transport};
 use crate::rig::InputsSpec;
 
 /// A section's value as JSON: its fields, the inputs by their names, every `f32` by its shortest decimal.
@@ -14,7 +14,7 @@ fn to_json(settings: &Settings) -> anyhow::Result<Value> {
     fn tidy(v: &mut Value) {
         match v {
             Value::Number(n) if n.is_f64() => {
-                let written = n.as_f64().map(crate::numbers::as_written);
+                let written = n.as_f64().map(crate::input::numbers::as_written);
                 if let Some(short) = written.and_then(serde_json::Number::from_f64) {
                     *n = short;
                 }

@@ -10,10 +10,10 @@ use ringpod_core::kinematics::{AxisKind, Mechanism, MotionState, MultiTurn, Payl
 use serde::Serialize;
 
 use crate::error::{CliError, EXIT_CHECK_FAILED};
+use crate::input::table::{self, InputError};
+use crate::out::plot::{self, Panel, Series, TimePlot};
 use crate::out::Outcome;
-use crate::plot::{self, Panel, Series, TimePlot};
 use crate::rig::Drive;
-use crate::table::{self, InputError};
 
 /// What `loads --input` works on.
 pub struct Job<'a> {
@@ -124,7 +124,7 @@ pub struct Profile {
 /// Inverse dynamics along the pose CSV at `input`.
 pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -> Result<Profile, CliError> {
     let bad = |reason: String| CliError::BadNumbers { what: "input", reason };
-    let text = crate::files::read_text(input, crate::files::DATA_LIMIT)
+    let text = crate::input::files::read_text(input, crate::input::files::DATA_LIMIT)
         .map_err(|e| bad(format!("{}: {e}", input.display())))?;
     let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
     let (rows, errors) = table::read(&text, &columns).map_err(bad)?;
@@ -151,7 +151,7 @@ pub fn profile_of(
     let (rows, garbage): (Vec<_>, Vec<_>) = rows.iter().cloned().partition(|r| {
         r.2.to_array()
             .iter()
-            .all(|c| c.is_finite() && c.abs() <= crate::numbers::MAX_TURNING)
+            .all(|c| c.is_finite() && c.abs() <= crate::input::numbers::MAX_TURNING)
     });
     let garbage: Vec<InputError> = garbage
         .into_iter()

@@ -10,9 +10,9 @@ use ringpod_core::kinematics::Pose;
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
-use crate::mechanism::{AnyMechanism, Selected};
-use crate::plot::{self, Panel, Series, TimePlot};
-use crate::table::{self, InputError};
+use crate::analysis::mechanism::{AnyMechanism, Selected};
+use crate::input::table::{self, InputError};
+use crate::out::plot::{self, Panel, Series, TimePlot};
 
 /// The columns of a telemetry file.
 pub const TELEMETRY_COLUMNS: [&str; 7] = ["t", "ax", "ay", "az", "wx", "wy", "wz"];
@@ -39,7 +39,7 @@ pub fn load_config(path: Option<&Path>) -> anyhow::Result<CueConfig> {
     let Some(path) = path else {
         return Ok(CueConfig::default());
     };
-    let text = crate::files::read_text(path, crate::files::CONFIG_LIMIT)
+    let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let config: CueConfig = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     config
@@ -76,7 +76,7 @@ pub struct Options<'a> {
 /// Runs the command; returns the summary as text and the exit code.
 pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
     let config = load_config(args.config)?;
-    let text = crate::files::read_text(args.input, crate::files::DATA_LIMIT)
+    let text = crate::input::files::read_text(args.input, crate::input::files::DATA_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
     let (rows, mut errors) =
         table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;

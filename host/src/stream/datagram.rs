@@ -61,11 +61,11 @@ pub fn parse_pose(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
     if let Some(i) = pose.iter().position(|x| !(*x as f32).is_finite()) {
         return Err(format!("value {} is not a finite number (in single precision)", i + 1));
     }
-    if pose[5].abs() > crate::numbers::MAX_TURNING {
+    if pose[5].abs() > crate::input::numbers::MAX_TURNING {
         return Err(format!(
             "a yaw of {} rad is beyond {} rad either way",
-            crate::numbers::readable(pose[5]),
-            crate::numbers::readable(crate::numbers::MAX_TURNING)
+            crate::input::numbers::readable(pose[5]),
+            crate::input::numbers::readable(crate::input::numbers::MAX_TURNING)
         ));
     }
     Ok(Pose::from_array(pose))
@@ -81,10 +81,10 @@ pub fn parse_telemetry(bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), St
     };
     // A time that is not a time would become the reference of every later sample's interval, and a value that is
     // not finite would reach the filters on a first sample: both are unreadable.
-    if t.is_some_and(|t| !t.is_finite() || t.abs() > crate::table::MAX_TIME_S) {
+    if t.is_some_and(|t| !t.is_finite() || t.abs() > crate::input::table::MAX_TIME_S) {
         return Err(format!(
             "its time is not a time (a finite number of seconds, at most {} either way)",
-            crate::numbers::readable(crate::table::MAX_TIME_S)
+            crate::input::numbers::readable(crate::input::table::MAX_TIME_S)
         ));
     }
     if v.iter().any(|x| !x.is_finite()) {

@@ -9,9 +9,9 @@ use ringpod_core::kinematics::{
 };
 use serde::Serialize;
 
+use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
-use crate::mechanism::{AnyMechanism, Selected};
-use crate::numbers;
+use crate::input::numbers;
 pub use crate::out::Outcome;
 
 /// What every analysis command is asked about: the platform (a preset by name, or a rig file) and how to answer.
@@ -428,7 +428,7 @@ pub fn loads(args: &LoadsOptions) -> Result<Outcome, CliError> {
     let names = m.axis_names();
     if let Some(input) = args.input {
         let inertia = numbers::inertia(args.inertia)?;
-        let job = crate::demand::Job {
+        let job = crate::analysis::demand::Job {
             name: &name,
             ring,
             names: &names,
@@ -438,7 +438,7 @@ pub fn loads(args: &LoadsOptions) -> Result<Outcome, CliError> {
             inertia,
             plot: args.plot,
         };
-        return crate::demand::run(&job, common.json);
+        return crate::analysis::demand::run(&job, common.json);
     }
     let pose = pose_arg(common, home, m.characteristic_length(), args.pose, "pose")?;
     let q = m.inverse(&pose)?;

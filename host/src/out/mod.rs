@@ -1,4 +1,6 @@
-//! What a command gives back: the text it prints and its exit code.
+//! What a command gives back: the text it prints and its exit code, and the pictures it draws.
+
+pub mod plot;
 
 /// What a command prints and its exit code.
 pub struct Outcome {

@@ -12,7 +12,7 @@ use plotters::style::{register_font, FontStyle};
 /// The font every picture's text uses.
 pub const FONT: &str = "sans-serif";
 
-static FONT_DATA: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static FONT_DATA: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 fn register_fonts() {
     static ONCE: Once = Once::new();

@@ -10,7 +10,7 @@ use ringpod_core::kinematics::geometry::DEG;
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 
-use crate::plot::{self, Picture};
+use crate::out::plot::{self, Picture};
 
 /// What limits a grid point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -106,7 +106,7 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
         anyhow::bail!("--z is the height of the xy section; the xz section is vertical and spans every height");
     }
     let z0 = args.z.unwrap_or(home[2]);
-    crate::numbers::length_in_range("z", z0, r)?;
+    crate::input::numbers::length_in_range("z", z0, r)?;
     if !(10..=2000).contains(&args.cells) {
         anyhow::bail!("--cells {} is out of range (10 to 2000)", args.cells);
     }

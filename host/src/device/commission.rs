@@ -9,10 +9,11 @@ use ringpod_core::protocol::InputReport;
 use ringpod_core::safety::debounce::InputBit;
 
 use ringpod_core::kinematics::AxisKind;
-use ringpod_core::protocol::{HostMessage, Settings, SettingsKind};
+use ringpod_core::protocol::endpoints::{Buzz, Jog};
+use ringpod_core::protocol::{Settings, SettingsKind};
 use ringpod_core::safety::State;
 
-use crate::client::{Client, Transport};
+use crate::link::client::{Client, Transport};
 
 /// The inputs in bit order, with their names.
 pub fn names() -> Vec<(InputBit, String)> {
@@ -111,11 +112,11 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
     };
     let motor = axes[usize::from(axis)];
     let per_unit = f64::from(motor.steps_per_unit) * if motor.reverse { -1.0 } else { 1.0 };
-    let (message, what) = if buzz {
+    let (jog, what) = if buzz {
         if words.len() != 1 {
             anyhow::bail!(usage);
         }
-        (HostMessage::Buzz { axis }, "buzzed".to_owned())
+        (None, "buzzed".to_owned())
     } else {
         let [_, distance] = words else { anyhow::bail!(usage) };
         let d: f64 = distance
@@ -130,13 +131,13 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
             anyhow::bail!("{d} {unit} is out of range");
         }
         let steps = steps.round() as i32;
-        (
-            HostMessage::Jog { axis, steps },
-            format!("jogged {d} {unit} ({steps} steps)"),
-        )
+        (Some(Jog { axis, steps }), format!("jogged {d} {unit} ({steps} steps)"))
     };
     let before = client.status()?.steps;
-    client.ack(message)?;
+    match jog {
+        Some(jog) => client.call(jog)?,
+        None => client.call(Buzz(axis))?,
+    }
     let status = client.wait_for(Duration::from_secs(120), |s| s.state != State::Jogging)?;
     if let State::Fault(reason, _) = status.state {
         anyhow::bail!("axis {} {what} into a fault: {reason}", axis + 1);

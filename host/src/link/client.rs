@@ -6,6 +6,9 @@ use std::time::Duration;
 
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::motion::{Accepted, RejectReason};
+use ringpod_core::protocol::endpoints::{
+    Do, Endpoint, GetInputs, GetRig, GetSettings, GetStatus, Hello, Restart, SetRig, SetSettings, TelemetryOn,
+};
 use ringpod_core::protocol::{
     self, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, RigRecord, RigSource,
     Settings, SettingsKind, Status, Telemetry, PROTOCOL_VERSION,
@@ -131,7 +134,7 @@ impl<T: Transport> Client<T> {
 
     /// Asks the device for telemetry on this connection (or to stop it).
     pub fn telemetry(&mut self, on: bool) -> Result<(), ClientError> {
-        self.ack(HostMessage::Telemetry(on))
+        self.call(TelemetryOn(on))
     }
 
     /// The telemetry samples that arrived since the last call, oldest first (reads what the transport has).
@@ -187,13 +190,14 @@ impl<T: Transport> Client<T> {
         self.wait_response(id)
     }
 
-    /// Sends a command that answers with an Ack; a Nack is [`ClientError::Device`].
-    pub fn ack(&mut self, body: HostMessage) -> Result<(), ClientError> {
-        match self.request(body)? {
-            DeviceMessage::Ack => Ok(()),
-            DeviceMessage::Nack(reason) => Err(ClientError::Device(reason)),
-            other => Err(ClientError::Unexpected(format!("{other:?}"))),
-        }
+    /// Sends a request and takes the answer its [`Endpoint`] names; a Nack is [`ClientError::Device`], any other
+    /// message [`ClientError::Unexpected`].
+    pub fn call<E: Endpoint>(&mut self, endpoint: E) -> Result<E::Answer, ClientError> {
+        let message = self.request(endpoint.request())?;
+        endpoint.answer(message).map_err(|other| match other {
+            DeviceMessage::Nack(reason) => ClientError::Device(reason),
+            other => ClientError::Unexpected(format!("{other:?}")),
+        })
     }
 
     /// Version handshake; returns the geometry the device drives.
@@ -209,9 +213,7 @@ impl<T: Transport> Client<T> {
         self.timeout = per_try;
         let mut tries = Vec::new();
         let answer = loop {
-            let id = match self.send(HostMessage::Hello {
-                version: PROTOCOL_VERSION,
-            }) {
+            let id = match self.send(Hello.request()) {
                 Ok(id) => id,
                 Err(e) => break Err(e),
             };
@@ -225,96 +227,83 @@ impl<T: Transport> Client<T> {
         self.timeout = timeout;
         self.pump()?;
         self.inbox.retain(|r| !tries.contains(&r.id));
-        match answer? {
-            DeviceMessage::Hello { version, preset, axes } if version == PROTOCOL_VERSION => {
-                Ok(Device { preset, axes })
-            }
-            DeviceMessage::Hello { version, .. }
-            | DeviceMessage::Nack(NackReason::VersionMismatch { device: version }) => {
-                Err(ClientError::VersionMismatch {
-                    host: PROTOCOL_VERSION,
-                    device: version,
+        let version = match Hello.answer(answer?) {
+            Ok(hello) if hello.version == PROTOCOL_VERSION => {
+                return Ok(Device {
+                    preset: hello.preset,
+                    axes: hello.axes,
                 })
             }
-            other => Err(ClientError::Unexpected(format!("{other:?}"))),
-        }
+            Ok(hello) => hello.version,
+            Err(DeviceMessage::Nack(NackReason::VersionMismatch { device })) => device,
+            Err(other) => return Err(ClientError::Unexpected(format!("{other:?}"))),
+        };
+        Err(ClientError::VersionMismatch {
+            host: PROTOCOL_VERSION,
+            device: version,
+        })
     }
 
     /// Power up (logic, then power).
     pub fn enable(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Command(Command::Enable))
+        self.call(Do(Command::Enable))
     }
     /// Shut down.
     pub fn disable(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Command(Command::Disable))
+        self.call(Do(Command::Disable))
     }
     /// Home all axes.
     pub fn home(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Command(Command::Home))
+        self.call(Do(Command::Home))
     }
     /// Start taking setpoints.
     pub fn start(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Command(Command::Start))
+        self.call(Do(Command::Start))
     }
     /// Ramp to rest.
     pub fn stop(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Command(Command::Stop))
+        self.call(Do(Command::Stop))
     }
     /// Clear a latched fault.
     pub fn clear(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Command(Command::ClearFault))
+        self.call(Do(Command::ClearFault))
     }
 
     /// A section of settings on the device as the next start runs it (what runs now, for a live section), and
     /// whether that differs from what runs now.
     pub fn settings(&mut self, kind: SettingsKind) -> Result<(Settings, bool), ClientError> {
-        match self.request(HostMessage::GetSettings(kind))? {
-            DeviceMessage::Settings { settings, pending } if settings.kind() == kind => Ok((settings, pending)),
-            DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
-            other => Err(ClientError::Unexpected(format!("{other:?}"))),
-        }
+        self.call(GetSettings(kind)).map(|a| (a.settings, a.pending))
     }
 
     /// Changes a section (refused while anything may move, or with the cause the device names).
     pub fn set_settings(&mut self, settings: Settings) -> Result<(), ClientError> {
-        self.ack(HostMessage::SetSettings(settings))
+        self.call(SetSettings(settings))
     }
 
     /// The rig the device runs, where it came from, and whether another waits for the next start.
     pub fn rig(&mut self) -> Result<(RigRecord, RigSource, bool), ClientError> {
-        match self.request(HostMessage::GetRig)? {
-            DeviceMessage::Rig { rig, source, pending } => Ok((rig, source, pending)),
-            DeviceMessage::Nack(r) => Err(ClientError::Device(r)),
-            other => Err(ClientError::Unexpected(format!("{other:?}"))),
-        }
+        self.call(GetRig).map(|a| (a.rig, a.source, a.pending))
     }
 
     /// Stores a rig for the next start (refused unless `Off`, or with the cause the checks give).
     pub fn set_rig(&mut self, rig: RigRecord) -> Result<(), ClientError> {
-        self.ack(HostMessage::SetRig(rig))
+        self.call(SetRig(rig))
     }
 
     /// Restarts the controller once everything is stored (refused unless `Off`). The device is gone for a moment:
     /// a new connection starts with `hello`.
     pub fn restart(&mut self) -> Result<(), ClientError> {
-        self.ack(HostMessage::Restart)
+        self.call(Restart)
     }
 
     /// The device's status.
     pub fn status(&mut self) -> Result<Status, ClientError> {
-        match self.request(HostMessage::GetStatus)? {
-            DeviceMessage::Status(s) => Ok(s),
-            other => Err(ClientError::Unexpected(format!("{other:?}"))),
-        }
+        self.call(GetStatus)
     }
 
     /// Every input's level and debounced state.
     pub fn inputs(&mut self) -> Result<InputReport, ClientError> {
-        match self.request(HostMessage::GetInputs)? {
-            DeviceMessage::Inputs(r) => Ok(r),
-            DeviceMessage::Nack(reason) => Err(ClientError::Device(reason)),
-            other => Err(ClientError::Unexpected(format!("{other:?}"))),
-        }
+        self.call(GetInputs)
     }
 
     /// Polls the status every 10 ms until `done` says so, or `limit` passes.
@@ -357,7 +346,7 @@ pub fn setpoint_answer(answer: DeviceMessage) -> Result<Result<Accepted, RejectR
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::transport::SimDevice;
+    use crate::link::transport::SimDevice;
 
     /// The simulated device behind a link that loses the first `lose` frames the host sends, and counts the time.
     struct Lossy {

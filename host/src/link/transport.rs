@@ -12,7 +12,7 @@ use ringpod_core::sim::RamFlash;
 use ringpod_core::sim::{Plant, Rig, TRAINER_MODEL_PARKED};
 use ringpod_core::store;
 
-use crate::client::Transport;
+use crate::link::client::Transport;
 
 /// USB CDC serial to a board.
 pub struct Serial {

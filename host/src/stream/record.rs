@@ -13,7 +13,7 @@ use ringpod_core::kinematics::Pose;
 use ringpod_core::protocol::{Telemetry, TelemetryFlags};
 use ringpod_core::safety::State;
 
-use crate::plot::{self, Event, Panel, Series, TimePlot};
+use crate::out::plot::{self, Event, Panel, Series, TimePlot};
 
 /// The record's columns.
 pub const COLUMNS: [&str; 28] = [
@@ -135,7 +135,7 @@ struct Run {
 }
 
 fn read(path: &Path) -> anyhow::Result<Run> {
-    let text = crate::files::read_text(path, crate::files::DATA_LIMIT)
+    let text = crate::input::files::read_text(path, crate::input::files::DATA_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
@@ -190,7 +190,7 @@ fn read(path: &Path) -> anyhow::Result<Run> {
     for series in [&mut run.commanded, &mut run.target] {
         for k in 3..6 {
             let mut angle: Vec<f64> = series.iter().map(|p| p[k]).collect();
-            crate::demand::unwrap(&mut angle);
+            crate::analysis::demand::unwrap(&mut angle);
             for (p, a) in series.iter_mut().zip(angle) {
                 p[k] = a;
             }

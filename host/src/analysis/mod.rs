@@ -1,0 +1,9 @@
+//! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `reactions`, `workspace` and
+//! `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
+
+pub mod cue;
+pub mod demand;
+pub mod kinematics;
+pub mod mechanism;
+pub mod reactions;
+pub mod workspace;

@@ -1,0 +1,160 @@
+//! Talking to one controller: `device ACTION`, `monitor`, `simulate --pty` and `ports`.
+
+pub mod commission;
+pub mod monitor;
+pub mod settings;
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use ringpod_core::protocol::RigSource;
+use ringpod_core::safety::State;
+
+use crate::link::{self, client::Client, transport, Target};
+use crate::signals::Signals;
+
+/// What `ringpod device` does.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Action {
+    /// Print the status and the rig the board runs.
+    Status,
+    Enable,
+    Disable,
+    /// Home, waiting for the supplies first and for the homing's end.
+    Home,
+    Start,
+    Stop,
+    Clear,
+    /// The settings: the words after `config` (nothing, `get SECTION[.PATH]`, `set SECTION.PATH VALUE`).
+    Config(Vec<String>),
+    /// Every input, once or watched until a signal.
+    Inputs {
+        watch: bool,
+    },
+    /// `jog AXIS DISTANCE`, the words as given.
+    Jog(Vec<String>),
+    /// `buzz AXIS`, the words as given.
+    Buzz(Vec<String>),
+    /// Store a rig file on the device for its next start.
+    LoadRig(PathBuf),
+    /// The rig the device runs, as a rig file.
+    ShowRig,
+    /// Restart once everything is stored.
+    Restart,
+}
+
+/// `ringpod device ACTION`: 0 when done; a signal ends `inputs --watch` with 128 + its number.
+pub fn run(target: &Target, action: &Action) -> anyhow::Result<u8> {
+    let mut client = Client::new(link::connect(target, false)?);
+    client.hello()?;
+    let mut out = std::io::stdout();
+    // A closed stdout (`| head`) is not an error of the device's.
+    let text = match action {
+        Action::Status => status(&mut client)?,
+        Action::Enable => status_after(&mut client, |c| c.enable())?,
+        Action::Disable => status_after(&mut client, |c| c.disable())?,
+        Action::Start => status_after(&mut client, |c| c.start())?,
+        Action::Stop => status_after(&mut client, |c| c.stop())?,
+        Action::Clear => status_after(&mut client, |c| c.clear())?,
+        Action::Home => status_after(&mut client, home)?,
+        Action::Jog(words) => commission::jog(&mut client, words, false)?,
+        Action::Buzz(words) => commission::jog(&mut client, words, true)?,
+        Action::Inputs { watch: true } => {
+            // Watched until a signal, which is its normal end: 128 + the signal, as a shell reports it.
+            let signals = Signals::install()?;
+            commission::inputs(&mut client, true, &|| signals.received())?;
+            return Ok(signals.exit_code());
+        }
+        Action::Inputs { watch: false } => {
+            commission::inputs(&mut client, false, &|| false)?;
+            return Ok(0);
+        }
+        Action::LoadRig(file) => crate::rig::device::load(&mut client, file)?,
+        Action::ShowRig => crate::rig::device::show(&mut client)?,
+        Action::Restart => crate::rig::device::restart(&mut client)?,
+        Action::Config(words) => serde_json::to_string_pretty(&settings::run(&mut client, words)?)?,
+    };
+    let _ = writeln!(out, "{text}");
+    Ok(0)
+}
+
+/// Homes: right after `device enable` the supplies may still be coming up, so it waits for them (as `stream`
+/// does) instead of being refused for the state, then waits for the homing's end.
+fn home<T: link::client::Transport>(client: &mut Client<T>) -> Result<(), link::client::ClientError> {
+    client.wait_for(std::time::Duration::from_secs(5), |s| {
+        !matches!(s.state, State::LogicOn | State::PowerOn { settled: false })
+    })?;
+    client.home()?;
+    client
+        .wait_for(std::time::Duration::from_secs(120), |s| {
+            !matches!(s.state, State::Homing)
+        })
+        .map(|_| ())
+}
+
+/// Does a command and then gives the status.
+fn status_after<T: link::client::Transport>(
+    client: &mut Client<T>,
+    command: impl FnOnce(&mut Client<T>) -> Result<(), link::client::ClientError>,
+) -> anyhow::Result<String> {
+    command(client)?;
+    status(client)
+}
+
+/// The status as JSON, and the rig the board runs: where it came from and whether another waits for the next
+/// start (a refused or unreadable stored rig is warned about on stderr).
+fn status<T: link::client::Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
+    let status = client.status()?;
+    let (rig, source, pending) = client.rig()?;
+    if let RigSource::Refused(_) | RigSource::Unreadable = source {
+        eprintln!("warning: {source}");
+    }
+    let mut json = serde_json::to_value(status)?;
+    json["rig"] = serde_json::json!({ "name": rig.name(), "source": source.to_string(), "pending": pending });
+    Ok(serde_json::to_string_pretty(&json)?)
+}
+
+/// `ringpod monitor`: until `frames` frames are drawn or a signal (then 128 + its number).
+pub fn monitor(target: &Target, frames: Option<u64>) -> anyhow::Result<u8> {
+    let mut client = Client::new(link::connect(target, true)?);
+    let source = match target {
+        Target::Port(port) => port.clone(),
+        Target::Sim => "the simulated controller".to_owned(),
+    };
+    let signals = Signals::install()?;
+    monitor::run(&mut client, &source, frames, &|| signals.received())?;
+    Ok(if signals.received() { signals.exit_code() } else { 0 })
+}
+
+/// `ringpod simulate --pty [--geometry RIG.toml]`: serves until a signal, and exits with 128 + its number.
+pub fn simulate(geometry: Option<&std::path::Path>) -> anyhow::Result<u8> {
+    let device = match geometry {
+        Some(path) => transport::SimDevice::for_rig(true, &crate::rig::load(path)?)?,
+        None => transport::SimDevice::new(true),
+    };
+    let signals = Signals::install()?;
+    link::pty::serve(device, &|| signals.received())?;
+    eprintln!("ringpod: simulator stopped by {}", signals.name());
+    Ok(signals.exit_code())
+}
+
+/// `ringpod ports`: the serial ports this machine has, and what each is.
+pub fn ports() -> anyhow::Result<u8> {
+    let ports = serialport::available_ports()?;
+    let mut out = std::io::stdout();
+    if ports.is_empty() {
+        let _ = writeln!(out, "no serial ports found");
+    }
+    for p in ports {
+        let kind = match p.port_type {
+            serialport::SerialPortType::UsbPort(u) => {
+                format!("USB {:04x}:{:04x} {}", u.vid, u.pid, u.product.unwrap_or_default())
+            }
+            serialport::SerialPortType::PciPort => "PCI".into(),
+            serialport::SerialPortType::BluetoothPort => "Bluetooth".into(),
+            serialport::SerialPortType::Unknown => "unknown".into(),
+        };
+        let _ = writeln!(out, "{}  {kind}", p.port_name);
+    }
+    Ok(0)
+}

@@ -1,0 +1,263 @@
+//! `ringpod stream` as a job: where its poses come from, which device follows them, what is checked first and how
+//! the end is reported. The command line builds a [`Job`]; [`run`] opens the source and the device, checks loads,
+//! streams and prints the report, and its exit code is [`super::exit`]'s.
+
+use std::io::Write;
+use std::net::{IpAddr, SocketAddr};
+use std::path::PathBuf;
+
+use super::{datagram, exit, Motion, Options, Report, Source, UdpSource};
+use crate::input::{files, numbers};
+use crate::link::{self, client};
+use crate::signals::Signals;
+
+/// Where a stream's poses come from.
+pub enum Input {
+    /// A built-in motion for `seconds` at `rate_hz` setpoints per second.
+    Motion { motion: Motion, seconds: f64, rate_hz: f64 },
+    /// A CSV pose file.
+    File { path: PathBuf, degrees: bool },
+    /// UDP datagrams: poses or vehicle telemetry.
+    Udp {
+        /// The address to listen on.
+        addr: SocketAddr,
+        /// What a datagram holds.
+        holds: Datagrams,
+        /// Only datagrams from this sender count.
+        from: Option<IpAddr>,
+        /// Seconds without a readable datagram after which the stream ends.
+        idle: f64,
+    },
+}
+
+/// What the datagrams of a UDP source hold.
+pub enum Datagrams {
+    /// Six numbers, a pose.
+    Poses { degrees: bool },
+    /// Vehicle telemetry in a format, cued by the washout of a cueing file (or the defaults).
+    Telemetry {
+        format: datagram::TelemetryFormat,
+        cue_config: Option<PathBuf>,
+    },
+}
+
+/// The device that follows: a board, or the simulated controller (of the trainer model or a rig file's platform).
+pub enum Device {
+    Port(String),
+    Sim { fast: bool, rig: Option<PathBuf> },
+}
+
+/// The payload `--check-loads` predicts the drive demand for.
+pub struct LoadsCheck {
+    /// kg, as given (checked here).
+    pub mass: f64,
+    /// `Ixx,Iyy,Izz` as given, or none.
+    pub inertia: Option<String>,
+}
+
+/// One `ringpod stream`.
+pub struct Job {
+    pub input: Input,
+    pub device: Device,
+    pub check_loads: Option<LoadsCheck>,
+    pub options: Options,
+    /// The run record to write.
+    pub record: Option<PathBuf>,
+    /// One JSON report instead of the summary line.
+    pub report_json: bool,
+}
+
+/// A number of a stream option: finite, above 0 and at most `max`.
+fn positive(name: &str, v: f64, max: f64) -> anyhow::Result<f64> {
+    if v.is_finite() && v > 0.0 && v <= max {
+        Ok(v)
+    } else {
+        anyhow::bail!(
+            "--{name} {}: must be a number of at most {max:e}, above 0",
+            numbers::readable(v)
+        )
+    }
+}
+
+/// Opens the source: its poses, and the lines of a file that could not be read (already printed).
+fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
+    Ok(match input {
+        Input::Udp {
+            addr,
+            holds,
+            from,
+            idle,
+        } => {
+            let decoder = match holds {
+                Datagrams::Poses { degrees } => datagram::Decoder::Poses { degrees: *degrees },
+                Datagrams::Telemetry { format, cue_config } => {
+                    let config = crate::analysis::cue::load_config(cue_config.as_deref())?;
+                    let washout = ringpod_core::cueing::Washout::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+                    datagram::Decoder::Telemetry {
+                        format: *format,
+                        washout: Box::new(washout),
+                        // The device's home pose, once the stream has asked for its rig.
+                        neutral: None,
+                        last: None,
+                        gaps: 0,
+                    }
+                }
+            };
+            let idle = positive("udp-idle", *idle, 1e6)?;
+            let socket = std::net::UdpSocket::bind(addr).map_err(|e| anyhow::anyhow!("{addr}: {e}"))?;
+            let source = UdpSource {
+                socket,
+                decoder,
+                idle: std::time::Duration::from_secs_f64(idle),
+                from: *from,
+            };
+            (Source::Udp(source), Vec::new())
+        }
+        Input::File { path, degrees } => {
+            let text =
+                files::read_text(path, files::DATA_LIMIT).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let (poses, errors) =
+                super::read_csv(&text, *degrees).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            for e in &errors {
+                eprintln!("{}: line {}: {}", path.display(), e.line, e.reason);
+            }
+            (Source::Poses(poses), errors)
+        }
+        Input::Motion {
+            motion,
+            seconds,
+            rate_hz,
+        } => (
+            Source::Motion {
+                motion: *motion,
+                seconds: positive("duration", *seconds, 1e9)?,
+                rate_hz: positive("rate", *rate_hz, 10_000.0)?,
+            },
+            Vec::new(),
+        ),
+    })
+}
+
+/// Whether the motion's drive demand on the platform the device runs is within its drives (printed either way).
+fn loads_keep_up<T: client::Transport>(
+    check: &LoadsCheck,
+    source: &Source,
+    client: &mut client::Client<T>,
+    rig: Option<&crate::rig::Rig>,
+) -> anyhow::Result<bool> {
+    let payload = ringpod_core::kinematics::Payload {
+        mass: numbers::mass(check.mass)?,
+        inertia: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::from(numbers::inertia(
+            check.inertia.as_deref(),
+        )?)),
+    };
+    let platform = super::loads_platform(client, rig)?;
+    let check = super::check_loads(source, &payload, &platform)?;
+    eprint!("{}", check.text);
+    Ok(check.keeps_up)
+}
+
+/// Runs a stream: the exit codes of [`exit`].
+pub fn run(job: &Job) -> anyhow::Result<u8> {
+    let signals = Signals::install()?;
+    let (source, input_errors) = open(&job.input)?;
+    let (rig, fast) = match &job.device {
+        Device::Sim { rig: Some(path), fast } => (Some(crate::rig::load(path)?), *fast),
+        Device::Sim { fast, .. } => (None, *fast),
+        Device::Port(_) => (None, false),
+    };
+    let transport = match (&job.device, &rig) {
+        (_, Some(r)) => link::transport::AnyTransport::Sim(Box::new(link::transport::SimDevice::for_rig(!fast, r)?)),
+        (Device::Port(port), None) => link::connect(&link::Target::Port(port.clone()), true)?,
+        (Device::Sim { .. }, None) => link::connect(&link::Target::Sim, !fast)?,
+    };
+    let mut client = client::Client::new(transport);
+    client.cancel = Some(signals.flag());
+    // Checked on the platform the device runs, before it powers up.
+    if let Some(check) = &job.check_loads {
+        if !loads_keep_up(check, &source, &mut client, rig.as_ref())? {
+            eprintln!("ringpod: the motion asks more than the drives give (--check-loads): not streamed");
+            return Ok(exit::NOT_STARTED);
+        }
+    }
+    let recorder = match &job.record {
+        Some(path) => Some((
+            super::record::Recorder::create(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
+            path.display().to_string(),
+        )),
+        None => None,
+    };
+    let report = match super::run(
+        &mut client,
+        source,
+        input_errors,
+        &job.options,
+        fast,
+        &|| signals.received(),
+        recorder,
+    ) {
+        Ok(mut report) => {
+            if report.exit_code == exit::INTERRUPTED {
+                report.exit_code = signals.exit_code();
+                report.reason = Some(format!("interrupted by {}", signals.name()));
+            }
+            report
+        }
+        Err(client::ClientError::Interrupted) => {
+            eprintln!("ringpod: interrupted by {} before the stream started", signals.name());
+            return Ok(signals.exit_code());
+        }
+        Err(e) => {
+            eprintln!("ringpod: the stream could not start: {e}");
+            return Ok(exit::NOT_STARTED);
+        }
+    };
+    print(&report, job.report_json)
+}
+
+/// Prints the report (the bar drew on stderr; the report goes to stdout) and gives the run's exit code.
+fn print(report: &Report, json: bool) -> anyhow::Result<u8> {
+    // A closed stdout (`| head -c1`) loses the summary, not the run's exit code.
+    let mut out = std::io::stdout();
+    if json {
+        let _ = writeln!(out, "{}", serde_json::to_string_pretty(report)?);
+    } else {
+        let rejected: u32 = report.rejected.values().sum();
+        let _ = writeln!(
+            out,
+            "{}: {} setpoints sent, {} applied ({} limited on the host, {} on the device), {} refused; final state {}; steps {:?}",
+            report.outcome,
+            report.setpoints_sent,
+            report.setpoints_applied,
+            report.limited.host,
+            report.limited.device,
+            rejected,
+            report.state,
+            report.final_steps
+        );
+        for (reason, n) in &report.rejected {
+            let _ = writeln!(out, "  refused {reason}: {n}");
+        }
+    }
+    if let Some(reason) = &report.reason {
+        eprintln!("ringpod: {reason}");
+    }
+    if let Some(record) = &report.record {
+        match &record.error {
+            Some(e) => {
+                eprintln!("ringpod: the record {} could not be written: {e}", record.path);
+                if report.exit_code == exit::FOLLOWED {
+                    return Ok(exit::RECORD_FAILED);
+                }
+            }
+            None if !json => {
+                eprintln!(
+                    "recorded {} rows to {} ({} dropped)",
+                    record.rows, record.path, record.dropped
+                )
+            }
+            None => {}
+        }
+    }
+    Ok(report.exit_code)
+}
