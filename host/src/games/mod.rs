@@ -36,7 +36,8 @@
 //! `OutSim Opts`) starts with `LFST` and is LFS's, not Forza's or Codemasters'. No size is shared between the
 //! headerless rules 5 to 7. An F1 header is checked before the bare sizes because it is three fields at once; a
 //! Forza packet cannot match it (its first word, `IsRaceOn`, is 0 or 1) and a Codemasters or classic OutSim
-//! packet only if its first float's low bytes happen to spell the format and year (about one in 2^27). An
+//! packet only if its first float's low bytes happen to spell a format, its year and a
+//! packet id (about one packet in a hundred million). An
 //! `OutSimPack2` without its header bit, or Codemasters' other extradata modes, are not recognised: set the header
 //! bit, or extradata 3.
 

@@ -1,6 +1,6 @@
 //! Live for Speed's `OutSimPack2`: the OutSim packet whose sections are chosen by `OutSim Opts` in `cfg.txt`.
 //!
-//! Source: Live for Speed's `docs/OutSimPack.txt` (0.7 series; the `OSO_EXTRA_1` bit from 0.7E on) and
+//! Source: Live for Speed's `docs/OutSimPack.txt` (0.7 series; later versions add the `OSO_EXTRA_1` bit) and
 //! `docs/InSim.txt`, section "OutSim - MOTION SIMULATOR SUPPORT". `OutSim Opts` is hexadecimal; LFS writes the
 //! sections in this order, each only when its bit is set, little-endian, packed:
 //!
