@@ -4,6 +4,7 @@ mod analysis;
 mod cli;
 mod device;
 mod error;
+mod games;
 mod input;
 mod link;
 mod out;

@@ -1,0 +1,219 @@
+//! EA SPORTS F1 23, F1 24 and F1 25: the motion packet of the player's car.
+//!
+//! Source: EA's "F1 23 UDP Specification", "F1 24 UDP Specification" and "F1 25 UDP Specification" (the EA forums'
+//! "General Discussion" threads, answers.ea.com/t5/General-Discussion/F1-23-UDP-Specification/td-p/12632888 and its
+//! successors, with EA's C++ header "C++ structures for F1 25 UDP specification"): sections "Packet Header" and
+//! "Motion Packet". Little-endian, packed:
+//!
+//! | bytes | field | |
+//! |---|---|---|
+//! | 0-1 | `m_packetFormat` | u16: 2023, 2024 or 2025 |
+//! | 2 | `m_gameYear` | u8: 23, 24 or 25 |
+//! | 3, 4, 5 | `m_gameMajorVersion`, `m_gameMinorVersion`, `m_packetVersion` | u8 |
+//! | 6 | `m_packetId` | u8: 0 is motion |
+//! | 7-14 | `m_sessionUID` | u64 |
+//! | 15-18 | `m_sessionTime` | f32, s |
+//! | 19-22, 23-26 | `m_frameIdentifier`, `m_overallFrameIdentifier` | u32 |
+//! | 27 | `m_playerCarIndex` | u8, index into the cars |
+//! | 28 | `m_secondaryPlayerCarIndex` | u8 |
+//! | 29 + 60 i | `CarMotionData` of car i (22 cars) | 1349 bytes in all |
+//!
+//! `CarMotionData` (60 bytes): `m_worldPositionX/Y/Z` (3 f32, m), `m_worldVelocityX/Y/Z` (3 f32, m/s),
+//! `m_worldForwardDirX/Y/Z` and `m_worldRightDirX/Y/Z` (6 i16, normalised: divide by 32767),
+//! `m_gForceLateral`, `m_gForceLongitudinal`, `m_gForceVertical` (3 f32, g), `m_yaw`, `m_pitch`, `m_roll` (3 f32,
+//! rad). F1 23, 24 and 25 use this same layout; F1 22 and earlier (format 2022 and below) had another header and
+//! are refused, as is every other packet id (the motion packet is "only sent while player is in control"; the
+//! extended motion packet, id 13, carries the player's angular velocity but no g-forces).
+//!
+//! ## Conversion
+//!
+//! The specification names the g-force components without their signs or whether gravity is in them. ringpod takes
+//! them as the car's acceleration in g without gravity, in the car's axes, lateral positive towards the car's right
+//! (as `m_worldRightDir`), longitudinal positive forwards, vertical positive up, and adds gravity's reaction from the
+//! direction vectors (the game's world y is up):
+//!
+//! | ringpod | from |
+//! |---|---|
+//! | force x | `g * m_gForceLongitudinal + g * forward.y` |
+//! | force y | `-g * m_gForceLateral - g * right.y` |
+//! | force z | `g * m_gForceVertical + g * sqrt(1 - forward.y^2 - right.y^2)` |
+//! | rate | 0: the motion packet has no angular rates (the cue comes from the forces alone) |
+//! | time | `m_sessionTime` |
+//!
+//! The signs of the three g-force components are assumed, not published: check them with a capture (accelerating
+//! must give force x > 0, a left turn force y > 0).
+
+use super::{add, gravity_from_axes, Format, Le, Sample, Telemetry, Unreadable, G};
+
+/// The header's size.
+pub const HEADER: usize = 29;
+/// One car's motion data.
+pub const CAR: usize = 60;
+/// Cars in the packet.
+pub const CARS: usize = 22;
+/// The motion packet's size.
+pub const MOTION_SIZE: usize = HEADER + CAR * CARS;
+
+/// Whether the first bytes are an F1 23/24/25 header: the packet format, its year and a known packet id.
+pub fn header_fits(bytes: &[u8]) -> bool {
+    bytes.len() >= HEADER && {
+        let format = Le(bytes).u16(0);
+        (2023..=2025).contains(&format) && u16::from(bytes[2]) + 2000 == format && bytes[6] <= 15
+    }
+}
+
+/// Reads the player's car from a motion packet.
+pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
+    let format = Format::F1;
+    if bytes.len() < HEADER {
+        return Err(Unreadable::Size {
+            format,
+            got: bytes.len(),
+            expected: "a 29-byte header, and 1349 bytes for the motion packet",
+        });
+    }
+    let le = Le(bytes);
+    let packet_format = le.u16(0);
+    if !(2023..=2025).contains(&packet_format) {
+        return Err(Unreadable::Header {
+            format,
+            why: format!("packet format {packet_format}, where F1 23, 24 and 25 send 2023, 2024 and 2025"),
+        });
+    }
+    let id = bytes[6];
+    if id != 0 {
+        return Err(Unreadable::NoMotion {
+            format,
+            why: format!("packet id {id}, not the motion packet (0)"),
+        });
+    }
+    if bytes.len() != MOTION_SIZE {
+        return Err(Unreadable::Size {
+            format,
+            got: bytes.len(),
+            expected: "1349 bytes for the motion packet",
+        });
+    }
+    let player = usize::from(bytes[27]);
+    if player >= CARS {
+        return Err(Unreadable::NoMotion {
+            format,
+            why: format!("player car index {player}: not a car (spectating?)"),
+        });
+    }
+    let at = HEADER + CAR * player;
+    let dir = |i: usize| f64::from(le.i16(at + 24 + 2 * i)) / 32767.0;
+    let (forward_up, right_up) = (dir(1), dir(4));
+    let [lateral, longitudinal, vertical] = le.vec3(at + 36);
+    // Gravity's reaction: unit vectors' y (world up) components, clamped against rounding of the i16s.
+    let gravity = gravity_from_axes(forward_up.clamp(-1.0, 1.0), (-right_up).clamp(-1.0, 1.0));
+    Ok(Sample {
+        time: Some(le.f32(15)),
+        telemetry: Telemetry {
+            force: add([G * longitudinal, -G * lateral, G * vertical], gravity),
+            rate: [0.0; 3],
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::recognise;
+    use super::super::testing::{close, decoded, Writer};
+    use super::*;
+
+    /// One car's `CarMotionData`: forward and right unit vectors (world, y up), g-forces (lateral, longitudinal,
+    /// vertical).
+    fn car(w: &mut Writer, forward: [f32; 3], right: [f32; 3], g_lat_long_vert: [f32; 3]) {
+        w.f32s(&[100.0, 2.0, -50.0]).f32s(&[10.0, 0.0, 0.0]);
+        for v in forward.iter().chain(&right) {
+            w.i16((v * 32767.0).round() as i16);
+        }
+        w.f32s(&g_lat_long_vert).f32s(&[0.1, 0.0, 0.0]);
+    }
+
+    /// A motion packet of `format` (2023..2025) with the player in slot `player`, every other car level and
+    /// braking hard (so that reading the wrong car shows).
+    fn packet(format: u16, id: u8, player: u8, forward: [f32; 3], right: [f32; 3], g: [f32; 3]) -> Vec<u8> {
+        let mut w = Writer::default();
+        w.u16(format).u8((format - 2000) as u8).u8(1).u8(5).u8(1).u8(id);
+        w.bytes(&0x1234_5678_9abc_def0u64.to_le_bytes())
+            .f32(61.5)
+            .u32(3000)
+            .u32(3000)
+            .u8(player)
+            .u8(255);
+        assert_eq!(w.0.len(), HEADER);
+        for i in 0..CARS as u8 {
+            if i == player {
+                car(&mut w, forward, right, g);
+            } else {
+                car(&mut w, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -4.0, 0.0]);
+            }
+        }
+        assert_eq!(w.0.len(), MOTION_SIZE);
+        w.0
+    }
+
+    const LEVEL_F: [f32; 3] = [0.0, 0.0, 1.0];
+    const LEVEL_R: [f32; 3] = [1.0, 0.0, 0.0];
+
+    #[test]
+    fn the_players_car_in_vehicle_axes() {
+        let g = G;
+        for format in [2023, 2024, 2025] {
+            // At rest, level.
+            let s = decoded(Format::F1, &packet(format, 0, 3, LEVEL_F, LEVEL_R, [0.0; 3]));
+            assert_eq!(s.time, Some(61.5));
+            assert!(
+                close(s.telemetry.force, [0.0, 0.0, g]) && s.telemetry.rate == [0.0; 3],
+                "{s:?}"
+            );
+            // Accelerating at 0.5 g.
+            let s = decoded(Format::F1, &packet(format, 0, 7, LEVEL_F, LEVEL_R, [0.0, 0.5, 0.0]));
+            assert!(close(s.telemetry.force, [0.5 * g, 0.0, g]), "{s:?}");
+            // A left turn: the car accelerates towards its left (lateral < 0), the seat pushes the rider left.
+            let s = decoded(Format::F1, &packet(format, 0, 0, LEVEL_F, LEVEL_R, [-2.0, 0.0, 0.0]));
+            assert!(close(s.telemetry.force, [0.0, 2.0 * g, g]), "{s:?}");
+            // Nose up 10 degrees at rest (forward has world y = sin 10 deg).
+            let (sp, cp) = 10f32.to_radians().sin_cos();
+            let s = decoded(Format::F1, &packet(format, 0, 21, [0.0, sp, cp], LEVEL_R, [0.0; 3]));
+            let (sp, cp) = (f64::from(sp), f64::from(cp));
+            assert!(close(s.telemetry.force, [g * sp, 0.0, g * cp]), "{s:?}");
+            // Right side down 10 degrees (right has world y = -sin 10 deg): the seat pushes left.
+            let s = decoded(
+                Format::F1,
+                &packet(format, 0, 1, LEVEL_F, [cp as f32, -sp as f32, 0.0], [0.0; 3]),
+            );
+            assert!(close(s.telemetry.force, [0.0, g * sp, g * cp]), "{s:?}");
+        }
+    }
+
+    #[test]
+    fn other_packets_and_games_are_refused() {
+        let good = packet(2024, 0, 2, LEVEL_F, LEVEL_R, [0.0; 3]);
+        // Another packet type of F1 (car telemetry, id 6) is F1's, but no motion.
+        let telemetry = packet(2024, 6, 2, LEVEL_F, LEVEL_R, [0.0; 3]);
+        assert_eq!(recognise(&telemetry[..1352.min(telemetry.len())]), Some(Format::F1));
+        assert!(matches!(decode(&telemetry), Err(Unreadable::NoMotion { .. })));
+        // F1 22 (format 2022) and F1 2019.
+        for old in [2022u16, 2019] {
+            let mut p = good.clone();
+            p[..2].copy_from_slice(&old.to_le_bytes());
+            assert!(matches!(decode(&p), Err(Unreadable::Header { .. })), "{old}");
+            assert_ne!(recognise(&p), Some(Format::F1));
+        }
+        // Wrong sizes.
+        assert!(decode(&good[..1348]).is_err());
+        assert!(decode(&good[..20]).is_err());
+        // Spectating: no player car.
+        let mut p = good.clone();
+        p[27] = 255;
+        assert!(matches!(decode(&p), Err(Unreadable::NoMotion { .. })));
+        // Not finite.
+        let mut p = good;
+        let at = HEADER + 2 * CAR + 36;
+        p[at..at + 4].copy_from_slice(&f32::INFINITY.to_le_bytes());
+        assert!(super::super::decode(Format::F1, &p).is_err());
+    }
+}

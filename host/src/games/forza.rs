@@ -1,0 +1,205 @@
+//! Forza "Data Out": Forza Motorsport 7 and Forza Motorsport (2023), Sled or Dash; Forza Horizon 4 and 5.
+//!
+//! Sources: Turn 10's "Forza Motorsport Data Out Documentation" (support.forzamotorsport.net, article
+//! 21742934024211: sections "Configuration", "Output Structures", "Sled", "Dash"), which repeats the FM7 "Data Out
+//! feature details" post (forums.forza.net, topic 74013), and Playground's "Forza Horizon 6 Data Out
+//! Documentation" (support.forza.net, article 51744149102611) for the Horizon packet of 324 bytes. Little-endian:
+//!
+//! | bytes | field | |
+//! |---|---|---|
+//! | 0-3 | `IsRaceOn` | s32: 1 when the race is on, 0 in menus or when the race is stopped |
+//! | 4-7 | `TimestampMS` | u32, ms ("can overflow to 0 eventually") |
+//! | 8-19 | `EngineMaxRpm`, `EngineIdleRpm`, `CurrentEngineRpm` | f32 |
+//! | 20-31 | `AccelerationX/Y/Z` | f32, m/s^2, "in the car's local space; X = right, Y = up, Z = forward" |
+//! | 32-43 | `VelocityX/Y/Z` | f32, m/s, same axes |
+//! | 44-55 | `AngularVelocityX/Y/Z` | f32, rad/s, "X = pitch, Y = yaw, Z = roll" |
+//! | 56-67 | `Yaw`, `Pitch`, `Roll` | f32, rad |
+//! | 68-211 | suspension, slip, wheel speed, rumble, puddle, surface rumble, slip angle, combined slip, suspension travel | 4 x 9 values |
+//! | 212-231 | `CarOrdinal`, `CarClass`, `CarPerformanceIndex`, `DrivetrainType`, `NumCylinders` | s32; end of Sled (232 bytes) |
+//! | 232-310 | Dash: position, speed, power, torque, tyre temperatures, boost, fuel, distance, lap times, lap, position, inputs, gear, steer, driving line | FM7 Dash: 311 bytes |
+//! | 311-330 | `TireWearFL/FR/RL/RR`, `TrackOrdinal` | Forza Motorsport (2023) Dash: 331 bytes |
+//!
+//! Forza Horizon 4 and 5 send the Sled fields, 12 bytes of their own, the Dash fields and one more byte: 324 bytes.
+//! Motion is in the Sled fields, at the same offsets in all four sizes.
+//!
+//! `IsRaceOn = 0` (menus, paused, the race stopped) is unreadable, not a car at rest: the stream's idle path then
+//! washes out to neutral as it does when a game stops sending.
+//!
+//! ## Conversion
+//!
+//! The car's local space (X right, Y up, Z forward) is left-handed, so its rotations turn by the left-hand rule:
+//! a positive rate about X is nose down, about Y a turn to the right, about Z the right side rising. ringpod's axes
+//! are right-handed (x forward, y left, z up). The acceleration is taken as the car's (without gravity, as its
+//! name says), and gravity's reaction added from `Pitch` and `Roll`, taken in the same left-handed sense (positive
+//! pitch nose down, positive roll right side up):
+//!
+//! | ringpod | from |
+//! |---|---|
+//! | force x | `AccelerationZ + g sin(-Pitch)` |
+//! | force y | `-AccelerationX + g cos(Pitch) sin(-Roll)` |
+//! | force z | `AccelerationY + g cos(Pitch) cos(Roll)` |
+//! | rate roll | `-AngularVelocityZ` |
+//! | rate pitch | `AngularVelocityX` |
+//! | rate yaw | `-AngularVelocityY` |
+//! | time | `TimestampMS / 1000` |
+//!
+//! The documentation gives the axes, not the sense of the rotations nor whether the acceleration holds gravity:
+//! those are assumed as above; check with a capture (accelerating gives force x > 0, a left turn force y > 0 and
+//! yaw rate > 0, a nose-up hill at rest force x > 0).
+
+use super::{add, gravity_from_attitude, Format, Le, Sample, Telemetry, Unreadable};
+
+/// Sled.
+pub const SLED: usize = 232;
+/// Forza Motorsport 7 Dash.
+pub const DASH_FM7: usize = 311;
+/// Forza Horizon 4 and 5.
+pub const HORIZON: usize = 324;
+/// Forza Motorsport (2023) Dash.
+pub const DASH_FM2023: usize = 331;
+/// Every size.
+pub const SIZES: [usize; 4] = [SLED, DASH_FM7, HORIZON, DASH_FM2023];
+
+/// Reads the Sled fields of any of the packets.
+pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
+    if !SIZES.contains(&bytes.len()) {
+        return Err(Unreadable::Size {
+            format: Format::Forza,
+            got: bytes.len(),
+            expected: "232 (Sled), 311 (FM7 Dash), 324 (Horizon) or 331 (FM 2023 Dash) bytes",
+        });
+    }
+    let le = Le(bytes);
+    match le.i32(0) {
+        1 => {}
+        0 => {
+            return Err(Unreadable::NoMotion {
+                format: Format::Forza,
+                why: "IsRaceOn is 0: in the menus, paused or the race stopped".into(),
+            })
+        }
+        other => {
+            return Err(Unreadable::Header {
+                format: Format::Forza,
+                why: format!("IsRaceOn is {other}, where Forza sends 0 or 1"),
+            })
+        }
+    }
+    let [ax, ay, az] = le.vec3(20);
+    let [wx, wy, wz] = le.vec3(44);
+    let (pitch, roll) = (le.f32(60), le.f32(64));
+    Ok(Sample {
+        time: Some(f64::from(le.u32(4)) / 1000.0),
+        telemetry: Telemetry {
+            force: add([az, -ax, ay], gravity_from_attitude(-pitch, -roll)),
+            rate: [-wz, wx, -wy],
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{close, decoded, Writer};
+    use super::super::G;
+    use super::*;
+
+    /// The Sled fields: race on, time 12.345 s, the car's acceleration, angular velocity and attitude (yaw,
+    /// pitch, roll), the wheel arrays and the car's identity.
+    fn sled(w: &mut Writer, race_on: i32, accel: [f32; 3], ang_vel: [f32; 3], ypr: [f32; 3]) {
+        w.i32(race_on).u32(12_345).f32s(&[8000.0, 900.0, 4000.0]);
+        w.f32s(&accel).f32s(&[0.0, 0.0, 20.0]).f32s(&ang_vel).f32s(&ypr);
+        // Normalised suspension travel, slip ratio, wheel rotation speed.
+        w.f32s(&[0.5; 4]).f32s(&[0.0; 4]).f32s(&[60.0; 4]);
+        // On rumble strip (s32), puddle depth, surface rumble, slip angle, combined slip, suspension travel (m).
+        (0..4).for_each(|_| {
+            w.i32(0);
+        });
+        w.f32s(&[0.0; 4])
+            .f32s(&[0.0; 4])
+            .f32s(&[0.0; 4])
+            .f32s(&[0.0; 4])
+            .f32s(&[0.05; 4]);
+        // Car ordinal, class, performance index, drivetrain, cylinders.
+        w.i32(2352).i32(5).i32(800).i32(1).i32(8);
+        assert_eq!(w.0.len(), SLED);
+    }
+
+    /// The Dash fields of FM7 (79 bytes).
+    fn dash(w: &mut Writer) {
+        w.f32s(&[1.0, 2.0, 3.0]).f32s(&[20.0, 1e5, 300.0]).f32s(&[80.0; 4]);
+        w.f32s(&[0.0, 40.0, 1500.0, 90.0, 91.0, 30.0, 300.0]);
+        w.u16(3).u8(1).u8(255).u8(0).u8(0).u8(0).u8(4).bytes(&[0, 0, 0]);
+    }
+
+    /// A packet of `size` with the given motion.
+    fn packet(size: usize, race_on: i32, accel: [f32; 3], ang_vel: [f32; 3], ypr: [f32; 3]) -> Vec<u8> {
+        let mut w = Writer::default();
+        sled(&mut w, race_on, accel, ang_vel, ypr);
+        match size {
+            SLED => {}
+            DASH_FM7 => dash(&mut w),
+            HORIZON => {
+                w.zeros(12);
+                dash(&mut w);
+                w.zeros(1);
+            }
+            DASH_FM2023 => {
+                dash(&mut w);
+                w.f32s(&[0.1; 4]).i32(110);
+            }
+            _ => unreachable!(),
+        }
+        assert_eq!(w.0.len(), size);
+        w.0
+    }
+
+    #[test]
+    fn sled_and_dash_in_vehicle_axes() {
+        let g = G;
+        for size in SIZES {
+            // At rest, level.
+            let s = decoded(Format::Forza, &packet(size, 1, [0.0; 3], [0.0; 3], [1.0, 0.0, 0.0]));
+            assert_eq!(s.time, Some(12.345));
+            assert!(
+                close(s.telemetry.force, [0.0, 0.0, g]) && close(s.telemetry.rate, [0.0; 3]),
+                "{s:?}"
+            );
+            // Accelerating at 4 m/s^2 (Z forward).
+            let s = decoded(Format::Forza, &packet(size, 1, [0.0, 0.0, 4.0], [0.0; 3], [0.0; 3]));
+            assert!(close(s.telemetry.force, [4.0, 0.0, g]), "{s:?}");
+            // A left turn: accelerating towards the car's left (X negative), yawing left (Y negative by the
+            // left-hand rule about up).
+            let s = decoded(
+                Format::Forza,
+                &packet(size, 1, [-5.0, 0.0, 0.0], [0.0, -0.4, 0.0], [0.0; 3]),
+            );
+            assert!(close(s.telemetry.force, [0.0, 5.0, g]), "{s:?}");
+            assert!(close(s.telemetry.rate, [0.0, 0.0, 0.4]), "{s:?}");
+            // Nose up 10 degrees at rest (Pitch negative: positive is nose down).
+            let p = 10f32.to_radians();
+            let s = decoded(Format::Forza, &packet(size, 1, [0.0; 3], [0.0; 3], [0.0, -p, 0.0]));
+            let (sp, cp) = f64::from(p).sin_cos();
+            assert!(close(s.telemetry.force, [g * sp, 0.0, g * cp]), "{s:?}");
+            // Pitching nose down at 0.2 rad/s and rolling the right side up at 0.1 rad/s.
+            let s = decoded(Format::Forza, &packet(size, 1, [0.0; 3], [0.2, 0.0, 0.1], [0.0; 3]));
+            assert!(close(s.telemetry.rate, [-0.1, 0.2, 0.0]), "{s:?}");
+        }
+    }
+
+    #[test]
+    fn paused_and_wrong_packets_are_refused() {
+        let paused = packet(SLED, 0, [0.0; 3], [0.0; 3], [0.0; 3]);
+        assert!(matches!(decode(&paused), Err(Unreadable::NoMotion { .. })));
+        let odd = packet(SLED, 7, [0.0; 3], [0.0; 3], [0.0; 3]);
+        assert!(matches!(decode(&odd), Err(Unreadable::Header { .. })));
+        let good = packet(DASH_FM7, 1, [0.0; 3], [0.0; 3], [0.0; 3]);
+        for len in [0, 231, 233, 310, 323, 400] {
+            let mut p = good.clone();
+            p.resize(len, 0);
+            assert!(matches!(decode(&p), Err(Unreadable::Size { .. })), "{len}");
+        }
+        let mut nan = good;
+        nan[24..28].copy_from_slice(&f32::NAN.to_le_bytes());
+        assert!(super::super::decode(Format::Forza, &nan).is_err());
+    }
+}
