@@ -52,7 +52,7 @@ pub mod xplane;
 use ringpod_core::cueing::{Telemetry, G};
 
 /// The games' telemetry formats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
     /// Live for Speed's classic OutSim packet (`OutSim Opts 0`): 64 bytes, or 68 with an OutSim ID.
     Outsim,
@@ -71,7 +71,8 @@ pub enum Format {
 }
 
 impl Format {
-    /// Every format, in the order [`recognise`] tries them (for tests and help texts).
+    /// Every format, in the order [`recognise`] tries them.
+    #[cfg(test)]
     pub const ALL: [Format; 7] = [
         Format::Outsim2,
         Format::Beamng,
@@ -92,6 +93,21 @@ impl Format {
             Format::F1 => "f1",
             Format::Forza => "forza",
             Format::Xplane => "xplane",
+        }
+    }
+}
+
+impl Format {
+    /// The games that send it.
+    pub fn games(self) -> &'static str {
+        match self {
+            Format::Outsim => "Live for Speed, OutSim Opts 0",
+            Format::Outsim2 => "Live for Speed, OutSim Opts with the header bit",
+            Format::Beamng => "BeamNG.drive, MotionSim",
+            Format::Codemasters => "DiRT Rally 1 and 2.0, DiRT 4, GRID: extradata 3",
+            Format::F1 => "EA SPORTS F1 23, 24, 25: motion packet",
+            Format::Forza => "Forza Motorsport 7 and 2023, Forza Horizon 4 and 5: Data Out",
+            Format::Xplane => "X-Plane 10-12: DATA sets 4 and 16",
         }
     }
 }
@@ -347,8 +363,8 @@ mod tests {
         for format in Format::ALL {
             assert!(decode(format, &[]).is_err(), "{format}");
             assert_eq!(
-                <Format as clap::ValueEnum>::from_str(format.name(), false),
-                Ok(format),
+                <crate::stream::datagram::TelemetryFormat as clap::ValueEnum>::from_str(format.name(), false),
+                Ok(crate::stream::datagram::TelemetryFormat::Game(format)),
                 "{format}"
             );
         }

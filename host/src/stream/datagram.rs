@@ -1,19 +1,57 @@
 //! What a UDP datagram from simulator software means: a pose, or vehicle telemetry that the core's washout turns
-//! into a pose (text, or Live for Speed's OutSim packet, which BeamNG.drive also sends).
+//! into a pose (a text line, or a game's own packet: [`crate::games`]).
 
 use std::time::Instant;
 
+use clap::builder::PossibleValue;
 use ringpod_core::cueing::{self, SampleError, Telemetry, Washout, G};
 use ringpod_core::kinematics::Pose;
 
-/// The telemetry formats `stream --telemetry-udp` reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+use crate::games::{self, Format};
+
+/// The telemetry formats `stream --telemetry-udp` reads: a text line, a game's own format, or whichever of the
+/// games' formats the first readable datagram is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TelemetryFormat {
     /// One text line `t ax ay az wx wy wz` (or without `t`: the arrival time), separated by spaces, commas or
     /// semicolons; the units and axes of `ringpod cue`.
     Text,
-    /// Live for Speed's OutSim packet (64 bytes, or 68 with an ID; layout in the README).
-    Outsim,
+    /// A game's own packet.
+    Game(Format),
+    /// The first datagram that one of the games' formats recognises names the format for the rest of the run.
+    Auto,
+}
+
+impl TelemetryFormat {
+    const ALL: [TelemetryFormat; 9] = [
+        TelemetryFormat::Text,
+        TelemetryFormat::Game(Format::Outsim),
+        TelemetryFormat::Game(Format::Outsim2),
+        TelemetryFormat::Game(Format::Beamng),
+        TelemetryFormat::Game(Format::Codemasters),
+        TelemetryFormat::Game(Format::F1),
+        TelemetryFormat::Game(Format::Forza),
+        TelemetryFormat::Game(Format::Xplane),
+        TelemetryFormat::Auto,
+    ];
+}
+
+impl clap::ValueEnum for TelemetryFormat {
+    fn value_variants<'a>() -> &'a [Self] {
+        &Self::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<PossibleValue> {
+        Some(match self {
+            TelemetryFormat::Text => {
+                PossibleValue::new("text").help("`[t] ax ay az wx wy wz`, the units of `ringpod cue`")
+            }
+            TelemetryFormat::Auto => {
+                PossibleValue::new("auto").help("the first game format recognised, said on stderr")
+            }
+            TelemetryFormat::Game(f) => PossibleValue::new(f.name()).help(f.games()),
+        })
+    }
 }
 
 /// Turns datagrams into poses.
@@ -99,70 +137,10 @@ pub fn parse_telemetry(bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), St
     ))
 }
 
-/// Live for Speed's OutSim packet (`OutSimPack`, the layout without the `OutSim Opts` extensions), little-endian:
-///
-/// | bytes | field | |
-/// |---|---|---|
-/// | 0-3 | `Time` | u32, ms |
-/// | 4-15 | `AngVel` | 3 x f32, rad/s, world axes |
-/// | 16-19, 20-23, 24-27 | `Heading`, `Pitch`, `Roll` | f32, rad |
-/// | 28-39 | `Accel` | 3 x f32, m/s^2, world axes |
-/// | 40-51 | `Vel` | 3 x f32, m/s |
-/// | 52-63 | `Pos` | 3 x i32, 1 m = 65536 |
-/// | 64-67 | `ID` | i32, only when an OutSim ID is set |
-///
-/// World axes are x right, y forward, z up at zero heading; heading turns about z, pitch about the car's right
-/// (x) axis, roll about its forward (y) axis, each anticlockwise, applied in that order. The car's acceleration
-/// plus gravity's reaction is turned into the car's frame and then into ringpod's vehicle axes (x forward, y left,
-/// z up), as are the angular rates.
-pub mod outsim {
-    use super::{Telemetry, G};
-
-    /// Reads one packet: its time (s) and the telemetry in ringpod's vehicle axes.
-    pub fn parse(bytes: &[u8]) -> Result<(f64, Telemetry<f64>), String> {
-        if bytes.len() != 64 && bytes.len() != 68 {
-            return Err(format!("an OutSim packet is 64 or 68 bytes, this one {}", bytes.len()));
-        }
-        let word = |at: usize| [bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]];
-        let f = |at: usize| f64::from(f32::from_le_bytes(word(at)));
-        let time = f64::from(u32::from_le_bytes(word(0))) / 1000.0;
-        let ang_vel = [f(4), f(8), f(12)];
-        let (heading, pitch, roll) = (f(16), f(20), f(24));
-        let accel = [f(28), f(32), f(36)];
-        // Specific force in world axes: acceleration minus gravity (gravity is -g on z).
-        let specific = [accel[0], accel[1], accel[2] + G];
-        let to_car = |v: [f64; 3]| {
-            // The car's axes in world axes: R = Rz(heading) Rx(pitch) Ry(roll); world to car is R^T.
-            let v = rotate_z(v, -heading);
-            let v = rotate_x(v, -pitch);
-            rotate_y(v, -roll)
-        };
-        let (fc, wc) = (to_car(specific), to_car(ang_vel));
-        // Car axes x right, y forward, z up -> ringpod's x forward, y left, z up.
-        let ours = |v: [f64; 3]| [v[1], -v[0], v[2]];
-        Ok((
-            time,
-            Telemetry {
-                force: ours(fc),
-                rate: ours(wc),
-            },
-        ))
-    }
-
-    fn rotate_z(v: [f64; 3], a: f64) -> [f64; 3] {
-        let (s, c) = a.sin_cos();
-        [c * v[0] - s * v[1], s * v[0] + c * v[1], v[2]]
-    }
-
-    fn rotate_x(v: [f64; 3], a: f64) -> [f64; 3] {
-        let (s, c) = a.sin_cos();
-        [v[0], c * v[1] - s * v[2], s * v[1] + c * v[2]]
-    }
-
-    fn rotate_y(v: [f64; 3], a: f64) -> [f64; 3] {
-        let (s, c) = a.sin_cos();
-        [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]]
-    }
+/// A game's packet: its time, if it sends one, and the telemetry.
+fn game(format: Format, bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), String> {
+    let sample = games::decode(format, bytes).map_err(|e| e.to_string())?;
+    Ok((sample.time, sample.telemetry))
 }
 
 impl Decoder {
@@ -178,9 +156,17 @@ impl Decoder {
                 gaps,
             } => {
                 let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
-                let (t, sample) = match format {
+                let (t, sample) = match *format {
                     TelemetryFormat::Text => parse_telemetry(bytes)?,
-                    TelemetryFormat::Outsim => outsim::parse(bytes).map(|(t, s)| (Some(t), s))?,
+                    TelemetryFormat::Game(f) => game(f, bytes)?,
+                    TelemetryFormat::Auto => {
+                        let f = games::recognise(bytes).ok_or(games::Unreadable::Unrecognised(bytes.len()).to_string())?;
+                        let sample = game(f, bytes)?;
+                        // Said once: every later datagram is read as this format.
+                        eprintln!("telemetry: the datagrams are {f} ({})", f.games());
+                        *format = TelemetryFormat::Game(f);
+                        sample
+                    }
                 };
                 let dt = match *last {
                     None => None,
@@ -251,53 +237,85 @@ impl Decoder {
 mod tests {
     use super::*;
 
-    /// An OutSim packet built as LFS lays it out: time (ms), angular velocity, heading, pitch, roll, acceleration
-    /// (world axes), velocity and position zero, and an ID when asked.
-    fn packet(time_ms: u32, ang_vel: [f32; 3], hpr: [f32; 3], accel: [f32; 3], id: bool) -> Vec<u8> {
+    /// Live for Speed's classic OutSim packet: time (ms), angular velocity, heading, pitch, roll, acceleration
+    /// (world axes), velocity and position zero.
+    fn outsim(time_ms: u32, accel: [f32; 3]) -> Vec<u8> {
         let mut out = time_ms.to_le_bytes().to_vec();
-        for v in ang_vel.iter().chain(&hpr).chain(&accel).chain(&[0.0f32; 3]) {
+        for v in [0.0f32; 6].iter().chain(&accel).chain(&[0.0f32; 3]) {
             out.extend(v.to_le_bytes());
         }
         out.extend([0u8; 12]);
-        if id {
-            out.extend(7i32.to_le_bytes());
-        }
-        assert_eq!(out.len(), if id { 68 } else { 64 });
         out
     }
 
-    fn close(a: [f64; 3], b: [f64; 3]) -> bool {
-        a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5)
+    fn decoder(format: TelemetryFormat) -> Decoder {
+        Decoder::Telemetry {
+            format,
+            washout: Box::new(Washout::new(ringpod_core::cueing::CueConfig::default()).unwrap()),
+            neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
+            last: None,
+            gaps: 0,
+        }
     }
 
     #[test]
-    fn outsim_packets_become_telemetry_in_vehicle_axes() {
-        let g = G;
-        // At rest, level, any heading: gravity's reaction straight up.
-        let (t, s) = outsim::parse(&packet(1500, [0.0; 3], [2.0, 0.0, 0.0], [0.0; 3], false)).unwrap();
-        assert_eq!(t, 1.5);
-        assert!(close(s.force, [0.0, 0.0, g]) && close(s.rate, [0.0; 3]), "{s:?}");
-        // Heading a quarter turn anticlockwise (facing world -x) and accelerating that way at 3 m/s^2: 3 forward.
-        let quarter = std::f32::consts::FRAC_PI_2;
-        let (_, s) = outsim::parse(&packet(0, [0.0; 3], [quarter, 0.0, 0.0], [-3.0, 0.0, 0.0], true)).unwrap();
-        assert!(close(s.force, [3.0, 0.0, g]), "{s:?}");
-        // Cornering to the left at heading 0 (world -x is the car's left): a force to the left.
-        let (_, s) = outsim::parse(&packet(0, [0.0, 0.0, 0.5], [0.0; 3], [-4.0, 0.0, 0.0], false)).unwrap();
-        assert!(close(s.force, [0.0, 4.0, g]) && close(s.rate, [0.0, 0.0, 0.5]), "{s:?}");
-        // Nose up 10 degrees at rest: gravity pushes the rider back, as accelerating does.
-        let p = 10f32.to_radians();
-        let (_, s) = outsim::parse(&packet(0, [0.0; 3], [0.0, p, 0.0], [0.0; 3], false)).unwrap();
-        let (sp, cp) = f64::from(p).sin_cos();
-        assert!(close(s.force, [g * sp, 0.0, g * cp]), "{s:?}");
-        // Rolled 10 degrees anticlockwise seen from the front (right side down): gravity pulls the rider to the
-        // right, so the seat pushes to the left.
-        let r = 10f32.to_radians();
-        let (_, s) = outsim::parse(&packet(0, [0.0; 3], [0.0, 0.0, r], [0.0; 3], false)).unwrap();
-        let (sr, cr) = f64::from(r).sin_cos();
-        assert!(close(s.force, [0.0, g * sr, g * cr]), "{s:?}");
-        for len in [0, 63, 65, 72] {
-            assert!(outsim::parse(&vec![0u8; len]).is_err(), "{len} bytes");
+    fn auto_names_the_format_once_and_holds_to_it() {
+        let now = Instant::now();
+        let mut d = decoder(TelemetryFormat::Auto);
+        // Not any game's: unreadable, and still auto.
+        assert!(d.decode(b"1 2 3 4 5 6", now).is_err());
+        assert!(matches!(
+            d,
+            Decoder::Telemetry {
+                format: TelemetryFormat::Auto,
+                ..
+            }
+        ));
+        // Braking at 6 m/s^2 (heading 0 faces world +y): the platform moves back, as with the text format.
+        let mut pose = None;
+        for k in 0..100 {
+            pose = Some(d.decode(&outsim(k * 10, [0.0, -6.0, 0.0]), now).unwrap());
         }
+        assert!(matches!(
+            d,
+            Decoder::Telemetry {
+                format: TelemetryFormat::Game(Format::Outsim),
+                ..
+            }
+        ));
+        assert!(pose.is_some_and(|p| p.x < 0.0 && p.beta > 0.0), "{pose:?}");
+        // Named: a text line is now unreadable, not taken as another format.
+        assert!(d.decode(format!("1.01 0 0 {G} 0 0 0").as_bytes(), now).is_err());
+        // A game's format named on the command line reads only that format.
+        let mut d = decoder(TelemetryFormat::Game(Format::Forza));
+        assert!(d.decode(&outsim(0, [0.0; 3]), now).is_err());
+    }
+
+    #[test]
+    fn every_format_has_a_name_on_the_command_line() {
+        use clap::ValueEnum;
+        let names: Vec<_> = TelemetryFormat::value_variants()
+            .iter()
+            .filter_map(|f| f.to_possible_value().map(|v| v.get_name().to_owned()))
+            .collect();
+        assert_eq!(
+            names,
+            [
+                "text",
+                "outsim",
+                "outsim2",
+                "beamng",
+                "codemasters",
+                "f1",
+                "forza",
+                "xplane",
+                "auto"
+            ]
+        );
+        assert_eq!(
+            TelemetryFormat::from_str("forza", false),
+            Ok(TelemetryFormat::Game(Format::Forza))
+        );
     }
 
     #[test]
