@@ -85,7 +85,7 @@ class Machine:
         self.resets = []  # (time, cause)
         self.reset_request = None
         self.fault = None
-        self.breakpoints = {}  # address -> callback(machine)
+        self.observers = []  # called between chunks, at most once a simulated millisecond
         self._build()
         # Erased flash reads 0xFF (RM0383 3.3); then the ELF exactly as a programmer writes it.
         self.uc.mem_write(FLASH_BASE, b"\xff" * FLASH_SIZE)
@@ -394,9 +394,10 @@ class Machine:
     def next_event(self):
         return min(model.next_event(self.now) for model in self.timed)
 
-    def run(self, until, observe=None):
-        """Run up to time `until` (cycles); `observe(machine)` is called between chunks."""
+    def run(self, until):
+        """Run up to time `until` (cycles)."""
         uc = self.uc
+        observed = self.now
         while self.now < until and self.fault is None:
             self.advance()
             if self.reset_request:
@@ -405,8 +406,10 @@ class Machine:
                 self.now = max(self.now, at)
                 self.system_reset(cause)
                 continue
-            if observe:
-                observe(self)
+            if self.now - observed >= SYSCLK // 1000:
+                observed = self.now
+                for observe in self.observers:
+                    observe()
             try:
                 if self.sleeping is not None:
                     if self.try_take(self.sleeping):

@@ -18,6 +18,7 @@ REPO = os.path.dirname(os.path.dirname(HERE))
 from unicorn import UC_HOOK_MEM_READ  # noqa: E402
 from unicorn import arm_const as A  # noqa: E402
 
+from defmt_log import DefmtLog  # noqa: E402
 from elf import memory_x  # noqa: E402
 from machine import SYSCLK, Machine  # noqa: E402
 from models import dma as D  # noqa: E402
@@ -121,6 +122,8 @@ def main():
     wall0 = time.time()
     m = Machine(args.elf, ram)
     p = Probes(m)
+    log = DefmtLog(m)
+    m.observers.append(log.poll)
     if args.count_instructions:
         m.count_instructions()
 
@@ -152,7 +155,8 @@ def main():
             f"APB1 {96 / (2 ** (ppre1 - 3) if ppre1 >= 4 else 1):g} MHz, FLASH_ACR {acr:#06x} "
             f"(LATENCY {acr & 0xF}, RM0383 Table 5: 3 WS for 90-100 MHz)" + (f"; wrong: {', '.join(bad)}" if bad else ""))
 
-    fault = m.fault or (p.faults and f"{p.faults[0][0]} entered at {ms(p.faults[0][1]):.2f} ms")
+    fault = m.fault or (p.faults and f"{p.faults[0][0]} entered at {ms(p.faults[0][1]):.2f} ms") or (
+        m.resets and f"{len(m.resets)} resets: {', '.join(f'{cause} at {ms(t):.1f} ms' for t, cause in m.resets[:3])}")
     c.check("boot-no-fault", not fault and not m.resets,
             fault or f"no HardFault, DefaultHandler, panic or emulator fault; no reset; "
             f"board::start at {ms(p.reached.get('board::start', 0)):.2f} ms, Executor::run at "
@@ -212,6 +216,14 @@ def main():
             f"no host command: {step_edges} STEP edges on PB0-PB5; ENABLE (PB13, active low) {odr >> ENABLE_N & 1}, "
             f"relays PB14/PB15 {odr >> LOGIC_RELAY & 1}/{odr >> POWER_RELAY & 1}; GPIOB.ODR {odr:#06x}")
 
+    log.poll()
+    boot_log = list(log.lines)
+    up = [text for _, level, text in boot_log if "firmware up" in text]
+    noisy = [f"{level}: {text}" for _, level, text in boot_log if level not in ("info", "debug", "trace")]
+    c.check("log", up and any("settings:" in text for _, _, text in boot_log) and not noisy,
+            f"{len(boot_log)} defmt lines read over RTT, none above info"
+            f"{'; ' + up[0] if up else ''}" + (f"; {noisy[:3]}" if noisy else ""))
+
     # -- the watchdog --
     iw = m.iwdg
     feeds = [t for t in iw.reloads if t >= before.t]
@@ -244,15 +256,18 @@ def main():
     after_reset = m.now
     m.run(after_reset + int(0.3 * SYSCLK))
     csr_after = [v for t, v in p.csr_reads if reset and t >= reset[0]]
+    log.poll()
+    said = [text for t, level, text in log.lines if reset and t >= reset[0] and level == "error"]
     refeeds = [t for t in m.iwdg.reloads if reset and t > reset[0]]
     since_reset = m.now - reset[0] if reset else 0
     c.check("watchdog-reset", reset is not None and reset[1] == "IWDG" and csr_after
             and csr_after[0] & IWDGRSTF and m.rcc.instance.CSR & IWDGRSTF == 0 and len(refeeds) > ms(since_reset) * 0.9
+            and any("the last reset was the watchdog's" in text for text in said)
             and m.fault is None,
             (f"TIM5's interrupt held from {ms(held_at):.1f} ms: IWDG reset at {ms(reset[0]):.1f} ms "
              f"({ms(reset[0] - last_feed):.1f} ms after the last feed); after the reset the firmware read "
              f"RCC_CSR {csr_after[0] if csr_after else 0:#010x} (IWDGRSTF {bool(csr_after and csr_after[0] & IWDGRSTF)}) "
-             f"and cleared it (RMVF), then fed the watchdog {len(refeeds)} times in the "
+             f"and cleared it (RMVF), logged {said[0].split(' ms ', 1)[-1] if said else 'no error'!r}, fed the watchdog {len(refeeds)} times in the "
              f"{ms(since_reset):.0f} ms after the reset"
              if reset else f"no reset within 200 ms of holding TIM5's interrupt (fault: {m.fault})"))
 
