@@ -25,7 +25,6 @@ from unicorn import UC_HOOK_CODE, UC_HOOK_INTR, UC_HOOK_MEM_WRITE, Uc, UcError
 from unicorn import arm_const as A
 
 from elf import Elf
-from models.base import NEVER
 from models.dma import Dma, unpack_words
 from models.dwt import Dwt
 from models.flash import FLASH_BASE, FLASH_SIZE, FlashInterface
@@ -381,7 +380,11 @@ class Machine:
             model.reset()
         for port in self.gpio.values():
             port.instance = type(port.instance)()
+        history = (self.flash.erases, self.flash.programs, self.flash.rejected)
         self.flash.__init__(self)
+        self.flash.erases, self.flash.programs, self.flash.rejected = history  # kept for the checks
+        self.otg.__init__()
+        self.dwt.__init__(self.clock)
         self._cache.clear()
         self._cpu_reset()
         self.rcc.set_reset_flags(flags)

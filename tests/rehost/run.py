@@ -23,7 +23,7 @@ from elf import memory_x  # noqa: E402
 from machine import SYSCLK, Machine  # noqa: E402
 from models import dma as D  # noqa: E402
 from models import tim as T  # noqa: E402
-from models.flash import FLASH_BASE, sector_of  # noqa: E402
+from models.flash import sector_of  # noqa: E402
 from models.rcc import IWDGRSTF  # noqa: E402
 
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411.rs, SETTINGS)
