@@ -42,7 +42,7 @@ PAINT = 0xA5  # unused RAM is painted with this before the run, to measure the s
 R = [A.UC_ARM_REG_R0, A.UC_ARM_REG_R1, A.UC_ARM_REG_R2, A.UC_ARM_REG_R3, A.UC_ARM_REG_R12, A.UC_ARM_REG_LR]
 S = [getattr(A, f"UC_ARM_REG_S{i}") for i in range(16)]
 
-# RM0383 10.2 Table 37: the NVIC lines of the modelled peripherals
+# RM0383 10.2 (vector table): the NVIC lines of the modelled peripherals
 TIMERS = {  # label: (base, irq_up, irq_cc, bits)
     "tim1": (0x4001_0000, 25, 27, 16),
     "tim2": (0x4000_0000, 28, 28, 32),
@@ -52,7 +52,7 @@ TIMERS = {  # label: (base, irq_up, irq_cc, bits)
 }
 DMA1_IRQS = [11, 12, 13, 14, 15, 16, 17, 47]
 DMA2_IRQS = [56, 57, 58, 59, 60, 68, 69, 70]
-# RM0383 9.3.3 Tables 27-28: where each timer's update request goes (controller, stream, channel)
+# RM0383 9.3.3 (request mapping tables): where each timer's update request goes (controller, stream, channel)
 UPDATE_REQUESTS = {
     "tim1": [("dma2", 5, 6)],
     "tim2": [("dma1", 1, 3), ("dma1", 7, 3)],
@@ -367,7 +367,7 @@ class Machine:
         self.stack_low = msp
 
     def system_reset(self, cause):
-        """A system reset: every peripheral to its reset state, RAM and flash kept (RM0383 6.1.2)."""
+        """A system reset: every peripheral to its reset state, RAM and flash kept (RM0383 6.1, system reset)."""
         flags = {"IWDG": IWDGRSTF | PINRSTF, "SYSRESETREQ": SFTRSTF | PINRSTF}[cause]
         self.resets.append((self.now, cause))
         for label in QILING_PERIPHERALS + ["scb", "systick"]:

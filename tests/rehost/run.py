@@ -153,7 +153,7 @@ def main():
     c.check("boot-clocks", not bad and m.rcc.sysclk_hz() == 96_000_000 and vco // pll_q == 48_000_000,
             f"SYSCLK {m.rcc.sysclk_hz() / 1e6:g} MHz (VCO {vco / 1e6:g} MHz / P {pll_p}), USB {vco / pll_q / 1e6:g} MHz, "
             f"APB1 {96 / (2 ** (ppre1 - 3) if ppre1 >= 4 else 1):g} MHz, FLASH_ACR {acr:#06x} "
-            f"(LATENCY {acr & 0xF}, RM0383 Table 5: 3 WS for 90-100 MHz)" + (f"; wrong: {', '.join(bad)}" if bad else ""))
+            f"(LATENCY {acr & 0xF}, RM0383 3.4: 3 WS for 90-100 MHz at 2.7-3.6 V)" + (f"; wrong: {', '.join(bad)}" if bad else ""))
 
     fault = m.fault or (p.faults and f"{p.faults[0][0]} entered at {ms(p.faults[0][1]):.2f} ms") or (
         m.resets and f"{len(m.resets)} resets: {', '.join(f'{cause} at {ms(t):.1f} ms' for t, cause in m.resets[:3])}")

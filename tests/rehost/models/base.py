@@ -6,7 +6,7 @@ NEVER = float("inf")
 class Block:
     """Subclasses implement `read32(offset)` and `write32(offset, value)` on word-aligned offsets.
 
-    A narrower write keeps the other bytes at what the register reads now (RM0383 2.1: the peripherals accept
+    A narrower write keeps the other bytes at what the register reads now (RM0383 ch. 2 and each register's description: the peripherals accept
     byte, half-word and word accesses); for write-1-to-clear registers, which read 0, that writes 0 there.
     """
 

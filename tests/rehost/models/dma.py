@@ -3,7 +3,7 @@ circular mode, half-transfer and transfer-complete flags and interrupts.
 
 Qiling's STM32F4xxDma moves a whole block at once without waiting for requests, has no circular reload and no
 half-transfer flag, and indexes stream 4 wrongly. Here a stream moves one data item per request of the channel
-its CR.CHSEL selects (RM0383 9.3.3, Tables 27-28); `request(stream, channel, n)` is called by the requesting
+its CR.CHSEL selects (RM0383 9.3.3, the DMA1/DMA2 request mapping tables); `request(stream, channel, n)` is called by the requesting
 peripheral model. Not modelled: memory-to-memory, double-buffer mode (CR.DBM), the FIFO's threshold behaviour
 (direct and FIFO mode move the same data here), bursts, priorities between streams, error flags.
 """
@@ -28,7 +28,7 @@ class Stream:
         self.par = self.m0ar = self.m1ar = 0
         self.fcr = 0x21  # RM0383 9.5.10: reset value (FIFO empty, direct mode)
         self.flags = 0
-        self.reload = 0  # NDTR when the stream was enabled: circular mode reloads it (RM0383 9.3.9)
+        self.reload = 0  # NDTR when the stream was enabled: circular mode reloads it (RM0383 9.3, circular mode)
         self.done = 0  # items moved in the current cycle
         self.items = 0  # items moved since reset
 
@@ -43,7 +43,7 @@ class Dma(Block):
     def __init__(self, name, bus, pend, irqs):
         """`bus.read_words(addr, n)` / `bus.write_words(addr, words)` (same address, PINC = 0) and
         `bus.read(addr, size)` / `bus.write(addr, size, value)`; `irqs`: the NVIC line of each stream
-        (DMA1: 11-17, 47; DMA2: 56-60, 68-70, RM0383 10.2 Table 37)."""
+        (DMA1: 11-17, 47; DMA2: 56-60, 68-70, RM0383 10.2, vector table)."""
         self.name, self.bus, self.pend, self.irqs = name, bus, pend, irqs
         self.reset()
 
@@ -67,13 +67,13 @@ class Dma(Block):
             st.items += k
             st.ndtr -= k
             if st.done >= half and st.done - k < half:
-                st.flags |= HTIF  # RM0383 9.3.11: half of the data items transferred
+                st.flags |= HTIF  # RM0383 9.3, interrupts: half of the data items transferred
             if st.ndtr == 0:
-                st.flags |= TCIF  # RM0383 9.3.11: NDTR reached 0
+                st.flags |= TCIF  # RM0383 9.3, interrupts: NDTR reached 0
                 if st.cr & CIRC:
-                    st.ndtr, st.done = st.reload, 0  # RM0383 9.3.9 circular mode: NDTR reloaded
+                    st.ndtr, st.done = st.reload, 0  # RM0383 9.3, circular mode: NDTR reloaded
                 else:
-                    st.cr &= ~EN  # RM0383 9.3.17: the stream is disabled at the end of the transfer
+                    st.cr &= ~EN  # RM0383 9.3, stream configuration: the stream is disabled at the end of the transfer
         self._irq(s)
 
     def horizon(self, s):
@@ -136,7 +136,7 @@ class Dma(Block):
         if reg == 0:
             if st.cr & EN:
                 if not value & EN:
-                    # RM0383 9.3.17: disabling a stream mid-transfer ends it and sets TCIF
+                    # RM0383 9.3, stream configuration: disabling a stream mid-transfer ends it and sets TCIF
                     st.cr &= ~EN
                     st.flags |= TCIF
                     self._irq(s)

@@ -9,15 +9,15 @@ routes every CPU store into flash through `cpu_write`.
 from .base import Block
 
 FLASH_BASE = 0x0800_0000
-# RM0383 3.3 Table 4: sectors 0-3 of 16 KiB, 4 of 64 KiB, 5-7 of 128 KiB (512 KiB, STM32F411xE)
+# RM0383 3.3 (flash module organisation): sectors 0-3 of 16 KiB, 4 of 64 KiB, 5-7 of 128 KiB (512 KiB, STM32F411xE)
 SECTORS = [(0x0000, 0x4000), (0x4000, 0x4000), (0x8000, 0x4000), (0xC000, 0x4000), (0x10000, 0x10000)] + [
     (0x20000 * i, 0x20000) for i in (1, 2, 3)
 ]
 FLASH_SIZE = 0x80000
-KEY1, KEY2 = 0x4567_0123, 0xCDEF_89AB  # RM0383 3.5.1 / 3.9.2 FLASH_KEYR unlock sequence
-# RM0383 3.9.5 FLASH_CR
+KEY1, KEY2 = 0x4567_0123, 0xCDEF_89AB  # RM0383 3.5.1, FLASH_KEYR: unlock sequence
+# RM0383 ch. 3 registers, FLASH_CR
 PG, SER, MER, STRT, LOCK = 1 << 0, 1 << 1, 1 << 2, 1 << 16, 1 << 31
-# RM0383 3.9.4 FLASH_SR
+# RM0383 ch. 3 registers, FLASH_SR
 EOP, OPERR, WRPERR, PGAERR, PGPERR, PGSERR, BSY = 1, 2, 1 << 4, 1 << 5, 1 << 6, 1 << 7, 1 << 16
 
 
@@ -37,8 +37,8 @@ class FlashInterface(Block):
         self.memory = memory
         self.acr = 0
         self.sr = 0
-        self.cr = LOCK  # RM0383 3.9.5: CR resets locked (0x8000_0000)
-        self.optcr = 0x0FFF_AAED  # RM0383 3.9.6 reset value
+        self.cr = LOCK  # RM0383 FLASH_CR: resets locked (0x8000_0000)
+        self.optcr = 0x0FFF_AAED  # RM0383 FLASH_OPTCR reset value
         self.key_step = 0
         self.key_error = False
         self.erases = []  # sector numbers erased
@@ -58,7 +58,7 @@ class FlashInterface(Block):
 
     def write32(self, off, value):
         if off == self.ACR:
-            self.acr = value & 0x1F0F  # LATENCY (3:0), PRFTEN, ICEN, DCEN, ICRST, DCRST (RM0383 3.9.1)
+            self.acr = value & 0x1F0F  # LATENCY (3:0), PRFTEN, ICEN, DCEN, ICRST, DCRST (RM0383 3.4, FLASH_ACR)
         elif off == self.KEYR:
             # RM0383 3.5.1: KEY1 then KEY2 clears LOCK; a wrong sequence locks the interface until reset
             if self.key_error or not self.cr & LOCK:
@@ -71,10 +71,10 @@ class FlashInterface(Block):
             else:
                 self.key_error = True
         elif off == self.SR:
-            self.sr &= ~(value & (EOP | OPERR | WRPERR | PGAERR | PGPERR | PGSERR))  # rc_w1 (3.9.4)
+            self.sr &= ~(value & (EOP | OPERR | WRPERR | PGAERR | PGPERR | PGSERR))  # rc_w1 (FLASH_SR)
         elif off == self.CR:
             if self.cr & LOCK:
-                return  # RM0383 3.9.5: CR cannot be written while locked
+                return  # RM0383 3.5.1 / FLASH_CR: CR cannot be written while locked
             self.cr = value & 0x8301_03FF
             if value & STRT and value & SER:
                 self._erase((value >> 3) & 0xF)
@@ -98,7 +98,7 @@ class FlashInterface(Block):
     def cpu_write(self, addr, size, value, old):
         """A CPU store of `size` bytes into flash, whose previous content was `old` (bytes). Returns the bytes the
         array holds afterwards: programming only clears bits (RM0383 3.5.4), and without CR.PG nothing changes
-        and PGSERR is set (3.9.4)."""
+        and PGSERR is set (FLASH_SR)."""
         if self.cr & LOCK or not self.cr & PG:
             self.sr |= PGSERR
             self.rejected.append((addr, size, "locked" if self.cr & LOCK else "PG not set"))

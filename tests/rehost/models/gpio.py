@@ -33,7 +33,7 @@ class Gpio(STM32F4xxGpio):
         return 1 if pull == 1 else 0
 
     def idr(self):
-        # RM0383 8.3.10: an output pin's input reads back its output level
+        # RM0383 8.3 (I/O port control): IDR samples every pin, so an output reads back its level
         odr, moder, value = self.instance.ODR, self.instance.MODER, 0
         for pin in range(16):
             mode = (moder >> (2 * pin)) & 3

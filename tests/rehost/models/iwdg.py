@@ -1,13 +1,13 @@
-"""Independent watchdog (RM0383 section 17). Qiling's profile names IWDG but has no model for it.
+"""Independent watchdog (RM0383 section 15). Qiling's profile names IWDG but has no model for it.
 
-The down-counter runs from the LSI (32 kHz nominal, RM0383 6.2.5) through the prescaler (4 << PR); when it
+The down-counter runs from the LSI (32 kHz nominal, RM0383 6.2, LSI clock) through the prescaler (4 << PR); when it
 reaches 0 the chip resets (17.3.1). Times are in CPU cycles: `cycles_per_s` converts (96 MHz on this board).
 """
 
 from .base import NEVER, Block
 
-KEY_RELOAD, KEY_ACCESS, KEY_START = 0xAAAA, 0x5555, 0xCCCC  # RM0383 17.4.1 IWDG_KR
-PVU, RVU = 1 << 0, 1 << 1  # RM0383 17.4.4 IWDG_SR
+KEY_RELOAD, KEY_ACCESS, KEY_START = 0xAAAA, 0x5555, 0xCCCC  # RM0383 15.4.1 IWDG_KR
+PVU, RVU = 1 << 0, 1 << 1  # RM0383 15.4.4 IWDG_SR
 
 
 class Iwdg(Block):
@@ -21,8 +21,8 @@ class Iwdg(Block):
     def reset(self):
         self.started = False
         self.access = False
-        self.pr = self.pr_act = 0  # RM0383 17.4.2: PR resets to 0 (divide by 4)
-        self.rlr = self.rlr_act = 0xFFF  # RM0383 17.4.3: RLR resets to 0xFFF
+        self.pr = self.pr_act = 0  # RM0383 15.4.2 IWDG_PR: PR resets to 0 (divide by 4)
+        self.rlr = self.rlr_act = 0xFFF  # RM0383 15.4.3 IWDG_RLR: RLR resets to 0xFFF
         self.pvu_until = self.rvu_until = 0
         self.t_a, self.c_a = 0, 0xFFF  # counter value c_a at time t_a
         self.reloads = []  # times of every KR = 0xAAAA while running
@@ -33,7 +33,7 @@ class Iwdg(Block):
         return (4 << pr) * self.cycles_per_s // self.lsi_hz
 
     def update_time(self):
-        # RM0383 17.4.4: a PR or RLR update takes up to 5 LSI periods (RC 40 kHz cycles) in the VDD domain
+        # RM0383 15.4.4 IWDG_SR: a PR or RLR update takes up to 5 LSI periods (RC 40 kHz cycles) in the VDD domain
         return 5 * self.cycles_per_s // self.lsi_hz
 
     def counter(self, now):
@@ -43,7 +43,7 @@ class Iwdg(Block):
         return self.t_a + self.c_a * self.tick(self.pr_act) if self.started else NEVER
 
     def _apply_updates(self, now):
-        # the new prescaler counts from here on; a new reload value is used from the next reload (17.3.2)
+        # the new prescaler counts from here on; a new reload value is used from the next reload (RM0383 15.3)
         if self.pvu_until and self.pvu_until <= now:
             at = self.pvu_until
             if self.started:
@@ -56,7 +56,7 @@ class Iwdg(Block):
         self._apply_updates(now)
         if self.started and self.expired_at is None and self.deadline() <= now:
             self.expired_at = self.deadline()
-            self.on_timeout(self.expired_at)  # RM0383 17.3.1: counter at 0x000: reset
+            self.on_timeout(self.expired_at)  # RM0383 15.3: counter at 0x000: reset
 
     def next_event(self, now):
         return max(now + 1, min(self.deadline(), self.pvu_until or NEVER, self.rvu_until or NEVER))
@@ -77,14 +77,14 @@ class Iwdg(Block):
         self.advance(now)
         if off == self.KR:
             key = value & 0xFFFF
-            self.access = key == KEY_ACCESS  # RM0383 17.3.4: any other key protects PR and RLR again
+            self.access = key == KEY_ACCESS  # RM0383 15.3 (register access protection): any other key protects PR and RLR again
             if key == KEY_START and not self.started:
-                self.started = True  # RM0383 17.3.1: start counting from the reset value 0xFFF
+                self.started = True  # RM0383 15.3: start counting from the reset value 0xFFF
                 self.c_a, self.t_a = self.rlr_act, now
             elif key == KEY_RELOAD:
                 if self.started:
                     self.reloads.append(now)
-                self.c_a, self.t_a = self.rlr_act, now  # RM0383 17.3.2: reload the counter with RLR
+                self.c_a, self.t_a = self.rlr_act, now  # RM0383 15.3: reload the counter with RLR
         elif off == self.PR and self.access:
             self.pr, self.pvu_until = value & 7, now + self.update_time()
         elif off == self.RLR and self.access:

@@ -10,7 +10,7 @@ call `set_pending(IRQn)` with IRQn < 0 for system exceptions (-2 PendSV, -1 SysT
 
 from .base import Block
 
-IRQS = 240  # PM0214 4.2: up to 240 interrupts (the F411 has 86, RM0383 10.2 Table 37)
+IRQS = 240  # PM0214 4.2: up to 240 interrupts (the F411 has 86, RM0383 10.2, vector table)
 PRIO_BITS = 0xF0  # PM0214 4.2.7: the STM32F4 implements the 4 upper bits of each priority byte
 
 

@@ -7,10 +7,10 @@ traffic is modelled: the link over USB is for the first board (tests/rehost/READ
 
 from .base import Block
 
-# RM0383 22.16.3 OTG_FS_GRSTCTL
+# RM0383 22.16, OTG_FS_GRSTCTL
 CSRST, RXFFLSH, TXFFLSH, AHBIDL = 1 << 0, 1 << 4, 1 << 5, 1 << 31
 SELF_CLEARING = CSRST | RXFFLSH | TXFFLSH | (1 << 2)  # core soft reset, FIFO flushes, HCLK soft reset
-# RM0383 22.16.4 OTG_FS_GINTSTS: bits the core sets, cleared by writing 1 (rc_w1)
+# RM0383 22.16, OTG_FS_GINTSTS: bits the core sets, cleared by writing 1 (rc_w1)
 GINTSTS_RC_W1 = 0xF030_FC0A
 
 
@@ -31,7 +31,7 @@ class OtgFs(Block):
             # CMOD (bit 0) = 0: device mode; no host: no reset, enumeration or traffic is ever flagged
             return self.regs.get(off, 0) & ~1
         if off == self.CID:
-            return self.regs.get(off, 0x0000_1200)  # RM0383 22.16.4 OTG_FS_CID reset value
+            return self.regs.get(off, 0x0000_1200)  # RM0383 22.16, OTG_FS_CID: a product ID, not checked
         return self.regs.get(off, 0)
 
     def write32(self, off, value):

@@ -7,10 +7,10 @@ does not do), and CSR.RMVF does not clear the reset flags.
 from qiling.hw.misc.stm32f4xx_rcc import STM32F4xxRcc
 
 CR, PLLCFGR, CFGR, CSR = 0x00, 0x04, 0x08, 0x74
-# RM0383 6.3.20 RCC_CSR reset flags
+# RM0383 6.3, RCC_CSR reset flags
 RMVF = 1 << 24
 BORRSTF, PINRSTF, PORRSTF, SFTRSTF, IWDGRSTF, WWDGRSTF, LPWRRSTF = (1 << n for n in range(25, 32))
-POWER_ON = BORRSTF | PINRSTF | PORRSTF  # RM0383 6.3.20: CSR after a power-on reset (0x0E00_0000)
+POWER_ON = BORRSTF | PINRSTF | PORRSTF  # RM0383 6.3, RCC_CSR after a power-on reset (0x0E00_0000)
 HSE_HZ = 25_000_000  # the Black Pill's crystal
 HSI_HZ = 16_000_000
 
@@ -24,7 +24,7 @@ class Rcc(STM32F4xxRcc):
 
     def write(self, offset, size, value):
         if offset == CSR and value & RMVF:
-            # RM0383 6.3.20: writing RMVF clears every reset flag
+            # RM0383 6.3, RCC_CSR: writing RMVF clears every reset flag
             value &= ~(RMVF | 0xFE00_0000)
         super().write(offset, size, value)
 

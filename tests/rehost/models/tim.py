@@ -6,7 +6,7 @@ stores SR writes instead of clearing on write 0, ignores EGR.UG and makes no DMA
 
 The counter is computed from the clock rather than stepped: at time `t_a` it held `c_a`, and it counts once per
 `PSC + 1` cycles of the timer clock (here the CPU clock: on this board both APB timer clocks equal SYSCLK, 96 MHz,
-RM0383 6.2 Figure 12). Not modelled: down and centre-aligned counting (CR1.DIR/CMS), slave modes (SMCR), input
+RM0383 6.2, clock tree). Not modelled: down and centre-aligned counting (CR1.DIR/CMS), slave modes (SMCR), input
 capture, output pins, break (BDTR), DMA burst (DCR/DMAR), CCxDE requests.
 """
 
@@ -33,7 +33,7 @@ class Tim(Block):
 
     def __init__(self, name, clock, pend, irq_up, irq_cc, bits=16):
         """`irq_up`/`irq_cc`: the NVIC lines of the update and capture/compare interrupts (the same line on
-        TIM2-5; TIM1_UP_TIM10 = 25 and TIM1_CC = 27 on TIM1, RM0383 10.2 Table 37)."""
+        TIM2-5; TIM1_UP_TIM10 = 25 and TIM1_CC = 27 on TIM1, RM0383 10.2, vector table)."""
         self.name, self.clock, self.pend = name, clock, pend
         self.irq_up, self.irq_cc = irq_up, irq_cc
         self.max = (1 << bits) - 1
@@ -47,7 +47,7 @@ class Tim(Block):
         self.cr1 = self.dier = self.sr = self.psc = self.rcr = 0
         self.arr = self.max  # RM0383 12.4.12 / 13.4.12: ARR resets to all ones
         self.ccr = [0, 0, 0, 0]
-        # active (shadow) registers, loaded at an update event (RM0383 12.3.1 Figures 71-74)
+        # active (shadow) registers, loaded at an update event (RM0383 12.3.1, time-base unit)
         self.psc_act, self.arr_act, self.rep = 0, self.max, 0
         self.t_a = self.last = self.clock()
         self.c_a = 0
@@ -94,7 +94,7 @@ class Tim(Block):
             end = min(now, t_wrap)
             c0, c1 = self._count(self.last), self.c_a + (end - self.t_a) // per
             if c1 > c0:
-                # RM0383 12.3.6 / 13.3.7 output compare: CCxIF when the counter matches CCRx
+                # RM0383 12.3 / 13.3, output compare mode: CCxIF when the counter matches CCRx
                 for ch in range(4):
                     ccr = self.ccr[ch]
                     if c0 < ccr <= min(c1, top) or (ccr == 0 and end == t_wrap):
