@@ -33,6 +33,8 @@ STEP_PINS, ENABLE_N, LOGIC_RELAY, POWER_RELAY = range(6), 13, 14, 15  # board::P
 
 
 class Checks:
+    """The checks' tally; one instance, `CHECKS`, so that a harness error still reports the count so far."""
+
     def __init__(self):
         self.passed = self.failed = 0
 
@@ -42,6 +44,9 @@ class Checks:
             self.passed += 1
         else:
             self.failed += 1
+
+
+CHECKS = Checks()
 
 
 def ms(cycles):
@@ -104,9 +109,15 @@ class Snapshot:
         self.feeds = len(m.iwdg.reloads)
 
 
-def source_constant(path, name):
-    text = open(os.path.join(REPO, path)).read()
-    return int(re.search(rf"const {name}: \w+ = ([\d_]+);", text).group(1).replace("_", ""))
+def source_constant(name):
+    """An integer `const` of the core (`shared/src`), wherever it is defined."""
+    for root, _dirs, files in os.walk(os.path.join(REPO, "shared/src")):
+        for f in sorted(files):
+            if f.endswith(".rs"):
+                found = re.search(rf"const {name}: \w+ = ([\d_]+);", open(os.path.join(root, f)).read())
+                if found:
+                    return int(found.group(1).replace("_", ""))
+    raise KeyError(f"const {name} not found under shared/src")
 
 
 def main():
@@ -117,7 +128,7 @@ def main():
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the README")
     args = ap.parse_args()
 
-    c = Checks()
+    c = CHECKS
     ram = memory_x(args.memory_x)["RAM"]
     wall0 = time.time()
     m = Machine(args.elf, ram)
@@ -178,8 +189,8 @@ def main():
 
     # -- the step generator: TIM1 update -> DMA2 stream 5 channel 6 -> GPIOB.BSRR --
     tim1, st = m.tim["tim1"], m.dma["dma2"].streams[5]
-    slot_ns = source_constant("shared/src/controller/config.rs", "STEP_SLOT_NS")
-    ring = 3 * source_constant("shared/src/controller/config.rs", "MAX_STEP_SLOTS")
+    slot_ns = source_constant("STEP_SLOT_NS")
+    ring = 3 * source_constant("MAX_STEP_SLOTS")
     ring_buf = m.elf.one(r"board::start::\{\{closure\}\}::RING_BUF$")[1]
     arr = SYSCLK * slot_ns // 1_000_000_000 - 1
     config = {
@@ -283,4 +294,12 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    try:
+        sys.exit(main())
+    except Exception as e:  # a harness error is a failed check, said as one, not a traceback alone
+        import traceback
+
+        traceback.print_exc()
+        print(f"FAIL harness: {type(e).__name__}: {e}")
+        print(f"{CHECKS.passed} passed, {CHECKS.failed + 1} failed")
+        sys.exit(1)
