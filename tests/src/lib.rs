@@ -2,6 +2,7 @@
 //! data-driven scenarios ([`scenario`], files under `tests/scenarios/`).
 
 pub mod scenario;
+pub mod setup;
 
 /// The simulated plant lives in the core, where the host's simulator uses it too.
 pub use ringpod_core::sim as plant;

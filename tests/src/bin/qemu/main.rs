@@ -17,7 +17,6 @@ mod emulator;
 mod host_cli;
 mod rig;
 mod self_check;
-mod setup;
 mod watchdog;
 
 use std::process::ExitCode;
@@ -25,8 +24,8 @@ use std::process::ExitCode;
 use crate::controller::controller_on_m4f;
 use crate::rig::rig_on_m4f;
 use crate::self_check::core_on_m4f;
-use crate::setup::preflight;
 use crate::watchdog::watchdog_on_m4f;
+use ringpod_tests::setup::{self, preflight};
 
 pub(crate) struct Tally {
     passed: u32,

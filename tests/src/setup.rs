@@ -1,4 +1,5 @@
-//! What the suite needs on this machine before anything is built: the `thumbv7em-none-eabihf` standard library for
+//! What the emulator suites need on this machine before anything is built (the QEMU runner, `--bin qemu`, and the
+//! rehost runner, `--bin rehost`, which needs only the target): the `thumbv7em-none-eabihf` standard library for
 //! the toolchain `tests/qemu` builds with, and `qemu-system-arm`. Each is installed when missing and this process
 //! may (rustup for the target; apt-get as root or through password-less sudo for QEMU); otherwise the runner stops
 //! before building, with one line naming the exact command to run.
@@ -10,21 +11,25 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use crate::emulator::qemu_dir;
+/// `tests/qemu`: rustc run there picks the toolchain of the repository's `rust-toolchain.toml`, as the firmware
+/// build does.
+fn qemu_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("qemu")
+}
 
 /// The target the QEMU programs are built for (tests/qemu/.cargo/config.toml).
-pub(crate) const TARGET: &str = "thumbv7em-none-eabihf";
+pub const TARGET: &str = "thumbv7em-none-eabihf";
 
 /// Set to 1 to forbid the runner to install anything: it then only says what is missing and how to install it.
-pub(crate) const NO_INSTALL: &str = "RINGPOD_NO_INSTALL";
+pub const NO_INSTALL: &str = "RINGPOD_NO_INSTALL";
 
 /// Both requirements, in the order the build needs them; the first error stops the run.
-pub(crate) fn preflight() -> Result<(), String> {
+pub fn preflight() -> Result<(), String> {
     ensure_target()?;
     ensure_qemu()
 }
 
-fn may_install() -> bool {
+pub fn may_install() -> bool {
     std::env::var(NO_INSTALL).map_or(true, |v| v.is_empty() || v == "0")
 }
 
@@ -71,7 +76,7 @@ fn rustup_toolchain() -> Option<String> {
 }
 
 /// Makes sure the target's standard library is installed, adding it with rustup when it is not.
-fn ensure_target() -> Result<(), String> {
+pub fn ensure_target() -> Result<(), String> {
     let (dir, present) = target_library()?;
     if present {
         return Ok(());

@@ -1,0 +1,305 @@
+"""Runs the release firmware ELF, exactly as flashed, on Qiling's stm32f411 model with the harness's peripheral
+models, and checks what it does. Prints `PASS name: detail` / `FAIL name: detail` per check and finally
+`N passed, M failed`; exits 1 when a check failed.
+
+    python run.py [--elf PATH] [--memory-x PATH] [--config PATH] [--seconds S]
+"""
+
+import argparse
+import os
+import re
+import sys
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+REPO = os.path.dirname(os.path.dirname(HERE))
+
+from unicorn import UC_HOOK_MEM_READ  # noqa: E402
+from unicorn import arm_const as A  # noqa: E402
+
+from defmt_log import DefmtLog  # noqa: E402
+from elf import memory_x  # noqa: E402
+from machine import SYSCLK, Machine  # noqa: E402
+from models import dma as D  # noqa: E402
+from models import tim as T  # noqa: E402
+from models.flash import sector_of  # noqa: E402
+from models.rcc import IWDGRSTF  # noqa: E402
+
+SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411.rs, SETTINGS)
+GPIOB_BSRR = 0x4002_0418
+TIM5_IRQ = 50
+STEP_PINS, ENABLE_N, LOGIC_RELAY, POWER_RELAY = range(6), 13, 14, 15  # board::PORT_MAP, pin table
+
+
+class Checks:
+    """The checks' tally; one instance, `CHECKS`, so that a harness error still reports the count so far."""
+
+    def __init__(self):
+        self.passed = self.failed = 0
+
+    def check(self, name, ok, detail):
+        print(f"{'PASS' if ok else 'FAIL'} {name}: {detail}", flush=True)
+        if ok:
+            self.passed += 1
+        else:
+            self.failed += 1
+
+
+CHECKS = Checks()
+
+
+def ms(cycles):
+    return cycles * 1000 / SYSCLK
+
+
+class Probes:
+    """Breakpoints and watches on the firmware, by the ELF's symbols."""
+
+    def __init__(self, m):
+        self.m = m
+        elf = m.elf
+        self.pools = {name.split("::")[-2]: (addr, size) for name, addr, size in elf.find(r"::POOL$")}
+        self.polled = {}  # task -> set of IPSR values it was polled in
+        for _name, addr, _size in elf.find(r"TaskStorage<F>::poll$"):
+            m.add_breakpoint(addr, self._poll)
+        self.reached = {}
+        for label, pattern in (("Executor::run", r"thread::Executor::run$"),
+                               ("board::start", r"board::start::\{\{closure\}\}$")):
+            for _name, addr, _size in elf.find(pattern):
+                m.add_breakpoint(addr, lambda mm, label=label: self.reached.setdefault(label, mm.now))
+        self.faults = []
+        for pattern in (r"^HardFault_?$", r"^DefaultHandler_?$", r"rust_begin_unwind", r"^_defmt_panic$"):
+            for name, addr, _size in elf.find(pattern):
+                m.add_breakpoint(addr, lambda mm, name=name: self.faults.append((name, mm.now)))
+        self.settings_reads = 0
+        self.settings_not_erased = 0
+        m.uc.hook_add(UC_HOOK_MEM_READ, self._settings_read, None, SETTINGS[0], SETTINGS[1] - 1)
+        self.csr_reads = []  # (time, value) of RCC_CSR reads
+        rcc_read = m.rcc.read
+
+        def read(offset, size, rcc_read=rcc_read):
+            value = rcc_read(offset, size)
+            if offset == 0x74:
+                self.csr_reads.append((m.now, value))
+            return value
+
+        m.rcc.read = read
+
+    def _poll(self, m):
+        r0 = m.reg(A.UC_ARM_REG_R0)
+        for task, (addr, size) in self.pools.items():
+            if addr <= r0 < addr + size:
+                self.polled.setdefault(task, set()).add(m.reg(A.UC_ARM_REG_IPSR) & 0x1FF)
+
+    def _settings_read(self, uc, access, addr, size, value, ud):
+        self.settings_reads += 1
+        if bytes(uc.mem_read(addr, size)) != b"\xff" * size:
+            self.settings_not_erased += 1
+
+
+class Snapshot:
+    def __init__(self, m):
+        st = m.dma["dma2"].streams[5]
+        self.t = m.now
+        self.updates = m.tim["tim1"].updates
+        self.items = st.items
+        self.bsrr = m.gpio["b"].dma_words
+        self.dma_irqs = m.entries.get(16 + 68, 0)
+        self.feeds = len(m.iwdg.reloads)
+
+
+def source_constant(name):
+    """An integer `const` of the core (`shared/src`), wherever it is defined."""
+    for root, _dirs, files in os.walk(os.path.join(REPO, "shared/src")):
+        for f in sorted(files):
+            if f.endswith(".rs"):
+                found = re.search(rf"const {name}: \w+ = ([\d_]+);", open(os.path.join(root, f)).read())
+                if found:
+                    return int(found.group(1).replace("_", ""))
+    raise KeyError(f"const {name} not found under shared/src")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--elf", default=os.path.join(REPO, "target/thumbv7em-none-eabihf/release/ringpod-firmware"))
+    ap.add_argument("--memory-x", default=os.path.join(REPO, "memory.x"))
+    ap.add_argument("--seconds", type=float, default=1.0, help="simulated seconds of normal running")
+    ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the README")
+    args = ap.parse_args()
+
+    c = CHECKS
+    ram = memory_x(args.memory_x)["RAM"]
+    wall0 = time.time()
+    m = Machine(args.elf, ram)
+    p = Probes(m)
+    log = DefmtLog(m)
+    m.observers.append(log.poll)
+    if args.count_instructions:
+        m.count_instructions()
+
+    # -- boot, then normal running: no host, no switch changes --
+    boot_end = int(0.1 * SYSCLK)
+    m.run(boot_end)
+    before = Snapshot(m)
+    m.run(boot_end + int(args.seconds * SYSCLK))
+    after = Snapshot(m)
+    wall_run = time.time() - wall0
+
+    rcc, acr = m.rcc.instance, m.flash.acr
+    pll = rcc.PLLCFGR
+    pll_m, pll_n, pll_p, pll_q = pll & 0x3F, (pll >> 6) & 0x1FF, 2 * (((pll >> 16) & 3) + 1), (pll >> 24) & 0xF
+    vco = 25_000_000 // pll_m * pll_n
+    cfgr = rcc.CFGR
+    ppre1, ppre2 = (cfgr >> 10) & 7, (cfgr >> 13) & 7
+    clocks = {
+        "HSE on+ready, oscillator (not bypass)": rcc.CR & (1 << 16) and rcc.CR & (1 << 17) and not rcc.CR & (1 << 18),
+        "PLL on+ready from HSE": rcc.CR & (1 << 24) and rcc.CR & (1 << 25) and pll & (1 << 22),
+        "M/N/P/Q = 25/384/4/8": (pll_m, pll_n, pll_p, pll_q) == (25, 384, 4, 8),
+        "SYSCLK = PLL (SWS)": (cfgr >> 2) & 3 == 2,
+        "AHB /1, APB1 /2, APB2 /1": (cfgr >> 4) & 0xF == 0 and ppre1 == 4 and ppre2 < 4,
+        "flash latency 3 WS": acr & 0xF == 3,
+    }
+    bad = [k for k, ok in clocks.items() if not ok]
+    c.check("boot-clocks", not bad and m.rcc.sysclk_hz() == 96_000_000 and vco // pll_q == 48_000_000,
+            f"SYSCLK {m.rcc.sysclk_hz() / 1e6:g} MHz (VCO {vco / 1e6:g} MHz / P {pll_p}), USB {vco / pll_q / 1e6:g} MHz, "
+            f"APB1 {96 / (2 ** (ppre1 - 3) if ppre1 >= 4 else 1):g} MHz, FLASH_ACR {acr:#06x} "
+            f"(LATENCY {acr & 0xF}, RM0383 3.4: 3 WS for 90-100 MHz at 2.7-3.6 V)" + (f"; wrong: {', '.join(bad)}" if bad else ""))
+
+    fault = m.fault or (p.faults and f"{p.faults[0][0]} entered at {ms(p.faults[0][1]):.2f} ms") or (
+        m.resets and f"{len(m.resets)} resets: {', '.join(f'{cause} at {ms(t):.1f} ms' for t, cause in m.resets[:3])}")
+    c.check("boot-no-fault", not fault and not m.resets,
+            fault or f"no HardFault, DefaultHandler, panic or emulator fault; no reset; "
+            f"board::start at {ms(p.reached.get('board::start', 0)):.2f} ms, Executor::run at "
+            f"{ms(p.reached.get('Executor::run', 0)):.2f} ms")
+
+    stack_top, stack_floor = ram[0] + ram[1], m.elf.address("_stack_end")
+    deepest = min(m.stack_depth_lowest(), m.stack_low)
+    c.check("boot-stack", stack_floor <= deepest < stack_top and m.stack_low >= stack_floor,
+            f"deepest stack write {deepest:#010x}: {stack_top - deepest} of {stack_top - stack_floor} bytes between "
+            f"_stack_end {stack_floor:#010x} and the top of RAM (memory.x {ram[0]:#010x}+{ram[1] // 1024}K); "
+            f"lowest SP seen {m.stack_low:#010x}")
+
+    tasks = ["control_task", "inputs_task", "usb_task", "link_task", "settings_task", "steps_task"]
+    missing = [t for t in tasks if t not in p.polled]
+    steps_ipsr = sorted(p.polled.get("steps_task", ()))
+    c.check("tasks-reached", not missing and steps_ipsr == [16 + 71] and "board::start" in p.reached,
+            f"polled: {', '.join(f'{t} (IPSR {sorted(v)})' for t, v in sorted(p.polled.items()))}; "
+            f"steps_task runs in USART6's interrupt (IPSR 87)" + (f"; never polled: {missing}" if missing else ""))
+
+    # -- the step generator: TIM1 update -> DMA2 stream 5 channel 6 -> GPIOB.BSRR --
+    tim1, st = m.tim["tim1"], m.dma["dma2"].streams[5]
+    slot_ns = source_constant("STEP_SLOT_NS")
+    ring = 3 * source_constant("MAX_STEP_SLOTS")
+    ring_buf = m.elf.one(r"board::start::\{\{closure\}\}::RING_BUF$")[1]
+    arr = SYSCLK * slot_ns // 1_000_000_000 - 1
+    config = {
+        f"TIM1 PSC 0 ARR {arr}": tim1.psc == 0 and tim1.arr == arr,
+        "TIM1 CEN, DIER.UDE": tim1.cr1 & T.CEN and tim1.dier & T.UDE,
+        "S5 CHSEL 6": st.channel == 6,
+        "memory-to-peripheral, circular, MINC, 32-bit": (st.cr >> 6) & 3 == 1 and st.cr & D.CIRC
+        and st.cr & D.MINC and not st.cr & D.PINC and (st.cr >> 11) & 3 == 2 and (st.cr >> 13) & 3 == 2,
+        "HTIE+TCIE": st.cr & D.HTIE and st.cr & D.TCIE,
+        "PAR = GPIOB.BSRR": st.par == GPIOB_BSRR,
+        f"M0AR = RING_BUF, NDTR {ring}": st.m0ar == ring_buf and st.reload == ring,
+    }
+    bad = [k for k, ok in config.items() if not ok]
+    c.check("steps-config", not bad and st.cr & D.EN,
+            f"TIM1 PSC {tim1.psc} ARR {tim1.arr} ({(tim1.arr + 1) * 1e9 / SYSCLK:g} ns) DIER {tim1.dier:#06x}; "
+            f"DMA2_S5CR {st.cr:#010x} (CHSEL {st.channel}) PAR {st.par:#010x} M0AR {st.m0ar:#010x} NDTR {st.reload}"
+            + (f"; wrong: {', '.join(bad)}" if bad else ""))
+
+    dt = after.t - before.t
+    updates, items, bsrr = after.updates - before.updates, after.items - before.items, after.bsrr - before.bsrr
+    expected = dt // (arr + 1)
+    irqs = after.dma_irqs - before.dma_irqs
+    c.check("steps-paced", abs(updates - expected) <= 1 and items == updates and bsrr == items
+            and abs(irqs - 2 * items / ring) <= 2,
+            f"over {ms(dt):.0f} ms: {updates} TIM1 updates (expected {expected}), {items} DMA words, "
+            f"{bsrr} GPIOB.BSRR writes by the DMA, {irqs} DMA2_STREAM5 interrupts (HT+TC every {ring // 2} words: "
+            f"{2 * items / ring:.1f})")
+
+    gpiob = m.gpio["b"]
+    step_edges = sum(gpiob.edges(pin, gpiob.rises) for pin in STEP_PINS)
+    odr = gpiob.instance.ODR
+    c.check("steps-idle", step_edges == 0 and odr >> ENABLE_N & 1 and not odr >> LOGIC_RELAY & 1
+            and not odr >> POWER_RELAY & 1,
+            f"no host command: {step_edges} STEP edges on PB0-PB5; ENABLE (PB13, active low) {odr >> ENABLE_N & 1}, "
+            f"relays PB14/PB15 {odr >> LOGIC_RELAY & 1}/{odr >> POWER_RELAY & 1}; GPIOB.ODR {odr:#06x}")
+
+    log.poll()
+    boot_log = list(log.lines)
+    up = [text for _, level, text in boot_log if "firmware up" in text]
+    noisy = [f"{level}: {text}" for _, level, text in boot_log if level not in ("info", "debug", "trace")]
+    c.check("log", up and any("settings:" in text for _, _, text in boot_log) and not noisy,
+            f"{len(boot_log)} defmt lines read over RTT, none above info"
+            f"{'; ' + up[0] if up else ''}" + (f"; {noisy[:3]}" if noisy else ""))
+
+    # -- the watchdog --
+    iw = m.iwdg
+    feeds = [t for t in iw.reloads if t >= before.t]
+    gaps = [b - a for a, b in zip(feeds, feeds[1:])]
+    timeout = iw.rlr_act * iw.tick(iw.pr_act)
+    c.check("watchdog-fed", iw.started and gaps and max(gaps) < timeout and not m.resets,
+            f"IWDG PR {iw.pr_act} (/{4 << iw.pr_act}) RLR {iw.rlr_act}: timeout {ms(timeout):.0f} ms at LSI 32 kHz; "
+            f"fed {len(feeds)} times in {ms(dt):.0f} ms, longest gap {ms(max(gaps or [0])):.2f} ms")
+
+    # -- settings flash --
+    erased = all(b == 0xFF for b in m.uc.mem_read(SETTINGS[0], SETTINGS[1] - SETTINGS[0]))
+    c.check("flash-erased", erased and p.settings_reads > 0 and p.settings_not_erased == 0,
+            f"sectors 6-7 read 0xFF; settings restore read them {p.settings_reads} times, all erased: nothing "
+            f"stored, the compiled-in configuration runs")
+    outside = [(a, s) for a, s in m.flash.programs if not SETTINGS[0] <= a < SETTINGS[1]]
+    bad_erase = [n for n in m.flash.erases if n not in (6, 7)]
+    c.check("flash-writes", not outside and not bad_erase and not m.flash.rejected,
+            f"{len(m.flash.programs)} programmed words, {len(m.flash.erases)} sector erases, "
+            f"{len(m.flash.rejected)} rejected stores; outside sectors 6-7: "
+            f"{[hex(a) for a, _ in outside] + [f'sector {n}' for n in bad_erase] or 'none'}"
+            + (f"; rejected at {[(hex(a), sector_of(a), why) for a, _, why in m.flash.rejected[:3]]}"
+               if m.flash.rejected else ""))
+
+    # -- the watchdog resets a stalled control loop --
+    held_at = m.now
+    last_feed = iw.reloads[-1] if iw.reloads else 0
+    m.nvic.held.add(TIM5_IRQ)  # the time driver's interrupt never arrives: every timer stalls
+    m.run(held_at + int(0.2 * SYSCLK))
+    reset = m.resets[0] if m.resets else None
+    after_reset = m.now
+    m.run(after_reset + int(0.3 * SYSCLK))
+    csr_after = [v for t, v in p.csr_reads if reset and t >= reset[0]]
+    log.poll()
+    said = [text for t, level, text in log.lines if reset and t >= reset[0] and level == "error"]
+    refeeds = [t for t in m.iwdg.reloads if reset and t > reset[0]]
+    since_reset = m.now - reset[0] if reset else 0
+    c.check("watchdog-reset", reset is not None and reset[1] == "IWDG" and csr_after
+            and csr_after[0] & IWDGRSTF and m.rcc.instance.CSR & IWDGRSTF == 0 and len(refeeds) > ms(since_reset) * 0.9
+            and any("the last reset was the watchdog's" in text for text in said)
+            and m.fault is None,
+            (f"TIM5's interrupt held from {ms(held_at):.1f} ms: IWDG reset at {ms(reset[0]):.1f} ms "
+             f"({ms(reset[0] - last_feed):.1f} ms after the last feed); after the reset the firmware read "
+             f"RCC_CSR {csr_after[0] if csr_after else 0:#010x} (IWDGRSTF {bool(csr_after and csr_after[0] & IWDGRSTF)}) "
+             f"and cleared it (RMVF), logged {said[0].split(' ms ', 1)[-1] if said else 'no error'!r}, fed the watchdog {len(refeeds)} times in the "
+             f"{ms(since_reset):.0f} ms after the reset"
+             if reset else f"no reset within 200 ms of holding TIM5's interrupt (fault: {m.fault})"))
+
+    wall = time.time() - wall0
+    sim = m.now / SYSCLK
+    print(f"rehost: {sim:.2f} simulated s in {wall:.1f} s wall ({wall / sim:.2f} s per simulated s; "
+          f"normal running {wall_run:.1f} s); the link, step edges of a move and switches are not run (no USB host)")
+    if args.count_instructions:
+        print(f"rehost: {m.instructions} instructions in {sim:.2f} simulated s ({m.instructions / sim / 1e6:.2f} M/s "
+              f"simulated, {100 * m.instructions / m.now:.1f}% of the cycles), {m.instructions / wall / 1e6:.2f} M/s wall")
+    print(f"{c.passed} passed, {c.failed} failed")
+    return 0 if c.failed == 0 else 1
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except Exception as e:  # a harness error is a failed check, said as one, not a traceback alone
+        import traceback
+
+        traceback.print_exc()
+        print(f"FAIL harness: {type(e).__name__}: {e}")
+        print(f"{CHECKS.passed} passed, {CHECKS.failed + 1} failed")
+        sys.exit(1)

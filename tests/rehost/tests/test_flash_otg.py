@@ -1,0 +1,68 @@
+import unittest
+
+from models.flash import FLASH_BASE, LOCK, PG, SER, STRT, FlashInterface, sector_of
+from models.otg import OtgFs
+from tests.helpers import Memory
+
+
+class FlashTest(unittest.TestCase):
+    def setUp(self):
+        self.mem = Memory()
+        self.f = FlashInterface(self.mem)
+
+    def unlock(self):
+        self.f.write(FlashInterface.KEYR, 4, 0x4567_0123)
+        self.f.write(FlashInterface.KEYR, 4, 0xCDEF_89AB)
+
+    def test_locked_until_the_key_sequence(self):
+        self.f.write(FlashInterface.CR, 4, PG)
+        self.assertEqual(self.f.read(FlashInterface.CR, 4), LOCK)
+        self.unlock()
+        self.f.write(FlashInterface.CR, 4, PG)
+        self.assertEqual(self.f.read(FlashInterface.CR, 4), PG)
+
+    def test_wrong_key_locks_until_reset(self):
+        self.f.write(FlashInterface.KEYR, 4, 0x1234)
+        self.unlock()
+        self.assertTrue(self.f.read(FlashInterface.CR, 4) & LOCK)
+
+    def test_sector_erase_fills_ff(self):
+        self.unlock()
+        self.f.write(FlashInterface.CR, 4, SER | (6 << 3) | STRT)
+        self.assertEqual(self.f.erases, [6])
+        self.assertEqual(self.mem.read(0x0804_0000, 4), 0xFFFFFFFF)
+        self.assertEqual(self.mem.read(0x0805_FFFC, 4), 0xFFFFFFFF)
+        self.assertNotIn(0x0806_0000, self.mem.mem)
+
+    def test_program_only_clears_bits_and_needs_pg(self):
+        old = b"\xff\xff\x0f\xff"
+        self.assertEqual(self.f.cpu_write(0x0804_0000, 4, 0x12345678, old), old)  # locked: rejected
+        self.unlock()
+        self.f.write(FlashInterface.CR, 4, PG)
+        self.assertEqual(self.f.cpu_write(0x0804_0000, 4, 0x12345678, old), bytes([0x78, 0x56, 0x04, 0x12]))
+        self.assertEqual(self.f.programs, [(0x0804_0000, 4)])
+
+    def test_sector_map(self):
+        self.assertEqual(sector_of(FLASH_BASE), 0)
+        self.assertEqual(sector_of(0x0801_0000), 4)
+        self.assertEqual(sector_of(0x0804_0000), 6)
+        self.assertEqual(sector_of(0x0807_FFFF), 7)
+        self.assertIsNone(sector_of(0x0808_0000))
+
+
+class OtgTest(unittest.TestCase):
+    def test_core_reset_completes_and_ahb_is_idle(self):
+        o = OtgFs()
+        o.write(OtgFs.GRSTCTL, 4, 1)
+        self.assertEqual(o.read(OtgFs.GRSTCTL, 4), 1 << 31)
+
+    def test_gintsts_is_rc_w1_in_device_mode(self):
+        o = OtgFs()
+        o.regs[OtgFs.GINTSTS] = (1 << 12) | 1
+        self.assertEqual(o.read(OtgFs.GINTSTS, 4), 1 << 12)
+        o.write(OtgFs.GINTSTS, 4, 1 << 12)
+        self.assertEqual(o.read(OtgFs.GINTSTS, 4), 0)
+
+
+if __name__ == "__main__":
+    unittest.main()

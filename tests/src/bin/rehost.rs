@@ -1,0 +1,180 @@
+//! `cargo run -p ringpod-tests --bin rehost`: the release firmware ELF, exactly as flashed, run on Qiling's
+//! stm32f411 model with the harness's peripheral models (`tests/rehost`, see its README).
+//!
+//! 1. The `thumbv7em-none-eabihf` standard library (the preflight the QEMU runner uses), then
+//!    `cargo build -p ringpod-firmware --target thumbv7em-none-eabihf --release`.
+//! 2. A Python venv in `target/rehost-venv` with the pinned emulator (`tests/rehost/requirements.txt`), made again
+//!    whenever that file changes.
+//! 3. The models' unit tests (`python -m unittest`), counted as one check, then `tests/rehost/run.py`, whose checks
+//!    print `PASS`/`FAIL` lines. The last line is the sum, `N passed, N failed`; the exit status is 1 when anything
+//!    failed.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode, Stdio};
+
+use ringpod_tests::setup;
+
+const FIRMWARE: &str = "ringpod-firmware";
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| repo().join("target"), PathBuf::from)
+}
+
+fn run(command: &mut Command, what: &str) -> Result<(), String> {
+    let status = command.status().map_err(|e| format!("{what}: cannot start: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("{what} failed ({status})"))
+    }
+}
+
+/// The release ELF, built as for flashing.
+fn build_firmware() -> Result<PathBuf, String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    run(
+        Command::new(cargo)
+            .current_dir(repo())
+            .args(["build", "-p", FIRMWARE, "--target", setup::TARGET, "--release"]),
+        "cargo build -p ringpod-firmware --release",
+    )?;
+    Ok(target_dir().join(setup::TARGET).join("release").join(FIRMWARE))
+}
+
+/// The venv's Python, with `requirements.txt` installed exactly.
+fn venv() -> Result<PathBuf, String> {
+    let dir = target_dir().join("rehost-venv");
+    let python = dir.join("bin/python");
+    let requirements = repo().join("tests/rehost/requirements.txt");
+    let wanted = std::fs::read_to_string(&requirements).map_err(|e| format!("{}: {e}", requirements.display()))?;
+    let stamp = dir.join("ringpod-requirements.txt");
+    if python.exists() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == wanted) {
+        return Ok(python);
+    }
+    let create = format!("python3 -m venv --clear {}", dir.display());
+    if !setup::may_install() {
+        return Err(format!(
+            "the emulator's venv is missing or stale: run `{create} && {} -m pip install -r {}`",
+            python.display(),
+            requirements.display()
+        ));
+    }
+    println!("== {create}; pip install -r tests/rehost/requirements.txt");
+    run(
+        Command::new("python3").args(["-m", "venv", "--clear"]).arg(&dir),
+        &create,
+    )
+    .map_err(|e| {
+        format!("{e}: the rehost runner needs Python 3.8+ with venv (on Debian: apt-get install python3-venv)")
+    })?;
+    run(
+        Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "-r"])
+            .arg(&requirements),
+        "pip install -r tests/rehost/requirements.txt",
+    )?;
+    std::fs::write(&stamp, wanted).map_err(|e| format!("{}: {e}", stamp.display()))?;
+    Ok(python)
+}
+
+/// The models' unit tests: Ok(number of tests) when all passed.
+fn unit_tests(python: &Path) -> Result<u32, String> {
+    let out = Command::new(python)
+        .current_dir(repo().join("tests/rehost"))
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .args(["-m", "unittest", "discover", "-s", "tests", "-t", "."])
+        .output()
+        .map_err(|e| format!("python -m unittest: {e}"))?;
+    let report = String::from_utf8_lossy(&out.stderr);
+    let ran = report
+        .lines()
+        .find_map(|l| l.strip_prefix("Ran ")?.split_whitespace().next()?.parse().ok())
+        .unwrap_or(0);
+    if out.status.success() && ran > 0 {
+        Ok(ran)
+    } else {
+        eprintln!("{report}");
+        Err(format!(
+            "{ran} tests ran, not all passed (python -m unittest, output above)"
+        ))
+    }
+}
+
+/// `N passed, M failed` alone on a line.
+fn tally(line: &str) -> Option<(u32, u32)> {
+    let (passed, failed) = line.trim().split_once(" passed, ")?;
+    Some((passed.parse().ok()?, failed.strip_suffix(" failed")?.parse().ok()?))
+}
+
+/// run.py, its lines passed through as they come, except its count, which is returned.
+fn checks(python: &Path, elf: &Path) -> Result<(u32, u32, bool), String> {
+    let mut child = Command::new(python)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .arg(repo().join("tests/rehost/run.py"))
+        .arg("--elf")
+        .arg(elf)
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("run.py: {e}"))?;
+    let mut count = None;
+    if let Some(out) = child.stdout.take() {
+        for line in BufReader::new(out).lines().map_while(Result::ok) {
+            match tally(&line) {
+                Some(c) => count = Some(c),
+                None => println!("{line}"),
+            }
+        }
+    }
+    let ok = child.wait().is_ok_and(|s| s.success());
+    let (passed, failed) = count.ok_or("run.py ended without its `N passed, N failed` line")?;
+    Ok((passed, failed, ok))
+}
+
+fn main() -> ExitCode {
+    let prepared = setup::ensure_target()
+        .and_then(|()| build_firmware())
+        .and_then(|elf| Ok((elf, venv()?)));
+    let (elf, python) = match prepared {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("rehost: {e}");
+            println!("0 passed, 1 failed");
+            return ExitCode::FAILURE;
+        }
+    };
+    let (mut passed, mut failed) = (0, 0);
+    match unit_tests(&python) {
+        Ok(n) => {
+            println!("PASS model-unit-tests: {n} tests of tests/rehost/models (python -m unittest)");
+            passed += 1;
+        }
+        Err(e) => {
+            println!("FAIL model-unit-tests: {e}");
+            failed += 1;
+        }
+    }
+    let mut ok = failed == 0;
+    match checks(&python, &elf) {
+        Ok((p, f, exited_ok)) => {
+            passed += p;
+            failed += f;
+            ok &= exited_ok && f == 0;
+        }
+        Err(e) => {
+            println!("FAIL run.py: {e}");
+            failed += 1;
+            ok = false;
+        }
+    }
+    println!("{passed} passed, {failed} failed");
+    if ok && failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
