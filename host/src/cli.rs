@@ -87,6 +87,9 @@ pub enum Command {
         /// model.
         #[arg(long, value_name = "RIG.toml")]
         geometry: Option<std::path::PathBuf>,
+        /// Simulate this preset's ring platform (`ringpod presets`), as --geometry does with its exported rig file.
+        #[arg(long, value_name = "PRESET", conflicts_with = "geometry")]
+        mechanism: Option<String>,
     },
 }
 
@@ -226,6 +229,10 @@ pub struct StreamArgs {
     /// trainer model.
     #[arg(long, value_name = "RIG.toml", requires = "sim")]
     pub geometry: Option<std::path::PathBuf>,
+    /// With --sim: simulate this preset's ring platform (`ringpod presets`) with the trainer model's drives and
+    /// switches, as --geometry does with its exported rig file.
+    #[arg(long, value_name = "PRESET", requires = "sim", conflicts_with = "geometry")]
+    pub mechanism: Option<String>,
     /// With --sim: run as fast as possible instead of in real time.
     #[arg(long, requires = "sim")]
     pub fast: bool,
@@ -497,7 +504,7 @@ impl StreamArgs {
             crate::link::Target::Port(port) => Device::Port(port),
             crate::link::Target::Sim => Device::Sim {
                 fast: self.fast,
-                rig: self.geometry.clone(),
+                platform: platform(&self.geometry, &self.mechanism),
             },
         };
         Ok(Job {
@@ -550,5 +557,15 @@ impl DeviceArgs {
             A::Restart => Action::Restart,
         };
         Ok((crate::link::Target::named(self.port.as_deref(), self.sim)?, action))
+    }
+}
+
+/// The platform a simulated controller runs: `--geometry RIG.toml` or `--mechanism PRESET` (clap keeps them apart),
+/// or the trainer model.
+pub fn platform(geometry: &Option<std::path::PathBuf>, mechanism: &Option<String>) -> Option<crate::device::Platform> {
+    match (geometry, mechanism) {
+        (Some(path), _) => Some(crate::device::Platform::File(path.clone())),
+        (None, Some(name)) => Some(crate::device::Platform::Preset(name.clone())),
+        (None, None) => None,
     }
 }

@@ -49,7 +49,9 @@ fn main() -> ExitCode {
             .request()
             .and_then(|(target, action)| device::run(&target, &action)),
         C::Ports => device::ports(),
-        C::Simulate { geometry, .. } => device::simulate(geometry.as_deref()),
+        C::Simulate {
+            geometry, mechanism, ..
+        } => device::simulate(cli::platform(geometry, mechanism).as_ref()),
         C::Cue(args) => analysis::cue::run(&args.options()).map(|(text, code)| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             code

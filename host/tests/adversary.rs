@@ -74,13 +74,6 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
             ),
             "ring_radius",
         ),
-        (
-            write(
-                "huge.toml",
-                good.replace("ring_radius = ", "ring_radius = 1e300 #").as_bytes(),
-            ),
-            "no solution",
-        ),
         (write("binary.toml", &[0xff, 0xfe, 0x00, 0x80, 0x13, 0x37]), "UTF-8"),
         (dir.join("missing.toml").display().to_string(), "No such file"),
         (dir.display().to_string(), "directory"),
@@ -116,6 +109,111 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
             assert_eq!(stderr.matches(cause).count(), 1, "{args:?}: the cause once: {stderr}");
         }
     }
+    // A valid mechanism that cannot be driven (a ring of 1e300 m: the home pose has no solution) is analysed and
+    // judged by `rig check` (exit 3, the reason once), and refused once, with its path, by what would drive it.
+    let huge = write(
+        "huge.toml",
+        good.replace("ring_radius = ", "ring_radius = 1e300 #").as_bytes(),
+    );
+    let (code, stdout, _) = run(&["rig", "check", &huge]);
+    assert_eq!(code, 3, "{stdout}");
+    assert!(stdout.contains("analysable: yes") && stdout.contains("drivable: no, because home: has no solution"));
+    assert_eq!(stdout.matches("no solution").count(), 1, "{stdout}");
+    for args in [
+        vec![
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--geometry",
+            &huge,
+            "--motion",
+            "demo",
+            "--duration",
+            "1",
+        ],
+        vec!["simulate", "--pty", "--geometry", &huge],
+    ] {
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        assert_eq!(
+            stderr.matches(huge.as_str()).count(),
+            1,
+            "{args:?}: the path once: {stderr}"
+        );
+        assert_eq!(
+            stderr.matches("no solution").count(),
+            1,
+            "{args:?}: the cause once: {stderr}"
+        );
+    }
+}
+
+/// The source's own geometries are analysed whether or not they can be driven: chapter 5's trainer (its home pose
+/// fails the carriage spacing) answers `ik`, `check` and `workspace`, and `rig check` says why it cannot be
+/// driven; the rotopod of chapters 3-4 is driven: `stream --sim --mechanism rotopod-ch4` homes its six carriages on
+/// one ring and follows the demo.
+#[test]
+fn every_mechanism_of_the_source_is_analysed_and_the_rotopod_driven() {
+    let dir = scratch("source-rigs");
+    let ch5 = dir.join("ch5.toml").display().to_string();
+    std::fs::write(&ch5, run(&["presets", "--export", "trainer-ch5"]).1).unwrap();
+    let (code, stdout, stderr) = run(&["rig", "check", &ch5]);
+    assert_eq!(code, 3, "{stderr}");
+    assert!(
+        stdout.contains("analysable: yes") && stdout.contains("drivable: no, because home: fails the carriage-spacing"),
+        "{stdout}"
+    );
+    let (code, stdout, stderr) = run(&["ik", "--geometry", &ch5, "--pose", "0,0,1,0,0,0"]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.contains("q1"), "{stdout}");
+    let (code, _, stderr) = run(&["check", "--geometry", &ch5, "--pose", "0,0,1,0,0,0"]);
+    assert_eq!(code, 3, "the home pose fails a check: {stderr}");
+    let picture = dir.join("ch5.svg").display().to_string();
+    let (code, _, stderr) = run(&[
+        "workspace",
+        "--geometry",
+        &ch5,
+        "--cells",
+        "10",
+        "--quiet",
+        "--out",
+        &picture,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let (code, _, stderr) = run(&[
+        "stream",
+        "--sim",
+        "--fast",
+        "--quiet",
+        "--geometry",
+        &ch5,
+        "--motion",
+        "demo",
+    ]);
+    assert_eq!(code, 1, "not drivable: {stderr}");
+    assert_eq!(stderr.matches("carriage-spacing").count(), 1, "{stderr}");
+
+    let (code, stdout, stderr) = run(&[
+        "stream",
+        "--sim",
+        "--fast",
+        "--quiet",
+        "--mechanism",
+        "rotopod-ch4",
+        "--motion",
+        "demo",
+        "--duration",
+        "3",
+        "--report-json",
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let report: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(report["setpoints_sent"], report["setpoints_applied"], "{report}");
+    assert_eq!(report["state"], "Ready", "{report}");
+    // Homed: every axis moved, the last two as carriages (not as the trainer model's linear actuators).
+    let steps = report["final_steps"].as_array().unwrap();
+    assert!(steps.iter().all(|s| s.as_i64().unwrap() != 0), "{report}");
 }
 
 /// Class: files that are not what a command reads (`/dev/zero`, binary bytes, a folder, missing) end at once with

@@ -442,11 +442,11 @@ fn a_rig_file_drives_the_kinematics_commands() {
     let rig = dir.join("my-rig.toml");
     std::fs::write(&rig, own).unwrap();
     let rig = rig.to_str().unwrap();
-    ringpod()
-        .args(["rig", "check", rig])
-        .assert()
-        .success()
-        .stdout(predicate::str::contains("my-rig: valid").and(predicate::str::contains("surge")));
+    ringpod().args(["rig", "check", rig]).assert().success().stdout(
+        predicate::str::contains("my-rig: analysable: yes")
+            .and(predicate::str::contains("drivable: yes"))
+            .and(predicate::str::contains("surge")),
+    );
     let pose = "--pose=0.02,-0.01,0.23,0.05,-0.04,1.2";
     let ours = json(&["ik", "--geometry", rig, pose, "--json"]);
     let preset = json(&["ik", pose, "--json"]);

@@ -35,7 +35,7 @@ impl Selected {
     pub fn of(mechanism: &str, geometry: Option<&std::path::Path>) -> Result<Self, CliError> {
         match geometry {
             Some(path) => {
-                let rig = crate::rig::load(path)?;
+                let rig = crate::rig::load_platform(path)?;
                 Ok(Self {
                     name: rig.geometry.name.to_owned(),
                     home: rig.home.to_array(),

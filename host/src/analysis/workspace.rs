@@ -85,7 +85,7 @@ pub struct Options<'a> {
 pub fn run(args: &Options) -> anyhow::Result<String> {
     let (geometry, home, ranges) = match &args.geometry {
         Some(path) => {
-            let rig = crate::rig::load(path)?;
+            let rig = crate::rig::load_platform(path)?;
             (rig.geometry, rig.home.to_array(), rig.ranges)
         }
         None => {

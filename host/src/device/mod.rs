@@ -126,10 +126,31 @@ pub fn monitor(target: &Target, frames: Option<u64>) -> anyhow::Result<u8> {
     Ok(if signals.received() { signals.exit_code() } else { 0 })
 }
 
-/// `ringpod simulate --pty [--geometry RIG.toml]`: serves until a signal, and exits with 128 + its number.
-pub fn simulate(geometry: Option<&std::path::Path>) -> anyhow::Result<u8> {
-    let device = match geometry {
-        Some(path) => transport::SimDevice::for_rig(true, &crate::rig::load(path)?)?,
+/// The platform a simulated controller runs instead of the trainer model.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Platform {
+    /// A rig file's.
+    File(PathBuf),
+    /// A preset's, by name.
+    Preset(String),
+}
+
+impl Platform {
+    /// The rig to simulate: none for the trainer model (compiled in).
+    pub fn rig(platform: Option<&Platform>) -> anyhow::Result<Option<crate::rig::Rig>> {
+        Ok(match platform {
+            None => None,
+            Some(Platform::File(path)) => Some(crate::rig::load(path)?),
+            Some(Platform::Preset(name)) => crate::rig::preset(name)?,
+        })
+    }
+}
+
+/// `ringpod simulate --pty [--geometry RIG.toml | --mechanism PRESET]`: serves until a signal, and exits with
+/// 128 + its number.
+pub fn simulate(platform: Option<&Platform>) -> anyhow::Result<u8> {
+    let device = match Platform::rig(platform)? {
+        Some(rig) => transport::SimDevice::for_rig(true, &rig)?,
         None => transport::SimDevice::new(true),
     };
     let signals = Signals::install()?;

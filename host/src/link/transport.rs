@@ -105,11 +105,7 @@ impl SimDevice {
         let config = ControllerConfig::from_record(&rig.record)
             .map_err(|e| anyhow::anyhow!("{}: the controller cannot drive it: {e}", rig.record.name()))?;
         let controller = Controller::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
-        Ok(Self::with(
-            realtime,
-            controller,
-            Plant::for_config(&config, TRAINER_MODEL_PARKED),
-        ))
+        Ok(Self::with(realtime, controller, Plant::for_config(&config)))
     }
 
     fn with(realtime: bool, controller: Controller, plant: Plant) -> Self {
@@ -155,7 +151,7 @@ impl SimDevice {
             };
             controller.set_rig_source(restored.rig);
             let plant = match restored.rig {
-                RigSource::Stored => Plant::for_config(&config, TRAINER_MODEL_PARKED),
+                RigSource::Stored => Plant::for_config(&config),
                 _ => Plant::trainer_model(TRAINER_MODEL_PARKED),
             };
             self.tick_us = u64::from(config.pipeline.tick_us);

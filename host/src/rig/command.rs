@@ -8,7 +8,7 @@ use ringpod_core::kinematics::RingPlatform;
 use serde::Serialize;
 
 use super::design::{design, Search, Target};
-use super::{coverage, load, read, RigFile};
+use super::{coverage, read, RigFile};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::out::Outcome;
 
@@ -17,15 +17,7 @@ const AXES: [&str; 5] = ["surge", "sway", "heave", "roll", "pitch"];
 
 /// `ringpod presets --export NAME`: the preset as a rig file, to start one's own from.
 pub fn export(name: &str) -> Result<Outcome, CliError> {
-    let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
-    let PresetGeometry::Ring(g) = preset.geometry() else {
-        return Err(CliError::BadNumbers {
-            what: "export",
-            reason: format!("{name} is not a ring platform; rig files describe ring platforms"),
-        });
-    };
-    let ranges = (preset == Preset::TrainerModel).then_some(presets::TRAINER_MODEL_RANGES);
-    let file = RigFile::of(g, preset.home(), ranges, super::drives::of_preset(preset));
+    let (preset, file) = preset_file(name, "export")?;
     let body = file.to_toml().map_err(|e| CliError::BadNumbers {
         what: "export",
         reason: e.to_string(),
@@ -39,6 +31,33 @@ pub fn export(name: &str) -> Result<Outcome, CliError> {
     Ok(Outcome::ok(header + &body))
 }
 
+/// A preset ring platform as the rig file `presets --export` writes.
+fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), CliError> {
+    let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
+    let PresetGeometry::Ring(g) = preset.geometry() else {
+        return Err(CliError::BadNumbers {
+            what,
+            reason: format!("{name} is not a ring platform; rig files describe ring platforms"),
+        });
+    };
+    let ranges = (preset == Preset::TrainerModel).then_some(presets::TRAINER_MODEL_RANGES);
+    Ok((
+        preset,
+        RigFile::of(g, preset.home(), ranges, super::drives::of_preset(preset)),
+    ))
+}
+
+/// The rig a simulated controller runs for a preset (`stream --sim --mechanism`, `simulate --mechanism`): none for
+/// the trainer model, whose configuration is compiled in; for another ring platform, its rig file with the trainer
+/// model's drives and switches, checked as `--geometry` checks a file.
+pub fn preset(name: &str) -> Result<Option<super::Rig>, CliError> {
+    let (preset, file) = preset_file(name, "--mechanism")?;
+    if preset == Preset::TrainerModel {
+        return Ok(None);
+    }
+    Ok(Some(file.check().map_err(|e| e.in_file(Path::new(name)))?))
+}
+
 #[derive(Serialize)]
 struct AxisJson {
     axis: &'static str,
@@ -50,7 +69,11 @@ struct AxisJson {
 #[derive(Serialize)]
 struct CheckJson<'a> {
     name: &'a str,
+    /// Kept for scripts that read it: a valid mechanism (analysable).
     valid: bool,
+    analysable: bool,
+    drivable: bool,
+    not_drivable_because: Option<String>,
     spec_covered: Option<bool>,
     per_axis: Vec<AxisJson>,
     combined_inside: Option<usize>,
@@ -59,18 +82,28 @@ struct CheckJson<'a> {
 
 /// `ringpod rig check FILE`: the verdict, and the spec coverage when the file gives spec ranges.
 pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
-    let rig = load(path)?;
+    let file = read(path)?;
+    // Not a mechanism at all: an error, as for every command. A mechanism that cannot be driven is a verdict.
+    let rig = file.platform().map_err(|e| e.in_file(path))?;
+    let drivable = file.check().map(|_| ()).map_err(|e| e.to_string());
     let m = RingPlatform::<f64>::new(&rig.geometry);
     let cover = rig.ranges.map(|r| (r, coverage(&m, &rig.home, &r)));
     let covered = cover
         .as_ref()
         .map(|(_, c)| c.per_axis.iter().all(|(inside, tried)| inside == tried));
-    let code = if covered == Some(false) { EXIT_CHECK_FAILED } else { 0 };
+    let code = if covered == Some(false) || drivable.is_err() {
+        EXIT_CHECK_FAILED
+    } else {
+        0
+    };
     let name = rig.geometry.name;
     if json {
         let out = CheckJson {
             name,
             valid: true,
+            analysable: true,
+            drivable: drivable.is_ok(),
+            not_drivable_because: drivable.as_ref().err().cloned(),
             spec_covered: covered,
             per_axis: cover
                 .iter()
@@ -95,11 +128,18 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
     let g = &rig.geometry;
     let _ = writeln!(
         t,
-        "{name}: valid ({} chains, ring radius {} m, rod {} m; the home pose is inside every check)",
+        "{name}: analysable: yes ({} chains, ring radius {} m, rod {} m)",
         g.chains().len(),
         g.ring_radius,
         g.rod_length
     );
+    let _ = match &drivable {
+        Ok(()) => writeln!(
+            t,
+            "drivable: yes (the home pose is inside every check; homing plan and step timing accepted)"
+        ),
+        Err(why) => writeln!(t, "drivable: no, because {why}"),
+    };
     match &cover {
         None => {
             let _ = writeln!(t, "no [spec] ranges: add them to measure the coverage");

@@ -36,7 +36,7 @@ pub mod drives;
 pub mod error;
 mod settings;
 
-pub use command::{check_command, design_command, export};
+pub use command::{check_command, design_command, export, preset};
 pub use coverage::coverage;
 pub use drives::{Drive, DriveSpec};
 pub use error::RigError;
@@ -192,7 +192,22 @@ fn err<T>(key: impl Into<String>, why: impl Into<String>) -> Result<T, RigError>
     Err(RigError::new(key, why))
 }
 
-/// A checked rig: the geometry the core drives, its home pose, spec ranges and drives.
+/// A rig that can be analysed: a valid mechanism (lengths, chains and joints that make sense) with a home pose, spec
+/// ranges and drives. Its home pose need not be inside every check, nor its axes homeable: that is [`Rig`]'s.
+#[derive(Debug, Clone)]
+pub struct Platform {
+    /// The geometry.
+    pub geometry: RingGeometry,
+    /// The home pose (finite; where the analysis commands start).
+    pub home: Pose<f64>,
+    /// The spec ranges, if the file gives them (m and rad).
+    pub ranges: Option<[f64; 5]>,
+    /// Each axis's drive, where the file gives one.
+    pub drives: [Option<Drive>; 6],
+}
+
+/// A rig that can be driven: a [`Platform`] whose home pose is inside every check and whose controller
+/// configuration (homing plan included) the core accepts.
 #[derive(Debug, Clone)]
 pub struct Rig {
     /// The geometry.
@@ -207,9 +222,14 @@ pub struct Rig {
     pub record: ringpod_core::protocol::RigRecord,
 }
 
-/// Reads and checks a rig file.
+/// Reads and checks a rig file to drive it.
 pub fn load(path: &Path) -> Result<Rig, RigError> {
     read(path)?.check().map_err(|e| e.in_file(path))
+}
+
+/// Reads a rig file to analyse it: only the mechanism must be valid.
+pub fn load_platform(path: &Path) -> Result<Platform, RigError> {
+    read(path)?.platform().map_err(|e| e.in_file(path))
 }
 
 /// Reads a rig file without checking it (a design template need not be a valid rig yet).
@@ -252,10 +272,39 @@ fn positive(key: &str, v: f64) -> Result<(), RigError> {
 }
 
 impl RigFile {
-    /// Every rule the presets obey, and the controller's: each error names its key.
-    pub fn check(&self) -> Result<Rig, RigError> {
+    /// The mechanism, spec ranges and drives: what analysis needs. Each error names its key.
+    pub fn platform(&self) -> Result<Platform, RigError> {
         let geometry = self.geometry()?;
-        let home = Pose::from_array(self.home);
+        let m = RingPlatform::<f64>::new(&geometry);
+        let ranges = match &self.spec {
+            Some(s) => {
+                let si = s.si();
+                let names = ["surge", "sway", "heave", "roll_deg", "pitch_deg"];
+                if let Some(i) = si.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
+                    return err(format!("spec.{}", names[i]), "a range is a finite number >= 0");
+                }
+                Some(si)
+            }
+            None => None,
+        };
+        let drives = drives::check(&self.drives, &m.axes())?;
+        Ok(Platform {
+            geometry,
+            home: Pose::from_array(self.home),
+            ranges,
+            drives,
+        })
+    }
+
+    /// Every rule the presets obey, and the controller's (the home pose inside every check, the homing plan, the
+    /// step timing): each error names its key.
+    pub fn check(&self) -> Result<Rig, RigError> {
+        let Platform {
+            geometry,
+            home,
+            ranges,
+            drives,
+        } = self.platform()?;
         let m = RingPlatform::<f64>::new(&geometry);
         match m.inverse_checked(&home) {
             Err(e) => return err("home", format!("has no solution: {e}")),
@@ -273,18 +322,6 @@ impl RigFile {
                 }
             }
         }
-        let ranges = match &self.spec {
-            Some(s) => {
-                let si = s.si();
-                let names = ["surge", "sway", "heave", "roll_deg", "pitch_deg"];
-                if let Some(i) = si.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
-                    return err(format!("spec.{}", names[i]), "a range is a finite number >= 0");
-                }
-                Some(si)
-            }
-            None => None,
-        };
-        let drives = drives::check(&self.drives, &m.axes())?;
         let record = self.record(ControllerConfig::default_record(&self.name, &geometry, self.home))?;
         Ok(Rig {
             geometry,

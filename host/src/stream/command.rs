@@ -41,10 +41,13 @@ pub enum Datagrams {
     },
 }
 
-/// The device that follows: a board, or the simulated controller (of the trainer model or a rig file's platform).
+/// The device that follows: a board, or the simulated controller (of the trainer model, or another platform).
 pub enum Device {
     Port(String),
-    Sim { fast: bool, rig: Option<PathBuf> },
+    Sim {
+        fast: bool,
+        platform: Option<crate::device::Platform>,
+    },
 }
 
 /// The payload `--check-loads` predicts the drive demand for.
@@ -162,8 +165,7 @@ pub fn run(job: &Job) -> anyhow::Result<u8> {
     let signals = Signals::install()?;
     let (source, input_errors) = open(&job.input)?;
     let (rig, fast) = match &job.device {
-        Device::Sim { rig: Some(path), fast } => (Some(crate::rig::load(path)?), *fast),
-        Device::Sim { fast, .. } => (None, *fast),
+        Device::Sim { platform, fast } => (crate::device::Platform::rig(platform.as_ref())?, *fast),
         Device::Port(_) => (None, false),
     };
     let transport = match (&job.device, &rig) {

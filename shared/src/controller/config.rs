@@ -182,12 +182,19 @@ impl ControllerConfig {
         let model = Self::trainer_model();
         let m = RingPlatform::<f64>::new(geometry);
         let axes = m.axes();
-        let q = m.inverse(&Pose::from_array(home)).map(|q| q.0).unwrap_or([0.0; 6]);
+        let solved = m.inverse(&Pose::from_array(home)).map(|q| q.0).ok();
+        let q = solved.unwrap_or([0.0; 6]);
         let mut machine = model.machine();
+        let carriages = axes.iter().filter(|k| **k == AxisKind::Ring).count();
         for (a, kind) in axes.iter().enumerate() {
             if *kind == AxisKind::Ring {
                 machine.axes[a].steps_per_unit = AxisScale::MODEL_CARRIAGE.steps_per_turn as f32;
-                machine.homing.axes[a] = CARRIAGE_HOMING;
+                machine.homing.axes[a] = SwitchSettings {
+                    search: solved.map_or(CARRIAGE_HOMING.search, |q| {
+                        carriage_search(&q, a, carriages, geometry.limits.carriage_spacing[0])
+                    }),
+                    ..CARRIAGE_HOMING
+                };
             } else {
                 machine.axes[a].steps_per_unit = AxisScale::MODEL_LINEAR.steps_per_unit;
                 let switch = geometry.limits.stroke[0] - 0.001 - q[a];
@@ -240,4 +247,19 @@ impl ControllerConfig {
             ..RigRecord::new("", &self.geometry, self.home, self.machine())
         }
     }
+}
+
+/// How far carriage `a` searches for its index flag in a rig's default homing: the trainer model's 20 degrees, or
+/// less where carriages sit close together at home (a rotopod's pairs), so that the homing plan's proof holds with
+/// every other carriage first (each may travel its search distance toward a neighbour that has not homed yet, which
+/// may travel its own): 45 % of the room beyond the minimum spacing to the nearer neighbour. The simulator parks
+/// each carriage at most 7 degrees before its flag ([`crate::sim::parked`]); a search shorter than that is refused
+/// by the plan's own check (the back-off) or fails homing, never moves blind.
+fn carriage_search(q: &[f64; 6], a: usize, carriages: usize, min_spacing: f64) -> f32 {
+    let gap =
+        |from: usize, to: usize| libm::fmod(q[to] - q[from] + 4.0 * core::f64::consts::TAU, core::f64::consts::TAU);
+    let next = (a + 1) % carriages;
+    let prev = (a + carriages - 1) % carriages;
+    let room = gap(a, next).min(gap(prev, a)) - min_spacing;
+    (CARRIAGE_HOMING.search as f64).min(0.45 * room).max(0.0) as f32
 }

@@ -21,6 +21,26 @@ pub struct AxisSwitches {
 }
 
 pub use crate::model::TRAINER_MODEL_PARKED;
+
+/// Where the simulator parks a ring platform's axes (steps from each switch), as it parks the trainer model
+/// ([`TRAINER_MODEL_PARKED`], which this gives for the model's axes): carriages 500 to 100 steps (7 to 1.4 degrees
+/// at the model's 25,600 steps per turn) before their index flags, linear actuators 8,000 to 9,000 steps (5 to 5.6
+/// mm) above their home ends. Carriages and linear actuators each take the next of their own kind's positions, so a
+/// rotopod's fifth and sixth carriages park like carriages, not like the model's actuators.
+pub fn parked(axes: &[crate::kinematics::AxisKind; 6]) -> [i64; 6] {
+    const CARRIAGES: [i64; 6] = [-500, -400, -300, -200, -150, -100];
+    const LINEAR: [i64; 6] = [8_000, 9_000, 8_500, 8_000, 9_000, 8_500];
+    let (mut carriage, mut linear) = (0, 0);
+    core::array::from_fn(|a| {
+        if axes[a] == crate::kinematics::AxisKind::Ring {
+            carriage += 1;
+            CARRIAGES[carriage - 1]
+        } else {
+            linear += 1;
+            LINEAR[linear - 1]
+        }
+    })
+}
 pub use flash::RamFlash;
 
 /// The simulated plant.
@@ -88,11 +108,12 @@ impl Plant {
         }
     }
 
-    /// The machine a configuration describes, parked at `start` (steps from each switch): carriages with index
-    /// flags, linear actuators with a home end switch and a far end switch 2 mm past their stroke.
-    pub fn for_config(config: &crate::controller::ControllerConfig, start: [i64; 6]) -> Self {
+    /// The machine a configuration describes, parked as [`parked`] parks its axes: carriages with index flags,
+    /// linear actuators with a home end switch and a far end switch 2 mm past their stroke.
+    pub fn for_config(config: &crate::controller::ControllerConfig) -> Self {
         use crate::kinematics::Mechanism;
         let axes = crate::kinematics::RingPlatform::<f64>::new(&config.geometry).axes();
+        let start = parked(&axes);
         let stroke = config.geometry.limits.stroke;
         let per_m = axes
             .iter()

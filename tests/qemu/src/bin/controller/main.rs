@@ -152,7 +152,7 @@ async fn main(spawner: Spawner) {
     // The machine of the rig that runs (the trainer model unless another was stored), parked where the host
     // simulator parks it, so that the same input ends at the same steps.
     let plant = match restored.rig {
-        RigSource::Stored => Plant::for_config(&config, TRAINER_MODEL_PARKED),
+        RigSource::Stored => Plant::for_config(&config),
         _ => Plant::trainer_model(TRAINER_MODEL_PARKED),
     };
     let world: &'static WorldCell = WORLD.init(Mutex::new(RefCell::new(World::new(plant, drivers))));
