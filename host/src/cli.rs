@@ -33,6 +33,9 @@ pub enum Command {
     Check(PoseArgs),
     /// Forward kinematics: the pose for six actuator values, by Newton iteration from a guess.
     Fk(FkArgs),
+    /// The velocity problem at a pose (A p' = -B q', chapter 4): the actuator rates for --pose-rates, or the pose
+    /// rates and the platform's angular velocity for --actuator-rates; A, B and the condition number of each.
+    Rates(RatesArgs),
     /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
@@ -319,6 +322,38 @@ pub struct Common {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct RatesArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// x',y',z',alpha',beta',gamma' (m/s; rad/s, or deg/s with --degrees): print the actuator rates.
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "actuator_rates")]
+    pub pose_rates: Option<String>,
+    /// Six actuator rates (rad/s or m/s; deg/s for angles with --degrees): print the pose rates.
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "pose_rates")]
+    pub actuator_rates: Option<String>,
+}
+
+impl RatesArgs {
+    /// The command's typed options.
+    pub fn options(&self) -> crate::analysis::rates::Options<'_> {
+        use crate::analysis::rates::Given;
+        crate::analysis::rates::Options {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            given: match (&self.pose_rates, &self.actuator_rates) {
+                (_, Some(q)) => Given::ActuatorRates(q),
+                (Some(p), None) => Given::PoseRates(p),
+                // clap requires one of them.
+                (None, None) => Given::PoseRates(""),
+            },
+        }
+    }
 }
 
 #[derive(Debug, Args)]

@@ -9,7 +9,11 @@ fn ringpod() -> Command {
 
 fn json(args: &[&str]) -> serde_json::Value {
     let out = ringpod().args(args).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -914,4 +918,98 @@ fn device_inputs_lists_every_input() {
         .assert()
         .code(1)
         .stderr(predicate::str::contains("--watch is for `device inputs`"));
+}
+
+/// `rates`: the velocity problem against finite differences of IK (actuator rates for pose rates) and of FK (pose
+/// rates for actuator rates), on the trainer model, the rotopod and chapter 5's trainer; the angular velocity of
+/// a pure yaw rate is that rate about z.
+#[test]
+fn rates_agree_with_finite_differences_of_ik_and_fk() {
+    let six =
+        |v: &serde_json::Value| -> Vec<f64> { v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect() };
+    let list = |v: &[f64]| v.iter().map(|x| format!("{x:.12}")).collect::<Vec<_>>().join(",");
+    let h = 1e-6;
+    for (mechanism, pose, rates) in [
+        (
+            "trainer-model",
+            [0.01, -0.02, 0.23, 0.05, -0.04, 0.7],
+            [0.02, -0.01, 0.015, 0.1, -0.2, 0.5],
+        ),
+        (
+            "rotopod-ch4",
+            [0.05, 0.02, 0.7, 0.03, 0.02, 0.1],
+            [0.1, 0.05, -0.02, 0.2, 0.1, -0.3],
+        ),
+        (
+            "trainer-ch5",
+            [0.1, 0.0, 1.0, 0.0, 0.0, 0.0],
+            [0.1, 0.05, 0.05, 0.02, 0.1, 0.2],
+        ),
+    ] {
+        let at = |s: f64| -> Vec<f64> {
+            let p: Vec<f64> = pose.iter().zip(rates).map(|(p, r)| p + s * r).collect();
+            six(&json(&[
+                "ik",
+                "--mechanism",
+                mechanism,
+                &format!("--pose={}", list(&p)),
+                "--json",
+            ])["actuators"])
+        };
+        let (plus, minus) = (at(h), at(-h));
+        let got = json(&[
+            "rates",
+            "--mechanism",
+            mechanism,
+            &format!("--pose={}", list(&pose)),
+            &format!("--pose-rates={}", list(&rates)),
+            "--json",
+        ]);
+        let qd = six(&got["actuator_rates"]);
+        for i in 0..6 {
+            let fd = (plus[i] - minus[i]) / (2.0 * h);
+            assert!(
+                (qd[i] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
+                "{mechanism} q{}: {} vs {fd}",
+                i + 1,
+                qd[i]
+            );
+        }
+        assert!(got["condition_a"].as_f64().unwrap() >= 1.0 && got["condition_b"].as_f64().unwrap() >= 1.0);
+        // Back: the actuator rates give the pose rates, and FK along them moves the pose by them.
+        let back = json(&[
+            "rates",
+            "--mechanism",
+            mechanism,
+            &format!("--pose={}", list(&pose)),
+            &format!("--actuator-rates={}", list(&qd)),
+            "--json",
+        ]);
+        let pd = six(&back["pose_rates"]);
+        let q = at(0.0);
+        let fk = |s: f64| -> Vec<f64> {
+            let a: Vec<f64> = q.iter().zip(&qd).map(|(q, r)| q + s * r).collect();
+            six(&json(&[
+                "fk",
+                "--mechanism",
+                mechanism,
+                &format!("--actuators={}", list(&a)),
+                &format!("--guess={}", list(&pose)),
+                "--anywhere",
+                "--json",
+            ])["pose"])
+        };
+        let (plus, minus) = (fk(h), fk(-h));
+        for i in 0..6 {
+            let fd = (plus[i] - minus[i]) / (2.0 * h);
+            assert!((pd[i] - rates[i]).abs() < 1e-6, "{mechanism} round trip {i}: {pd:?}");
+            assert!(
+                (pd[i] - fd).abs() < 1e-4 * (1.0 + fd.abs()),
+                "{mechanism} FK {i}: {} vs {fd}",
+                pd[i]
+            );
+        }
+    }
+    let yaw = json(&["rates", "--pose-rates=0,0,0,0,0,0.5", "--json"]);
+    assert_eq!(six(&yaw["angular_velocity"]), [0.0, 0.0, 0.5]);
 }

@@ -1,9 +1,10 @@
-//! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `reactions`, `workspace` and
+//! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `rates`, `reactions`, `workspace` and
 //! `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
 pub mod cue;
 pub mod demand;
 pub mod kinematics;
 pub mod mechanism;
+pub mod rates;
 pub mod reactions;
 pub mod workspace;
