@@ -412,6 +412,8 @@ impl CueArgs {
             config: self.config.as_deref(),
             plot: self.plot.as_deref(),
             json: self.json,
+            telemetry_format: self.telemetry_format,
+            udp_port: self.udp_port,
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
         }
@@ -446,7 +448,8 @@ pub struct WorkspaceArgs {
 #[derive(Debug, Args)]
 pub struct CueArgs {
     /// Telemetry CSV with the header t,ax,ay,az,wx,wy,wz (s; specific force in m/s^2 in the vehicle frame, x
-    /// forward, y left, z up, +9.81 on z at rest; angular rates in rad/s).
+    /// forward, y left, z up, +9.81 on z at rest; angular rates in rad/s), or a packet capture (pcap, pcapng) of a
+    /// game's telemetry datagrams (see --telemetry-format).
     #[arg(long)]
     pub input: std::path::PathBuf,
     /// Output pose CSV (t,x,y,z,alpha,beta,gamma in s, m, rad).
@@ -467,6 +470,13 @@ pub struct CueArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
+    /// With a packet capture as --input (pcap or pcapng, from `stream --capture`, tcpdump or Wireshark): the
+    /// datagrams' format, as for `stream --telemetry-format`; `auto` without.
+    #[arg(long, value_enum)]
+    pub telemetry_format: Option<crate::stream::datagram::TelemetryFormat>,
+    /// With a packet capture as --input: its UDP datagrams to this port only (a capture of several flows).
+    #[arg(long)]
+    pub udp_port: Option<u16>,
 }
 
 impl StreamArgs {
