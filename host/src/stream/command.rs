@@ -168,7 +168,7 @@ pub fn run(job: &Job) -> anyhow::Result<u8> {
         let local = udp.socket.local_addr()?;
         let writer = crate::input::capture::CaptureWriter::create(path, local)
             .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        udp.capture = Some((writer, path.display().to_string()));
+        udp.capture = Some((Box::new(writer), path.display().to_string()));
     }
     let (rig, fast) = match &job.device {
         Device::Sim { rig: Some(path), fast } => (Some(crate::rig::load(path)?), *fast),

@@ -53,7 +53,7 @@ pub struct UdpSource {
     pub from: Option<std::net::IpAddr>,
     /// `--capture`: every datagram that arrives (from any sender, readable or not) written to a pcap file, and the
     /// file's name.
-    pub capture: Option<(crate::input::capture::CaptureWriter, String)>,
+    pub capture: Option<(Box<crate::input::capture::CaptureWriter>, String)>,
 }
 
 /// The columns of a pose file.
