@@ -40,7 +40,7 @@ pub enum Command {
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
     /// lines that could not be read, 4 setpoints the device refused, 5 the device stopped streaming or faulted,
-    /// 6 the link was lost, 7 the --record file could not be written, 128 + the signal when stopped by one (130 Ctrl-C, 143 SIGTERM).
+    /// 6 the link was lost, 7 the --record or --capture file could not be written, 128 + the signal when stopped by one (130 Ctrl-C, 143 SIGTERM).
     Stream(StreamArgs),
     /// Draws a run record (`stream --record`): commanded vs followed per pose axis, the actuator positions, and
     /// the events (limits, refusals, state changes), labelled, as PNG or SVG.
@@ -295,6 +295,11 @@ pub struct StreamArgs {
     /// (limited, refused, held). `ringpod plot FILE` draws it.
     #[arg(long, value_name = "FILE.csv")]
     pub record: Option<std::path::PathBuf>,
+    /// With --udp or --telemetry-udp: capture every datagram that arrives on the socket (from any sender, readable
+    /// or not) to a pcap file, as tcpdump writes one, with its arrival time; `ringpod cue --input FILE.pcap` cues it
+    /// again, Wireshark shows it.
+    #[arg(long, value_name = "FILE.pcap", conflicts_with_all = ["input", "motion"])]
+    pub capture: Option<std::path::PathBuf>,
     /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics) on the platform
     /// the device runs, against its drives (the --geometry file's `[[drives]]`, or the preset's motor data) for a
     /// payload of --mass kg; where it exceeds the motors, say where and do not stream (exit 1).
@@ -449,6 +454,8 @@ impl CueArgs {
             config: self.config.as_deref(),
             plot: self.plot.as_deref(),
             json: self.json,
+            telemetry_format: self.telemetry_format,
+            udp_port: self.udp_port,
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
         }
@@ -483,7 +490,8 @@ pub struct WorkspaceArgs {
 #[derive(Debug, Args)]
 pub struct CueArgs {
     /// Telemetry CSV with the header t,ax,ay,az,wx,wy,wz (s; specific force in m/s^2 in the vehicle frame, x
-    /// forward, y left, z up, +9.81 on z at rest; angular rates in rad/s).
+    /// forward, y left, z up, +9.81 on z at rest; angular rates in rad/s), or a packet capture (pcap, pcapng) of a
+    /// game's telemetry datagrams (see --telemetry-format).
     #[arg(long)]
     pub input: std::path::PathBuf,
     /// Output pose CSV (t,x,y,z,alpha,beta,gamma in s, m, rad).
@@ -504,6 +512,13 @@ pub struct CueArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     pub json: bool,
+    /// With a packet capture as --input (pcap or pcapng, from `stream --capture`, tcpdump or Wireshark): the
+    /// datagrams' format, as for `stream --telemetry-format`; `auto` without.
+    #[arg(long, value_enum)]
+    pub telemetry_format: Option<crate::stream::datagram::TelemetryFormat>,
+    /// With a packet capture as --input: its UDP datagrams to this port only (a capture of several flows).
+    #[arg(long)]
+    pub udp_port: Option<u16>,
 }
 
 impl StreamArgs {
@@ -516,6 +531,9 @@ impl StreamArgs {
             from: self.udp_from,
             idle: self.udp_idle,
         };
+        if self.capture.is_some() && self.udp.is_none() && self.telemetry_udp.is_none() {
+            anyhow::bail!("--capture records a UDP source: it needs --udp or --telemetry-udp");
+        }
         let input = match (self.udp, self.telemetry_udp, &self.input) {
             (Some(addr), _, _) => udp(addr, Datagrams::Poses { degrees: self.degrees }),
             (None, Some(addr), _) => udp(
@@ -555,6 +573,7 @@ impl StreamArgs {
                 quiet: self.quiet,
             },
             record: self.record.clone(),
+            capture: self.capture.clone(),
             report_json: self.report_json,
         })
     }

@@ -32,6 +32,9 @@ pub struct Summary {
     /// Rows that could not be used: unreadable, not finite (the platform held), or after a gap of more than a
     /// second (the washout went back to neutral).
     pub input_errors: Vec<InputError>,
+    /// A packet capture's input: what it held (its input errors are numbered by packet).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub capture: Option<super::cue_capture::CaptureSummary>,
 }
 
 /// Loads a washout configuration from TOML (every key optional); errors name the key.
@@ -57,8 +60,12 @@ struct Cued {
 
 /// What `cue` is asked to do.
 pub struct Options<'a> {
-    /// The telemetry CSV.
+    /// The telemetry CSV, or a packet capture (pcap, pcapng) of a game's telemetry.
     pub input: &'a Path,
+    /// A capture's telemetry format (`auto` without).
+    pub telemetry_format: Option<crate::stream::datagram::TelemetryFormat>,
+    /// A capture: its datagrams to this UDP port only.
+    pub udp_port: Option<u16>,
     /// The pose CSV to write.
     pub out: &'a Path,
     /// Washout parameters (TOML); the defaults without.
@@ -76,10 +83,7 @@ pub struct Options<'a> {
 /// Runs the command; returns the summary as text and the exit code.
 pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
     let config = load_config(args.config)?;
-    let text = crate::input::files::read_text(args.input, crate::input::files::DATA_LIMIT)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
-    let (rows, mut errors) =
-        table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{}: {e}", args.input.display()))?;
+    let (rows, mut errors, capture) = read_input(args)?;
     let selected = Selected::of(args.mechanism, args.geometry)?;
     let AnyMechanism::Ring(mechanism) = selected.mechanism else {
         anyhow::bail!("cueing moves a ring platform; {} is not one", selected.name);
@@ -139,6 +143,7 @@ pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
         poses: cued.len(),
         limited,
         input_errors: errors,
+        capture,
     };
     let code = if summary.input_errors.is_empty() && summary.rows > 0 {
         0
@@ -155,12 +160,50 @@ pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
             args.out.display(),
             summary.limited
         );
+        if let Some(c) = &summary.capture {
+            s += &format!(
+                "{}: {} packets, {} UDP datagrams read as {}; skipped: {:?}\n",
+                c.file_format, c.packets, c.datagrams, c.telemetry_format, c.skipped
+            );
+        }
+        let unit = if summary.capture.is_some() { "packet" } else { "line" };
         for e in &summary.input_errors {
-            s += &format!("line {}: {}\n", e.line, e.reason);
+            s += &format!("{unit} {}: {}\n", e.line, e.reason);
         }
         s
     };
     Ok((text, code))
+}
+
+/// The telemetry rows of the input: a CSV, or a packet capture ([`super::cue_capture`]).
+#[allow(clippy::type_complexity)]
+fn read_input(
+    args: &Options,
+) -> anyhow::Result<(
+    Vec<(usize, Vec<f64>)>,
+    Vec<InputError>,
+    Option<super::cue_capture::CaptureSummary>,
+)> {
+    let name = args.input.display();
+    let bytes = crate::input::files::read_bytes(args.input, crate::input::files::DATA_LIMIT)
+        .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    if crate::input::capture::is_capture(&bytes) {
+        let format = args
+            .telemetry_format
+            .unwrap_or(crate::stream::datagram::TelemetryFormat::Auto);
+        let (rows, errors, summary) =
+            super::cue_capture::rows(&bytes, format, args.udp_port).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        return Ok((rows, errors, Some(summary)));
+    }
+    if args.telemetry_format.is_some() || args.udp_port.is_some() {
+        anyhow::bail!(
+            "{name}: --telemetry-format and --udp-port are for a packet capture (pcap, pcapng); this is not one"
+        );
+    }
+    let text = crate::input::files::read_text(args.input, crate::input::files::DATA_LIMIT)
+        .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    let (rows, errors) = table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    Ok((rows, errors, None))
 }
 
 fn write_poses(path: &Path, cued: &[Cued]) -> anyhow::Result<()> {

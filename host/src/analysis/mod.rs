@@ -2,6 +2,7 @@
 //! `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
 pub mod cue;
+pub mod cue_capture;
 pub mod demand;
 pub mod kinematics;
 pub mod mechanism;

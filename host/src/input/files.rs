@@ -12,6 +12,12 @@ pub const CONFIG_LIMIT: u64 = 1 << 20;
 /// The text of the file at `path`, at most `limit` bytes, or why not, without the path: the callers name the file
 /// in their own way (a rig error's key, a command's option).
 pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
+    let bytes = read_bytes(path, limit)?;
+    String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (byte {} is not)", e.utf8_error().valid_up_to() + 1))
+}
+
+/// The bytes of the file at `path` (a packet capture), at most `limit`, or why not, without the path.
+pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
     let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
     if file.metadata().is_ok_and(|m| m.is_dir()) {
         return Err("is a directory, not a file".into());
@@ -27,5 +33,5 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
             limit >> 20
         ));
     }
-    String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (byte {} is not)", e.utf8_error().valid_up_to() + 1))
+    Ok(bytes)
 }

@@ -66,6 +66,8 @@ pub struct Job {
     pub options: Options,
     /// The run record to write.
     pub record: Option<PathBuf>,
+    /// A UDP source: the pcap file its datagrams are captured to.
+    pub capture: Option<PathBuf>,
     /// One JSON report instead of the summary line.
     pub report_json: bool,
 }
@@ -113,6 +115,7 @@ fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
                 decoder,
                 idle: std::time::Duration::from_secs_f64(idle),
                 from: *from,
+                capture: None,
             };
             (Source::Udp(source), Vec::new())
         }
@@ -163,7 +166,13 @@ fn loads_keep_up<T: client::Transport>(
 /// Runs a stream: the exit codes of [`exit`].
 pub fn run(job: &Job) -> anyhow::Result<u8> {
     let signals = Signals::install()?;
-    let (source, input_errors) = open(&job.input)?;
+    let (mut source, input_errors) = open(&job.input)?;
+    if let (Some(path), Source::Udp(udp)) = (&job.capture, &mut source) {
+        let local = udp.socket.local_addr()?;
+        let writer = crate::input::capture::CaptureWriter::create(path, local)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        udp.capture = Some((Box::new(writer), path.display().to_string()));
+    }
     let (rig, fast) = match &job.device {
         Device::Sim { platform, fast } => (crate::device::Platform::rig(platform.as_ref())?, *fast),
         Device::Port(_) => (None, false),
@@ -258,6 +267,18 @@ fn print(report: &Report, json: bool) -> anyhow::Result<u8> {
                     record.rows, record.path, record.dropped
                 )
             }
+            None => {}
+        }
+    }
+    if let Some(capture) = &report.capture {
+        match &capture.error {
+            Some(e) => {
+                eprintln!("ringpod: the capture {} could not be written: {e}", capture.path);
+                if report.exit_code == exit::FOLLOWED {
+                    return Ok(exit::RECORD_FAILED);
+                }
+            }
+            None if !json => eprintln!("captured {} datagrams to {}", capture.packets, capture.path),
             None => {}
         }
     }

@@ -24,7 +24,7 @@ use ringpod_core::protocol::{MotionSettings, RigSource, Settings, SettingsKind, 
 use ringpod_core::safety::{FaultReason, State};
 
 pub use loads::{check_loads, platform as loads_platform};
-pub use report::{DatagramReport, LimitedReport, RecordReport, Report};
+pub use report::{CaptureReport, DatagramReport, LimitedReport, RecordReport, Report};
 use session::{Stop, StreamError, Streamer};
 pub use source::{motion_pose, read_csv, Motion, Source, UdpSource};
 
@@ -46,7 +46,7 @@ pub mod exit {
     pub const DEVICE_STOPPED: u8 = 5;
     /// The link to the device was lost.
     pub const TRANSPORT_LOST: u8 = 6;
-    /// Everything was followed but `--record` could not write its file.
+    /// Everything was followed but `--record` (or `--capture`) could not write its file.
     pub const RECORD_FAILED: u8 = 7;
     /// Interrupted (Ctrl-C).
     pub const INTERRUPTED: u8 = 130;
@@ -243,6 +243,7 @@ pub fn run<T: Transport>(
     };
     let mut input_errors = input_errors;
     let mut datagrams = None;
+    let mut capture = None;
     let home = platform.home;
     let mut source = source;
     let outcome = match &mut source {
@@ -268,6 +269,10 @@ pub fn run<T: Transport>(
             let r = s.live(udp, &mut d, &mut input_errors);
             d.telemetry_gaps = udp.decoder.gaps();
             datagrams = Some(d);
+            capture = udp.capture.take().map(|(writer, path)| {
+                let (packets, error) = writer.finish();
+                CaptureReport { path, packets, error }
+            });
             r
         }
     };
@@ -379,5 +384,6 @@ pub fn run<T: Transport>(
         last_applied_pose: s.last_applied.map(|p| p.to_array()),
         counts_agree,
         record,
+        capture,
     })
 }

@@ -81,6 +81,8 @@ pub struct Report {
     pub counts_agree: bool,
     /// `--record`: rows written (a row per telemetry sample), or why the record failed.
     pub record: Option<RecordReport>,
+    /// `--capture`: datagrams written, or why the capture failed.
+    pub capture: Option<CaptureReport>,
 }
 
 /// What `--record` wrote.
@@ -93,6 +95,17 @@ pub struct RecordReport {
     /// Telemetry samples the client dropped before they were written (none unless the host fell behind).
     pub dropped: u64,
     /// Why the file could not be written, if it could not.
+    pub error: Option<String>,
+}
+
+/// What `--capture` wrote.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CaptureReport {
+    /// The file.
+    pub path: String,
+    /// Datagrams written (every one that arrived on the socket, from any sender).
+    pub packets: u64,
+    /// Why the file could not be written, if it could not: the capture stops there, the stream goes on.
     pub error: Option<String>,
 }
 

@@ -384,6 +384,9 @@ impl<'a, T: Transport> Streamer<'a, T> {
             }
             let got = source.socket.recv_from(&mut buf);
             let now = Instant::now();
+            if let (Ok((n, from)), Some((capture, _))) = (&got, source.capture.as_mut()) {
+                capture.write(&buf[..*n], *from, std::time::SystemTime::now());
+            }
             self.elapse(now - wall)?;
             wall = now;
             let datagram = match got {

@@ -51,6 +51,9 @@ pub struct UdpSource {
     pub idle: Duration,
     /// Take datagrams from this address only.
     pub from: Option<std::net::IpAddr>,
+    /// `--capture`: every datagram that arrives (from any sender, readable or not) written to a pcap file, and the
+    /// file's name.
+    pub capture: Option<(Box<crate::input::capture::CaptureWriter>, String)>,
 }
 
 /// The columns of a pose file.

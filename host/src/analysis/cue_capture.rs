@@ -1,0 +1,123 @@
+//! `ringpod cue --input FILE.pcap`: a packet capture of a game's telemetry (`stream --capture`, tcpdump, Wireshark)
+//! as the telemetry rows `cue` reads from a CSV, so a drive recorded once is cued again with other parameters.
+//!
+//! Each UDP datagram (to `--udp-port` only, when given) is decoded in `--telemetry-format` (`auto` when not given:
+//! the first datagram a game's format recognises names it). A row's time is the game's own time when its format
+//! carries one, as the live path (`stream --telemetry-udp`) takes it, else the packet's capture time (from the first
+//! datagram taken), the live path's arrival time. A datagram the format cannot read, or whose time is not after the
+//! last one's, is an input error named by its packet number (as the live path counts an unreadable datagram);
+//! packets that are not UDP, go to another port, are IP fragments or are cut short are skipped and counted.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::games;
+use crate::input::capture;
+use crate::input::table::InputError;
+use crate::stream::datagram::{self, TelemetryFormat};
+
+/// What a capture held, in `cue`'s summary.
+#[derive(Debug, Serialize)]
+pub struct CaptureSummary {
+    /// `pcap` or `pcapng`.
+    pub file_format: &'static str,
+    /// Packets in the file.
+    pub packets: usize,
+    /// UDP datagrams to the port (or any), decoded or not.
+    pub datagrams: usize,
+    /// The telemetry format they were read as (`auto` when none was recognised).
+    pub telemetry_format: String,
+    /// The UDP destination ports in the file and their datagrams (to choose `--udp-port` when there are several).
+    pub ports: BTreeMap<u16, usize>,
+    /// The senders of the datagrams taken (address and port) and their datagrams.
+    pub senders: BTreeMap<String, usize>,
+    /// Packets not taken, by why.
+    pub skipped: BTreeMap<String, usize>,
+}
+
+/// A telemetry row as `cue` reads it from a CSV: its packet number and `t ax ay az wx wy wz`.
+pub type Row = (usize, Vec<f64>);
+
+/// The telemetry rows of a capture, the datagrams that could not be used, and what the capture held.
+pub fn rows(
+    bytes: &[u8],
+    format: TelemetryFormat,
+    port: Option<u16>,
+) -> Result<(Vec<Row>, Vec<InputError>, CaptureSummary), String> {
+    let cap = capture::read(bytes)?;
+    let mut summary = CaptureSummary {
+        file_format: cap.format,
+        packets: cap.packets,
+        datagrams: 0,
+        telemetry_format: String::new(),
+        ports: BTreeMap::new(),
+        senders: BTreeMap::new(),
+        skipped: cap.skipped,
+    };
+    let mut format = format;
+    let mut rows = Vec::new();
+    let mut errors = Vec::new();
+    let mut first: Option<std::time::Duration> = None;
+    let mut last_t: Option<f64> = None;
+    for d in &cap.datagrams {
+        *summary.ports.entry(d.to.port()).or_default() += 1;
+        if port.is_some_and(|p| p != d.to.port()) {
+            *summary.skipped.entry("UDP to another port".into()).or_default() += 1;
+            continue;
+        }
+        summary.datagrams += 1;
+        *summary.senders.entry(d.from.to_string()).or_default() += 1;
+        let decoded = match format {
+            TelemetryFormat::Text => datagram::parse_telemetry(&d.payload),
+            TelemetryFormat::Game(f) => games::decode(f, &d.payload)
+                .map(|s| (s.time, s.telemetry))
+                .map_err(|e| e.to_string()),
+            TelemetryFormat::Auto => match games::recognise(&d.payload) {
+                Some(f) => {
+                    let decoded = games::decode(f, &d.payload)
+                        .map(|s| (s.time, s.telemetry))
+                        .map_err(|e| e.to_string());
+                    if decoded.is_ok() {
+                        eprintln!("telemetry: the datagrams are {f} ({})", f.games());
+                        format = TelemetryFormat::Game(f);
+                    }
+                    decoded
+                }
+                None => Err(games::Unreadable::Unrecognised(d.payload.len()).to_string()),
+            },
+        };
+        let (time, telemetry) = match decoded {
+            Ok(ok) => ok,
+            Err(reason) => {
+                errors.push(InputError { line: d.number, reason });
+                continue;
+            }
+        };
+        let t = time.unwrap_or_else(|| (d.time - *first.get_or_insert(d.time)).as_secs_f64());
+        if last_t.is_some_and(|l| t <= l) {
+            errors.push(InputError {
+                line: d.number,
+                reason: "its time is not after the last one's".into(),
+            });
+            continue;
+        }
+        last_t = Some(t);
+        let [ax, ay, az] = telemetry.force;
+        let [wx, wy, wz] = telemetry.rate;
+        rows.push((d.number, vec![t, ax, ay, az, wx, wy, wz]));
+    }
+    if cap.cut_short {
+        errors.push(InputError {
+            line: cap.packets + 1,
+            reason: "the file ends in the middle of this packet (a capture cut off): the packets before it are cued"
+                .into(),
+        });
+    }
+    summary.telemetry_format = match format {
+        TelemetryFormat::Text => "text".into(),
+        TelemetryFormat::Game(f) => f.name().into(),
+        TelemetryFormat::Auto => "auto".into(),
+    };
+    Ok((rows, errors, summary))
+}

@@ -1,0 +1,553 @@
+//! Packet captures of a game's telemetry: `stream --capture` writes one, `cue --input` reads one back (or one that
+//! tcpdump or Wireshark wrote).
+//!
+//! Written: a classic pcap file (the format of `tcpdump -w`), link type `LINKTYPE_RAW` (101, raw IP): each datagram
+//! that arrived on the socket, from any sender, with an IPv4 (or IPv6) and a UDP header synthesised from its source
+//! address and the socket's address (a socket bound to `0.0.0.0` is written as the loopback address when the sender
+//! is local, else as `0.0.0.0`), checksums computed, and its arrival time (the host's clock, microseconds).
+//! Wireshark shows them as the UDP packets they were, with their ports.
+//!
+//! Read: pcap (either byte order, micro- or nanosecond times) and pcapng (Wireshark's default: Enhanced Packet
+//! Blocks, with each interface's `if_tsresol` and `if_tsoffset`), on the link types Ethernet (VLAN tags too), raw
+//! IP, raw IPv4, raw IPv6, BSD loopback (`NULL`, `LOOP`: a capture on macOS's `lo0`) and Linux cooked (`SLL`,
+//! `SLL2`: `tcpdump -i any`). Other link types are refused by name. The UDP payloads are taken; packets that are not
+//! UDP, fragments of IP datagrams (not reassembled) and packets cut short by the snap length are skipped and counted.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr};
+use std::time::{Duration, SystemTime};
+
+use pcap_file::pcap::{PcapHeader, PcapPacket, PcapParser, PcapWriter};
+use pcap_file::pcapng::blocks::interface_description::InterfaceDescriptionOption;
+use pcap_file::pcapng::{Block, PcapNgParser};
+use pcap_file::{DataLink, PcapError, TsResolution};
+
+/// The datagrams of a live source written to a pcap file as they arrive.
+pub struct CaptureWriter {
+    writer: PcapWriter<std::io::BufWriter<std::fs::File>>,
+    /// The socket's address (the packets' destination).
+    local: SocketAddr,
+    /// Packets written.
+    pub packets: u64,
+    /// The first write error: nothing more is written after it.
+    pub error: Option<String>,
+}
+
+impl CaptureWriter {
+    /// Creates the file (its header written) for datagrams arriving at `local`.
+    pub fn create(path: &std::path::Path, local: SocketAddr) -> Result<Self, String> {
+        let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+        let header = PcapHeader {
+            datalink: DataLink::RAW,
+            ts_resolution: TsResolution::MicroSecond,
+            ..PcapHeader::default()
+        };
+        let writer = PcapWriter::with_header(std::io::BufWriter::new(file), header).map_err(|e| e.to_string())?;
+        Ok(Self {
+            writer,
+            local,
+            packets: 0,
+            error: None,
+        })
+    }
+
+    /// Writes a datagram from `from` that arrived at `at`; a failure is kept in `error` and ends the capture.
+    pub fn write(&mut self, payload: &[u8], from: SocketAddr, at: SystemTime) {
+        if self.error.is_some() {
+            return;
+        }
+        let data = udp_packet(from, self.local, payload);
+        let time = at.duration_since(SystemTime::UNIX_EPOCH).unwrap_or_default();
+        match self
+            .writer
+            .write_packet(&PcapPacket::new(time, data.len() as u32, &data))
+        {
+            Ok(_) => self.packets += 1,
+            Err(e) => self.error = Some(e.to_string()),
+        }
+    }
+
+    /// Flushes the file: the packets written, or the first error.
+    pub fn finish(self) -> (u64, Option<String>) {
+        let packets = self.packets;
+        if let Some(e) = self.error {
+            return (packets, Some(e));
+        }
+        let mut file = self.writer.into_writer();
+        match file.flush().and_then(|()| file.get_ref().sync_all()) {
+            Ok(()) => (packets, None),
+            Err(e) => (packets, Some(e.to_string())),
+        }
+    }
+}
+
+/// The Internet checksum (RFC 1071) of the 16-bit words of `parts`, each part of even length but the last.
+fn checksum(parts: &[&[u8]]) -> u16 {
+    let mut sum: u64 = 0;
+    for part in parts {
+        for pair in part.chunks(2) {
+            let hi = u64::from(pair[0]) << 8;
+            sum += hi | pair.get(1).map_or(0, |&b| u64::from(b));
+        }
+    }
+    while sum > 0xffff {
+        sum = (sum & 0xffff) + (sum >> 16);
+    }
+    !(sum as u16)
+}
+
+/// A raw IP packet (IPv4 for an IPv4 sender, IPv6 otherwise) carrying `payload` in a UDP datagram from `from` to
+/// `to`, with its checksums. A destination of the other family is mapped into the sender's; an unspecified one is
+/// the loopback address when the sender is local.
+pub fn udp_packet(from: SocketAddr, to: SocketAddr, payload: &[u8]) -> Vec<u8> {
+    let to_ip = match to.ip() {
+        ip if ip.is_unspecified() && from.ip().is_loopback() => from.ip(),
+        ip => ip,
+    };
+    let udp_len = (8 + payload.len()).min(0xffff) as u16;
+    let mut udp = Vec::with_capacity(8 + payload.len());
+    udp.extend(from.port().to_be_bytes());
+    udp.extend(to.port().to_be_bytes());
+    udp.extend(udp_len.to_be_bytes());
+    udp.extend([0, 0]);
+    udp.extend(payload);
+    let ports_and_data = |pseudo: &[u8], udp: &mut Vec<u8>| {
+        let sum = match checksum(&[pseudo, udp]) {
+            // A computed zero is sent as all ones (zero means "no checksum").
+            0 => 0xffff,
+            s => s,
+        };
+        udp[6..8].copy_from_slice(&sum.to_be_bytes());
+    };
+    match from.ip() {
+        IpAddr::V4(src) => {
+            let dst = match to_ip {
+                IpAddr::V4(d) => d,
+                IpAddr::V6(d) => d.to_ipv4_mapped().unwrap_or(Ipv4Addr::UNSPECIFIED),
+            };
+            let mut pseudo = Vec::with_capacity(12);
+            pseudo.extend(src.octets());
+            pseudo.extend(dst.octets());
+            pseudo.extend([0, 17]);
+            pseudo.extend(udp_len.to_be_bytes());
+            ports_and_data(&pseudo, &mut udp);
+            let total = (20 + udp.len()).min(0xffff) as u16;
+            let mut ip = vec![0x45, 0];
+            ip.extend(total.to_be_bytes());
+            // Identification 0, "don't fragment", TTL 64, UDP, checksum filled in below.
+            ip.extend([0, 0, 0x40, 0, 64, 17, 0, 0]);
+            ip.extend(src.octets());
+            ip.extend(dst.octets());
+            let sum = checksum(&[&ip]);
+            ip[10..12].copy_from_slice(&sum.to_be_bytes());
+            ip.extend(udp);
+            ip
+        }
+        IpAddr::V6(src) => {
+            let dst = match to_ip {
+                IpAddr::V6(d) => d,
+                IpAddr::V4(d) => d.to_ipv6_mapped(),
+            };
+            let mut pseudo = Vec::with_capacity(40);
+            pseudo.extend(src.octets());
+            pseudo.extend(dst.octets());
+            pseudo.extend(u32::from(udp_len).to_be_bytes());
+            pseudo.extend([0, 0, 0, 17]);
+            ports_and_data(&pseudo, &mut udp);
+            let mut ip = vec![0x60, 0, 0, 0];
+            ip.extend(udp_len.to_be_bytes());
+            ip.extend([17, 64]);
+            ip.extend(src.octets());
+            ip.extend(dst.octets());
+            ip.extend(udp);
+            ip
+        }
+    }
+}
+
+/// A UDP datagram of a capture.
+#[derive(Debug, Clone)]
+pub struct Datagram {
+    /// Its packet's number in the file (1-based, as Wireshark numbers them).
+    pub number: usize,
+    /// Its capture time (since 1970).
+    pub time: Duration,
+    /// Its sender.
+    pub from: SocketAddr,
+    /// Its destination.
+    pub to: SocketAddr,
+    /// The UDP payload.
+    pub payload: Vec<u8>,
+}
+
+/// What a capture holds.
+#[derive(Debug, Default)]
+pub struct Capture {
+    /// `pcap` or `pcapng`.
+    pub format: &'static str,
+    /// Packets in the file.
+    pub packets: usize,
+    /// The UDP datagrams, in the file's order.
+    pub datagrams: Vec<Datagram>,
+    /// Packets that were not taken, by why (not UDP, a fragment, cut short...).
+    pub skipped: BTreeMap<String, usize>,
+    /// The file ends in the middle of a packet (a capture that was cut off): the packets before it are read.
+    pub cut_short: bool,
+}
+
+/// Whether `bytes` start as a pcap or pcapng file.
+pub fn is_capture(bytes: &[u8]) -> bool {
+    matches!(
+        bytes.get(..4),
+        Some([0xa1, 0xb2, 0xc3, 0xd4] | [0xd4, 0xc3, 0xb2, 0xa1] | [0xa1, 0xb2, 0x3c, 0x4d] | [0x4d, 0x3c, 0xb2, 0xa1])
+            | Some([0x0a, 0x0d, 0x0d, 0x0a])
+    )
+}
+
+/// The link types read.
+fn link_supported(link: DataLink) -> bool {
+    matches!(
+        link,
+        DataLink::ETHERNET
+            | DataLink::RAW
+            | DataLink::IPV4
+            | DataLink::IPV6
+            | DataLink::NULL
+            | DataLink::LOOP
+            | DataLink::LINUX_SLL
+            | DataLink::LINUX_SLL2
+    )
+}
+
+fn unsupported(link: DataLink) -> String {
+    format!(
+        "link type {link:?} ({}) is not read: captures on Ethernet, raw IP, loopback or Linux cooked (`any`) \
+         interfaces are",
+        u32::from(link)
+    )
+}
+
+/// Reads a capture: its UDP datagrams, or why the file is not one that can be read.
+pub fn read(bytes: &[u8]) -> Result<Capture, String> {
+    match bytes.get(..4) {
+        Some([0x0a, 0x0d, 0x0d, 0x0a]) => read_pcapng(bytes),
+        _ if is_capture(bytes) => read_pcap(bytes),
+        _ => Err("not a packet capture (neither pcap nor pcapng)".into()),
+    }
+}
+
+fn read_pcap(bytes: &[u8]) -> Result<Capture, String> {
+    let (mut rest, parser) = PcapParser::new(bytes).map_err(|e| match e {
+        PcapError::IncompleteBuffer => "the pcap header is cut short".to_string(),
+        e => format!("not a pcap file: {e}"),
+    })?;
+    let link = parser.header().datalink;
+    if !link_supported(link) {
+        return Err(unsupported(link));
+    }
+    let mut capture = Capture {
+        format: "pcap",
+        ..Capture::default()
+    };
+    while !rest.is_empty() {
+        match parser.next_packet(rest) {
+            Ok((next, packet)) => {
+                rest = next;
+                capture.packets += 1;
+                let number = capture.packets;
+                let cut = (packet.data.len() as u32) < packet.orig_len;
+                capture.take(number, packet.timestamp, link, &packet.data, cut);
+            }
+            Err(PcapError::IncompleteBuffer) => {
+                capture.cut_short = true;
+                break;
+            }
+            Err(e) => return Err(format!("packet {}: {e}", capture.packets + 1)),
+        }
+    }
+    Ok(capture)
+}
+
+/// An interface's time: its `if_tsresol` (10^-n s, or 2^-n s with the high bit; microseconds without) and
+/// `if_tsoffset` (s).
+fn pcapng_time(units: u128, tsresol: u8, offset_s: u64) -> Duration {
+    let nanos = if tsresol & 0x80 != 0 {
+        let shift = u32::from(tsresol & 0x7f).min(127);
+        (units * 1_000_000_000) >> shift
+    } else {
+        let n = u32::from(tsresol).min(30);
+        if n <= 9 {
+            units.saturating_mul(10u128.pow(9 - n))
+        } else {
+            units / 10u128.pow(n - 9)
+        }
+    };
+    let nanos = u64::try_from(nanos).unwrap_or(u64::MAX);
+    Duration::from_nanos(nanos) + Duration::from_secs(offset_s)
+}
+
+fn read_pcapng(bytes: &[u8]) -> Result<Capture, String> {
+    let (mut rest, mut parser) = PcapNgParser::new(bytes).map_err(|e| match e {
+        PcapError::IncompleteBuffer => "the pcapng section header is cut short".to_string(),
+        e => format!("not a pcapng file: {e}"),
+    })?;
+    let mut capture = Capture {
+        format: "pcapng",
+        ..Capture::default()
+    };
+    while !rest.is_empty() {
+        let block = match parser.next_block(rest) {
+            Ok((next, block)) => {
+                rest = next;
+                block
+            }
+            Err(PcapError::IncompleteBuffer) => {
+                capture.cut_short = true;
+                break;
+            }
+            Err(e) => return Err(format!("block after packet {}: {e}", capture.packets)),
+        };
+        match block {
+            Block::InterfaceDescription(idb) if !link_supported(idb.linktype) => {
+                return Err(unsupported(idb.linktype));
+            }
+            Block::EnhancedPacket(epb) => {
+                capture.packets += 1;
+                let number = capture.packets;
+                let idb = parser
+                    .packet_interface(&epb)
+                    .ok_or_else(|| format!("packet {number}: no interface {} described", epb.interface_id))?;
+                let (mut tsresol, mut offset) = (6u8, 0u64);
+                for option in &idb.options {
+                    match option {
+                        InterfaceDescriptionOption::IfTsResol(r) => tsresol = *r,
+                        InterfaceDescriptionOption::IfTsOffset(o) => offset = *o,
+                        _ => {}
+                    }
+                }
+                // pcap-file 2 takes the timestamp's units for nanoseconds whatever the interface says: the units
+                // back, then the interface's resolution.
+                let time = pcapng_time(epb.timestamp.as_nanos(), tsresol, offset);
+                let cut = (epb.data.len() as u32) < epb.original_len;
+                capture.take(number, time, idb.linktype, &epb.data, cut);
+            }
+            Block::SimplePacket(_) | Block::Packet(_) => {
+                capture.packets += 1;
+                *capture
+                    .skipped
+                    .entry("a simple or obsolete packet block (no time)".into())
+                    .or_default() += 1;
+            }
+            _ => {}
+        }
+    }
+    Ok(capture)
+}
+
+impl Capture {
+    /// Takes packet `number`'s UDP datagram, or counts why not.
+    fn take(&mut self, number: usize, time: Duration, link: DataLink, data: &[u8], cut: bool) {
+        match udp_of(link, data, cut) {
+            Ok((from, to, payload)) => self.datagrams.push(Datagram {
+                number,
+                time,
+                from,
+                to,
+                payload: payload.to_vec(),
+            }),
+            Err(why) => *self.skipped.entry(why).or_default() += 1,
+        }
+    }
+}
+
+const ETHERTYPE_IPV4: u16 = 0x0800;
+const ETHERTYPE_IPV6: u16 = 0x86dd;
+
+fn be16(b: &[u8], at: usize) -> Option<u16> {
+    Some(u16::from_be_bytes(b.get(at..at + 2)?.try_into().ok()?))
+}
+
+/// The IP packet in a link-layer frame.
+fn ip_of(link: DataLink, data: &[u8]) -> Result<&[u8], String> {
+    let short = || "cut short in its link header".to_string();
+    let by_ethertype = |ty: u16| match ty {
+        ETHERTYPE_IPV4 | ETHERTYPE_IPV6 => Ok(()),
+        other => Err(format!("not IP (ethertype 0x{other:04x})")),
+    };
+    match link {
+        DataLink::RAW | DataLink::IPV4 | DataLink::IPV6 => Ok(data),
+        DataLink::ETHERNET => {
+            let mut at = 12;
+            let mut ty = be16(data, at).ok_or_else(short)?;
+            // 802.1Q and 802.1ad tags.
+            while matches!(ty, 0x8100 | 0x88a8) {
+                at += 4;
+                ty = be16(data, at).ok_or_else(short)?;
+            }
+            by_ethertype(ty)?;
+            Ok(&data[at + 2..])
+        }
+        DataLink::LINUX_SLL => {
+            let ty = be16(data, 14).ok_or_else(short)?;
+            by_ethertype(ty)?;
+            Ok(&data[16..])
+        }
+        DataLink::LINUX_SLL2 => {
+            let ty = be16(data, 0).ok_or_else(short)?;
+            by_ethertype(ty)?;
+            data.get(20..).ok_or_else(short)
+        }
+        DataLink::NULL | DataLink::LOOP => {
+            let family = data.get(..4).ok_or_else(short)?;
+            // In the capturing host's byte order (NULL) or big endian (LOOP): either way one byte is not zero.
+            let family = u32::from_le_bytes(family.try_into().unwrap_or_default())
+                .max(u32::from_be_bytes(family.try_into().unwrap_or_default()));
+            match family {
+                2 | 24 | 28 | 30 => Ok(&data[4..]),
+                other => Err(format!("not IP (loopback family {other})")),
+            }
+        }
+        other => Err(unsupported(other)),
+    }
+}
+
+/// The sender, destination and payload of the UDP datagram in a frame, or why there is none.
+fn udp_of(link: DataLink, data: &[u8], cut: bool) -> Result<(SocketAddr, SocketAddr, &[u8]), String> {
+    let ip = ip_of(link, data)?;
+    let (src, dst, udp) = match ip.first().map(|b| b >> 4) {
+        Some(4) => {
+            let ihl = usize::from(ip[0] & 0x0f) * 4;
+            if ip.len() < ihl.max(20) {
+                return Err("cut short in its IPv4 header".into());
+            }
+            let frag = u16::from_be_bytes([ip[6], ip[7]]);
+            if frag & 0x3fff != 0 {
+                return Err("an IPv4 fragment (fragments are not reassembled)".into());
+            }
+            if ip[9] != 17 {
+                return Err(format!("not UDP (IP protocol {})", ip[9]));
+            }
+            let total = usize::from(u16::from_be_bytes([ip[2], ip[3]]));
+            let end = if (ihl..=ip.len()).contains(&total) {
+                total
+            } else {
+                ip.len()
+            };
+            let src: [u8; 4] = ip[12..16].try_into().unwrap_or_default();
+            let dst: [u8; 4] = ip[16..20].try_into().unwrap_or_default();
+            (IpAddr::from(src), IpAddr::from(dst), &ip[ihl..end])
+        }
+        Some(6) => {
+            if ip.len() < 40 {
+                return Err("cut short in its IPv6 header".into());
+            }
+            let src: [u8; 16] = ip[8..24].try_into().unwrap_or_default();
+            let dst: [u8; 16] = ip[24..40].try_into().unwrap_or_default();
+            let mut next = ip[6];
+            let mut rest = &ip[40..];
+            // Hop-by-hop, routing and destination options headers; a fragment header ends the search.
+            loop {
+                match next {
+                    17 => break,
+                    0 | 43 | 60 => {
+                        let len = rest
+                            .get(1)
+                            .map(|l| (usize::from(*l) + 1) * 8)
+                            .ok_or("cut short in its IPv6 headers")?;
+                        next = rest[0];
+                        rest = rest.get(len..).ok_or("cut short in its IPv6 headers")?;
+                    }
+                    44 => return Err("an IPv6 fragment (fragments are not reassembled)".into()),
+                    other => return Err(format!("not UDP (IPv6 next header {other})")),
+                }
+            }
+            (
+                IpAddr::from(Ipv6Addr::from(src)),
+                IpAddr::from(Ipv6Addr::from(dst)),
+                rest,
+            )
+        }
+        Some(v) => return Err(format!("not IP (version {v})")),
+        None => return Err("empty".into()),
+    };
+    if udp.len() < 8 {
+        return Err("cut short in its UDP header".into());
+    }
+    let len = usize::from(u16::from_be_bytes([udp[4], udp[5]]));
+    if len < 8 || len > udp.len() {
+        return Err(if cut {
+            "cut short by the capture's snap length".into()
+        } else {
+            "its UDP length does not fit the packet".into()
+        });
+    }
+    let from = SocketAddr::new(src, u16::from_be_bytes([udp[0], udp[1]]));
+    let to = SocketAddr::new(dst, u16::from_be_bytes([udp[2], udp[3]]));
+    Ok((from, to, &udp[8..len]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_written_capture_reads_back_with_its_addresses_times_and_checksums() {
+        let dir = std::env::temp_dir().join(format!("ringpod-capture-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("w.pcap");
+        let local: SocketAddr = "0.0.0.0:4123".parse().unwrap();
+        let mut w = CaptureWriter::create(&path, local).unwrap();
+        let t0 = SystemTime::UNIX_EPOCH + Duration::from_micros(1_700_000_000_123_456);
+        w.write(b"hello", "127.0.0.1:5000".parse().unwrap(), t0);
+        w.write(b"odd", "[::1]:5001".parse().unwrap(), t0 + Duration::from_millis(10));
+        assert_eq!(w.finish(), (2, None));
+        let c = read(&std::fs::read(&path).unwrap()).unwrap();
+        assert_eq!((c.format, c.packets, c.datagrams.len()), ("pcap", 2, 2));
+        let d = &c.datagrams[0];
+        assert_eq!(d.payload, b"hello");
+        assert_eq!(d.from, "127.0.0.1:5000".parse().unwrap());
+        assert_eq!(d.to, "127.0.0.1:4123".parse().unwrap());
+        assert_eq!(d.time, Duration::from_micros(1_700_000_000_123_456));
+        assert_eq!(c.datagrams[1].to, "[::1]:4123".parse().unwrap());
+        assert_eq!(c.datagrams[1].payload, b"odd");
+        // The checksums verify: a packet summed with its checksum gives zero.
+        let p = udp_packet("10.0.0.2:7".parse().unwrap(), "10.0.0.1:9".parse().unwrap(), b"abc");
+        assert_eq!(checksum(&[&p[..20]]), 0);
+        let mut pseudo = p[12..20].to_vec();
+        pseudo.extend([0, 17, 0, 11]);
+        assert_eq!(checksum(&[&pseudo, &p[20..]]), 0);
+    }
+
+    #[test]
+    fn pcapng_times_follow_the_interface_resolution() {
+        assert_eq!(pcapng_time(1_500_000, 6, 0), Duration::from_millis(1500));
+        assert_eq!(pcapng_time(1_500_000_000, 9, 0), Duration::from_millis(1500));
+        assert_eq!(pcapng_time(3 << 19, 0x80 | 20, 1), Duration::from_millis(2500));
+    }
+
+    #[test]
+    fn any_bytes_are_read_or_refused_without_panic() {
+        let base = {
+            let mut v = vec![
+                0xd4, 0xc3, 0xb2, 0xa1, 2, 0, 4, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0xff, 0, 0, 1, 0, 0, 0,
+            ];
+            v.extend([0; 8]);
+            v.extend(60u32.to_le_bytes());
+            v.extend(60u32.to_le_bytes());
+            v.extend([0u8; 60]);
+            v
+        };
+        let mut seed = 1u64;
+        for _ in 0..3000 {
+            let mut v = base.clone();
+            for _ in 0..4 {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                let i = (seed >> 33) as usize % v.len();
+                v[i] = (seed >> 17) as u8;
+            }
+            let _ = read(&v);
+            let _ = read(&v[..(seed as usize % v.len())]);
+        }
+    }
+}

@@ -1,0 +1,321 @@
+//! Captures: `stream --telemetry-udp --capture FILE.pcap` records what the game sent, `cue --input FILE.pcap` cues
+//! it again as the live run did; pcapng files as Wireshark saves them read the same way; damaged files are refused.
+
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("ringpod-capture-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Live for Speed's classic OutSim packet (64 bytes): time (ms), angular velocity, heading, pitch, roll,
+/// acceleration (world axes), velocity and position.
+fn outsim(time_ms: u32, rate: [f32; 3], accel: [f32; 3]) -> Vec<u8> {
+    let mut out = time_ms.to_le_bytes().to_vec();
+    for v in rate.iter().chain(&[0.0f32; 3]).chain(&accel).chain(&[0.0f32; 3]) {
+        out.extend(v.to_le_bytes());
+    }
+    out.extend([0u8; 12]);
+    out
+}
+
+/// `ringpod cue --json --input FILE ARGS`: the exit code, the summary and stderr.
+fn cue(input: &Path, out: &Path, args: &[&str]) -> (Option<i32>, serde_json::Value, String) {
+    let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["cue", "--json", "--input"])
+        .arg(input)
+        .arg("--out")
+        .arg(out)
+        .args(args)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr).into_owned();
+    let summary = serde_json::from_slice(&o.stdout).unwrap_or(serde_json::Value::Null);
+    (o.status.code(), summary, stderr)
+}
+
+/// The last row of a pose CSV.
+fn last_pose(path: &Path) -> Vec<f64> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let last = text.lines().last().unwrap();
+    last.split(',').skip(1).map(|v| v.parse().unwrap()).collect()
+}
+
+/// A drive in OutSim packets to `stream --sim --telemetry-udp --capture`, a stranger's datagram among them; the
+/// capture cued offline gives the live run's poses: one per readable datagram, the same last pose.
+#[test]
+fn a_captured_drive_cues_offline_as_it_was_cued_live() {
+    let d = dir("live");
+    let pcap = d.join("drive.pcap");
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["stream", "--sim", "--fast", "--report-json", "--quiet"])
+        .args([
+            "--telemetry-udp",
+            "127.0.0.1:0",
+            "--telemetry-format",
+            "outsim",
+            "--udp-idle",
+            "0.3",
+        ])
+        .arg("--capture")
+        .arg(&pcap)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while !line.contains("send datagrams to") {
+        line.clear();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "the stream announces its address"
+        );
+    }
+    let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
+    let game = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let stranger = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    // Heading 0 faces world +y: braking at 3 m/s^2 for 0.8 s, then a left turn (yaw rate 0.3 rad/s, 2 m/s^2 to
+    // the left, world -x).
+    for k in 0..120u32 {
+        let (rate, accel) = if k < 80 {
+            ([0.0, 0.0, 0.0], [0.0, -3.0, 0.0])
+        } else {
+            ([0.0, 0.0, 0.3], [-2.0, 0.0, 0.0])
+        };
+        game.send_to(&outsim(10 * k, rate, accel), &addr).unwrap();
+        if k == 40 {
+            stranger.send_to(b"not telemetry", &addr).unwrap();
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let out = child.wait_with_output().unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "the stranger's datagram is unreadable: {report}"
+    );
+    assert_eq!(report["setpoints_applied"], 120, "{report}");
+    assert_eq!(
+        report["capture"]["packets"], 121,
+        "every datagram that arrived: {report}"
+    );
+    assert_eq!(report["capture"]["error"], serde_json::Value::Null);
+    let live: Vec<f64> = report["last_applied_pose"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    for format in ["outsim", "auto"] {
+        let poses = d.join(format!("poses-{format}.csv"));
+        let (code, summary, said) = cue(&pcap, &poses, &["--telemetry-format", format]);
+        assert_eq!(code, Some(3), "{summary} {said}");
+        assert_eq!(summary["rows"], 120, "{summary}");
+        assert_eq!(summary["poses"], 120);
+        assert_eq!(summary["capture"]["file_format"], "pcap");
+        assert_eq!(summary["capture"]["packets"], 121);
+        assert_eq!(summary["capture"]["telemetry_format"], "outsim");
+        let errors = summary["input_errors"].as_array().unwrap();
+        assert_eq!(errors.len(), 1, "{summary}");
+        assert_eq!(errors[0]["line"], 42, "the stranger's datagram, packet 42");
+        let offline = last_pose(&poses);
+        for (a, b) in live.iter().zip(&offline) {
+            assert!((a - b).abs() < 1e-6, "live {live:?} offline {offline:?}");
+        }
+        assert!(
+            offline[3] != 0.0 || offline[4] != 0.0,
+            "the drive moved the platform: {offline:?}"
+        );
+    }
+    // The stranger's port only: nothing readable, said by the exit code.
+    let stranger_port = stranger.local_addr().unwrap().port().to_string();
+    let game_port = addr.rsplit(':').next().unwrap().to_owned();
+    let (code, summary, _) = cue(&pcap, &d.join("p.csv"), &["--udp-port", &stranger_port]);
+    assert_eq!(
+        (code, summary["rows"].as_u64()),
+        (Some(3), Some(0)),
+        "no datagram to that port: {summary}"
+    );
+    let (code, summary, _) = cue(&pcap, &d.join("p.csv"), &["--udp-port", &game_port]);
+    assert_eq!((code, summary["rows"].as_u64()), (Some(3), Some(120)), "{summary}");
+}
+
+/// An Ethernet frame: IPv4, protocol `proto`, fragment field `frag`, from 192.168.1.20:9000 to 192.168.1.10:4123.
+fn ethernet_ipv4(proto: u8, frag: u16, payload: &[u8]) -> Vec<u8> {
+    let mut f = vec![0x02, 0, 0, 0, 0, 1, 0x02, 0, 0, 0, 0, 2, 0x08, 0x00];
+    let udp_len = (8 + payload.len()) as u16;
+    f.extend([0x45, 0]);
+    f.extend((20 + udp_len).to_be_bytes());
+    f.extend([0, 1]);
+    f.extend(frag.to_be_bytes());
+    f.extend([64, proto, 0, 0, 192, 168, 1, 20, 192, 168, 1, 10]);
+    f.extend(9000u16.to_be_bytes());
+    f.extend(4123u16.to_be_bytes());
+    f.extend(udp_len.to_be_bytes());
+    f.extend([0, 0]);
+    f.extend(payload);
+    f
+}
+
+/// A pcapng block: type, body, length before and after.
+fn block(kind: u32, body: &[u8]) -> Vec<u8> {
+    let mut body = body.to_vec();
+    while !body.len().is_multiple_of(4) {
+        body.push(0);
+    }
+    let len = (12 + body.len()) as u32;
+    let mut b = kind.to_le_bytes().to_vec();
+    b.extend(len.to_le_bytes());
+    b.extend(body);
+    b.extend(len.to_le_bytes());
+    b
+}
+
+/// A pcapng file as Wireshark saves one (section header, an Ethernet interface with nanosecond times, enhanced
+/// packet blocks): text telemetry without a time at 100 Hz, and among it an ARP frame, a TCP segment and an IPv4
+/// fragment, skipped and counted.
+#[test]
+fn a_wireshark_pcapng_capture_is_cued() {
+    let d = dir("pcapng");
+    let mut file = Vec::new();
+    let mut shb = 0x1a2b_3c4du32.to_le_bytes().to_vec();
+    shb.extend([1, 0, 0, 0]);
+    shb.extend(u64::MAX.to_le_bytes());
+    file.extend(block(0x0a0d_0d0a, &shb));
+    // Interface: Ethernet, snap length 262144, option if_tsresol = 9, end of options.
+    let mut idb = vec![1, 0, 0, 0];
+    idb.extend(262_144u32.to_le_bytes());
+    idb.extend([9, 0, 1, 0, 9, 0, 0, 0, 0, 0, 0, 0]);
+    file.extend(block(1, &idb));
+    let t0: u64 = 1_700_000_000_000_000_000;
+    let epb = |ns: u64, frame: &[u8]| {
+        let mut b = 0u32.to_le_bytes().to_vec();
+        b.extend(((ns >> 32) as u32).to_le_bytes());
+        b.extend((ns as u32).to_le_bytes());
+        b.extend((frame.len() as u32).to_le_bytes());
+        b.extend((frame.len() as u32).to_le_bytes());
+        b.extend(frame);
+        while !b.len().is_multiple_of(4) {
+            b.push(0);
+        }
+        block(6, &b)
+    };
+    let g = 9.80665;
+    for k in 0..50u64 {
+        let text = format!("-4 0 {g} 0 0 0");
+        file.extend(epb(t0 + k * 10_000_000, &ethernet_ipv4(17, 0, text.as_bytes())));
+        if k == 10 {
+            let mut arp = vec![0xff; 6];
+            arp.extend([0x02, 0, 0, 0, 0, 2, 0x08, 0x06]);
+            arp.extend([0u8; 28]);
+            file.extend(epb(t0 + k * 10_000_000 + 1, &arp));
+            file.extend(epb(t0 + k * 10_000_000 + 2, &ethernet_ipv4(6, 0, b"tcp")));
+            file.extend(epb(t0 + k * 10_000_000 + 3, &ethernet_ipv4(17, 0x2000, b"1 2 3")));
+        }
+    }
+    let path = d.join("wireshark.pcapng");
+    std::fs::write(&path, &file).unwrap();
+    let poses = d.join("poses.csv");
+    let (code, summary, said) = cue(&path, &poses, &["--telemetry-format", "text"]);
+    assert_eq!(code, Some(0), "{summary} {said}");
+    assert_eq!(summary["rows"], 50);
+    let c = &summary["capture"];
+    assert_eq!(c["file_format"], "pcapng");
+    assert_eq!(c["packets"], 53);
+    assert_eq!(c["datagrams"], 50);
+    assert_eq!(c["ports"]["4123"], 50, "{c}");
+    assert_eq!(c["skipped"]["not IP (ethertype 0x0806)"], 1, "{c}");
+    assert_eq!(c["skipped"]["not UDP (IP protocol 6)"], 1, "{c}");
+    assert_eq!(
+        c["skipped"]["an IPv4 fragment (fragments are not reassembled)"], 1,
+        "{c}"
+    );
+    // No time in the datagrams: the capture's, from the first one, at the interface's nanosecond resolution.
+    let text = std::fs::read_to_string(&poses).unwrap();
+    let t: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(t.len(), 50);
+    assert!((t[0]).abs() < 1e-12 && (t[49] - 0.49).abs() < 1e-9, "{:?}", &t[..3]);
+    // Braking: the platform moves back.
+    assert!(last_pose(&poses)[0] < 0.0);
+}
+
+/// Damaged or foreign captures: refused with a message (or, cut off in a packet, cued up to it and said).
+#[test]
+fn damaged_captures_are_refused_with_a_message() {
+    let d = dir("damaged");
+    let out = d.join("p.csv");
+    let header = |link: u32| {
+        let mut h = vec![0xd4, 0xc3, 0xb2, 0xa1, 2, 0, 4, 0];
+        h.extend([0u8; 8]);
+        h.extend(65_535u32.to_le_bytes());
+        h.extend(link.to_le_bytes());
+        h
+    };
+    let cases: [(&str, Vec<u8>, &str); 3] = [
+        ("cut.pcap", header(101)[..10].to_vec(), "cut short"),
+        ("wifi.pcap", header(105), "IEEE802_11 (105) is not read"),
+        ("ng.pcapng", vec![0x0a, 0x0d, 0x0d, 0x0a, 1, 2, 3], "pcapng"),
+    ];
+    for (name, bytes, says) in cases {
+        let path = d.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let (code, _, said) = cue(&path, &out, &["--telemetry-format", "outsim"]);
+        assert_eq!(code, Some(1), "{name}: {said}");
+        assert!(said.contains(says) && said.contains(name), "{name}: {said}");
+    }
+    // A raw-IP capture cut off in its second packet: the first is cued, the cut is an input error.
+    let mut file = header(101);
+    let packet = {
+        let mut p = ethernet_ipv4(17, 0, b"0 0 9.8 0 0 0.1");
+        p.drain(..14);
+        p
+    };
+    for k in 0..2u32 {
+        file.extend([0, 0, 0, 0]);
+        file.extend((k * 10_000).to_le_bytes());
+        file.extend((packet.len() as u32).to_le_bytes());
+        file.extend((packet.len() as u32).to_le_bytes());
+        file.extend(&packet);
+    }
+    file.truncate(file.len() - 5);
+    let path = d.join("cutoff.pcap");
+    std::fs::write(&path, file).unwrap();
+    let (code, summary, said) = cue(&path, &out, &["--telemetry-format", "text"]);
+    assert_eq!(code, Some(3), "{said}");
+    assert_eq!(summary["rows"], 1, "{summary}");
+    assert!(summary["input_errors"][0]["reason"]
+        .as_str()
+        .unwrap()
+        .contains("middle of this packet"));
+    // A CSV given a capture's options is told so.
+    let csv = d.join("t.csv");
+    std::fs::write(&csv, "t,ax,ay,az,wx,wy,wz\n0,0,0,9.8,0,0,0\n").unwrap();
+    let (code, _, said) = cue(&csv, &out, &["--telemetry-format", "outsim"]);
+    assert_eq!(code, Some(1));
+    assert!(said.contains("not one"), "{said}");
+}
+
+/// `--capture` without a UDP source is refused; a capture that cannot be created stops the stream before it starts.
+#[test]
+fn capture_needs_a_udp_source_and_a_writable_file() {
+    let run = |args: &[&str]| {
+        std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(["stream", "--sim", "--fast", "--quiet"])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let o = run(&["--motion", "heave", "--duration", "0.1", "--capture", "x.pcap"]);
+    assert_ne!(o.status.code(), Some(0));
+    let o = run(&["--telemetry-udp", "127.0.0.1:0", "--capture", "/nonexistent/dir/x.pcap"]);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/dir/x.pcap"));
+}
