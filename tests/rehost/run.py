@@ -25,6 +25,8 @@ from models import dma as D  # noqa: E402
 from models import tim as T  # noqa: E402
 from models.flash import sector_of  # noqa: E402
 from models.rcc import IWDGRSTF  # noqa: E402
+from plant import Plant  # noqa: E402
+from serial_link import Cli, PtyBridge  # noqa: E402
 
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411.rs, SETTINGS)
 GPIOB_BSRR = 0x4002_0418
@@ -120,11 +122,33 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
+def serial_checks(m, p, log, plant, ringpod):
+    import json
+
+    c = CHECKS
+    u = m.usart1
+    bridge = PtyBridge(u)
+    m.observers.append(bridge.poll)
+    cli = Cli(m, ringpod, bridge)
+    port = ["--port", bridge.path]
+
+    r = cli.run("device", "status", *port)
+    try:
+        status = json.loads(r.stdout)
+    except ValueError:
+        status = {}
+    baud = SYSCLK / max(1, u.brr)
+    c.check("serial-status", r.code == 0 and "state" in status and u.overruns == 0,
+            f"{r} | USART1 BRR {u.brr} ({baud:.0f} baud), CR1 {u.cr1:#06x}; {bridge.to_board} bytes in, "
+            f"{bridge.to_host} out, {u.overruns} overruns; {r.sim_s:.2f} simulated s")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--elf", default=os.path.join(REPO, "target/thumbv7em-none-eabihf/release/ringpod-firmware"))
     ap.add_argument("--memory-x", default=os.path.join(REPO, "memory.x"))
     ap.add_argument("--seconds", type=float, default=1.0, help="simulated seconds of normal running")
+    ap.add_argument("--ringpod", help="the host CLI binary: runs the serial-link checks over a pty")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the README")
     args = ap.parse_args()
 
@@ -135,6 +159,7 @@ def main():
     p = Probes(m)
     log = DefmtLog(m)
     m.observers.append(log.poll)
+    plant = Plant(m)
     if args.count_instructions:
         m.count_instructions()
 
@@ -281,6 +306,11 @@ def main():
              f"and cleared it (RMVF), logged {said[0].split(' ms ', 1)[-1] if said else 'no error'!r}, fed the watchdog {len(refeeds)} times in the "
              f"{ms(since_reset):.0f} ms after the reset"
              if reset else f"no reset within 200 ms of holding TIM5's interrupt (fault: {m.fault})"))
+
+    # -- the host link on USART1: the real CLI over a pty --
+    m.nvic.held.discard(TIM5_IRQ)
+    if args.ringpod:
+        serial_checks(m, p, log, plant, args.ringpod)
 
     wall = time.time() - wall0
     sim = m.now / SYSCLK

@@ -258,12 +258,23 @@ impl Link for UartLink {
         }
     }
 
+    /// In pieces of at most half the transmit buffer, each sent before the next: embassy's buffered write refuses
+    /// a slice longer than its buffer, and waits for room without a waker when the slice does not fit.
     async fn write(&mut self, bytes: &[u8]) -> Result<(), Disconnected> {
-        embedded_io_async::Write::write_all(&mut self.uart, bytes)
-            .await
-            .map_err(|_| Disconnected)
+        for chunk in bytes.chunks(UART_BUF / 2) {
+            embedded_io_async::Write::write_all(&mut self.uart, chunk)
+                .await
+                .map_err(|_| Disconnected)?;
+            embedded_io_async::Write::flush(&mut self.uart)
+                .await
+                .map_err(|_| Disconnected)?;
+        }
+        Ok(())
     }
 }
+
+/// Bytes of each of USART1's software buffers.
+const UART_BUF: usize = 256;
 
 /// The DMA ring into GPIOB.BSRR.
 struct DmaPort {
@@ -463,8 +474,8 @@ pub async fn start(spawner: Spawner) {
     let device = builder.build();
 
     // USART1: TX PA15, RX PA10 (pulled up, so an unplugged adapter reads as an idle line, not noise).
-    static UART_TX: StaticCell<[u8; 256]> = StaticCell::new();
-    static UART_RX: StaticCell<[u8; 256]> = StaticCell::new();
+    static UART_TX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
+    static UART_RX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
     let mut uart_config = usart::Config::default();
     uart_config.baudrate = USART_BAUD;
     uart_config.rx_pull = Pull::Up;
@@ -472,8 +483,8 @@ pub async fn start(spawner: Spawner) {
         p.USART1,
         p.PA10,
         p.PA15,
-        UART_TX.init([0; 256]),
-        UART_RX.init([0; 256]),
+        UART_TX.init([0; UART_BUF]),
+        UART_RX.init([0; UART_BUF]),
         Irqs,
         uart_config,
     ) {
