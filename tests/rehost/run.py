@@ -142,6 +142,49 @@ def serial_checks(m, p, log, plant, ringpod):
             f"{r} | USART1 BRR {u.brr} ({baud:.0f} baud), CR1 {u.cr1:#06x}; {bridge.to_board} bytes in, "
             f"{bridge.to_host} out, {u.overruns} overruns; {r.sim_s:.2f} simulated s")
 
+    def steps():
+        r = cli.run("device", "status", *port)
+        try:
+            return json.loads(r.stdout)["steps"]
+        except (ValueError, KeyError):
+            return None
+
+    # a jog: the STEP edges on GPIOB (the plant) against the steps the device counts
+    before = steps()
+    plant.reset_counts()
+    for w in plant.widths + plant.setups:
+        w.clear()
+    en = cli.run("device", "enable", *port)
+    jog = cli.run("device", "jog", "1", "5", *port)
+    after = steps()
+    dev = [b - a for a, b in zip(before, after)] if before and after else None
+    slot_us = source_constant("STEP_SLOT_NS") / 1000
+    widths = sorted(set().union(*plant.widths))
+    setups = sorted(set().union(*plant.setups))
+    c.check("serial-jog", en.code == 0 and jog.code == 0 and dev is not None and dev[0] != 0
+            and dev == plant.net and widths and min(widths) * slot_us >= 2.5
+            and (not setups or min(setups) * slot_us >= 5.0),
+            f"{en}; {jog}; device steps moved {dev}, STEP edges on PB0-PB5 (signed by DIR) {plant.net}; STEP high "
+            f"{[w * slot_us for w in widths]} us (>= 2.5), DIR set-up {[t * slot_us for t in setups[:3]]} us (>= 5)")
+    cli.run("device", "disable", *port)
+
+    # a setting stored into sectors 6-7 and restored after a reset
+    programs, erases = len(m.flash.programs), len(m.flash.erases)
+    resets = len(m.resets)
+    st = cli.run("device", "config", "set", "stream.timeout_ms", "250", *port)
+    m.run(m.now + int(0.3 * SYSCLK))  # the settings task stores within 100 ms with the supplies off
+    rs = cli.run("device", "restart", *port)
+    m.run(m.now + int(0.3 * SYSCLK))
+    got = cli.run("device", "config", "get", "stream.timeout_ms", *port)
+    new = m.flash.programs[programs:]
+    outside = [a for a, _ in new if not SETTINGS[0] <= a < SETTINGS[1]]
+    bad_erase = [n for n in m.flash.erases[erases:] if n not in (6, 7)]
+    restarted = [cause for _, cause in m.resets[resets:]]
+    c.check("serial-settings", st.code == 0 and got.code == 0 and "250" in got.stdout and new and not outside
+            and not bad_erase and restarted == ["SYSRESETREQ"],
+            f"{st}; {rs}; resets {restarted}; {got}; {len(new)} words programmed, sector erases "
+            f"{m.flash.erases[erases:]}, outside sectors 6-7: {outside + bad_erase or 'none'}")
+
 
 def main():
     ap = argparse.ArgumentParser()
@@ -315,7 +358,7 @@ def main():
     wall = time.time() - wall0
     sim = m.now / SYSCLK
     print(f"rehost: {sim:.2f} simulated s in {wall:.1f} s wall ({wall / sim:.2f} s per simulated s; "
-          f"normal running {wall_run:.1f} s); the link, step edges of a move and switches are not run (no USB host)")
+          f"normal running {wall_run:.1f} s); the host link over USART1 and a pty")
     if args.count_instructions:
         print(f"rehost: {m.instructions} instructions in {sim:.2f} simulated s ({m.instructions / sim / 1e6:.2f} M/s "
               f"simulated, {100 * m.instructions / m.now:.1f}% of the cycles), {m.instructions / wall / 1e6:.2f} M/s wall")
