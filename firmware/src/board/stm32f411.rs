@@ -202,12 +202,17 @@ const SWITCH_BITS: [InputBit; 11] = [
     InputBit::PowerOk,
 ];
 
+/// The inputs this board has no pin for (far ends of carriages 1-4) read high, as an open switch to ground on a
+/// pull-up does: inactive with the default wiring, instead of four limit switches always tripped.
+const UNWIRED_HIGH: u16 =
+    InputBit::Limit(0).mask() | InputBit::Limit(1).mask() | InputBit::Limit(2).mask() | InputBit::Limit(3).mask();
+
 impl InputPins for Switches {
     fn read(&mut self) -> u16 {
         self.pins
             .iter()
             .zip(SWITCH_BITS)
-            .fold(0, |w, (p, b)| if p.is_high() { w | b.mask() } else { w })
+            .fold(UNWIRED_HIGH, |w, (p, b)| if p.is_high() { w | b.mask() } else { w })
     }
 
     async fn edge(&mut self) {
