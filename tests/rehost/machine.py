@@ -27,6 +27,7 @@ from unicorn import arm_const as A
 from elf import Elf
 from models.dma import Dma, unpack_words
 from models.dwt import Dwt
+from models.exti import Exti
 from models.flash import FLASH_BASE, FLASH_SIZE, FlashInterface
 from models.gpio import Gpio
 from models.iwdg import Iwdg
@@ -34,10 +35,11 @@ from models.nvic import Nvic
 from models.otg import OtgFs
 from models.rcc import IWDGRSTF, PINRSTF, POWER_ON, SFTRSTF, Rcc
 from models.tim import Tim
+from models.usart import Usart
 
 SYSCLK = 96_000_000
 EXCP_EXCEPTION_EXIT = 8  # QEMU's exception number for an EXC_RETURN branch
-WFE, WFI, SEV = 0xBF20, 0xBF30, 0xBF40
+WFE, WFI, SEV, CPSIE_I = 0xBF20, 0xBF30, 0xBF40, 0xB662
 PAINT = 0xA5  # unused RAM is painted with this before the run, to measure the stack's deepest point
 R = [A.UC_ARM_REG_R0, A.UC_ARM_REG_R1, A.UC_ARM_REG_R2, A.UC_ARM_REG_R3, A.UC_ARM_REG_R12, A.UC_ARM_REG_LR]
 S = [getattr(A, f"UC_ARM_REG_S{i}") for i in range(16)]
@@ -60,7 +62,8 @@ UPDATE_REQUESTS = {
     "tim4": [("dma1", 6, 2)],
     "tim5": [("dma1", 0, 6), ("dma1", 6, 6)],
 }
-QILING_PERIPHERALS = ["pwr", "exti", "syscfg", "dbgmcu", "usart1", "usart2", "usart6"]
+QILING_PERIPHERALS = ["pwr", "syscfg", "dbgmcu", "usart2", "usart6"]
+USART1_IRQ = 37  # RM0383 10.2: USART1 global interrupt; on APB2, clocked at SYSCLK here
 
 
 class Fault(Exception):
@@ -148,7 +151,13 @@ class Machine:
         self.iwdg = self.install("iwdg", 0x4000_3000, Iwdg(self.clock, self._watchdog_timeout, SYSCLK))
         self.otg = self.install("otg_fs", 0x5000_0000, OtgFs())
         self.dwt = self.install("dwt", 0xE000_1000, Dwt(self.clock))
-        self.timed = [self.iwdg, *self.tim.values()]
+        self.exti = self.install("exti", 0x4001_3C00, Exti(self.pend, self._exticr))
+        self.usart1 = self.install("usart1", 0x4001_1000, Usart("usart1", self.clock, self.pend, USART1_IRQ))
+        self.timed = [self.iwdg, self.usart1, *self.tim.values()]
+
+    def _exticr(self, line):
+        """RM0383 7.2.3: SYSCFG_EXTICR1-4, four bits per line: the port routed to EXTI `line` (0 = A)."""
+        return self.read(0x4001_3808 + 4 * (line // 4), 4) >> (4 * (line % 4)) & 0xF
 
     # memory access for the DMA and the flash model
     def read(self, addr, size):
@@ -187,6 +196,10 @@ class Machine:
             uc.hook_add(UC_HOOK_CODE, self._wfe, None, addr, addr)
         for addr in self.elf.hint_sites(SEV):
             uc.hook_add(UC_HOOK_CODE, self._sev, None, addr, addr)
+        for addr in self.elf.hint_sites(CPSIE_I):
+            uc.hook_add(UC_HOOK_CODE, self._cpsie, None, addr, addr)
+        for addr, rn in self.elf.msr_primask_sites():
+            uc.hook_add(UC_HOOK_CODE, self._msr_primask, rn, addr, addr)
         uc.hook_add(UC_HOOK_MEM_WRITE, self._flash_store, None, FLASH_BASE, FLASH_BASE + FLASH_SIZE - 1)
         self.flash_fixups = []
 
@@ -333,6 +346,22 @@ class Machine:
         self.sleeping = addr
         uc.emu_stop()
 
+    def _cpsie(self, uc, addr, size, ud):
+        # B5.2.1 CPS, B5.2.3 MSR: an interrupt that became pending inside a critical section is taken right after
+        # the instruction that ends it, not at the end of the chunk (at 921600 baud a received byte waits only
+        # ~1,000 cycles): the instruction is done here and the exception entered, as `_wfe` does
+        self._unmask(uc, addr, 2, 0)
+
+    def _msr_primask(self, uc, addr, size, rn):
+        self._unmask(uc, addr, 4, uc.reg_read(A.UC_ARM_REG_R0 + rn) & 1)
+
+    def _unmask(self, uc, addr, size, primask):
+        if primask or self.nvic.best_pending() is None:
+            return
+        uc.reg_write(A.UC_ARM_REG_PRIMASK, 0)
+        if not self.try_take(addr + size):
+            uc.reg_write(A.UC_ARM_REG_PC, (addr + size) | 1)
+
     def _sev(self, uc, addr, size, ud):
         self.event = True
 
@@ -376,7 +405,7 @@ class Machine:
         self.hw.entity["scb"].hook_write(self._scb_write)
         self.nvic.sys_priority = lambda exc, scb=self.hw.entity["scb"]: scb.instance.SHP[exc - 4]
         self.rcc.instance = Rcc(self.ql, "rcc").instance
-        for model in (self.nvic, self.iwdg, *self.tim.values(), *self.dma.values()):
+        for model in (self.nvic, self.iwdg, self.usart1, self.exti, *self.tim.values(), *self.dma.values()):
             model.reset()
         for port in self.gpio.values():
             port.instance = type(port.instance)()

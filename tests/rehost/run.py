@@ -25,6 +25,8 @@ from models import dma as D  # noqa: E402
 from models import tim as T  # noqa: E402
 from models.flash import sector_of  # noqa: E402
 from models.rcc import IWDGRSTF  # noqa: E402
+from plant import Plant  # noqa: E402
+from serial_link import Cli, PtyBridge  # noqa: E402
 
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411.rs, SETTINGS)
 GPIOB_BSRR = 0x4002_0418
@@ -120,11 +122,63 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
+def serial_checks(m, p, log, plant, ringpod):
+    import json
+
+    c = CHECKS
+    u = m.usart1
+    bridge = PtyBridge(u)
+    m.observers.append(bridge.poll)
+    cli = Cli(m, ringpod, bridge)
+    port = ["--port", bridge.path]
+
+    r = cli.run("device", "status", *port)
+    try:
+        status = json.loads(r.stdout)
+    except ValueError:
+        status = {}
+    baud = SYSCLK / max(1, u.brr)
+    c.check("serial-status", r.code == 0 and "state" in status and u.overruns == 0,
+            f"{r} | USART1 BRR {u.brr} ({baud:.0f} baud), CR1 {u.cr1:#06x}; {bridge.to_board} bytes in, "
+            f"{bridge.to_host} out, {u.overruns} overruns; {r.sim_s:.2f} simulated s")
+
+    def steps():
+        r = cli.run("device", "status", *port)
+        try:
+            return json.loads(r.stdout)["steps"]
+        except (ValueError, KeyError):
+            return None
+
+    # a jog: the STEP edges on GPIOB (the plant) against the steps the device counts; the watchdog reset above
+    # latched a fault, which the host clears first
+    clear = cli.run("device", "clear", *port)
+    before = steps()
+    plant.reset_counts()
+    for w in plant.widths + plant.setups:
+        w.clear()
+    en = cli.run("device", "enable", *port)
+    m.run(m.now + int(0.6 * SYSCLK))  # logic, then power, each with its settling time
+    jog = cli.run("device", "jog", "1", "0.5", *port)
+    after = steps()
+    dev = [b - a for a, b in zip(before, after)] if before and after else None
+    slot_us = source_constant("STEP_SLOT_NS") / 1000
+    widths = sorted(set().union(*plant.widths))
+    setups = sorted(set().union(*plant.setups))
+    c.check("serial-jog", en.code == 0 and jog.code == 0 and dev is not None and dev[0] != 0
+            and dev == plant.net and widths and min(widths) * slot_us >= 2.5
+            and (not setups or min(setups) * slot_us >= 5.0),
+            f"{clear}; {en}; {jog}; device steps moved {dev}, STEP edges on PB0-PB5 (signed by DIR) {plant.net}; STEP high "
+            f"{[w * slot_us for w in widths]} us (>= 2.5), DIR set-up {[t * slot_us for t in setups[:3]]} us (>= 5)")
+    cli.run("device", "disable", *port)
+    m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--elf", default=os.path.join(REPO, "target/thumbv7em-none-eabihf/release/ringpod-firmware"))
     ap.add_argument("--memory-x", default=os.path.join(REPO, "memory.x"))
     ap.add_argument("--seconds", type=float, default=1.0, help="simulated seconds of normal running")
+    ap.add_argument("--ringpod", help="the host CLI binary: runs the serial-link checks over a pty")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the README")
     args = ap.parse_args()
 
@@ -135,6 +189,7 @@ def main():
     p = Probes(m)
     log = DefmtLog(m)
     m.observers.append(log.poll)
+    plant = Plant(m)
     if args.count_instructions:
         m.count_instructions()
 
@@ -180,7 +235,7 @@ def main():
             f"_stack_end {stack_floor:#010x} and the top of RAM (memory.x {ram[0]:#010x}+{ram[1] // 1024}K); "
             f"lowest SP seen {m.stack_low:#010x}")
 
-    tasks = ["control_task", "inputs_task", "usb_task", "link_task", "settings_task", "steps_task"]
+    tasks = ["control_task", "inputs_task", "usb_task", "link_task", "uart_link_task", "settings_task", "steps_task"]
     missing = [t for t in tasks if t not in p.polled]
     steps_ipsr = sorted(p.polled.get("steps_task", ()))
     c.check("tasks-reached", not missing and steps_ipsr == [16 + 71] and "board::start" in p.reached,
@@ -282,10 +337,15 @@ def main():
              f"{ms(since_reset):.0f} ms after the reset"
              if reset else f"no reset within 200 ms of holding TIM5's interrupt (fault: {m.fault})"))
 
+    # -- the host link on USART1: the real CLI over a pty --
+    m.nvic.held.discard(TIM5_IRQ)
+    if args.ringpod:
+        serial_checks(m, p, log, plant, args.ringpod)
+
     wall = time.time() - wall0
     sim = m.now / SYSCLK
     print(f"rehost: {sim:.2f} simulated s in {wall:.1f} s wall ({wall / sim:.2f} s per simulated s; "
-          f"normal running {wall_run:.1f} s); the link, step edges of a move and switches are not run (no USB host)")
+          f"normal running {wall_run:.1f} s); the host link over USART1 and a pty")
     if args.count_instructions:
         print(f"rehost: {m.instructions} instructions in {sim:.2f} simulated s ({m.instructions / sim / 1e6:.2f} M/s "
               f"simulated, {100 * m.instructions / m.now:.1f}% of the cycles), {m.instructions / wall / 1e6:.2f} M/s wall")

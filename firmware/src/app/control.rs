@@ -51,8 +51,7 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
         let depth = shared.steps.len() as u16;
         shared.with(|c| c.set_platform_stats(cost, depth));
         if let Some(m) = message {
-            // The fault stays latched in the state whether or not the message fits; the host sees it in the status.
-            let _ = shared.outbox.try_send(m);
+            shared.post(m);
         }
         worst = worst.max(cost);
         n = n.wrapping_add(1);

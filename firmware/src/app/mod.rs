@@ -13,7 +13,7 @@ pub mod settings;
 pub mod steps;
 
 use core::cell::RefCell;
-use core::sync::atomic::{AtomicU16, AtomicU32};
+use core::sync::atomic::{AtomicU16, AtomicU32, AtomicU8, Ordering};
 
 use embassy_sync::blocking_mutex::raw::{CriticalSectionRawMutex, ThreadModeRawMutex};
 use embassy_sync::blocking_mutex::Mutex;
@@ -23,6 +23,9 @@ use ringpod_core::motion::AxisMove;
 use ringpod_core::protocol::Response;
 use ringpod_core::safety::debounce::Debouncer;
 
+/// Host links a board may serve at once (the F411: USB CDC-ACM and USART1), numbered from 0.
+pub const LINKS: usize = 2;
+
 /// Periods of step moves the control tick may run ahead of the step generator.
 pub const STEP_QUEUE: usize = 4;
 
@@ -31,8 +34,11 @@ pub const STEP_QUEUE: usize = 4;
 pub struct Shared {
     /// The control core.
     pub controller: Mutex<ThreadModeRawMutex, RefCell<Controller>>,
-    /// Unsolicited messages (faults) for the link to send.
-    pub outbox: Channel<ThreadModeRawMutex, Response, 4>,
+    /// Unsolicited messages (faults, telemetry) for each link to send; [`Shared::post`] picks the link.
+    pub outboxes: [Channel<ThreadModeRawMutex, Response, 4>; LINKS],
+    /// The link whose hello the controller accepted last: its connection is the controller's, so the unsolicited
+    /// messages go there. Every link's requests are answered on that link.
+    pub host_link: AtomicU8,
     /// One period's step moves per entry, from the control tick to the step generator.
     pub steps: Channel<CriticalSectionRawMutex, [AxisMove; 6], STEP_QUEUE>,
     /// Debounced logical input levels (`safety::debounce` layout), written by the inputs task.
@@ -50,12 +56,20 @@ impl Shared {
         let inputs = Debouncer::new(controller.config().inputs, levels).stable();
         Self {
             controller: Mutex::new(RefCell::new(controller)),
-            outbox: Channel::new(),
+            outboxes: [Channel::new(), Channel::new()],
+            host_link: AtomicU8::new(0),
             steps: Channel::new(),
             inputs: AtomicU16::new(inputs),
             step_underruns: AtomicU32::new(0),
             step_fault: core::sync::atomic::AtomicBool::new(false),
         }
+    }
+
+    /// Queues an unsolicited message for the link that said hello last; dropped when its queue is full (a fault
+    /// stays latched in the state, and the host sees it in the status).
+    pub fn post(&self, message: Response) {
+        let link = usize::from(self.host_link.load(Ordering::Relaxed)).min(LINKS - 1);
+        let _ = self.outboxes[link].try_send(message);
     }
 
     /// Runs `f` on the controller.

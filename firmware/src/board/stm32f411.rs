@@ -1,7 +1,7 @@
 //! Board: STM32F411CE "Black Pill" (25 MHz crystal, USB-C, 512 KiB flash, 128 KiB RAM).
 //!
-//! Everything specific to this chip is here: clocks, the pin map, interrupt bindings, USB CDC-ACM, the
-//! TIM1 + DMA2 step generator, EXTI switch inputs, the independent watchdog and the settings flash. Another STM32
+//! Everything specific to this chip is here: clocks, the pin map, interrupt bindings, USB CDC-ACM and the USART1
+//! link, the TIM1 + DMA2 step generator, EXTI switch inputs, the independent watchdog and the settings flash. Another STM32
 //! (F446, G474, H743) is another module like this one plus its `memory.x`; `app` stays as it is.
 //!
 //! | signal | pin | | signal | pin |
@@ -9,13 +9,19 @@
 //! | STEP 1-6 | PB0-PB5 | | E-STOP (NC chain) | PA0 |
 //! | DIR 1-6 | PB6-PB10, PB12 | | HOME 1-6 | PA1-PA6 |
 //! | ENABLE (active low) | PB13 | | LIMIT 5, 6 (far ends) | PA7, PA8 |
-//! | LOGIC_EN relay | PB14 | | LOGIC_OK, POWER_OK | PA9, PA10 |
+//! | LOGIC_EN relay | PB14 | | LOGIC_OK, POWER_OK | PA9, PC14 |
 //! | POWER_EN relay | PB15 | | USB D-/D+ | PA11/PA12 |
+//! | | | | USART1 TX, RX (AF7) | PA15, PA10 |
 //!
 //! All STEP and DIR pins are on port B so that one 32-bit write to `GPIOB.BSRR` sets and clears all of them at
 //! once: the step generator is TIM1 updating every 2.5 us and DMA2 stream 5 (channel 6, TIM1_UP) copying one word
 //! per update from a ring of rendered periods into `BSRR`. The CPU renders a period per millisecond; it never
-//! touches a pin per step. Inputs are on port A, lines 0-10, each on its own EXTI line.
+//! touches a pin per step. Inputs are on PA0-PA9 and PC14, each on its own EXTI line (0-9, 14).
+//!
+//! The host link is served on USB CDC-ACM (the default) and, at the same time, on USART1 at [`USART_BAUD`] for an
+//! isolated USB-serial adapter. USART1 is the only USART with a TX pin free on this package (PA15); its RX pins are
+//! PA10, PB3 and PB7, so POWER_OK moved from PA10 to PC14 (a plain input; the Black Pill's 32.768 kHz crystal there
+//! is unused by this firmware and passes no DC, so it only slows the edges of a debounced supply signal).
 
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_executor::{InterruptExecutor, Spawner};
@@ -28,6 +34,7 @@ use embassy_stm32::mode::Async;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{RoundTo, Timer};
 use embassy_stm32::timer::UpDma;
+use embassy_stm32::usart::{self, BufferedUart};
 use embassy_stm32::usb::{self, Driver};
 use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config};
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
@@ -47,6 +54,7 @@ use ringpod_firmware::app::{self, control::Machine, inputs::InputPins, Shared};
 
 bind_interrupts!(struct Irqs {
     OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
+    USART1 => usart::BufferedInterruptHandler<peripherals::USART1>;
     DMA2_STREAM5 => dma::InterruptHandler<peripherals::DMA2_CH5>;
     EXTI0 => exti::InterruptHandler<interrupt::typelevel::EXTI0>;
     EXTI1 => exti::InterruptHandler<interrupt::typelevel::EXTI1>;
@@ -67,6 +75,10 @@ pub const PORT_MAP: PortMap = PortMap {
 /// The settings live in flash sectors 6 and 7 (0x0804_0000-0x0807_FFFF, two 128 KiB erase pages); `memory.x`
 /// gives the program the first 256 KiB. Offsets are from the start of flash.
 const SETTINGS: core::ops::Range<u32> = 0x0004_0000..0x0008_0000;
+
+/// The USART link's baud rate (8N1): a 1 kHz stream of setpoints is about 45 kB/s, beyond 115200 baud. APB2 at
+/// 96 MHz gives 923,077 baud (+0.16 %), within any adapter's tolerance.
+pub const USART_BAUD: u32 = 921_600;
 
 /// Normal watchdog timeout: 50 control periods.
 const WATCHDOG_US: u32 = 50_000;
@@ -170,7 +182,7 @@ impl Machine for BlackPill {
     }
 }
 
-/// The switch inputs on PA0-PA10 (order of `InputBit`).
+/// The switch inputs on PA0-PA9 and PC14 (order of `InputBit`).
 struct Switches {
     pins: [ExtiInput<'static, Async>; 11],
 }
@@ -190,12 +202,17 @@ const SWITCH_BITS: [InputBit; 11] = [
     InputBit::PowerOk,
 ];
 
+/// The inputs this board has no pin for (far ends of carriages 1-4) read high, as an open switch to ground on a
+/// pull-up does: inactive with the default wiring, instead of four limit switches always tripped.
+const UNWIRED_HIGH: u16 =
+    InputBit::Limit(0).mask() | InputBit::Limit(1).mask() | InputBit::Limit(2).mask() | InputBit::Limit(3).mask();
+
 impl InputPins for Switches {
     fn read(&mut self) -> u16 {
         self.pins
             .iter()
             .zip(SWITCH_BITS)
-            .fold(0, |w, (p, b)| if p.is_high() { w | b.mask() } else { w })
+            .fold(UNWIRED_HIGH, |w, (p, b)| if p.is_high() { w | b.mask() } else { w })
     }
 
     async fn edge(&mut self) {
@@ -229,6 +246,41 @@ impl Link for UsbLink {
     }
 }
 
+/// USART1 through embassy's interrupt-driven buffered driver. A UART has no connection to wait for; line errors
+/// (noise, framing, overrun) are logged by the driver and the frame they damaged is answered as malformed.
+struct UartLink {
+    uart: BufferedUart<'static>,
+}
+
+impl Link for UartLink {
+    async fn connected(&mut self) {}
+
+    async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Disconnected> {
+        loop {
+            if let Ok(n @ 1..) = embedded_io_async::Read::read(&mut self.uart, buf).await {
+                return Ok(n);
+            }
+        }
+    }
+
+    /// In pieces of at most half the transmit buffer, each sent before the next: embassy's buffered write refuses
+    /// a slice longer than its buffer, and waits for room without a waker when the slice does not fit.
+    async fn write(&mut self, bytes: &[u8]) -> Result<(), Disconnected> {
+        for chunk in bytes.chunks(UART_BUF / 2) {
+            embedded_io_async::Write::write_all(&mut self.uart, chunk)
+                .await
+                .map_err(|_| Disconnected)?;
+            embedded_io_async::Write::flush(&mut self.uart)
+                .await
+                .map_err(|_| Disconnected)?;
+        }
+        Ok(())
+    }
+}
+
+/// Bytes of each of USART1's software buffers.
+const UART_BUF: usize = 256;
+
 /// The DMA ring into GPIOB.BSRR.
 struct DmaPort {
     ring: WritableRingBuffer<'static, u32>,
@@ -258,7 +310,12 @@ async fn usb_task(mut device: UsbDevice<'static, Driver<'static, peripherals::US
 
 #[embassy_executor::task]
 async fn link_task(mut link: UsbLink, shared: &'static Shared) -> ! {
-    app::link::serve(&mut link, shared).await
+    app::link::serve(&mut link, 0, shared).await
+}
+
+#[embassy_executor::task]
+async fn uart_link_task(mut link: UartLink, shared: &'static Shared) -> ! {
+    app::link::serve(&mut link, 1, shared).await
 }
 
 #[embassy_executor::task]
@@ -355,7 +412,7 @@ pub async fn start(spawner: Spawner) {
             ExtiInput::new(p.PA7, p.EXTI7, Pull::Up, Irqs),
             ExtiInput::new(p.PA8, p.EXTI8, Pull::Up, Irqs),
             ExtiInput::new(p.PA9, p.EXTI9, Pull::Down, Irqs),
-            ExtiInput::new(p.PA10, p.EXTI10, Pull::Down, Irqs),
+            ExtiInput::new(p.PC14, p.EXTI14, Pull::Down, Irqs),
         ],
     };
     let mut switches = switches;
@@ -421,6 +478,25 @@ pub async fn start(spawner: Spawner) {
     let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), 64);
     let device = builder.build();
 
+    // USART1: TX PA15, RX PA10 (pulled up, so an unplugged adapter reads as an idle line, not noise).
+    static UART_TX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
+    static UART_RX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
+    let mut uart_config = usart::Config::default();
+    uart_config.baudrate = USART_BAUD;
+    uart_config.rx_pull = Pull::Up;
+    let uart = match BufferedUart::new(
+        p.USART1,
+        p.PA10,
+        p.PA15,
+        UART_TX.init([0; UART_BUF]),
+        UART_RX.init([0; UART_BUF]),
+        Irqs,
+        uart_config,
+    ) {
+        Ok(u) => u,
+        Err(e) => defmt::panic!("USART1: {}", e),
+    };
+
     watchdog::start(WATCHDOG_US);
     let machine = BlackPill {
         logic_relay,
@@ -431,6 +507,7 @@ pub async fn start(spawner: Spawner) {
     spawner.spawn(defmt::unwrap!(inputs_task(switches, shared)));
     spawner.spawn(defmt::unwrap!(usb_task(device)));
     spawner.spawn(defmt::unwrap!(link_task(UsbLink { class }, shared)));
+    spawner.spawn(defmt::unwrap!(uart_link_task(UartLink { uart }, shared)));
     spawner.spawn(defmt::unwrap!(settings_task(flash, shared)));
     defmt::info!(
         "ringpod firmware up: {} Hz control tick",

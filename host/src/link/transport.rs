@@ -24,9 +24,10 @@ pub struct Serial {
 }
 
 impl Serial {
-    /// Opens a port (the baud rate is ignored by USB CDC but required by the API).
+    /// Opens a port at the firmware's USART baud rate (921600, for a USB-serial adapter on the board's USART1;
+    /// USB CDC ignores it).
     pub fn open(path: &str) -> Result<Self, serialport::Error> {
-        let port = serialport::new(path, 115_200)
+        let port = serialport::new(path, 921_600)
             .timeout(Duration::from_millis(1))
             .open()?;
         Ok(Self {

@@ -17,6 +17,7 @@ impl Controller {
             HostMessage::Hello { version } => {
                 if version == PROTOCOL_VERSION {
                     self.connected = true;
+                    self.hellos = self.hellos.wrapping_add(1);
                     self.telemetry.on = false;
                     DeviceMessage::Hello {
                         version: PROTOCOL_VERSION,

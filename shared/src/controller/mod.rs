@@ -46,6 +46,8 @@ pub struct Controller {
     plan: HomingPlan,
     homing: Homing,
     connected: bool,
+    /// Hellos accepted since start: a board with several links sends unsolicited messages to the latest.
+    hellos: u32,
     inputs: Inputs,
     elapsed_us: u32,
     bad_frames: u32,
@@ -99,6 +101,7 @@ impl Controller {
             plan,
             homing: Homing::Idle,
             connected: false,
+            hellos: 0,
             inputs: Inputs::default(),
             elapsed_us: 0,
             bad_frames: 0,
@@ -216,6 +219,13 @@ impl Controller {
                 self.event(Event::Limit(a, now & bit != 0));
             }
         }
+    }
+
+    /// How many hellos the controller has accepted since it started. A board serving the protocol on more than one
+    /// link compares it before and after a frame to learn which link holds the connection: that link gets the
+    /// unsolicited messages ([`Controller::unsolicited`]).
+    pub fn hellos(&self) -> u32 {
+        self.hellos
     }
 
     /// An unsolicited message to send, if one is pending: a newly latched fault first, then a telemetry sample

@@ -20,6 +20,7 @@ class Gpio(STM32F4xxGpio):
         self.dma_words = 0  # of bsrr_writes, those the DMA made (counted by the bus)
         self.rises = Counter()  # mask of pins that rose together -> count
         self.falls = Counter()
+        self.on_change = None  # called with (old ODR, new ODR, DMA word index) on every change of the pins
 
     def drive(self, pin, level):
         """Drive an input pin from outside (a switch, a relay contact)."""
@@ -50,6 +51,8 @@ class Gpio(STM32F4xxGpio):
 
     def _set_odr(self, new):
         old = self.instance.ODR
+        if new != old and self.on_change:
+            self.on_change(old, new, self.dma_words)
         if new != old:
             if new & ~old:
                 self.rises[new & ~old] += 1
@@ -69,7 +72,8 @@ class Gpio(STM32F4xxGpio):
         """RM0383 8.4.7 GPIOx_BSRR: BRy (bits 31:16) reset, BSy (15:0) set; BSy has priority over BRy."""
         self.bsrr_writes += len(words)
         odr = self.instance.ODR
-        for w in words:
+        watch = self.on_change
+        for i, w in enumerate(words):
             if w:
                 new = (odr & ~(w >> 16) | w) & 0xFFFF
                 if new != odr:
@@ -77,6 +81,8 @@ class Gpio(STM32F4xxGpio):
                         self.rises[new & ~odr] += 1
                     if odr & ~new:
                         self.falls[odr & ~new] += 1
+                    if watch:
+                        watch(odr, new, self.dma_words + i)
                     odr = new
         self.instance.ODR = odr
 

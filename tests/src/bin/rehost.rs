@@ -3,6 +3,7 @@
 //!
 //! 1. The `thumbv7em-none-eabihf` standard library (the preflight the QEMU runner uses), then
 //!    `cargo build -p ringpod-firmware --target thumbv7em-none-eabihf --release`.
+//!    Then the host CLI (`cargo build -p ringpod`), which run.py drives over a pty bridged to the emulated USART1.
 //! 2. A Python venv in `target/rehost-venv` with the pinned emulator (`tests/rehost/requirements.txt`), made again
 //!    whenever that file changes.
 //! 3. The models' unit tests (`python -m unittest`), counted as one check, then `tests/rehost/run.py`, whose checks
@@ -44,6 +45,16 @@ fn build_firmware() -> Result<PathBuf, String> {
         "cargo build -p ringpod-firmware --release",
     )?;
     Ok(target_dir().join(setup::TARGET).join("release").join(FIRMWARE))
+}
+
+/// The host CLI, driven by run.py over a pty on the emulated USART1.
+fn build_cli() -> Result<PathBuf, String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    run(
+        Command::new(cargo).current_dir(repo()).args(["build", "-p", "ringpod"]),
+        "cargo build -p ringpod",
+    )?;
+    Ok(target_dir().join("debug").join("ringpod"))
 }
 
 /// The venv's Python, with `requirements.txt` installed exactly.
@@ -112,12 +123,14 @@ fn tally(line: &str) -> Option<(u32, u32)> {
 }
 
 /// run.py, its lines passed through as they come, except its count, which is returned.
-fn checks(python: &Path, elf: &Path) -> Result<(u32, u32, bool), String> {
+fn checks(python: &Path, elf: &Path, cli: &Path) -> Result<(u32, u32, bool), String> {
     let mut child = Command::new(python)
         .env("PYTHONDONTWRITEBYTECODE", "1")
         .arg(repo().join("tests/rehost/run.py"))
         .arg("--elf")
         .arg(elf)
+        .arg("--ringpod")
+        .arg(cli)
         .stdout(Stdio::piped())
         .spawn()
         .map_err(|e| format!("run.py: {e}"))?;
@@ -138,8 +151,8 @@ fn checks(python: &Path, elf: &Path) -> Result<(u32, u32, bool), String> {
 fn main() -> ExitCode {
     let prepared = setup::ensure_target()
         .and_then(|()| build_firmware())
-        .and_then(|elf| Ok((elf, venv()?)));
-    let (elf, python) = match prepared {
+        .and_then(|elf| Ok((elf, build_cli()?, venv()?)));
+    let (elf, cli, python) = match prepared {
         Ok(p) => p,
         Err(e) => {
             eprintln!("rehost: {e}");
@@ -159,7 +172,7 @@ fn main() -> ExitCode {
         }
     }
     let mut ok = failed == 0;
-    match checks(&python, &elf) {
+    match checks(&python, &elf, &cli) {
         Ok((p, f, exited_ok)) => {
             passed += p;
             failed += f;

@@ -77,7 +77,7 @@ unsafe fn DefaultHandler(irqn: i16) {
 
 #[embassy_executor::task]
 async fn link_task(mut link: UartLink, shared: &'static Shared) -> ! {
-    app::link::serve(&mut link, shared).await
+    app::link::serve(&mut link, 0, shared).await
 }
 
 #[embassy_executor::task]
