@@ -1,7 +1,8 @@
 //! Captures: `stream --telemetry-udp --capture FILE.pcap` records what the game sent, `cue --input FILE.pcap` cues
 //! it again as the live run did; pcapng files as Wireshark saves them read the same way; damaged files are refused.
 
-use std::io::BufRead;
+mod common;
+
 use std::path::{Path, PathBuf};
 
 fn dir(name: &str) -> PathBuf {
@@ -49,32 +50,18 @@ fn last_pose(path: &Path) -> Vec<f64> {
 fn a_captured_drive_cues_offline_as_it_was_cued_live() {
     let d = dir("live");
     let pcap = d.join("drive.pcap");
-    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-        .args(["stream", "--sim", "--fast", "--report-json", "--quiet"])
-        .args([
-            "--telemetry-udp",
-            "127.0.0.1:0",
-            "--telemetry-format",
-            "outsim",
-            "--udp-idle",
-            "0.3",
-        ])
-        .arg("--capture")
-        .arg(&pcap)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    while !line.contains("send datagrams to") {
-        line.clear();
-        assert!(
-            stderr.read_line(&mut line).unwrap() > 0,
-            "the stream announces its address"
-        );
-    }
-    let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
+    let pcap_arg = pcap.display().to_string();
+    let (child, _stderr, addr) = common::spawn_live_stream(&[
+        "--fast",
+        "--telemetry-udp",
+        "127.0.0.1:0",
+        "--telemetry-format",
+        "outsim",
+        "--udp-idle",
+        "0.3",
+        "--capture",
+        &pcap_arg,
+    ]);
     let game = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     let stranger = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     // Heading 0 faces world +y: braking at 3 m/s^2 for 0.8 s, then a left turn (yaw rate 0.3 rad/s, 2 m/s^2 to

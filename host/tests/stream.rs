@@ -1,6 +1,9 @@
 //! `ringpod stream` against the simulated controller: the same core as the firmware behind the real framed bytes.
 
+mod common;
+
 use assert_cmd::Command;
+use common::{spawn_live_stream, spawn_sim_stream};
 use nix::sys::signal::Signal;
 use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
 use ringpod_core::motion::{AxisScale, StepConverter};
@@ -38,17 +41,6 @@ fn steps_at(pose: [f64; 6]) -> [i64; 6] {
     let mut q = home;
     q.inverse_near(&m, &Pose::from_array(pose).cast()).unwrap();
     conv.to_steps(&q)
-}
-
-/// Starts `ringpod stream --sim --report-json --quiet ARGS` with its output piped.
-fn spawn_sim_stream(args: &[&str]) -> std::process::Child {
-    std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-        .args(["stream", "--sim", "--report-json", "--quiet"])
-        .args(args)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap()
 }
 
 /// Starts `ringpod simulate --pty` and returns it with the path of its pseudo-terminal.
@@ -464,29 +456,6 @@ fn ended(
     let _ = std::io::Read::read_to_string(stderr, &mut said);
     let report = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}; status {:?}; {said}", out.status));
     (out, report, said)
-}
-
-/// Starts `ringpod stream --sim ARGS` with a live source and waits until it announces the address to send to.
-fn spawn_live_stream(
-    args: &[&str],
-) -> (
-    std::process::Child,
-    std::io::BufReader<std::process::ChildStderr>,
-    String,
-) {
-    use std::io::BufRead;
-    let mut child = spawn_sim_stream(args);
-    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
-    let mut line = String::new();
-    while !line.contains("send datagrams to") {
-        line.clear();
-        assert!(
-            stderr.read_line(&mut line).unwrap() > 0,
-            "the stream announces its address"
-        );
-    }
-    let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
-    (child, stderr, addr)
 }
 
 /// Poses from UDP datagrams, as motion-simulator software sends them.

@@ -1,0 +1,38 @@
+//! What the CLI test files share: a stream into the simulated controller, started as a user starts it.
+
+// Each test file is its own crate and uses a part of this.
+#![allow(dead_code)]
+
+/// Starts `ringpod stream --sim --report-json --quiet ARGS` with its output piped.
+pub fn spawn_sim_stream(args: &[&str]) -> std::process::Child {
+    std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["stream", "--sim", "--report-json", "--quiet"])
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Starts `ringpod stream --sim ARGS` with a live source and waits until it announces the address to send to.
+pub fn spawn_live_stream(
+    args: &[&str],
+) -> (
+    std::process::Child,
+    std::io::BufReader<std::process::ChildStderr>,
+    String,
+) {
+    use std::io::BufRead;
+    let mut child = spawn_sim_stream(args);
+    let mut stderr = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while !line.contains("send datagrams to") {
+        line.clear();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "the stream announces its address"
+        );
+    }
+    let addr = line.trim().rsplit(' ').next().unwrap().to_owned();
+    (child, stderr, addr)
+}
