@@ -160,7 +160,8 @@ impl Decoder {
                     TelemetryFormat::Text => parse_telemetry(bytes)?,
                     TelemetryFormat::Game(f) => game(f, bytes)?,
                     TelemetryFormat::Auto => {
-                        let f = games::recognise(bytes).ok_or(games::Unreadable::Unrecognised(bytes.len()).to_string())?;
+                        let f =
+                            games::recognise(bytes).ok_or(games::Unreadable::Unrecognised(bytes.len()).to_string())?;
                         let sample = game(f, bytes)?;
                         // Said once: every later datagram is read as this format.
                         eprintln!("telemetry: the datagrams are {f} ({})", f.games());
