@@ -384,6 +384,8 @@ impl<'a, T: Transport> Streamer<'a, T> {
             }
             let got = source.socket.recv_from(&mut buf);
             let now = Instant::now();
+            // A changed cueing file takes over here, between two samples.
+            source.decoder.poll_config(now);
             self.elapse(now - wall)?;
             wall = now;
             let datagram = match got {
