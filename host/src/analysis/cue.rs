@@ -331,8 +331,11 @@ mod tests {
         };
         assert_eq!(parse_config(old, None).unwrap(), want);
         assert_eq!(parse_config(new, None).unwrap(), want);
-        let e = parse_config("translation_high_pass = [{ omega = 3, zeta = 0.8 }, { omega = 0, zeta = 1 }, \
-                              { omega = 3, zeta = 0.8 }]", None)
+        let e = parse_config(
+            "translation_high_pass = [{ omega = 3, zeta = 0.8 }, { omega = 0, zeta = 1 }, \
+                              { omega = 3, zeta = 0.8 }]",
+            None,
+        )
         .unwrap_err();
         assert!(e.starts_with("translation_high_pass (sway) must be"), "{e}");
         let s = parse_config("[smoothing]\nkind = \"median\"\nwindow = 5\n", None).unwrap();
@@ -365,7 +368,10 @@ mod tests {
         );
         let f1 = parse_config(PROFILES, Some("f1")).unwrap();
         assert_eq!(f1.translation_scale, [0.2; 3]);
-        assert_eq!(f1.tilt_limit_deg, [12.0; 2], "what a profile does not name stays the base's");
+        assert_eq!(
+            f1.tilt_limit_deg, [12.0; 2],
+            "what a profile does not name stays the base's"
+        );
         assert_eq!(f1.smoothing, base.smoothing);
         let e = parse_config(PROFILES, Some("gt3")).unwrap_err();
         assert_eq!(e, "no profile `gt3`; the file's profiles: rally, f1, broken");
@@ -400,7 +406,11 @@ mod tests {
         run(&options).unwrap();
         let poses = std::fs::read_to_string(&out).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
-        poses.lines().skip(1).map(|l| l.split(',').nth(1).unwrap().parse().unwrap()).collect()
+        poses
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+            .collect()
     }
 
     #[test]
