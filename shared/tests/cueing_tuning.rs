@@ -13,13 +13,15 @@ fn at_rest() -> Telemetry<f64> {
 
 #[test]
 fn per_axis_corners_give_each_axis_its_own_response() {
-    let mut config = CueConfig::default();
-    config.translation_high_pass = [
-        Corner { omega: 2.0, zeta: 1.0 },
-        Corner { omega: 6.0, zeta: 0.7 },
-        Corner { omega: 4.0, zeta: 1.0 },
-    ];
-    config.translation_break = [0.0; 3];
+    let config = CueConfig {
+        translation_high_pass: [
+            Corner { omega: 2.0, zeta: 1.0 },
+            Corner { omega: 6.0, zeta: 0.7 },
+            Corner { omega: 4.0, zeta: 1.0 },
+        ],
+        translation_break: [0.0; 3],
+        ..CueConfig::default()
+    };
     let step = sample([3.0, 3.0, G + 3.0], [0.0; 3]);
     let mut w = Washout::<f64>::new(config).unwrap();
     let mut same = Washout::<f64>::new(CueConfig {
@@ -44,8 +46,10 @@ fn per_axis_corners_give_each_axis_its_own_response() {
     assert!(peak[1] < f / 36.0 * 1.1 && peak[1] > f / 36.0 * 0.9, "{peak:?}");
     assert!((peak[2] - peak_same[2]).abs() < 1e-12, "heave keeps the default corner");
     // Tilt per axis: a lower limit on y (roll) only.
-    let mut config = CueConfig::default();
-    config.tilt_limit_deg = [15.0, 2.0];
+    let config = CueConfig {
+        tilt_limit_deg: [15.0, 2.0],
+        ..CueConfig::default()
+    };
     let mut w = Washout::<f64>::new(config).unwrap();
     let corner = sample([4.0, 4.0, G], [0.0; 3]);
     for _ in 0..2000 {

@@ -108,7 +108,7 @@ fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
                         gaps: 0,
                         watch: cue_config
                             .as_ref()
-                            .map(|path| datagram::Watch::new(path.clone(), profile.clone())),
+                            .map(|path| Box::new(datagram::Watch::new(path.clone(), profile.clone()))),
                     }
                 }
             };

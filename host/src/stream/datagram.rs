@@ -76,7 +76,7 @@ pub enum Decoder {
         /// Gaps of more than a second after which the washout started again at neutral.
         gaps: u32,
         /// The cueing file, watched for changes.
-        watch: Option<Watch>,
+        watch: Option<Box<Watch>>,
     },
 }
 
@@ -475,7 +475,7 @@ mod tests {
             neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
             last: None,
             gaps: 0,
-            watch: Some(Watch::new(path.clone(), None)),
+            watch: Some(Box::new(Watch::new(path.clone(), None))),
         };
         let start = Instant::now();
         let mut last: Option<[f64; 6]> = None;
