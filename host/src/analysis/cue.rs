@@ -81,7 +81,7 @@ pub fn parse_config(text: &str, profile: Option<&str>) -> Result<CueConfig, Stri
     }
     let config: CueConfig = toml::Value::Table(table)
         .try_into()
-        .map_err(|e: toml::de::Error| format!("{where_}{}", e.message()))?;
+        .map_err(|e: toml::de::Error| format!("{where_}{}", e.to_string().trim_end()))?;
     config.validate().map_err(|e| format!("{where_}{e}"))?;
     Ok(config)
 }
