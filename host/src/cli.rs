@@ -261,9 +261,13 @@ pub struct StreamArgs {
     /// (the first datagram a game's format recognises names it, said on stderr).
     #[arg(long, value_enum, default_value = "text")]
     pub telemetry_format: crate::stream::datagram::TelemetryFormat,
-    /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`).
+    /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`). The file is watched while
+    /// the stream runs: a changed, valid file takes over within a second, blended in; an invalid one is refused.
     #[arg(long, requires = "telemetry_udp", conflicts_with_all = ["udp", "input", "motion"])]
     pub cue_config: Option<std::path::PathBuf>,
+    /// With --cue-config: a profile of the cueing file (its `[profiles.NAME]` table overrides the base keys).
+    #[arg(long, requires = "cue_config")]
+    pub profile: Option<String>,
     /// With --udp or --telemetry-udp: take datagrams from this sender only (others are counted and ignored).
     #[arg(long, conflicts_with_all = ["input", "motion"])]
     pub udp_from: Option<std::net::IpAddr>,
@@ -452,6 +456,7 @@ impl CueArgs {
             input: &self.input,
             out: &self.out,
             config: self.config.as_deref(),
+            profile: self.profile.as_deref(),
             plot: self.plot.as_deref(),
             json: self.json,
             telemetry_format: self.telemetry_format,
@@ -500,6 +505,9 @@ pub struct CueArgs {
     /// Washout parameters (TOML; every key optional, see the README).
     #[arg(long)]
     pub config: Option<std::path::PathBuf>,
+    /// A profile of the --config file (its `[profiles.NAME]` table overrides the base keys).
+    #[arg(long, requires = "config")]
+    pub profile: Option<String>,
     /// A plot of the cues (SVG): per axis the specific force asked and delivered, and the angular rates.
     #[arg(long)]
     pub plot: Option<std::path::PathBuf>,
@@ -541,6 +549,7 @@ impl StreamArgs {
                 Datagrams::Telemetry {
                     format: self.telemetry_format,
                     cue_config: self.cue_config.clone(),
+                    profile: self.profile.clone(),
                 },
             ),
             (None, None, Some(path)) => Input::File {

@@ -107,7 +107,7 @@ fn zero_input_at_rest_is_neutral_exactly() {
 #[test]
 fn a_sustained_force_tilts_slowly_while_translation_washes_out() {
     let config = CueConfig::default();
-    let tilt_rate = config.tilt_rate_deg.to_radians();
+    let tilt_rate = config.tilt_rate_deg[0].to_radians();
     for (axis, sign) in [(0usize, 1.0f64), (0, -1.0), (1, 1.0), (1, -1.0)] {
         let mut w = Washout::<f64>::new(config).unwrap();
         let a = 3.0 * sign;
@@ -217,7 +217,7 @@ fn bad_samples_and_bad_parameters_are_refused_by_name() {
     let bad = [
         (
             CueConfig {
-                tilt_rate_deg: -1.0,
+                tilt_rate_deg: [3.0, -1.0],
                 ..CueConfig::default()
             },
             "tilt_rate_deg",
@@ -231,7 +231,7 @@ fn bad_samples_and_bad_parameters_are_refused_by_name() {
         ),
         (
             CueConfig {
-                tilt_limit_deg: 60.0,
+                tilt_limit_deg: [60.0; 2],
                 ..CueConfig::default()
             },
             "tilt_limit_deg",

@@ -37,17 +37,55 @@ pub struct Summary {
     pub capture: Option<super::cue_capture::CaptureSummary>,
 }
 
-/// Loads a washout configuration from TOML (every key optional); errors name the key.
-pub fn load_config(path: Option<&Path>) -> anyhow::Result<CueConfig> {
+/// Loads a washout configuration from TOML (every key optional), with a profile's overrides
+/// ([`parse_config`]); errors name the file and the key.
+pub fn load_config(path: Option<&Path>, profile: Option<&str>) -> anyhow::Result<CueConfig> {
     let Some(path) = path else {
+        if let Some(name) = profile {
+            anyhow::bail!("profile `{name}`: profiles are chosen from a cueing file, and none was given");
+        }
         return Ok(CueConfig::default());
     };
     let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let config: CueConfig = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    config
-        .validate()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    parse_config(&text, profile).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// A cueing file's text: the base keys, and `[profiles.NAME]` tables, each a partial override of the base. With
+/// `profile`, that profile's keys replace the base's, each key as a whole (a `[profiles.NAME.smoothing]` table
+/// replaces `[smoothing]`, a per-axis list replaces the list); an unknown profile is refused naming the known
+/// ones. The result is checked: an error names the key (and the axis).
+pub fn parse_config(text: &str, profile: Option<&str>) -> Result<CueConfig, String> {
+    let mut table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+    let profiles = match table.remove("profiles") {
+        None => toml::Table::new(),
+        Some(toml::Value::Table(t)) => t,
+        Some(_) => return Err("`profiles` must be a table of tables: [profiles.NAME]".into()),
+    };
+    for (name, p) in &profiles {
+        if !p.is_table() {
+            return Err(format!("profiles.{name} must be a table: [profiles.{name}]"));
+        }
+    }
+    let mut where_ = String::new();
+    if let Some(name) = profile {
+        let Some(toml::Value::Table(over)) = profiles.get(name) else {
+            let known: Vec<&str> = profiles.keys().map(String::as_str).collect();
+            return Err(if known.is_empty() {
+                format!("no profile `{name}`: the file has no [profiles.NAME] table")
+            } else {
+                format!("no profile `{name}`; the file's profiles: {}", known.join(", "))
+            });
+        };
+        for (k, v) in over {
+            table.insert(k.clone(), v.clone());
+        }
+        where_ = format!("profile `{name}`: ");
+    }
+    let config: CueConfig = toml::Value::Table(table)
+        .try_into()
+        .map_err(|e: toml::de::Error| format!("{where_}{}", e.to_string().trim_end()))?;
+    config.validate().map_err(|e| format!("{where_}{e}"))?;
     Ok(config)
 }
 
@@ -70,6 +108,8 @@ pub struct Options<'a> {
     pub out: &'a Path,
     /// Washout parameters (TOML); the defaults without.
     pub config: Option<&'a Path>,
+    /// A profile of the cueing file (`[profiles.NAME]`).
+    pub profile: Option<&'a str>,
     /// A plot of the cues (SVG).
     pub plot: Option<&'a Path>,
     /// The summary as JSON.
@@ -82,7 +122,7 @@ pub struct Options<'a> {
 
 /// Runs the command; returns the summary as text and the exit code.
 pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
-    let config = load_config(args.config)?;
+    let config = load_config(args.config, args.profile)?;
     let (rows, mut errors, capture) = read_input(args)?;
     let selected = Selected::of(args.mechanism, args.geometry)?;
     let AnyMechanism::Ring(mechanism) = selected.mechanism else {
@@ -101,10 +141,10 @@ pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
             force: [v[1], v[2], v[3]],
             rate: [v[4], v[5], v[6]],
         };
-        let offset = match last_t.map(|l| washout.step(&sample, t - l)) {
-            // The first row starts the washout at neutral.
-            None => Ok(washout.offset()),
-            Some(result) => result,
+        let offset = match last_t {
+            // The first row (and the first after a gap) starts the washout at neutral and is its first input.
+            None => washout.begin(&sample),
+            Some(l) => washout.step(&sample, t - l),
         };
         last_t = Some(t);
         let pose = match offset {
@@ -127,6 +167,8 @@ pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
                     reason: "more than a second after the row before: the washout starts again at neutral".into(),
                 });
                 washout.reset();
+                // This row starts the washout again: its first input.
+                let _ = washout.begin(&sample);
                 cueing::pose(&neutral, &washout.offset())
             }
         };
@@ -309,4 +351,124 @@ fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
         ],
     };
     plot::save(path, (1000, 1000), &plot)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ringpod_core::cueing::{Corner, Smoothing};
+
+    #[test]
+    fn a_file_with_one_corner_for_all_axes_reads_as_before() {
+        let old = "translation_high_pass = { omega = 3, zeta = 0.8 }\ntilt_low_pass = { omega = 4, zeta = 1 }\n\
+                   tilt_limit_deg = 12\ntranslation_break = 0.5\n";
+        let new = "translation_high_pass = [{ omega = 3, zeta = 0.8 }, { omega = 3, zeta = 0.8 }, \
+                   { omega = 3, zeta = 0.8 }]\ntilt_low_pass = [{ omega = 4, zeta = 1 }, { omega = 4, zeta = 1 }]\n\
+                   tilt_limit_deg = [12, 12]\ntranslation_break = [0.5, 0.5, 0.5]\n";
+        let want = CueConfig {
+            translation_high_pass: [Corner { omega: 3.0, zeta: 0.8 }; 3],
+            tilt_low_pass: [Corner { omega: 4.0, zeta: 1.0 }; 2],
+            tilt_limit_deg: [12.0; 2],
+            translation_break: [0.5; 3],
+            ..CueConfig::default()
+        };
+        assert_eq!(parse_config(old, None).unwrap(), want);
+        assert_eq!(parse_config(new, None).unwrap(), want);
+        let e = parse_config(
+            "translation_high_pass = [{ omega = 3, zeta = 0.8 }, { omega = 0, zeta = 1 }, \
+                              { omega = 3, zeta = 0.8 }]",
+            None,
+        )
+        .unwrap_err();
+        assert!(e.starts_with("translation_high_pass (sway) must be"), "{e}");
+        let s = parse_config("[smoothing]\nkind = \"median\"\nwindow = 5\n", None).unwrap();
+        assert_eq!(s.smoothing, Smoothing::Median { window: 5 });
+        let e = parse_config("[smoothing]\nkind = \"median\"\nwindow = 4\n", None).unwrap_err();
+        assert!(e.starts_with("smoothing.window must be"), "{e}");
+        assert!(parse_config("[smoothing]\nkind = \"boxcar\"\n", None).is_err());
+    }
+
+    const PROFILES: &str = "translation_scale = [0.1, 0.1, 0.1]\ntilt_limit_deg = 12\n\
+                            [smoothing]\nkind = \"median\"\nwindow = 5\n\
+                            [profiles.rally]\ntilt_limit_deg = [10, 6]\n\
+                            [profiles.rally.smoothing]\nkind = \"low_pass\"\ncorner_hz = 6\n\
+                            [profiles.f1]\ntranslation_scale = 0.2\nforward = \"+y\"\n\
+                            [profiles.broken]\ntilt_rate_deg = 500\n";
+
+    #[test]
+    fn a_profile_overrides_the_base_and_an_unknown_one_is_refused() {
+        let base = parse_config(PROFILES, None).unwrap();
+        assert_eq!(base.tilt_limit_deg, [12.0; 2]);
+        assert_eq!(base.smoothing, Smoothing::Median { window: 5 });
+        let rally = parse_config(PROFILES, Some("rally")).unwrap();
+        assert_eq!(rally.tilt_limit_deg, [10.0, 6.0]);
+        assert_eq!(
+            rally.smoothing,
+            Smoothing::LowPass {
+                corner_hz: 6.0,
+                order: 2
+            }
+        );
+        let f1 = parse_config(PROFILES, Some("f1")).unwrap();
+        assert_eq!(f1.translation_scale, [0.2; 3]);
+        assert_eq!(
+            f1.tilt_limit_deg, [12.0; 2],
+            "what a profile does not name stays the base's"
+        );
+        assert_eq!(f1.smoothing, base.smoothing);
+        let e = parse_config(PROFILES, Some("gt3")).unwrap_err();
+        assert_eq!(e, "no profile `gt3`; the file's profiles: rally, f1, broken");
+        let e = parse_config(PROFILES, Some("broken")).unwrap_err();
+        assert!(e.starts_with("profile `broken`: tilt_rate_deg (x) must be"), "{e}");
+        let e = parse_config("tilt_limit_deg = 12\n", Some("rally")).unwrap_err();
+        assert!(e.contains("no [profiles.NAME]"), "{e}");
+        assert!(parse_config("profiles = 3\n", None).is_err());
+        assert!(load_config(None, Some("rally")).is_err());
+    }
+
+    /// Cues `rows` of telemetry (`t, ax`) on the trainer model and returns the poses' x.
+    fn cue_x(name: &str, rows: &[(f64, f64)]) -> Vec<f64> {
+        let dir = std::env::temp_dir().join(format!("ringpod-cue-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (input, out) = (dir.join("in.csv"), dir.join("out.csv"));
+        let mut text = "t,ax,ay,az,wx,wy,wz\n".to_string();
+        for (t, ax) in rows {
+            text += &format!("{t},{ax},0,{},0,0,0\n", cueing::G);
+        }
+        std::fs::write(&input, text).unwrap();
+        let options = Options {
+            input: &input,
+            telemetry_format: None,
+            udp_port: None,
+            out: &out,
+            config: None,
+            profile: None,
+            plot: None,
+            json: false,
+            mechanism: "trainer-model",
+            geometry: None,
+        };
+        run(&options).unwrap();
+        let poses = std::fs::read_to_string(&out).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        poses
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn the_first_row_reaches_the_filters() {
+        // Braking from the first row on, and the same but at rest on the first row: the first row's force is
+        // the input of the first interval, so the two drives differ from the second pose on (when the first row
+        // only set the time, they were the same).
+        let braking: Vec<(f64, f64)> = (0..50).map(|k| (f64::from(k) * 0.01, -6.0)).collect();
+        let mut at_rest_first = braking.clone();
+        at_rest_first[0].1 = 0.0;
+        let (a, b) = (cue_x("braking", &braking), cue_x("rest-first", &at_rest_first));
+        assert_eq!(a[0], b[0], "the first pose is neutral either way");
+        assert!(a[1] < b[1] && a[1] < 0.0, "{} vs {}", a[1], b[1]);
+        assert!(a.iter().zip(&b).skip(1).all(|(a, b)| a < b));
+    }
 }

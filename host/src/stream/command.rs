@@ -38,6 +38,8 @@ pub enum Datagrams {
     Telemetry {
         format: datagram::TelemetryFormat,
         cue_config: Option<PathBuf>,
+        /// A profile of the cueing file.
+        profile: Option<String>,
     },
 }
 
@@ -95,9 +97,13 @@ fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
         } => {
             let decoder = match holds {
                 Datagrams::Poses { degrees } => datagram::Decoder::Poses { degrees: *degrees },
-                Datagrams::Telemetry { format, cue_config } => {
-                    let config = crate::analysis::cue::load_config(cue_config.as_deref())?;
-                    let washout = ringpod_core::cueing::Washout::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+                Datagrams::Telemetry {
+                    format,
+                    cue_config,
+                    profile,
+                } => {
+                    let config = crate::analysis::cue::load_config(cue_config.as_deref(), profile.as_deref())?;
+                    let washout = ringpod_core::cueing::Live::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
                     datagram::Decoder::Telemetry {
                         format: *format,
                         washout: Box::new(washout),
@@ -105,6 +111,9 @@ fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
                         neutral: None,
                         last: None,
                         gaps: 0,
+                        watch: cue_config
+                            .as_ref()
+                            .map(|path| Box::new(datagram::Watch::new(path.clone(), profile.clone()))),
                     }
                 }
             };

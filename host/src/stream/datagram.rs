@@ -1,10 +1,11 @@
 //! What a UDP datagram from simulator software means: a pose, or vehicle telemetry that the core's washout turns
 //! into a pose (a text line, or a game's own packet: [`crate::games`]).
 
-use std::time::Instant;
+use std::path::PathBuf;
+use std::time::{Duration, Instant, SystemTime};
 
 use clap::builder::PossibleValue;
-use ringpod_core::cueing::{self, SampleError, Telemetry, Washout, G};
+use ringpod_core::cueing::{self, Live, SampleError, Telemetry, G};
 use ringpod_core::kinematics::Pose;
 
 use crate::games::{self, Format};
@@ -65,8 +66,8 @@ pub enum Decoder {
     Telemetry {
         /// The format.
         format: TelemetryFormat,
-        /// The washout.
-        washout: Box<Washout<f64>>,
+        /// The washout, retuned live when its file changes.
+        washout: Box<Live<f64>>,
         /// The platform's neutral pose: the home pose of the rig the device runs, set by the stream once it knows it
         /// ([`Decoder::centre_on`]), before the first datagram is read.
         neutral: Option<Pose<f64>>,
@@ -74,7 +75,81 @@ pub enum Decoder {
         last: Option<(Option<f64>, Instant)>,
         /// Gaps of more than a second after which the washout started again at neutral.
         gaps: u32,
+        /// The cueing file, watched for changes.
+        watch: Option<Box<Watch>>,
     },
+}
+
+/// How often the cueing file is looked at while streaming.
+pub const WATCH_EVERY: Duration = Duration::from_millis(500);
+
+/// A cueing file watched while streaming: its modification time and length are polled every [`WATCH_EVERY`] from
+/// the stream's loop (a `stat`, no thread; a file system watcher would add a thread and a dependency to save a
+/// call that costs microseconds twice a second, and would not see files on network shares any better). A change
+/// is read, checked and handed to the washout ([`Live::retune`]: blended in over a second); an invalid file is
+/// refused with its key on stderr and the running configuration stays.
+pub struct Watch {
+    path: PathBuf,
+    profile: Option<String>,
+    /// The file's modification time and length when last read.
+    seen: Option<(SystemTime, u64)>,
+    /// When it was last looked at.
+    polled: Option<Instant>,
+    /// Changes that took effect.
+    pub reloads: u32,
+    /// Changes refused (unreadable, or a key out of range).
+    pub refused: u32,
+}
+
+fn stamp(path: &std::path::Path) -> Option<(SystemTime, u64)> {
+    let m = std::fs::metadata(path).ok()?;
+    Some((m.modified().ok()?, m.len()))
+}
+
+impl Watch {
+    /// Watches `path`, as read just now (with `profile`).
+    pub fn new(path: PathBuf, profile: Option<String>) -> Self {
+        Self {
+            seen: stamp(&path),
+            path,
+            profile,
+            polled: None,
+            reloads: 0,
+            refused: 0,
+        }
+    }
+
+    /// Looks at the file if [`WATCH_EVERY`] has passed, and retunes `washout` if it changed and is valid.
+    pub fn poll(&mut self, now: Instant, washout: &mut Live<f64>) {
+        if self.polled.is_some_and(|p| now.duration_since(p) < WATCH_EVERY) {
+            return;
+        }
+        self.polled = Some(now);
+        // A file being replaced (an editor's save) may be missing for a moment: looked at again next time.
+        let Some(stamp) = stamp(&self.path) else {
+            return;
+        };
+        if self.seen == Some(stamp) {
+            return;
+        }
+        self.seen = Some(stamp);
+        let shown = self.path.display();
+        let config = crate::input::files::read_text(&self.path, crate::input::files::CONFIG_LIMIT)
+            .and_then(|text| crate::analysis::cue::parse_config(&text, self.profile.as_deref()))
+            .and_then(|config| washout.retune(config).map_err(|e| e.to_string()));
+        match config {
+            Ok(true) => {
+                self.reloads += 1;
+                eprintln!("{shown}: changed, the new cueing blends in over a second");
+            }
+            // The same parameters (a save without a change): nothing to do.
+            Ok(false) => {}
+            Err(e) => {
+                self.refused += 1;
+                eprintln!("{shown}: changed but refused, the running cueing stays: {e}");
+            }
+        }
+    }
 }
 
 /// Six or seven numbers separated by spaces, commas or semicolons.
@@ -154,6 +229,7 @@ impl Decoder {
                 neutral,
                 last,
                 gaps,
+                ..
             } => {
                 let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
                 let (t, sample) = match *format {
@@ -175,14 +251,16 @@ impl Decoder {
                     Some((_, arrived)) => Some(now.duration_since(arrived).as_secs_f64()),
                 };
                 let offset = match dt.map(|dt| washout.step(&sample, dt)) {
-                    None => Ok(washout.offset()),
+                    // The first sample: the washout's first input, at neutral.
+                    None => washout.begin(&sample).map_err(|_| "a value is not finite".to_string()),
                     Some(Ok(offset)) => Ok(offset),
                     Some(Err(SampleError::NonFinite)) => Err("a value is not finite".to_string()),
                     Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| dt > 0.0) => {
-                        // A pause of more than a second: wash out to neutral and start again from here.
+                        // A pause of more than a second: wash out to neutral and start again from here, this
+                        // sample the first input.
                         *gaps += 1;
                         washout.reset();
-                        Ok(washout.offset())
+                        washout.begin(&sample).map_err(|_| "a value is not finite".to_string())
                     }
                     Some(Err(SampleError::Interval)) => Err("its time is not after the last one's".to_string()),
                 };
@@ -225,6 +303,27 @@ impl Decoder {
         matches!(self, Decoder::Telemetry { .. })
     }
 
+    /// Looks at the cueing file (every [`WATCH_EVERY`]) and retunes the washout if it changed: call it from the
+    /// stream's loop.
+    pub fn poll_config(&mut self, now: Instant) {
+        if let Decoder::Telemetry {
+            washout,
+            watch: Some(watch),
+            ..
+        } = self
+        {
+            watch.poll(now, washout);
+        }
+    }
+
+    /// Cueing-file changes that took effect, and that were refused.
+    pub fn reloads(&self) -> (u32, u32) {
+        match self {
+            Decoder::Telemetry { watch: Some(w), .. } => (w.reloads, w.refused),
+            _ => (0, 0),
+        }
+    }
+
     /// Gaps after which the washout started again (telemetry only).
     pub fn gaps(&self) -> u32 {
         match self {
@@ -252,10 +351,11 @@ mod tests {
     fn decoder(format: TelemetryFormat) -> Decoder {
         Decoder::Telemetry {
             format,
-            washout: Box::new(Washout::new(ringpod_core::cueing::CueConfig::default()).unwrap()),
+            washout: Box::new(Live::new(ringpod_core::cueing::CueConfig::default()).unwrap()),
             neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
             last: None,
             gaps: 0,
+            watch: None,
         }
     }
 
@@ -334,7 +434,7 @@ mod tests {
 
     #[test]
     fn a_telemetry_stream_is_cued_and_a_pause_washes_out() {
-        let washout = Washout::new(ringpod_core::cueing::CueConfig::default()).unwrap();
+        let washout = Live::new(ringpod_core::cueing::CueConfig::default()).unwrap();
         let neutral = Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0);
         let mut d = Decoder::Telemetry {
             format: TelemetryFormat::Text,
@@ -342,6 +442,7 @@ mod tests {
             neutral: Some(neutral),
             last: None,
             gaps: 0,
+            watch: None,
         };
         let now = Instant::now();
         // Braking at 6 m/s^2 for a second at 100 Hz: the platform moves back and pitches nose down.
@@ -357,5 +458,93 @@ mod tests {
         let text = format!("4.0 0 0 {G} 0 0 0");
         assert_eq!(d.decode(text.as_bytes(), now).unwrap(), neutral);
         assert_eq!(d.gaps(), 1);
+    }
+
+    /// Streams a drive of text datagrams at 100 Hz for 4 s, the cueing file rewritten with `change` at 2 s (if
+    /// any); returns the largest change of the pose between consecutive datagrams from 1.5 s to 3.5 s, per axis,
+    /// and the decoder.
+    fn reload_run(name: &str, initial: &str, change: Option<&str>) -> ([f64; 6], Decoder) {
+        let dir = std::env::temp_dir().join(format!("ringpod-reload-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("cue.toml");
+        std::fs::write(&path, initial).unwrap();
+        let config = crate::analysis::cue::load_config(Some(&path), None).unwrap();
+        let mut d = Decoder::Telemetry {
+            format: TelemetryFormat::Text,
+            washout: Box::new(Live::new(config).unwrap()),
+            neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
+            last: None,
+            gaps: 0,
+            watch: Some(Box::new(Watch::new(path.clone(), None))),
+        };
+        let start = Instant::now();
+        let mut last: Option<[f64; 6]> = None;
+        let mut worst = [0.0f64; 6];
+        for k in 0..400u32 {
+            let t = f64::from(k) * 0.01;
+            let now = start + Duration::from_millis(u64::from(k) * 10);
+            if k == 200 {
+                if let Some(text) = change {
+                    std::fs::write(&path, text).unwrap();
+                    // A modification time that differs whatever the file system's resolution.
+                    let f = std::fs::File::options().write(true).open(&path).unwrap();
+                    f.set_modified(SystemTime::now() + Duration::from_secs(5)).unwrap();
+                }
+            }
+            d.poll_config(now);
+            let (ax, ay) = (3.0 * (0.7 * t).sin(), 4.0 * (1.3 * t).sin());
+            let text = format!("{t} {ax} {ay} {G} 0 0 {}", 0.4 * (0.3 * t).sin());
+            let p = d.decode(text.as_bytes(), now).unwrap().to_array();
+            if let Some(l) = last.filter(|_| (1.5..3.5).contains(&t)) {
+                for i in 0..6 {
+                    worst[i] = worst[i].max((p[i] - l[i]).abs());
+                }
+            }
+            last = Some(p);
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+        (worst, d)
+    }
+
+    #[test]
+    fn a_changed_cueing_file_blends_in_and_a_bad_one_is_refused() {
+        let new = "tilt_limit_deg = 12\ntranslation_scale = [0.15, 0.05, 0.1]\n\
+                   translation_high_pass = [{ omega = 2, zeta = 0.8 }, { omega = 6, zeta = 1 }, { omega = 3, zeta = 1 }]\n\
+                   tilt_scale = [0.3, 0.8]\n[smoothing]\nkind = \"median\"\nwindow = 5\n";
+        let old = "tilt_limit_deg = 12\n";
+        let (steady, d) = reload_run("none", old, None);
+        assert_eq!(d.reloads(), (0, 0));
+        let (steady_new, _) = reload_run("new", new, None);
+        let (reloaded, d) = reload_run("valid", old, Some(new));
+        assert_eq!(d.reloads(), (1, 0));
+        let Decoder::Telemetry { washout, .. } = &d else {
+            unreachable!()
+        };
+        assert_eq!(
+            washout.config(),
+            &crate::analysis::cue::parse_config(new, None).unwrap()
+        );
+        for i in 0..6 {
+            // No jump: the largest step across the reload is of the order of the motion's under either
+            // configuration; the blend adds the weight's step times the two offsets' distance (the exact bound is
+            // the core's test; measured here: 0.71 mm on x against 0.37 mm for the new configuration alone,
+            // where a switch without the blend would move x by tens of mm at once).
+            let motion = steady[i].max(steady_new[i]);
+            assert!(
+                reloaded[i] <= 2.5 * motion + 1e-9,
+                "axis {i}: {} with the reload vs {} and {} without",
+                reloaded[i],
+                steady[i],
+                steady_new[i]
+            );
+        }
+        // Refused: a key out of range, the old configuration kept, the steps as without the change.
+        let (kept, d) = reload_run("invalid", old, Some("tilt_limit_deg = 90\n"));
+        assert_eq!(d.reloads(), (0, 1));
+        let Decoder::Telemetry { washout, .. } = &d else {
+            unreachable!()
+        };
+        assert_eq!(washout.config().tilt_limit_deg, [12.0; 2]);
+        assert_eq!(kept, steady);
     }
 }

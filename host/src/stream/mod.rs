@@ -268,6 +268,7 @@ pub fn run<T: Transport>(
             let mut d = DatagramReport::default();
             let r = s.live(udp, &mut d, &mut input_errors);
             d.telemetry_gaps = udp.decoder.gaps();
+            (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
             datagrams = Some(d);
             capture = udp.capture.take().map(|(writer, path)| {
                 let (packets, error) = writer.finish();

@@ -35,6 +35,12 @@ pub struct DatagramReport {
     pub resumed: u32,
     /// Telemetry: pauses of more than a second after which the washout started again at neutral.
     pub telemetry_gaps: u32,
+    /// Telemetry: changes of the `--cue-config` file that took effect while streaming (each blended in over a
+    /// second).
+    pub cue_reloads: u32,
+    /// Telemetry: changes of the `--cue-config` file refused (unreadable, or a key out of range; the running
+    /// configuration stayed).
+    pub cue_refused: u32,
 }
 
 /// The end-of-run report (`--report-json`).

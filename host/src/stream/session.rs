@@ -387,6 +387,8 @@ impl<'a, T: Transport> Streamer<'a, T> {
             if let (Ok((n, from)), Some((capture, _))) = (&got, source.capture.as_mut()) {
                 capture.write(&buf[..*n], *from, std::time::SystemTime::now());
             }
+            // A changed cueing file takes over here, between two samples.
+            source.decoder.poll_config(now);
             self.elapse(now - wall)?;
             wall = now;
             let datagram = match got {

@@ -53,6 +53,14 @@ impl<T: Real> Section<T> {
         }
     }
 
+    /// `omega / (s + omega)`: first-order low-pass, unit gain at rest (run it with [`Biquad::first_order`]).
+    pub fn first_order_low_pass(omega: T) -> Self {
+        Self {
+            b: [T::zero(), T::zero(), omega],
+            a: [omega, T::zero()],
+        }
+    }
+
     /// `s / (s + omega)`: first-order high-pass (the third order of the translational washout). A first-order
     /// section: run it with [`Biquad::first_order`], which reads `b[1] s + b[2]` over `s + a[0]`.
     pub fn first_order_high_pass(omega: T) -> Self {
@@ -118,6 +126,75 @@ impl<T: Real> Biquad<T> {
         let dx2 = (r2 - a0 * half * r1) / det;
         self.x = [x1 + dx1, x2 + dx2];
         (b0 - b2 * a0) * self.x[0] + (b1 - b2 * a1) * self.x[1] + b2 * u
+    }
+
+    /// The section it runs.
+    pub fn section(&self) -> &Section<T> {
+        &self.section
+    }
+
+    /// The output for the state and the last input, and its rate of change for a steady input: `(y, dy/dt)`.
+    pub fn output(&self) -> (T, T) {
+        let [b2, b1, b0] = self.section.b;
+        let [a1, a0] = self.section.a;
+        let [x1, x2] = self.x;
+        if self.first_order {
+            let c = b0 - b1 * a1;
+            return (c * x1 + b1 * self.u, c * (self.u - a1 * x1));
+        }
+        let (c1, c2) = (b0 - b2 * a0, b1 - b2 * a1);
+        let dx2 = self.u - a0 * x1 - a1 * x2;
+        (c1 * x1 + c2 * x2 + b2 * self.u, c1 * x2 + c2 * dx2)
+    }
+
+    /// Sets the state so that the output is `y` and (second order) changes at `dy` per second, with the last input
+    /// kept; where the section cannot reach that output from its state (no state in its output), nothing changes.
+    pub fn set_output(&mut self, y: T, dy: T) {
+        let [b2, b1, b0] = self.section.b;
+        let [a1, a0] = self.section.a;
+        let u = self.u;
+        if self.first_order {
+            let c = b0 - b1 * a1;
+            if c != T::zero() {
+                self.x[0] = (y - b1 * u) / c;
+            }
+            return;
+        }
+        // y = c1 x1 + c2 x2 + b2 u, dy = c1 x2 + c2 (u - a0 x1 - a1 x2): two equations in x1, x2.
+        let (c1, c2) = (b0 - b2 * a0, b1 - b2 * a1);
+        let (r1, r2) = (y - b2 * u, dy - c2 * u);
+        let (m11, m12, m21, m22) = (c1, c2, -c2 * a0, c1 - c2 * a1);
+        let det = m11 * m22 - m12 * m21;
+        if det != T::zero() && det.finite() {
+            let x1 = (r1 * m22 - m12 * r2) / det;
+            let x2 = (m11 * r2 - m21 * r1) / det;
+            if x1.finite() && x2.finite() {
+                self.x = [x1, x2];
+            }
+        }
+    }
+
+    /// Runs `section` from here on, its output and the output's rate carried over (bumpless transfer): a change
+    /// of corner or damping does not make the output jump.
+    pub fn retune(&mut self, section: Section<T>) {
+        let (y, dy) = self.output();
+        self.section = section;
+        self.set_output(y, dy);
+    }
+
+    /// Holds `u` as the last input, the state at rest: the first sample of a stream, which has no interval
+    /// before it, so that the next interval's input is taken from this sample rather than from zero.
+    pub fn begin(&mut self, u: T) {
+        self.x = [T::zero(); 2];
+        self.u = u;
+    }
+
+    /// The steady state of a constant input `u` (a low-pass then outputs `u`).
+    pub fn settle(&mut self, u: T) {
+        self.u = u;
+        let [a1, a0] = self.section.a;
+        let x1 = if self.first_order { u / a1 } else { u / a0 };
+        self.x = if x1.finite() { [x1, T::zero()] } else { [T::zero(); 2] };
     }
 
     /// Back to rest.

@@ -20,9 +20,16 @@
 //! up (`beta < 0`) and a force to the left rolls the right side down (`alpha > 0`). Every filter is discretised by
 //! Tustin at each sample's interval ([`filter`]). Generic over `f32`/`f64`, no allocation, no panics.
 
+pub mod axes;
+mod config;
 pub mod filter;
+mod live;
+pub mod smoothing;
 
+pub use config::{ConfigError, Corner, CueConfig, Forward, YawMode, ROTATION_AXES, TILT_AXES, TRANSLATION_AXES};
 use filter::{Biquad, Section};
+pub use live::{Live, HANDOVER_S};
+pub use smoothing::{Smoother, Smoothing};
 
 use crate::kinematics::Pose;
 use crate::Real;
@@ -37,176 +44,6 @@ pub struct Telemetry<T> {
     pub force: [T; 3],
     /// Angular rates `[roll, pitch, yaw]` about x, y, z (rad/s).
     pub rate: [T; 3],
-}
-
-/// Which platform direction faces the vehicle's forward.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-pub enum Forward {
-    /// The platform's +x (default).
-    #[default]
-    #[serde(rename = "+x")]
-    PlusX,
-    /// The platform's +y.
-    #[serde(rename = "+y")]
-    PlusY,
-    /// The platform's -x.
-    #[serde(rename = "-x")]
-    MinusX,
-    /// The platform's -y.
-    #[serde(rename = "-y")]
-    MinusY,
-}
-
-/// How the yaw channel follows the vehicle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum YawMode {
-    /// One to one with the vehicle's heading, continuous (a ring platform turns without limit), the rate within
-    /// the yaw-rate limit (default).
-    #[default]
-    Heading,
-    /// High-passed like roll and pitch: onset cues only, back to the neutral heading.
-    Washout,
-}
-
-/// A second-order filter's corner (rad/s) and damping.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Corner {
-    /// Natural frequency (rad/s).
-    pub omega: f64,
-    /// Damping ratio.
-    pub zeta: f64,
-}
-
-/// The washout's parameters. Every field has a documented default (the trainer model, 1:20: a car's forces
-/// scaled into +-50 mm and +-20 deg); a TOML file names only what it changes.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct CueConfig {
-    /// Scale of the specific force into the translational channel, per vehicle axis (default 0.1, 0.1, 0.1).
-    pub translation_scale: [f64; 3],
-    /// Limit of the scaled specific force, per vehicle axis (m/s^2; default 6).
-    pub translation_limit: [f64; 3],
-    /// High-pass of the translational channel (default 4 rad/s, damping 1).
-    pub translation_high_pass: Corner,
-    /// Third-order break of the translational channel (rad/s), which brings a sustained force back to neutral;
-    /// 0 keeps second order (default 1).
-    pub translation_break: f64,
-    /// Scale of the specific force into tilt coordination, x and y (default 0.6).
-    pub tilt_scale: [f64; 2],
-    /// Low-pass of tilt coordination (default 5 rad/s, damping 1).
-    pub tilt_low_pass: Corner,
-    /// Largest tilt angle (deg; default 15).
-    pub tilt_limit_deg: f64,
-    /// Tilt rate limit, below the perception threshold (deg/s; default 3).
-    pub tilt_rate_deg: f64,
-    /// Scale of the roll and pitch rates (default 0.5).
-    pub rotation_scale: [f64; 2],
-    /// Limit of the scaled roll and pitch rates (rad/s; default 1).
-    pub rotation_limit: f64,
-    /// High-pass of the roll and pitch rates (default 1 rad/s, damping 1).
-    pub rotation_high_pass: Corner,
-    /// How yaw follows (default heading, one to one).
-    pub yaw: YawMode,
-    /// Scale of the yaw rate (default 1).
-    pub yaw_scale: f64,
-    /// Yaw-rate limit (rad/s; default 1.9, the trainer model's).
-    pub yaw_rate_limit: f64,
-    /// High-pass of the yaw rate in washout mode (default 0.5 rad/s, damping 1).
-    pub yaw_high_pass: Corner,
-    /// Which platform direction faces the vehicle's forward (default +x).
-    pub forward: Forward,
-}
-
-impl Default for CueConfig {
-    fn default() -> Self {
-        Self {
-            translation_scale: [0.1; 3],
-            translation_limit: [6.0; 3],
-            translation_high_pass: Corner { omega: 4.0, zeta: 1.0 },
-            translation_break: 1.0,
-            tilt_scale: [0.6; 2],
-            tilt_low_pass: Corner { omega: 5.0, zeta: 1.0 },
-            tilt_limit_deg: 15.0,
-            tilt_rate_deg: 3.0,
-            rotation_scale: [0.5; 2],
-            rotation_limit: 1.0,
-            rotation_high_pass: Corner { omega: 1.0, zeta: 1.0 },
-            yaw: YawMode::Heading,
-            yaw_scale: 1.0,
-            yaw_rate_limit: 1.9,
-            yaw_high_pass: Corner { omega: 0.5, zeta: 1.0 },
-            forward: Forward::PlusX,
-        }
-    }
-}
-
-/// A parameter out of its range: its key and why.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ConfigError {
-    /// The key, as in the TOML file.
-    pub key: &'static str,
-    /// What it must be.
-    pub must: &'static str,
-}
-
-impl core::fmt::Display for ConfigError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        write!(f, "{} must be {}", self.key, self.must)
-    }
-}
-
-impl CueConfig {
-    /// Checks every parameter; the error names the first key out of range.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        let err = |key, must| Err(ConfigError { key, must });
-        let in_range = |v: f64, lo: f64, hi: f64| v.is_finite() && v >= lo && v <= hi;
-        let corner_ok = |c: &Corner| in_range(c.omega, 1e-3, 1e3) && in_range(c.zeta, 0.05, 10.0);
-        if !self.translation_scale.iter().all(|v| in_range(*v, 0.0, 10.0)) {
-            return err("translation_scale", "three numbers from 0 to 10");
-        }
-        if !self.translation_limit.iter().all(|v| in_range(*v, 0.0, 100.0)) {
-            return err("translation_limit", "three numbers from 0 to 100 m/s^2");
-        }
-        if !corner_ok(&self.translation_high_pass) {
-            return err("translation_high_pass", "omega 0.001-1000 rad/s, zeta 0.05-10");
-        }
-        if !in_range(self.translation_break, 0.0, 1e3) {
-            return err("translation_break", "0 (second order) to 1000 rad/s");
-        }
-        if !self.tilt_scale.iter().all(|v| in_range(*v, 0.0, 10.0)) {
-            return err("tilt_scale", "two numbers from 0 to 10");
-        }
-        if !corner_ok(&self.tilt_low_pass) {
-            return err("tilt_low_pass", "omega 0.001-1000 rad/s, zeta 0.05-10");
-        }
-        if !in_range(self.tilt_limit_deg, 0.0, 45.0) {
-            return err("tilt_limit_deg", "0 to 45 deg");
-        }
-        if !in_range(self.tilt_rate_deg, 0.0, 90.0) {
-            return err("tilt_rate_deg", "0 to 90 deg/s");
-        }
-        if !self.rotation_scale.iter().all(|v| in_range(*v, 0.0, 10.0)) {
-            return err("rotation_scale", "two numbers from 0 to 10");
-        }
-        if !in_range(self.rotation_limit, 0.0, 100.0) {
-            return err("rotation_limit", "0 to 100 rad/s");
-        }
-        if !corner_ok(&self.rotation_high_pass) {
-            return err("rotation_high_pass", "omega 0.001-1000 rad/s, zeta 0.05-10");
-        }
-        if !in_range(self.yaw_scale, 0.0, 10.0) {
-            return err("yaw_scale", "0 to 10");
-        }
-        if !in_range(self.yaw_rate_limit, 0.0, 100.0) {
-            return err("yaw_rate_limit", "0 to 100 rad/s");
-        }
-        if !corner_ok(&self.yaw_high_pass) {
-            return err("yaw_high_pass", "omega 0.001-1000 rad/s, zeta 0.05-10");
-        }
-        Ok(())
-    }
 }
 
 /// Why a sample was not taken (the caller holds the last pose).
@@ -235,8 +72,14 @@ pub struct Channels<T> {
 #[derive(Debug, Clone)]
 pub struct Washout<T: Real> {
     config: CueConfig,
+    smoother: Smoother<T>,
+    /// Whether a sample has been taken since the start (or the last reset).
+    started: bool,
+    /// The last raw sample taken.
+    last: Option<Telemetry<T>>,
     translation: [Biquad<T>; 3],
     break_: [Biquad<T>; 3],
+    /// Roll (from the lateral force, the `y` keys) and pitch (from the longitudinal force, the `x` keys).
     tilt_filter: [Biquad<T>; 2],
     rotation: [Biquad<T>; 2],
     yaw_filter: Biquad<T>,
@@ -253,22 +96,66 @@ fn clamp<T: Real>(v: T, limit: T) -> T {
     }
 }
 
+/// Tilt channel `i` (0 roll, 1 pitch) cues the force on this vehicle axis, whose per-axis tilt keys it reads.
+const TILT_FORCE_AXIS: [usize; 2] = [1, 0];
+
+/// A (smoothed) sample's inputs to each filter.
+struct Inputs<T> {
+    translation: [T; 3],
+    tilt: [T; 2],
+    rotation: [T; 2],
+    yaw: T,
+}
+
+/// The filters' sections of a configuration.
+struct Sections<T> {
+    translation: [Section<T>; 3],
+    break_: [Section<T>; 3],
+    tilt: [Section<T>; 2],
+    rotation: [Section<T>; 2],
+    yaw: Section<T>,
+}
+
+impl<T: Real> Sections<T> {
+    fn of(config: &CueConfig) -> Self {
+        let c = |x: Corner| (T::of(x.omega), T::of(x.zeta));
+        Self {
+            translation: core::array::from_fn(|i| {
+                let (w, z) = c(config.translation_high_pass[i]);
+                Section::high_pass_position(w, z)
+            }),
+            break_: core::array::from_fn(|i| Section::first_order_high_pass(T::of(config.translation_break[i]))),
+            tilt: core::array::from_fn(|i| {
+                let (w, z) = c(config.tilt_low_pass[TILT_FORCE_AXIS[i]]);
+                Section::low_pass(w, z)
+            }),
+            rotation: core::array::from_fn(|i| {
+                let (w, z) = c(config.rotation_high_pass[i]);
+                Section::high_pass_angle(w, z)
+            }),
+            yaw: {
+                let (w, z) = c(config.yaw_high_pass);
+                Section::high_pass_angle(w, z)
+            },
+        }
+    }
+}
+
 impl<T: Real> Washout<T> {
     /// A washout at neutral; the configuration must be valid.
     pub fn new(config: CueConfig) -> Result<Self, ConfigError> {
         config.validate()?;
-        let c = |x: Corner| (T::of(x.omega), T::of(x.zeta));
-        let (tw, tz) = c(config.translation_high_pass);
-        let (lw, lz) = c(config.tilt_low_pass);
-        let (rw, rz) = c(config.rotation_high_pass);
-        let (yw, yz) = c(config.yaw_high_pass);
+        let s = Sections::<T>::of(&config);
         Ok(Self {
             config,
-            translation: [Biquad::new(Section::high_pass_position(tw, tz)); 3],
-            break_: [Biquad::first_order(Section::first_order_high_pass(T::of(config.translation_break))); 3],
-            tilt_filter: [Biquad::new(Section::low_pass(lw, lz)); 2],
-            rotation: [Biquad::new(Section::high_pass_angle(rw, rz)); 2],
-            yaw_filter: Biquad::new(Section::high_pass_angle(yw, yz)),
+            smoother: Smoother::new(&config.smoothing),
+            started: false,
+            last: None,
+            translation: s.translation.map(Biquad::new),
+            break_: s.break_.map(Biquad::first_order),
+            tilt_filter: s.tilt.map(Biquad::new),
+            rotation: s.rotation.map(Biquad::new),
+            yaw_filter: Biquad::new(s.yaw),
             channels: Channels::default(),
         })
     }
@@ -283,39 +170,98 @@ impl<T: Real> Washout<T> {
         &self.channels
     }
 
+    fn check(sample: &Telemetry<T>) -> Result<(), SampleError> {
+        if sample.force.iter().chain(&sample.rate).all(|v| v.finite()) {
+            Ok(())
+        } else {
+            Err(SampleError::NonFinite)
+        }
+    }
+
+    /// The inputs of each filter for a (smoothed) sample: scaled and limited.
+    fn inputs(&self, s: &Telemetry<T>) -> Inputs<T> {
+        let cfg = &self.config;
+        // Translation: the force the vehicle feels beyond gravity at rest.
+        let rest = [T::zero(), T::zero(), T::of(G)];
+        Inputs {
+            translation: core::array::from_fn(|i| {
+                clamp(
+                    (s.force[i] - rest[i]) * T::of(cfg.translation_scale[i]),
+                    T::of(cfg.translation_limit[i]),
+                )
+            }),
+            tilt: core::array::from_fn(|i| {
+                let a = TILT_FORCE_AXIS[i];
+                s.force[a] * T::of(cfg.tilt_scale[a])
+            }),
+            rotation: core::array::from_fn(|i| {
+                clamp(s.rate[i] * T::of(cfg.rotation_scale[i]), T::of(cfg.rotation_limit[i]))
+            }),
+            yaw: clamp(s.rate[2] * T::of(cfg.yaw_scale), T::of(cfg.yaw_rate_limit)),
+        }
+    }
+
+    /// Takes the first sample of a stream (or the first after [`Washout::reset`]), which has no interval before
+    /// it: the smoothing starts on it and every filter holds it as its last input, so that the next interval's
+    /// input runs from this sample's value (not from zero, as if the vehicle had been at rest). No time passes:
+    /// the offset is unchanged. A sample that is not finite is refused and changes nothing.
+    pub fn begin(&mut self, sample: &Telemetry<T>) -> Result<[T; 6], SampleError> {
+        Self::check(sample)?;
+        let s = self.smoother.begin(sample);
+        self.started = true;
+        self.last = Some(*sample);
+        let u = self.inputs(&s);
+        for (f, u) in self.translation.iter_mut().zip(u.translation) {
+            f.begin(u);
+        }
+        for f in &mut self.break_ {
+            f.begin(T::zero());
+        }
+        for (f, u) in self.tilt_filter.iter_mut().zip(u.tilt) {
+            f.begin(u);
+        }
+        for (f, u) in self.rotation.iter_mut().zip(u.rotation) {
+            f.begin(u);
+        }
+        self.yaw_filter.begin(u.yaw);
+        Ok(self.offset())
+    }
+
     /// Takes one sample covering `dt` seconds and returns the platform's offset from neutral: `[x, y, z, alpha,
-    /// beta, gamma]` in platform axes. A refused sample changes nothing.
+    /// beta, gamma]` in platform axes. A refused sample changes nothing. A first sample taken here rather than by
+    /// [`Washout::begin`] starts the smoothing on itself and reaches the filters as a step from rest.
     // One index runs through the parallel per-axis arrays of a channel (input, scale, limit, filter, output).
     #[allow(clippy::needless_range_loop)]
     pub fn step(&mut self, sample: &Telemetry<T>, dt: T) -> Result<[T; 6], SampleError> {
-        if !(sample.force.iter().chain(&sample.rate).all(|v| v.finite()) && dt.finite()) {
-            return Err(SampleError::NonFinite);
-        }
-        if !(dt > T::zero() && dt <= T::one()) {
+        Self::check(sample)?;
+        if !(dt.finite() && dt > T::zero() && dt <= T::one()) {
             return Err(SampleError::Interval);
         }
+        let s = if self.started {
+            self.smoother.step(sample, dt)
+        } else {
+            self.started = true;
+            self.smoother.begin(sample)
+        };
+        self.last = Some(*sample);
         let cfg = self.config;
         let g = T::of(G);
-        // Translation: the force the vehicle feels beyond gravity at rest, scaled, limited, washed out.
-        let rest = [T::zero(), T::zero(), g];
+        let u = self.inputs(&s);
         for i in 0..3 {
-            let f = clamp(
-                (sample.force[i] - rest[i]) * T::of(cfg.translation_scale[i]),
-                T::of(cfg.translation_limit[i]),
-            );
-            let p = self.translation[i].step(f, dt);
-            self.channels.translation[i] = if cfg.translation_break > 0.0 {
+            let p = self.translation[i].step(u.translation[i], dt);
+            self.channels.translation[i] = if cfg.translation_break[i] > 0.0 {
                 self.break_[i].step(p, dt)
             } else {
                 p
             };
         }
         // Tilt coordination: the sustained horizontal force as a tilt of gravity, slowly.
-        let sin_limit = T::of(libm::sin(cfg.tilt_limit_deg.to_radians()));
-        let max_step = T::of(cfg.tilt_rate_deg.to_radians()) * dt;
-        for (i, force_axis) in [(0, 1), (1, 0)] {
+        for i in 0..2 {
             // Roll (index 0) comes from the lateral force (y), pitch (index 1) from the longitudinal (x).
-            let f = self.tilt_filter[i].step(sample.force[force_axis] * T::of(cfg.tilt_scale[force_axis]), dt);
+            let a = TILT_FORCE_AXIS[i];
+            let sin_limit = T::of(libm::sin(cfg.tilt_limit_deg[a].to_radians()));
+            let max_step = T::of(cfg.tilt_rate_deg[a].to_radians()) * dt;
+            let f = self.tilt_filter[i].step(u.tilt[i], dt);
             let s = clamp(f / g, sin_limit);
             // alpha = asin(f_y / g); beta = -asin(f_x / g).
             let want = if i == 0 { s.asin_() } else { -s.asin_() };
@@ -324,16 +270,56 @@ impl<T: Real> Washout<T> {
         }
         // Roll and pitch onsets.
         for i in 0..2 {
-            let w = clamp(sample.rate[i] * T::of(cfg.rotation_scale[i]), T::of(cfg.rotation_limit));
-            self.channels.rotation[i] = self.rotation[i].step(w, dt);
+            self.channels.rotation[i] = self.rotation[i].step(u.rotation[i], dt);
         }
         // Yaw.
-        let w = clamp(sample.rate[2] * T::of(cfg.yaw_scale), T::of(cfg.yaw_rate_limit));
         self.channels.yaw = match cfg.yaw {
-            YawMode::Heading => self.channels.yaw + w * dt,
-            YawMode::Washout => self.yaw_filter.step(w, dt),
+            YawMode::Heading => self.channels.yaw + u.yaw * dt,
+            YawMode::Washout => self.yaw_filter.step(u.yaw, dt),
         };
         Ok(self.offset())
+    }
+
+    /// The same washout under another configuration from here on, its state carried: the channels (tilt, the
+    /// heading), every filter's output and the output's rate (each filter retuned without a bump:
+    /// [`Biquad::retune`]) and the smoothing, if it is the same (a new smoothing starts on the last sample). What
+    /// the carried state cannot hide (a new scale, limit or `forward`) changes the offset from the next sample:
+    /// [`Live`] blends that in over [`HANDOVER_S`].
+    pub fn retuned(&self, config: CueConfig) -> Result<Self, ConfigError> {
+        config.validate()?;
+        let s = Sections::<T>::of(&config);
+        let mut w = self.clone();
+        w.config = config;
+        for (f, s) in w.translation.iter_mut().zip(s.translation) {
+            f.retune(s);
+        }
+        for i in 0..3 {
+            if self.config.translation_break[i] > 0.0 {
+                w.break_[i].retune(s.break_[i]);
+            } else {
+                // The break was not running: it starts passing the translation through as it stands.
+                w.break_[i] = Biquad::first_order(s.break_[i]);
+                w.break_[i].begin(self.channels.translation[i]);
+            }
+        }
+        for (f, s) in w.tilt_filter.iter_mut().zip(s.tilt) {
+            f.retune(s);
+        }
+        for (f, s) in w.rotation.iter_mut().zip(s.rotation) {
+            f.retune(s);
+        }
+        w.yaw_filter.retune(s.yaw);
+        if self.config.yaw == YawMode::Heading && config.yaw == YawMode::Washout {
+            // From the heading where it stands, washed out from there.
+            w.yaw_filter.set_output(self.channels.yaw, T::zero());
+        }
+        if config.smoothing != self.config.smoothing {
+            w.smoother = Smoother::new(&config.smoothing);
+            if let Some(last) = self.last {
+                w.smoother.begin(&last);
+            }
+        }
+        Ok(w)
     }
 
     /// The current offset from neutral in platform axes: `[x, y, z, alpha, beta, gamma]`.
@@ -351,7 +337,7 @@ impl<T: Real> Washout<T> {
         [px, py, c.translation[2], pa, pb, c.yaw]
     }
 
-    /// Back to neutral (filters at rest, yaw kept).
+    /// Back to neutral (filters at rest, smoothing empty, yaw kept): the next sample is a first one.
     pub fn reset(&mut self) {
         let yaw = self.channels.yaw;
         for f in self.translation.iter_mut().chain(&mut self.break_) {
@@ -361,6 +347,8 @@ impl<T: Real> Washout<T> {
             f.reset();
         }
         self.yaw_filter.reset();
+        self.smoother = Smoother::new(&self.config.smoothing);
+        self.started = false;
         self.channels = Channels {
             yaw,
             ..Channels::default()
