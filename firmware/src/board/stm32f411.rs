@@ -36,7 +36,7 @@ use embassy_stm32::timer::low_level::{RoundTo, Timer};
 use embassy_stm32::timer::UpDma;
 use embassy_stm32::usart::{self, BufferedUart};
 use embassy_stm32::usb::{self, Driver};
-use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config};
+use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config, Peri};
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embassy_usb::{Builder, UsbDevice};
 use ringpod_core::controller::Controller;
@@ -423,79 +423,15 @@ pub async fn start(spawner: Spawner) {
         shared.with(|c| c.watchdog_reset());
     }
 
-    // Step generator: DMA ring first (it starts playing zeros: no pin changes), then the timer that paces it.
-    static RING_BUF: StaticCell<[u32; RING]> = StaticCell::new();
-    let ring_buf = RING_BUF.init([0; RING]);
-    let request = p.DMA2_CH5.request();
-    let bsrr = pac::GPIOB.bsrr().as_ptr() as *mut u32;
-    // SAFETY: the ring buffer owns the channel and its memory for the life of the program; the peripheral address
-    // is GPIOB's set/reset register, which accepts any 32-bit word.
-    let mut ring = unsafe {
-        WritableRingBuffer::new(
-            dma::Channel::new(p.DMA2_CH5, Irqs),
-            request,
-            bsrr,
-            ring_buf,
-            TransferOptions::default(),
-        )
-    };
-    ring.start();
-    let timer = Timer::new(p.TIM1);
-    timer.set_frequency(
-        Hertz(1_000_000_000 / ringpod_core::motion::pulse::STEP_SLOT_NS),
-        RoundTo::Faster,
-    );
-    timer.enable_update_dma(true);
-    timer.start();
-    core::mem::forget(timer);
+    let ring = step_generator(p.DMA2_CH5, p.TIM1);
 
     interrupt::USART6.set_priority(Priority::P1);
     let high = STEP_EXECUTOR.start(interrupt::USART6);
     high.spawn(defmt::unwrap!(steps_task(DmaPort { ring }, renderer, shared)));
 
-    // USB CDC-ACM.
-    static EP_OUT: StaticCell<[u8; 256]> = StaticCell::new();
-    static CONFIG_DESC: StaticCell<[u8; 256]> = StaticCell::new();
-    static BOS_DESC: StaticCell<[u8; 256]> = StaticCell::new();
-    static CONTROL_BUF: StaticCell<[u8; 64]> = StaticCell::new();
-    static CDC_STATE: StaticCell<State> = StaticCell::new();
-    let mut usb_config = usb::Config::default();
-    // The Black Pill does not wire VBUS to PA9 (PA9 is LOGIC_OK here).
-    usb_config.vbus_detection = false;
-    let driver = Driver::new_fs(p.USB_OTG_FS, Irqs, p.PA12, p.PA11, EP_OUT.init([0; 256]), usb_config);
-    let mut device_config = embassy_usb::Config::new(0x1209, 0x0001);
-    device_config.manufacturer = Some("ringpod");
-    device_config.product = Some("ringpod motion controller");
-    device_config.serial_number = Some("ringpod-f411");
-    let mut builder = Builder::new(
-        driver,
-        device_config,
-        CONFIG_DESC.init([0; 256]),
-        BOS_DESC.init([0; 256]),
-        &mut [],
-        CONTROL_BUF.init([0; 64]),
-    );
-    let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), 64);
-    let device = builder.build();
+    let (device, class) = usb(p.USB_OTG_FS, p.PA12, p.PA11);
 
-    // USART1: TX PA15, RX PA10 (pulled up, so an unplugged adapter reads as an idle line, not noise).
-    static UART_TX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
-    static UART_RX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
-    let mut uart_config = usart::Config::default();
-    uart_config.baudrate = USART_BAUD;
-    uart_config.rx_pull = Pull::Up;
-    let uart = match BufferedUart::new(
-        p.USART1,
-        p.PA10,
-        p.PA15,
-        UART_TX.init([0; UART_BUF]),
-        UART_RX.init([0; UART_BUF]),
-        Irqs,
-        uart_config,
-    ) {
-        Ok(u) => u,
-        Err(e) => defmt::panic!("USART1: {}", e),
-    };
+    let uart = usart1(p.USART1, p.PA10, p.PA15);
 
     watchdog::start(WATCHDOG_US);
     let machine = BlackPill {
@@ -513,6 +449,100 @@ pub async fn start(spawner: Spawner) {
         "ringpod firmware up: {} Hz control tick",
         1_000_000 / config.pipeline.tick_us
     );
+}
+
+/// The USB CDC-ACM device and its serial class (the default host link).
+fn usb(
+    otg: Peri<'static, peripherals::USB_OTG_FS>,
+    dp: Peri<'static, peripherals::PA12>,
+    dm: Peri<'static, peripherals::PA11>,
+) -> (
+    UsbDevice<'static, Driver<'static, peripherals::USB_OTG_FS>>,
+    CdcAcmClass<'static, Driver<'static, peripherals::USB_OTG_FS>>,
+) {
+    static EP_OUT: StaticCell<[u8; 256]> = StaticCell::new();
+    static CONFIG_DESC: StaticCell<[u8; 256]> = StaticCell::new();
+    static BOS_DESC: StaticCell<[u8; 256]> = StaticCell::new();
+    static CONTROL_BUF: StaticCell<[u8; 64]> = StaticCell::new();
+    static CDC_STATE: StaticCell<State> = StaticCell::new();
+    let mut usb_config = usb::Config::default();
+    // The Black Pill does not wire VBUS to PA9 (PA9 is LOGIC_OK here).
+    usb_config.vbus_detection = false;
+    let driver = Driver::new_fs(otg, Irqs, dp, dm, EP_OUT.init([0; 256]), usb_config);
+    let mut device_config = embassy_usb::Config::new(0x1209, 0x0001);
+    device_config.manufacturer = Some("ringpod");
+    device_config.product = Some("ringpod motion controller");
+    device_config.serial_number = Some("ringpod-f411");
+    let mut builder = Builder::new(
+        driver,
+        device_config,
+        CONFIG_DESC.init([0; 256]),
+        BOS_DESC.init([0; 256]),
+        &mut [],
+        CONTROL_BUF.init([0; 64]),
+    );
+    let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), 64);
+    let device = builder.build();
+    (device, class)
+}
+
+/// USART1 on TX PA15, RX PA10 (pulled up, so an unplugged adapter reads as an idle line, not noise): the second
+/// host link.
+fn usart1(
+    usart: Peri<'static, peripherals::USART1>,
+    rx: Peri<'static, peripherals::PA10>,
+    tx: Peri<'static, peripherals::PA15>,
+) -> BufferedUart<'static> {
+    static UART_TX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
+    static UART_RX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
+    let mut uart_config = usart::Config::default();
+    uart_config.baudrate = USART_BAUD;
+    uart_config.rx_pull = Pull::Up;
+    match BufferedUart::new(
+        usart,
+        rx,
+        tx,
+        UART_TX.init([0; UART_BUF]),
+        UART_RX.init([0; UART_BUF]),
+        Irqs,
+        uart_config,
+    ) {
+        Ok(u) => u,
+        Err(e) => defmt::panic!("USART1: {}", e),
+    }
+}
+
+/// The step generator: the DMA ring first (it starts playing zeros: no pin changes), then TIM1, whose update
+/// every slot paces it into GPIOB's BSRR.
+fn step_generator(
+    channel: Peri<'static, peripherals::DMA2_CH5>,
+    tim: Peri<'static, peripherals::TIM1>,
+) -> WritableRingBuffer<'static, u32> {
+    static RING_BUF: StaticCell<[u32; RING]> = StaticCell::new();
+    let ring_buf = RING_BUF.init([0; RING]);
+    let request = channel.request();
+    let bsrr = pac::GPIOB.bsrr().as_ptr() as *mut u32;
+    // SAFETY: the ring buffer owns the channel and its memory for the life of the program; the peripheral address
+    // is GPIOB's set/reset register, which accepts any 32-bit word.
+    let mut ring = unsafe {
+        WritableRingBuffer::new(
+            dma::Channel::new(channel, Irqs),
+            request,
+            bsrr,
+            ring_buf,
+            TransferOptions::default(),
+        )
+    };
+    ring.start();
+    let timer = Timer::new(tim);
+    timer.set_frequency(
+        Hertz(1_000_000_000 / ringpod_core::motion::pulse::STEP_SLOT_NS),
+        RoundTo::Faster,
+    );
+    timer.enable_update_dma(true);
+    timer.start();
+    core::mem::forget(timer);
+    ring
 }
 
 fn unwrap_core() -> cortex_m::Peripherals {

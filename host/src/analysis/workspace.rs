@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use ringpod_core::kinematics::geometry::DEG;
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
-use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
+use ringpod_core::kinematics::{Check, Mechanism, Pose, RingGeometry, RingPlatform};
 
 use crate::out::plot::{self, Picture};
 
@@ -82,8 +82,9 @@ pub struct Options<'a> {
 }
 
 /// Runs the command; returns the text to print.
-pub fn run(args: &Options) -> anyhow::Result<String> {
-    let (geometry, home, ranges) = match &args.geometry {
+/// The ring platform scanned: a rig file's (any valid mechanism) or a preset's, its home pose and spec ranges.
+fn platform(args: &Options) -> anyhow::Result<(RingGeometry, [f64; 6], Option<[f64; 5]>)> {
+    Ok(match &args.geometry {
         Some(path) => {
             let rig = crate::rig::load_platform(path)?;
             (rig.geometry, rig.home.to_array(), rig.ranges)
@@ -97,7 +98,34 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
             let ranges = (preset == Preset::TrainerModel).then_some(TRAINER_MODEL_RANGES);
             (*g, preset.home(), ranges)
         }
+    })
+}
+
+/// Every cell of an `n` x `n` grid classified at its centre, rows in parallel, with a bar of rows.
+fn scan(n: usize, quiet: bool, cell: &(dyn Fn(usize, usize) -> Cell + Sync)) -> Vec<Vec<Cell>> {
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(n as u64)
     };
+    bar.set_style(
+        ProgressStyle::with_template("scanning {bar:40} {pos}/{len} rows")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let grid = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let row = (0..n).map(|i| cell(i, j)).collect();
+            bar.inc(1);
+            row
+        })
+        .collect();
+    bar.finish_and_clear();
+    grid
+}
+
+pub fn run(args: &Options) -> anyhow::Result<String> {
+    let (geometry, home, ranges) = platform(args)?;
     let g = &geometry;
     let m = RingPlatform::<f64>::new(g);
     let r = g.ring_radius;
@@ -121,27 +149,10 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
     };
     let du = (u_range.1 - u_range.0) / n as f64;
     let dv = (v_range.1 - v_range.0) / n as f64;
-    let bar = if args.quiet {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(n as u64)
-    };
-    bar.set_style(
-        ProgressStyle::with_template("scanning {bar:40} {pos}/{len} rows")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let grid: Vec<Vec<Cell>> = (0..n)
-        .into_par_iter()
-        .map(|j| {
-            let v = v_range.0 + (j as f64 + 0.5) * dv;
-            let row = (0..n)
-                .map(|i| classify(&m, &pose_at(u_range.0 + (i as f64 + 0.5) * du, v)))
-                .collect();
-            bar.inc(1);
-            row
-        })
-        .collect();
-    bar.finish_and_clear();
+    let grid = scan(n, args.quiet, &|i, j| {
+        let (u, v) = (u_range.0 + (i as f64 + 0.5) * du, v_range.0 + (j as f64 + 0.5) * dv);
+        classify(&m, &pose_at(u, v))
+    });
     draw(args.out, &grid, u_range, v_range, args.section, g.name)?;
 
     let mut text = String::new();

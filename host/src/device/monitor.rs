@@ -71,7 +71,15 @@ pub fn draw(frame: &mut Frame, view: &View) {
         frame.render_widget(waiting, frame.area());
         return;
     };
-    let state = Paragraph::new(Line::from(vec![
+    frame.render_widget(header(&t, view), rows[0]);
+    frame.render_widget(supplies(&t), rows[1]);
+    frame.render_widget(axes(&t), rows[2]);
+    frame.render_widget(motion(&t), rows[3]);
+}
+
+/// The state, device time, tick cost and telemetry rate.
+fn header<'a>(t: &Telemetry, view: &View) -> Paragraph<'a> {
+    Paragraph::new(Line::from(vec![
         Span::styled(
             format!(" {} ", state_name(t.state)),
             Style::default().add_modifier(Modifier::BOLD | Modifier::REVERSED),
@@ -90,11 +98,13 @@ pub fn draw(frame: &mut Frame, view: &View) {
         Block::default()
             .borders(Borders::ALL)
             .title(format!(" ringpod monitor: {} ", view.source)),
-    );
-    frame.render_widget(state, rows[0]);
+    )
+}
 
+/// Relays, driver enable, supply sense and the e-stop, as lamps.
+fn supplies<'a>(t: &Telemetry) -> Paragraph<'a> {
     let input = |bit: InputBit| t.inputs & bit.mask() != 0;
-    let supplies = Paragraph::new(vec![
+    Paragraph::new(vec![
         Line::from(vec![
             Span::raw("relays and drivers: "),
             lamp(t.outputs & 1 != 0, "LOGIC_EN"),
@@ -112,10 +122,13 @@ pub fn draw(frame: &mut Frame, view: &View) {
             alarm(input(InputBit::EStop), "E-STOP OPEN"),
         ]),
     ])
-    .block(Block::default().borders(Borders::ALL).title(" supplies "));
-    frame.render_widget(supplies, rows[1]);
+    .block(Block::default().borders(Borders::ALL).title(" supplies "))
+}
 
-    let axes = Table::new(
+/// Each axis's steps and its home and end switches.
+fn axes<'a>(t: &Telemetry) -> Table<'a> {
+    let input = |bit: InputBit| t.inputs & bit.mask() != 0;
+    Table::new(
         (0..6u8).map(|a| {
             Row::new(vec![
                 format!("axis {}", a + 1),
@@ -140,9 +153,11 @@ pub fn draw(frame: &mut Frame, view: &View) {
         ],
     )
     .header(Row::new(vec!["", "steps", "home", "end"]).style(Style::default().add_modifier(Modifier::BOLD)))
-    .block(Block::default().borders(Borders::ALL).title(" axes and switches "));
-    frame.render_widget(axes, rows[2]);
+    .block(Block::default().borders(Borders::ALL).title(" axes and switches "))
+}
 
+/// The counters with their lamps, and the target pose.
+fn motion<'a>(t: &Telemetry) -> Paragraph<'a> {
     let p = t.target.to_array();
     let flags = [
         (TelemetryFlags::LIMITED, "limited"),
@@ -154,7 +169,7 @@ pub fn draw(frame: &mut Frame, view: &View) {
         t.applied, t.limited, t.refused
     ))];
     counters.extend(flags.iter().map(|(bit, name)| alarm(t.flags & bit != 0, name)));
-    let motion = Paragraph::new(vec![
+    Paragraph::new(vec![
         Line::from(counters),
         Line::from(format!(
             "target: x {:+.4} y {:+.4} z {:.4} m   roll {:+.2} pitch {:+.2} yaw {:+.2} deg",
@@ -166,8 +181,7 @@ pub fn draw(frame: &mut Frame, view: &View) {
             p[5].to_degrees()
         )),
     ])
-    .block(Block::default().borders(Borders::ALL).title(" motion (q: quit) "));
-    frame.render_widget(motion, rows[3]);
+    .block(Block::default().borders(Borders::ALL).title(" motion (q: quit) "))
 }
 
 /// Runs the view until `q`, Esc or Ctrl-C, or for `frames` redraws. Draws ten times a second.

@@ -134,6 +134,60 @@ struct DeviceEnvelope {
     limits: MotionSettings,
 }
 
+impl<'a, T: Transport> Streamer<'a, T> {
+    /// A run on the device's envelope, its counts from zero against the device's status before it (`baseline`).
+    fn new(
+        client: &'a mut Client<T>,
+        interrupted: &'a dyn Fn() -> bool,
+        bar: ProgressBar,
+        envelope: DeviceEnvelope,
+        host_limits: bool,
+        baseline: Status,
+        recorder: Option<Recorder>,
+    ) -> Self {
+        let DeviceEnvelope {
+            platform,
+            margins,
+            stream_timeout,
+            limits,
+        } = envelope;
+        Self {
+            client,
+            interrupted,
+            bar,
+            mechanism: RingPlatform::new(&platform.geometry),
+            margins,
+            host_limits,
+            limits,
+            stream_timeout,
+            centre: Pose::from_array(platform.home),
+            last_sent: baseline.pose.cast(),
+            clock_us: 0,
+            seq: 0,
+            baseline,
+            sent_all: 0,
+            applied_all: 0,
+            rejected_all: 0,
+            device_limited: 0,
+            input_sent: 0,
+            input_applied: 0,
+            lead_in: 0,
+            settle: 0,
+            washout: 0,
+            restarts: 0,
+            rejected: BTreeMap::new(),
+            refusals: Vec::new(),
+            limited: LimitedReport::default(),
+            last_applied: None,
+            in_flight: VecDeque::new(),
+            refused_in_a_row: 0,
+            last_refusal: None,
+            recorder,
+            record_error: None,
+        }
+    }
+}
+
 fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelope, ClientError> {
     let (rig, source, _) = client.rig()?;
     if let RigSource::Refused(_) | RigSource::Unreadable = source {
@@ -180,103 +234,25 @@ pub fn run<T: Transport>(
         None => (None, None),
     };
     let baseline = prepare(client, options.home, recorder.is_some())?;
-    let DeviceEnvelope {
-        platform,
-        margins,
-        stream_timeout,
-        limits,
-    } = device_envelope(client)?;
-    let geometry = &platform.geometry;
+    let envelope = device_envelope(client)?;
+    let home = envelope.platform.home;
     let mut source = source;
     if let Source::Udp(udp) = &mut source {
-        udp.decoder.centre_on(Pose::from_array(platform.home));
+        udp.decoder.centre_on(Pose::from_array(home));
     }
-    let total = match &source {
-        Source::Motion { seconds, rate_hz, .. } => (seconds * rate_hz).round() as u64 + 1,
-        Source::Poses(p) => p.len() as u64,
-        Source::Udp(_) => 0,
-    };
-    let bar = if options.quiet {
-        ProgressBar::hidden()
-    } else if total > 0 {
-        ProgressBar::new(total)
-    } else {
-        ProgressBar::new_spinner()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} setpoints {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    let mut s = Streamer {
+    let bar = progress_bar(&source, options.quiet);
+    let limits = envelope.limits;
+    let mut s = Streamer::new(
         client,
         interrupted,
         bar,
-        mechanism: RingPlatform::new(geometry),
-        margins,
-        host_limits: options.host_limits,
-        limits,
-        stream_timeout,
-        centre: Pose::from_array(platform.home),
-        last_sent: baseline.pose.cast(),
-        clock_us: 0,
-        seq: 0,
+        envelope,
+        options.host_limits,
         baseline,
-        sent_all: 0,
-        applied_all: 0,
-        rejected_all: 0,
-        device_limited: 0,
-        input_sent: 0,
-        input_applied: 0,
-        lead_in: 0,
-        settle: 0,
-        washout: 0,
-        restarts: 0,
-        rejected: BTreeMap::new(),
-        refusals: Vec::new(),
-        limited: LimitedReport::default(),
-        last_applied: None,
-        in_flight: VecDeque::new(),
-        refused_in_a_row: 0,
-        last_refusal: None,
         recorder,
-        record_error: None,
-    };
+    );
     let mut input_errors = input_errors;
-    let mut datagrams = None;
-    let mut capture = None;
-    let home = platform.home;
-    let mut source = source;
-    let outcome = match &mut source {
-        Source::Motion {
-            motion,
-            seconds,
-            rate_hz,
-        } => {
-            let (motion, seconds, rate_hz) = (*motion, *seconds, *rate_hz);
-            let n = (seconds * rate_hz).round() as u64;
-            let mut poses = (0..=n).map(|k| {
-                let t = k as f64 / rate_hz;
-                (None, t, motion_pose(motion, t, home, &limits))
-            });
-            s.timed(&mut poses, fast)
-        }
-        Source::Poses(p) => {
-            let mut poses = p.iter().map(|(line, t, pose)| (Some(*line), *t, *pose));
-            s.timed(&mut poses, fast)
-        }
-        Source::Udp(udp) => {
-            let mut d = DatagramReport::default();
-            let r = s.live(udp, &mut d, &mut input_errors);
-            d.telemetry_gaps = udp.decoder.gaps();
-            (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
-            datagrams = Some(d);
-            capture = udp.capture.take().map(|(writer, path)| {
-                let (packets, error) = writer.finish();
-                CaptureReport { path, packets, error }
-            });
-            r
-        }
-    };
+    let (outcome, datagrams, capture) = feed(&mut s, &mut source, fast, home, &limits, &mut input_errors);
     s.bar.finish_and_clear();
     // Stop, and wait for rest (also after Ctrl-C or a device that stopped by itself).
     let (stop, transport) = match outcome {
@@ -285,77 +261,20 @@ pub fn run<T: Transport>(
         Err(StreamError::Client(e)) => (None, Some(e)),
     };
     let status = if transport.is_none() {
-        // The answers still in flight count too (a device that stopped streaming has refused them).
-        while !s.in_flight.is_empty() {
-            if let Err(StreamError::Client(_)) = s.collect(0) {
-                break;
-            }
-        }
-        let _ = s.client.stop();
-        let cancel = s.client.cancel.take();
-        let status = s.client.wait_for(Duration::from_secs(10), |st| {
-            !matches!(st.state, State::Running | State::Stopping)
-        });
-        s.client.cancel = cancel;
-        status.ok()
+        stop_and_rest(&mut s)
     } else {
         None
     };
     // The samples of the stop and the ramp to rest.
     let _ = s.record();
-    let record = record_path.map(|path| {
-        let dropped = s.client.telemetry_dropped;
-        let (rows, error) = match (s.recorder.take(), s.record_error.take()) {
-            (Some(r), None) => {
-                let rows = r.rows;
-                (rows, r.finish().err().map(|e| e.to_string()))
-            }
-            (r, e) => (r.map_or(0, |r| r.rows), e),
-        };
-        RecordReport {
-            path,
-            rows,
-            dropped,
-            error,
-        }
-    });
+    let record = record_path.map(|path| record_report(&mut s, path));
     let (status, transport) = match (status, transport) {
         (Some(st), None) => (Some(st), None),
         (None, None) => (None, Some("the device did not answer after the stop".to_string())),
         (_, Some(e)) => (None, Some(e.to_string())),
     };
     let refused: u32 = s.rejected.values().sum();
-    let (outcome, reason, code) = if let Some(t) = transport {
-        ("transport_lost", Some(t), exit::TRANSPORT_LOST)
-    } else if let Some(Stop::Device(why)) = &stop {
-        ("device_stopped", Some(why.clone()), exit::DEVICE_STOPPED)
-    } else if let Some(Stop::Interrupted) = &stop {
-        (
-            "interrupted",
-            Some("interrupted (Ctrl-C)".to_string()),
-            exit::INTERRUPTED,
-        )
-    } else if refused > 0 {
-        (
-            "refused",
-            Some(format!("the device refused {refused} setpoints")),
-            exit::REFUSED,
-        )
-    } else if !input_errors.is_empty() {
-        (
-            "input_errors",
-            Some(format!("{} input lines could not be read", input_errors.len())),
-            exit::INPUT_ERRORS,
-        )
-    } else if s.input_sent == 0 {
-        (
-            "input_errors",
-            Some("no pose in the input".to_string()),
-            exit::INPUT_ERRORS,
-        )
-    } else {
-        ("followed", None, exit::FOLLOWED)
-    };
+    let (outcome, reason, code) = verdict(transport, stop.as_ref(), refused, &input_errors, s.input_sent);
     let counts_agree = status.as_ref().is_some_and(|st| {
         let b = &s.baseline;
         st.applied.wrapping_sub(b.applied) == s.applied_all
@@ -387,4 +306,146 @@ pub fn run<T: Transport>(
         record,
         capture,
     })
+}
+
+/// A bar of setpoints for a source of known length, a spinner for a live one (on stderr, hidden without a
+/// terminal or with `--quiet`).
+fn progress_bar(source: &Source, quiet: bool) -> ProgressBar {
+    let total = match source {
+        Source::Motion { seconds, rate_hz, .. } => (seconds * rate_hz).round() as u64 + 1,
+        Source::Poses(p) => p.len() as u64,
+        Source::Udp(_) => 0,
+    };
+    let bar = if quiet {
+        ProgressBar::hidden()
+    } else if total > 0 {
+        ProgressBar::new(total)
+    } else {
+        ProgressBar::new_spinner()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} setpoints {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar
+}
+
+/// Sends the source's poses: timed ones (a motion, a file) on their clock, a live source as it arrives; a live
+/// source's datagram counts and capture come back with the outcome.
+fn feed<T: Transport>(
+    s: &mut Streamer<'_, T>,
+    source: &mut Source,
+    fast: bool,
+    home: [f64; 6],
+    limits: &MotionSettings,
+    input_errors: &mut Vec<InputError>,
+) -> (Result<(), StreamError>, Option<DatagramReport>, Option<CaptureReport>) {
+    match source {
+        Source::Motion {
+            motion,
+            seconds,
+            rate_hz,
+        } => {
+            let (motion, seconds, rate_hz) = (*motion, *seconds, *rate_hz);
+            let n = (seconds * rate_hz).round() as u64;
+            let mut poses = (0..=n).map(|k| {
+                let t = k as f64 / rate_hz;
+                (None, t, motion_pose(motion, t, home, limits))
+            });
+            (s.timed(&mut poses, fast), None, None)
+        }
+        Source::Poses(p) => {
+            let mut poses = p.iter().map(|(line, t, pose)| (Some(*line), *t, *pose));
+            (s.timed(&mut poses, fast), None, None)
+        }
+        Source::Udp(udp) => {
+            let mut d = DatagramReport::default();
+            let r = s.live(udp, &mut d, input_errors);
+            d.telemetry_gaps = udp.decoder.gaps();
+            (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
+            let capture = udp.capture.take().map(|(writer, path)| {
+                let (packets, error) = writer.finish();
+                CaptureReport { path, packets, error }
+            });
+            (r, Some(d), capture)
+        }
+    }
+}
+
+/// Collects the answers still in flight (a device that stopped streaming has refused them), stops, and waits up
+/// to 10 s for rest; the status at rest, or none when the device did not answer.
+fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
+    while !s.in_flight.is_empty() {
+        if let Err(StreamError::Client(_)) = s.collect(0) {
+            break;
+        }
+    }
+    let _ = s.client.stop();
+    // The wait for rest runs to its end even after a signal: the platform is brought to rest, then reported.
+    let cancel = s.client.cancel.take();
+    let status = s.client.wait_for(Duration::from_secs(10), |st| {
+        !matches!(st.state, State::Running | State::Stopping)
+    });
+    s.client.cancel = cancel;
+    status.ok()
+}
+
+/// What `--record` wrote: its rows, the samples dropped, and why it stopped writing, if it did.
+fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordReport {
+    let dropped = s.client.telemetry_dropped;
+    let (rows, error) = match (s.recorder.take(), s.record_error.take()) {
+        (Some(r), None) => {
+            let rows = r.rows;
+            (rows, r.finish().err().map(|e| e.to_string()))
+        }
+        (r, e) => (r.map_or(0, |r| r.rows), e),
+    };
+    RecordReport {
+        path,
+        rows,
+        dropped,
+        error,
+    }
+}
+
+/// The run's outcome, its reason and exit code: the most serious of a lost link, a device that stopped, a
+/// signal, refusals, input errors, no input at all; else followed.
+fn verdict(
+    transport: Option<String>,
+    stop: Option<&Stop>,
+    refused: u32,
+    input_errors: &[InputError],
+    input_sent: u32,
+) -> (&'static str, Option<String>, u8) {
+    if let Some(t) = transport {
+        ("transport_lost", Some(t), exit::TRANSPORT_LOST)
+    } else if let Some(Stop::Device(why)) = stop {
+        ("device_stopped", Some(why.clone()), exit::DEVICE_STOPPED)
+    } else if let Some(Stop::Interrupted) = stop {
+        (
+            "interrupted",
+            Some("interrupted (Ctrl-C)".to_string()),
+            exit::INTERRUPTED,
+        )
+    } else if refused > 0 {
+        (
+            "refused",
+            Some(format!("the device refused {refused} setpoints")),
+            exit::REFUSED,
+        )
+    } else if !input_errors.is_empty() {
+        (
+            "input_errors",
+            Some(format!("{} input lines could not be read", input_errors.len())),
+            exit::INPUT_ERRORS,
+        )
+    } else if input_sent == 0 {
+        (
+            "input_errors",
+            Some("no pose in the input".to_string()),
+            exit::INPUT_ERRORS,
+        )
+    } else {
+        ("followed", None, exit::FOLLOWED)
+    }
 }
