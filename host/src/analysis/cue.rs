@@ -5,12 +5,13 @@ use std::io::Write;
 use std::path::Path;
 
 use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
-use ringpod_core::cueing::{self, CueConfig, SampleError, Telemetry, Washout};
+use ringpod_core::cueing::{self, SampleError, Telemetry, Washout};
 use ringpod_core::kinematics::Pose;
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
 use crate::analysis::mechanism::{AnyMechanism, Selected};
+use crate::input::cueing::load_config;
 use crate::input::table::{self, InputError};
 use crate::out::plot::{self, Panel, Series, TimePlot};
 
@@ -35,58 +36,6 @@ pub struct Summary {
     /// A packet capture's input: what it held (its input errors are numbered by packet).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub capture: Option<super::cue_capture::CaptureSummary>,
-}
-
-/// Loads a washout configuration from TOML (every key optional), with a profile's overrides
-/// ([`parse_config`]); errors name the file and the key.
-pub fn load_config(path: Option<&Path>, profile: Option<&str>) -> anyhow::Result<CueConfig> {
-    let Some(path) = path else {
-        if let Some(name) = profile {
-            anyhow::bail!("profile `{name}`: profiles are chosen from a cueing file, and none was given");
-        }
-        return Ok(CueConfig::default());
-    };
-    let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    parse_config(&text, profile).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
-}
-
-/// A cueing file's text: the base keys, and `[profiles.NAME]` tables, each a partial override of the base. With
-/// `profile`, that profile's keys replace the base's, each key as a whole (a `[profiles.NAME.smoothing]` table
-/// replaces `[smoothing]`, a per-axis list replaces the list); an unknown profile is refused naming the known
-/// ones. The result is checked: an error names the key (and the axis).
-pub fn parse_config(text: &str, profile: Option<&str>) -> Result<CueConfig, String> {
-    let mut table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
-    let profiles = match table.remove("profiles") {
-        None => toml::Table::new(),
-        Some(toml::Value::Table(t)) => t,
-        Some(_) => return Err("`profiles` must be a table of tables: [profiles.NAME]".into()),
-    };
-    for (name, p) in &profiles {
-        if !p.is_table() {
-            return Err(format!("profiles.{name} must be a table: [profiles.{name}]"));
-        }
-    }
-    let mut where_ = String::new();
-    if let Some(name) = profile {
-        let Some(toml::Value::Table(over)) = profiles.get(name) else {
-            let known: Vec<&str> = profiles.keys().map(String::as_str).collect();
-            return Err(if known.is_empty() {
-                format!("no profile `{name}`: the file has no [profiles.NAME] table")
-            } else {
-                format!("no profile `{name}`; the file's profiles: {}", known.join(", "))
-            });
-        };
-        for (k, v) in over {
-            table.insert(k.clone(), v.clone());
-        }
-        where_ = format!("profile `{name}`: ");
-    }
-    let config: CueConfig = toml::Value::Table(table)
-        .try_into()
-        .map_err(|e: toml::de::Error| format!("{where_}{}", e.to_string().trim_end()))?;
-    config.validate().map_err(|e| format!("{where_}{e}"))?;
-    Ok(config)
 }
 
 /// One cued sample, for the output and the plot.
@@ -356,7 +305,8 @@ fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ringpod_core::cueing::{Corner, Smoothing};
+    use crate::input::cueing::parse_config;
+    use ringpod_core::cueing::{Corner, CueConfig, Smoothing};
 
     #[test]
     fn a_file_with_one_corner_for_all_axes_reads_as_before() {

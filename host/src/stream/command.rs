@@ -102,7 +102,7 @@ fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
                     cue_config,
                     profile,
                 } => {
-                    let config = crate::analysis::cue::load_config(cue_config.as_deref(), profile.as_deref())?;
+                    let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
                     let washout = ringpod_core::cueing::Live::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
                     datagram::Decoder::Telemetry {
                         format: *format,

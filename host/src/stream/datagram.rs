@@ -135,7 +135,7 @@ impl Watch {
         self.seen = Some(stamp);
         let shown = self.path.display();
         let config = crate::input::files::read_text(&self.path, crate::input::files::CONFIG_LIMIT)
-            .and_then(|text| crate::analysis::cue::parse_config(&text, self.profile.as_deref()))
+            .and_then(|text| crate::input::cueing::parse_config(&text, self.profile.as_deref()))
             .and_then(|config| washout.retune(config).map_err(|e| e.to_string()));
         match config {
             Ok(true) => {
@@ -468,7 +468,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("cue.toml");
         std::fs::write(&path, initial).unwrap();
-        let config = crate::analysis::cue::load_config(Some(&path), None).unwrap();
+        let config = crate::input::cueing::load_config(Some(&path), None).unwrap();
         let mut d = Decoder::Telemetry {
             format: TelemetryFormat::Text,
             washout: Box::new(Live::new(config).unwrap()),
@@ -522,7 +522,7 @@ mod tests {
         };
         assert_eq!(
             washout.config(),
-            &crate::analysis::cue::parse_config(new, None).unwrap()
+            &crate::input::cueing::parse_config(new, None).unwrap()
         );
         for i in 0..6 {
             // No jump: the largest step across the reload is of the order of the motion's under either
