@@ -1,0 +1,197 @@
+//! What each command's arguments ask for, as the typed options and requests the commands take: the commands
+//! never see a clap struct.
+
+use super::{Common, CueArgs, DeviceAction, DeviceArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs, WorkspaceArgs};
+
+impl RatesArgs {
+    /// The command's typed options.
+    pub fn options(&self) -> crate::analysis::rates::Options<'_> {
+        use crate::analysis::rates::Given;
+        crate::analysis::rates::Options {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            given: match (&self.pose_rates, &self.actuator_rates) {
+                (_, Some(q)) => Given::ActuatorRates(q),
+                (Some(p), None) => Given::PoseRates(p),
+                // clap requires one of them.
+                (None, None) => Given::PoseRates(""),
+            },
+        }
+    }
+}
+
+impl Common {
+    /// The options the analysis commands take.
+    pub fn on(&self) -> crate::analysis::kinematics::On<'_> {
+        crate::analysis::kinematics::On {
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+            degrees: self.degrees,
+            json: self.json,
+        }
+    }
+}
+
+impl FkArgs {
+    /// The options `fk` takes.
+    pub fn options(&self) -> crate::analysis::kinematics::FkOptions<'_> {
+        crate::analysis::kinematics::FkOptions {
+            on: self.common.on(),
+            actuators: &self.actuators,
+            guess: self.guess.as_deref(),
+            max_iterations: self.max_iterations,
+            anywhere: self.anywhere,
+        }
+    }
+}
+
+impl LoadsArgs {
+    /// The options `loads` takes.
+    pub fn options(&self) -> crate::analysis::kinematics::LoadsOptions<'_> {
+        crate::analysis::kinematics::LoadsOptions {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            mass: self.mass,
+            input: self.input.as_deref(),
+            inertia: self.inertia.as_deref(),
+            plot: self.plot.as_deref(),
+        }
+    }
+}
+
+impl WorkspaceArgs {
+    /// The options `workspace` takes.
+    pub fn options(&self) -> crate::analysis::workspace::Options<'_> {
+        crate::analysis::workspace::Options {
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+            section: self.section,
+            z: self.z,
+            cells: self.cells,
+            out: &self.out,
+            quiet: self.quiet,
+        }
+    }
+}
+
+impl CueArgs {
+    /// The options `cue` takes.
+    pub fn options(&self) -> crate::analysis::cue::Options<'_> {
+        crate::analysis::cue::Options {
+            input: &self.input,
+            out: &self.out,
+            config: self.config.as_deref(),
+            profile: self.profile.as_deref(),
+            plot: self.plot.as_deref(),
+            json: self.json,
+            telemetry_format: self.telemetry_format,
+            udp_port: self.udp_port,
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+        }
+    }
+}
+
+impl StreamArgs {
+    /// The stream these arguments ask for (clap has already refused the combinations that make no sense).
+    pub fn job(&self) -> anyhow::Result<crate::stream::command::Job> {
+        use crate::stream::command::{Datagrams, Device, Input, Job, LoadsCheck};
+        let udp = |addr, holds| Input::Udp {
+            addr,
+            holds,
+            from: self.udp_from,
+            idle: self.udp_idle,
+        };
+        if self.capture.is_some() && self.udp.is_none() && self.telemetry_udp.is_none() {
+            anyhow::bail!("--capture records a UDP source: it needs --udp or --telemetry-udp");
+        }
+        let input = match (self.udp, self.telemetry_udp, &self.input) {
+            (Some(addr), _, _) => udp(addr, Datagrams::Poses { degrees: self.degrees }),
+            (None, Some(addr), _) => udp(
+                addr,
+                Datagrams::Telemetry {
+                    format: self.telemetry_format,
+                    cue_config: self.cue_config.clone(),
+                    profile: self.profile.clone(),
+                },
+            ),
+            (None, None, Some(path)) => Input::File {
+                path: path.clone(),
+                degrees: self.degrees,
+            },
+            (None, None, None) => Input::Motion {
+                motion: self.motion.unwrap_or(crate::stream::Motion::Demo),
+                seconds: self.duration,
+                rate_hz: self.rate,
+            },
+        };
+        let device = match crate::link::Target::named(self.port.as_deref(), self.sim)? {
+            crate::link::Target::Port(port) => Device::Port(port),
+            crate::link::Target::Sim => Device::Sim {
+                fast: self.fast,
+                platform: platform(&self.geometry, &self.mechanism),
+            },
+        };
+        Ok(Job {
+            input,
+            device,
+            check_loads: self.check_loads.then(|| LoadsCheck {
+                mass: self.mass.unwrap_or(f64::NAN),
+                inertia: self.inertia.clone(),
+            }),
+            options: crate::stream::Options {
+                home: self.home,
+                host_limits: !self.device_limits_only,
+                quiet: self.quiet,
+            },
+            record: self.record.clone(),
+            capture: self.capture.clone(),
+            report_json: self.report_json,
+        })
+    }
+}
+
+impl DeviceArgs {
+    /// The device and what to do there; words that an action does not take are refused here.
+    pub fn request(&self) -> anyhow::Result<(crate::link::Target, crate::device::Action)> {
+        use crate::device::Action;
+        use DeviceAction as A;
+        if !matches!(self.action, A::Config | A::Jog | A::Buzz | A::Rig) && !self.config.is_empty() {
+            anyhow::bail!("only `device config`, `jog`, `buzz` and `rig` take further words");
+        }
+        if self.watch && self.action != A::Inputs {
+            anyhow::bail!("--watch is for `device inputs`");
+        }
+        let words = self.config.clone();
+        let action = match self.action {
+            A::Status => Action::Status,
+            A::Enable => Action::Enable,
+            A::Disable => Action::Disable,
+            A::Home => Action::Home,
+            A::Start => Action::Start,
+            A::Stop => Action::Stop,
+            A::Clear => Action::Clear,
+            A::Config => Action::Config(words),
+            A::Inputs => Action::Inputs { watch: self.watch },
+            A::Jog => Action::Jog(words),
+            A::Buzz => Action::Buzz(words),
+            A::Rig => match words.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+                ["load", file] => Action::LoadRig(std::path::PathBuf::from(file)),
+                ["show"] => Action::ShowRig,
+                _ => anyhow::bail!("`device rig load RIG.toml` or `device rig show`"),
+            },
+            A::Restart => Action::Restart,
+        };
+        Ok((crate::link::Target::named(self.port.as_deref(), self.sim)?, action))
+    }
+}
+
+/// The platform a simulated controller runs: `--geometry RIG.toml` or `--mechanism PRESET` (clap keeps them apart),
+/// or the trainer model.
+pub fn platform(geometry: &Option<std::path::PathBuf>, mechanism: &Option<String>) -> Option<crate::device::Platform> {
+    match (geometry, mechanism) {
+        (Some(path), _) => Some(crate::device::Platform::File(path.clone())),
+        (None, Some(name)) => Some(crate::device::Platform::Preset(name.clone())),
+        (None, None) => None,
+    }
+}
