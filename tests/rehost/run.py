@@ -246,7 +246,8 @@ def main():
     tim1, st = m.tim["tim1"], m.dma["dma2"].streams[5]
     slot_ns = source_constant("STEP_SLOT_NS")
     ring = 3 * source_constant("MAX_STEP_SLOTS")
-    ring_buf = m.elf.one(r"board::start::\{\{closure\}\}::RING_BUF$")[1]
+    # The ring is a static of the board module (wherever its set-up function lives).
+    ring_buf = m.elf.one(r"board::(\w+::)*(\{\{closure\}\}::)?RING_BUF$")[1]
     arr = SYSCLK * slot_ns // 1_000_000_000 - 1
     config = {
         f"TIM1 PSC 0 ARR {arr}": tim1.psc == 0 and tim1.arr == arr,
