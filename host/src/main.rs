@@ -11,6 +11,7 @@ mod out;
 mod rig;
 mod signals;
 mod stream;
+mod ui;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -50,6 +51,7 @@ fn main() -> ExitCode {
             .request()
             .and_then(|(target, action)| device::run(&target, &action)),
         C::Ports => device::ports(),
+        C::Ui(args) => args.options().and_then(ui::run),
         C::Simulate {
             geometry, mechanism, ..
         } => device::simulate(cli::platform(geometry, mechanism).as_ref()),

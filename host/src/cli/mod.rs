@@ -70,6 +70,10 @@ pub enum Command {
     },
     /// One command to the controller (--port, or a fresh simulated controller with --sim).
     Device(DeviceArgs),
+    /// The workbench in a browser: the platform live in 3D, the controls with the supervisor's gating, cueing on a
+    /// replayed drive, the rig file checked as you type, run records. Prints the URL to open (with its per-run
+    /// token); runs until interrupted.
+    Ui(UiArgs),
     /// Lists the serial ports (a board shows up as a USB CDC port, /dev/ttyACM* on Linux).
     Ports,
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
@@ -442,4 +446,24 @@ pub struct CueArgs {
     /// With a packet capture as --input: its UDP datagrams to this port only (a capture of several flows).
     #[arg(long)]
     pub udp_port: Option<u16>,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct UiArgs {
+    /// The board's serial port.
+    #[arg(long, conflicts_with = "sim")]
+    pub port: Option<String>,
+    /// A fresh simulated controller (ticking in real time).
+    #[arg(long)]
+    pub sim: bool,
+    /// Simulate this rig file's platform instead of the trainer model (with --sim).
+    #[arg(long, value_name = "RIG.toml", requires = "sim")]
+    pub geometry: Option<std::path::PathBuf>,
+    /// Simulate this preset's ring platform (with --sim).
+    #[arg(long, value_name = "PRESET", conflicts_with = "geometry", requires = "sim")]
+    pub mechanism: Option<String>,
+    /// Where to serve the page. Another address than loopback lets other machines move the platform: the
+    /// token in the printed URL is all that keeps them out.
+    #[arg(long, default_value = "127.0.0.1:8080")]
+    pub listen: std::net::SocketAddr,
 }

@@ -142,6 +142,7 @@ impl StreamArgs {
             options: crate::stream::Options {
                 home: self.home,
                 host_limits: !self.device_limits_only,
+                telemetry: false,
                 quiet: self.quiet,
             },
             record: self.record.clone(),
@@ -193,5 +194,16 @@ pub fn platform(geometry: &Option<std::path::PathBuf>, mechanism: &Option<String
         (Some(path), _) => Some(crate::device::Platform::File(path.clone())),
         (None, Some(name)) => Some(crate::device::Platform::Preset(name.clone())),
         (None, None) => None,
+    }
+}
+
+impl super::UiArgs {
+    /// The workbench's options.
+    pub fn options(&self) -> anyhow::Result<crate::ui::Options> {
+        Ok(crate::ui::Options {
+            target: crate::link::Target::named(self.port.as_deref(), self.sim)?,
+            platform: platform(&self.geometry, &self.mechanism),
+            listen: self.listen,
+        })
     }
 }

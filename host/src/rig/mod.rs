@@ -236,10 +236,11 @@ pub fn load_platform(path: &Path) -> Result<Platform, RigError> {
 pub fn read(path: &Path) -> Result<RigFile, RigError> {
     let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
         .or_else(|e| err(path.display().to_string(), e))?;
-    from_text(&text).map_err(|e| e.in_file(path))
+    parse(&text).map_err(|e| e.in_file(path))
 }
 
-fn from_text(text: &str) -> Result<RigFile, RigError> {
+/// A rig file's text, read but not checked (the workbench's editor checks as the user types).
+pub fn parse(text: &str) -> Result<RigFile, RigError> {
     toml::from_str(text).or_else(|e| {
         // toml names the key and the line; keep its words.
         err("", e.message().trim().to_owned() + &span_of(text, e.span()))
@@ -536,7 +537,7 @@ mod tests {
 
     #[test]
     fn a_rig_restating_the_preset_drives_bit_identical_ik() {
-        let rig = from_text(&trainer_file().to_toml().unwrap())
+        let rig = parse(&trainer_file().to_toml().unwrap())
             .and_then(|f| f.check())
             .unwrap();
         let (ours, preset) = (
@@ -627,7 +628,7 @@ mod tests {
             assert!(!e.why.is_empty());
         }
         // Syntax and unknown keys: toml's message with the line.
-        let e = from_text("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
+        let e = parse("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
         assert!(e.why.contains("rod_lenght") && e.why.contains("line 3"), "{e}");
     }
 

@@ -87,7 +87,7 @@ fn positive(name: &str, v: f64, max: f64) -> anyhow::Result<f64> {
 }
 
 /// Opens the source: its poses, and the lines of a file that could not be read (already printed).
-fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
+pub(crate) fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
     Ok(match input {
         Input::Udp {
             addr,

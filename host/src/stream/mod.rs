@@ -60,6 +60,8 @@ pub struct Options {
     pub host_limits: bool,
     /// No progress bar.
     pub quiet: bool,
+    /// Keep the device's telemetry on for someone watching (the workbench); a record turns it on anyway.
+    pub telemetry: bool,
 }
 
 /// A ring platform and its home pose.
@@ -233,7 +235,7 @@ pub fn run<T: Transport>(
         Some((r, path)) => (Some(r), Some(path)),
         None => (None, None),
     };
-    let baseline = prepare(client, options.home, recorder.is_some())?;
+    let baseline = prepare(client, options.home, recorder.is_some() || options.telemetry)?;
     let envelope = device_envelope(client)?;
     let home = envelope.platform.home;
     let mut source = source;
