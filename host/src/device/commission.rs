@@ -10,10 +10,10 @@ use ringpod_core::safety::debounce::InputBit;
 
 use ringpod_core::kinematics::AxisKind;
 use ringpod_core::protocol::endpoints::{Buzz, Jog};
-use ringpod_core::protocol::{Settings, SettingsKind};
+use ringpod_core::protocol::{NackReason, Settings, SettingsKind};
 use ringpod_core::safety::State;
 
-use crate::link::client::{Client, Transport};
+use crate::link::client::{Client, ClientError, Transport};
 
 /// The inputs in bit order, with their names.
 pub fn names() -> Vec<(InputBit, String)> {
@@ -161,7 +161,13 @@ pub fn begin_move<T: Transport>(
         anyhow::bail!("{d} {unit} is out of range");
     }
     let steps = steps.round() as i32;
-    client.call(Jog { axis, steps })?;
+    match client.call(Jog { axis, steps }) {
+        Err(ClientError::Device(NackReason::OutOfRange)) => anyhow::bail!(
+            "{d} {unit} ({steps} steps) is further than a jog goes: a carriage at most its homing back-off, a linear \
+             actuator its homing search travel"
+        ),
+        other => other?,
+    }
     Ok(format!("jogged {d} {unit} ({steps} steps)"))
 }
 

@@ -97,8 +97,18 @@ fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) ->
         client.stop()?;
         status = client.wait_for(Duration::from_secs(10), |s| !matches!(s.state, State::Stopping))?;
     }
+    if matches!(status.state, State::ShuttingDown(_)) {
+        // Powering down (a disable just before): it must reach Off before it can power up again.
+        status = client.wait_for(Duration::from_secs(10), |s| !matches!(s.state, State::ShuttingDown(_)))?;
+    }
     if status.state == State::Off {
         client.enable()?;
+    }
+    if matches!(
+        status.state,
+        State::Off | State::LogicOn | State::PowerOn { settled: false }
+    ) {
+        // Powering up (now, or by an enable just before): homing is refused until the supplies have settled.
         status = client.wait_for(Duration::from_secs(5), |s| {
             matches!(s.state, State::PowerOn { settled: true } | State::Fault(..))
         })?;

@@ -80,6 +80,14 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
     let signals = Signals::install()?;
     let token = Token::random()?;
     let rig = Platform::rig(options.platform.as_ref())?;
+    // The address first: a port in use is said before anything else starts.
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()?;
+    let listener = runtime
+        .block_on(tokio::net::TcpListener::bind(options.listen))
+        .map_err(|e| anyhow::anyhow!("--listen {}: {e}", options.listen))?;
     let (out, _) = tokio::sync::broadcast::channel(256);
     let cue_file = std::env::temp_dir().join(format!("ringpod-ui-{}-cueing.toml", std::process::id()));
     std::fs::write(&cue_file, toml::to_string(&ringpod_core::cueing::CueConfig::default())?)
@@ -99,13 +107,6 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
         let target = options.target.clone();
         std::thread::spawn(move || worker::run(target, rig, hub, inbox))
     };
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()?;
-    let listener = runtime
-        .block_on(tokio::net::TcpListener::bind(options.listen))
-        .map_err(|e| anyhow::anyhow!("--listen {}: {e}", options.listen))?;
     let local = listener.local_addr()?;
     let app = Arc::new(App {
         listen: local,

@@ -414,13 +414,16 @@ impl Device {
 
     fn load_rig(&mut self, text: &str) -> anyhow::Result<String> {
         let file = crate::rig::parse(text)?;
-        let stored = crate::rig::device::store(&mut self.client, &file)?;
+        if self.client.status()?.state != State::Off {
+            anyhow::bail!("a rig is loaded with the supplies off: Disable first");
+        }
+        crate::rig::device::store(&mut self.client, &file)?;
         let restarted = crate::rig::device::restart(&mut self.client)?;
         self.client.telemetry(true)?;
         let m = announce_rig(&mut self.client, &self.hub)?;
         if let Ok(mut mechanism) = self.mechanism.lock() {
             *mechanism = m;
         }
-        Ok(format!("{stored}; {restarted}"))
+        Ok(format!("{} stored; {restarted}", file.name))
     }
 }
