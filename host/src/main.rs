@@ -39,6 +39,7 @@ fn main() -> ExitCode {
         C::Check(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), true)),
         C::Fk(args) => answer(analysis::kinematics::fk(&args.options())),
         C::Rates(args) => answer(analysis::rates::run(&args.options())),
+        C::Structure(args) => answer(analysis::structure::run(&args.options())),
         C::Loads(args) => answer(analysis::kinematics::loads(&args.options())),
         C::Reactions(args) => answer(analysis::reactions::run(
             &args.common.on(),

@@ -1013,3 +1013,112 @@ fn rates_agree_with_finite_differences_of_ik_and_fk() {
     let yaw = json(&["rates", "--pose-rates=0,0,0,0,0,0.5", "--json"]);
     assert_eq!(six(&yaw["angular_velocity"]), [0.0, 0.0, 0.5]);
 }
+
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+#[test]
+fn structure_prints_the_sources_chain_determinants() {
+    for (chain, published, unit) in [
+        ("fig5.1", -0.2, -0.2),
+        ("fig5.1-singular", 0.0, 0.0),
+        ("fig5.2", -0.25, -0.25),
+        ("fig5.3", 0.625, 0.559017),
+    ] {
+        let v = json(&["structure", "--chain", chain, "--json"]);
+        let c = &v["chains"][0];
+        let det = c["determinant"].as_f64().unwrap();
+        assert!((det - published).abs() < 1e-9, "{chain}: {det}");
+        assert!((c["determinant_unit"].as_f64().unwrap() - unit).abs() < 1e-6, "{chain}");
+        assert_eq!(v["published"].as_f64().unwrap(), published);
+        assert_eq!(v["mobility"]["w"], 6, "{chain}: one open chain of six freedoms");
+        assert_eq!(c["unit_screws"].as_array().unwrap().len(), 6);
+        assert!(v["determinant"].is_null(), "one chain has no mechanism determinant");
+    }
+    let text = ringpod().args(["structure", "--chain", "fig5.1"]).output().unwrap();
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(text.contains("determinant -0.200000"), "{text}");
+    assert!(text.contains("the source prints -0.2"), "{text}");
+}
+
+/// The trainer of chapter 5: W = 6 (8 without the pins), four chains of six unit screws, every transmitted wrench
+/// reciprocal to its chain's unactuated joints, the rods' lines through the carriages IK places, and the wrench
+/// determinant -8.065 (the source's -3.945 has a sign typo in row 4; corrected, its rounded matrix gives -8.04).
+#[test]
+fn structure_of_the_trainer_agrees_with_the_source_and_ik() {
+    let pose = "--pose=0.1,-0.05,1,0.05,-0.03,0.4";
+    let v = json(&["structure", "--mechanism", "trainer-ch5", pose, "--json"]);
+    assert_eq!(v["mobility"]["w"], 6);
+    assert_eq!(v["mobility"]["without_pins"], 8);
+    assert_eq!(v["mobility"]["moving_links"], 11);
+    let chains = v["chains"].as_array().unwrap();
+    assert_eq!(chains.len(), 4);
+    let q = numbers(&json(&["ik", "--mechanism", "trainer-ch5", pose, "--json"])["actuators"]);
+    for (i, c) in chains.iter().enumerate() {
+        let screws: Vec<Vec<f64>> = c["unit_screws"].as_array().unwrap().iter().map(numbers).collect();
+        let driven: Vec<bool> = c["joints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|j| j.as_str().unwrap().ends_with('*'))
+            .collect();
+        assert_eq!(screws.len(), 6);
+        for w in c["wrenches"].as_array().unwrap().iter().map(numbers) {
+            for (t, d) in screws.iter().zip(&driven) {
+                let work: f64 = (0..3).map(|k| t[k] * w[k + 3] + t[k + 3] * w[k]).sum();
+                if !d {
+                    assert!(work.abs() < 1e-9, "chain {i}: {work}");
+                }
+            }
+        }
+        // The carriage of IK: B = 3 (cos q, sin q, 0). A rod chain's wrench is a line through B.
+        if i < 2 {
+            let w = numbers(&c["wrenches"][0]);
+            let b = [3.0 * q[i].cos(), 3.0 * q[i].sin(), 0.0];
+            let m = [
+                b[1] * w[2] - b[2] * w[1],
+                b[2] * w[0] - b[0] * w[2],
+                b[0] * w[1] - b[1] * w[0],
+            ];
+            for k in 0..3 {
+                assert!((m[k] - w[k + 3]).abs() < 1e-9, "chain {i}: {w:?} not through {b:?}");
+            }
+        }
+    }
+    let home = json(&[
+        "structure",
+        "--mechanism",
+        "trainer-ch5",
+        "--pose=0,0,1,0,0,0",
+        "--json",
+    ]);
+    let det = home["determinant"].as_f64().unwrap();
+    assert!((det + 8.064855).abs() < 1e-5, "{det}");
+    for preset in ["trainer-model", "rotopod-ch4", "tool5-ex"] {
+        let v = json(&["structure", "--mechanism", preset, "--json"]);
+        assert!(v["determinant"].as_f64().unwrap().abs() > 1e-6, "{preset}");
+        let w = if preset == "tool5-ex" { 5 } else { 6 };
+        assert_eq!(v["mobility"]["w"], w, "{preset}");
+    }
+}
+
+#[test]
+fn structure_refuses_bad_input_in_one_line() {
+    for args in [
+        &["structure", "--mechanism", "trainer-ch5", "--pose=0,0,5,0,0,0"][..],
+        &["structure", "--mechanism", "nothing"][..],
+        &["structure", "--pose=0,0,nan,0,0,0"][..],
+    ] {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("ringpod: "), "{err}");
+    }
+    ringpod()
+        .args(["structure", "--chain", "fig5.9"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("possible values"));
+}

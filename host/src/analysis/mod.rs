@@ -1,5 +1,5 @@
-//! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `rates`, `reactions`, `workspace` and
-//! `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
+//! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `rates`, `structure`, `reactions`,
+//! `workspace` and `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
 pub mod cue;
 pub mod cue_capture;
@@ -8,4 +8,5 @@ pub mod kinematics;
 pub mod mechanism;
 pub mod rates;
 pub mod reactions;
+pub mod structure;
 pub mod workspace;

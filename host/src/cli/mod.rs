@@ -40,6 +40,10 @@ pub enum Command {
     /// The velocity problem at a pose (A p' = -B q', chapter 4): the actuator rates for --pose-rates, or the pose
     /// rates and the platform's angular velocity for --actuator-rates; A, B and the condition number of each.
     Rates(RatesArgs),
+    /// Structural analysis (chapters 2 and 5.1): mobility by the structural formula, every joint's unit screw at a
+    /// pose, the wrenches each chain transmits, each chain's determinant and the mechanism's wrench determinant;
+    /// or one of the source's chains of figs. 5.1-5.3 with --chain.
+    Structure(StructureArgs),
     /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
@@ -350,6 +354,18 @@ pub struct RatesArgs {
     /// Six actuator rates (rad/s or m/s; deg/s for angles with --degrees): print the pose rates.
     #[arg(long, allow_hyphen_values = true, conflicts_with = "pose_rates")]
     pub actuator_rates: Option<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct StructureArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// One of the source's single chains at its coordinates, instead of a mechanism.
+    #[arg(long, value_enum, conflicts_with_all = ["pose", "geometry", "mechanism"])]
+    pub chain: Option<crate::analysis::structure::SourceChain>,
 }
 
 #[derive(Debug, Args)]

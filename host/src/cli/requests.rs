@@ -1,7 +1,9 @@
 //! What each command's arguments ask for, as the typed options and requests the commands take: the commands
 //! never see a clap struct.
 
-use super::{Common, CueArgs, DeviceAction, DeviceArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs, WorkspaceArgs};
+use super::{
+    Common, CueArgs, DeviceAction, DeviceArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs, StructureArgs, WorkspaceArgs,
+};
 
 impl RatesArgs {
     /// The command's typed options.
@@ -16,6 +18,17 @@ impl RatesArgs {
                 // clap requires one of them.
                 (None, None) => Given::PoseRates(""),
             },
+        }
+    }
+}
+
+impl StructureArgs {
+    /// The options `structure` takes.
+    pub fn options(&self) -> crate::analysis::structure::Options<'_> {
+        crate::analysis::structure::Options {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            chain: self.chain,
         }
     }
 }

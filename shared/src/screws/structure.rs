@@ -237,7 +237,7 @@ fn oriented(w: &Vector6<f64>, along: &Vector3<f64>, first: Option<&Joint>) -> Ve
     let m = Vector3::new(w[3], w[4], w[5]);
     let part = if f.norm() > 1e-9 * w.norm() { f } else { m };
     let n = part.norm();
-    if !(n > 0.0) {
+    if n <= 0.0 || !n.is_finite() {
         return *w;
     }
     let (w, part) = (w / n, part / n);
