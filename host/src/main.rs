@@ -61,7 +61,17 @@ fn main() -> ExitCode {
         C::Monitor { port, sim, frames } => {
             link::Target::named(port.as_deref(), *sim).and_then(|target| device::monitor(&target, *frames))
         }
-        C::Plot { record, out } => stream::record::plot_command(record, out).map(|text| {
+        C::Plot {
+            record,
+            out,
+            derivatives,
+            window,
+        } => if *derivatives {
+            analysis::derivatives::plot_command(record, out, *window)
+        } else {
+            stream::record::plot_command(record, out)
+        }
+        .map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),

@@ -1122,3 +1122,106 @@ fn structure_refuses_bad_input_in_one_line() {
         .failure()
         .stderr(predicate::str::contains("possible values"));
 }
+
+/// A run record with the 28 columns of `stream --record`, the followed pose `pose(t)` every `dt` seconds.
+fn synthetic_record(path: &std::path::Path, seconds: f64, dt: f64, pose: impl Fn(f64) -> [f64; 6]) {
+    let mut text = String::from(
+        "host_s,device_s,cmd_x,cmd_y,cmd_z,cmd_alpha,cmd_beta,cmd_gamma,x,y,z,alpha,beta,gamma,steps_1,steps_2,\
+         steps_3,steps_4,steps_5,steps_6,state,limited,refused,held,applied,limited_total,refused_total,tick_cost\n",
+    );
+    for i in 0..=(seconds / dt).round() as usize {
+        let t = i as f64 * dt;
+        let p = pose(t).map(|v| v.to_string()).join(",");
+        text += &format!("{t},{t},{p},{p},0,0,0,0,0,0,Running,0,0,0,{i},0,0,0\n");
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// The peak |velocity| and |acceleration| `plot --derivatives` prints for an axis.
+fn peaks(summary: &str, axis: &str) -> (f64, f64) {
+    let line = summary.lines().find(|l| l.starts_with(axis)).unwrap();
+    let words: Vec<&str> = line[axis.len()..].split_whitespace().collect();
+    (words[0].parse().unwrap(), words[2].parse().unwrap())
+}
+
+/// `plot --derivatives` reads a 2 Hz, 10 mm heave's velocity (0.1257 m/s) and acceleration (1.579 m/s^2) from a
+/// 100 Hz record within 1 %, the other axes at rest; a yaw at 1.9 rad/s as 1.9 rad/s; a real run's heave motion
+/// at its 31.4 mm/s.
+#[test]
+fn plot_derivatives_reads_velocity_and_acceleration_from_a_record() {
+    let dir = std::env::temp_dir().join(format!("ringpod-derivatives-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let w = std::f64::consts::TAU * 2.0;
+    let record = dir.join("sine.csv");
+    synthetic_record(&record, 3.0, 0.01, |t| {
+        [0.0, 0.0, 0.227 + 0.01 * (w * t).sin(), 0.0, 0.0, 1.9 * t]
+    });
+    let svg = dir.join("sine.svg");
+    let out = ringpod()
+        .args([
+            "plot",
+            record.to_str().unwrap(),
+            "--derivatives",
+            "--out",
+            svg.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary = String::from_utf8(out.stdout).unwrap();
+    let (v, a) = peaks(&summary, "heave z");
+    assert!((v / (0.01 * w) - 1.0).abs() < 0.01, "{v}\n{summary}");
+    assert!((a / (0.01 * w * w) - 1.0).abs() < 0.01, "{a}\n{summary}");
+    assert_eq!(peaks(&summary, "surge x"), (0.0, 0.0));
+    let (yaw_rate, yaw_acceleration) = peaks(&summary, "yaw gamma");
+    assert!((yaw_rate - 1.9).abs() < 1e-6 && yaw_acceleration < 1e-6, "{summary}");
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    for label in ["velocity: translation", "acceleration: rotation", "heave z", "m/s^2"] {
+        assert!(picture.contains(label), "{label} not in the picture");
+    }
+    // A real run: the simulated controller following the 10 mm, 0.5 Hz heave motion.
+    let run = dir.join("run.csv");
+    ringpod()
+        .args([
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--motion",
+            "heave",
+            "--duration",
+            "6",
+        ])
+        .args(["--record", run.to_str().unwrap()])
+        .assert()
+        .success();
+    let out = ringpod()
+        .args([
+            "plot",
+            run.to_str().unwrap(),
+            "--derivatives",
+            "--out",
+            svg.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let summary = String::from_utf8(out.stdout).unwrap();
+    let (v, _) = peaks(&summary, "heave z");
+    assert!((v / (0.01 * std::f64::consts::PI) - 1.0).abs() < 0.05, "{v}\n{summary}");
+    // Bad windows: one line, exit 1.
+    for window in ["0", "-1", "nan"] {
+        let out = ringpod()
+            .args([
+                "plot",
+                record.to_str().unwrap(),
+                "--derivatives",
+                "--out",
+                svg.to_str().unwrap(),
+            ])
+            .arg(format!("--window={window}"))
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{window}");
+        assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1);
+    }
+}

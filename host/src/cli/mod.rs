@@ -51,13 +51,21 @@ pub enum Command {
     /// 6 the link was lost, 7 the --record or --capture file could not be written, 128 + the signal when stopped by one (130 Ctrl-C, 143 SIGTERM).
     Stream(StreamArgs),
     /// Draws a run record (`stream --record`): commanded vs followed per pose axis, the actuator positions, and
-    /// the events (limits, refusals, state changes), labelled, as PNG or SVG.
+    /// the events (limits, refusals, state changes), labelled, as PNG or SVG; or with --derivatives the velocity
+    /// and acceleration of each pose axis.
     Plot {
         /// The run record (CSV).
         record: std::path::PathBuf,
         /// The picture: .png or .svg.
         #[arg(long)]
         out: std::path::PathBuf,
+        /// Draw the velocity and acceleration of each pose axis instead (numerically: a least-squares quadratic
+        /// over --window around each sample).
+        #[arg(long)]
+        derivatives: bool,
+        /// With --derivatives: the window of the fit (s).
+        #[arg(long, default_value_t = 0.05, requires = "derivatives")]
+        window: f64,
     },
     /// A live terminal view of the device from its telemetry: state, supplies and outputs, every input, each
     /// axis's position and switches, the counters and the tick cost. q, Esc or Ctrl-C ends it.

@@ -124,17 +124,20 @@ impl Recorder {
 }
 
 /// A record read back.
-struct Run {
-    t: Vec<f64>,
+pub(crate) struct Run {
+    /// Device time (s).
+    pub t: Vec<f64>,
     commanded: Vec<[f64; 6]>,
-    target: Vec<[f64; 6]>,
+    /// The pose followed (after limiting), angles unwrapped.
+    pub target: Vec<[f64; 6]>,
     steps: Vec<[f64; 6]>,
     state: Vec<String>,
     limited: Vec<bool>,
     refused: Vec<bool>,
 }
 
-fn read(path: &Path) -> anyhow::Result<Run> {
+/// Reads a run record (`stream --record`).
+pub(crate) fn read(path: &Path) -> anyhow::Result<Run> {
     let text = crate::input::files::read_text(path, crate::input::files::DATA_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     let mut lines = text.lines();
