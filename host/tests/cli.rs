@@ -1225,3 +1225,107 @@ fn plot_derivatives_reads_velocity_and_acceleration_from_a_record() {
         assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1);
     }
 }
+
+/// `stream --motion sine`: chapter 5.2's 18.8 Hz at 0.008 m/s and 25 Hz at 0.001 m/s run as asked (inside the
+/// model's 1 m/s^2); a velocity amplitude beyond the acceleration limit is cut to it, saying by how much; a 1 Hz
+/// sine's record reads its velocity amplitude back through `plot --derivatives`.
+#[test]
+fn sine_experiments_run_as_asked_or_say_how_they_were_limited() {
+    let sine = |axis: &str, hz: &str, amplitude: &[&str], seconds: &str, extra: &[&str]| {
+        let out = ringpod()
+            .args([
+                "stream",
+                "--sim",
+                "--fast",
+                "--quiet",
+                "--motion",
+                "sine",
+                "--axis",
+                axis,
+                "--frequency",
+                hz,
+            ])
+            .args(amplitude)
+            .args(["--duration", seconds])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let said = sine("z", "18.8", &["--velocity-amplitude", "0.008"], "1", &[]);
+    // 0.008 / (2 pi 18.8) = 6.773e-5 m, 0.008 * 2 pi 18.8 = 0.945 m/s^2.
+    assert!(said.contains("amplitude 6.7726e-5 m"), "{said}");
+    assert!(said.contains("acceleration 0.944991 m/s^2 (as asked"), "{said}");
+    let said = sine("z", "25", &["--velocity-amplitude", "0.001"], "1", &[]);
+    assert!(
+        said.contains("velocity 0.001000 m/s, acceleration 0.157080 m/s^2 (as asked"),
+        "{said}"
+    );
+    let said = sine("z", "18.8", &["--velocity-amplitude", "0.02"], "1", &[]);
+    // 1 / (0.02 * 2 pi 18.8) = 42.3 % of the amplitude asked.
+    assert!(
+        said.contains("limited to 42.3 % of the amplitude asked, 1.6931e-4 m, by the acceleration limit of 1 m/s^2"),
+        "{said}"
+    );
+    let said = sine("x", "0.5", &["--amplitude", "0.05"], "1", &[]);
+    assert!(said.contains("by the velocity limit of 0.05 m/s"), "{said}");
+    // Read back: a 1 Hz pitch at 0.3 rad/s (0.0477 rad).
+    let dir = std::env::temp_dir().join(format!("ringpod-sine-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (record, png) = (dir.join("pitch.csv"), dir.join("pitch.png"));
+    sine(
+        "pitch",
+        "1",
+        &["--velocity-amplitude", "0.3"],
+        "8",
+        &["--record", record.to_str().unwrap()],
+    );
+    let out = ringpod()
+        .args([
+            "plot",
+            record.to_str().unwrap(),
+            "--derivatives",
+            "--out",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let summary = String::from_utf8(out.stdout).unwrap();
+    let (v, a) = peaks(&summary, "pitch beta");
+    assert!((v / 0.3 - 1.0).abs() < 0.02, "{v}\n{summary}");
+    assert!((a / (0.3 * std::f64::consts::TAU) - 1.0).abs() < 0.05, "{a}\n{summary}");
+    // Parameters without a sine, a sine without them: exit 1 in one line.
+    for args in [
+        &["stream", "--sim", "--fast", "--quiet", "--axis", "z"][..],
+        &[
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--motion",
+            "sine",
+            "--axis",
+            "z",
+            "--frequency",
+            "2",
+        ][..],
+        &[
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--motion",
+            "sine",
+            "--axis",
+            "z",
+            "--frequency=-2",
+            "--amplitude",
+            "0.01",
+        ][..],
+    ] {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1, "{args:?}");
+    }
+}

@@ -49,7 +49,7 @@ pub enum Command {
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
     /// lines that could not be read, 4 setpoints the device refused, 5 the device stopped streaming or faulted,
     /// 6 the link was lost, 7 the --record or --capture file could not be written, 128 + the signal when stopped by one (130 Ctrl-C, 143 SIGTERM).
-    Stream(StreamArgs),
+    Stream(Box<StreamArgs>),
     /// Draws a run record (`stream --record`): commanded vs followed per pose axis, the actuator positions, and
     /// the events (limits, refusals, state changes), labelled, as PNG or SVG; or with --derivatives the velocity
     /// and acceleration of each pose axis.
@@ -261,6 +261,18 @@ pub struct StreamArgs {
     /// Length of a built-in motion (s).
     #[arg(long, default_value_t = 20.0)]
     pub duration: f64,
+    /// With --motion sine: the pose axis.
+    #[arg(long, value_enum)]
+    pub axis: Option<crate::stream::Axis>,
+    /// With --motion sine: the frequency (Hz).
+    #[arg(long)]
+    pub frequency: Option<f64>,
+    /// With --motion sine: the velocity amplitude (m/s; rad/s for roll, pitch and yaw).
+    #[arg(long, conflicts_with = "amplitude")]
+    pub velocity_amplitude: Option<f64>,
+    /// With --motion sine: the position amplitude (m; rad for roll, pitch and yaw).
+    #[arg(long)]
+    pub amplitude: Option<f64>,
     /// CSV file with header t,x,y,z,alpha,beta,gamma (s, m, rad unless --degrees).
     #[arg(long, conflicts_with = "udp")]
     pub input: Option<std::path::PathBuf>,
