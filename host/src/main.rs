@@ -40,6 +40,7 @@ fn main() -> ExitCode {
         C::Check(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), true)),
         C::Fk(args) => answer(analysis::kinematics::fk(&args.options())),
         C::Rates(args) => answer(analysis::rates::run(&args.options())),
+        C::Structure(args) => answer(analysis::structure::run(&args.options())),
         C::Loads(args) => answer(analysis::kinematics::loads(&args.options())),
         C::Reactions(args) => answer(analysis::reactions::run(
             &args.common.on(),
@@ -62,7 +63,17 @@ fn main() -> ExitCode {
         C::Monitor { port, sim, frames } => {
             link::Target::named(port.as_deref(), *sim).and_then(|target| device::monitor(&target, *frames))
         }
-        C::Plot { record, out } => stream::record::plot_command(record, out).map(|text| {
+        C::Plot {
+            record,
+            out,
+            derivatives,
+            window,
+        } => if *derivatives {
+            analysis::derivatives::plot_command(record, out, *window)
+        } else {
+            stream::record::plot_command(record, out)
+        }
+        .map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),

@@ -26,7 +26,7 @@ use ringpod_core::safety::{FaultReason, State};
 pub use loads::{check_loads, platform as loads_platform};
 pub use report::{CaptureReport, DatagramReport, LimitedReport, RecordReport, Report};
 use session::{Stop, StreamError, Streamer};
-pub use source::{motion_pose, read_csv, Motion, Source, UdpSource};
+pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source, UdpSource};
 
 pub use crate::input::table::InputError;
 use crate::link::client::{Client, ClientError, Transport};
@@ -355,14 +355,18 @@ fn feed<T: Transport>(
     match source {
         Source::Motion {
             motion,
+            sine,
             seconds,
             rate_hz,
         } => {
-            let (motion, seconds, rate_hz) = (*motion, *seconds, *rate_hz);
+            let (motion, sine, seconds, rate_hz) = (*motion, *sine, *seconds, *rate_hz);
+            if let Some(sine) = &sine {
+                eprintln!("{}", sine.describe(limits));
+            }
             let n = (seconds * rate_hz).round() as u64;
             let mut poses = (0..=n).map(|k| {
                 let t = k as f64 / rate_hz;
-                (None, t, motion_pose(motion, t, home, limits))
+                (None, t, motion_pose(motion, sine.as_ref(), t, home, limits))
             });
             (s.timed(&mut poses, fast), None, None)
         }

@@ -126,10 +126,11 @@ impl Recorder {
 /// A record read back (device time, each angle made continuous).
 #[derive(Debug, serde::Serialize)]
 pub struct Run {
+    /// Device time (s).
     pub t: Vec<f64>,
     /// The pose the host commanded last (the record's `cmd_*`).
     pub commanded: Vec<[f64; 6]>,
-    /// What the device followed: its setpoint as limited.
+    /// The pose followed: the device's setpoint as limited, angles unwrapped.
     pub target: Vec<[f64; 6]>,
     pub steps: Vec<[f64; 6]>,
     pub state: Vec<String>,
@@ -137,7 +138,8 @@ pub struct Run {
     pub refused: Vec<bool>,
 }
 
-fn read(path: &Path) -> anyhow::Result<Run> {
+/// Reads a run record (`stream --record`).
+pub(crate) fn read(path: &Path) -> anyhow::Result<Run> {
     let text = crate::input::files::read_text(path, crate::input::files::DATA_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
     parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))

@@ -257,10 +257,16 @@ impl Device {
             } => clap::ValueEnum::from_str(motion, true)
                 .map_err(|e| anyhow::anyhow!("motion {motion:?}: {e}"))
                 .and_then(|motion: Motion| {
+                    if motion == Motion::Sine {
+                        anyhow::bail!(
+                            "the sine needs its axis, frequency and amplitude: `ringpod stream --motion sine`"
+                        );
+                    }
                     self.stream(
                         job.page,
                         &Input::Motion {
                             motion,
+                            sine: None,
                             seconds: *seconds,
                             rate_hz: *rate_hz,
                         },
