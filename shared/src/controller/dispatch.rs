@@ -120,7 +120,9 @@ impl Controller {
                 // checks, to where the first homing started (each axis a little before its switch), so that
                 // every search is as short as the first one was. The home pose is often further from a linear
                 // actuator's end switch than its search travel.
-                let parking = was_homed
+                // One homed since start but not now (powered down, jogged, faulted) first finds where its counted
+                // steps put it, whole carriage turns included.
+                let parking = (was_homed || (self.origins && self.resume_from_steps()))
                     && self
                         .parking_pose()
                         .is_ok_and(|pose| self.pipeline.move_to(pose).is_ok());

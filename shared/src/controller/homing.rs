@@ -87,6 +87,47 @@ impl Controller {
         self.pose_at_steps(&steps)
     }
 
+    /// Puts the pipeline where the counted steps say the axes are, whole carriage turns included, so that homing
+    /// again after a power-down, a jog or a fault can park near the switches as a homed machine does: without it
+    /// the search starts wherever the platform stopped (a turned ring, or linear actuators further from their
+    /// switches than their search). False where the steps give no pose, or a pose whose steps are not the counted
+    /// ones to within a quarter back-off (a far forward solution): homing then searches from where it is.
+    pub(super) fn resume_from_steps(&mut self) -> bool {
+        let position = self.scheduler.position();
+        let mechanism = *self.pipeline.mechanism();
+        let Ok(q_home) = mechanism.inverse(&self.home_pose) else {
+            return false;
+        };
+        let axes = mechanism.axes();
+        let totals = crate::kinematics::Actuators(core::array::from_fn(|a| {
+            let scale = &self.config.scales[a];
+            let per_unit = scale.per_unit(axes[a]) * if scale.invert { -1.0 } else { 1.0 };
+            q_home.0[a] + position[a] as f32 / per_unit
+        }));
+        let guess = crate::kinematics::start_from_home(&mechanism, &totals, &self.home_pose);
+        let options = crate::kinematics::NewtonOptions {
+            max_distance: crate::kinematics::FROM_HOME_DISTANCE as f32,
+            ..Default::default()
+        };
+        let Ok(found) = mechanism.forward(&totals, &guess, &options) else {
+            return false;
+        };
+        if self.pipeline.reset(found.pose).is_err() {
+            return false;
+        }
+        let within = self.pipeline.actuators().within;
+        let turns = core::array::from_fn(|a| match axes[a] {
+            crate::kinematics::AxisKind::Ring => {
+                libm::roundf((totals.0[a] - within.0[a]) / core::f32::consts::TAU) as i32
+            }
+            _ => 0,
+        });
+        self.pipeline.set_turns(turns);
+        let steps = self.pipeline.converter().to_steps(self.pipeline.actuators());
+        let homing = &self.plan.config().axes;
+        (0..6).all(|a| (steps[a] - position[a]).abs() <= i64::from(homing[a].backoff_steps / 4))
+    }
+
     /// The pose at motor step positions in homed coordinates (step 0 of each axis at the home pose).
     pub(super) fn pose_at_steps(&self, position: &[i64; 6]) -> Result<Pose<f32>, KinematicsError> {
         let mechanism = *self.pipeline.mechanism();
@@ -159,6 +200,7 @@ impl Controller {
                     .pose_after_homing()
                     .ok()
                     .and_then(|pose| self.pipeline.reset(pose).ok());
+                self.origins = started.is_some();
                 if started.is_some() && self.pipeline.move_to(self.home_pose).is_ok() {
                     self.homing = Homing::Returning;
                 } else {

@@ -63,6 +63,9 @@ pub struct Controller {
     rig_source: RigSource,
     /// The host asked for a restart.
     restart: bool,
+    /// A homing since start set every axis's origin: the counted steps say where the axes are (whatever moved them
+    /// since, a power-down, a jog or a fault, the motors did it step by step), so homing again can park first.
+    origins: bool,
 }
 
 /// When the next telemetry sample is due, and what the previous one counted (for its flags).
@@ -113,6 +116,7 @@ impl Controller {
             jog: None,
             rig_source: RigSource::Compiled,
             restart: false,
+            origins: false,
         })
     }
 

@@ -16,6 +16,9 @@ pub struct AxisSwitches {
     pub home: i64,
     /// Width of a carriage's index flag (steps); `None` for a linear actuator's end switch.
     pub flag_width: Option<i64>,
+    /// A carriage's steps per turn of the ring: its flag passes once a turn, wherever the count is (a platform that
+    /// turned twice finds it two turns on). `None` for a linear actuator.
+    pub per_turn: Option<i64>,
     /// A linear actuator's far end-of-travel switch trips at or above this.
     pub far_limit: Option<i64>,
 }
@@ -70,11 +73,15 @@ impl Plant {
         let carriage = AxisSwitches {
             home: 0,
             flag_width: Some(60),
+            per_turn: Some(i64::from(
+                crate::motion::steps::AxisScale::MODEL_CARRIAGE.steps_per_turn,
+            )),
             far_limit: None,
         };
         let linear = AxisSwitches {
             home: 0,
             flag_width: None,
+            per_turn: None,
             far_limit: Some(240_000),
         };
         Self {
@@ -121,7 +128,13 @@ impl Plant {
             .find(|(k, _)| **k != crate::kinematics::AxisKind::Ring)
             .map_or(0.0, |(_, s)| f64::from(s.steps_per_unit));
         let far = ((stroke[1] - stroke[0] + 0.002) * per_m) as i64;
-        Self::for_axes(&axes, start, far)
+        let mut plant = Self::for_axes(&axes, start, far);
+        for (s, scale) in plant.switches.iter_mut().zip(&config.scales) {
+            if s.per_turn.is_some() {
+                s.per_turn = Some(i64::from(scale.steps_per_turn));
+            }
+        }
+        plant
     }
 
     /// Switch and supply levels for the controller, given the relays of the last tick.
@@ -129,9 +142,10 @@ impl Plant {
         let mut home = 0u16;
         let mut limits = 0u16;
         for (a, (p, s)) in self.position.iter().zip(&self.switches).enumerate() {
-            let active = match s.flag_width {
-                Some(w) => *p >= s.home && *p < s.home + w,
-                None => *p <= s.home,
+            let active = match (s.flag_width, s.per_turn) {
+                (Some(w), Some(turn)) if turn > 0 => (*p - s.home).rem_euclid(turn) < w,
+                (Some(w), _) => *p >= s.home && *p < s.home + w,
+                (None, _) => *p <= s.home,
             };
             if active {
                 home |= 1 << a;

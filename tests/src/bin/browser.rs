@@ -6,7 +6,7 @@
 //! 2. `ringpod ui --sim --listen 127.0.0.1:0`, its URL read from its first line; ChromeDriver on a free port.
 //! 3. The checks, each a `PASS`/`FAIL` line: the page connects and draws; Enable and Home through the buttons, a
 //!    disabled button says why; the demo runs and the 3D pose and the counters advance; STOP (the button, and the
-//!    space bar) stops and powers down; a page of another origin cannot open the WebSocket, nor can a request
+//!    space bar) stops and powers down; a UDP session is followed; a page of another origin cannot open the WebSocket, nor can a request
 //!    without the token; the rig editor names a bad key; cueing redraws when a parameter changes; a run record
 //!    opens; a page that goes away stops the stream it started.
 //!
@@ -379,6 +379,55 @@ async fn space_bar(c: &Client) -> Result<String, String> {
     Ok("enabled, then space: Off".into())
 }
 
+async fn udp_session(c: &Client) -> Result<String, String> {
+    tab(c, "control").await?;
+    let port = free_port()?;
+    js(
+        c,
+        &format!(
+            "(document.getElementById('udp-port').value = '{port}', document.getElementById('udp-holds').value = 'poses', true)"
+        ),
+    )
+    .await?;
+    until(
+        c,
+        "!document.getElementById('run-udp').disabled",
+        Duration::from_secs(20),
+    )
+    .await?;
+    click(c, "#run-udp").await?;
+    // It powers up and homes first, then waits for datagrams.
+    until(
+        c,
+        &format!("{STATE} === 'Running' && window.ringpod.frame.streaming"),
+        Duration::from_secs(60),
+    )
+    .await?;
+    let socket = std::net::UdpSocket::bind("127.0.0.1:0").map_err(|e| e.to_string())?;
+    for _ in 0..150 {
+        socket
+            .send_to(b"0 0 0.237 0 0 0", ("127.0.0.1", port))
+            .map_err(|e| e.to_string())?;
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    // The platform is led in to the 10 mm higher pose the datagrams hold.
+    let z = until(
+        c,
+        "Math.abs(window.ringpod.frame.pose[2] - 0.237) < 0.0005 && window.ringpod.frame.pose[2]",
+        Duration::from_secs(10),
+    )
+    .await?;
+    click(c, "#halt").await?;
+    until(c, &format!("{STATE} === 'Off'"), Duration::from_secs(30)).await?;
+    let report = until(
+        c,
+        "window.ringpod.replies.map(r => r.text).filter(t => t.startsWith('interrupted') && !t.startsWith('interrupted: 0 ')).pop()",
+        Duration::from_secs(10),
+    )
+    .await?;
+    Ok(format!("followed to z = {z}; {report}"))
+}
+
 async fn other_origin(c: &Client, url: &str) -> Result<String, String> {
     let token = url.split("token=").nth(1).ok_or("no token in the URL")?;
     let ws = url.replace("http://", "ws://").replace("/?token=", "/ws?token=");
@@ -552,6 +601,10 @@ async fn checks(driver: &str, url: &str, record: &Path, shots: Option<&Path>) ->
     );
     k.report("STOP ends the stream and powers down", stop_button(&c).await);
     k.report("the space bar is STOP", space_bar(&c).await);
+    k.report(
+        "a UDP poses session from the Control panel is followed",
+        udp_session(&c).await,
+    );
     k.report(
         "a page of another origin cannot open the WebSocket",
         other_origin(&c, url).await,

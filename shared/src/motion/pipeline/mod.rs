@@ -233,6 +233,12 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         Ok(())
     }
 
+    /// Sets the whole turns of the ring axes after a [`reset`](Self::reset), which starts at turn zero: a machine
+    /// whose carriages went round since homing resumes at its counted steps.
+    pub fn set_turns(&mut self, turns: [i32; 6]) {
+        self.actuators.turns = turns;
+    }
+
     /// Starts taking setpoints (explicit command), from where the platform is.
     pub fn start(&mut self) {
         self.mode = Mode::Streaming;
