@@ -440,7 +440,7 @@ fn verdict(
     } else if let Some(Stop::Interrupted) = stop {
         (
             "interrupted",
-            Some("interrupted (Ctrl-C)".to_string()),
+            Some("interrupted (a signal, or STOP in the workbench)".to_string()),
             exit::INTERRUPTED,
         )
     } else if refused > 0 {

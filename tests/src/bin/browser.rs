@@ -396,10 +396,10 @@ async fn udp_session(c: &Client) -> Result<String, String> {
     )
     .await?;
     click(c, "#run-udp").await?;
-    // It powers up and homes first, then waits for datagrams.
+    // It powers up and homes first (from where the demo and STOP left the platform), then waits for datagrams.
     until(
         c,
-        &format!("{STATE} === 'Running' && window.ringpod.frame.streaming"),
+        &format!("window.ringpod.frame.streaming && ({STATE} === 'Ready' || {STATE} === 'Running')"),
         Duration::from_secs(60),
     )
     .await?;
