@@ -73,9 +73,7 @@ impl Plant {
         let carriage = AxisSwitches {
             home: 0,
             flag_width: Some(60),
-            per_turn: Some(i64::from(
-                crate::motion::steps::AxisScale::MODEL_CARRIAGE.steps_per_turn,
-            )),
+            per_turn: Some(crate::motion::steps::AxisScale::MODEL_CARRIAGE.steps_per_turn),
             far_limit: None,
         };
         let linear = AxisSwitches {
@@ -131,7 +129,7 @@ impl Plant {
         let mut plant = Self::for_axes(&axes, start, far);
         for (s, scale) in plant.switches.iter_mut().zip(&config.scales) {
             if s.per_turn.is_some() {
-                s.per_turn = Some(i64::from(scale.steps_per_turn));
+                s.per_turn = Some(scale.steps_per_turn);
             }
         }
         plant
