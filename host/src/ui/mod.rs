@@ -124,24 +124,9 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
                 "note: listening on {local}, not only on this machine: anyone with the URL can move the platform"
             );
         }
-        let router = Router::new()
+        // Every route but the static scripts and style passes the token, origin and host check, once, here.
+        let checked = Router::new()
             .route("/", get(page))
-            .route(
-                "/app.js",
-                get(|| async { ([(header::CONTENT_TYPE, "text/javascript")], SCRIPT) }),
-            )
-            .route(
-                "/chart.js",
-                get(|| async { ([(header::CONTENT_TYPE, "text/javascript")], CHART) }),
-            )
-            .route(
-                "/view3d.js",
-                get(|| async { ([(header::CONTENT_TYPE, "text/javascript")], VIEW3D) }),
-            )
-            .route(
-                "/style.css",
-                get(|| async { ([(header::CONTENT_TYPE, "text/css")], STYLE) }),
-            )
             .route("/ws", get(socket))
             .route("/api/cue/defaults", get(cue_defaults))
             .route("/api/cue", post(cue))
@@ -149,6 +134,15 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
             .route("/api/rig/check", post(rig_check))
             .route("/api/rig/current", get(rig_current))
             .route("/api/run", post(run_record))
+            .route_layer(axum::middleware::from_fn_with_state(app.clone(), admitted));
+        let asset =
+            |kind: &'static str, body: &'static str| get(move || async move { ([(header::CONTENT_TYPE, kind)], body) });
+        let router = Router::new()
+            .merge(checked)
+            .route("/app.js", asset("text/javascript", SCRIPT))
+            .route("/chart.js", asset("text/javascript", CHART))
+            .route("/view3d.js", asset("text/javascript", VIEW3D))
+            .route("/style.css", asset("text/css", STYLE))
             .with_state(app.clone());
         let stop = {
             let hub = hub.clone();
@@ -182,22 +176,11 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
     }
 }
 
-async fn page(State(app): State<Arc<App>>, Query(access): Query<Access>, headers: HeaderMap) -> Response {
-    if let Err(refused) = app.admit(&access, &headers) {
-        return forbidden(refused);
-    }
+async fn page() -> Response {
     ([(header::CONTENT_TYPE, "text/html; charset=utf-8")], PAGE).into_response()
 }
 
-async fn socket(
-    State(app): State<Arc<App>>,
-    Query(access): Query<Access>,
-    headers: HeaderMap,
-    upgrade: WebSocketUpgrade,
-) -> Response {
-    if let Err(refused) = app.admit(&access, &headers) {
-        return forbidden(refused);
-    }
+async fn socket(State(app): State<Arc<App>>, upgrade: WebSocketUpgrade) -> Response {
     let page = app.pages.fetch_add(1, Ordering::SeqCst) + 1;
     upgrade.on_upgrade(move |ws| serve_page(app, page, ws))
 }
@@ -279,8 +262,16 @@ fn take(app: &App, page: u64, text: &str) -> Option<Value> {
     }
 }
 
-fn forbidden(refused: guard::Refused) -> Response {
-    (StatusCode::FORBIDDEN, refused.to_string()).into_response()
+async fn admitted(
+    State(app): State<Arc<App>>,
+    Query(access): Query<Access>,
+    request: axum::extract::Request,
+    next: axum::middleware::Next,
+) -> Response {
+    match app.admit(&access, request.headers()) {
+        Ok(()) => next.run(request).await,
+        Err(refused) => (StatusCode::FORBIDDEN, refused.to_string()).into_response(),
+    }
 }
 
 fn answer(result: Result<Value, String>) -> Response {
@@ -290,22 +281,11 @@ fn answer(result: Result<Value, String>) -> Response {
     }
 }
 
-async fn cue_defaults(State(app): State<Arc<App>>, Query(access): Query<Access>, headers: HeaderMap) -> Response {
-    match app.admit(&access, &headers) {
-        Err(r) => forbidden(r),
-        Ok(()) => Json(api::cue_defaults()).into_response(),
-    }
+async fn cue_defaults() -> Response {
+    Json(api::cue_defaults()).into_response()
 }
 
-async fn cue(
-    State(app): State<Arc<App>>,
-    Query(access): Query<Access>,
-    headers: HeaderMap,
-    Json(request): Json<api::CueRequest>,
-) -> Response {
-    if let Err(r) = app.admit(&access, &headers) {
-        return forbidden(r);
-    }
+async fn cue(State(app): State<Arc<App>>, Json(request): Json<api::CueRequest>) -> Response {
     let Some((geometry, home)) = app.platform() else {
         return answer(Err("the device's rig is not known yet".into()));
     };
@@ -317,15 +297,7 @@ async fn cue(
 }
 
 /// Writes the parameters to the cueing file a telemetry session of this workbench watches: it blends them in.
-async fn cue_apply(
-    State(app): State<Arc<App>>,
-    Query(access): Query<Access>,
-    headers: HeaderMap,
-    Json(request): Json<api::CueRequest>,
-) -> Response {
-    if let Err(r) = app.admit(&access, &headers) {
-        return forbidden(r);
-    }
+async fn cue_apply(State(app): State<Arc<App>>, Json(request): Json<api::CueRequest>) -> Response {
     let written = api::cue_config(&request.config).and_then(|config| {
         let text = toml::to_string(&config).map_err(|e| e.to_string())?;
         std::fs::write(&app.hub.cue_file, text).map_err(|e| format!("{}: {e}", app.hub.cue_file.display()))
@@ -334,10 +306,7 @@ async fn cue_apply(
 }
 
 /// The rig the device runs, as a rig file (what `device rig show` prints), for the Rig panel's editor.
-async fn rig_current(State(app): State<Arc<App>>, Query(access): Query<Access>, headers: HeaderMap) -> Response {
-    if let Err(r) = app.admit(&access, &headers) {
-        return forbidden(r);
-    }
+async fn rig_current(State(app): State<Arc<App>>) -> Response {
     let record = app.hub.record.lock().ok().and_then(|r| *r);
     answer(
         record
@@ -352,15 +321,7 @@ struct TextBody {
     text: String,
 }
 
-async fn rig_check(
-    State(app): State<Arc<App>>,
-    Query(access): Query<Access>,
-    headers: HeaderMap,
-    Json(body): Json<TextBody>,
-) -> Response {
-    if let Err(r) = app.admit(&access, &headers) {
-        return forbidden(r);
-    }
+async fn rig_check(Json(body): Json<TextBody>) -> Response {
     answer(
         tokio::task::spawn_blocking(move || Ok(api::rig_check(&body.text)))
             .await
@@ -368,14 +329,6 @@ async fn rig_check(
     )
 }
 
-async fn run_record(
-    State(app): State<Arc<App>>,
-    Query(access): Query<Access>,
-    headers: HeaderMap,
-    Json(body): Json<TextBody>,
-) -> Response {
-    if let Err(r) = app.admit(&access, &headers) {
-        return forbidden(r);
-    }
+async fn run_record(Json(body): Json<TextBody>) -> Response {
     answer(api::run_record(&body.text))
 }
