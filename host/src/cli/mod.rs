@@ -242,20 +242,9 @@ pub struct DeviceArgs {
 
 #[derive(Debug, Args)]
 pub struct StreamArgs {
-    /// Serial port of the board (USB CDC).
-    #[arg(long, conflicts_with = "sim")]
-    pub port: Option<String>,
-    /// The in-process simulated controller (same core as the firmware, real framed bytes).
-    #[arg(long)]
-    pub sim: bool,
-    /// With --sim: simulate this rig file's platform (with the trainer model's drives and switches) instead of the
-    /// trainer model.
-    #[arg(long, value_name = "RIG.toml", requires = "sim")]
-    pub geometry: Option<std::path::PathBuf>,
-    /// With --sim: simulate this preset's ring platform (`ringpod presets`) with the trainer model's drives and
-    /// switches, as --geometry does with its exported rig file.
-    #[arg(long, value_name = "PRESET", requires = "sim", conflicts_with = "geometry")]
-    pub mechanism: Option<String>,
+    /// The controller.
+    #[command(flatten)]
+    pub controller: ControllerArgs,
     /// With --sim: run as fast as possible instead of in real time.
     #[arg(long, requires = "sim")]
     pub fast: bool,
@@ -486,20 +475,31 @@ pub struct CueArgs {
 
 #[derive(Debug, clap::Args)]
 pub struct UiArgs {
-    /// The board's serial port.
-    #[arg(long, conflicts_with = "sim")]
-    pub port: Option<String>,
-    /// A fresh simulated controller (ticking in real time).
-    #[arg(long)]
-    pub sim: bool,
-    /// Simulate this rig file's platform instead of the trainer model (with --sim).
-    #[arg(long, value_name = "RIG.toml", requires = "sim")]
-    pub geometry: Option<std::path::PathBuf>,
-    /// Simulate this preset's ring platform (with --sim).
-    #[arg(long, value_name = "PRESET", conflicts_with = "geometry", requires = "sim")]
-    pub mechanism: Option<String>,
+    /// The controller.
+    #[command(flatten)]
+    pub controller: ControllerArgs,
     /// Where to serve the page. Another address than loopback lets other machines move the platform: the
     /// token in the printed URL is all that keeps them out.
     #[arg(long, default_value = "127.0.0.1:8080")]
     pub listen: std::net::SocketAddr,
+}
+
+/// Which controller a command drives: a board on a serial port, or the simulated controller in this process (of the
+/// trainer model, or of a rig file's or a preset's platform).
+#[derive(Debug, Args)]
+pub struct ControllerArgs {
+    /// Serial port of the board (USB CDC).
+    #[arg(long, conflicts_with = "sim")]
+    pub port: Option<String>,
+    /// The in-process simulated controller (same core as the firmware, real framed bytes).
+    #[arg(long)]
+    pub sim: bool,
+    /// With --sim: simulate this rig file's platform (with the trainer model's drives and switches) instead of the
+    /// trainer model.
+    #[arg(long, value_name = "RIG.toml", requires = "sim")]
+    pub geometry: Option<std::path::PathBuf>,
+    /// With --sim: simulate this preset's ring platform (`ringpod presets`) with the trainer model's drives and
+    /// switches, as --geometry does with its exported rig file.
+    #[arg(long, value_name = "PRESET", requires = "sim", conflicts_with = "geometry")]
+    pub mechanism: Option<String>,
 }

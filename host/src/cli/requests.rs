@@ -139,11 +139,12 @@ impl StreamArgs {
                 rate_hz: self.rate,
             },
         };
-        let device = match crate::link::Target::named(self.port.as_deref(), self.sim)? {
+        let c = &self.controller;
+        let device = match crate::link::Target::named(c.port.as_deref(), c.sim)? {
             crate::link::Target::Port(port) => Device::Port(port),
             crate::link::Target::Sim => Device::Sim {
                 fast: self.fast,
-                platform: platform(&self.geometry, &self.mechanism),
+                platform: platform(&c.geometry, &c.mechanism),
             },
         };
         Ok(Job {
@@ -240,8 +241,8 @@ impl super::UiArgs {
     /// The workbench's options.
     pub fn options(&self) -> anyhow::Result<crate::ui::Options> {
         Ok(crate::ui::Options {
-            target: crate::link::Target::named(self.port.as_deref(), self.sim)?,
-            platform: platform(&self.geometry, &self.mechanism),
+            target: crate::link::Target::named(self.controller.port.as_deref(), self.controller.sim)?,
+            platform: platform(&self.controller.geometry, &self.controller.mechanism),
             listen: self.listen,
         })
     }
