@@ -302,6 +302,20 @@ impl RingGeometry {
     pub fn chains(&self) -> &[Chain] {
         self.chains.get(..self.chain_count).unwrap_or(&[])
     }
+
+    /// The arm of the elbow chain whose shoulder angle is actuator `axis` (0-based), if it is one.
+    pub fn arm_of_axis(&self, axis: usize) -> Option<Elbow> {
+        let chains = self.chains();
+        let radial = chains.iter().filter(|c| c.kind == ChainKind::Radial).count();
+        let k = axis.checked_sub(chains.len() + radial)?;
+        chains
+            .iter()
+            .filter_map(|c| match c.kind {
+                ChainKind::Elbow(e) => Some(e),
+                _ => None,
+            })
+            .nth(k)
+    }
 }
 
 /// The five-DOF parallel-serial tool carrier of KINEMATICS.md 2.3 (all lengths in metres).
