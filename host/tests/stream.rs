@@ -887,6 +887,50 @@ fn a_rig_of_ones_own_streams_on_the_simulator() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The elbow trainer (ch. 5.1 fig. 5.2 arms with rotary shoulders in place of the linear actuators) homes and
+/// follows a demo on the simulator, as a preset and as its exported rig file: every setpoint applied, the counts
+/// agreeing, no fault (the shoulders pass their index flags at home without tripping anything), and the shoulders'
+/// motors turned.
+#[test]
+fn the_elbow_trainer_streams_on_the_simulator() {
+    let dir = std::env::temp_dir().join(format!("ringpod-elbow-rig-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exported = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["presets", "--export", "trainer-elbow"])
+        .output()
+        .unwrap();
+    assert!(exported.status.success());
+    let file = dir.join("elbow.toml");
+    std::fs::write(&file, exported.stdout).unwrap();
+    let demo = |extra: &[&str]| {
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(["stream", "--sim", "--fast", "--quiet", "--report-json"])
+            .args(["--motion", "demo", "--duration", "6"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["outcome"], "followed", "{report}");
+        assert_eq!(report["state"], "Ready");
+        assert_eq!(report["setpoints_applied"], report["setpoints_sent"]);
+        assert_eq!(report["counts_agree"], true);
+        assert_eq!(
+            report["faults"].as_array().map(Vec::len),
+            Some(0),
+            "{}",
+            report["faults"]
+        );
+        report
+    };
+    let preset = demo(&["--mechanism", "trainer-elbow"]);
+    let rig = demo(&["--geometry", file.to_str().unwrap()]);
+    assert_eq!(preset["final_steps"], rig["final_steps"]);
+    let model = demo(&[]);
+    assert_ne!(preset["final_steps"], model["final_steps"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `cue --geometry` and `stream --check-loads --geometry` work on the rig given, not on the trainer model: the cues
 /// centre on its home pose (another height) and the drive margins are those of its geometry, so both answers differ
 /// from the trainer model's for the same input.

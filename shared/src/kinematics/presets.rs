@@ -151,7 +151,11 @@ pub const TRAINER_ELBOW: RingGeometry = unwrap_geometry(RingGeometry::new(
         elbow(0.181, 0.160),
         elbow(-0.181, 0.160),
     ],
-    TRAINER_MODEL.limits,
+    // The model's limits; no linear actuators, so the stroke is a rig file's default for none.
+    RingLimits {
+        stroke: [0.0, 1.0],
+        ..TRAINER_MODEL.limits
+    },
 ));
 
 /// Motion ranges of the model's spec table around [`TRAINER_MODEL_HOME_Z`]: surge, sway, heave (m), roll, pitch
@@ -231,6 +235,15 @@ impl Preset {
             Preset::TrainerModel => PresetGeometry::Ring(&TRAINER_MODEL),
             Preset::TrainerElbow => PresetGeometry::Ring(&TRAINER_ELBOW),
             Preset::Tool5Ex => PresetGeometry::Tool(&TOOL5_EX),
+        }
+    }
+
+    /// The motion ranges of its spec table, `+-` around home (surge, sway, heave in m, roll, pitch in rad), for the
+    /// 1:20 model and its elbow variant; `None` for the reference geometries.
+    pub const fn spec_ranges(self) -> Option<[f64; 5]> {
+        match self {
+            Preset::TrainerModel | Preset::TrainerElbow => Some(TRAINER_MODEL_RANGES),
+            _ => None,
         }
     }
 
