@@ -8,9 +8,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::RingPlatform;
+use super::{RingPlatform, Shape};
 use crate::kinematics::velocity::hadamard_ratio_in_place;
-use crate::kinematics::{Actuators, ChainKind, Pose, WorkspaceReport};
+use crate::kinematics::{Actuators, Pose, WorkspaceReport};
 use crate::real::{length, wrap_once, wrap_pi};
 use crate::Real;
 
@@ -122,17 +122,17 @@ impl<T: Real> RingPlatform<T> {
         for (i, (a, kind)) in joints.iter().zip(&self.kinds).enumerate().take(self.n) {
             let rho = (a.x * a.x + a.y * a.y).sqrt_();
             let m = match kind {
-                ChainKind::Rod(_) => {
+                Shape::Rod(_) => {
                     let h = (self.rod * self.rod - a.z * a.z).max_(T::zero()).sqrt_();
                     (self.rod - a.z.abs())
                         .min_(h - (self.rr - rho).abs())
                         .min_(self.rr + rho - h)
                 }
-                ChainKind::Radial => {
+                Shape::Radial => {
                     let s = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
                     (s - self.stroke[0]).min_(self.stroke[1] - s)
                 }
-                ChainKind::Elbow(_) => match &self.arms[i] {
+                Shape::Elbow => match &self.arms[i] {
                     Some(arm) => arm.reach(rho, a.z),
                     None => T::zero(),
                 },

@@ -19,6 +19,30 @@ use super::geometry::{Branch, ChainKind, RingGeometry};
 use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
 
+/// A chain's kind without an elbow chain's dimensions (those are in the platform's `arms`): what the per-pose code
+/// branches on, a byte instead of a whole [`ChainKind`] per chain (the firmware keeps several platforms in RAM).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Shape {
+    Rod(Branch),
+    Radial,
+    Elbow,
+}
+
+impl Shape {
+    fn of(kind: &ChainKind) -> Self {
+        match kind {
+            ChainKind::Rod(b) => Self::Rod(*b),
+            ChainKind::Radial => Self::Radial,
+            ChainKind::Elbow(_) => Self::Elbow,
+        }
+    }
+
+    /// Radial and elbow chains: a planarity constraint and a tangent wrench.
+    pub(super) fn is_planar(self) -> bool {
+        matches!(self, Self::Radial | Self::Elbow)
+    }
+}
+
 /// A ring platform in scalar type `T`, built from a validated [`RingGeometry`].
 #[derive(Debug, Clone, Copy)]
 pub struct RingPlatform<T: Real> {
@@ -27,7 +51,7 @@ pub struct RingPlatform<T: Real> {
     rod: T,
     n: usize,
     points: [Vector3<T>; 6],
-    kinds: [ChainKind; 6],
+    kinds: [Shape; 6],
     /// Actuator index of the length of each radial chain.
     length_axis: [Option<usize>; 6],
     /// The arm of each elbow chain (with its shoulder's actuator index).
@@ -46,7 +70,7 @@ impl<T: Real> RingPlatform<T> {
         let chains = geometry.chains();
         let n = chains.len();
         let mut points = [Vector3::zeros(); 6];
-        let mut kinds = [ChainKind::Radial; 6];
+        let mut kinds = [Shape::Radial; 6];
         let mut length_axis = [None; 6];
         let mut arms = [None; 6];
         let mut axes = [AxisKind::Ring; 6];
@@ -54,7 +78,7 @@ impl<T: Real> RingPlatform<T> {
         // The validated geometry has at most six chains and exactly six actuators, so every index is in range.
         for (i, c) in chains.iter().enumerate() {
             points[i] = Vector3::from(c.platform_point.map(T::of));
-            kinds[i] = c.kind;
+            kinds[i] = Shape::of(&c.kind);
             if c.kind == ChainKind::Radial {
                 length_axis[i] = Some(next_length);
                 axes[next_length] = AxisKind::Linear;
@@ -165,7 +189,7 @@ impl<T: Real> RingPlatform<T> {
                 });
             }
             match self.kinds[i] {
-                ChainKind::Rod(branch) => {
+                Shape::Rod(branch) => {
                     let h2 = self.rod * self.rod - a.z * a.z;
                     if h2 <= T::zero() {
                         return Err(KinematicsError::Unreachable {
@@ -195,7 +219,7 @@ impl<T: Real> RingPlatform<T> {
                     let scale = T::one() / (rho2 + rho2);
                     c.carriages[i] = Vector3::new(cx * scale, cy * scale, T::zero());
                 }
-                ChainKind::Radial => {
+                Shape::Radial => {
                     q[i] = a.y.atan2_(a.x);
                     let scale = self.rr / rho;
                     c.carriages[i] = Vector3::new(a.x * scale, a.y * scale, T::zero());
@@ -203,7 +227,7 @@ impl<T: Real> RingPlatform<T> {
                         q[k] = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
                     }
                 }
-                ChainKind::Elbow(_) => {
+                Shape::Elbow => {
                     // The carriage is on the joint's radius, as a radial chain's; the arm is a planar dyad there.
                     q[i] = a.y.atan2_(a.x);
                     let (cq, sq) = (a.x / rho, a.y / rho);
