@@ -44,9 +44,13 @@ impl Shape {
 }
 
 /// A ring platform in scalar type `T`, built from a validated [`RingGeometry`].
+///
+/// Laid out in this order (`repr(C)`): what every pose reads first, the elbow chains' arms next, the geometry (large
+/// since chains carry an elbow's `f64` dimensions, and read only by reports) last, so that the hot fields keep small
+/// offsets wherever the platform is embedded (on the M4F a load beyond 4 KB of its base takes extra instructions).
 #[derive(Debug, Clone, Copy)]
+#[repr(C)]
 pub struct RingPlatform<T: Real> {
-    geometry: RingGeometry,
     rr: T,
     rod: T,
     n: usize,
@@ -54,14 +58,15 @@ pub struct RingPlatform<T: Real> {
     kinds: [Shape; 6],
     /// Actuator index of the length of each radial chain.
     length_axis: [Option<usize>; 6],
-    /// The arm of each elbow chain (with its shoulder's actuator index).
-    arms: [Option<Arm<T>>; 6],
     axes: [AxisKind; 6],
     stroke: [T; 2],
     spacing: [T; 2],
     cones: [T; 2],
     min_index: T,
     com: Vector3<T>,
+    /// The arm of each elbow chain (with its shoulder's actuator index).
+    arms: [Option<Arm<T>>; 6],
+    geometry: RingGeometry,
 }
 
 impl<T: Real> RingPlatform<T> {
