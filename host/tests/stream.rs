@@ -45,9 +45,15 @@ fn steps_at(pose: [f64; 6]) -> [i64; 6] {
 
 /// Starts `ringpod simulate --pty` and returns it with the path of its pseudo-terminal.
 fn simulator_on_a_pty() -> (std::process::Child, String) {
+    simulator_on_a_pty_with(&[])
+}
+
+/// [`simulator_on_a_pty`] with further arguments to `simulate` (`--mechanism trainer-elbow`).
+fn simulator_on_a_pty_with(args: &[&str]) -> (std::process::Child, String) {
     use std::io::BufRead;
     let mut server = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
         .args(["simulate", "--pty"])
+        .args(args)
         .stdout(std::process::Stdio::piped())
         .spawn()
         .unwrap();
@@ -797,6 +803,34 @@ fn a_games_own_packets_are_recognised_and_cued_live() {
     // 0.7 s of a left turn at 0.4 rad/s: the heading follows; the braking's nose-down pitch not yet washed back.
     assert!((last[5] - 0.28).abs() < 1e-3, "{last:?}");
     assert!(last[4] > 0.0, "{last:?}");
+}
+
+/// `device jog` of an elbow chain's shoulder takes degrees, as a carriage's: 2 degrees of its 64,000 steps per turn
+/// are 356 steps.
+#[test]
+fn device_jog_turns_a_shoulder_by_degrees() {
+    let (mut server, path) = simulator_on_a_pty_with(&["--mechanism", "trainer-elbow"]);
+    let device = |words: &[&str]| {
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .arg("device")
+            .args(words)
+            .args(["--port", &path])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr),
+        )
+    };
+    assert_eq!(device(&["enable"]).0, Some(0));
+    std::thread::sleep(std::time::Duration::from_millis(600));
+    let (code, said) = device(&["jog", "6", "2"]);
+    assert!(
+        code == Some(0) && said.contains("jogged 2 deg (356 steps): moved 356 steps"),
+        "{said}"
+    );
+    let _ = server.kill();
+    let _ = server.wait();
 }
 
 /// Commissioning over the serial transport: `device jog` is refused unpowered; powered, a linear actuator jogs
