@@ -38,6 +38,9 @@ pub enum CliError {
     /// A number on the command line cannot be used.
     #[error(transparent)]
     Number(#[from] crate::input::numbers::BadNumber),
+    /// A mechanism's chains could not be analysed.
+    #[error("structure: {0}")]
+    Structure(String),
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),

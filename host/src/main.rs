@@ -11,6 +11,7 @@ mod out;
 mod rig;
 mod signals;
 mod stream;
+mod ui;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -39,6 +40,7 @@ fn main() -> ExitCode {
         C::Check(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), true)),
         C::Fk(args) => answer(analysis::kinematics::fk(&args.options())),
         C::Rates(args) => answer(analysis::rates::run(&args.options())),
+        C::Structure(args) => answer(analysis::structure::run(&args.options())),
         C::Loads(args) => answer(analysis::kinematics::loads(&args.options())),
         C::Reactions(args) => answer(analysis::reactions::run(
             &args.common.on(),
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
             .request()
             .and_then(|(target, action)| device::run(&target, &action)),
         C::Ports => device::ports(),
+        C::Ui(args) => args.options().and_then(ui::run),
         C::Simulate {
             geometry, mechanism, ..
         } => device::simulate(cli::platform(geometry, mechanism).as_ref()),
@@ -60,7 +63,17 @@ fn main() -> ExitCode {
         C::Monitor { port, sim, frames } => {
             link::Target::named(port.as_deref(), *sim).and_then(|target| device::monitor(&target, *frames))
         }
-        C::Plot { record, out } => stream::record::plot_command(record, out).map(|text| {
+        C::Plot {
+            record,
+            out,
+            derivatives,
+            window,
+        } => if *derivatives {
+            analysis::derivatives::plot_command(record, out, *window)
+        } else {
+            stream::record::plot_command(record, out)
+        }
+        .map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),

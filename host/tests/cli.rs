@@ -1022,3 +1022,319 @@ fn rates_agree_with_finite_differences_of_ik_and_fk() {
     let yaw = json(&["rates", "--pose-rates=0,0,0,0,0,0.5", "--json"]);
     assert_eq!(six(&yaw["angular_velocity"]), [0.0, 0.0, 0.5]);
 }
+
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
+#[test]
+fn structure_prints_the_sources_chain_determinants() {
+    for (chain, published, unit) in [
+        ("fig5.1", -0.2, -0.2),
+        ("fig5.1-singular", 0.0, 0.0),
+        ("fig5.2", -0.25, -0.25),
+        ("fig5.3", 0.625, 0.559017),
+    ] {
+        let v = json(&["structure", "--chain", chain, "--json"]);
+        let c = &v["chains"][0];
+        let det = c["determinant"].as_f64().unwrap();
+        assert!((det - published).abs() < 1e-9, "{chain}: {det}");
+        assert!((c["determinant_unit"].as_f64().unwrap() - unit).abs() < 1e-6, "{chain}");
+        assert_eq!(v["published"].as_f64().unwrap(), published);
+        assert_eq!(v["mobility"]["w"], 6, "{chain}: one open chain of six freedoms");
+        assert_eq!(c["unit_screws"].as_array().unwrap().len(), 6);
+        assert!(v["determinant"].is_null(), "one chain has no mechanism determinant");
+    }
+    let text = ringpod().args(["structure", "--chain", "fig5.1"]).output().unwrap();
+    let text = String::from_utf8(text.stdout).unwrap();
+    assert!(text.contains("determinant -0.200000"), "{text}");
+    assert!(text.contains("the source prints -0.2"), "{text}");
+}
+
+/// The trainer of chapter 5: W = 6 (8 without the pins), four chains of six unit screws, every transmitted wrench
+/// reciprocal to its chain's unactuated joints, the rods' lines through the carriages IK places, and the wrench
+/// determinant -8.065 (the source's -3.945 has a sign typo in row 4; corrected, its rounded matrix gives -8.04).
+#[test]
+fn structure_of_the_trainer_agrees_with_the_source_and_ik() {
+    let pose = "--pose=0.1,-0.05,1,0.05,-0.03,0.4";
+    let v = json(&["structure", "--mechanism", "trainer-ch5", pose, "--json"]);
+    assert_eq!(v["mobility"]["w"], 6);
+    assert_eq!(v["mobility"]["without_pins"], 8);
+    assert_eq!(v["mobility"]["moving_links"], 11);
+    let chains = v["chains"].as_array().unwrap();
+    assert_eq!(chains.len(), 4);
+    let q = numbers(&json(&["ik", "--mechanism", "trainer-ch5", pose, "--json"])["actuators"]);
+    for (i, c) in chains.iter().enumerate() {
+        let screws: Vec<Vec<f64>> = c["unit_screws"].as_array().unwrap().iter().map(numbers).collect();
+        let driven: Vec<bool> = c["joints"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|j| j.as_str().unwrap().ends_with('*'))
+            .collect();
+        assert_eq!(screws.len(), 6);
+        for w in c["wrenches"].as_array().unwrap().iter().map(numbers) {
+            for (t, d) in screws.iter().zip(&driven) {
+                let work: f64 = (0..3).map(|k| t[k] * w[k + 3] + t[k + 3] * w[k]).sum();
+                if !d {
+                    assert!(work.abs() < 1e-9, "chain {i}: {work}");
+                }
+            }
+        }
+        // The carriage of IK: B = 3 (cos q, sin q, 0). A rod chain's wrench is a line through B.
+        if i < 2 {
+            let w = numbers(&c["wrenches"][0]);
+            let b = [3.0 * q[i].cos(), 3.0 * q[i].sin(), 0.0];
+            let m = [
+                b[1] * w[2] - b[2] * w[1],
+                b[2] * w[0] - b[0] * w[2],
+                b[0] * w[1] - b[1] * w[0],
+            ];
+            for k in 0..3 {
+                assert!((m[k] - w[k + 3]).abs() < 1e-9, "chain {i}: {w:?} not through {b:?}");
+            }
+        }
+    }
+    let home = json(&[
+        "structure",
+        "--mechanism",
+        "trainer-ch5",
+        "--pose=0,0,1,0,0,0",
+        "--json",
+    ]);
+    let det = home["determinant"].as_f64().unwrap();
+    assert!((det + 8.064855).abs() < 1e-5, "{det}");
+    for preset in ["trainer-model", "rotopod-ch4", "tool5-ex"] {
+        let v = json(&["structure", "--mechanism", preset, "--json"]);
+        assert!(v["determinant"].as_f64().unwrap().abs() > 1e-6, "{preset}");
+        let w = if preset == "tool5-ex" { 5 } else { 6 };
+        assert_eq!(v["mobility"]["w"], w, "{preset}");
+    }
+}
+
+#[test]
+fn structure_refuses_bad_input_in_one_line() {
+    for args in [
+        &["structure", "--mechanism", "trainer-ch5", "--pose=0,0,5,0,0,0"][..],
+        &["structure", "--mechanism", "nothing"][..],
+        &["structure", "--pose=0,0,nan,0,0,0"][..],
+    ] {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("ringpod: "), "{err}");
+    }
+    ringpod()
+        .args(["structure", "--chain", "fig5.9"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("possible values"));
+}
+
+/// A run record with the 28 columns of `stream --record`, the followed pose `pose(t)` every `dt` seconds.
+fn synthetic_record(path: &std::path::Path, seconds: f64, dt: f64, pose: impl Fn(f64) -> [f64; 6]) {
+    let mut text = String::from(
+        "host_s,device_s,cmd_x,cmd_y,cmd_z,cmd_alpha,cmd_beta,cmd_gamma,x,y,z,alpha,beta,gamma,steps_1,steps_2,\
+         steps_3,steps_4,steps_5,steps_6,state,limited,refused,held,applied,limited_total,refused_total,tick_cost\n",
+    );
+    for i in 0..=(seconds / dt).round() as usize {
+        let t = i as f64 * dt;
+        let p = pose(t).map(|v| v.to_string()).join(",");
+        text += &format!("{t},{t},{p},{p},0,0,0,0,0,0,Running,0,0,0,{i},0,0,0\n");
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// The peak |velocity| and |acceleration| `plot --derivatives` prints for an axis.
+fn peaks(summary: &str, axis: &str) -> (f64, f64) {
+    let line = summary.lines().find(|l| l.starts_with(axis)).unwrap();
+    let words: Vec<&str> = line[axis.len()..].split_whitespace().collect();
+    (words[0].parse().unwrap(), words[2].parse().unwrap())
+}
+
+/// `plot --derivatives` reads a 2 Hz, 10 mm heave's velocity (0.1257 m/s) and acceleration (1.579 m/s^2) from a
+/// 100 Hz record within 1 %, the other axes at rest; a yaw at 1.9 rad/s as 1.9 rad/s; a real run's heave motion
+/// at its 31.4 mm/s.
+#[test]
+fn plot_derivatives_reads_velocity_and_acceleration_from_a_record() {
+    let dir = std::env::temp_dir().join(format!("ringpod-derivatives-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let w = std::f64::consts::TAU * 2.0;
+    let record = dir.join("sine.csv");
+    synthetic_record(&record, 3.0, 0.01, |t| {
+        [0.0, 0.0, 0.227 + 0.01 * (w * t).sin(), 0.0, 0.0, 1.9 * t]
+    });
+    let svg = dir.join("sine.svg");
+    let out = ringpod()
+        .args([
+            "plot",
+            record.to_str().unwrap(),
+            "--derivatives",
+            "--out",
+            svg.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary = String::from_utf8(out.stdout).unwrap();
+    let (v, a) = peaks(&summary, "heave z");
+    assert!((v / (0.01 * w) - 1.0).abs() < 0.01, "{v}\n{summary}");
+    assert!((a / (0.01 * w * w) - 1.0).abs() < 0.01, "{a}\n{summary}");
+    assert_eq!(peaks(&summary, "surge x"), (0.0, 0.0));
+    let (yaw_rate, yaw_acceleration) = peaks(&summary, "yaw gamma");
+    assert!((yaw_rate - 1.9).abs() < 1e-6 && yaw_acceleration < 1e-6, "{summary}");
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    for label in ["velocity: translation", "acceleration: rotation", "heave z", "m/s^2"] {
+        assert!(picture.contains(label), "{label} not in the picture");
+    }
+    // A real run: the simulated controller following the 10 mm, 0.5 Hz heave motion.
+    let run = dir.join("run.csv");
+    ringpod()
+        .args([
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--motion",
+            "heave",
+            "--duration",
+            "6",
+        ])
+        .args(["--record", run.to_str().unwrap()])
+        .assert()
+        .success();
+    let out = ringpod()
+        .args([
+            "plot",
+            run.to_str().unwrap(),
+            "--derivatives",
+            "--out",
+            svg.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let summary = String::from_utf8(out.stdout).unwrap();
+    let (v, _) = peaks(&summary, "heave z");
+    assert!((v / (0.01 * std::f64::consts::PI) - 1.0).abs() < 0.05, "{v}\n{summary}");
+    // Bad windows: one line, exit 1.
+    for window in ["0", "-1", "nan"] {
+        let out = ringpod()
+            .args([
+                "plot",
+                record.to_str().unwrap(),
+                "--derivatives",
+                "--out",
+                svg.to_str().unwrap(),
+            ])
+            .arg(format!("--window={window}"))
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{window}");
+        assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1);
+    }
+}
+
+/// `stream --motion sine`: chapter 5.2's 18.8 Hz at 0.008 m/s and 25 Hz at 0.001 m/s run as asked (inside the
+/// model's 1 m/s^2); a velocity amplitude beyond the acceleration limit is cut to it, saying by how much; a 1 Hz
+/// sine's record reads its velocity amplitude back through `plot --derivatives`.
+#[test]
+fn sine_experiments_run_as_asked_or_say_how_they_were_limited() {
+    let sine = |axis: &str, hz: &str, amplitude: &[&str], seconds: &str, extra: &[&str]| {
+        let out = ringpod()
+            .args([
+                "stream",
+                "--sim",
+                "--fast",
+                "--quiet",
+                "--motion",
+                "sine",
+                "--axis",
+                axis,
+                "--frequency",
+                hz,
+            ])
+            .args(amplitude)
+            .args(["--duration", seconds])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let said = sine("z", "18.8", &["--velocity-amplitude", "0.008"], "1", &[]);
+    // 0.008 / (2 pi 18.8) = 6.773e-5 m, 0.008 * 2 pi 18.8 = 0.945 m/s^2.
+    assert!(said.contains("amplitude 6.7726e-5 m"), "{said}");
+    assert!(said.contains("acceleration 0.944991 m/s^2 (as asked"), "{said}");
+    let said = sine("z", "25", &["--velocity-amplitude", "0.001"], "1", &[]);
+    assert!(
+        said.contains("velocity 0.001000 m/s, acceleration 0.157080 m/s^2 (as asked"),
+        "{said}"
+    );
+    let said = sine("z", "18.8", &["--velocity-amplitude", "0.02"], "1", &[]);
+    // 1 / (0.02 * 2 pi 18.8) = 42.3 % of the amplitude asked.
+    assert!(
+        said.contains("limited to 42.3 % of the amplitude asked, 1.6931e-4 m, by the acceleration limit of 1 m/s^2"),
+        "{said}"
+    );
+    let said = sine("x", "0.5", &["--amplitude", "0.05"], "1", &[]);
+    assert!(said.contains("by the velocity limit of 0.05 m/s"), "{said}");
+    // Read back: a 1 Hz pitch at 0.3 rad/s (0.0477 rad).
+    let dir = std::env::temp_dir().join(format!("ringpod-sine-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (record, png) = (dir.join("pitch.csv"), dir.join("pitch.png"));
+    sine(
+        "pitch",
+        "1",
+        &["--velocity-amplitude", "0.3"],
+        "8",
+        &["--record", record.to_str().unwrap()],
+    );
+    let out = ringpod()
+        .args([
+            "plot",
+            record.to_str().unwrap(),
+            "--derivatives",
+            "--out",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let summary = String::from_utf8(out.stdout).unwrap();
+    let (v, a) = peaks(&summary, "pitch beta");
+    assert!((v / 0.3 - 1.0).abs() < 0.02, "{v}\n{summary}");
+    assert!((a / (0.3 * std::f64::consts::TAU) - 1.0).abs() < 0.05, "{a}\n{summary}");
+    // Parameters without a sine, a sine without them: exit 1 in one line.
+    for args in [
+        &["stream", "--sim", "--fast", "--quiet", "--axis", "z"][..],
+        &[
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--motion",
+            "sine",
+            "--axis",
+            "z",
+            "--frequency",
+            "2",
+        ][..],
+        &[
+            "stream",
+            "--sim",
+            "--fast",
+            "--quiet",
+            "--motion",
+            "sine",
+            "--axis",
+            "z",
+            "--frequency=-2",
+            "--amplitude",
+            "0.01",
+        ][..],
+    ] {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1, "{args:?}");
+    }
+}

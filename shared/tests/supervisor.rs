@@ -313,3 +313,35 @@ fn supply_timeout_and_loss() {
     assert!(matches!(s.state(), State::Fault(FaultReason::PowerLost, _)));
     assert!(!s.outputs().power_relay);
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 500, ..ProptestConfig::default() })]
+    /// What a host shows as allowed is what the supervisor then does: `permits` answers as `handle` would for
+    /// every command in every state reached, never changes anything, and a supervisor rebuilt from its telemetry
+    /// (state and input levels) answers the same.
+    #[test]
+    fn permits_is_what_handle_would_do(events in prop::collection::vec(event(), 0..60)) {
+        let config = SupervisorConfig::default();
+        let mut s = Supervisor::new(config);
+        for e in events {
+            let _ = s.handle(e);
+        }
+        let reported = Supervisor::as_reported(config, s.state(), s.inputs());
+        for command in [
+            Event::Command(Command::Enable),
+            Event::Command(Command::Disable),
+            Event::Command(Command::Home),
+            Event::Command(Command::Start),
+            Event::Command(Command::Stop),
+            Event::Command(Command::ClearFault),
+            Event::Jog,
+        ] {
+            let before = s;
+            let asked = s.permits(command);
+            prop_assert_eq!(s, before, "permits changed the supervisor");
+            prop_assert_eq!(reported.permits(command), asked, "telemetry's view of {:?} in {:?}", command, s.state());
+            let mut done = s;
+            prop_assert_eq!(done.handle(command), asked, "{:?} in {:?}", command, s.state());
+        }
+    }
+}

@@ -109,12 +109,34 @@ pub fn ensure_target() -> Result<(), String> {
 /// Makes sure `qemu-system-arm` is there: on a Debian or Ubuntu machine it installs it (as root, or through `sudo`
 /// without a password), as the README's test command promises; otherwise it says what to install.
 fn ensure_qemu() -> Result<(), String> {
+    ensure_packages(
+        &["qemu-system-arm"],
+        &["qemu-system-arm"],
+        "QEMU's Arm system emulator (7.2 or later)",
+    )
+}
+
+/// What the browser tests need (`--bin browser`): Debian's Chromium and its ChromeDriver, installed as QEMU is.
+pub fn ensure_browser() -> Result<(), String> {
+    ensure_packages(
+        &["chromium", "chromedriver"],
+        &["chromium", "chromium-driver"],
+        "Chromium and ChromeDriver",
+    )
+}
+
+/// Each of `programs` answers `--version`, or `packages` are installed with apt-get when this process may (as
+/// root, or through sudo without a password); otherwise the one line that says what to run.
+fn ensure_packages(programs: &[&str], packages: &[&str], what: &str) -> Result<(), String> {
     let present = || {
-        Command::new("qemu-system-arm")
-            .arg("--version")
-            .stdout(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success())
+        programs.iter().all(|p| {
+            Command::new(p)
+                .arg("--version")
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+                .is_ok_and(|s| s.success())
+        })
     };
     if present() {
         return Ok(());
@@ -131,21 +153,22 @@ fn ensure_qemu() -> Result<(), String> {
         .stdout(Stdio::null())
         .status()
         .is_ok();
+    let list = packages.join(" ");
     let command = if root {
-        "apt-get update && apt-get install -y qemu-system-arm"
+        format!("apt-get update && apt-get install -y {list}")
     } else {
-        "sudo apt-get update && sudo apt-get install -y qemu-system-arm"
+        format!("sudo apt-get update && sudo apt-get install -y {list}")
     };
+    let missing = programs.join(" or ");
     let help = if apt {
-        format!("qemu-system-arm is missing: run `{command}`")
+        format!("{missing} is missing: run `{command}`")
     } else {
-        "qemu-system-arm is missing: install QEMU's Arm system emulator (7.2 or later) with this system's packages"
-            .to_string()
+        format!("{missing} is missing: install {what} with this system's packages")
     };
     if !apt || !(root || sudo) || !may_install() {
         return Err(help);
     }
-    println!("== qemu-system-arm is missing: {command}");
+    println!("== {missing} is missing: {command}");
     let apt_get = |args: &[&str]| {
         let mut c = if root {
             Command::new("apt-get")
@@ -159,7 +182,9 @@ fn ensure_qemu() -> Result<(), String> {
             .status()
             .is_ok_and(|s| s.success())
     };
-    if apt_get(&["update"]) && apt_get(&["install", "-y", "qemu-system-arm"]) && present() {
+    let mut install = vec!["install", "-y"];
+    install.extend(packages);
+    if apt_get(&["update"]) && apt_get(&install) && present() {
         Ok(())
     } else {
         Err(help)

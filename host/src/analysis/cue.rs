@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
 use ringpod_core::cueing::{self, SampleError, Telemetry, Washout};
-use ringpod_core::kinematics::Pose;
+use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
@@ -39,10 +39,23 @@ pub struct Summary {
 }
 
 /// One cued sample, for the output and the plot.
-struct Cued {
-    t: f64,
-    input: Telemetry<f64>,
-    pose: Pose<f64>,
+pub struct Cued {
+    /// Its time (s).
+    pub t: f64,
+    /// The vehicle's specific force and rates.
+    pub input: Telemetry<f64>,
+    /// The platform's pose, limited into the envelope.
+    pub pose: Pose<f64>,
+}
+
+/// A drive cued: every sample, how many the envelope limited, and the rows that could not be used.
+pub struct Replay {
+    /// Every row's sample.
+    pub cued: Vec<Cued>,
+    /// Poses the envelope limited.
+    pub limited: usize,
+    /// Rows that could not be used, by line.
+    pub errors: Vec<InputError>,
 }
 
 /// What `cue` is asked to do.
@@ -78,52 +91,12 @@ pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
         anyhow::bail!("cueing moves a ring platform; {} is not one", selected.name);
     };
     let neutral = Pose::from_array(selected.home);
-    let margins = EnvelopeMargins::default();
-    let mut washout = Washout::<f64>::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
-    let mut limited = 0;
-    let mut last_t: Option<f64> = None;
-    let mut held = neutral;
-    for (line, v) in &rows {
-        let t = v[0];
-        let sample = Telemetry {
-            force: [v[1], v[2], v[3]],
-            rate: [v[4], v[5], v[6]],
-        };
-        let offset = match last_t {
-            // The first row (and the first after a gap) starts the washout at neutral and is its first input.
-            None => washout.begin(&sample),
-            Some(l) => washout.step(&sample, t - l),
-        };
-        last_t = Some(t);
-        let pose = match offset {
-            Ok(offset) => {
-                let wanted = cueing::pose(&neutral, &offset);
-                let l = envelope::limit(&*mechanism, &neutral, &wanted, &margins, 16);
-                limited += usize::from(l.is_limited());
-                l.pose
-            }
-            Err(SampleError::NonFinite) => {
-                errors.push(InputError {
-                    line: *line,
-                    reason: "a value is not finite: the platform holds".into(),
-                });
-                held
-            }
-            Err(SampleError::Interval) => {
-                errors.push(InputError {
-                    line: *line,
-                    reason: "more than a second after the row before: the washout starts again at neutral".into(),
-                });
-                washout.reset();
-                // This row starts the washout again: its first input.
-                let _ = washout.begin(&sample);
-                cueing::pose(&neutral, &washout.offset())
-            }
-        };
-        held = pose;
-        cued.push(Cued { t, input: sample, pose });
-    }
+    let Replay {
+        cued,
+        limited,
+        errors: mut cue_errors,
+    } = replay(&rows, config, &mechanism, &neutral)?;
+    errors.append(&mut cue_errors);
     errors.sort_by_key(|e| e.line);
     write_poses(args.out, &cued)?;
     if let Some(plot) = &args.plot {
@@ -164,6 +137,64 @@ pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
         s
     };
     Ok((text, code))
+}
+
+/// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`,
+/// every pose limited into the envelope.
+pub fn replay(
+    rows: &[(usize, Vec<f64>)],
+    config: cueing::CueConfig,
+    mechanism: &RingPlatform<f64>,
+    neutral: &Pose<f64>,
+) -> anyhow::Result<Replay> {
+    let margins = EnvelopeMargins::default();
+    let mut washout = Washout::<f64>::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut errors = Vec::new();
+    let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
+    let mut limited = 0;
+    let mut last_t: Option<f64> = None;
+    let mut held = *neutral;
+    for (line, v) in rows {
+        let t = v[0];
+        let sample = Telemetry {
+            force: [v[1], v[2], v[3]],
+            rate: [v[4], v[5], v[6]],
+        };
+        let offset = match last_t {
+            // The first row (and the first after a gap) starts the washout at neutral and is its first input.
+            None => washout.begin(&sample),
+            Some(l) => washout.step(&sample, t - l),
+        };
+        last_t = Some(t);
+        let pose = match offset {
+            Ok(offset) => {
+                let wanted = cueing::pose(neutral, &offset);
+                let l = envelope::limit(mechanism, neutral, &wanted, &margins, 16);
+                limited += usize::from(l.is_limited());
+                l.pose
+            }
+            Err(SampleError::NonFinite) => {
+                errors.push(InputError {
+                    line: *line,
+                    reason: "a value is not finite: the platform holds".into(),
+                });
+                held
+            }
+            Err(SampleError::Interval) => {
+                errors.push(InputError {
+                    line: *line,
+                    reason: "more than a second after the row before: the washout starts again at neutral".into(),
+                });
+                washout.reset();
+                // This row starts the washout again: its first input.
+                let _ = washout.begin(&sample);
+                cueing::pose(neutral, &washout.offset())
+            }
+        };
+        held = pose;
+        cued.push(Cued { t, input: sample, pose });
+    }
+    Ok(Replay { cued, limited, errors })
 }
 
 /// The telemetry rows of the input: a CSV, or a packet capture ([`super::cue_capture`]).
@@ -216,7 +247,7 @@ fn write_poses(path: &Path, cued: &[Cued]) -> anyhow::Result<()> {
 
 /// The specific force the platform delivers at each sample (platform axes): its acceleration by central
 /// differences of its positions, and gravity in its tilted frame.
-fn delivered_forces(cued: &[Cued]) -> Vec<[f64; 3]> {
+pub fn delivered_forces(cued: &[Cued]) -> Vec<[f64; 3]> {
     (0..cued.len())
         .map(|k| {
             let accel = if k == 0 || k + 1 == cued.len() {

@@ -1,11 +1,14 @@
-//! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `rates`, `reactions`, `workspace` and
-//! `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
+//! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `rates`, `structure`, `reactions`,
+//! the derivatives of a run record (`plot --derivatives`),
+//! `workspace` and `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
 pub mod cue;
 pub mod cue_capture;
 pub mod demand;
+pub mod derivatives;
 pub mod kinematics;
 pub mod mechanism;
 pub mod rates;
 pub mod reactions;
+pub mod structure;
 pub mod workspace;

@@ -14,7 +14,7 @@ use crate::out::plot::{self, Picture};
 
 /// What limits a grid point.
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Cell {
+pub(crate) enum Cell {
     /// No IK solution.
     Unreachable,
     /// The first check that fails.
@@ -23,7 +23,7 @@ enum Cell {
     Inside(f64),
 }
 
-fn classify(m: &RingPlatform<f64>, pose: &Pose<f64>) -> Cell {
+pub(crate) fn classify(m: &RingPlatform<f64>, pose: &Pose<f64>) -> Cell {
     match m.inverse_checked(pose) {
         Err(_) => Cell::Unreachable,
         Ok((_, r)) => match r.first_failure() {

@@ -40,20 +40,32 @@ pub enum Command {
     /// The velocity problem at a pose (A p' = -B q', chapter 4): the actuator rates for --pose-rates, or the pose
     /// rates and the platform's angular velocity for --actuator-rates; A, B and the condition number of each.
     Rates(RatesArgs),
+    /// Structural analysis (chapters 2 and 5.1): mobility by the structural formula, every joint's unit screw at a
+    /// pose, the wrenches each chain transmits, each chain's determinant and the mechanism's wrench determinant;
+    /// or one of the source's chains of figs. 5.1-5.3 with --chain.
+    Structure(StructureArgs),
     /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
     /// lines that could not be read, 4 setpoints the device refused, 5 the device stopped streaming or faulted,
     /// 6 the link was lost, 7 the --record or --capture file could not be written, 128 + the signal when stopped by one (130 Ctrl-C, 143 SIGTERM).
-    Stream(StreamArgs),
+    Stream(Box<StreamArgs>),
     /// Draws a run record (`stream --record`): commanded vs followed per pose axis, the actuator positions, and
-    /// the events (limits, refusals, state changes), labelled, as PNG or SVG.
+    /// the events (limits, refusals, state changes), labelled, as PNG or SVG; or with --derivatives the velocity
+    /// and acceleration of each pose axis.
     Plot {
         /// The run record (CSV).
         record: std::path::PathBuf,
         /// The picture: .png or .svg.
         #[arg(long)]
         out: std::path::PathBuf,
+        /// Draw the velocity and acceleration of each pose axis instead (numerically: a least-squares quadratic
+        /// over --window around each sample).
+        #[arg(long)]
+        derivatives: bool,
+        /// With --derivatives: the window of the fit (s).
+        #[arg(long, default_value_t = 0.05, requires = "derivatives")]
+        window: f64,
     },
     /// A live terminal view of the device from its telemetry: state, supplies and outputs, every input, each
     /// axis's position and switches, the counters and the tick cost. q, Esc or Ctrl-C ends it.
@@ -70,6 +82,10 @@ pub enum Command {
     },
     /// One command to the controller (--port, or a fresh simulated controller with --sim).
     Device(DeviceArgs),
+    /// The workbench in a browser: the platform live in 3D, the controls with the supervisor's gating, cueing on a
+    /// replayed drive, the rig file checked as you type, run records. Prints the URL to open (with its per-run
+    /// token); runs until interrupted.
+    Ui(UiArgs),
     /// Lists the serial ports (a board shows up as a USB CDC port, /dev/ttyACM* on Linux).
     Ports,
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
@@ -249,6 +265,18 @@ pub struct StreamArgs {
     /// Length of a built-in motion (s).
     #[arg(long, default_value_t = 20.0)]
     pub duration: f64,
+    /// With --motion sine: the pose axis.
+    #[arg(long, value_enum)]
+    pub axis: Option<crate::stream::Axis>,
+    /// With --motion sine: the frequency (Hz).
+    #[arg(long)]
+    pub frequency: Option<f64>,
+    /// With --motion sine: the velocity amplitude (m/s; rad/s for roll, pitch and yaw).
+    #[arg(long, conflicts_with = "amplitude")]
+    pub velocity_amplitude: Option<f64>,
+    /// With --motion sine: the position amplitude (m; rad for roll, pitch and yaw).
+    #[arg(long)]
+    pub amplitude: Option<f64>,
     /// CSV file with header t,x,y,z,alpha,beta,gamma (s, m, rad unless --degrees).
     #[arg(long, conflicts_with = "udp")]
     pub input: Option<std::path::PathBuf>,
@@ -353,6 +381,18 @@ pub struct RatesArgs {
 }
 
 #[derive(Debug, Args)]
+pub struct StructureArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// One of the source's single chains at its coordinates, instead of a mechanism.
+    #[arg(long, value_enum, conflicts_with_all = ["pose", "geometry", "mechanism"])]
+    pub chain: Option<crate::analysis::structure::SourceChain>,
+}
+
+#[derive(Debug, Args)]
 pub struct PoseArgs {
     #[command(flatten)]
     pub common: Common,
@@ -442,4 +482,24 @@ pub struct CueArgs {
     /// With a packet capture as --input: its UDP datagrams to this port only (a capture of several flows).
     #[arg(long)]
     pub udp_port: Option<u16>,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct UiArgs {
+    /// The board's serial port.
+    #[arg(long, conflicts_with = "sim")]
+    pub port: Option<String>,
+    /// A fresh simulated controller (ticking in real time).
+    #[arg(long)]
+    pub sim: bool,
+    /// Simulate this rig file's platform instead of the trainer model (with --sim).
+    #[arg(long, value_name = "RIG.toml", requires = "sim")]
+    pub geometry: Option<std::path::PathBuf>,
+    /// Simulate this preset's ring platform (with --sim).
+    #[arg(long, value_name = "PRESET", conflicts_with = "geometry", requires = "sim")]
+    pub mechanism: Option<String>,
+    /// Where to serve the page. Another address than loopback lets other machines move the platform: the
+    /// token in the printed URL is all that keeps them out.
+    #[arg(long, default_value = "127.0.0.1:8080")]
+    pub listen: std::net::SocketAddr,
 }

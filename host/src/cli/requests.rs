@@ -1,7 +1,9 @@
 //! What each command's arguments ask for, as the typed options and requests the commands take: the commands
 //! never see a clap struct.
 
-use super::{Common, CueArgs, DeviceAction, DeviceArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs, WorkspaceArgs};
+use super::{
+    Common, CueArgs, DeviceAction, DeviceArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs, StructureArgs, WorkspaceArgs,
+};
 
 impl RatesArgs {
     /// The command's typed options.
@@ -16,6 +18,17 @@ impl RatesArgs {
                 // clap requires one of them.
                 (None, None) => Given::PoseRates(""),
             },
+        }
+    }
+}
+
+impl StructureArgs {
+    /// The options `structure` takes.
+    pub fn options(&self) -> crate::analysis::structure::Options<'_> {
+        crate::analysis::structure::Options {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            chain: self.chain,
         }
     }
 }
@@ -121,6 +134,7 @@ impl StreamArgs {
             },
             (None, None, None) => Input::Motion {
                 motion: self.motion.unwrap_or(crate::stream::Motion::Demo),
+                sine: self.sine()?,
                 seconds: self.duration,
                 rate_hz: self.rate,
             },
@@ -142,12 +156,38 @@ impl StreamArgs {
             options: crate::stream::Options {
                 home: self.home,
                 host_limits: !self.device_limits_only,
+                telemetry: false,
                 quiet: self.quiet,
             },
             record: self.record.clone(),
             capture: self.capture.clone(),
             report_json: self.report_json,
         })
+    }
+}
+
+impl StreamArgs {
+    /// `--motion sine`'s parameters: all of them for a sine, none for anything else.
+    fn sine(&self) -> anyhow::Result<Option<crate::stream::Sine>> {
+        use crate::stream::{Amplitude, Motion, Sine};
+        let amplitude = match (self.velocity_amplitude, self.amplitude) {
+            (Some(v), _) => Some(Amplitude::Velocity(v)),
+            (None, Some(a)) => Some(Amplitude::Position(a)),
+            (None, None) => None,
+        };
+        match (self.motion, self.axis, self.frequency, amplitude) {
+            (Some(Motion::Sine), Some(axis), Some(frequency), Some(amplitude)) => Ok(Some(Sine {
+                axis,
+                frequency,
+                amplitude,
+                seconds: self.duration,
+            })),
+            (Some(Motion::Sine), ..) => {
+                anyhow::bail!("--motion sine needs --axis, --frequency and --velocity-amplitude or --amplitude")
+            }
+            (_, None, None, None) => Ok(None),
+            _ => anyhow::bail!("--axis, --frequency and the amplitudes are for --motion sine"),
+        }
     }
 }
 
@@ -193,5 +233,16 @@ pub fn platform(geometry: &Option<std::path::PathBuf>, mechanism: &Option<String
         (Some(path), _) => Some(crate::device::Platform::File(path.clone())),
         (None, Some(name)) => Some(crate::device::Platform::Preset(name.clone())),
         (None, None) => None,
+    }
+}
+
+impl super::UiArgs {
+    /// The workbench's options.
+    pub fn options(&self) -> anyhow::Result<crate::ui::Options> {
+        Ok(crate::ui::Options {
+            target: crate::link::Target::named(self.port.as_deref(), self.sim)?,
+            platform: platform(&self.geometry, &self.mechanism),
+            listen: self.listen,
+        })
     }
 }

@@ -10,10 +10,10 @@ use ringpod_core::safety::debounce::InputBit;
 
 use ringpod_core::kinematics::AxisKind;
 use ringpod_core::protocol::endpoints::{Buzz, Jog};
-use ringpod_core::protocol::{Settings, SettingsKind};
+use ringpod_core::protocol::{NackReason, Settings, SettingsKind};
 use ringpod_core::safety::State;
 
-use crate::link::client::{Client, Transport};
+use crate::link::client::{Client, ClientError, Transport};
 
 /// The inputs in bit order, with their names.
 pub fn names() -> Vec<(InputBit, String)> {
@@ -92,9 +92,8 @@ pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn()
     Ok(())
 }
 
-/// `device jog AXIS DISTANCE` (`Some`) or `device buzz AXIS` (`None`): AXIS 1-6, DISTANCE in degrees of ring for a
-/// carriage and millimetres for a linear actuator, turned into steps with the device's own steps per unit. Waits
-/// until the move is done; returns the step positions and a line to print.
+/// `device jog AXIS DISTANCE` or `device buzz AXIS`: AXIS 1-6, DISTANCE in degrees of ring for a carriage and
+/// millimetres for a linear actuator. Waits until the move is done; returns the step positions and a line to print.
 pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -> anyhow::Result<String> {
     let usage = if buzz {
         "usage: ringpod device buzz AXIS (1-6)"
@@ -105,39 +104,18 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
         Some(Ok(a)) if (1..=6).contains(&a) => a - 1,
         _ => anyhow::bail!(usage),
     };
+    let distance = match (buzz, words) {
+        (true, [_]) => None,
+        (false, [_, distance]) => Some(
+            distance
+                .parse::<f64>()
+                .map_err(|_| anyhow::anyhow!("{usage}: {distance:?} is not a number"))?,
+        ),
+        _ => anyhow::bail!(usage),
+    };
     let kind = client.hello()?.axes[usize::from(axis)];
-    // Motor steps per unit, signed: a reversed motor steps the other way for the same distance.
-    let (Settings::Axes(axes), _) = client.settings(SettingsKind::Axes)? else {
-        anyhow::bail!("the device answered with another section");
-    };
-    let motor = axes[usize::from(axis)];
-    let per_unit = f64::from(motor.steps_per_unit) * if motor.reverse { -1.0 } else { 1.0 };
-    let (jog, what) = if buzz {
-        if words.len() != 1 {
-            anyhow::bail!(usage);
-        }
-        (None, "buzzed".to_owned())
-    } else {
-        let [_, distance] = words else { anyhow::bail!(usage) };
-        let d: f64 = distance
-            .parse()
-            .map_err(|_| anyhow::anyhow!("{usage}: {distance:?} is not a number"))?;
-        // Steps per carriage or shoulder turn, or per metre.
-        let (steps, unit) = match kind {
-            AxisKind::Ring | AxisKind::Angle => (d / 360.0 * per_unit, "deg"),
-            AxisKind::Linear => (d / 1000.0 * per_unit, "mm"),
-        };
-        if !steps.is_finite() || steps.abs() > f64::from(i32::MAX) {
-            anyhow::bail!("{d} {unit} is out of range");
-        }
-        let steps = steps.round() as i32;
-        (Some(Jog { axis, steps }), format!("jogged {d} {unit} ({steps} steps)"))
-    };
     let before = client.status()?.steps;
-    match jog {
-        Some(jog) => client.call(jog)?,
-        None => client.call(Buzz(axis))?,
-    }
+    let what = begin_move(client, axis, kind, distance)?;
     let status = client.wait_for(Duration::from_secs(120), |s| s.state != State::Jogging)?;
     if let State::Fault(reason, _) = status.state {
         anyhow::bail!("axis {} {what} into a fault: {reason}", axis + 1);
@@ -149,6 +127,48 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
         status.steps[usize::from(axis)],
         status.state
     ))
+}
+
+/// Starts a commissioning move of `axis` (0-5) without waiting for its end: a jog by `distance` (degrees of ring
+/// for a carriage, mm for a linear actuator), turned into steps with the device's own steps per unit, or a buzz
+/// (`None`). `kind` is what the axis measures, as the device's hello said. Returns what was done ("jogged 5 deg
+/// (120 steps)", "buzzed").
+pub fn begin_move<T: Transport>(
+    client: &mut Client<T>,
+    axis: u8,
+    kind: AxisKind,
+    distance: Option<f64>,
+) -> anyhow::Result<String> {
+    if axis > 5 {
+        anyhow::bail!("axis {} does not exist (1-6)", u16::from(axis) + 1);
+    }
+    let Some(d) = distance else {
+        client.call(Buzz(axis))?;
+        return Ok("buzzed".to_owned());
+    };
+    // Motor steps per unit, signed: a reversed motor steps the other way for the same distance.
+    let (Settings::Axes(axes), _) = client.settings(SettingsKind::Axes)? else {
+        anyhow::bail!("the device answered with another section");
+    };
+    let motor = axes[usize::from(axis)];
+    let per_unit = f64::from(motor.steps_per_unit) * if motor.reverse { -1.0 } else { 1.0 };
+    // Steps per carriage or shoulder turn, or per metre.
+    let (steps, unit) = match kind {
+        AxisKind::Ring | AxisKind::Angle => (d / 360.0 * per_unit, "deg"),
+        AxisKind::Linear => (d / 1000.0 * per_unit, "mm"),
+    };
+    if !steps.is_finite() || steps.abs() > f64::from(i32::MAX) {
+        anyhow::bail!("{d} {unit} is out of range");
+    }
+    let steps = steps.round() as i32;
+    match client.call(Jog { axis, steps }) {
+        Err(ClientError::Device(NackReason::OutOfRange)) => anyhow::bail!(
+            "{d} {unit} ({steps} steps) is further than a jog goes: a carriage at most its homing back-off, a linear \
+             actuator or a shoulder its homing search travel"
+        ),
+        other => other?,
+    }
+    Ok(format!("jogged {d} {unit} ({steps} steps)"))
 }
 
 #[cfg(test)]

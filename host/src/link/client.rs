@@ -18,6 +18,9 @@ use ringpod_core::safety::{Command, FaultReason};
 /// Telemetry samples kept for a taker (a minute at 1 kHz); older ones are dropped and counted.
 pub const TELEMETRY_KEPT: usize = 60_000;
 
+/// Sees each telemetry sample as it arrives ([`Client::tap`]).
+pub type TelemetryTap = Box<dyn FnMut(&Telemetry) + Send>;
+
 /// A byte pipe to a controller, with its notion of time.
 pub trait Transport {
     /// Writes bytes.
@@ -81,6 +84,9 @@ pub struct Client<T: Transport> {
     pub timeout: Duration,
     /// Set by Ctrl-C: long waits ([`Client::wait_for`]) end with [`ClientError::Interrupted`].
     pub cancel: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>,
+    /// Sees every telemetry sample as it arrives, whoever drives the client (the workbench's live view while a
+    /// stream runs); the samples are kept for [`Client::take_telemetry`] all the same.
+    pub tap: Option<TelemetryTap>,
 }
 
 impl<T: Transport> Client<T> {
@@ -96,6 +102,7 @@ impl<T: Transport> Client<T> {
             telemetry_dropped: 0,
             timeout: Duration::from_secs(2),
             cancel: None,
+            tap: None,
         }
     }
 
@@ -118,6 +125,9 @@ impl<T: Transport> Client<T> {
                         match (response.id, response.body) {
                             (0, DeviceMessage::Fault(reason)) => self.faults.push(reason),
                             (0, DeviceMessage::Telemetry(sample)) => {
+                                if let Some(tap) = &mut self.tap {
+                                    tap(&sample);
+                                }
                                 if self.telemetry.len() >= TELEMETRY_KEPT {
                                     self.telemetry.pop_front();
                                     self.telemetry_dropped += 1;

@@ -13,7 +13,11 @@ use crate::link::client::{Client, ClientError, Transport};
 /// `device rig load FILE`: checks the file here (every error names its key), then the device checks and stores
 /// it for the next start. Returns what to print.
 pub fn load<T: Transport>(client: &mut Client<T>, path: &Path) -> anyhow::Result<String> {
-    let file = super::read(path)?;
+    store(client, &super::read(path)?)
+}
+
+/// Checks a rig file here, then stores it on the device for its next start. Returns what to print.
+pub fn store<T: Transport>(client: &mut Client<T>, file: &RigFile) -> anyhow::Result<String> {
     let record = file.check()?.record;
     if record.name() != file.name {
         eprintln!(
@@ -33,11 +37,7 @@ pub fn load<T: Transport>(client: &mut Client<T>, path: &Path) -> anyhow::Result
 /// gives a file `device rig load` takes back.
 pub fn show<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
     let (record, source, pending) = client.rig()?;
-    let geometry = record
-        .geometry()
-        .map_err(|e| anyhow::anyhow!("the device's rig: {e}"))?;
-    let mut file = RigFile::of(&geometry, record.home, None, Vec::new()).with_sections(&record);
-    file.name = record.name().to_owned();
+    let text = as_file(&record)?;
     let mut header = format!("# running on the device: {} ({source})\n", record.name());
     if pending {
         header += "# another rig is stored for the next start (`ringpod device restart`)\n";
@@ -45,7 +45,17 @@ pub fn show<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
     if let RigSource::Refused(_) | RigSource::Unreadable = source {
         eprintln!("warning: {source}");
     }
-    Ok(header + &file.to_toml()?)
+    Ok(header + &text)
+}
+
+/// A rig the device runs, as a rig file.
+pub fn as_file(record: &ringpod_core::protocol::RigRecord) -> anyhow::Result<String> {
+    let geometry = record
+        .geometry()
+        .map_err(|e| anyhow::anyhow!("the device's rig: {e}"))?;
+    let mut file = RigFile::of(&geometry, record.home, None, Vec::new()).with_sections(record);
+    file.name = record.name().to_owned();
+    Ok(file.to_toml()?)
 }
 
 /// `device restart`: the device stores everything, then resets; waits until it answers as a new start (a

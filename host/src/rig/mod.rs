@@ -384,10 +384,11 @@ pub fn load_platform(path: &Path) -> Result<Platform, RigError> {
 pub fn read(path: &Path) -> Result<RigFile, RigError> {
     let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
         .or_else(|e| err(path.display().to_string(), e))?;
-    from_text(&text).map_err(|e| e.in_file(path))
+    parse(&text).map_err(|e| e.in_file(path))
 }
 
-fn from_text(text: &str) -> Result<RigFile, RigError> {
+/// A rig file's text, read but not checked (the workbench's editor checks as the user types).
+pub fn parse(text: &str) -> Result<RigFile, RigError> {
     toml::from_str(text).or_else(|e| {
         // toml names the key and the line; keep its words.
         err("", e.message().trim().to_owned() + &span_of(text, e.span()))
@@ -718,7 +719,7 @@ mod tests {
 
     #[test]
     fn a_rig_restating_the_preset_drives_bit_identical_ik() {
-        let rig = from_text(&trainer_file().to_toml().unwrap())
+        let rig = parse(&trainer_file().to_toml().unwrap())
             .and_then(|f| f.check())
             .unwrap();
         let (ours, preset) = (
@@ -809,7 +810,7 @@ mod tests {
             assert!(!e.why.is_empty());
         }
         // Syntax and unknown keys: toml's message with the line.
-        let e = from_text("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
+        let e = parse("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
         assert!(e.why.contains("rod_lenght") && e.why.contains("line 3"), "{e}");
     }
 
@@ -858,7 +859,7 @@ centre_of_mass = [0, 0, 0.02]
 
     #[test]
     fn a_rig_file_with_elbow_chains_drives_the_preset_s_ik() {
-        let rig = from_text(ELBOW_RIG).and_then(|f| f.check()).unwrap();
+        let rig = parse(ELBOW_RIG).and_then(|f| f.check()).unwrap();
         let m = RingPlatform::<f64>::new(&rig.geometry);
         let preset = RingPlatform::<f64>::new(&presets::TRAINER_ELBOW);
         assert_eq!(m.axes(), preset.axes());
@@ -882,7 +883,7 @@ centre_of_mass = [0, 0, 0.02]
             drives::of_preset(Preset::TrainerElbow),
         );
         let text = file.to_toml().unwrap();
-        let back = from_text(&text).unwrap();
+        let back = parse(&text).unwrap();
         assert_eq!(back, file);
         let rig = back.check().unwrap();
         let mut renamed = rig.geometry;
@@ -971,7 +972,7 @@ centre_of_mass = [0, 0, 0.02]
             ),
         ];
         for (key, break_it) in cases {
-            let mut f = from_text(ELBOW_RIG).unwrap();
+            let mut f = parse(ELBOW_RIG).unwrap();
             break_it(&mut f);
             let e = f.check().expect_err(key);
             assert_eq!(e.key, key, "{e}");
@@ -979,10 +980,10 @@ centre_of_mass = [0, 0, 0.02]
         }
         // A value or a key toml cannot take: its message names it and the line.
         let line_of = |what: &str| ELBOW_RIG[..ELBOW_RIG.find(what).unwrap()].matches('\n').count() + 1;
-        let e = from_text(&ELBOW_RIG.replacen("elbow = \"up\"", "elbow = \"sideways\"", 1)).unwrap_err();
+        let e = parse(&ELBOW_RIG.replacen("elbow = \"up\"", "elbow = \"sideways\"", 1)).unwrap_err();
         let line = format!("line {}", line_of("elbow = \"up\""));
         assert!(e.why.contains("sideways") && e.why.contains(&line), "{e}");
-        let e = from_text(&ELBOW_RIG.replacen("forearm = 0.189", "fore_arm = 0.189", 1)).unwrap_err();
+        let e = parse(&ELBOW_RIG.replacen("forearm = 0.189", "fore_arm = 0.189", 1)).unwrap_err();
         let line = format!("line {}", line_of("forearm = 0.189"));
         assert!(e.why.contains("fore_arm") && e.why.contains(&line), "{e}");
     }

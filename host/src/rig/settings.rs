@@ -120,7 +120,7 @@ mod tests {
     use ringpod_core::sim::RamFlash;
     use ringpod_core::store::{restore, store};
 
-    use super::super::{from_text, RigFile};
+    use super::super::{parse, RigFile};
     use super::*;
 
     /// The trainer model's rig file with every controller section written out and changed from the defaults.
@@ -158,7 +158,7 @@ mod tests {
     /// TOML -> typed -> postcard record in flash -> typed, exactly; and back to a file that gives the same record.
     #[test]
     fn a_rig_file_round_trips_through_the_device_record_exactly() {
-        let record = from_text(&with_sections()).unwrap().check().unwrap().record;
+        let record = parse(&with_sections()).unwrap().check().unwrap().record;
         let m = &record.machine;
         assert_eq!(m.axes[1].steps_per_unit, 12_800.0);
         assert!(m.axes[1].reverse && m.axes[5].reverse && !m.axes[0].reverse);
@@ -189,7 +189,7 @@ mod tests {
             text.contains("pose_velocity = [0.04, 0.04, 0.03, 0.8, 0.8, 1.5]"),
             "{text}"
         );
-        let again = from_text(&text).unwrap().check().unwrap().record;
+        let again = parse(&text).unwrap().check().unwrap().record;
         assert_eq!(again, record);
     }
 
@@ -222,15 +222,15 @@ mod tests {
         for (from, to, key) in cases {
             assert!(good.contains(from), "{from}");
             let bad = good.replacen(from, to, 1);
-            let e = from_text(&bad).unwrap().check().unwrap_err();
+            let e = parse(&bad).unwrap().check().unwrap_err();
             assert!(e.to_string().starts_with(key), "{key}: {e}");
         }
         // Five motors for six actuators.
         let five = good.replacen("[[axes]]\nsteps_per_unit = 3200000\n", "", 1);
-        let e = from_text(&five).unwrap().check().unwrap_err();
+        let e = parse(&five).unwrap().check().unwrap_err();
         assert!(e.to_string().starts_with("axes"), "{e}");
         // An unknown key in a section.
         let typo = good.replacen("reverse = true", "reversed = true", 1);
-        assert!(from_text(&typo).is_err());
+        assert!(parse(&typo).is_err());
     }
 }

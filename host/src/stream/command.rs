@@ -14,7 +14,13 @@ use crate::signals::Signals;
 /// Where a stream's poses come from.
 pub enum Input {
     /// A built-in motion for `seconds` at `rate_hz` setpoints per second.
-    Motion { motion: Motion, seconds: f64, rate_hz: f64 },
+    Motion {
+        motion: Motion,
+        /// The sine's parameters, for `--motion sine`.
+        sine: Option<super::Sine>,
+        seconds: f64,
+        rate_hz: f64,
+    },
     /// A CSV pose file.
     File { path: PathBuf, degrees: bool },
     /// UDP datagrams: poses or vehicle telemetry.
@@ -87,7 +93,7 @@ fn positive(name: &str, v: f64, max: f64) -> anyhow::Result<f64> {
 }
 
 /// Opens the source: its poses, and the lines of a file that could not be read (already printed).
-fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
+pub(crate) fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
     Ok(match input {
         Input::Udp {
             addr,
@@ -140,11 +146,28 @@ fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
         }
         Input::Motion {
             motion,
+            sine,
             seconds,
             rate_hz,
         } => (
             Source::Motion {
                 motion: *motion,
+                sine: match sine {
+                    Some(s) => Some(super::Sine {
+                        frequency: positive("frequency", s.frequency, 1_000.0)?,
+                        amplitude: match s.amplitude {
+                            super::Amplitude::Velocity(v) => {
+                                super::Amplitude::Velocity(positive("velocity-amplitude", v, 100.0)?)
+                            }
+                            super::Amplitude::Position(a) => {
+                                super::Amplitude::Position(positive("amplitude", a, 10.0)?)
+                            }
+                        },
+                        axis: s.axis,
+                        seconds: s.seconds,
+                    }),
+                    None => None,
+                },
                 seconds: positive("duration", *seconds, 1e9)?,
                 rate_hz: positive("rate", *rate_hz, 10_000.0)?,
             },

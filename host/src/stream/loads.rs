@@ -60,6 +60,7 @@ pub fn check_loads(
         Source::Poses(p) => p.clone(),
         Source::Motion {
             motion,
+            sine,
             seconds,
             rate_hz,
         } => {
@@ -77,7 +78,11 @@ pub fn check_loads(
             (0..=n)
                 .map(|k| {
                     let t = k as f64 / rate_hz;
-                    (k + 1, t, motion_pose(*motion, t, platform.home, &platform.limits))
+                    (
+                        k + 1,
+                        t,
+                        motion_pose(*motion, sine.as_ref(), t, platform.home, &platform.limits),
+                    )
                 })
                 .collect()
         }

@@ -26,7 +26,7 @@ use ringpod_core::safety::{FaultReason, State};
 pub use loads::{check_loads, platform as loads_platform};
 pub use report::{CaptureReport, DatagramReport, LimitedReport, RecordReport, Report};
 use session::{Stop, StreamError, Streamer};
-pub use source::{motion_pose, read_csv, Motion, Source, UdpSource};
+pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source, UdpSource};
 
 pub use crate::input::table::InputError;
 use crate::link::client::{Client, ClientError, Transport};
@@ -60,6 +60,8 @@ pub struct Options {
     pub host_limits: bool,
     /// No progress bar.
     pub quiet: bool,
+    /// Keep the device's telemetry on for someone watching (the workbench); a record turns it on anyway.
+    pub telemetry: bool,
 }
 
 /// A ring platform and its home pose.
@@ -95,8 +97,18 @@ fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) ->
         client.stop()?;
         status = client.wait_for(Duration::from_secs(10), |s| !matches!(s.state, State::Stopping))?;
     }
+    if matches!(status.state, State::ShuttingDown(_)) {
+        // Powering down (a disable just before): it must reach Off before it can power up again.
+        status = client.wait_for(Duration::from_secs(10), |s| !matches!(s.state, State::ShuttingDown(_)))?;
+    }
     if status.state == State::Off {
         client.enable()?;
+    }
+    if matches!(
+        status.state,
+        State::Off | State::LogicOn | State::PowerOn { settled: false }
+    ) {
+        // Powering up (now, or by an enable just before): homing is refused until the supplies have settled.
         status = client.wait_for(Duration::from_secs(5), |s| {
             matches!(s.state, State::PowerOn { settled: true } | State::Fault(..))
         })?;
@@ -233,7 +245,7 @@ pub fn run<T: Transport>(
         Some((r, path)) => (Some(r), Some(path)),
         None => (None, None),
     };
-    let baseline = prepare(client, options.home, recorder.is_some())?;
+    let baseline = prepare(client, options.home, recorder.is_some() || options.telemetry)?;
     let envelope = device_envelope(client)?;
     let home = envelope.platform.home;
     let mut source = source;
@@ -343,14 +355,18 @@ fn feed<T: Transport>(
     match source {
         Source::Motion {
             motion,
+            sine,
             seconds,
             rate_hz,
         } => {
-            let (motion, seconds, rate_hz) = (*motion, *seconds, *rate_hz);
+            let (motion, sine, seconds, rate_hz) = (*motion, *sine, *seconds, *rate_hz);
+            if let Some(sine) = &sine {
+                eprintln!("{}", sine.describe(limits));
+            }
             let n = (seconds * rate_hz).round() as u64;
             let mut poses = (0..=n).map(|k| {
                 let t = k as f64 / rate_hz;
-                (None, t, motion_pose(motion, t, home, limits))
+                (None, t, motion_pose(motion, sine.as_ref(), t, home, limits))
             });
             (s.timed(&mut poses, fast), None, None)
         }

@@ -123,27 +123,37 @@ impl Recorder {
     }
 }
 
-/// A record read back.
-struct Run {
-    t: Vec<f64>,
-    commanded: Vec<[f64; 6]>,
-    target: Vec<[f64; 6]>,
-    steps: Vec<[f64; 6]>,
-    state: Vec<String>,
-    limited: Vec<bool>,
-    refused: Vec<bool>,
+/// A record read back (device time, each angle made continuous).
+#[derive(Debug, serde::Serialize)]
+pub struct Run {
+    /// Device time (s).
+    pub t: Vec<f64>,
+    /// The pose the host commanded last (the record's `cmd_*`).
+    pub commanded: Vec<[f64; 6]>,
+    /// The pose followed: the device's setpoint as limited, angles unwrapped.
+    pub target: Vec<[f64; 6]>,
+    pub steps: Vec<[f64; 6]>,
+    pub state: Vec<String>,
+    pub limited: Vec<bool>,
+    pub refused: Vec<bool>,
 }
 
-fn read(path: &Path) -> anyhow::Result<Run> {
+/// Reads a run record (`stream --record`).
+pub(crate) fn read(path: &Path) -> anyhow::Result<Run> {
     let text = crate::input::files::read_text(path, crate::input::files::DATA_LIMIT)
         .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+}
+
+/// A run record's text.
+pub fn parse(text: &str) -> anyhow::Result<Run> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
     let col = |name: &str| {
         header
             .iter()
             .position(|h| h.trim() == name)
-            .ok_or_else(|| anyhow::anyhow!("{}: no column {name:?} (is it a run record?)", path.display()))
+            .ok_or_else(|| anyhow::anyhow!("no column {name:?} (is it a run record?)"))
     };
     let index: Vec<usize> = COLUMNS.iter().map(|c| col(c)).collect::<anyhow::Result<_>>()?;
     let mut run = Run {
@@ -184,7 +194,7 @@ fn read(path: &Path) -> anyhow::Result<Run> {
         run.refused.push(number(22)? != 0.0);
     }
     if run.t.is_empty() {
-        anyhow::bail!("{}: no rows", path.display());
+        anyhow::bail!("no rows");
     }
     // The device keeps yaw within a turn and a source may wrap it too: draw each angle continuous.
     for series in [&mut run.commanded, &mut run.target] {

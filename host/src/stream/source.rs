@@ -19,6 +19,150 @@ pub enum Motion {
     Yaw,
     /// Heave sine, 10 mm at 0.5 Hz.
     Heave,
+    /// A sine on one axis (--axis, --frequency, --velocity-amplitude or --amplitude), chapter 5.2's experiments:
+    /// its amplitude limited to the device's pose velocity and acceleration limits, saying by how much.
+    Sine,
+}
+
+/// The pose axis of a sine.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+    Roll,
+    Pitch,
+    Yaw,
+}
+
+impl Axis {
+    /// The index in `x, y, z, alpha, beta, gamma`.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// What a sine's amplitude is given as.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Amplitude {
+    /// Of the velocity (m/s, or rad/s for roll, pitch and yaw).
+    Velocity(f64),
+    /// Of the position (m, or rad).
+    Position(f64),
+}
+
+/// A fixed-frequency sine on one axis around home, easing in over its first [`Sine::EASE_PERIODS`] periods (and at
+/// least a second) and out over its last, so that it starts and ends at rest without a jump in velocity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sine {
+    pub axis: Axis,
+    /// Hz.
+    pub frequency: f64,
+    pub amplitude: Amplitude,
+    /// The motion's length (s): it eases out before.
+    pub seconds: f64,
+}
+
+/// A sine's amplitudes after the device's limits.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SinePlan {
+    /// Position amplitude (m or rad).
+    pub position: f64,
+    /// Velocity amplitude: `position * 2 pi f`.
+    pub velocity: f64,
+    /// Acceleration amplitude: `position * (2 pi f)^2`.
+    pub acceleration: f64,
+    /// The share of the asked amplitude kept (1 when inside the limits), and the limit that bounds it.
+    pub kept: f64,
+    pub bound: Option<&'static str>,
+}
+
+impl Sine {
+    /// The ease-in: the amplitude grows over this many periods (and at least a second).
+    pub const EASE_PERIODS: f64 = 3.0;
+
+    /// The amplitudes, scaled down to the device's pose velocity and acceleration limits on the axis.
+    pub fn plan(&self, limits: &MotionSettings) -> SinePlan {
+        let w = std::f64::consts::TAU * self.frequency;
+        let asked = match self.amplitude {
+            Amplitude::Velocity(v) => v / w,
+            Amplitude::Position(a) => a,
+        };
+        let k = self.axis.index();
+        let (vmax, amax) = (
+            f64::from(limits.pose_velocity[k]),
+            f64::from(limits.pose_acceleration[k]),
+        );
+        let (by_v, by_a) = (vmax / (asked * w), amax / (asked * w * w));
+        let (kept, bound) = if by_v < 1.0 && by_v <= by_a {
+            (by_v, Some("velocity"))
+        } else if by_a < 1.0 {
+            (by_a, Some("acceleration"))
+        } else {
+            (1.0, None)
+        };
+        let position = asked * kept;
+        SinePlan {
+            position,
+            velocity: position * w,
+            acceleration: position * w * w,
+            kept,
+            bound,
+        }
+    }
+
+    /// The plan in one line: what is run, and by how much and by which limit it was cut.
+    pub fn describe(&self, limits: &MotionSettings) -> String {
+        let p = self.plan(limits);
+        let k = self.axis.index();
+        let (len, vel, acc) = if k < 3 {
+            ("m", "m/s", "m/s^2")
+        } else {
+            ("rad", "rad/s", "rad/s^2")
+        };
+        let mut line = format!(
+            "sine on {} at {} Hz: amplitude {:.4e} {len}, velocity {:.6} {vel}, acceleration {:.6} {acc}",
+            ["x", "y", "z", "roll", "pitch", "yaw"][k],
+            self.frequency,
+            p.position,
+            p.velocity,
+            p.acceleration
+        );
+        match p.bound {
+            None => line += " (as asked, inside the limits)",
+            Some(bound) => {
+                let limit = if bound == "velocity" {
+                    format!("{} {vel}", limits.pose_velocity[k])
+                } else {
+                    format!("{} {acc}", limits.pose_acceleration[k])
+                };
+                line += &format!(
+                    " (limited to {:.1} % of the amplitude asked, {:.4e} {len}, by the {bound} limit of {limit})",
+                    p.kept * 100.0,
+                    p.position / p.kept
+                );
+            }
+        }
+        line
+    }
+
+    /// The pose at `t` around `home`.
+    pub fn pose(&self, t: f64, home: [f64; 6], limits: &MotionSettings) -> Pose<f64> {
+        let p = self.plan(limits);
+        let ease_time = (Self::EASE_PERIODS / self.frequency).max(1.0);
+        // A raised cosine from 0 to 1 over the ease-in, and back over the ease-out.
+        let raised = |s: f64| {
+            if s >= ease_time {
+                1.0
+            } else {
+                0.5 - 0.5 * (std::f64::consts::PI * s.max(0.0) / ease_time).cos()
+            }
+        };
+        let ease = raised(t).min(raised(self.seconds - t));
+        let mut pose = home;
+        pose[self.axis.index()] += ease * p.position * (std::f64::consts::TAU * self.frequency * t).sin();
+        Pose::from_array(pose)
+    }
 }
 
 /// A pose of an input file: its line number, its time (s) and the pose.
@@ -30,6 +174,8 @@ pub enum Source {
     Motion {
         /// Which.
         motion: Motion,
+        /// The sine's parameters, for [`Motion::Sine`].
+        sine: Option<Sine>,
         /// How long (s).
         seconds: f64,
         /// Setpoints per second.
@@ -75,7 +221,10 @@ pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputE
 /// Pose of a built-in motion at time `t` (s) around `home`; the vibration sweep scales its amplitude to `limits` (the
 /// device's pose limits). On the trainer model every motion stays inside the envelope at any time and yaw (tested for
 /// 120 s each), so host limiting leaves it unchanged.
-pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6], limits: &MotionSettings) -> Pose<f64> {
+pub fn motion_pose(motion: Motion, sine: Option<&Sine>, t: f64, home: [f64; 6], limits: &MotionSettings) -> Pose<f64> {
+    if let (Motion::Sine, Some(sine)) = (motion, sine) {
+        return sine.pose(t, home, limits);
+    }
     let mut p = home;
     let tau = std::f64::consts::TAU;
     match motion {
@@ -104,6 +253,8 @@ pub fn motion_pose(motion: Motion, t: f64, home: [f64; 6], limits: &MotionSettin
         }
         Motion::Yaw => p[5] = (1.9 * t.min(1.0).powi(2) * 0.5 + 1.9 * (t - 1.0).max(0.0)).rem_euclid(tau),
         Motion::Heave => p[2] += 0.010 * (tau * 0.5 * t).sin(),
+        // Without its parameters (the command line requires them): home.
+        Motion::Sine => {}
     }
     Pose::from_array(p)
 }

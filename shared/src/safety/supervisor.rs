@@ -239,6 +239,28 @@ impl Supervisor {
         }
     }
 
+    /// A supervisor as its telemetry reports it: in `state` with these debounced inputs. Asked what it
+    /// [`permits`](Self::permits), it answers as the device's own would (a host shows why a button is disabled).
+    pub fn as_reported(config: SupervisorConfig, state: State, inputs: Inputs) -> Self {
+        Self {
+            config,
+            state,
+            timer_ms: 0,
+            homed: state == State::Ready,
+            inputs,
+        }
+    }
+
+    /// Whether a command (or a jog) would be taken now, and if not why: the decision [`handle`](Self::handle)
+    /// makes, on a copy, so nothing changes. Events that are not commands always apply.
+    pub fn permits(&self, command: Event) -> Result<(), Refusal> {
+        let mut probe = *self;
+        match command {
+            Event::Command(_) | Event::Jog => probe.command(command),
+            _ => Ok(()),
+        }
+    }
+
     /// Current state.
     pub fn state(&self) -> State {
         self.state
@@ -247,6 +269,11 @@ impl Supervisor {
     /// Whether the axes are homed.
     pub fn homed(&self) -> bool {
         self.homed
+    }
+
+    /// The input levels its events reported.
+    pub fn inputs(&self) -> Inputs {
+        self.inputs
     }
 
     /// The configuration.

@@ -45,13 +45,13 @@ pub struct ChainReactions {
 }
 
 /// `[a; b] -> [b; a]`: a row whose Euclidean product with a wrench is the reciprocal product with the twist.
-fn swap(t: &Vector6<f64>) -> Vector6<f64> {
+pub(crate) fn swap(t: &Vector6<f64>) -> Vector6<f64> {
     Vector6::new(t[3], t[4], t[5], t[0], t[1], t[2])
 }
 
 /// An orthonormal basis of the vectors orthogonal to every row (at most six rows), by SVD: the right singular
 /// vectors whose singular values are below `1e-9` of the largest.
-fn null_space(rows: &[Vector6<f64>]) -> Option<([Vector6<f64>; 6], usize)> {
+pub(crate) fn null_space(rows: &[Vector6<f64>]) -> Option<([Vector6<f64>; 6], usize)> {
     if rows.len() > 6 || !rows.iter().flat_map(|r| r.iter()).all(|v| v.is_finite()) {
         return None;
     }

@@ -1,10 +1,13 @@
 //! Screws (SCREWS.md): Plücker lines, twists and wrenches as `[direction; moment]` six-vectors, their reciprocal
-//! product, paper 002's matrix method for closed loops ([`matrix`]) and paper 003's generalised reactions
-//! ([`reactions`]).
+//! product, paper 002's matrix method for closed loops ([`matrix`]), paper 003's generalised reactions
+//! ([`reactions`]) and the dissertation's structural analysis ([`structure`], with each mechanism's chains in
+//! [`layouts`]).
 
 pub mod chains;
+pub mod layouts;
 pub mod matrix;
 pub mod reactions;
+pub mod structure;
 pub mod tool;
 
 use nalgebra::{Vector3, Vector6};

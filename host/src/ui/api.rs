@@ -1,0 +1,241 @@
+//! The workbench's computations that move nothing: cueing a drive with the panel's parameters, checking a rig
+//! file as it is typed, reading a run record. Each takes the page's JSON and gives JSON, through the same code as
+//! `ringpod cue`, `ringpod rig check` and `ringpod plot`.
+
+use ringpod_core::cueing::CueConfig;
+use ringpod_core::kinematics::{Check, Pose, RingGeometry, RingPlatform};
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+use super::frame::{place, RigView};
+use crate::analysis::cue::{delivered_forces, replay, TELEMETRY_COLUMNS};
+use crate::analysis::workspace::{classify, Cell};
+
+/// The example drive the Cueing panel replays until the user gives one (a braking, a lane change, a bump).
+pub const EXAMPLE_DRIVE: &str = include_str!("../../../docs/drive-telemetry.csv");
+
+/// Cells per side of the Rig panel's workspace section.
+const SECTION_CELLS: usize = 48;
+
+/// The cueing parameters as the panel starts them: the defaults, and the example drive's name.
+pub fn cue_defaults() -> Value {
+    json!({ "config": CueConfig::default(), "drive": "example" })
+}
+
+/// What the Cueing panel sends: the parameters, and the drive (a telemetry CSV's text; the example without).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CueRequest {
+    pub config: Value,
+    #[serde(default)]
+    pub drive: Option<String>,
+}
+
+/// The panel's parameters, checked as a cueing file's are: each error names its key.
+pub fn cue_config(config: &Value) -> Result<CueConfig, String> {
+    let config: CueConfig = serde_json::from_value(config.clone()).map_err(|e| e.to_string())?;
+    config.validate().map_err(|e| e.to_string())?;
+    Ok(config)
+}
+
+/// Cues the drive on the platform and gives, per sample, the specific force asked (as the vehicle felt it) and
+/// delivered (by the limited poses), the poses, and the parameters as a cueing file (TOML).
+pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Result<Value, String> {
+    let config = cue_config(&request.config)?;
+    let text = request.drive.as_deref().unwrap_or(EXAMPLE_DRIVE);
+    let (rows, mut errors) = crate::input::table::read(text, &TELEMETRY_COLUMNS)?;
+    let m = RingPlatform::<f64>::new(geometry);
+    let run = replay(&rows, config, &m, &Pose::from_array(home)).map_err(|e| format!("{e:#}"))?;
+    errors.extend(run.errors);
+    let delivered = delivered_forces(&run.cued);
+    let toml = toml::to_string(&config).map_err(|e| e.to_string())?;
+    let t: Vec<f64> = run.cued.iter().map(|c| c.t).collect();
+    let asked: Vec<[f64; 3]> = run.cued.iter().map(|c| c.input.force).collect();
+    let poses: Vec<[f64; 6]> = run.cued.iter().map(|c| c.pose.to_array()).collect();
+    let errors: Vec<String> = errors
+        .iter()
+        .map(|e| format!("line {}: {}", e.line, e.reason))
+        .collect();
+    Ok(json!({
+        "t": t,
+        "asked": asked,
+        "delivered": delivered,
+        "poses": poses,
+        "limited": run.limited,
+        "errors": errors,
+        "toml": toml,
+    }))
+}
+
+/// A rig file's text checked as `rig check` checks it: whether it is a mechanism at all (the error names its
+/// key), whether it can be driven (and why not), the mechanism at home, an xy workspace section at the home
+/// height, and the spec coverage when the file gives ranges.
+pub fn rig_check(text: &str) -> Value {
+    let file = match crate::rig::parse(text) {
+        Ok(f) => f,
+        Err(e) => return refused(&e),
+    };
+    let platform = match file.platform() {
+        Ok(p) => p,
+        Err(e) => return refused(&e),
+    };
+    let drivable = file.check().map(|_| ()).map_err(|e| e.to_string());
+    let g = &platform.geometry;
+    let m = RingPlatform::<f64>::new(g);
+    let home = platform.home;
+    let coverage = platform.ranges.map(|r| {
+        let c = crate::rig::coverage(&m, &home, &r);
+        let per_axis: Vec<Value> = ["surge", "sway", "heave", "roll", "pitch"]
+            .iter()
+            .zip(c.per_axis)
+            .map(|(name, (inside, tried))| json!({ "axis": name, "inside": inside, "tried": tried }))
+            .collect();
+        json!({ "per_axis": per_axis, "combined": c.combined })
+    });
+    json!({
+        "analysable": true,
+        "drivable": drivable.is_ok(),
+        "why": drivable.err(),
+        "errors": [],
+        "rig": RigView::of(g, home.to_array(), "this file".into()),
+        "at_home": place(&m, &home),
+        "section": section(&m, g.ring_radius, home.to_array()[2]),
+        "coverage": coverage,
+    })
+}
+
+fn refused(e: &crate::rig::error::RigError) -> Value {
+    json!({ "analysable": false, "drivable": false, "errors": [{ "key": e.key, "why": e.why }] })
+}
+
+/// The xy section at height `z` over the ring's square: a character per cell, rows from -y up: `.` no solution,
+/// a digit the first failing check (1-6, KINEMATICS.md 4's order), `#` inside every check.
+fn section(m: &RingPlatform<f64>, r: f64, z: f64) -> Value {
+    let n = SECTION_CELLS;
+    let d = 2.0 * r / n as f64;
+    let rows: Vec<String> = (0..n)
+        .map(|j| {
+            (0..n)
+                .map(|i| {
+                    let (x, y) = (-r + (i as f64 + 0.5) * d, -r + (j as f64 + 0.5) * d);
+                    match classify(m, &Pose::new(x, y, z, 0.0, 0.0, 0.0)) {
+                        Cell::Unreachable => '.',
+                        Cell::Inside(_) => '#',
+                        Cell::Fails(c) => {
+                            let k = Check::ALL.iter().position(|a| *a == c).unwrap_or(0);
+                            char::from(b'1' + k as u8)
+                        }
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let checks: Vec<String> = Check::ALL.iter().map(|c| format!("{c:?}")).collect();
+    json!({ "z": z, "half_width": r, "rows": rows, "checks": checks })
+}
+
+/// A run record's text, as columns.
+pub fn run_record(text: &str) -> Result<Value, String> {
+    let run = crate::stream::record::parse(text).map_err(|e| format!("{e:#}"))?;
+    serde_json::to_value(run).map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
+
+    fn trainer() -> (RingGeometry, [f64; 6]) {
+        let PresetGeometry::Ring(g) = Preset::TrainerModel.geometry() else {
+            unreachable!("the trainer model is a ring platform")
+        };
+        (*g, Preset::TrainerModel.home())
+    }
+
+    #[test]
+    fn the_example_drive_is_cued_and_a_bad_parameter_is_named() {
+        let (g, home) = trainer();
+        let request = CueRequest {
+            config: cue_defaults()["config"].clone(),
+            drive: None,
+        };
+        let out = cue(&request, &g, home).unwrap();
+        let n = out["t"].as_array().unwrap().len();
+        assert!(n > 100, "{n} samples");
+        assert_eq!(out["asked"].as_array().unwrap().len(), n);
+        assert_eq!(out["delivered"].as_array().unwrap().len(), n);
+        assert!(out["errors"].as_array().unwrap().is_empty());
+        // The TOML is a cueing file that reads back as the same parameters.
+        let again = crate::input::cueing::parse_config(out["toml"].as_str().unwrap(), None).unwrap();
+        assert_eq!(again, CueConfig::default());
+        // A value out of range is refused by the core's check, naming the key and the axis; a value of the wrong
+        // kind by the types.
+        let mut bad = cue_defaults()["config"].clone();
+        bad["translation_scale"][0] = json!(-5.0);
+        let e = cue(
+            &CueRequest {
+                config: bad,
+                drive: None,
+            },
+            &g,
+            home,
+        )
+        .unwrap_err();
+        assert!(e.contains("translation_scale (surge)"), "{e}");
+        let mut wrong = cue_defaults()["config"].clone();
+        wrong["forward"] = json!("sideways");
+        let e = cue(
+            &CueRequest {
+                config: wrong,
+                drive: None,
+            },
+            &g,
+            home,
+        )
+        .unwrap_err();
+        assert!(e.contains("sideways"), "{e}");
+        // The drive's unusable rows are counted, not dropped silently.
+        let drive = "t,ax,ay,az,wx,wy,wz\n0,0,0,9.8,0,0,0\n0.01,x,0,9.8,0,0,0\n0.02,0,0,9.8,0,0,0\n";
+        let out = cue(
+            &CueRequest {
+                config: cue_defaults()["config"].clone(),
+                drive: Some(drive.into()),
+            },
+            &g,
+            home,
+        )
+        .unwrap();
+        assert_eq!(out["t"].as_array().unwrap().len(), 2);
+        assert_eq!(out["errors"].as_array().unwrap().len(), 1, "{out}");
+    }
+
+    #[test]
+    fn a_rig_file_is_checked_by_key_and_drawn() {
+        let text = crate::rig::export("trainer-model").unwrap().text;
+        let ok = rig_check(&text);
+        assert_eq!(ok["analysable"], true, "{ok}");
+        assert_eq!(ok["drivable"], true, "{ok}");
+        let rows = ok["section"]["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), SECTION_CELLS);
+        assert!(
+            rows.iter().any(|r| r.as_str().unwrap().contains('#')),
+            "some of the section is inside"
+        );
+        assert_eq!(ok["at_home"]["carriages"].as_array().unwrap().len(), 4);
+        let typo = text.replacen("ring_radius", "ring_raduis", 1);
+        let bad = rig_check(&typo);
+        assert_eq!(bad["analysable"], false);
+        let why = bad["errors"][0]["why"].as_str().unwrap();
+        assert!(why.contains("ring_raduis"), "{bad}");
+    }
+
+    #[test]
+    fn a_record_is_read_as_columns_and_garbage_is_refused() {
+        let header = crate::stream::record::COLUMNS.join(",");
+        let row = "0.1,0.01,0,0,0.2,0,0,0,0,0,0.2,0,0,0,1,2,3,4,5,6,Ready,0,0,0,1,0,0,1000";
+        let out = run_record(&format!("{header}\n{row}\n")).unwrap();
+        assert_eq!(out["t"][0], 0.01);
+        assert_eq!(out["state"][0], "Ready");
+        assert!(run_record("a,b\n1,2\n").unwrap_err().contains("no column"));
+    }
+}

@@ -1,0 +1,381 @@
+//! `ringpod ui`: the workbench in a browser. One local web application, embedded in the binary: the platform
+//! live in 3D, the controls with the supervisor's gating, cueing on a replayed drive, the rig file checked as it is
+//! typed, and run records. The page and its one WebSocket (`/ws`) carry the per-run token; see [`guard`].
+
+mod api;
+mod frame;
+pub mod guard;
+mod worker;
+
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+
+use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
+use axum::extract::{Query, State};
+use axum::http::{header, HeaderMap, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::Deserialize;
+use serde_json::{json, Value};
+
+use crate::device::Platform;
+use crate::link::Target;
+use crate::signals::Signals;
+use guard::Token;
+use worker::{Hub, Job, Request};
+
+/// What `ringpod ui` is asked to do.
+pub struct Options {
+    /// The controller.
+    pub target: Target,
+    /// A simulated controller of this platform instead of the trainer model.
+    pub platform: Option<Platform>,
+    /// Where to listen.
+    pub listen: SocketAddr,
+}
+
+/// The page, its scripts and its style, compiled in.
+const PAGE: &str = include_str!("page/index.html");
+const SCRIPT: &str = include_str!("page/app.js");
+const CHART: &str = include_str!("page/chart.js");
+const VIEW3D: &str = include_str!("page/view3d.js");
+const STYLE: &str = include_str!("page/style.css");
+
+struct App {
+    listen: SocketAddr,
+    token: Token,
+    hub: Arc<Hub>,
+    jobs: Mutex<mpsc::Sender<Job>>,
+    pages: AtomicU64,
+}
+
+#[derive(Deserialize)]
+struct Access {
+    token: Option<String>,
+}
+
+impl App {
+    fn admit(&self, access: &Access, headers: &HeaderMap) -> Result<(), guard::Refused> {
+        let text = |name: header::HeaderName| headers.get(name).and_then(|v| v.to_str().ok());
+        guard::check(
+            self.listen,
+            &self.token,
+            access.token.as_deref(),
+            text(header::ORIGIN),
+            text(header::HOST),
+        )
+    }
+
+    /// The platform the device runs and its home pose, for the computations.
+    fn platform(&self) -> Option<(ringpod_core::kinematics::RingGeometry, [f64; 6])> {
+        let record = (*self.hub.record.lock().ok()?)?;
+        Some((record.geometry().ok()?, record.home))
+    }
+}
+
+/// Serves the workbench until a signal; exits with 128 + its number (0 when the device thread ended first).
+pub fn run(options: Options) -> anyhow::Result<u8> {
+    let signals = Signals::install()?;
+    let token = Token::random()?;
+    let rig = Platform::rig(options.platform.as_ref())?;
+    // The address first: a port in use is said before anything else starts.
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()?;
+    let listener = runtime
+        .block_on(tokio::net::TcpListener::bind(options.listen))
+        .map_err(|e| anyhow::anyhow!("--listen {}: {e}", options.listen))?;
+    let (out, _) = tokio::sync::broadcast::channel(256);
+    let cue_file = std::env::temp_dir().join(format!("ringpod-ui-{}-cueing.toml", std::process::id()));
+    std::fs::write(&cue_file, toml::to_string(&ringpod_core::cueing::CueConfig::default())?)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", cue_file.display()))?;
+    let hub = Arc::new(Hub {
+        out,
+        halt: Arc::new(AtomicBool::new(false)),
+        streaming: AtomicU64::new(0),
+        rig: Mutex::new(None),
+        record: Mutex::new(None),
+        cue_file: cue_file.clone(),
+        closing: AtomicBool::new(false),
+    });
+    let (jobs, inbox) = mpsc::channel();
+    let device = {
+        let hub = hub.clone();
+        let target = options.target.clone();
+        std::thread::spawn(move || worker::run(target, rig, hub, inbox))
+    };
+    let local = listener.local_addr()?;
+    let app = Arc::new(App {
+        listen: local,
+        token,
+        hub: hub.clone(),
+        jobs: Mutex::new(jobs),
+        pages: AtomicU64::new(0),
+    });
+    let served = runtime.block_on(async {
+        println!("ringpod ui: open http://{local}/?token={}", app.token.as_str());
+        // Scripts and tests read the URL as soon as it is printed.
+        let _ = std::io::Write::flush(&mut std::io::stdout());
+        if !local.ip().is_loopback() {
+            eprintln!(
+                "note: listening on {local}, not only on this machine: anyone with the URL can move the platform"
+            );
+        }
+        let router = Router::new()
+            .route("/", get(page))
+            .route(
+                "/app.js",
+                get(|| async { ([(header::CONTENT_TYPE, "text/javascript")], SCRIPT) }),
+            )
+            .route(
+                "/chart.js",
+                get(|| async { ([(header::CONTENT_TYPE, "text/javascript")], CHART) }),
+            )
+            .route(
+                "/view3d.js",
+                get(|| async { ([(header::CONTENT_TYPE, "text/javascript")], VIEW3D) }),
+            )
+            .route(
+                "/style.css",
+                get(|| async { ([(header::CONTENT_TYPE, "text/css")], STYLE) }),
+            )
+            .route("/ws", get(socket))
+            .route("/api/cue/defaults", get(cue_defaults))
+            .route("/api/cue", post(cue))
+            .route("/api/cue/apply", post(cue_apply))
+            .route("/api/rig/check", post(rig_check))
+            .route("/api/rig/current", get(rig_current))
+            .route("/api/run", post(run_record))
+            .with_state(app.clone());
+        let stop = {
+            let hub = hub.clone();
+            async move {
+                while !signals.received() && !device.is_finished() {
+                    tokio::time::sleep(std::time::Duration::from_millis(100)).await;
+                }
+                hub.closing.store(true, Ordering::SeqCst);
+                hub.halt.store(true, Ordering::SeqCst);
+                (signals, device)
+            }
+        };
+        let (tx, rx) = tokio::sync::oneshot::channel();
+        let shutdown = async move {
+            let ended = stop.await;
+            let _ = tx.send(ended);
+        };
+        axum::serve(listener, router).with_graceful_shutdown(shutdown).await?;
+        rx.await.map_err(|_| anyhow::anyhow!("the server ended without a stop"))
+    });
+    let _ = std::fs::remove_file(&cue_file);
+    let (signals, device) = served?;
+    match device.join() {
+        Ok(Err(e)) => Err(e.context("the device")),
+        Err(_) => anyhow::bail!("the device thread failed"),
+        Ok(Ok(())) if signals.received() => {
+            eprintln!("ringpod ui: stopped by {}", signals.name());
+            Ok(signals.exit_code())
+        }
+        Ok(Ok(())) => Ok(0),
+    }
+}
+
+async fn page(State(app): State<Arc<App>>, Query(access): Query<Access>, headers: HeaderMap) -> Response {
+    if let Err(refused) = app.admit(&access, &headers) {
+        return forbidden(refused);
+    }
+    ([(header::CONTENT_TYPE, "text/html; charset=utf-8")], PAGE).into_response()
+}
+
+async fn socket(
+    State(app): State<Arc<App>>,
+    Query(access): Query<Access>,
+    headers: HeaderMap,
+    upgrade: WebSocketUpgrade,
+) -> Response {
+    if let Err(refused) = app.admit(&access, &headers) {
+        return forbidden(refused);
+    }
+    let page = app.pages.fetch_add(1, Ordering::SeqCst) + 1;
+    upgrade.on_upgrade(move |ws| serve_page(app, page, ws))
+}
+
+/// One page: the pages' messages out, its requests in. When it goes, a stream it started stops.
+async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
+    let mut out = app.hub.out.subscribe();
+    let hello = json!({ "type": "hello", "page": page });
+    let rig = app.hub.rig.lock().ok().and_then(|r| r.clone());
+    for text in [Some(hello.to_string()), rig].into_iter().flatten() {
+        if ws.send(Message::Text(text.into())).await.is_err() {
+            return;
+        }
+    }
+    loop {
+        tokio::select! {
+            message = out.recv() => match message {
+                Ok(text) => {
+                    if ws.send(Message::Text(text.into())).await.is_err() {
+                        break;
+                    }
+                }
+                // A slow page misses frames, never replies: frames are many, replies follow them.
+                Err(tokio::sync::broadcast::error::RecvError::Lagged(_)) => continue,
+                Err(tokio::sync::broadcast::error::RecvError::Closed) => break,
+            },
+            incoming = ws.recv() => match incoming {
+                Some(Ok(Message::Text(text))) => {
+                    if let Some(answer) = take(&app, page, &text) {
+                        if ws.send(Message::Text(answer.to_string().into())).await.is_err() {
+                            break;
+                        }
+                    }
+                }
+                Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
+                Some(Ok(_)) => {}
+            },
+        }
+    }
+    if app.hub.streaming.load(Ordering::SeqCst) == page {
+        // The page that started the stream is gone: nobody watches it any more.
+        app.hub.halt.store(true, Ordering::SeqCst);
+    }
+}
+
+/// A page's request: queued for the device, or answered at once when it cannot be taken (unreadable, or not
+/// STOP while a stream runs). STOP also ends a running stream right away.
+fn take(app: &App, page: u64, text: &str) -> Option<Value> {
+    #[derive(Deserialize)]
+    struct Numbered {
+        id: u64,
+        #[serde(flatten)]
+        request: Value,
+    }
+    let (id, request) = match serde_json::from_str::<Numbered>(text) {
+        Ok(n) => (n.id, serde_json::from_value::<Request>(n.request)),
+        Err(e) => return Some(json!({ "type": "reply", "page": page, "id": 0, "ok": false, "text": e.to_string() })),
+    };
+    let reply =
+        |ok: bool, text: String| Some(json!({ "type": "reply", "page": page, "id": id, "ok": ok, "text": text }));
+    let request = match request {
+        Ok(r) => r,
+        Err(e) => return reply(false, format!("not a request: {e}")),
+    };
+    if request == Request::Halt {
+        app.hub.halt.store(true, Ordering::SeqCst);
+    } else if app.hub.streaming.load(Ordering::SeqCst) != 0 {
+        return reply(false, "a stream is running: STOP ends it".into());
+    }
+    let sent = app
+        .jobs
+        .lock()
+        .ok()
+        .map(|jobs| jobs.send(Job { page, id, request }).is_ok());
+    if sent == Some(true) {
+        None
+    } else {
+        reply(false, "the device thread has ended".into())
+    }
+}
+
+fn forbidden(refused: guard::Refused) -> Response {
+    (StatusCode::FORBIDDEN, refused.to_string()).into_response()
+}
+
+fn answer(result: Result<Value, String>) -> Response {
+    match result {
+        Ok(v) => Json(v).into_response(),
+        Err(e) => (StatusCode::UNPROCESSABLE_ENTITY, Json(json!({ "error": e }))).into_response(),
+    }
+}
+
+async fn cue_defaults(State(app): State<Arc<App>>, Query(access): Query<Access>, headers: HeaderMap) -> Response {
+    match app.admit(&access, &headers) {
+        Err(r) => forbidden(r),
+        Ok(()) => Json(api::cue_defaults()).into_response(),
+    }
+}
+
+async fn cue(
+    State(app): State<Arc<App>>,
+    Query(access): Query<Access>,
+    headers: HeaderMap,
+    Json(request): Json<api::CueRequest>,
+) -> Response {
+    if let Err(r) = app.admit(&access, &headers) {
+        return forbidden(r);
+    }
+    let Some((geometry, home)) = app.platform() else {
+        return answer(Err("the device's rig is not known yet".into()));
+    };
+    answer(
+        tokio::task::spawn_blocking(move || api::cue(&request, &geometry, home))
+            .await
+            .unwrap_or_else(|e| Err(e.to_string())),
+    )
+}
+
+/// Writes the parameters to the cueing file a telemetry session of this workbench watches: it blends them in.
+async fn cue_apply(
+    State(app): State<Arc<App>>,
+    Query(access): Query<Access>,
+    headers: HeaderMap,
+    Json(request): Json<api::CueRequest>,
+) -> Response {
+    if let Err(r) = app.admit(&access, &headers) {
+        return forbidden(r);
+    }
+    let written = api::cue_config(&request.config).and_then(|config| {
+        let text = toml::to_string(&config).map_err(|e| e.to_string())?;
+        std::fs::write(&app.hub.cue_file, text).map_err(|e| format!("{}: {e}", app.hub.cue_file.display()))
+    });
+    answer(written.map(|()| json!({ "applied": app.hub.cue_file.display().to_string() })))
+}
+
+/// The rig the device runs, as a rig file (what `device rig show` prints), for the Rig panel's editor.
+async fn rig_current(State(app): State<Arc<App>>, Query(access): Query<Access>, headers: HeaderMap) -> Response {
+    if let Err(r) = app.admit(&access, &headers) {
+        return forbidden(r);
+    }
+    let record = app.hub.record.lock().ok().and_then(|r| *r);
+    answer(
+        record
+            .ok_or_else(|| "the device's rig is not known yet".to_owned())
+            .and_then(|r| crate::rig::device::as_file(&r).map_err(|e| format!("{e:#}")))
+            .map(|text| json!({ "text": text })),
+    )
+}
+
+#[derive(Deserialize)]
+struct TextBody {
+    text: String,
+}
+
+async fn rig_check(
+    State(app): State<Arc<App>>,
+    Query(access): Query<Access>,
+    headers: HeaderMap,
+    Json(body): Json<TextBody>,
+) -> Response {
+    if let Err(r) = app.admit(&access, &headers) {
+        return forbidden(r);
+    }
+    answer(
+        tokio::task::spawn_blocking(move || Ok(api::rig_check(&body.text)))
+            .await
+            .unwrap_or_else(|e| Err(e.to_string())),
+    )
+}
+
+async fn run_record(
+    State(app): State<Arc<App>>,
+    Query(access): Query<Access>,
+    headers: HeaderMap,
+    Json(body): Json<TextBody>,
+) -> Response {
+    if let Err(r) = app.admit(&access, &headers) {
+        return forbidden(r);
+    }
+    answer(api::run_record(&body.text))
+}

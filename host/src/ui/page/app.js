@@ -1,0 +1,379 @@
+// The workbench page: one WebSocket for the live data and every command, the panels, and the computations
+// (cueing, rig checks, run records) over the token-checked API.
+"use strict";
+
+const token = new URLSearchParams(location.search).get("token") || "";
+const api = (path) => `${path}?token=${encodeURIComponent(token)}`;
+const $ = (id) => document.getElementById(id);
+const AXES = ["x", "y", "z", "alpha", "beta", "gamma"];
+const HISTORY_S = 10;
+
+// What tests and curious users can read: the newest frame and counts of what the page did.
+const state = { rig: null, frame: null, frames: 0, page: 0, nextId: 1, replies: [], connected: false };
+window.ringpod = state;
+
+// ---- tabs ----
+document.querySelectorAll(".tab").forEach((b) => b.addEventListener("click", () => {
+  document.querySelectorAll(".tab").forEach((t) => t.classList.toggle("active", t === b));
+  document.querySelectorAll(".panel").forEach((p) => p.classList.toggle("active", p.id === "panel-" + b.dataset.panel));
+  if (b.dataset.panel === "rig" && !$("rig-text").value) loadDeviceRig();
+  if (b.dataset.panel === "cueing" && !cue.config) loadCueDefaults();
+}));
+
+// ---- the WebSocket ----
+let ws = null;
+function connect() {
+  const scheme = location.protocol === "https:" ? "wss" : "ws";
+  ws = new WebSocket(`${scheme}://${location.host}/ws?token=${encodeURIComponent(token)}`);
+  ws.onopen = () => { state.connected = true; $("link").textContent = "connected"; };
+  ws.onclose = () => {
+    state.connected = false;
+    if (leaving) return;
+    $("link").textContent = "connection lost: reconnecting…";
+    setTimeout(connect, 1000);
+  };
+  ws.onmessage = (e) => {
+    const m = JSON.parse(e.data);
+    if (m.type === "hello") state.page = m.page;
+    else if (m.type === "rig") showRig(m);
+    else if (m.type === "frame") showFrame(m);
+    else if (m.type === "reply") showReply(m);
+    else if (m.type === "report") log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
+  };
+}
+
+// A page the user leaves closes its connection at once, so that a stream it started stops (the browser may keep
+// the page frozen, its socket open, for the back button); coming back connects again.
+let leaving = false;
+window.addEventListener("pagehide", () => { leaving = true; if (ws) ws.close(); });
+window.addEventListener("pageshow", (e) => { if (e.persisted) { leaving = false; connect(); } });
+
+function send(request) {
+  const id = state.nextId++;
+  if (!ws || ws.readyState !== WebSocket.OPEN) { log(`${request.do}: not connected`, true); return; }
+  ws.send(JSON.stringify(Object.assign({ id }, request)));
+  log(`> ${request.do}`);
+  return id;
+}
+
+function log(text, error) {
+  const li = document.createElement("li");
+  li.textContent = `${new Date().toLocaleTimeString()}  ${text}`;
+  if (error) li.className = "error";
+  const list = $("log");
+  list.appendChild(li);
+  while (list.children.length > 200) list.removeChild(list.firstChild);
+  list.scrollTop = list.scrollHeight;
+}
+
+function showReply(m) {
+  if (m.page !== state.page) { log(`(another page) ${m.text}`, !m.ok); return; }
+  state.replies.push(m);
+  log(m.text, !m.ok);
+}
+
+// ---- the STOP: always on screen, space anywhere but in a text field ----
+function halt() {
+  send({ do: "halt" });
+}
+$("halt").addEventListener("click", halt);
+document.addEventListener("keydown", (e) => {
+  const typing = ["INPUT", "TEXTAREA", "SELECT"].includes(document.activeElement.tagName);
+  if (e.code === "Space" && !typing) { e.preventDefault(); halt(); }
+});
+
+// ---- Live ----
+const view = new View3d($("view3d"));
+const history = { t: [], pose: [], target: [], cost: [] };
+const liveCharts = [];
+
+function showRig(rig) {
+  state.rig = rig;
+  $("rig-name").textContent = `${rig.name} (${rig.source})`;
+  const axis = $("jog-axis");
+  axis.innerHTML = "";
+  rig.axes.forEach((kind, i) => {
+    const o = document.createElement("option");
+    o.value = i + 1;
+    o.textContent = `${i + 1} (${kind === "ring" ? "carriage" : kind})`;
+    axis.appendChild(o);
+  });
+  axis.onchange = () => { $("jog-unit").textContent = rig.axes[axis.value - 1] === "ring" ? "deg" : "mm"; };
+  axis.onchange();
+  const charts = $("live-charts");
+  charts.innerHTML = "";
+  liveCharts.length = 0;
+  AXES.forEach((a, i) => liveCharts.push(new Chart(charts, a, i < 3 ? " m" : " rad")));
+  liveCharts.push(new Chart(charts, "tick cost", ""));
+  view.show(rig, null, null);
+}
+
+function lamp(on, label, alarm) {
+  return `<span class="lamp ${on ? (alarm ? "alarm" : "on") : ""}">${label}</span>`;
+}
+
+function showFrame(f) {
+  state.frame = f;
+  state.frames++;
+  const s = $("state");
+  s.textContent = f.state;
+  s.className = "state " + f.state.split(/[ :(]/)[0].toLowerCase();
+  $("link").textContent = `telemetry ${f.rate_hz.toFixed(0)} Hz, ${f.received} samples`;
+  view.show(state.rig, f.placed, f.ghost);
+  $("view3d").dataset.pose = f.pose.map((v) => v.toFixed(5)).join(",");
+  $("outputs").innerHTML = lamp(f.outputs & 1, "LOGIC_EN") + lamp(f.outputs & 2, "POWER_EN") + lamp(f.outputs & 4, "DRIVERS");
+  if (state.rig) {
+    $("inputs").innerHTML = state.rig.inputs.map(([mask, name]) => {
+      const on = (f.inputs & mask) !== 0;
+      const alarm = name === "e-stop" || name.startsWith("end");
+      return lamp(on, name, alarm);
+    }).join("");
+  }
+  const rows = [["applied", f.applied], ["limited", f.limited], ["refused", f.refused], ["tick cost", f.tick_cost],
+    ["device time", f.t.toFixed(2) + " s"], ["streaming", f.streaming ? "yes" : "no"]];
+  $("counters").innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td id="count-${k.replace(" ", "-")}">${v}</td></tr>`).join("");
+  $("pose").innerHTML = AXES.map((a, i) => `<tr><td>${a}</td><td>${f.pose[i].toFixed(4)}</td><td class="muted">${f.target[i].toFixed(4)}</td></tr>`).join("");
+  // The rolling history.
+  history.t.push(f.t); history.pose.push(f.pose); history.target.push(f.target); history.cost.push(f.tick_cost);
+  while (history.t.length && history.t[0] < f.t - HISTORY_S) {
+    history.t.shift(); history.pose.shift(); history.target.shift(); history.cost.shift();
+  }
+  if (document.querySelector("#panel-live.active") && state.frames % 5 === 0) {
+    liveCharts.forEach((c, i) => {
+      if (i < 6) {
+        c.set([
+          { x: history.t, y: history.target.map((p) => p[i]), colour: pale(COLOURS[i]), width: 4 },
+          { x: history.t, y: history.pose.map((p) => p[i]), colour: COLOURS[i] },
+        ]);
+      } else {
+        c.set([{ x: history.t, y: history.cost, colour: "#374151" }]);
+      }
+    });
+  }
+  showGates(f.gates);
+}
+
+// ---- Control ----
+function showGates(gates) {
+  document.querySelectorAll("[data-do]").forEach((b) => {
+    const why = gates[b.dataset.do];
+    b.disabled = !!why;
+    b.title = why || "";
+  });
+  document.querySelectorAll("[data-gate]").forEach((b) => {
+    const why = gates[b.dataset.gate];
+    b.disabled = !!why;
+    b.title = why || "";
+  });
+  $("gates").innerHTML = Object.entries(gates).filter(([, why]) => why)
+    .map(([k, why]) => `<div><b>${k}</b>: ${why}</div>`).join("");
+}
+document.querySelectorAll("[data-do]").forEach((b) => b.addEventListener("click", () => send({ do: b.dataset.do })));
+$("jog").addEventListener("click", () => send({ do: "jog", axis: +$("jog-axis").value, distance: +$("jog-distance").value }));
+$("buzz").addEventListener("click", () => send({ do: "buzz", axis: +$("jog-axis").value }));
+$("run-motion").addEventListener("click", () => send({
+  do: "motion", motion: $("motion").value, seconds: +$("motion-seconds").value, rate_hz: +$("motion-rate").value,
+}));
+$("stream-file").addEventListener("click", () => send({ do: "file", path: $("file-path").value, degrees: $("file-degrees").checked }));
+$("run-udp").addEventListener("click", () => send({
+  do: "udp", port: +$("udp-port").value, holds: $("udp-holds").value, format: $("udp-format").value, idle: +$("udp-idle").value,
+}));
+$("park").addEventListener("click", () => send({ do: "park" }));
+
+// ---- Cueing ----
+const cue = { config: null, drive: null, charts: [], timer: null };
+
+async function post(path, body) {
+  const r = await fetch(api(path), { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
+  const j = await r.json().catch(() => ({ error: `HTTP ${r.status}` }));
+  if (!r.ok) throw new Error(j.error || `HTTP ${r.status}`);
+  return j;
+}
+
+async function loadCueDefaults() {
+  const r = await fetch(api("/api/cue/defaults"));
+  const j = await r.json();
+  cue.config = j.config;
+  buildControls($("cue-controls"), cue.config, []);
+  const charts = $("cue-charts");
+  charts.innerHTML = "";
+  cue.charts = ["surge (x)", "sway (y)", "heave (z)"].map((n) => new Chart(charts, n, " m/s²"));
+  recue();
+}
+
+// The axes of a per-axis list, by the key's first word (the core's TRANSLATION_AXES, TILT_AXES, ROTATION_AXES).
+const AXIS_NAMES = { translation: ["surge", "sway", "heave"], tilt: ["x force", "y force"], rotation: ["roll", "pitch"] };
+
+// A number input per number of the configuration (nested tables as fieldsets, lists per axis).
+function buildControls(parent, obj, path) {
+  parent.innerHTML = "";
+  const axes = Array.isArray(obj) ? AXIS_NAMES[String(path[path.length - 1]).split("_")[0]] : null;
+  for (const [key, value] of Object.entries(obj)) {
+    const here = path.concat(key);
+    const name = axes && axes[+key] ? axes[+key] : key;
+    if (value !== null && typeof value === "object") {
+      const fs = document.createElement("fieldset");
+      const lg = document.createElement("legend");
+      lg.textContent = name;
+      fs.appendChild(lg);
+      const inner = document.createElement("div");
+      fs.appendChild(inner);
+      parent.appendChild(fs);
+      buildControls(inner, value, here);
+    } else if (typeof value === "string") {
+      // A choice (`forward`, `yaw`, a smoothing kind): its words are checked by the server as a cueing file's.
+      const label = document.createElement("label");
+      label.textContent = name;
+      const input = document.createElement("input");
+      input.type = "text"; input.size = 9; input.value = value;
+      input.dataset.path = here.join(".");
+      input.addEventListener("input", () => {
+        setPath(cue.config, here, input.value);
+        clearTimeout(cue.timer);
+        cue.timer = setTimeout(recue, 300);
+      });
+      label.appendChild(input);
+      parent.appendChild(label);
+    } else if (typeof value === "number" || typeof value === "boolean") {
+      const label = document.createElement("label");
+      label.textContent = name;
+      const input = document.createElement("input");
+      input.dataset.path = here.join(".");
+      if (typeof value === "boolean") { input.type = "checkbox"; input.checked = value; }
+      else { input.type = "number"; input.step = "any"; input.value = value; }
+      input.addEventListener("input", () => {
+        setPath(cue.config, here, input.type === "checkbox" ? input.checked : parseFloat(input.value));
+        clearTimeout(cue.timer);
+        cue.timer = setTimeout(recue, 200);
+      });
+      label.appendChild(input);
+      parent.appendChild(label);
+    }
+  }
+}
+
+function setPath(obj, path, v) {
+  let o = obj;
+  for (const k of path.slice(0, -1)) o = o[k];
+  o[path[path.length - 1]] = v;
+}
+
+async function recue() {
+  const status = $("cue-status");
+  try {
+    const j = await post("/api/cue", { config: cue.config, drive: cue.drive });
+    status.className = "small"; status.textContent = `${j.t.length} samples cued, ${j.limited} limited into the envelope` + (j.errors.length ? `; ${j.errors.length} rows unusable` : "");
+    $("cue-summary").textContent = cue.drive ? "(your drive)" : "(the example drive)";
+    cue.toml = j.toml;
+    // For tests and the curious: how many replays, and the largest surge delivered in the last.
+    state.cueRuns = (state.cueRuns || 0) + 1;
+    state.cuePeak = Math.max(...j.delivered.map((f) => Math.abs(f[0])));
+    cue.charts.forEach((c, i) => c.set([
+      { x: j.t, y: j.asked.map((f) => f[i]), colour: pale(COLOURS[i]), width: 4 },
+      { x: j.t, y: j.delivered.map((f) => f[i]), colour: COLOURS[i] },
+    ]));
+    document.querySelectorAll("#cue-controls input").forEach((i) => i.classList.remove("bad"));
+  } catch (e) {
+    status.className = "small msg bad"; status.textContent = e.message;
+  }
+}
+
+$("cue-save").addEventListener("click", () => {
+  if (!cue.toml) return;
+  const a = document.createElement("a");
+  a.href = URL.createObjectURL(new Blob([cue.toml], { type: "application/toml" }));
+  a.download = "cueing.toml";
+  a.click();
+});
+$("cue-apply").addEventListener("click", async () => {
+  try {
+    const j = await post("/api/cue/apply", { config: cue.config });
+    $("cue-status").textContent = `applied: ${j.applied} (a running telemetry session blends them in)`;
+  } catch (e) { $("cue-status").textContent = e.message; }
+});
+$("cue-drive").addEventListener("change", async (e) => {
+  const file = e.target.files[0];
+  if (file) { cue.drive = await file.text(); recue(); }
+});
+
+// ---- Rig ----
+let rigTimer = null;
+async function loadDeviceRig() {
+  const r = await fetch(api("/api/rig/current"));
+  const j = await r.json();
+  if (j.text) { $("rig-text").value = j.text; checkRig(); }
+}
+$("rig-text").addEventListener("input", () => { clearTimeout(rigTimer); rigTimer = setTimeout(checkRig, 300); });
+$("rig-reset").addEventListener("click", loadDeviceRig);
+$("rig-load").addEventListener("click", () => send({ do: "load_rig", text: $("rig-text").value }));
+
+async function checkRig() {
+  let j;
+  try { j = await post("/api/rig/check", { text: $("rig-text").value }); }
+  catch (e) { $("rig-messages").innerHTML = `<div class="msg bad">${escapeHtml(e.message)}</div>`; return; }
+  const m = [];
+  for (const e of j.errors) m.push(`<div class="msg bad rig-error"><code>${escapeHtml(e.key || "file")}</code>: ${escapeHtml(e.why)}</div>`);
+  if (j.analysable) m.push(`<div class="msg ok">analysable: yes</div>`);
+  if (j.analysable) m.push(j.drivable ? `<div class="msg ok">drivable: yes</div>` : `<div class="msg warn">drivable: no, because ${escapeHtml(j.why)}</div>`);
+  $("rig-messages").innerHTML = m.join("");
+  if (!j.analysable) return;
+  const v = new View3d($("rig-view"));
+  v.pitch = 0.35;
+  v.show(j.rig, j.at_home, null);
+  drawSection(j.section);
+  const cov = j.coverage;
+  $("rig-coverage").innerHTML = cov
+    ? cov.per_axis.map((a) => `<tr><td>${a.axis}</td><td>${a.inside} of ${a.tried}</td></tr>`).join("") +
+      `<tr><td>all at once</td><td>${cov.combined[0]} of ${cov.combined[1]}</td></tr>`
+    : `<tr><td class="muted">no [spec] ranges in the file</td></tr>`;
+}
+
+const CHECK_COLOURS = ["#f97316", "#a855f7", "#ec4899", "#eab308", "#ef4444", "#14b8a6"];
+function drawSection(s) {
+  const c = $("rig-section"), g = c.getContext("2d");
+  const n = s.rows.length, w = c.width / n;
+  g.clearRect(0, 0, c.width, c.height);
+  s.rows.forEach((row, j) => [...row].forEach((ch, i) => {
+    g.fillStyle = ch === "#" ? "#16a34a" : ch === "." ? "#e5e7eb" : CHECK_COLOURS[+ch - 1];
+    g.fillRect(i * w, c.height - (j + 1) * w, w + 0.5, w + 0.5);
+  }));
+  $("rig-legend").innerHTML = `xy at z = ${s.z.toFixed(3)} m over ±${s.half_width} m: <span style="color:#16a34a">■</span> inside every check, ` +
+    `<span style="color:#9ca3af">■</span> no solution, ` +
+    s.checks.map((n, i) => `<span style="color:${CHECK_COLOURS[i]}">■</span> ${n}`).join(", ");
+}
+
+function escapeHtml(s) {
+  return String(s).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
+}
+
+// ---- Runs ----
+$("run-file").addEventListener("change", async (e) => {
+  const file = e.target.files[0];
+  if (!file) return;
+  try {
+    showRun(await post("/api/run", { text: await file.text() }), file.name);
+  } catch (err) {
+    $("run-status").className = "small msg bad"; $("run-status").textContent = `${file.name}: ${err.message}`;
+  }
+});
+
+function showRun(run, name) {
+  const events = [];
+  run.state.forEach((s, i) => { if (i > 0 && s !== run.state[i - 1]) events.push({ x: run.t[i], colour: "#9ca3af", label: s }); });
+  run.limited.forEach((l, i) => { if (l && (i === 0 || !run.limited[i - 1])) events.push({ x: run.t[i], colour: "#f59e0b" }); });
+  run.refused.forEach((r, i) => { if (r && (i === 0 || !run.refused[i - 1])) events.push({ x: run.t[i], colour: "#dc2626" }); });
+  $("run-status").className = "small";
+  $("run-status").textContent = `${name}: ${run.t.length} rows over ${(run.t[run.t.length - 1] - run.t[0]).toFixed(2)} s; ` +
+    `grey lines: state changes, amber: limited, red: refused`;
+  const charts = $("run-charts");
+  charts.innerHTML = "";
+  AXES.forEach((a, i) => new Chart(charts, a, i < 3 ? " m" : " rad").set([
+    { x: run.t, y: run.commanded.map((p) => p[i]), colour: pale(COLOURS[i]), width: 4 },
+    { x: run.t, y: run.target.map((p) => p[i]), colour: COLOURS[i] },
+  ], events));
+  for (let k = 0; k < 6; k++) {
+    new Chart(charts, `steps ${k + 1}`, "").set([{ x: run.t, y: run.steps.map((s) => s[k]), colour: COLOURS[k] }], events);
+  }
+}
+
+connect();

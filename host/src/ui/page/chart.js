@@ -1,0 +1,116 @@
+// Line charts on a canvas: time on x, one or more series on y, optional event lines, wheel zoom on x.
+"use strict";
+
+const COLOURS = ["#dc2626", "#2563eb", "#16a34a", "#9333ea", "#0891b2", "#ca8a04"];
+
+// A paler shade of a "#rrggbb" colour (the commanded line under the followed one).
+function pale(hex) {
+  const n = parseInt(hex.slice(1), 16);
+  const mix = (c) => Math.round(c / 2 + 128);
+  return `rgb(${mix(n >> 16)},${mix((n >> 8) & 255)},${mix(n & 255)})`;
+}
+
+class Chart {
+  // title: shown top left; unit: after the y labels.
+  constructor(parent, title, unit) {
+    this.canvas = document.createElement("canvas");
+    this.canvas.width = 660;
+    this.canvas.height = 300;
+    this.canvas.title = title;
+    parent.appendChild(this.canvas);
+    this.title = title;
+    this.unit = unit || "";
+    this.series = [];
+    this.events = [];
+    this.view = null; // [x0, x1] when zoomed
+    this.canvas.addEventListener("wheel", (e) => this.zoom(e), { passive: false });
+    this.canvas.addEventListener("dblclick", () => { this.view = null; this.draw(); });
+  }
+
+  // series: [{x: [], y: [], colour, width}]; events: [{x, colour, label}]
+  set(series, events) {
+    this.series = series;
+    this.events = events || [];
+    this.draw();
+  }
+
+  extent() {
+    let x0 = Infinity, x1 = -Infinity;
+    for (const s of this.series) {
+      if (s.x.length) { x0 = Math.min(x0, s.x[0]); x1 = Math.max(x1, s.x[s.x.length - 1]); }
+    }
+    return [x0, x1];
+  }
+
+  zoom(e) {
+    e.preventDefault();
+    const [a, b] = this.view || this.extent();
+    if (!isFinite(a) || b <= a) return;
+    const r = this.canvas.getBoundingClientRect();
+    const f = Math.min(Math.max((e.clientX - r.left) / r.width, 0), 1);
+    const at = a + f * (b - a);
+    const k = e.deltaY < 0 ? 0.8 : 1.25;
+    this.view = [at - (at - a) * k, at + (b - at) * k];
+    this.draw();
+  }
+
+  draw() {
+    const c = this.canvas, g = c.getContext("2d");
+    const W = c.width, H = c.height, L = 70, R = 10, T = 28, B = 30;
+    g.clearRect(0, 0, W, H);
+    g.font = "20px system-ui";
+    g.fillStyle = "#374151";
+    g.fillText(this.title, L, 20);
+    const [x0, x1] = this.view || this.extent();
+    if (!isFinite(x0) || x1 <= x0) return;
+    let y0 = Infinity, y1 = -Infinity;
+    for (const s of this.series) {
+      for (let i = 0; i < s.x.length; i++) {
+        if (s.x[i] < x0 || s.x[i] > x1 || !isFinite(s.y[i])) continue;
+        y0 = Math.min(y0, s.y[i]); y1 = Math.max(y1, s.y[i]);
+      }
+    }
+    if (!isFinite(y0)) return;
+    if (y1 - y0 < 1e-9) { y0 -= 1; y1 += 1; }
+    const pad = (y1 - y0) * 0.08; y0 -= pad; y1 += pad;
+    const X = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
+    const Y = (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
+    g.strokeStyle = "#e5e7eb"; g.lineWidth = 1; g.fillStyle = "#6b7280"; g.font = "17px system-ui";
+    for (let k = 0; k <= 4; k++) {
+      const y = y0 + (y1 - y0) * k / 4;
+      g.beginPath(); g.moveTo(L, Y(y)); g.lineTo(W - R, Y(y)); g.stroke();
+      g.fillText(fmt(y) + this.unit, 2, Y(y) + 5);
+    }
+    for (let k = 0; k <= 5; k++) {
+      const x = x0 + (x1 - x0) * k / 5;
+      g.fillText(fmt(x) + " s", X(x) - 16, H - 8);
+    }
+    for (const e of this.events) {
+      if (e.x < x0 || e.x > x1) continue;
+      g.strokeStyle = e.colour; g.beginPath(); g.moveTo(X(e.x), T); g.lineTo(X(e.x), H - B); g.stroke();
+    }
+    g.save();
+    g.beginPath(); g.rect(L, T, W - L - R, H - T - B); g.clip();
+    for (const s of this.series) {
+      g.strokeStyle = s.colour; g.lineWidth = s.width || 2;
+      g.beginPath();
+      let started = false;
+      for (let i = 0; i < s.x.length; i++) {
+        if (!isFinite(s.y[i])) { started = false; continue; }
+        const px = X(s.x[i]), py = Y(s.y[i]);
+        if (started) g.lineTo(px, py); else { g.moveTo(px, py); started = true; }
+      }
+      g.stroke();
+    }
+    g.restore();
+  }
+}
+
+function fmt(v) {
+  const a = Math.abs(v);
+  if (a === 0) return "0";
+  if (a >= 1000) return v.toFixed(0);
+  if (a >= 10) return v.toFixed(1);
+  if (a >= 0.1) return v.toFixed(2);
+  return v.toPrecision(2);
+}

@@ -1,0 +1,435 @@
+//! The device's side of the workbench: one thread owns the client (a board's port or the simulated controller),
+//! as every other command does, and runs what the pages ask through the same client calls and the same
+//! `stream::run` as the CLI. Its telemetry tap publishes frames to every page at [`FRAME_HZ`], also while a
+//! stream runs; a stream ends when STOP is pressed or the page that started it goes away.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
+use ringpod_core::protocol::{RigRecord, RigSource, Telemetry};
+use ringpod_core::safety::State;
+use serde::Deserialize;
+use serde_json::json;
+
+use super::frame::{self, LinkCounts, RigView};
+use crate::link::client::{Client, ClientError, Transport};
+use crate::link::transport::{AnyTransport, SimDevice};
+use crate::link::{self, Target};
+use crate::stream::command::{self as job, Datagrams, Input};
+use crate::stream::{self, Motion, Source};
+
+/// Frames a page is sent per second at most (a browser draws at 60; telemetry may come at 1 kHz).
+pub const FRAME_HZ: f64 = 50.0;
+
+/// What a page asks the device to do.
+#[derive(Debug, Clone, Deserialize, PartialEq)]
+#[serde(tag = "do", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Request {
+    Enable,
+    Disable,
+    Home,
+    Start,
+    Stop,
+    Clear,
+    /// The STOP button: ends a stream, stops whatever moves, and powers down.
+    Halt,
+    /// Axis 1-6; degrees of ring for a carriage, mm for a linear actuator.
+    Jog {
+        axis: u8,
+        distance: f64,
+    },
+    Buzz {
+        axis: u8,
+    },
+    /// To the home pose, then power down.
+    Park,
+    /// A built-in motion (`demo`, `heave`, `yaw`, `vibration`).
+    Motion {
+        motion: String,
+        seconds: f64,
+        rate_hz: f64,
+    },
+    /// A pose CSV on this machine.
+    File {
+        path: String,
+        #[serde(default)]
+        degrees: bool,
+    },
+    /// Poses (`holds = "poses"`) or a game's telemetry (`holds = "telemetry"`, cued by the workbench's live
+    /// cueing file) on a UDP port.
+    Udp {
+        port: u16,
+        holds: String,
+        #[serde(default)]
+        format: Option<String>,
+        #[serde(default)]
+        degrees: bool,
+        /// Seconds without a datagram after which the session ends.
+        #[serde(default = "default_idle")]
+        idle: f64,
+    },
+    /// A rig file's text, stored on the device (it must be `Off`), then the device restarted to run it.
+    LoadRig {
+        text: String,
+    },
+}
+
+fn default_idle() -> f64 {
+    30.0
+}
+
+/// A request of one page (its connection number) with the number the page gave it.
+pub struct Job {
+    pub page: u64,
+    pub id: u64,
+    pub request: Request,
+}
+
+/// What the pages and the device thread share.
+pub struct Hub {
+    /// Every message to the pages (JSON text).
+    pub out: tokio::sync::broadcast::Sender<String>,
+    /// Set by STOP (and by the loss of the page that started a stream): ends the stream at once.
+    pub halt: Arc<AtomicBool>,
+    /// The page whose stream runs (0: none).
+    pub streaming: AtomicU64,
+    /// The newest rig message, for a page that connects later.
+    pub rig: Mutex<Option<String>>,
+    /// The rig the device runs, for the computations and the Rig panel.
+    pub record: Mutex<Option<RigRecord>>,
+    /// The cueing file a telemetry session reloads when it changes (the Cueing panel's "apply live").
+    pub cue_file: PathBuf,
+    /// Set when the server ends: the device thread powers down and returns.
+    pub closing: AtomicBool,
+}
+
+impl Hub {
+    /// Sends a message to every page (none listening is not an error).
+    pub fn publish(&self, message: &serde_json::Value) {
+        let _ = self.out.send(message.to_string());
+    }
+
+    /// A reply to a page's request, seen by every page.
+    fn reply(&self, job: &Job, ok: bool, text: impl Into<String>) {
+        self.publish(&json!({ "type": "reply", "page": job.page, "id": job.id, "ok": ok, "text": text.into() }));
+    }
+}
+
+/// Makes frames of the telemetry the client sees, at most [`FRAME_HZ`] a second.
+struct Publisher {
+    hub: Arc<Hub>,
+    mechanism: Arc<Mutex<RingPlatform<f64>>>,
+    counts: LinkCounts,
+    last_sent: Option<Instant>,
+    window: (Instant, u64),
+}
+
+impl Publisher {
+    fn see(&mut self, sample: &Telemetry) {
+        self.counts.received += 1;
+        let now = Instant::now();
+        let (since, n) = self.window;
+        if now.duration_since(since) >= Duration::from_secs(1) {
+            self.counts.rate_hz = (self.counts.received - n) as f64 / now.duration_since(since).as_secs_f64();
+            self.window = (now, self.counts.received);
+        }
+        if self
+            .last_sent
+            .is_some_and(|t| now.duration_since(t) < Duration::from_secs_f64(1.0 / FRAME_HZ))
+        {
+            return;
+        }
+        self.last_sent = Some(now);
+        let streaming = self.hub.streaming.load(Ordering::SeqCst) != 0;
+        let Ok(m) = self.mechanism.lock() else { return };
+        let frame = frame::frame(&m, sample, self.counts, streaming);
+        let mut message = serde_json::to_value(frame).unwrap_or_default();
+        message["type"] = json!("frame");
+        self.hub.publish(&message);
+    }
+}
+
+/// Opens the device and serves the pages' requests until the hub closes. Errors here mean no device.
+pub fn run(
+    target: Target,
+    rig: Option<crate::rig::Rig>,
+    hub: Arc<Hub>,
+    jobs: mpsc::Receiver<Job>,
+) -> anyhow::Result<()> {
+    let transport = match (&target, &rig) {
+        (_, Some(r)) => AnyTransport::Sim(Box::new(SimDevice::for_rig(true, r)?)),
+        _ => link::connect(&target, true)?,
+    };
+    let mut client = Client::new(transport);
+    client.hello()?;
+    let mechanism = Arc::new(Mutex::new(announce_rig(&mut client, &hub)?));
+    let publisher = Arc::new(Mutex::new(Publisher {
+        hub: hub.clone(),
+        mechanism: mechanism.clone(),
+        counts: LinkCounts::default(),
+        last_sent: None,
+        window: (Instant::now(), 0),
+    }));
+    let tap = publisher.clone();
+    client.tap = Some(Box::new(move |sample| {
+        if let Ok(mut p) = tap.lock() {
+            p.see(sample);
+        }
+    }));
+    client.telemetry(true)?;
+    let mut device = Device {
+        client,
+        hub: hub.clone(),
+        mechanism,
+    };
+    let mut last_sample = Instant::now();
+    while !hub.closing.load(Ordering::SeqCst) {
+        while let Ok(job) = jobs.try_recv() {
+            device.serve(&job);
+        }
+        // The samples were published by the tap; none is kept. A device that stopped sending (a restart, a
+        // hello by another program on a shared link) is asked again once a second.
+        if device.client.take_telemetry().is_ok_and(|s| !s.is_empty()) {
+            last_sample = Instant::now();
+        } else if last_sample.elapsed() > Duration::from_secs(1) {
+            let _ = device.client.telemetry(true);
+            last_sample = Instant::now();
+        }
+        device.client.transport().elapse(Duration::from_millis(2));
+    }
+    // The workbench ends: nothing keeps moving without it.
+    let _ = device.halt();
+    Ok(())
+}
+
+/// Reads the rig the device runs, tells the pages, and gives its mechanism.
+fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> anyhow::Result<RingPlatform<f64>> {
+    let (record, source, _) = client.rig()?;
+    if let RigSource::Refused(_) | RigSource::Unreadable = source {
+        eprintln!("warning: {source}");
+    }
+    let geometry = record
+        .geometry()
+        .map_err(|e| anyhow::anyhow!("the device's rig does not check: {e}"))?;
+    let view = RigView::of(&geometry, record.home, source.to_string());
+    let mut message = serde_json::to_value(view)?;
+    message["type"] = json!("rig");
+    *hub.rig.lock().map_err(|_| anyhow::anyhow!("rig lock poisoned"))? = Some(message.to_string());
+    *hub.record.lock().map_err(|_| anyhow::anyhow!("rig lock poisoned"))? = Some(record);
+    hub.publish(&message);
+    Ok(RingPlatform::new(&geometry))
+}
+
+struct Device {
+    client: Client<AnyTransport>,
+    hub: Arc<Hub>,
+    mechanism: Arc<Mutex<RingPlatform<f64>>>,
+}
+
+impl Device {
+    fn serve(&mut self, job: &Job) {
+        let result = match &job.request {
+            Request::Enable => self.client.enable().map(|()| "enabling".to_owned()).map_err(Into::into),
+            Request::Disable => self
+                .client
+                .disable()
+                .map(|()| "powering down".to_owned())
+                .map_err(Into::into),
+            Request::Home => self.client.home().map(|()| "homing".to_owned()).map_err(Into::into),
+            Request::Start => self.client.start().map(|()| "running".to_owned()).map_err(Into::into),
+            Request::Stop => self.client.stop().map(|()| "stopping".to_owned()).map_err(Into::into),
+            Request::Clear => self
+                .client
+                .clear()
+                .map(|()| "fault cleared".to_owned())
+                .map_err(Into::into),
+            Request::Halt => self.halt(),
+            Request::Jog { axis, distance } => self.commission(*axis, Some(*distance)),
+            Request::Buzz { axis } => self.commission(*axis, None),
+            Request::Park => self.park(job.page),
+            Request::Motion {
+                motion,
+                seconds,
+                rate_hz,
+            } => clap::ValueEnum::from_str(motion, true)
+                .map_err(|e| anyhow::anyhow!("motion {motion:?}: {e}"))
+                .and_then(|motion: Motion| {
+                    if motion == Motion::Sine {
+                        anyhow::bail!(
+                            "the sine needs its axis, frequency and amplitude: `ringpod stream --motion sine`"
+                        );
+                    }
+                    self.stream(
+                        job.page,
+                        &Input::Motion {
+                            motion,
+                            sine: None,
+                            seconds: *seconds,
+                            rate_hz: *rate_hz,
+                        },
+                    )
+                }),
+            Request::File { path, degrees } => self.stream(
+                job.page,
+                &Input::File {
+                    path: PathBuf::from(path),
+                    degrees: *degrees,
+                },
+            ),
+            Request::Udp {
+                port,
+                holds,
+                format,
+                degrees,
+                idle,
+            } => self.udp(job.page, *port, holds, format.as_deref(), *degrees, *idle),
+            Request::LoadRig { text } => self.load_rig(text),
+        };
+        match result {
+            Ok(text) => self.hub.reply(job, true, text),
+            Err(e) => self.hub.reply(job, false, format!("{e:#}")),
+        }
+    }
+
+    /// STOP: ends a stream (its owner already saw the flag), ramps whatever moves to rest, powers down.
+    fn halt(&mut self) -> anyhow::Result<String> {
+        self.hub.halt.store(false, Ordering::SeqCst);
+        let status = self.client.status()?;
+        if matches!(status.state, State::Running | State::Homing | State::Jogging) {
+            self.client.stop()?;
+        }
+        let status = self.client.wait_for(Duration::from_secs(10), |s| {
+            !matches!(
+                s.state,
+                State::Stopping | State::Running | State::Homing | State::Jogging
+            )
+        })?;
+        if matches!(status.state, State::LogicOn | State::PowerOn { .. } | State::Ready) {
+            self.client.disable()?;
+        }
+        Ok("stopped and powering down".to_owned())
+    }
+
+    fn commission(&mut self, axis: u8, distance: Option<f64>) -> anyhow::Result<String> {
+        if !(1..=6).contains(&axis) {
+            anyhow::bail!("axis {axis} does not exist (1-6)");
+        }
+        let kind = match self.mechanism.lock() {
+            Ok(m) => m.axes()[usize::from(axis - 1)],
+            Err(_) => anyhow::bail!("the mechanism is not known"),
+        };
+        let what = crate::device::commission::begin_move(&mut self.client, axis - 1, kind, distance)?;
+        Ok(format!("axis {axis} {what}; home again before streaming"))
+    }
+
+    /// To the home pose (powering up and homing first if needed), then powered down.
+    fn park(&mut self, page: u64) -> anyhow::Result<String> {
+        let (record, _, _) = self.client.rig()?;
+        let home = Pose::from_array(record.home);
+        let poses = vec![(1, 0.0, home), (2, 1.0, home)];
+        let report = self.run(page, Source::Poses(poses), Vec::new())?;
+        if report.exit_code != stream::exit::FOLLOWED {
+            anyhow::bail!("park: {}", report.reason.as_deref().unwrap_or(report.outcome));
+        }
+        self.client.disable()?;
+        Ok("parked at home and powering down".to_owned())
+    }
+
+    fn udp(
+        &mut self,
+        page: u64,
+        port: u16,
+        holds: &str,
+        format: Option<&str>,
+        degrees: bool,
+        idle: f64,
+    ) -> anyhow::Result<String> {
+        let holds = match holds {
+            "poses" => Datagrams::Poses { degrees },
+            "telemetry" => Datagrams::Telemetry {
+                format: clap::ValueEnum::from_str(format.unwrap_or("auto"), true)
+                    .map_err(|e| anyhow::anyhow!("telemetry format: {e}"))?,
+                cue_config: Some(self.hub.cue_file.clone()),
+                profile: None,
+            },
+            other => anyhow::bail!("a UDP session holds `poses` or `telemetry`, not {other:?}"),
+        };
+        self.stream(
+            page,
+            &Input::Udp {
+                addr: std::net::SocketAddr::from(([0, 0, 0, 0], port)),
+                holds,
+                from: None,
+                idle,
+            },
+        )
+    }
+
+    fn stream(&mut self, page: u64, input: &Input) -> anyhow::Result<String> {
+        let (source, errors) = job::open(input)?;
+        let report = self.run(page, source, errors)?;
+        let text = format!(
+            "{}: {} setpoints sent, {} applied, {} limited, {} refused{}",
+            report.outcome,
+            report.setpoints_sent,
+            report.setpoints_applied,
+            report.limited.device + report.limited.host,
+            report.rejected.values().sum::<u32>(),
+            report.reason.as_deref().map(|r| format!(" ({r})")).unwrap_or_default()
+        );
+        let mut message = serde_json::to_value(&report)?;
+        message["type"] = json!("report");
+        self.hub.publish(&message);
+        if report.exit_code == stream::exit::FOLLOWED || report.exit_code == stream::exit::INTERRUPTED {
+            Ok(text)
+        } else {
+            anyhow::bail!(text)
+        }
+    }
+
+    /// Runs a stream as `ringpod stream` does (powering up and homing first if needed), owned by `page`.
+    fn run(&mut self, page: u64, source: Source, errors: Vec<stream::InputError>) -> anyhow::Result<stream::Report> {
+        self.hub.halt.store(false, Ordering::SeqCst);
+        self.hub.streaming.store(page, Ordering::SeqCst);
+        self.client.cancel = Some(self.hub.halt.clone());
+        let halt = self.hub.halt.clone();
+        let options = stream::Options {
+            home: false,
+            host_limits: true,
+            telemetry: true,
+            quiet: true,
+        };
+        let report = stream::run(
+            &mut self.client,
+            source,
+            errors,
+            &options,
+            false,
+            &|| halt.load(Ordering::SeqCst),
+            None,
+        );
+        self.client.cancel = None;
+        self.hub.streaming.store(0, Ordering::SeqCst);
+        // Telemetry stays on for the pages whatever the stream did with it.
+        self.client.telemetry(true)?;
+        report.map_err(|e: ClientError| anyhow::anyhow!("the stream did not start: {e}"))
+    }
+
+    fn load_rig(&mut self, text: &str) -> anyhow::Result<String> {
+        let file = crate::rig::parse(text)?;
+        if self.client.status()?.state != State::Off {
+            anyhow::bail!("a rig is loaded with the supplies off: Disable first");
+        }
+        crate::rig::device::store(&mut self.client, &file)?;
+        let restarted = crate::rig::device::restart(&mut self.client)?;
+        self.client.telemetry(true)?;
+        let m = announce_rig(&mut self.client, &self.hub)?;
+        if let Ok(mut mechanism) = self.mechanism.lock() {
+            *mechanism = m;
+        }
+        Ok(format!("{} stored; {restarted}", file.name))
+    }
+}
