@@ -168,7 +168,16 @@ fn presets_lists_every_geometry() {
         .iter()
         .map(|p| p["name"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["trainer-model", "trainer-ch5", "rotopod-ch4", "tool5-ex"]);
+    assert_eq!(
+        names,
+        [
+            "trainer-model",
+            "trainer-elbow",
+            "trainer-ch5",
+            "rotopod-ch4",
+            "tool5-ex"
+        ]
+    );
 }
 
 #[test]

@@ -45,9 +45,15 @@ fn steps_at(pose: [f64; 6]) -> [i64; 6] {
 
 /// Starts `ringpod simulate --pty` and returns it with the path of its pseudo-terminal.
 fn simulator_on_a_pty() -> (std::process::Child, String) {
+    simulator_on_a_pty_with(&[])
+}
+
+/// [`simulator_on_a_pty`] with further arguments to `simulate` (`--mechanism trainer-elbow`).
+fn simulator_on_a_pty_with(args: &[&str]) -> (std::process::Child, String) {
     use std::io::BufRead;
     let mut server = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
         .args(["simulate", "--pty"])
+        .args(args)
         .stdout(std::process::Stdio::piped())
         .spawn()
         .unwrap();
@@ -799,6 +805,34 @@ fn a_games_own_packets_are_recognised_and_cued_live() {
     assert!(last[4] > 0.0, "{last:?}");
 }
 
+/// `device jog` of an elbow chain's shoulder takes degrees, as a carriage's: 2 degrees of its 64,000 steps per turn
+/// are 356 steps.
+#[test]
+fn device_jog_turns_a_shoulder_by_degrees() {
+    let (mut server, path) = simulator_on_a_pty_with(&["--mechanism", "trainer-elbow"]);
+    let device = |words: &[&str]| {
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .arg("device")
+            .args(words)
+            .args(["--port", &path])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr),
+        )
+    };
+    assert_eq!(device(&["enable"]).0, Some(0));
+    std::thread::sleep(std::time::Duration::from_millis(600));
+    let (code, said) = device(&["jog", "6", "2"]);
+    assert!(
+        code == Some(0) && said.contains("jogged 2 deg (356 steps): moved 356 steps"),
+        "{said}"
+    );
+    let _ = server.kill();
+    let _ = server.wait();
+}
+
 /// Commissioning over the serial transport: `device jog` is refused unpowered; powered, a linear actuator jogs
 /// 2 mm (3,200 steps) and comes back; a buzz ends where it began; a missing axis is a usage error.
 #[test]
@@ -884,6 +918,50 @@ fn a_rig_of_ones_own_streams_on_the_simulator() {
     let model = demo(&[]);
     let model: serde_json::Value = serde_json::from_slice(&model.stdout).unwrap();
     assert_ne!(report["final_steps"], model["final_steps"]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The elbow trainer (ch. 5.1 fig. 5.2 arms with rotary shoulders in place of the linear actuators) homes and
+/// follows a demo on the simulator, as a preset and as its exported rig file: every setpoint applied, the counts
+/// agreeing, no fault (the shoulders pass their index flags at home without tripping anything), and the shoulders'
+/// motors turned.
+#[test]
+fn the_elbow_trainer_streams_on_the_simulator() {
+    let dir = std::env::temp_dir().join(format!("ringpod-elbow-rig-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let exported = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["presets", "--export", "trainer-elbow"])
+        .output()
+        .unwrap();
+    assert!(exported.status.success());
+    let file = dir.join("elbow.toml");
+    std::fs::write(&file, exported.stdout).unwrap();
+    let demo = |extra: &[&str]| {
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(["stream", "--sim", "--fast", "--quiet", "--report-json"])
+            .args(["--motion", "demo", "--duration", "6"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["outcome"], "followed", "{report}");
+        assert_eq!(report["state"], "Ready");
+        assert_eq!(report["setpoints_applied"], report["setpoints_sent"]);
+        assert_eq!(report["counts_agree"], true);
+        assert_eq!(
+            report["faults"].as_array().map(Vec::len),
+            Some(0),
+            "{}",
+            report["faults"]
+        );
+        report
+    };
+    let preset = demo(&["--mechanism", "trainer-elbow"]);
+    let rig = demo(&["--geometry", file.to_str().unwrap()]);
+    assert_eq!(preset["final_steps"], rig["final_steps"]);
+    let model = demo(&[]);
+    assert_ne!(preset["final_steps"], model["final_steps"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -38,7 +38,38 @@ impl AxisScale {
         steps_per_unit: 1.6e6,
         invert: false,
     };
+    /// An elbow chain's shoulder (`trainer-elbow`): FL20 at 1/16 on a 20:1 gear, 64,000 steps per shoulder turn
+    /// (10.2 k steps/rad). The source builds no such arm: the gear is an assumption, chosen so that the FL20 holds
+    /// the arm's static torque with margin and the shoulder's top speed stays within the step generator's rate.
+    pub const MODEL_SHOULDER: AxisScale = AxisScale {
+        steps_per_turn: 64_000,
+        steps_per_unit: 64_000.0 / core::f32::consts::TAU,
+        invert: false,
+    };
 }
+
+/// Actuator limits of an elbow chain's shoulder on the trainer model's FL20 drives: 3 rad/s (30.6 k steps/s at
+/// [`AxisScale::MODEL_SHOULDER`]) and 60 rad/s^2, above what the pose limits ask through the Jacobian over the
+/// spec box (the arm's 105 mm upper arm turns about 0.5 rad/s at 0.05 m/s of heave).
+pub const SHOULDER_VELOCITY: f32 = 3.0;
+/// See [`SHOULDER_VELOCITY`] (rad/s^2).
+pub const SHOULDER_ACCELERATION: f32 = 60.0;
+
+/// An elbow chain's shoulder homing: an index flag at the shoulder's home-pose angle, as a carriage's, searched
+/// up to 20 degrees at 8,000 steps/s of its 64,000 per turn, backed off 2 degrees, approached at 1,000 steps/s.
+///
+/// Not an end switch at the end of the travel, as a linear actuator's: with one shoulder at the end of its travel
+/// and the other axes at home the platform is far outside its workspace (`trainer-elbow`: both shoulders at the
+/// lower end roll it by 56 degrees), where forward kinematics after homing cannot find it. The flag is passed in
+/// normal motion, so it is no limit; the reach check keeps the shoulder inside its travel.
+pub const SHOULDER_HOMING: SwitchSettings = SwitchSettings {
+    toward: Toward::Plus,
+    switch: 0.0,
+    search: 20.0 * core::f32::consts::PI / 180.0,
+    backoff: 2.0 * core::f32::consts::PI / 180.0,
+    fast: 8_000.0 * core::f32::consts::TAU / 64_000.0,
+    slow: 1_000.0 * core::f32::consts::TAU / 64_000.0,
+};
 
 /// The trainer model's motors in actuator order: four carriages on the ring, two linear actuators.
 pub const SCALES: [AxisScale; 6] = [

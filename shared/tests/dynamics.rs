@@ -48,7 +48,18 @@ fn payload(rng: &mut Lcg) -> Payload<f64> {
 
 #[test]
 fn the_drives_power_is_the_rate_of_change_of_energy() {
-    let m = RingPlatform::<f64>::new(&presets::TRAINER_MODEL);
+    power_is_the_rate_of_change_of_energy(&presets::TRAINER_MODEL);
+}
+
+/// The elbow chains' shoulder torques by the same energy balance (and their carriages', which the tangent force
+/// and the forearm's line share).
+#[test]
+fn the_elbow_trainers_drives_power_is_the_rate_of_change_of_energy() {
+    power_is_the_rate_of_change_of_energy(&presets::TRAINER_ELBOW);
+}
+
+fn power_is_the_rate_of_change_of_energy(geometry: &ringpod_core::kinematics::RingGeometry) {
+    let m = RingPlatform::<f64>::new(geometry);
     let mut rng = Lcg(21);
     let mut checked = 0;
     for _ in 0..300 {

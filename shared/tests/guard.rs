@@ -121,6 +121,34 @@ fn proved_checks_pass_exactly_when_evaluated_ones_do() {
             assert!(t32.proved * 2 > t32.steps, "{t32:?}");
         }
     }
+    // The elbow chains' bounds (forearm row through the elbow, tangent row through the joint).
+    let elbow = presets::TRAINER_ELBOW;
+    for (seed, step, turn) in [(5, 5e-5, 1e-3), (6, 1e-3, 2e-2)] {
+        let t64 = walk(
+            &RingPlatform::<f64>::new(&elbow),
+            trainer_home(),
+            step,
+            turn,
+            seed,
+            50_000,
+            1e-9,
+        );
+        let t32 = walk(
+            &RingPlatform::<f32>::new(&elbow),
+            trainer_home(),
+            step,
+            turn,
+            seed,
+            50_000,
+            2e-5,
+        );
+        for t in [&t64, &t32] {
+            assert!(t.steps > 25_000 && t.near_edge > 100, "{t:?}");
+        }
+        if step <= 5e-5 {
+            assert!(t32.proved * 2 > t32.steps, "{t32:?}");
+        }
+    }
     let rotopod = RingPlatform::<f32>::new(&presets::ROTOPOD_CH4);
     let t = walk(
         &rotopod,

@@ -68,19 +68,21 @@ impl AnyMechanism {
         Ok((preset, m))
     }
 
-    /// Actuator names in the canonical order: `q<chain>` for carriage angles, `s<chain>` for radial lengths.
+    /// Actuator names in the canonical order: `q<chain>` for carriage angles, `s<chain>` for radial lengths and
+    /// then for elbow chains' shoulder angles (a chain has one or the other).
     pub fn axis_names(&self) -> [String; 6] {
         match self {
             AnyMechanism::Ring(r) => {
                 let chains = r.geometry().chains();
                 let mut names: Vec<String> = (1..=chains.len()).map(|i| format!("q{i}")).collect();
-                names.extend(
+                let second = |radial: bool| {
                     chains
                         .iter()
                         .enumerate()
-                        .filter(|(_, c)| c.kind == ChainKind::Radial)
-                        .map(|(i, _)| format!("s{}", i + 1)),
-                );
+                        .filter(move |(_, c)| (c.kind == ChainKind::Radial) == radial && c.kind.is_planar())
+                        .map(|(i, _)| format!("s{}", i + 1))
+                };
+                names.extend(second(true).chain(second(false)));
                 std::array::from_fn(|i| names.get(i).cloned().unwrap_or_default())
             }
             AnyMechanism::Tool(_) => std::array::from_fn(|i| format!("q{}", i + 1)),

@@ -7,7 +7,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use rayon::prelude::*;
 use ringpod_core::kinematics::geometry::DEG;
-use ringpod_core::kinematics::presets::{Preset, PresetGeometry, TRAINER_MODEL_RANGES};
+use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingGeometry, RingPlatform};
 
 use crate::out::plot::{self, Picture};
@@ -95,7 +95,7 @@ fn platform(args: &Options) -> anyhow::Result<(RingGeometry, [f64; 6], Option<[f
             let PresetGeometry::Ring(g) = preset.geometry() else {
                 anyhow::bail!("the workspace scan is for ring platforms")
             };
-            let ranges = (preset == Preset::TrainerModel).then_some(TRAINER_MODEL_RANGES);
+            let ranges = preset.spec_ranges();
             (*g, preset.home(), ranges)
         }
     })

@@ -340,7 +340,7 @@ pub struct StreamArgs {
 
 #[derive(Debug, Args)]
 pub struct Common {
-    /// Geometry: trainer-model, trainer-ch5, rotopod-ch4, tool5-ex (see `ringpod presets`).
+    /// Geometry: trainer-model, trainer-elbow, trainer-ch5, rotopod-ch4, tool5-ex (see `ringpod presets`).
     #[arg(long, short, default_value = "trainer-model")]
     pub mechanism: String,
     /// Your own ring platform: a rig file (TOML; see `ringpod rig check`), instead of --mechanism.

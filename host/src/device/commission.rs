@@ -98,7 +98,7 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
     let usage = if buzz {
         "usage: ringpod device buzz AXIS (1-6)"
     } else {
-        "usage: ringpod device jog AXIS DISTANCE (1-6; degrees for a carriage, mm for a linear actuator)"
+        "usage: ringpod device jog AXIS DISTANCE (1-6; degrees for a carriage or a shoulder, mm for a linear actuator)"
     };
     let axis: u8 = match words.first().map(|w| w.parse::<u8>()) {
         Some(Ok(a)) if (1..=6).contains(&a) => a - 1,
@@ -152,10 +152,10 @@ pub fn begin_move<T: Transport>(
     };
     let motor = axes[usize::from(axis)];
     let per_unit = f64::from(motor.steps_per_unit) * if motor.reverse { -1.0 } else { 1.0 };
-    // Steps per carriage turn, or per metre.
+    // Steps per carriage or shoulder turn, or per metre.
     let (steps, unit) = match kind {
-        AxisKind::Ring => (d / 360.0 * per_unit, "deg"),
-        AxisKind::Linear | AxisKind::Angle => (d / 1000.0 * per_unit, "mm"),
+        AxisKind::Ring | AxisKind::Angle => (d / 360.0 * per_unit, "deg"),
+        AxisKind::Linear => (d / 1000.0 * per_unit, "mm"),
     };
     if !steps.is_finite() || steps.abs() > f64::from(i32::MAX) {
         anyhow::bail!("{d} {unit} is out of range");
@@ -164,7 +164,7 @@ pub fn begin_move<T: Transport>(
     match client.call(Jog { axis, steps }) {
         Err(ClientError::Device(NackReason::OutOfRange)) => anyhow::bail!(
             "{d} {unit} ({steps} steps) is further than a jog goes: a carriage at most its homing back-off, a linear \
-             actuator its homing search travel"
+             actuator or a shoulder its homing search travel"
         ),
         other => other?,
     }

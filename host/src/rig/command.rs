@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use ringpod_core::kinematics::presets::{self, Preset, PresetGeometry};
+use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
 use ringpod_core::kinematics::RingPlatform;
 use serde::Serialize;
 
@@ -25,7 +25,7 @@ pub fn export(name: &str) -> Result<Outcome, CliError> {
     let header = format!(
         "# {name}: {}\n# Lengths in metres, angles of [limits] and [spec] in degrees, home = [x, y, z, roll, pitch, yaw]\n\
          # (m, rad). Chains counter-clockwise around the ring; actuators: every carriage in chain order, then every\n\
-         # radial length. Check with `ringpod rig check FILE`, use with `--geometry FILE`.\n",
+         # radial length, then every elbow chain's shoulder angle. Check with `ringpod rig check FILE`, use with `--geometry FILE`.\n",
         preset.description()
     );
     Ok(Outcome::ok(header + &body))
@@ -40,7 +40,7 @@ fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), CliE
             reason: format!("{name} is not a ring platform; rig files describe ring platforms"),
         });
     };
-    let ranges = (preset == Preset::TrainerModel).then_some(presets::TRAINER_MODEL_RANGES);
+    let ranges = preset.spec_ranges();
     Ok((
         preset,
         RigFile::of(g, preset.home(), ranges, super::drives::of_preset(preset)),

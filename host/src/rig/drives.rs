@@ -177,6 +177,7 @@ pub fn check(specs: &[DriveSpec], axes: &[AxisKind; 6]) -> Result<[Option<Drive>
 pub fn of_preset(preset: Preset) -> Vec<DriveSpec> {
     match preset {
         Preset::TrainerModel => trainer_model(),
+        Preset::TrainerElbow => trainer_elbow(),
         _ => Vec::new(),
     }
 }
@@ -221,6 +222,24 @@ fn trainer_model() -> Vec<DriveSpec> {
             source,
         },
     ]
+}
+
+/// The elbow trainer's drives: the model's carriages, and an FL20 on a 20:1 gear at each shoulder (64,000 steps
+/// per shoulder turn at 1/16 microstepping, `model::MODEL_SHOULDER`).
+fn trainer_elbow() -> Vec<DriveSpec> {
+    let mut drives = trainer_model();
+    drives[1] = DriveSpec {
+        axes: vec![5, 6],
+        motor: "FL20 on a 20:1 shoulder gear".into(),
+        gear_ratio: Some(20.0),
+        lead: None,
+        efficiency: 0.7,
+        source: "assumed: FL20STH30 size, NEMA 8 curve shape at 24 V, a 20:1 two-stage gear at 70 % (the source \
+                 builds no such arm); measure yours"
+            .to_owned(),
+        ..drives[1].clone()
+    };
+    drives
 }
 
 #[cfg(test)]

@@ -1,5 +1,6 @@
 //! Rig files: a ring platform of the builder's own, in TOML (the geometry and the names of KINEMATICS.md 2.1 and 2.2,
-//! joint limits, the home pose, the spec ranges), checked with an error that names the key and says why.
+//! the elbow chains of dissertation ch. 5.1, joint limits, the home pose, the spec ranges), checked with an error
+//! that names the key and says why.
 //!
 //! ```toml
 //! name = "my-rig"
@@ -11,9 +12,20 @@
 //! kind = "rod"
 //! branch = "plus"
 //! platform_point = [-0.06, -0.12, 0]
+//!
+//! [[chains]]
+//! kind = "elbow"               # carriage, driven shoulder, upper arm, elbow, forearm, spherical joint
+//! shoulder_radius = 0.258      # m from the ring axis, on the carriage's radius
+//! shoulder_height = 0.017      # m above the ring plane
+//! upper_arm = 0.105            # m, shoulder axis to elbow axis
+//! forearm = 0.189              # m, elbow axis to the platform joint
+//! elbow = "up"                 # or "down": the side of the shoulder-to-joint line the elbow is on
+//! platform_point = [0.181, 0.160, 0]
 //! ...
 //! [limits]                     # optional; the source's joint limits by default
 //! stroke = [0.160, 0.310]      # m, required with radial chains
+//! shoulder_angle_deg = [100, 190]  # required with elbow chains: the shoulder's travel
+//! elbow_angle_deg = [25, 155]  # interior angle at the elbow; 10..170 by default
 //! carriage_spacing_deg = [12, 120]
 //! base_cone_deg = 11
 //! platform_cone_deg = 22
@@ -45,7 +57,7 @@ pub use settings::InputsSpec;
 use std::path::Path;
 
 use ringpod_core::controller::ControllerConfig;
-use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, RingGeometry, RingLimits, DEG};
+use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, Elbow, ElbowBranch, RingGeometry, RingLimits, DEG};
 use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
 use ringpod_core::protocol::{AxisSettings, HomingSettings, MotionSettings};
 use serde::{Deserialize, Serialize};
@@ -96,13 +108,56 @@ pub struct RigFile {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChainSpec {
-    /// Rod (one actuator: the carriage) or radial (two: the carriage and the length).
+    /// Rod (one actuator: the carriage), radial (two: the carriage and the length) or elbow (two: the carriage and
+    /// the shoulder angle).
     pub kind: KindSpec,
     /// Which of the two solutions a rod chain takes (rod chains only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub branch: Option<BranchSpec>,
+    /// Elbow chains: the shoulder axis's distance from the ring axis, on the carriage's radius (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shoulder_radius: Option<f64>,
+    /// Elbow chains: the shoulder axis's height above the ring plane (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shoulder_height: Option<f64>,
+    /// Elbow chains: shoulder axis to elbow axis (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upper_arm: Option<f64>,
+    /// Elbow chains: elbow axis to the platform joint (m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub forearm: Option<f64>,
+    /// Elbow chains: which side of the shoulder-to-joint line the elbow is on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elbow: Option<ElbowSpec>,
     /// The platform joint in the platform frame (m).
     pub platform_point: [f64; 3],
+}
+
+impl ChainSpec {
+    /// A chain of `kind` at `platform_point` with no other keys.
+    fn bare(kind: KindSpec, platform_point: [f64; 3]) -> Self {
+        Self {
+            kind,
+            branch: None,
+            shoulder_radius: None,
+            shoulder_height: None,
+            upper_arm: None,
+            forearm: None,
+            elbow: None,
+            platform_point,
+        }
+    }
+
+    /// The keys only elbow chains take, with whether each is given.
+    fn elbow_keys(&self) -> [(&'static str, bool); 5] {
+        [
+            ("shoulder_radius", self.shoulder_radius.is_some()),
+            ("shoulder_height", self.shoulder_height.is_some()),
+            ("upper_arm", self.upper_arm.is_some()),
+            ("forearm", self.forearm.is_some()),
+            ("elbow", self.elbow.is_some()),
+        ]
+    }
 }
 
 /// `kind` of a chain.
@@ -113,6 +168,19 @@ pub enum KindSpec {
     Rod,
     /// Carriage, revolute joint tangent to the ring, linear actuator in the radial plane.
     Radial,
+    /// Carriage, driven shoulder revolute tangent to the ring, upper arm, elbow revolute, forearm (ch. 5.1).
+    Elbow,
+}
+
+/// `elbow` of an elbow chain.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ElbowSpec {
+    /// The elbow on the higher side of the shoulder-to-joint line (while the joint is nearer the ring axis than the
+    /// shoulder; the assembly is kept beyond).
+    Up,
+    /// The elbow on the lower side.
+    Down,
 }
 
 /// `branch` of a rod chain: `q = theta + phi` or `theta - phi`.
@@ -132,6 +200,13 @@ pub struct LimitsSpec {
     /// Linear-actuator length range (m); required when there are radial chains.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stroke: Option<[f64; 2]>,
+    /// The travel of elbow chains' shoulders (deg, the angle from the horizontal toward the ring axis, up
+    /// positive); required when there are elbow chains.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shoulder_angle_deg: Option<[f64; 2]>,
+    /// Allowed interior angle at elbow chains' elbows (deg, 0 folded, 180 stretched); 10 to 170 by default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elbow_angle_deg: Option<[f64; 2]>,
     /// Allowed central angle between neighbouring carriages (deg).
     pub carriage_spacing_deg: [f64; 2],
     /// Least angle of a chain to the base plane (deg).
@@ -150,6 +225,8 @@ impl Default for LimitsSpec {
     fn default() -> Self {
         Self {
             stroke: None,
+            shoulder_angle_deg: None,
+            elbow_angle_deg: None,
             carriage_spacing_deg: [12.0, 120.0],
             base_cone_deg: 11.0,
             platform_cone_deg: 22.0,
@@ -190,6 +267,77 @@ impl SpecRanges {
 
 fn err<T>(key: impl Into<String>, why: impl Into<String>) -> Result<T, RigError> {
     Err(RigError::new(key, why))
+}
+
+/// `limits.elbow_angle_deg` when a file does not give it: 10 degrees short of folded and of stretched, where the
+/// arm's Jacobian is singular.
+const DEFAULT_ELBOW_ANGLE_DEG: [f64; 2] = [10.0, 170.0];
+
+/// The arm of elbow chain `i`, each key checked; the joint limits are `[limits]`'s (rad), the shoulders' travel
+/// given (checked by the caller otherwise).
+fn elbow_of(c: &ChainSpec, i: usize, shoulder: Option<[f64; 2]>, elbow_angle: [f64; 2]) -> Result<Elbow, RigError> {
+    let key = |k: &str| format!("chains[{i}].{k}");
+    let need =
+        |k: &str, v: Option<f64>| v.ok_or_else(|| RigError::new(key(k), format!("an elbow chain takes `{k}` (m)")));
+    let shoulder_radius = need("shoulder_radius", c.shoulder_radius)?;
+    let shoulder_height = need("shoulder_height", c.shoulder_height)?;
+    let upper_arm = need("upper_arm", c.upper_arm)?;
+    let forearm = need("forearm", c.forearm)?;
+    for (k, v) in [
+        ("shoulder_radius", shoulder_radius),
+        ("upper_arm", upper_arm),
+        ("forearm", forearm),
+    ] {
+        positive(&key(k), v)?;
+    }
+    if !shoulder_height.is_finite() {
+        return err(
+            key("shoulder_height"),
+            format!("{shoulder_height} is not a finite height (m)"),
+        );
+    }
+    let branch = match c.elbow {
+        Some(ElbowSpec::Up) => ElbowBranch::Up,
+        Some(ElbowSpec::Down) => ElbowBranch::Down,
+        None => return err(key("elbow"), "an elbow chain takes \"up\" or \"down\""),
+    };
+    Ok(Elbow {
+        shoulder_radius,
+        shoulder_height,
+        upper_arm,
+        forearm,
+        branch,
+        // Without a travel the count of actuators or the travel's own error comes first.
+        shoulder_angle: shoulder.unwrap_or([0.0, 1.0]),
+        elbow_angle,
+    })
+}
+
+impl ChainSpec {
+    /// The chain as a rig file writes it.
+    fn of(c: &Chain) -> Self {
+        match c.kind {
+            ChainKind::Rod(b) => Self {
+                branch: Some(match b {
+                    Branch::Plus => BranchSpec::Plus,
+                    Branch::Minus => BranchSpec::Minus,
+                }),
+                ..Self::bare(KindSpec::Rod, c.platform_point)
+            },
+            ChainKind::Radial => Self::bare(KindSpec::Radial, c.platform_point),
+            ChainKind::Elbow(e) => Self {
+                shoulder_radius: Some(e.shoulder_radius),
+                shoulder_height: Some(e.shoulder_height),
+                upper_arm: Some(e.upper_arm),
+                forearm: Some(e.forearm),
+                elbow: Some(match e.branch {
+                    ElbowBranch::Up => ElbowSpec::Up,
+                    ElbowBranch::Down => ElbowSpec::Down,
+                }),
+                ..Self::bare(KindSpec::Elbow, c.platform_point)
+            },
+        }
+    }
 }
 
 /// A rig that can be analysed: a valid mechanism (lengths, chains and joints that make sense) with a home pose, spec
@@ -352,16 +500,28 @@ impl RigFile {
         if !(3..=6).contains(&n) {
             return err("chains", format!("{n} chains; a ring platform has 3 to 6"));
         }
+        let (shoulder, elbow_angle) = self.arm_limits()?;
         let mut chains = Vec::with_capacity(n);
         for (i, c) in self.chains.iter().enumerate() {
             let key = |k: &str| format!("chains[{i}].{k}");
             finite(&key("platform_point"), &c.platform_point)?;
+            if c.kind != KindSpec::Elbow {
+                if let Some((k, _)) = c.elbow_keys().into_iter().find(|(_, given)| *given) {
+                    return err(key(k), "only elbow chains have it");
+                }
+            }
             let kind = match (c.kind, c.branch) {
                 (KindSpec::Rod, Some(BranchSpec::Plus)) => ChainKind::Rod(Branch::Plus),
                 (KindSpec::Rod, Some(BranchSpec::Minus)) => ChainKind::Rod(Branch::Minus),
                 (KindSpec::Rod, None) => return err(key("branch"), "a rod chain takes \"plus\" or \"minus\""),
+                (KindSpec::Radial | KindSpec::Elbow, Some(_)) => {
+                    return err(
+                        key("branch"),
+                        "only rod chains have a branch (an elbow chain has `elbow`)",
+                    )
+                }
                 (KindSpec::Radial, None) => ChainKind::Radial,
-                (KindSpec::Radial, Some(_)) => return err(key("branch"), "only rod chains have a branch"),
+                (KindSpec::Elbow, None) => ChainKind::Elbow(elbow_of(c, i, shoulder, elbow_angle)?),
             };
             for (j, other) in self.chains[..i].iter().enumerate() {
                 let d: f64 = (0..3)
@@ -377,18 +537,49 @@ impl RigFile {
             });
         }
         let radial = chains.iter().filter(|c| c.kind == ChainKind::Radial).count();
-        if n + radial != 6 {
+        let elbows = chains.iter().filter(|c| matches!(c.kind, ChainKind::Elbow(_))).count();
+        if n + radial + elbows != 6 {
             return err(
                 "chains",
                 format!(
-                    "{n} carriages and {radial} radial lengths make {} actuators; a ring platform drives six",
-                    n + radial
+                    "{n} carriages, {radial} radial lengths and {elbows} shoulders make {} actuators; a ring \
+                     platform drives six",
+                    n + radial + elbows
                 ),
+            );
+        }
+        if elbows > 0 && shoulder.is_none() {
+            return err(
+                "limits.shoulder_angle_deg",
+                "required with elbow chains: [min, max] of the shoulders' travel (deg)",
             );
         }
         let limits = self.limits(radial)?;
         // The core's own validation is the last word (it is what the firmware builds from).
         RingGeometry::new(name, self.ring_radius, self.rod_length, &chains, limits).or_else(|e| err("", e.to_string()))
+    }
+
+    /// The elbow chains' joint limits (rad): the shoulders' travel if given, and the elbow angle's range.
+    fn arm_limits(&self) -> Result<(Option<[f64; 2]>, [f64; 2]), RigError> {
+        let l = &self.limits;
+        let shoulder = match l.shoulder_angle_deg {
+            Some(s) => {
+                finite("limits.shoulder_angle_deg", &s)?;
+                if !(s[0] < s[1] && s[1] - s[0] <= 360.0) {
+                    return err(
+                        "limits.shoulder_angle_deg",
+                        "[min, max] with min < max <= min + 360 (deg)",
+                    );
+                }
+                Some(s.map(|v| v * DEG))
+            }
+            None => None,
+        };
+        let [lo, hi] = l.elbow_angle_deg.unwrap_or(DEFAULT_ELBOW_ANGLE_DEG);
+        if !(lo >= 0.0 && lo < hi && hi <= 180.0) {
+            return err("limits.elbow_angle_deg", "[min, max] with 0 <= min < max <= 180 (deg)");
+        }
+        Ok((shoulder, [lo * DEG, hi * DEG]))
     }
 
     fn limits(&self, radial: usize) -> Result<RingLimits, RigError> {
@@ -437,29 +628,20 @@ impl RigFile {
     pub fn of(geometry: &RingGeometry, home: [f64; 6], ranges: Option<[f64; 5]>, drives: Vec<DriveSpec>) -> Self {
         let l = &geometry.limits;
         let has_radial = geometry.chains().iter().any(|c| c.kind == ChainKind::Radial);
+        let arm = geometry.chains().iter().find_map(|c| match c.kind {
+            ChainKind::Elbow(e) => Some(e),
+            _ => None,
+        });
         Self {
             name: geometry.name.to_owned(),
             ring_radius: geometry.ring_radius,
             rod_length: geometry.rod_length,
             home,
-            chains: geometry
-                .chains()
-                .iter()
-                .map(|c| ChainSpec {
-                    kind: match c.kind {
-                        ChainKind::Rod(_) => KindSpec::Rod,
-                        ChainKind::Radial => KindSpec::Radial,
-                    },
-                    branch: match c.kind {
-                        ChainKind::Rod(Branch::Plus) => Some(BranchSpec::Plus),
-                        ChainKind::Rod(Branch::Minus) => Some(BranchSpec::Minus),
-                        ChainKind::Radial => None,
-                    },
-                    platform_point: c.platform_point,
-                })
-                .collect(),
+            chains: geometry.chains().iter().map(ChainSpec::of).collect(),
             limits: LimitsSpec {
                 stroke: has_radial.then_some(l.stroke),
+                shoulder_angle_deg: arm.map(|e| e.shoulder_angle.map(degrees)),
+                elbow_angle_deg: arm.map(|e| e.elbow_angle.map(degrees)),
                 carriage_spacing_deg: l.carriage_spacing.map(degrees),
                 base_cone_deg: degrees(l.base_cone),
                 platform_cone_deg: degrees(l.platform_cone),
@@ -630,6 +812,180 @@ mod tests {
         // Syntax and unknown keys: toml's message with the line.
         let e = parse("name = \"x\"\nring_radius = 0.3\nrod_lenght = 0.2\n").unwrap_err();
         assert!(e.why.contains("rod_lenght") && e.why.contains("line 3"), "{e}");
+    }
+
+    /// A rig file with elbow chains as a builder writes it (the README's example): the trainer model's rods and
+    /// two arms of ch. 5.1 fig. 5.2.
+    const ELBOW_RIG: &str = r#"
+name = "my-elbow-rig"
+ring_radius = 0.286
+rod_length = 0.312
+home = [0, 0, 0.227, 0, 0, 0]
+
+[[chains]]
+kind = "rod"
+branch = "plus"
+platform_point = [-0.194, -0.031, 0]
+
+[[chains]]
+kind = "rod"
+branch = "minus"
+platform_point = [0.194, -0.031, 0]
+
+[[chains]]
+kind = "elbow"
+shoulder_radius = 0.258
+shoulder_height = 0.017
+upper_arm = 0.105
+forearm = 0.189
+elbow = "up"
+platform_point = [0.181, 0.160, 0]
+
+[[chains]]
+kind = "elbow"
+shoulder_radius = 0.258
+shoulder_height = 0.017
+upper_arm = 0.105
+forearm = 0.189
+elbow = "up"
+platform_point = [-0.181, 0.160, 0]
+
+[limits]
+shoulder_angle_deg = [100, 190]
+elbow_angle_deg = [25, 155]
+min_singularity_index = 0.02
+centre_of_mass = [0, 0, 0.02]
+"#;
+
+    #[test]
+    fn a_rig_file_with_elbow_chains_drives_the_preset_s_ik() {
+        let rig = parse(ELBOW_RIG).and_then(|f| f.check()).unwrap();
+        let m = RingPlatform::<f64>::new(&rig.geometry);
+        let preset = RingPlatform::<f64>::new(&presets::TRAINER_ELBOW);
+        assert_eq!(m.axes(), preset.axes());
+        let mut uniform = uniform(9);
+        for _ in 0..1_000 {
+            let p = Pose::new(
+                uniform() * 0.05,
+                uniform() * 0.05,
+                0.227 + uniform() * 0.04,
+                uniform() * 0.3,
+                uniform() * 0.3,
+                uniform() * 4.0,
+            );
+            assert_eq!(m.inverse(&p), preset.inverse(&p));
+        }
+        // The preset's own file round-trips and restates the preset exactly.
+        let file = RigFile::of(
+            &presets::TRAINER_ELBOW,
+            Preset::TrainerElbow.home(),
+            Preset::TrainerElbow.spec_ranges(),
+            drives::of_preset(Preset::TrainerElbow),
+        );
+        let text = file.to_toml().unwrap();
+        let back = parse(&text).unwrap();
+        assert_eq!(back, file);
+        let rig = back.check().unwrap();
+        let mut renamed = rig.geometry;
+        renamed.name = presets::TRAINER_ELBOW.name;
+        assert_eq!(renamed, presets::TRAINER_ELBOW);
+        assert_eq!(rig.record.geometry().unwrap(), presets::TRAINER_ELBOW);
+    }
+
+    /// Each mistake in an elbow chain or its limits, and the key its error names.
+    #[test]
+    fn every_invalid_elbow_key_is_named() {
+        type Mistake = Box<dyn Fn(&mut RigFile)>;
+        let cases: Vec<(&str, Mistake)> = vec![
+            (
+                "chains[2].shoulder_radius",
+                Box::new(|f| f.chains[2].shoulder_radius = None),
+            ),
+            (
+                "chains[2].shoulder_radius",
+                Box::new(|f| f.chains[2].shoulder_radius = Some(0.0)),
+            ),
+            (
+                "chains[3].shoulder_height",
+                Box::new(|f| f.chains[3].shoulder_height = None),
+            ),
+            (
+                "chains[3].shoulder_height",
+                Box::new(|f| f.chains[3].shoulder_height = Some(f64::INFINITY)),
+            ),
+            ("chains[2].upper_arm", Box::new(|f| f.chains[2].upper_arm = Some(-0.1))),
+            ("chains[2].upper_arm", Box::new(|f| f.chains[2].upper_arm = None)),
+            ("chains[3].forearm", Box::new(|f| f.chains[3].forearm = Some(f64::NAN))),
+            ("chains[2].elbow", Box::new(|f| f.chains[2].elbow = None)),
+            (
+                "chains[2].branch",
+                Box::new(|f| f.chains[2].branch = Some(BranchSpec::Plus)),
+            ),
+            ("chains[0].upper_arm", Box::new(|f| f.chains[0].upper_arm = Some(0.1))),
+            (
+                "chains[1].elbow",
+                Box::new(|f| f.chains[1].elbow = Some(ElbowSpec::Down)),
+            ),
+            (
+                "chains[2].shoulder_radius",
+                Box::new(|f| {
+                    f.chains[2].kind = KindSpec::Radial;
+                    f.limits.stroke = Some([0.1, 0.3]);
+                }),
+            ),
+            (
+                "limits.shoulder_angle_deg",
+                Box::new(|f| f.limits.shoulder_angle_deg = None),
+            ),
+            (
+                "limits.shoulder_angle_deg",
+                Box::new(|f| f.limits.shoulder_angle_deg = Some([190.0, 100.0])),
+            ),
+            (
+                "limits.shoulder_angle_deg",
+                Box::new(|f| f.limits.shoulder_angle_deg = Some([0.0, f64::NAN])),
+            ),
+            (
+                "limits.elbow_angle_deg",
+                Box::new(|f| f.limits.elbow_angle_deg = Some([0.0, 200.0])),
+            ),
+            (
+                "limits.elbow_angle_deg",
+                Box::new(|f| f.limits.elbow_angle_deg = Some([90.0, 90.0])),
+            ),
+            // Arms too short for the home pose, or the home pose outside the shoulders' travel.
+            (
+                "home",
+                Box::new(|f| {
+                    f.chains[2].upper_arm = Some(0.05);
+                    f.chains[2].forearm = Some(0.05);
+                }),
+            ),
+            ("home", Box::new(|f| f.limits.shoulder_angle_deg = Some([160.0, 190.0]))),
+            (
+                "chains",
+                Box::new(|f| {
+                    let mut extra = f.chains[2].clone();
+                    extra.platform_point = [0.0, -0.2, 0.0];
+                    f.chains.push(extra);
+                }),
+            ),
+        ];
+        for (key, break_it) in cases {
+            let mut f = parse(ELBOW_RIG).unwrap();
+            break_it(&mut f);
+            let e = f.check().expect_err(key);
+            assert_eq!(e.key, key, "{e}");
+            assert!(!e.why.is_empty());
+        }
+        // A value or a key toml cannot take: its message names it and the line.
+        let line_of = |what: &str| ELBOW_RIG[..ELBOW_RIG.find(what).unwrap()].matches('\n').count() + 1;
+        let e = parse(&ELBOW_RIG.replacen("elbow = \"up\"", "elbow = \"sideways\"", 1)).unwrap_err();
+        let line = format!("line {}", line_of("elbow = \"up\""));
+        assert!(e.why.contains("sideways") && e.why.contains(&line), "{e}");
+        let e = parse(&ELBOW_RIG.replacen("forearm = 0.189", "fore_arm = 0.189", 1)).unwrap_err();
+        let line = format!("line {}", line_of("forearm = 0.189"));
+        assert!(e.why.contains("fore_arm") && e.why.contains(&line), "{e}");
     }
 
     fn perturbed(factors: [f64; 10]) -> RigFile {

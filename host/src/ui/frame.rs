@@ -39,7 +39,8 @@ impl RigView {
                 .iter()
                 .map(|c| match c.kind {
                     ChainKind::Radial => "radial",
-                    _ => "rod",
+                    ChainKind::Elbow(_) => "elbow",
+                    ChainKind::Rod(_) => "rod",
                 })
                 .collect(),
             axes: m

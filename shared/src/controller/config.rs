@@ -6,7 +6,7 @@ use super::Controller;
 use crate::kinematics::presets::{self, Preset};
 use crate::kinematics::{AxisKind, KinematicsError, Mechanism, Pose, RingPlatform};
 use crate::kinematics::{GeometryError, RingGeometry};
-use crate::model::{self, CARRIAGE_HOMING, LINEAR_HOMING};
+use crate::model::{self, CARRIAGE_HOMING, LINEAR_HOMING, SHOULDER_HOMING};
 use crate::motion::pulse::{PulseTiming, PulseTimingError, MAX_STEP_SLOTS, STEP_SLOT_NS};
 use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
 use crate::protocol::{ConfigRefusal, Field, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
@@ -169,8 +169,10 @@ impl ControllerConfig {
 
     /// The trainer model's drives, switches and timings on another ring platform (its own geometry and home
     /// pose): each carriage with the model's carriage drive and index-switch homing, each linear actuator with the
-    /// model's lead screw and its lower end switch 1 mm below the stroke; linear actuators home first, then every
-    /// other carriage, then the rest (the homing plan's spacing proof decides whether that order is safe).
+    /// model's lead screw and its lower end switch 1 mm below the stroke, each elbow chain's shoulder with
+    /// [`AxisScale::MODEL_SHOULDER`] and an index flag at its home angle ([`model::SHOULDER_HOMING`]); linear
+    /// actuators and shoulders home first, then every other carriage, then the rest (the homing plan's spacing
+    /// proof decides whether that order is safe).
     pub fn for_rig(geometry: &RingGeometry, home: [f64; 6]) -> Result<Self, ConfigError> {
         Self::from_record(&Self::default_record(geometry.name, geometry, home))
     }
@@ -195,6 +197,9 @@ impl ControllerConfig {
                     }),
                     ..CARRIAGE_HOMING
                 };
+            } else if *kind == AxisKind::Angle {
+                machine.axes[a].steps_per_unit = AxisScale::MODEL_SHOULDER.steps_per_turn as f32;
+                machine.homing.axes[a] = SHOULDER_HOMING;
             } else {
                 machine.axes[a].steps_per_unit = AxisScale::MODEL_LINEAR.steps_per_unit;
                 let switch = geometry.limits.stroke[0] - 0.001 - q[a];
@@ -226,6 +231,19 @@ impl ControllerConfig {
             rig_name: record.name,
             ..Self::trainer_model()
         };
+        // Each axis's actuator limits are its kind's on the model's drives (a rig's fifth carriage turns like a
+        // carriage, a shoulder like a shoulder).
+        let model = crate::motion::MotionLimits::TRAINER_MODEL;
+        let limits = &mut config.pipeline.limits;
+        for (a, kind) in RingPlatform::<f64>::new(&geometry).axes().iter().enumerate() {
+            let (v, acc) = match kind {
+                AxisKind::Ring => (model.actuator_velocity[0], model.actuator_acceleration[0]),
+                AxisKind::Linear => (model.actuator_velocity[4], model.actuator_acceleration[4]),
+                AxisKind::Angle => (model::SHOULDER_VELOCITY, model::SHOULDER_ACCELERATION),
+            };
+            limits.actuator_velocity[a] = v;
+            limits.actuator_acceleration[a] = acc;
+        }
         let m = &record.machine;
         for section in [
             Settings::Axes(m.axes),

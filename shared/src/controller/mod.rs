@@ -191,8 +191,9 @@ impl Controller {
         }
     }
 
-    /// New input levels: changes become supervisor events. A linear actuator's home end is also an
-    /// end-of-travel limit outside homing; a carriage passes its index switch every turn, which is no fault.
+    /// New input levels: changes become supervisor events. A linear actuator's home end is also an end-of-travel
+    /// limit outside homing; a carriage passes its index switch every turn and a shoulder its index flag, which is
+    /// no fault.
     pub fn set_inputs(&mut self, inputs: Inputs) {
         let old = self.inputs;
         self.inputs = inputs;

@@ -67,7 +67,8 @@ impl ControllerConfig {
             AxisSettings {
                 steps_per_unit: match kinds[a] {
                     AxisKind::Ring => s.steps_per_turn as f32,
-                    AxisKind::Linear | AxisKind::Angle => s.steps_per_unit,
+                    AxisKind::Angle => s.steps_per_unit * core::f32::consts::TAU,
+                    AxisKind::Linear => s.steps_per_unit,
                 },
                 reverse: s.invert,
             }
@@ -262,7 +263,8 @@ pub(super) fn supervisor_fields(s: &SupervisorConfig) -> Result<(), ConfigError>
     }
 }
 
-/// A motor's scale, checked: 1 to 2^24 steps per unit, whole steps per carriage turn on the ring.
+/// A motor's scale, checked: 1 to 2^24 steps per unit, whole steps per carriage turn on the ring; a shoulder's
+/// (an angle axis) is given per turn too, not necessarily whole (a gear's ratio need not be).
 fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Option<AxisScale> {
     let v = axis.steps_per_unit;
     if !(v.is_finite() && (1.0..=16_777_216.0).contains(&v)) {
@@ -275,7 +277,12 @@ fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Option<AxisScale> {
             steps_per_unit: v / core::f32::consts::TAU,
             invert: axis.reverse,
         },
-        AxisKind::Linear | AxisKind::Angle => AxisScale {
+        AxisKind::Angle => AxisScale {
+            steps_per_turn: 0,
+            steps_per_unit: v / core::f32::consts::TAU,
+            invert: axis.reverse,
+        },
+        AxisKind::Linear => AxisScale {
             steps_per_turn: 0,
             steps_per_unit: v,
             invert: axis.reverse,

@@ -13,7 +13,8 @@ pub enum Reach {
     Ring,
     /// The platform joint is on the ring axis, where the carriage angle is undefined.
     Centre,
-    /// A planar dyad cannot close: the pivot distance is out of `[|L2 - L3|, L2 + L3]`.
+    /// A planar dyad cannot close: the pivot distance is out of `[|L2 - L3|, L2 + L3]` (the tool carrier's dyads;
+    /// an elbow chain's arm, shoulder to platform joint, out of `[|upper_arm - forearm|, upper_arm + forearm]`).
     Dyad,
 }
 

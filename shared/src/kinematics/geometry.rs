@@ -57,8 +57,78 @@ pub enum Branch {
     Minus,
 }
 
-/// The kind of a chain from a ring carriage to the platform.
+/// Which of the two assemblies of its arm an elbow chain takes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[derive(serde::Serialize, serde::Deserialize)]
+pub enum ElbowBranch {
+    /// The elbow on the higher side of the shoulder-to-joint line (while the joint is nearer the ring axis than the
+    /// shoulder): `s = psi + phi` in the arm's plane, counter-clockwise from the shoulder-to-joint direction `psi`
+    /// seen with `u` (toward the ring axis) to the right and `z` up.
+    Up,
+    /// The elbow on the lower side: `s = psi - phi`.
+    Down,
+}
+
+/// The arm of an elbow chain (chapter 5.1, fig. 5.2): on the carriage, a shoulder revolute whose axis is tangent to
+/// the ring, an upper arm, an elbow revolute parallel to it, a forearm to the platform's spherical joint. The arm
+/// moves in the carriage's vertical radial plane; its drive is the shoulder (a rotary motor).
+///
+/// The shoulder angle `s` (rad) is measured in that plane from `u`, the horizontal unit vector from the shoulder
+/// toward the ring axis, toward `z` (up): the upper arm points along `cos(s) u + sin(s) z`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Elbow {
+    /// Distance of the shoulder axis from the ring axis, on the carriage's radius (m).
+    pub shoulder_radius: f64,
+    /// Height of the shoulder axis above the ring plane (m).
+    pub shoulder_height: f64,
+    /// Shoulder axis to elbow axis (m).
+    pub upper_arm: f64,
+    /// Elbow axis to the platform joint's centre (m).
+    pub forearm: f64,
+    /// Which assembly the arm takes.
+    pub branch: ElbowBranch,
+    /// The shoulder's travel `[min, max]` (rad), at most one turn: the reach check keeps `s` inside, and IK gives
+    /// `s` within half a turn of its middle.
+    pub shoulder_angle: [f64; 2],
+    /// Allowed interior angle at the elbow between upper arm and forearm `[min, max]` (rad, within `[0, pi]`):
+    /// 0 is folded, `pi` stretched (both singular).
+    pub elbow_angle: [f64; 2],
+}
+
+impl Elbow {
+    /// Checks the arm's dimensions and limits.
+    pub const fn validate(&self) -> Result<(), GeometryError> {
+        let e = self;
+        let finite = e.shoulder_radius.is_finite()
+            && e.shoulder_height.is_finite()
+            && e.upper_arm.is_finite()
+            && e.forearm.is_finite()
+            && e.shoulder_angle[0].is_finite()
+            && e.shoulder_angle[1].is_finite()
+            && e.elbow_angle[0].is_finite()
+            && e.elbow_angle[1].is_finite();
+        if !finite {
+            return Err(GeometryError::NonFinite);
+        }
+        if e.shoulder_radius <= 0.0 || e.upper_arm <= 0.0 || e.forearm <= 0.0 {
+            return Err(GeometryError::NonPositiveLength);
+        }
+        let [s0, s1] = e.shoulder_angle;
+        let [e0, e1] = e.elbow_angle;
+        // Written as "all in range" so that NaN, which compares false, fails.
+        let ok =
+            s0 < s1 && s1 - s0 <= 2.0 * core::f64::consts::PI && e0 >= 0.0 && e0 < e1 && e1 <= core::f64::consts::PI;
+        if !ok {
+            return Err(GeometryError::BadLimits);
+        }
+        Ok(())
+    }
+}
+
+/// The kind of a chain from a ring carriage to the platform.
+#[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[derive(serde::Serialize, serde::Deserialize)]
 pub enum ChainKind {
@@ -67,12 +137,25 @@ pub enum ChainKind {
     /// Carriage -> revolute joint tangent to the ring -> linear actuator -> spherical joint; the actuator stays in
     /// the vertical plane through the ring centre. Two actuators: the carriage angle and the length.
     Radial,
+    /// Carriage -> shoulder revolute tangent to the ring (driven) -> upper arm -> elbow revolute -> forearm ->
+    /// spherical joint; the arm stays in the vertical plane through the ring centre. Two actuators: the carriage
+    /// angle and the shoulder angle.
+    Elbow(Elbow),
+}
+
+impl ChainKind {
+    /// Whether the chain's platform joint stays in its carriage's vertical radial plane (radial and elbow chains):
+    /// a second actuator, a planarity constraint and a second transmitted wrench (through the joint, tangent to the
+    /// ring).
+    pub const fn is_planar(&self) -> bool {
+        matches!(self, Self::Radial | Self::Elbow(_))
+    }
 }
 
 /// One chain: its kind and its platform joint in platform coordinates (m).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Chain {
-    /// Rod or radial chain.
+    /// Rod, radial or elbow chain.
     pub kind: ChainKind,
     /// Platform joint `a_i` in the platform frame (m).
     pub platform_point: [f64; 3],
@@ -137,7 +220,8 @@ impl RingGeometry {
     /// Builds and validates a ring geometry.
     ///
     /// Actuators are numbered as in KINEMATICS.md: first the carriage angle of every chain in chain order, then
-    /// the length of every radial chain in chain order; there must be exactly six. Chains are listed counter-
+    /// the length of every radial chain in chain order, then the shoulder angle of every elbow chain in chain order;
+    /// there must be exactly six. Chains are listed counter-
     /// clockwise around the ring, which is the order the spacing and crossing checks assume.
     pub const fn new(
         name: &'static str,
@@ -167,8 +251,15 @@ impl RingGeometry {
             if !finite3(c.platform_point) {
                 return Err(GeometryError::NonFinite);
             }
-            if let ChainKind::Radial = c.kind {
-                actuators += 1;
+            match c.kind {
+                ChainKind::Rod(_) => {}
+                ChainKind::Radial => actuators += 1,
+                ChainKind::Elbow(e) => {
+                    if let Err(e) = e.validate() {
+                        return Err(e);
+                    }
+                    actuators += 1;
+                }
             }
             let mut j = 0;
             while j < i {
@@ -210,6 +301,20 @@ impl RingGeometry {
     /// The chains, in counter-clockwise order around the ring.
     pub fn chains(&self) -> &[Chain] {
         self.chains.get(..self.chain_count).unwrap_or(&[])
+    }
+
+    /// The arm of the elbow chain whose shoulder angle is actuator `axis` (0-based), if it is one.
+    pub fn arm_of_axis(&self, axis: usize) -> Option<Elbow> {
+        let chains = self.chains();
+        let radial = chains.iter().filter(|c| c.kind == ChainKind::Radial).count();
+        let k = axis.checked_sub(chains.len() + radial)?;
+        chains
+            .iter()
+            .filter_map(|c| match c.kind {
+                ChainKind::Elbow(e) => Some(e),
+                _ => None,
+            })
+            .nth(k)
     }
 }
 

@@ -18,7 +18,9 @@ pub mod workspace;
 
 pub use error::{KinematicsError, Reach};
 pub use forward::{start_from_home, ForwardSolution, NewtonOptions, FROM_HOME_DISTANCE};
-pub use geometry::{Branch, Chain, ChainKind, GeometryError, RingGeometry, RingLimits, ToolGeometry};
+pub use geometry::{
+    Branch, Chain, ChainKind, Elbow, ElbowBranch, GeometryError, RingGeometry, RingLimits, ToolGeometry,
+};
 pub use multiturn::MultiTurn;
 pub use pose::{Actuators, Pose};
 pub use ring::{ActuatorLoads, BodyMotion, MotionState, Payload, RingPlatform, SlowCheckGuard};

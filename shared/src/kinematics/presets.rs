@@ -1,7 +1,8 @@
 //! Built-in geometries. Each is validated in `const` context: a preset that cannot be built fails compilation.
 
 use super::geometry::{
-    unwrap_geometry, Branch, Chain, ChainKind, RingGeometry, RingLimits, ToolGeometry, DEG, SOURCE_SPACING,
+    unwrap_geometry, Branch, Chain, ChainKind, Elbow, ElbowBranch, RingGeometry, RingLimits, ToolGeometry, DEG,
+    SOURCE_SPACING,
 };
 
 const fn rod(branch: Branch, x: f64, y: f64) -> Chain {
@@ -110,6 +111,53 @@ pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
     },
 ));
 
+/// The arm of [`TRAINER_ELBOW`]'s elbow chains, in metres.
+///
+/// Found by `examples/trainer_elbow_design.rs` (a random search over shoulder radius 0.22..0.33 m, height, upper arm,
+/// forearm and branch, scoring the arms' worst margin over the model's spec table swept axis by axis at 24 yaws) and
+/// rounded to millimetres: the shoulder 28 mm inside the ring, 17 mm above it; upper arm 105 mm, forearm 189 mm,
+/// elbow up. Over that sweep the elbow's interior angle stays 20 degrees or more inside its 25..155 degree limits,
+/// the forearm 10 degrees or more above the platform cone, the singularity index above 0.05; the shoulder needs
+/// 114..175 degrees (the upper arm points outward and up), and its travel is that plus 14..15 degrees each way
+/// (index or end switch below 100 degrees). An arm whose shoulder sits up to 0.40 m out (an outrigger) scored only
+/// a little better.
+pub const TRAINER_ELBOW_ARM: Elbow = Elbow {
+    shoulder_radius: 0.258,
+    shoulder_height: 0.017,
+    upper_arm: 0.105,
+    forearm: 0.189,
+    branch: ElbowBranch::Up,
+    shoulder_angle: [100.0 * DEG, 190.0 * DEG],
+    elbow_angle: [25.0 * DEG, 155.0 * DEG],
+};
+
+const fn elbow(x: f64, y: f64) -> Chain {
+    Chain {
+        kind: ChainKind::Elbow(TRAINER_ELBOW_ARM),
+        platform_point: [x, y, 0.0],
+    }
+}
+
+/// The 1:20 trainer model with the arms of dissertation ch. 5.1 (fig. 5.2) in place of its linear actuators: the
+/// same ring, rods, platform joints, limits and home pose, and two elbow chains whose shoulders are driven by rotary
+/// motors (actuators: four carriages, then the two shoulder angles). See [`TRAINER_ELBOW_ARM`] for the arms.
+pub const TRAINER_ELBOW: RingGeometry = unwrap_geometry(RingGeometry::new(
+    "trainer-elbow",
+    TRAINER_MODEL.ring_radius,
+    TRAINER_MODEL.rod_length,
+    &[
+        rod(Branch::Plus, -0.194, -0.031),
+        rod(Branch::Minus, 0.194, -0.031),
+        elbow(0.181, 0.160),
+        elbow(-0.181, 0.160),
+    ],
+    // The model's limits; no linear actuators, so the stroke is a rig file's default for none.
+    RingLimits {
+        stroke: [0.0, 1.0],
+        ..TRAINER_MODEL.limits
+    },
+));
+
 /// Motion ranges of the model's spec table around [`TRAINER_MODEL_HOME_Z`]: surge, sway, heave (m), roll, pitch
 /// (rad); yaw is continuous.
 pub const TRAINER_MODEL_RANGES: [f64; 5] = [0.050, 0.050, 0.040, 20.0 * DEG, 20.0 * DEG];
@@ -125,6 +173,8 @@ pub enum Preset {
     RotopodCh4,
     /// [`TRAINER_MODEL`].
     TrainerModel,
+    /// [`TRAINER_ELBOW`].
+    TrainerElbow,
     /// [`TOOL5_EX`].
     Tool5Ex,
 }
@@ -140,8 +190,9 @@ pub enum PresetGeometry {
 
 impl Preset {
     /// Every preset.
-    pub const ALL: [Preset; 4] = [
+    pub const ALL: [Preset; 5] = [
         Preset::TrainerModel,
+        Preset::TrainerElbow,
         Preset::TrainerCh5,
         Preset::RotopodCh4,
         Preset::Tool5Ex,
@@ -153,6 +204,7 @@ impl Preset {
             Preset::TrainerCh5 => "trainer-ch5",
             Preset::RotopodCh4 => "rotopod-ch4",
             Preset::TrainerModel => "trainer-model",
+            Preset::TrainerElbow => "trainer-elbow",
             Preset::Tool5Ex => "tool5-ex",
         }
     }
@@ -168,6 +220,9 @@ impl Preset {
             Preset::TrainerCh5 => "trainer of dissertation ch. 5, normalised units (ring radius 3)",
             Preset::RotopodCh4 => "rotopod of dissertation ch. 4, six rod chains, normalised units",
             Preset::TrainerModel => "1:20 trainer model driven by the firmware, metres (ring radius 0.286 m)",
+            Preset::TrainerElbow => {
+                "the 1:20 trainer model with elbow arms (ch. 5.1 fig. 5.2) for its linear actuators"
+            }
             Preset::Tool5Ex => "five-DOF tool carrier of the worked position problem, metres",
         }
     }
@@ -178,7 +233,17 @@ impl Preset {
             Preset::TrainerCh5 => PresetGeometry::Ring(&TRAINER_CH5),
             Preset::RotopodCh4 => PresetGeometry::Ring(&ROTOPOD_CH4),
             Preset::TrainerModel => PresetGeometry::Ring(&TRAINER_MODEL),
+            Preset::TrainerElbow => PresetGeometry::Ring(&TRAINER_ELBOW),
             Preset::Tool5Ex => PresetGeometry::Tool(&TOOL5_EX),
+        }
+    }
+
+    /// The motion ranges of its spec table, `+-` around home (surge, sway, heave in m, roll, pitch in rad), for the
+    /// 1:20 model and its elbow variant; `None` for the reference geometries.
+    pub const fn spec_ranges(self) -> Option<[f64; 5]> {
+        match self {
+            Preset::TrainerModel | Preset::TrainerElbow => Some(TRAINER_MODEL_RANGES),
+            _ => None,
         }
     }
 
@@ -187,7 +252,7 @@ impl Preset {
         match self {
             Preset::TrainerCh5 => [0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
             Preset::RotopodCh4 => [0.0, 0.0, 0.7, 0.0, 0.0, 0.0],
-            Preset::TrainerModel => [0.0, 0.0, TRAINER_MODEL_HOME_Z, 0.0, 0.0, 0.0],
+            Preset::TrainerModel | Preset::TrainerElbow => [0.0, 0.0, TRAINER_MODEL_HOME_Z, 0.0, 0.0, 0.0],
             Preset::Tool5Ex => [0.0, 0.0, 0.4, 0.0, 0.0, 0.0],
         }
     }

@@ -50,7 +50,8 @@ pub struct MotionSettings {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AxisSettings {
-    /// Motor steps per carriage turn (ring axes, a whole number) or per metre (linear axes), 1 to 2^24.
+    /// Motor steps per carriage turn (ring axes, a whole number), per metre (linear axes) or per shoulder turn
+    /// (elbow chains' shoulders), 1 to 2^24.
     pub steps_per_unit: f32,
     /// The motor turns the other way round: its steps and its homing (direction, switch) are mirrored.
     #[serde(default)]

@@ -62,7 +62,10 @@ impl Chains {
 /// - rod chain: the carriage (revolute about the ring axis Z through the centre, driven), the spherical pair at
 ///   the carriage `B`, the pin-spherical pair at the platform joint `A` (along the platform's X' and Y');
 /// - radial chain: the carriage (driven), the revolute at `B` along the ring's tangent, the prismatic pair along
-///   `B -> A` (driven; the source's screw is `B -> A` itself), the spherical pair at `A`.
+///   `B -> A` (driven; the source's screw is `B -> A` itself), the spherical pair at `A`;
+/// - elbow chain (fig. 5.2): the carriage (driven), the shoulder revolute along the ring's tangent at the shoulder
+///   `S` (driven), the elbow revolute parallel to it at the elbow `E`, the spherical pair at `A` (wrenches oriented
+///   along the forearm `E -> A`).
 pub fn ring_chains(platform: &RingPlatform<f64>, pose: &Pose<f64>) -> Result<Chains, LayoutError> {
     let q = platform.inverse(pose)?.0;
     let geometry = platform.geometry();
@@ -73,16 +76,33 @@ pub fn ring_chains(platform: &RingPlatform<f64>, pose: &Pose<f64>) -> Result<Cha
         chains: [None; 6],
         count: 0,
     };
-    for (i, c) in geometry.chains().iter().enumerate() {
+    // Shoulder angles follow the carriages and the radial lengths.
+    let chains = geometry.chains();
+    let mut shoulder_axis = chains.len() + chains.iter().filter(|c| c.kind == ChainKind::Radial).count();
+    for (i, c) in chains.iter().enumerate() {
         let (qi, a) = (q[i], joints[i]);
         let (s, co) = libm::sincos(qi);
         let b = Vector3::new(rr * co, rr * s, 0.0);
+        if let ChainKind::Elbow(e) = c.kind {
+            let shoulder = Vector3::new(e.shoulder_radius * co, e.shoulder_radius * s, e.shoulder_height);
+            let (ss, cs) = libm::sincos(q.get(shoulder_axis).copied().unwrap_or(0.0));
+            shoulder_axis += 1;
+            let elbow = shoulder + (Vector3::new(-co, -s, 0.0) * cs + Vector3::z() * ss) * e.upper_arm;
+            let tangent = Vector3::new(-s, co, 0.0);
+            let chain = Chain::new(elbow, a)?
+                .revolute(Vector3::z(), Vector3::zeros(), true)?
+                .revolute(tangent, shoulder, true)?
+                .revolute(tangent, elbow, false)?
+                .spherical(a)?;
+            out.push(chain)?;
+            continue;
+        }
         let carriage = Chain::new(b, a)?.revolute(Vector3::z(), Vector3::zeros(), true)?;
         let chain = match c.kind {
             ChainKind::Rod(_) => carriage
                 .spherical(b)?
                 .pin_spherical(a, [rotation * Vector3::x(), rotation * Vector3::y()])?,
-            ChainKind::Radial => carriage
+            ChainKind::Radial | ChainKind::Elbow(_) => carriage
                 .revolute(Vector3::new(-s, co, 0.0), b, false)?
                 .prismatic(a - b, (a - b).norm(), true)?
                 .spherical(a)?,

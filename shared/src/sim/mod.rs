@@ -28,20 +28,23 @@ pub use crate::model::TRAINER_MODEL_PARKED;
 /// Where the simulator parks a ring platform's axes (steps from each switch), as it parks the trainer model
 /// ([`TRAINER_MODEL_PARKED`], which this gives for the model's axes): carriages 500 to 100 steps (7 to 1.4 degrees
 /// at the model's 25,600 steps per turn) before their index flags, linear actuators 8,000 to 9,000 steps (5 to 5.6
-/// mm) above their home ends. Carriages and linear actuators each take the next of their own kind's positions, so a
-/// rotopod's fifth and sixth carriages park like carriages, not like the model's actuators.
+/// mm) above their home ends, elbow chains' shoulders 900 to 400 steps (5 to 2.3 degrees at 64,000 steps per turn)
+/// before their index flags. Each kind takes the next of its own kind's positions, so a rotopod's fifth and sixth
+/// carriages park like carriages, not like the model's actuators.
 pub fn parked(axes: &[crate::kinematics::AxisKind; 6]) -> [i64; 6] {
+    use crate::kinematics::AxisKind;
     const CARRIAGES: [i64; 6] = [-500, -400, -300, -200, -150, -100];
     const LINEAR: [i64; 6] = [8_000, 9_000, 8_500, 8_000, 9_000, 8_500];
-    let (mut carriage, mut linear) = (0, 0);
+    const SHOULDERS: [i64; 6] = [-900, -400, -700, -600, -500, -800];
+    let mut next = [0usize; 3];
     core::array::from_fn(|a| {
-        if axes[a] == crate::kinematics::AxisKind::Ring {
-            carriage += 1;
-            CARRIAGES[carriage - 1]
-        } else {
-            linear += 1;
-            LINEAR[linear - 1]
-        }
+        let (k, positions) = match axes[a] {
+            AxisKind::Ring => (0, &CARRIAGES),
+            AxisKind::Linear => (1, &LINEAR),
+            AxisKind::Angle => (2, &SHOULDERS),
+        };
+        next[k] += 1;
+        positions[(next[k] - 1) % 6]
     })
 }
 pub use flash::RamFlash;
@@ -93,14 +96,14 @@ impl Plant {
         }
     }
 
-    /// Another ring platform parked like the trainer model: carriages with index flags, linear actuators with a
-    /// home end switch and a far end `far_limit` steps above it.
+    /// Another ring platform parked like the trainer model: carriages and elbow chains' shoulders with index flags,
+    /// linear actuators with a home end switch and a far end `far_limit` steps above it.
     pub fn for_axes(axes: &[crate::kinematics::AxisKind; 6], start: [i64; 6], far_limit: i64) -> Self {
         let model = Self::trainer_model(start);
         let (carriage, linear) = (model.switches[0], model.switches[4]);
         Self {
             switches: core::array::from_fn(|a| {
-                if axes[a] == crate::kinematics::AxisKind::Ring {
+                if axes[a] != crate::kinematics::AxisKind::Linear {
                     carriage
                 } else {
                     AxisSwitches {
@@ -113,8 +116,9 @@ impl Plant {
         }
     }
 
-    /// The machine a configuration describes, parked as [`parked`] parks its axes: carriages with index flags,
-    /// linear actuators with a home end switch and a far end switch 2 mm past their stroke.
+    /// The machine a configuration describes, parked as [`parked`] parks its axes: carriages and elbow chains'
+    /// shoulders with index flags, linear actuators with a home end switch and a far end switch 2 mm past their
+    /// stroke.
     pub fn for_config(config: &crate::controller::ControllerConfig) -> Self {
         use crate::kinematics::Mechanism;
         let axes = crate::kinematics::RingPlatform::<f64>::new(&config.geometry).axes();
@@ -123,7 +127,7 @@ impl Plant {
         let per_m = axes
             .iter()
             .zip(&config.scales)
-            .find(|(k, _)| **k != crate::kinematics::AxisKind::Ring)
+            .find(|(k, _)| **k == crate::kinematics::AxisKind::Linear)
             .map_or(0.0, |(_, s)| f64::from(s.steps_per_unit));
         let far = ((stroke[1] - stroke[0] + 0.002) * per_m) as i64;
         let mut plant = Self::for_axes(&axes, start, far);

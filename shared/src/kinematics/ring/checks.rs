@@ -8,9 +8,9 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::RingPlatform;
+use super::{RingPlatform, Shape};
 use crate::kinematics::velocity::hadamard_ratio_in_place;
-use crate::kinematics::{Actuators, ChainKind, Pose, WorkspaceReport};
+use crate::kinematics::{Actuators, Pose, WorkspaceReport};
 use crate::real::{length, wrap_once, wrap_pi};
 use crate::Real;
 
@@ -25,7 +25,9 @@ pub(super) struct Configuration<T: Real> {
     pub joints: [Vector3<T>; 6],
     /// Carriage joints `B_i` on the ring.
     pub carriages: [Vector3<T>; 6],
-    /// Unit vector from carriage to platform joint.
+    /// Where each chain's last link starts: the carriage joint, or an elbow chain's elbow.
+    pub bases: [Vector3<T>; 6],
+    /// Unit vector along each chain's last link, toward the platform joint.
     pub dirs: [Vector3<T>; 6],
 }
 
@@ -46,14 +48,15 @@ impl<T: Real> Configuration<T> {
             rotation: Matrix3::zeros(),
             joints: [Vector3::zeros(); 6],
             carriages: [Vector3::zeros(); 6],
+            bases: [Vector3::zeros(); 6],
             dirs: [Vector3::z(); 6],
         }
     }
 
-    /// The directions of the first `n` chains, from their joints and carriages.
+    /// The directions of the first `n` chains' last links, from their joints and bases.
     pub fn direct(&mut self, n: usize) {
         for i in 0..n.min(6) {
-            let d = self.joints[i] - self.carriages[i];
+            let d = self.joints[i] - self.bases[i];
             let len = length(&d);
             if len > T::zero() {
                 self.dirs[i] = d / len;
@@ -69,8 +72,13 @@ impl<T: Real> RingPlatform<T> {
         c.q = *q;
         c.rotation = pose.rotation();
         self.place_joints(pose, &mut c);
-        for (b, qi) in c.carriages.iter_mut().zip(&q.0).take(self.n) {
-            *b = self.carriage(*qi);
+        for i in 0..self.n {
+            let qi = q.0[i];
+            c.carriages[i] = self.carriage(qi);
+            c.bases[i] = match &self.arms[i] {
+                Some(arm) => self.elbow(arm, qi, q.0[arm.axis]),
+                None => c.carriages[i],
+            };
         }
         c.direct(self.n);
         c
@@ -111,19 +119,23 @@ impl<T: Real> RingPlatform<T> {
 
     pub(super) fn reach_of(&self, joints: &[Vector3<T>; 6]) -> T {
         let mut margin = T::max_value().unwrap_or(T::one());
-        for (a, kind) in joints.iter().zip(&self.kinds).take(self.n) {
+        for (i, (a, kind)) in joints.iter().zip(&self.kinds).enumerate().take(self.n) {
             let rho = (a.x * a.x + a.y * a.y).sqrt_();
             let m = match kind {
-                ChainKind::Rod(_) => {
+                Shape::Rod(_) => {
                     let h = (self.rod * self.rod - a.z * a.z).max_(T::zero()).sqrt_();
                     (self.rod - a.z.abs())
                         .min_(h - (self.rr - rho).abs())
                         .min_(self.rr + rho - h)
                 }
-                ChainKind::Radial => {
+                Shape::Radial => {
                     let s = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
                     (s - self.stroke[0]).min_(self.stroke[1] - s)
                 }
+                Shape::Elbow => match &self.arms[i] {
+                    Some(arm) => arm.reach(rho, a.z),
+                    None => T::zero(),
+                },
             };
             margin = margin.min_(m);
         }
@@ -167,12 +179,16 @@ impl<T: Real> RingPlatform<T> {
         (spacing, order)
     }
 
-    /// The smallest angle of a chain to the base plane and to the platform plane, each above its cone limit.
+    /// The smallest angle of a chain to the base plane and to the platform plane, each above its cone limit. An
+    /// elbow chain has no ball joint at the base (its shoulder is a revolute, limited by its travel): only its
+    /// forearm's angle to the platform plane counts.
     pub(super) fn cone_margin(&self, c: &Configuration<T>) -> T {
         let normal = c.rotation.column(2).into_owned();
         let (mut base, mut platform) = (T::one(), T::one());
-        for u in c.dirs.iter().take(self.n) {
-            base = base.min_(u.z);
+        for (u, arm) in c.dirs.iter().zip(&self.arms).take(self.n) {
+            if arm.is_none() {
+                base = base.min_(u.z);
+            }
             platform = platform.min_(u.dot(&normal));
         }
         let angle = |sine: T| sine.clamp(-T::one(), T::one()).asin_();

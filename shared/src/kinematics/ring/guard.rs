@@ -23,7 +23,6 @@
 
 use super::checks::{Configuration, SlowMargins};
 use super::RingPlatform;
-use crate::kinematics::ChainKind;
 use crate::real::length;
 use crate::Real;
 
@@ -77,8 +76,14 @@ impl<T: Real> RingPlatform<T> {
             let du = length(&(c.dirs[i] - r.dirs[i]));
             let db = length(&(c.carriages[i] - r.carriages[i]));
             turn = turn.max_(du);
-            rows += du + du + db * inv_rr;
-            if self.kinds[i] == ChainKind::Radial {
+            if self.arms[i].is_some() {
+                // The forearm's row `(u, E x u / Rr)` moves at most `|du| + (|dE| + |E| |du|) / Rr`.
+                let de = length(&(c.bases[i] - r.bases[i]));
+                rows += du + (de + length(&r.bases[i]) * du) * inv_rr;
+            } else {
+                rows += du + du + db * inv_rr;
+            }
+            if self.kinds[i].is_planar() {
                 let da = length(&(c.joints[i] - r.joints[i]));
                 let reach = length(&r.joints[i]) * inv_rr;
                 rows += db * inv_rr + (da + reach * db) * inv_rr;

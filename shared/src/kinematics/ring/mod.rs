@@ -1,7 +1,8 @@
-//! Ring platforms: carriages on a circular guide with rod chains and radial linear-actuator chains
-//! (KINEMATICS.md 2.1 trainer, 2.2 rotopod, 3 velocities; the checks of 4 in `checks`, the statics of 5 in
-//! `statics`, the inverse dynamics in `dynamics`).
+//! Ring platforms: carriages on a circular guide with rod chains, radial linear-actuator chains and elbow chains
+//! (KINEMATICS.md 2.1 trainer, 2.2 rotopod, 3 velocities; the elbow chain's arm in `arm`; the checks of 4 in
+//! `checks`, the statics of 5 in `statics`, the inverse dynamics in `dynamics`).
 
+mod arm;
 mod checks;
 mod dynamics;
 mod guard;
@@ -9,6 +10,7 @@ mod statics;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
+use self::arm::Arm;
 use self::checks::Configuration;
 pub use self::dynamics::{BodyMotion, MotionState, Payload};
 pub use self::guard::SlowCheckGuard;
@@ -17,15 +19,43 @@ use super::geometry::{Branch, ChainKind, RingGeometry};
 use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
 
+/// A chain's kind without an elbow chain's dimensions (those are in the platform's `arms`): what the per-pose code
+/// branches on, a byte instead of a whole [`ChainKind`] per chain (the firmware keeps several platforms in RAM).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Shape {
+    Rod(Branch),
+    Radial,
+    Elbow,
+}
+
+impl Shape {
+    fn of(kind: &ChainKind) -> Self {
+        match kind {
+            ChainKind::Rod(b) => Self::Rod(*b),
+            ChainKind::Radial => Self::Radial,
+            ChainKind::Elbow(_) => Self::Elbow,
+        }
+    }
+
+    /// Radial and elbow chains: a planarity constraint and a tangent wrench.
+    pub(super) fn is_planar(self) -> bool {
+        matches!(self, Self::Radial | Self::Elbow)
+    }
+}
+
 /// A ring platform in scalar type `T`, built from a validated [`RingGeometry`].
+///
+/// Laid out in this order (`repr(C)`): what every pose reads first, the elbow chains' arms next, the geometry (large
+/// since chains carry an elbow's `f64` dimensions, and read only by reports) last, so that the hot fields keep small
+/// offsets wherever the platform is embedded (on the M4F a load beyond 4 KB of its base takes extra instructions).
 #[derive(Debug, Clone, Copy)]
+#[repr(C)]
 pub struct RingPlatform<T: Real> {
-    geometry: RingGeometry,
     rr: T,
     rod: T,
     n: usize,
     points: [Vector3<T>; 6],
-    kinds: [ChainKind; 6],
+    kinds: [Shape; 6],
     /// Actuator index of the length of each radial chain.
     length_axis: [Option<usize>; 6],
     axes: [AxisKind; 6],
@@ -34,6 +64,9 @@ pub struct RingPlatform<T: Real> {
     cones: [T; 2],
     min_index: T,
     com: Vector3<T>,
+    /// The arm of each elbow chain (with its shoulder's actuator index).
+    arms: [Option<Arm<T>>; 6],
+    geometry: RingGeometry,
 }
 
 impl<T: Real> RingPlatform<T> {
@@ -42,17 +75,28 @@ impl<T: Real> RingPlatform<T> {
         let chains = geometry.chains();
         let n = chains.len();
         let mut points = [Vector3::zeros(); 6];
-        let mut kinds = [ChainKind::Radial; 6];
+        let mut kinds = [Shape::Radial; 6];
         let mut length_axis = [None; 6];
+        let mut arms = [None; 6];
         let mut axes = [AxisKind::Ring; 6];
         let mut next_length = n;
         // The validated geometry has at most six chains and exactly six actuators, so every index is in range.
         for (i, c) in chains.iter().enumerate() {
             points[i] = Vector3::from(c.platform_point.map(T::of));
-            kinds[i] = c.kind;
+            kinds[i] = Shape::of(&c.kind);
             if c.kind == ChainKind::Radial {
                 length_axis[i] = Some(next_length);
                 axes[next_length] = AxisKind::Linear;
+                next_length += 1;
+            }
+        }
+        // Shoulder angles follow every radial length.
+        for (i, c) in chains.iter().enumerate() {
+            if let ChainKind::Elbow(e) = &c.kind {
+                arms[i] = Some(Arm::new(e, next_length));
+                if let Some(axis) = axes.get_mut(next_length) {
+                    *axis = AxisKind::Angle;
+                }
                 next_length += 1;
             }
         }
@@ -65,6 +109,7 @@ impl<T: Real> RingPlatform<T> {
             points,
             kinds,
             length_axis,
+            arms,
             axes,
             stroke: l.stroke.map(T::of),
             spacing: l.carriage_spacing.map(T::of),
@@ -98,9 +143,17 @@ impl<T: Real> RingPlatform<T> {
         Vector3::new(self.rr * c, self.rr * s, T::zero())
     }
 
+    /// An elbow chain's elbow for its carriage angle `q` and shoulder angle `shoulder`.
+    fn elbow(&self, arm: &Arm<T>, q: T, shoulder: T) -> Vector3<T> {
+        let (sq, cq) = q.sin_cos_();
+        let (ss, cs) = shoulder.sin_cos_();
+        arm.elbow(cq, sq, cs, ss)
+    }
+
     /// Reach margin of a pose (m), defined whether or not the pose is reachable: the smallest slack of the rod
-    /// conditions `|Az| < L` and `|Rr - rho| <= h <= Rr + rho`, and of the radial strokes `s_min <= s <= s_max`.
-    /// Negative outside, by how far.
+    /// conditions `|Az| < L` and `|Rr - rho| <= h <= Rr + rho`, of the radial strokes `s_min <= s <= s_max`, and of
+    /// the elbow chains' arms (the shoulder-to-joint distance within what the elbow angle limits allow, the elbow's
+    /// arc within the shoulder's travel). Negative outside, by how far.
     pub fn reach_margin(&self, pose: &Pose<T>) -> T {
         self.reach_of(&self.joints(pose))
     }
@@ -141,7 +194,7 @@ impl<T: Real> RingPlatform<T> {
                 });
             }
             match self.kinds[i] {
-                ChainKind::Rod(branch) => {
+                Shape::Rod(branch) => {
                     let h2 = self.rod * self.rod - a.z * a.z;
                     if h2 <= T::zero() {
                         return Err(KinematicsError::Unreachable {
@@ -171,7 +224,7 @@ impl<T: Real> RingPlatform<T> {
                     let scale = T::one() / (rho2 + rho2);
                     c.carriages[i] = Vector3::new(cx * scale, cy * scale, T::zero());
                 }
-                ChainKind::Radial => {
+                Shape::Radial => {
                     q[i] = a.y.atan2_(a.x);
                     let scale = self.rr / rho;
                     c.carriages[i] = Vector3::new(a.x * scale, a.y * scale, T::zero());
@@ -179,7 +232,23 @@ impl<T: Real> RingPlatform<T> {
                         q[k] = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
                     }
                 }
+                Shape::Elbow => {
+                    // The carriage is on the joint's radius, as a radial chain's; the arm is a planar dyad there.
+                    q[i] = a.y.atan2_(a.x);
+                    let (cq, sq) = (a.x / rho, a.y / rho);
+                    c.carriages[i] = Vector3::new(self.rr * cq, self.rr * sq, T::zero());
+                    if let Some(arm) = &self.arms[i] {
+                        let s = arm.shoulder(rho, a.z).ok_or(KinematicsError::Unreachable {
+                            chain,
+                            reason: Reach::Dyad,
+                        })?;
+                        q[arm.axis] = s.angle;
+                        c.bases[i] = arm.elbow(cq, sq, s.cos, s.sin);
+                        continue;
+                    }
+                }
             }
+            c.bases[i] = c.carriages[i];
         }
         Ok(())
     }
@@ -233,13 +302,13 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         let mut extra = self.n;
         for i in 0..self.n {
             let (a, qi) = (joints[i], q.0[i]);
-            let d = a - self.carriage(qi);
-            let length = match self.length_axis[i] {
-                Some(k) => q.0[k],
-                None => self.rod,
+            let (d, length) = match (&self.arms[i], self.length_axis[i]) {
+                (Some(arm), _) => (a - self.elbow(arm, qi, q.0[arm.axis]), arm.l2),
+                (None, Some(k)) => (a - self.carriage(qi), q.0[k]),
+                (None, None) => (a - self.carriage(qi), self.rod),
             };
             f[i] = d.dot(&d) - length * length;
-            if self.kinds[i] == ChainKind::Radial && extra < 6 {
+            if self.kinds[i].is_planar() && extra < 6 {
                 let (s, c) = qi.sin_cos_();
                 f[extra] = a.x * s - a.y * c;
                 extra += 1;
@@ -258,24 +327,43 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         for i in 0..self.n {
             let (a, qi) = (joints[i], q.0[i]);
             let (s, c) = qi.sin_cos_();
-            let d = a - self.carriage(qi);
             let p = &self.points[i];
             // Columns dA/dp_k of this joint.
             let partials = [Vector3::x(), Vector3::y(), Vector3::z(), da * p, db * p, dg * p];
-            for (k, da) in partials.iter().enumerate() {
-                a_mat[(i, k)] = two * d.dot(da);
-            }
-            // dF/dq = -2 d . dB/dq with dB/dq = Rr (-sin q, cos q, 0).
-            b_mat[(i, i)] = -two * self.rr * (-d.x * s + d.y * c);
-            if let Some(k) = self.length_axis[i] {
-                b_mat[(i, k)] = -two * q.0[k];
-                if extra < 6 {
-                    for (col, da) in partials.iter().enumerate() {
-                        a_mat[(extra, col)] = s * da.x - c * da.y;
+            let second = match &self.arms[i] {
+                Some(arm) => {
+                    // dF/dq = -2 d . dE/dq with dE/dq = r_e (-sin q, cos q, 0), r_e the elbow's distance from the
+                    // axis; dF/ds = -2 d . dE/ds with dE/ds = l1 (sin s (cos q, sin q, 0) + cos s z).
+                    let shoulder = q.0[arm.axis];
+                    let (ss, cs) = shoulder.sin_cos_();
+                    let d = a - arm.elbow(c, s, cs, ss);
+                    for (k, da) in partials.iter().enumerate() {
+                        a_mat[(i, k)] = two * d.dot(da);
                     }
-                    b_mat[(extra, i)] = a.x * c + a.y * s;
-                    extra += 1;
+                    b_mat[(i, i)] = -two * (arm.rs - arm.l1 * cs) * (-d.x * s + d.y * c);
+                    b_mat[(i, arm.axis)] = -two * arm.l1 * (ss * (d.x * c + d.y * s) + cs * d.z);
+                    Some(arm.axis)
                 }
+                None => {
+                    let d = a - self.carriage(qi);
+                    for (k, da) in partials.iter().enumerate() {
+                        a_mat[(i, k)] = two * d.dot(da);
+                    }
+                    // dF/dq = -2 d . dB/dq with dB/dq = Rr (-sin q, cos q, 0).
+                    b_mat[(i, i)] = -two * self.rr * (-d.x * s + d.y * c);
+                    if let Some(k) = self.length_axis[i] {
+                        b_mat[(i, k)] = -two * q.0[k];
+                    }
+                    self.length_axis[i]
+                }
+            };
+            // The planarity row of a radial or elbow chain.
+            if second.is_some() && extra < 6 {
+                for (col, da) in partials.iter().enumerate() {
+                    a_mat[(extra, col)] = s * da.x - c * da.y;
+                }
+                b_mat[(extra, i)] = a.x * c + a.y * s;
+                extra += 1;
             }
         }
         Jacobians {

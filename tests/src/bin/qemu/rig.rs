@@ -11,15 +11,45 @@ use crate::Tally;
 /// it ends at exactly the steps the host simulator reaches with `--geometry` of the same file.
 pub(crate) fn rig_on_m4f(t: &mut Tally) {
     println!("== a rig of its own on the emulated Cortex-M4F: load, restart, stream");
-    let dir = std::env::temp_dir().join(format!("ringpod-qemu-rig-{}", std::process::id()));
-    let _ = std::fs::create_dir_all(&dir);
-    let (rig, input) = (dir.join("wider.toml"), dir.join("input.csv"));
     let (exported, model) = ringpod_text(&["presets", "--export", "trainer-model"]);
     let wider = model
         .replace("name = \"trainer-model\"", "name = \"wider-ring\"")
         .replace("ring_radius = 0.286", "ring_radius = 0.3")
         .replace("rod_length = 0.312", "rod_length = 0.325");
-    if !exported || wider == model || std::fs::write(&rig, wider).is_err() || write_input(&input).is_err() {
+    if !exported || wider == model {
+        t.check(false, "the rig file is written");
+        return;
+    }
+    drive_on_m4f(
+        t,
+        "wider-ring",
+        &wider,
+        &["ring_radius = 0.3\n", "rod_length = 0.325\n"],
+    );
+}
+
+/// The elbow trainer (ch. 5.1 fig. 5.2 arms, rotary shoulders) on the device, as its exported rig file renamed (so
+/// that it is a rig of its own, not the preset): its shoulders home to their index flags on the M4F and the stream
+/// ends at the simulator's steps.
+pub(crate) fn elbow_on_m4f(t: &mut Tally) {
+    println!("== the elbow trainer on the emulated Cortex-M4F: load, restart, stream");
+    let (exported, preset) = ringpod_text(&["presets", "--export", "trainer-elbow"]);
+    let renamed = preset.replace("name = \"trainer-elbow\"", "name = \"my-elbow\"");
+    if !exported || renamed == preset {
+        t.check(false, "the rig file is written");
+        return;
+    }
+    drive_on_m4f(t, "my-elbow", &renamed, &["kind = \"elbow\"", "upper_arm = 0.105\n"]);
+}
+
+/// Loads `rig` (named `name`) into the emulated controller, restarts it into the stored rig, checks that `device rig
+/// show` gives it back (`shown` among its lines), and streams a CSV into it and into the simulator with the same
+/// file: both end at the same steps, not the trainer model's.
+fn drive_on_m4f(t: &mut Tally, name: &str, rig_text: &str, shown_lines: &[&str]) {
+    let dir = std::env::temp_dir().join(format!("ringpod-qemu-{name}-{}", std::process::id()));
+    let _ = std::fs::create_dir_all(&dir);
+    let (rig, input) = (dir.join(format!("{name}.toml")), dir.join("input.csv"));
+    if std::fs::write(&rig, rig_text).is_err() || write_input(&input).is_err() {
         t.check(false, "the rig file and the input are written");
         return;
     }
@@ -33,15 +63,15 @@ pub(crate) fn rig_on_m4f(t: &mut Tally) {
     let printed = emulated.wait_for(Duration::from_secs(10), |l| l.trim() == "READY");
     println!("restart: {} / {printed:?}", said.trim());
     let (_, shown) = ringpod_text(&["device", "rig", "show", "--port", pty]);
+    let banner = format!("RIG {name} (Stored)");
     t.check(
         loaded
             && restarted
-            && said.contains("running wider-ring (stored)")
-            && printed.is_ok_and(|l| l.iter().any(|l| l == "RIG wider-ring (Stored)"))
-            && shown.contains("name = \"wider-ring\"")
-            && shown.contains("ring_radius = 0.3\n")
-            && shown.contains("rod_length = 0.325\n"),
-        "a rig file loaded into the emulated controller is stored and runs after a restart",
+            && said.contains(&format!("running {name} (stored)"))
+            && printed.is_ok_and(|l| l.contains(&banner))
+            && shown.contains(&format!("name = \"{name}\""))
+            && shown_lines.iter().all(|l| shown.contains(l)),
+        &format!("{name}: a rig file loaded into the emulated controller is stored and runs after a restart"),
     );
     let args = ["--input", &input_file, "--quiet", "--report-json"];
     let emu = ringpod_json(&[&["stream", "--port", pty][..], &args].concat());
@@ -51,7 +81,7 @@ pub(crate) fn rig_on_m4f(t: &mut Tally) {
     match (&emu, &sim, &model) {
         (Ok(e), Ok(s), Ok(m)) => {
             println!(
-                "wider ring: emulated final steps {}, simulator {}, the trainer model {}",
+                "{name}: emulated final steps {}, simulator {}, the trainer model {}",
                 e["final_steps"], s["final_steps"], m["final_steps"]
             );
             t.check(
@@ -59,12 +89,15 @@ pub(crate) fn rig_on_m4f(t: &mut Tally) {
                     && e["counts_agree"] == true
                     && e["final_steps"] == s["final_steps"]
                     && e["final_steps"] != m["final_steps"],
-                "the emulated controller drives the stored rig to the simulator's steps for it (not the model's)",
+                &format!("{name}: the emulated controller drives the stored rig to the simulator's steps for it"),
             );
         }
         _ => {
             eprintln!("{emu:?} {sim:?} {model:?}");
-            t.check(false, "stream into the emulated controller's rig and the simulator's");
+            t.check(
+                false,
+                &format!("{name}: stream into the emulated controller's rig and the simulator's"),
+            );
         }
     }
     drop(emulated);
