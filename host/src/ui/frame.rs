@@ -62,19 +62,45 @@ impl RigView {
     }
 }
 
-/// The mechanism at one pose: each chain's carriage on the ring and its platform joint (m, base frame).
+/// The mechanism at one pose: each chain's carriage on the ring, an elbow chain's shoulder and elbow axes, and
+/// its platform joint (m, base frame).
 #[derive(Debug, Clone, Serialize, PartialEq)]
 pub struct Placed {
     pub carriages: Vec<[f64; 3]>,
+    /// Per chain: `[shoulder, elbow]` of an elbow chain, none for the others.
+    pub arms: Vec<Option<[[f64; 3]; 2]>>,
     pub joints: Vec<[f64; 3]>,
 }
 
 /// Places the mechanism at `pose`: `None` where the pose has no inverse kinematics.
+///
+/// An elbow chain's shoulder angle `s` is the actuator after every carriage and every radial length, in chain
+/// order; the upper arm points along `cos(s) u + sin(s) z`, with `u` the horizontal unit vector from the shoulder
+/// toward the ring axis (KINEMATICS, the rig file's `elbow` chain).
 pub fn place(m: &RingPlatform<f64>, pose: &Pose<f64>) -> Option<Placed> {
     let q = m.inverse(pose).ok()?;
-    let n = m.geometry().chains().len();
+    let chains = m.geometry().chains();
+    let n = chains.len();
     let r = m.geometry().ring_radius;
     let joints = m.joints(pose);
+    let radial = chains.iter().filter(|c| c.kind == ChainKind::Radial).count();
+    let mut next_shoulder = n + radial;
+    let arms = chains
+        .iter()
+        .enumerate()
+        .map(|(i, c)| match c.kind {
+            ChainKind::Elbow(e) => {
+                let (s, (sq, cq)) = (q.0.get(next_shoulder).copied()?, q.0[i].sin_cos());
+                next_shoulder += 1;
+                let reach = e.shoulder_radius - e.upper_arm * s.cos();
+                Some(Some([
+                    [e.shoulder_radius * cq, e.shoulder_radius * sq, e.shoulder_height],
+                    [reach * cq, reach * sq, e.shoulder_height + e.upper_arm * s.sin()],
+                ]))
+            }
+            _ => Some(None),
+        })
+        .collect::<Option<Vec<_>>>()?;
     Some(Placed {
         carriages: (0..n)
             .map(|i| {
@@ -82,6 +108,7 @@ pub fn place(m: &RingPlatform<f64>, pose: &Pose<f64>) -> Option<Placed> {
                 [r * a.cos(), r * a.sin(), 0.0]
             })
             .collect(),
+        arms,
         joints: joints.iter().take(n).map(|j| [j.x, j.y, j.z]).collect(),
     })
 }
@@ -247,6 +274,32 @@ mod tests {
             place(&m, &Pose::new(0.0, 0.0, 10.0, 0.0, 0.0, 0.0)).is_none(),
             "out of reach"
         );
+    }
+
+    #[test]
+    fn an_elbow_chain_is_placed_with_its_arms_lengths() {
+        let PresetGeometry::Ring(g) = Preset::TrainerElbow.geometry() else {
+            unreachable!("the elbow trainer is a ring platform")
+        };
+        let m = RingPlatform::<f64>::new(g);
+        let p = place(&m, &Pose::from_array(Preset::TrainerElbow.home())).unwrap();
+        let d =
+            |a: [f64; 3], b: [f64; 3]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        let mut elbows = 0;
+        for (i, c) in g.chains().iter().enumerate() {
+            if let ChainKind::Elbow(e) = c.kind {
+                let [shoulder, elbow] = p.arms[i].expect("an elbow chain has arms");
+                assert!(
+                    (d(shoulder, elbow) - e.upper_arm).abs() < 1e-9,
+                    "upper arm of chain {i}"
+                );
+                assert!((d(elbow, p.joints[i]) - e.forearm).abs() < 1e-9, "forearm of chain {i}");
+                elbows += 1;
+            } else {
+                assert!(p.arms[i].is_none());
+            }
+        }
+        assert_eq!(elbows, 2);
     }
 
     #[test]

@@ -71,7 +71,11 @@ class Chart {
       }
     }
     if (!isFinite(y0)) return;
-    if (y1 - y0 < 1e-9) { y0 -= 1; y1 += 1; }
+    if (y1 - y0 < 1e-9) {
+      // A flat series: a band around it, scaled to its value (not a whole metre around a millimetre).
+      const h = Math.max(Math.abs(y0) * 0.05, 1e-3);
+      y0 -= h; y1 += h;
+    }
     const pad = (y1 - y0) * 0.08; y0 -= pad; y1 += pad;
     const X = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
     const Y = (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);

@@ -65,7 +65,17 @@ class View3d {
     const radial = ghost ? "rgba(148,163,184,0.45)" : "#38bdf8";
     g.lineWidth = ghost ? 2 : 3;
     g.setLineDash(ghost ? [6, 4] : []);
+    const elbow = ghost ? "rgba(148,163,184,0.45)" : "#a3e635";
     m.joints.forEach((j, i) => {
+      const arm = m.arms && m.arms[i];
+      if (arm) {
+        // An elbow chain: the carriage's post to the shoulder axis, the upper arm, the forearm.
+        g.strokeStyle = elbow;
+        this.line(g, m.carriages[i], arm[0]);
+        this.line(g, arm[0], arm[1]);
+        this.line(g, arm[1], j);
+        return;
+      }
       g.strokeStyle = (this.rig.chains[i] === "radial") ? radial : rod;
       this.line(g, m.carriages[i], j);
     });
@@ -84,6 +94,8 @@ class View3d {
       m.carriages.forEach((c) => this.dot(g, c, 6));
       g.fillStyle = "#e2e8f0";
       m.joints.forEach((j) => this.dot(g, j, 4));
+      g.fillStyle = "#a3e635";
+      (m.arms || []).forEach((a) => { if (a) { this.dot(g, a[0], 4); this.dot(g, a[1], 4); } });
     }
   }
 
