@@ -21,7 +21,10 @@ pub use forward::{start_from_home, ForwardSolution, NewtonOptions, FROM_HOME_DIS
 pub use geometry::{Branch, Chain, ChainKind, GeometryError, RingGeometry, RingLimits, ToolGeometry};
 pub use multiturn::MultiTurn;
 pub use pose::{Actuators, Pose};
-pub use ring::{ActuatorLoads, BodyMotion, MotionState, Payload, RingPlatform, SlowCheckGuard};
+pub use ring::{
+    ActuatorLoads, BodyMotion, Loaded, MotionState, Payload, RingPlatform, SlowCheckGuard, TipOver, TipOverError,
+    GRAVITY,
+};
 pub use tool::ToolCarrier;
 pub use velocity::{Jacobians, Singularity};
 pub use workspace::{Check, WorkspaceReport};

@@ -1,11 +1,12 @@
 //! Ring platforms: carriages on a circular guide with rod chains and radial linear-actuator chains
 //! (KINEMATICS.md 2.1 trainer, 2.2 rotopod, 3 velocities; the checks of 4 in `checks`, the statics of 5 in
-//! `statics`, the inverse dynamics in `dynamics`).
+//! `statics`, the inverse dynamics in `dynamics`, tip-over under a lateral acceleration in `tipping`).
 
 mod checks;
 mod dynamics;
 mod guard;
 mod statics;
+mod tipping;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
@@ -13,6 +14,7 @@ use self::checks::Configuration;
 pub use self::dynamics::{BodyMotion, MotionState, Payload};
 pub use self::guard::SlowCheckGuard;
 pub use self::statics::ActuatorLoads;
+pub use self::tipping::{Loaded, TipOver, TipOverError, GRAVITY};
 use super::geometry::{Branch, ChainKind, RingGeometry};
 use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
