@@ -37,6 +37,7 @@ fn main() -> ExitCode {
             } => rig::design_command(file, *combined, *starts, *steps, *seed),
         }),
         C::Ik(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), false)),
+        C::Check(args) if args.tip_over => answer(analysis::tipover::run(&args.tip_over())),
         C::Check(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), true)),
         C::Fk(args) => answer(analysis::kinematics::fk(&args.options())),
         C::Rates(args) => answer(analysis::rates::run(&args.options())),

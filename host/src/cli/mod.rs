@@ -34,7 +34,8 @@ pub enum Command {
     /// Exits 0 whenever the pose has a solution (failing checks are reported), 1 when it has none.
     Ik(PoseArgs),
     /// Workspace checks of a pose. Exits 0 when all pass, 3 when any fails, 1 when the pose has no solution.
-    Check(PoseArgs),
+    /// With --tip-over: a payload over the carriages' polygon under a lateral acceleration (3 when it tips).
+    Check(CheckArgs),
     /// Forward kinematics: the pose for six actuator values, by Newton iteration from a guess.
     Fk(FkArgs),
     /// The velocity problem at a pose (A p' = -B q', chapter 4): the actuator rates for --pose-rates, or the pose
@@ -379,6 +380,27 @@ pub struct StructureArgs {
     /// One of the source's single chains at its coordinates, instead of a mechanism.
     #[arg(long, value_enum, conflicts_with_all = ["pose", "geometry", "mechanism"])]
     pub chain: Option<crate::analysis::structure::SourceChain>,
+}
+
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// Tip-over instead of the workspace checks (ring platforms): the largest lateral acceleration in each
+    /// direction before the payload's centre of mass, projected along g - a onto the ring plane, leaves the
+    /// carriages' polygon, and the weakest over all directions.
+    #[arg(long)]
+    pub tip_over: bool,
+    /// With --tip-over: the payload's centre of mass X,Y,Z in the platform frame (m). Default: the geometry's.
+    #[arg(long, allow_hyphen_values = true, requires = "tip_over", value_name = "X,Y,Z")]
+    pub payload_com: Option<String>,
+    /// With --tip-over: a lateral acceleration AX,AY of the platform (m/s^2, base frame): does it tip, by what
+    /// margin.
+    #[arg(long, allow_hyphen_values = true, requires = "tip_over", value_name = "AX,AY")]
+    pub accel: Option<String>,
 }
 
 #[derive(Debug, Args)]
