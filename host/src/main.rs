@@ -78,6 +78,10 @@ fn main() -> ExitCode {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),
+        C::Draw(args) => analysis::draw::run(&args.options()).map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+            0
+        }),
         C::Workspace(args) => analysis::workspace::run(&args.options()).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0

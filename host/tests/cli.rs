@@ -1434,3 +1434,67 @@ fn tip_over_refuses_bad_input_in_one_line() {
     // The tip-over options belong to --tip-over.
     ringpod().args(["check", "--accel=1,0"]).assert().code(2);
 }
+
+#[test]
+fn draw_puts_trainer_ch5s_joints_where_the_spec_does() {
+    // KINEMATICS.md 2.1 at (0, 0, 1, 0, 0, 0): joints a_i + (0, 0, 1), carriages B1 = (-1, -sqrt 8),
+    // B2 = (1, -sqrt 8), B3 = (3/sqrt 5, 6/sqrt 5), B4 = (-3/sqrt 5, 6/sqrt 5).
+    let dir = std::env::temp_dir().join(format!("ringpod-draw-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("fig.svg");
+    let v = json(&[
+        "draw",
+        "-m",
+        "trainer-ch5",
+        "--pose=0,0,1,0,0,0",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let (s8, bx, by) = (8f64.sqrt(), 3.0 / 5f64.sqrt(), 6.0 / 5f64.sqrt());
+    let joints = [[-1.0, -2.0, 1.0], [1.0, -2.0, 1.0], [1.0, 2.0, 1.0], [-1.0, 2.0, 1.0]];
+    let carriages = [[-1.0, -s8, 0.0], [1.0, -s8, 0.0], [bx, by, 0.0], [-bx, by, 0.0]];
+    for (key, want) in [("joints", joints), ("carriages", carriages)] {
+        let got = v[key].as_array().unwrap();
+        assert_eq!(got.len(), 4);
+        for (g, w) in got.iter().zip(want) {
+            for k in 0..3 {
+                let g = g[k].as_f64().unwrap();
+                assert!((g - w[k]).abs() < 1e-9, "{key}: {g} vs {}", w[k]);
+            }
+        }
+    }
+    assert_eq!(v["chains"], serde_json::json!(["rod", "rod", "radial", "radial"]));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    for label in ["A1", "A4", "B1", "B4", "X", "Y", "Z"] {
+        assert!(svg.lines().any(|l| l.trim() == label), "{label} missing");
+    }
+    assert!(svg.contains("trainer-ch5 at x, y, z"));
+    assert_eq!(svg.matches("<circle").count(), 8);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn draw_refuses_bad_input_in_one_line() {
+    let dir = std::env::temp_dir().join(format!("ringpod-draw-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("fig.svg");
+    let svg = svg.to_str().unwrap();
+    let txt = dir.join("fig.txt");
+    for args in [
+        &["draw", "-m", "trainer-ch5", "--pose=0,0,5,0,0,0", "--out", svg][..],
+        &["draw", "--pose=0,0,nan,0,0,0", "--out", svg][..],
+        &["draw", "--pose=0,0,0.2", "--out", svg][..],
+        &["draw", "-m", "tool5-ex", "--out", svg][..],
+        &["draw", "-m", "nothing", "--out", svg][..],
+        &["draw", "--out", txt.to_str().unwrap()][..],
+    ] {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("ringpod: "), "{err}");
+    }
+    assert!(!dir.join("fig.svg").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,5 +1,5 @@
 //! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `rates`, `structure`, `reactions`,
-//! tip-over (`check --tip-over`),
+//! tip-over (`check --tip-over`), the drawing of a platform at a pose (`draw`),
 //! the derivatives of a run record (`plot --derivatives`),
 //! `workspace` and `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
@@ -7,6 +7,7 @@ pub mod cue;
 pub mod cue_capture;
 pub mod demand;
 pub mod derivatives;
+pub mod draw;
 pub mod kinematics;
 pub mod mechanism;
 pub mod rates;

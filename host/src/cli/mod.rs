@@ -45,6 +45,9 @@ pub enum Command {
     /// pose, the wrenches each chain transmits, each chain's determinant and the mechanism's wrench determinant;
     /// or one of the source's chains of figs. 5.1-5.3 with --chain.
     Structure(StructureArgs),
+    /// A labelled isometric drawing of a ring platform at a pose (ring, carriages, chains, platform, axes), every
+    /// point from its inverse kinematics, as SVG or PNG.
+    Draw(DrawArgs),
     /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
@@ -380,6 +383,18 @@ pub struct StructureArgs {
     /// One of the source's single chains at its coordinates, instead of a mechanism.
     #[arg(long, value_enum, conflicts_with_all = ["pose", "geometry", "mechanism"])]
     pub chain: Option<crate::analysis::structure::SourceChain>,
+}
+
+#[derive(Debug, Args)]
+pub struct DrawArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// The picture: .svg or .png.
+    #[arg(long)]
+    pub out: std::path::PathBuf,
 }
 
 #[derive(Debug, Args)]

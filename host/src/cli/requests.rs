@@ -2,8 +2,8 @@
 //! never see a clap struct.
 
 use super::{
-    CheckArgs, Common, CueArgs, DeviceAction, DeviceArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs, StructureArgs,
-    WorkspaceArgs,
+    CheckArgs, Common, CueArgs, DeviceAction, DeviceArgs, DrawArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs,
+    StructureArgs, WorkspaceArgs,
 };
 
 impl RatesArgs {
@@ -31,6 +31,17 @@ impl CheckArgs {
             pose: self.pose.as_deref(),
             payload_com: self.payload_com.as_deref(),
             accel: self.accel.as_deref(),
+        }
+    }
+}
+
+impl DrawArgs {
+    /// The options `draw` takes.
+    pub fn options(&self) -> crate::analysis::draw::Options<'_> {
+        crate::analysis::draw::Options {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            out: &self.out,
         }
     }
 }
