@@ -1485,7 +1485,7 @@ fn draw_refuses_bad_input_in_one_line() {
         &["draw", "-m", "trainer-ch5", "--pose=0,0,5,0,0,0", "--out", svg][..],
         &["draw", "--pose=0,0,nan,0,0,0", "--out", svg][..],
         &["draw", "--pose=0,0,0.2", "--out", svg][..],
-        &["draw", "-m", "tool5-ex", "--out", svg][..],
+        &["draw", "-m", "tool5-ex", "--pose=0,0,0.4,0,0,0.1", "--out", svg][..],
         &["draw", "-m", "nothing", "--out", svg][..],
         &["draw", "--out", txt.to_str().unwrap()][..],
     ] {
@@ -1496,5 +1496,36 @@ fn draw_refuses_bad_input_in_one_line() {
         assert!(err.starts_with("ringpod: "), "{err}");
     }
     assert!(!dir.join("fig.svg").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn draw_the_tool_carrier_at_the_sources_third_example() {
+    // KINEMATICS.md 2.3: alpha = 15 deg 13', beta = 25 deg 20' gives q1 = 128.4 mm, q2 = 65 deg 01', q4 = 34 deg 22'.
+    let dir = std::env::temp_dir().join(format!("ringpod-draw-tool-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("tool.svg");
+    let v = json(&[
+        "draw",
+        "-m",
+        "tool5-ex",
+        "--degrees",
+        &format!("--pose=0,0,0.4,{},{},0", 15.0 + 13.0 / 60.0, 25.0 + 20.0 / 60.0),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let q = |i: usize| v["actuators"][i].as_f64().unwrap();
+    assert!((q(0) - 0.1284).abs() < 1e-4, "{}", q(0));
+    assert!((q(1) - (65.0 + 1.0 / 60.0)).abs() < 1.0 / 60.0, "{}", q(1));
+    assert!((q(3) - (34.0 + 22.0 / 60.0)).abs() < 1.0 / 60.0, "{}", q(3));
+    // The frame pivots are in the dyads' plane x = q1.
+    for k in 0..2 {
+        assert!((v["pivots"][k][0].as_f64().unwrap() - q(0)).abs() < 1e-12);
+    }
+    let svg = std::fs::read_to_string(&out).unwrap();
+    for label in ["A2", "A3", "B", "D", "tool"] {
+        assert!(svg.lines().any(|l| l.trim() == label), "{label} missing");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

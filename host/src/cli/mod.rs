@@ -45,8 +45,8 @@ pub enum Command {
     /// pose, the wrenches each chain transmits, each chain's determinant and the mechanism's wrench determinant;
     /// or one of the source's chains of figs. 5.1-5.3 with --chain.
     Structure(StructureArgs),
-    /// A labelled isometric drawing of a ring platform at a pose (ring, carriages, chains, platform, axes), every
-    /// point from its inverse kinematics, as SVG or PNG.
+    /// A labelled isometric drawing of a mechanism at a pose (ring, carriages, chains, platform, axes; the tool
+    /// carrier's guide, dyads, frame and tool), every point from its inverse kinematics, as SVG or PNG.
     Draw(DrawArgs),
     /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
