@@ -41,7 +41,16 @@ pub enum CliError {
     /// A mechanism's chains could not be analysed.
     #[error("structure: {0}")]
     Structure(String),
+    /// A tip-over analysis has no answer.
+    #[error("tip-over: {0}")]
+    TipOver(ringpod_core::kinematics::TipOverError),
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),
+}
+
+impl From<ringpod_core::kinematics::TipOverError> for CliError {
+    fn from(e: ringpod_core::kinematics::TipOverError) -> Self {
+        Self::TipOver(e)
+    }
 }

@@ -37,6 +37,7 @@ fn main() -> ExitCode {
             } => rig::design_command(file, *combined, *starts, *steps, *seed),
         }),
         C::Ik(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), false)),
+        C::Check(args) if args.tip_over => answer(analysis::tipover::run(&args.tip_over())),
         C::Check(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), true)),
         C::Fk(args) => answer(analysis::kinematics::fk(&args.options())),
         C::Rates(args) => answer(analysis::rates::run(&args.options())),
@@ -74,6 +75,10 @@ fn main() -> ExitCode {
             stream::record::plot_command(record, out)
         }
         .map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+            0
+        }),
+        C::Draw(args) => analysis::draw::run(&args.options()).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),

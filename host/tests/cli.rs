@@ -1338,3 +1338,203 @@ fn sine_experiments_run_as_asked_or_say_how_they_were_limited() {
         assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1, "{args:?}");
     }
 }
+
+/// Standard gravity, as the tip-over check takes it.
+const G: f64 = 9.80665;
+
+#[test]
+fn tip_over_of_trainer_ch5_matches_the_hand_values() {
+    // KINEMATICS.md 2.1: at (0, 0, 1, 0, 0, 0) the carriages are (+-1, -sqrt 8) and (+-3/sqrt 5, 6/sqrt 5); a
+    // payload 0.5 above the platform centre is 1.5 above the ring plane over the origin. An acceleration along
+    // +Y throws it back onto the rear edge (sqrt 8 away): g sqrt 8 / 1.5; along -Y onto the front (6/sqrt 5).
+    let v = json(&[
+        "check",
+        "--tip-over",
+        "-m",
+        "trainer-ch5",
+        "--pose=0,0,1,0,0,0",
+        "--payload-com=0,0,0.5",
+        "--accel=3,0",
+        "--json",
+    ]);
+    let close = |a: &serde_json::Value, b: f64| {
+        let a = a.as_f64().unwrap();
+        assert!((a - b).abs() < 1e-9 * (1.0 + b.abs()), "{a} != {b}");
+    };
+    let (s8, bx, by) = (8f64.sqrt(), 3.0 / 5f64.sqrt(), 6.0 / 5f64.sqrt());
+    close(&v["height"], 1.5);
+    assert_eq!(v["polygon"].as_array().unwrap().len(), 4);
+    let dirs = v["directions"].as_array().unwrap();
+    let named = |n: &str| &dirs.iter().find(|d| d["name"] == n).unwrap()["acceleration"];
+    close(named("+Y"), G * s8 / 1.5);
+    close(named("-Y"), G * by / 1.5);
+    // The side edges, through (1, -sqrt 8) and (bx, by): the distance of the origin, and sideways the edge is
+    // approached at the cosine of its normal's angle to X.
+    let len = ((bx - 1.0).powi(2) + (by + s8).powi(2)).sqrt();
+    let side = (by + bx * s8) / len;
+    close(named("+X"), G * side / (1.5 * ((by + s8) / len)));
+    close(named("-X"), G * side / (1.5 * ((by + s8) / len)));
+    close(&v["static_margin"], side);
+    close(&v["weakest"]["acceleration"], G * side / 1.5);
+    // Under 3 m/s^2 along +X the projection moves back by 3 h / g.
+    close(&v["under"]["point"][0], -3.0 * 1.5 / G);
+    close(&v["under"]["point"][1], 0.0);
+    assert_eq!(v["under"]["tips"], false);
+    assert_eq!(v["tips"], false);
+}
+
+#[test]
+fn tip_over_exits_3_when_it_tips() {
+    let limit = G * 8f64.sqrt() / 1.5;
+    let run = |a: f64| {
+        ringpod()
+            .args([
+                "check",
+                "--tip-over",
+                "-m",
+                "trainer-ch5",
+                "--pose=0,0,1,0,0,0",
+                "--payload-com=0,0,0.5",
+                &format!("--accel=0,{a}"),
+            ])
+            .output()
+            .unwrap()
+    };
+    let below = run(limit * 0.999);
+    assert_eq!(below.status.code(), Some(0));
+    assert!(String::from_utf8_lossy(&below.stdout).contains("stands"));
+    let above = run(limit * 1.001);
+    assert_eq!(above.status.code(), Some(3));
+    assert!(String::from_utf8_lossy(&above.stdout).contains("TIPS"));
+    // A centre of mass outside the polygon at rest tips without any acceleration.
+    ringpod()
+        .args([
+            "check",
+            "--tip-over",
+            "-m",
+            "trainer-ch5",
+            "--pose=0,0,1,0,0,0",
+            "--payload-com=5,0,0.5",
+        ])
+        .assert()
+        .code(3)
+        .stdout(predicate::str::contains("OUTSIDE"));
+}
+
+#[test]
+fn tip_over_refuses_bad_input_in_one_line() {
+    for args in [
+        &["check", "--tip-over", "--accel=nan,0"][..],
+        &["check", "--tip-over", "--accel=1"][..],
+        &["check", "--tip-over", "--accel=1e9,0"][..],
+        &["check", "--tip-over", "--payload-com=0,0"][..],
+        &["check", "--tip-over", "--payload-com=0,inf,0.1"][..],
+        &["check", "--tip-over", "--payload-com=0,0,-1"][..],
+        &["check", "--tip-over", "-m", "tool5-ex"][..],
+        &["check", "--tip-over", "-m", "trainer-ch5", "--pose=0,0,5,0,0,0"][..],
+        &["check", "--tip-over", "--pose=0,0,nan,0,0,0"][..],
+    ] {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("ringpod: "), "{err}");
+    }
+    // The tip-over options belong to --tip-over.
+    ringpod().args(["check", "--accel=1,0"]).assert().code(2);
+}
+
+#[test]
+fn draw_puts_trainer_ch5s_joints_where_the_spec_does() {
+    // KINEMATICS.md 2.1 at (0, 0, 1, 0, 0, 0): joints a_i + (0, 0, 1), carriages B1 = (-1, -sqrt 8),
+    // B2 = (1, -sqrt 8), B3 = (3/sqrt 5, 6/sqrt 5), B4 = (-3/sqrt 5, 6/sqrt 5).
+    let dir = std::env::temp_dir().join(format!("ringpod-draw-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("fig.svg");
+    let v = json(&[
+        "draw",
+        "-m",
+        "trainer-ch5",
+        "--pose=0,0,1,0,0,0",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let (s8, bx, by) = (8f64.sqrt(), 3.0 / 5f64.sqrt(), 6.0 / 5f64.sqrt());
+    let joints = [[-1.0, -2.0, 1.0], [1.0, -2.0, 1.0], [1.0, 2.0, 1.0], [-1.0, 2.0, 1.0]];
+    let carriages = [[-1.0, -s8, 0.0], [1.0, -s8, 0.0], [bx, by, 0.0], [-bx, by, 0.0]];
+    for (key, want) in [("joints", joints), ("carriages", carriages)] {
+        let got = v[key].as_array().unwrap();
+        assert_eq!(got.len(), 4);
+        for (g, w) in got.iter().zip(want) {
+            for k in 0..3 {
+                let g = g[k].as_f64().unwrap();
+                assert!((g - w[k]).abs() < 1e-9, "{key}: {g} vs {}", w[k]);
+            }
+        }
+    }
+    assert_eq!(v["chains"], serde_json::json!(["rod", "rod", "radial", "radial"]));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    for label in ["A1", "A4", "B1", "B4", "X", "Y", "Z"] {
+        assert!(svg.lines().any(|l| l.trim() == label), "{label} missing");
+    }
+    assert!(svg.contains("trainer-ch5 at x, y, z"));
+    assert_eq!(svg.matches("<circle").count(), 8);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn draw_refuses_bad_input_in_one_line() {
+    let dir = std::env::temp_dir().join(format!("ringpod-draw-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("fig.svg");
+    let svg = svg.to_str().unwrap();
+    let txt = dir.join("fig.txt");
+    for args in [
+        &["draw", "-m", "trainer-ch5", "--pose=0,0,5,0,0,0", "--out", svg][..],
+        &["draw", "--pose=0,0,nan,0,0,0", "--out", svg][..],
+        &["draw", "--pose=0,0,0.2", "--out", svg][..],
+        &["draw", "-m", "tool5-ex", "--pose=0,0,0.4,0,0,0.1", "--out", svg][..],
+        &["draw", "-m", "nothing", "--out", svg][..],
+        &["draw", "--out", txt.to_str().unwrap()][..],
+    ] {
+        let out = ringpod().args(args).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        assert!(err.starts_with("ringpod: "), "{err}");
+    }
+    assert!(!dir.join("fig.svg").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn draw_the_tool_carrier_at_the_sources_third_example() {
+    // KINEMATICS.md 2.3: alpha = 15 deg 13', beta = 25 deg 20' gives q1 = 128.4 mm, q2 = 65 deg 01', q4 = 34 deg 22'.
+    let dir = std::env::temp_dir().join(format!("ringpod-draw-tool-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("tool.svg");
+    let v = json(&[
+        "draw",
+        "-m",
+        "tool5-ex",
+        "--degrees",
+        &format!("--pose=0,0,0.4,{},{},0", 15.0 + 13.0 / 60.0, 25.0 + 20.0 / 60.0),
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ]);
+    let q = |i: usize| v["actuators"][i].as_f64().unwrap();
+    assert!((q(0) - 0.1284).abs() < 1e-4, "{}", q(0));
+    assert!((q(1) - (65.0 + 1.0 / 60.0)).abs() < 1.0 / 60.0, "{}", q(1));
+    assert!((q(3) - (34.0 + 22.0 / 60.0)).abs() < 1.0 / 60.0, "{}", q(3));
+    // The frame pivots are in the dyads' plane x = q1.
+    for k in 0..2 {
+        assert!((v["pivots"][k][0].as_f64().unwrap() - q(0)).abs() < 1e-12);
+    }
+    let svg = std::fs::read_to_string(&out).unwrap();
+    for label in ["A2", "A3", "B", "D", "tool"] {
+        assert!(svg.lines().any(|l| l.trim() == label), "{label} missing");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

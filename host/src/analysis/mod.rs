@@ -1,4 +1,5 @@
 //! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`), `rates`, `structure`, `reactions`,
+//! tip-over (`check --tip-over`), the drawing of a platform at a pose (`draw`),
 //! the derivatives of a run record (`plot --derivatives`),
 //! `workspace` and `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
@@ -6,9 +7,11 @@ pub mod cue;
 pub mod cue_capture;
 pub mod demand;
 pub mod derivatives;
+pub mod draw;
 pub mod kinematics;
 pub mod mechanism;
 pub mod rates;
 pub mod reactions;
 pub mod structure;
+pub mod tipover;
 pub mod workspace;

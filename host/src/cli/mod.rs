@@ -34,7 +34,8 @@ pub enum Command {
     /// Exits 0 whenever the pose has a solution (failing checks are reported), 1 when it has none.
     Ik(PoseArgs),
     /// Workspace checks of a pose. Exits 0 when all pass, 3 when any fails, 1 when the pose has no solution.
-    Check(PoseArgs),
+    /// With --tip-over: a payload over the carriages' polygon under a lateral acceleration (3 when it tips).
+    Check(CheckArgs),
     /// Forward kinematics: the pose for six actuator values, by Newton iteration from a guess.
     Fk(FkArgs),
     /// The velocity problem at a pose (A p' = -B q', chapter 4): the actuator rates for --pose-rates, or the pose
@@ -44,6 +45,9 @@ pub enum Command {
     /// pose, the wrenches each chain transmits, each chain's determinant and the mechanism's wrench determinant;
     /// or one of the source's chains of figs. 5.1-5.3 with --chain.
     Structure(StructureArgs),
+    /// A labelled isometric drawing of a mechanism at a pose (ring, carriages, chains, platform, axes; the tool
+    /// carrier's guide, dyads, frame and tool), every point from its inverse kinematics, as SVG or PNG.
+    Draw(DrawArgs),
     /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
     /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
     /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
@@ -379,6 +383,39 @@ pub struct StructureArgs {
     /// One of the source's single chains at its coordinates, instead of a mechanism.
     #[arg(long, value_enum, conflicts_with_all = ["pose", "geometry", "mechanism"])]
     pub chain: Option<crate::analysis::structure::SourceChain>,
+}
+
+#[derive(Debug, Args)]
+pub struct DrawArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// The picture: .svg or .png.
+    #[arg(long)]
+    pub out: std::path::PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// Tip-over instead of the workspace checks (ring platforms): the largest lateral acceleration in each
+    /// direction before the payload's centre of mass, projected along g - a onto the ring plane, leaves the
+    /// carriages' polygon, and the weakest over all directions.
+    #[arg(long)]
+    pub tip_over: bool,
+    /// With --tip-over: the payload's centre of mass X,Y,Z in the platform frame (m). Default: the geometry's.
+    #[arg(long, allow_hyphen_values = true, requires = "tip_over", value_name = "X,Y,Z")]
+    pub payload_com: Option<String>,
+    /// With --tip-over: a lateral acceleration AX,AY of the platform (m/s^2, base frame): does it tip, by what
+    /// margin.
+    #[arg(long, allow_hyphen_values = true, requires = "tip_over", value_name = "AX,AY")]
+    pub accel: Option<String>,
 }
 
 #[derive(Debug, Args)]

@@ -2,7 +2,8 @@
 //! never see a clap struct.
 
 use super::{
-    Common, CueArgs, DeviceAction, DeviceArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs, StructureArgs, WorkspaceArgs,
+    CheckArgs, Common, CueArgs, DeviceAction, DeviceArgs, DrawArgs, FkArgs, LoadsArgs, RatesArgs, StreamArgs,
+    StructureArgs, WorkspaceArgs,
 };
 
 impl RatesArgs {
@@ -18,6 +19,29 @@ impl RatesArgs {
                 // clap requires one of them.
                 (None, None) => Given::PoseRates(""),
             },
+        }
+    }
+}
+
+impl CheckArgs {
+    /// The options `check --tip-over` takes.
+    pub fn tip_over(&self) -> crate::analysis::tipover::Options<'_> {
+        crate::analysis::tipover::Options {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            payload_com: self.payload_com.as_deref(),
+            accel: self.accel.as_deref(),
+        }
+    }
+}
+
+impl DrawArgs {
+    /// The options `draw` takes.
+    pub fn options(&self) -> crate::analysis::draw::Options<'_> {
+        crate::analysis::draw::Options {
+            on: self.common.on(),
+            pose: self.pose.as_deref(),
+            out: &self.out,
         }
     }
 }

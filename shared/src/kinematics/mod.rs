@@ -23,7 +23,10 @@ pub use geometry::{
 };
 pub use multiturn::MultiTurn;
 pub use pose::{Actuators, Pose};
-pub use ring::{ActuatorLoads, BodyMotion, MotionState, Payload, RingPlatform, SlowCheckGuard};
+pub use ring::{
+    ActuatorLoads, BodyMotion, Loaded, MotionState, Payload, RingPlatform, SlowCheckGuard, TipOver, TipOverError,
+    GRAVITY,
+};
 pub use tool::ToolCarrier;
 pub use velocity::{Jacobians, Singularity};
 pub use workspace::{Check, WorkspaceReport};

@@ -208,7 +208,7 @@ impl<T: Real> RingPlatform<T> {
     }
 
     /// The chains in the order their carriages come around the ring (counter-clockwise from angle 0).
-    fn ring_order(&self, q: &Actuators<T>) -> [usize; 6] {
+    pub(super) fn ring_order(&self, q: &Actuators<T>) -> [usize; 6] {
         let angle = |i: usize| {
             let a = wrap_pi(q.0[i]);
             if a < T::zero() {

@@ -1,12 +1,14 @@
 //! Ring platforms: carriages on a circular guide with rod chains, radial linear-actuator chains and elbow chains
 //! (KINEMATICS.md 2.1 trainer, 2.2 rotopod, 3 velocities; the elbow chain's arm in `arm`; the checks of 4 in
-//! `checks`, the statics of 5 in `statics`, the inverse dynamics in `dynamics`).
+//! `checks`, the statics of 5 in `statics`, the inverse dynamics in `dynamics`, tip-over under a lateral
+//! acceleration in `tipping`).
 
 mod arm;
 mod checks;
 mod dynamics;
 mod guard;
 mod statics;
+mod tipping;
 
 use nalgebra::{Matrix6, Vector3, Vector6};
 
@@ -15,6 +17,7 @@ use self::checks::Configuration;
 pub use self::dynamics::{BodyMotion, MotionState, Payload};
 pub use self::guard::SlowCheckGuard;
 pub use self::statics::ActuatorLoads;
+pub use self::tipping::{Loaded, TipOver, TipOverError, GRAVITY};
 use super::geometry::{Branch, ChainKind, RingGeometry};
 use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
