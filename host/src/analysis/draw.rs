@@ -39,6 +39,8 @@ pub struct Scene {
     pub carriages: Vec<[f64; 3]>,
     /// Each chain's platform joint, from IK's joints.
     pub joints: Vec<[f64; 3]>,
+    /// Per chain: `[shoulder, elbow]` axes of an elbow chain ([`super::placement`]), none for the others.
+    pub arms: Vec<Option<[[f64; 3]; 2]>>,
     /// `rod`, `radial` or `elbow` per chain.
     pub chains: Vec<&'static str>,
     /// The actuators IK gives (the mechanism's order).
@@ -53,7 +55,9 @@ impl Scene {
         let chains = g.chains();
         let rr = g.ring_radius;
         let joints = ring.joints(pose);
+        let arms = super::placement::place(ring, pose).map_or_else(|| vec![None; chains.len()], |p| p.arms);
         Ok(Self {
+            arms,
             mechanism: name.to_owned(),
             pose: pose.to_array(),
             ring_radius: rr,
@@ -66,7 +70,6 @@ impl Scene {
                 .map(|c| match c.kind {
                     ChainKind::Rod(_) => "rod",
                     ChainKind::Radial => "radial",
-                    // Drawn carriage to joint, as a rod is: its arms are not drawn here yet (the workbench draws them).
                     ChainKind::Elbow(_) => "elbow",
                 })
                 .collect(),
@@ -78,6 +81,7 @@ impl Scene {
     fn extent(&self) -> Vec<[f64; 3]> {
         let mut p: Vec<[f64; 3]> = ring_points(self.ring_radius).collect();
         p.extend(&self.joints);
+        p.extend(self.arms.iter().flatten().flatten());
         p.extend(self.axes().iter().map(|(_, end)| *end));
         p
     }
@@ -189,7 +193,7 @@ impl Picture for Scene {
         );
         root.draw(&Text::new(title, (16, 12), font(18))).map_err(|e| fail(&e))?;
         let legend =
-            "ring (grey), carriages B (blue), rods (black), radial actuators (orange), platform joints A (red)";
+            "ring (grey), carriages B (blue), rods and elbow arms (black), radial actuators (orange), platform joints A (red)";
         root.draw(&Text::new(legend, (16, 36), font(13)))
             .map_err(|e| fail(&e))?;
         // Base axes, with the ring plane's centre O.
@@ -222,7 +226,12 @@ impl Picture for Scene {
         for (i, ((b, a), kind)) in self.carriages.iter().zip(&self.joints).zip(&self.chains).enumerate() {
             let colour = if *kind == "radial" { RADIAL } else { ROD };
             let (pb, pa) = (view.at(*b), view.at(*a));
-            root.draw(&PathElement::new(vec![pb, pa], colour.stroke_width(3)))
+            // An elbow chain: carriage to shoulder axis, upper arm, forearm; the others a straight line.
+            let path = match self.arms.get(i).copied().flatten() {
+                Some([shoulder, elbow]) => vec![pb, view.at(shoulder), view.at(elbow), pa],
+                None => vec![pb, pa],
+            };
+            root.draw(&PathElement::new(path, colour.stroke_width(3)))
                 .map_err(|e| fail(&e))?;
             root.draw(&Circle::new(pb, 6, CARRIAGE.filled()))
                 .map_err(|e| fail(&e))?;

@@ -10,6 +10,7 @@ pub mod derivatives;
 pub mod draw;
 pub mod kinematics;
 pub mod mechanism;
+pub mod placement;
 pub mod rates;
 pub mod reactions;
 pub mod structure;

@@ -7,8 +7,9 @@ use ringpod_core::kinematics::{Check, Pose, RingGeometry, RingPlatform};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
-use super::frame::{place, RigView};
+use super::frame::RigView;
 use crate::analysis::cue::{delivered_forces, replay, TELEMETRY_COLUMNS};
+use crate::analysis::placement::place;
 use crate::analysis::workspace::{classify, Cell};
 
 /// The example drive the Cueing panel replays until the user gives one (a braking, a lane change, a bump).
