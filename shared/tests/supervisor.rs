@@ -327,15 +327,11 @@ proptest! {
             let _ = s.handle(e);
         }
         let reported = Supervisor::as_reported(config, s.state(), s.inputs());
-        for command in [
-            Event::Command(Command::Enable),
-            Event::Command(Command::Disable),
-            Event::Command(Command::Home),
-            Event::Command(Command::Start),
-            Event::Command(Command::Stop),
-            Event::Command(Command::ClearFault),
-            Event::Jog,
-        ] {
+        // Every command of the alphabet the other tests use (the six commands and the jog).
+        let commands = alphabet(&config)
+            .into_iter()
+            .filter(|e| matches!(e, Event::Command(_) | Event::Jog));
+        for command in commands {
             let before = s;
             let asked = s.permits(command);
             prop_assert_eq!(s, before, "permits changed the supervisor");
