@@ -36,9 +36,14 @@ pub(crate) fn ringpod_text(args: &[&str]) -> (bool, String) {
         .unwrap_or((false, String::new()))
 }
 
-/// A 3 s input: 2 s of motion on every axis, then 1 s holding the last pose, so that both runs end at rest at the
-/// same pose whatever their timing.
+/// A 3 s input about the trainer model's home height: see [`write_input_about`].
 pub(crate) fn write_input(path: &Path) -> std::io::Result<()> {
+    write_input_about(path, 0.227)
+}
+
+/// A 3 s input about home height `z0` (m): 2 s of motion on every axis, then 1 s holding the last pose, so that
+/// both runs end at rest at the same pose whatever their timing.
+pub(crate) fn write_input_about(path: &Path, z0: f64) -> std::io::Result<()> {
     let mut csv = String::from("t,x,y,z,alpha,beta,gamma\n");
     for k in 0..=300 {
         let t = f64::from(k) * 0.01;
@@ -47,7 +52,7 @@ pub(crate) fn write_input(path: &Path) -> std::io::Result<()> {
             "{t:.3},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}\n",
             0.01 * (2.0 * u).sin(),
             0.008 * (1.5 * u).sin(),
-            0.227 + 0.006 * (2.5 * u).sin(),
+            z0 + 0.006 * (2.5 * u).sin(),
             0.03 * u.sin(),
             0.04 * (2.0 * u).sin(),
             0.3 * u

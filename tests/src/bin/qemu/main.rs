@@ -7,7 +7,7 @@
 //!    control path in instructions (`-icount shift=0`), printed as a table with the budget.
 //! 2. `controller`: the controller's firmware tasks on the emulated MCU, streamed through its UART.
 //! 3. `watchdog`: a stalled control loop reset by the watchdog. 4. `rig`: a rig of one's own loaded and run, and
-//!    the elbow trainer's rig file likewise.
+//!    the elbow trainer's and the rotopod's rig files likewise.
 //!
 //! `setup` installs what the suite needs first (the target's standard library, QEMU) or says how;
 //! `cargo run -p ringpod-tests --bin qemu -- --preflight` runs only that. `emulator` starts QEMU and the programs;
@@ -23,7 +23,7 @@ mod watchdog;
 use std::process::ExitCode;
 
 use crate::controller::controller_on_m4f;
-use crate::rig::{elbow_on_m4f, rig_on_m4f};
+use crate::rig::{elbow_on_m4f, rig_on_m4f, rotopod_on_m4f};
 use crate::self_check::core_on_m4f;
 use crate::watchdog::watchdog_on_m4f;
 use ringpod_tests::setup::{self, preflight};
@@ -72,6 +72,7 @@ fn main() -> ExitCode {
     watchdog_on_m4f(&mut t);
     rig_on_m4f(&mut t);
     elbow_on_m4f(&mut t);
+    rotopod_on_m4f(&mut t);
     println!("{} passed, {} failed", t.passed, t.failed);
     if t.failed == 0 {
         ExitCode::SUCCESS

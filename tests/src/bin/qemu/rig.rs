@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use crate::emulator::start_or_fail;
-use crate::host_cli::{ringpod_json, ringpod_text, write_input};
+use crate::host_cli::{ringpod_json, ringpod_text, write_input_about};
 use crate::Tally;
 
 /// A rig no preset describes, on the device: loaded over the UART (checked by the M4F), stored in its flash,
@@ -25,6 +25,7 @@ pub(crate) fn rig_on_m4f(t: &mut Tally) {
         "wider-ring",
         &wider,
         &["ring_radius = 0.3\n", "rod_length = 0.325\n"],
+        0.227,
     );
 }
 
@@ -39,17 +40,43 @@ pub(crate) fn elbow_on_m4f(t: &mut Tally) {
         t.check(false, "the rig file is written");
         return;
     }
-    drive_on_m4f(t, "my-elbow", &renamed, &["kind = \"elbow\"", "upper_arm = 0.105\n"]);
+    drive_on_m4f(
+        t,
+        "my-elbow",
+        &renamed,
+        &["kind = \"elbow\"", "upper_arm = 0.105\n"],
+        0.227,
+    );
+}
+
+/// The rotopod of chapter 4 (six carriages on one ring, six rods) on the device, as its exported rig file renamed:
+/// the M4F plans its homing (six carriages that cannot pass each other), homes them to their index flags, and the
+/// stream about its home height ends at the simulator's steps.
+pub(crate) fn rotopod_on_m4f(t: &mut Tally) {
+    println!("== the rotopod on the emulated Cortex-M4F: load, restart, stream");
+    let (exported, preset) = ringpod_text(&["presets", "--export", "rotopod-ch4"]);
+    let renamed = preset.replace("name = \"rotopod-ch4\"", "name = \"my-rotopod\"");
+    if !exported || renamed == preset {
+        t.check(false, "the rig file is written");
+        return;
+    }
+    drive_on_m4f(
+        t,
+        "my-rotopod",
+        &renamed,
+        &["ring_radius = 1.0198\n", "rod_length = 0.98\n"],
+        0.7,
+    );
 }
 
 /// Loads `rig` (named `name`) into the emulated controller, restarts it into the stored rig, checks that `device rig
-/// show` gives it back (`shown` among its lines), and streams a CSV into it and into the simulator with the same
-/// file: both end at the same steps, not the trainer model's.
-fn drive_on_m4f(t: &mut Tally, name: &str, rig_text: &str, shown_lines: &[&str]) {
+/// show` gives it back (`shown` among its lines), and streams a CSV about home height `z0` (m) into it and into the
+/// simulator with the same file: both end at the same steps, not the trainer model's.
+fn drive_on_m4f(t: &mut Tally, name: &str, rig_text: &str, shown_lines: &[&str], z0: f64) {
     let dir = std::env::temp_dir().join(format!("ringpod-qemu-{name}-{}", std::process::id()));
     let _ = std::fs::create_dir_all(&dir);
     let (rig, input) = (dir.join(format!("{name}.toml")), dir.join("input.csv"));
-    if std::fs::write(&rig, rig_text).is_err() || write_input(&input).is_err() {
+    if std::fs::write(&rig, rig_text).is_err() || write_input_about(&input, z0).is_err() {
         t.check(false, "the rig file and the input are written");
         return;
     }
