@@ -31,10 +31,11 @@ fn main() -> ExitCode {
             cli::RigAction::Design {
                 file,
                 combined,
+                arms_only,
                 starts,
                 steps,
                 seed,
-            } => rig::design_command(file, *combined, *starts, *steps, *seed),
+            } => rig::design_command(file, *combined, *arms_only, *starts, *steps, *seed),
         }),
         C::Ik(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), false)),
         C::Check(args) if args.tip_over => answer(analysis::tipover::run(&args.tip_over())),

@@ -1538,3 +1538,57 @@ fn draw_the_tool_carrier_at_the_sources_third_example() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `rig design --arms-only`: from the elbow trainer's rig file with arms too short for its spec, the search moves
+/// only the arms, covers each spec axis (exit 0) and prints a rig file whose ring and rods are the template's; on a
+/// rig without elbow chains it is refused by key, exit 1.
+#[test]
+fn rig_design_moves_only_the_elbow_arms_when_asked() {
+    let dir = std::env::temp_dir().join(format!("ringpod-design-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let export = |preset: &str| {
+        let out = ringpod().args(["presets", "--export", preset]).output().unwrap();
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let elbow = export("trainer-elbow");
+    let short = elbow
+        .replace("upper_arm = 0.105", "upper_arm = 0.12")
+        .replace("forearm = 0.189", "forearm = 0.12");
+    assert_ne!(short, elbow);
+    let (template, model) = (dir.join("short.toml"), dir.join("model.toml"));
+    std::fs::write(&template, short).unwrap();
+    std::fs::write(&model, export("trainer-model")).unwrap();
+    let out = ringpod()
+        .args([
+            "rig",
+            "design",
+            "--arms-only",
+            "--starts",
+            "4",
+            "--steps",
+            "150",
+            "--seed",
+            "3",
+        ])
+        .arg(&template)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "covers each axis: {text}");
+    assert!(
+        text.contains("ring_radius = 0.286\n") && text.contains("rod_length = 0.312\n"),
+        "{text}"
+    );
+    assert!(!text.contains("forearm = 0.12\n"), "the arms moved: {text}");
+    assert_eq!(text.matches("forearm = ").count(), 2, "{text}");
+    ringpod()
+        .args(["rig", "design", "--arms-only"])
+        .arg(&model)
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains(
+            "chains: designing the arms alone needs elbow chains",
+        ));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -132,15 +132,19 @@ pub enum RigAction {
         #[arg(long)]
         json: bool,
     },
-    /// Searches dimensions (ring radius, rod length, home height, every platform joint) for a template rig's chains,
-    /// joint limits and [spec] ranges, and prints the best as a rig file with its coverage. Exits 0 when it covers
-    /// the spec, 3 when the best found does not.
+    /// Searches dimensions (ring radius, rod length, home height, every platform joint, every elbow chain's arm) for
+    /// a template rig's chains, joint limits and [spec] ranges, and prints the best as a rig file with its coverage.
+    /// Exits 0 when it covers the spec, 3 when the best found does not.
     Design {
         /// The template rig file (its [spec] ranges are the target).
         file: std::path::PathBuf,
         /// Cover all spec axes at once (the combined box), not each axis over its range alone.
         #[arg(long)]
         combined: bool,
+        /// Move only the elbow chains' arms (shoulder radius and height, upper arm, forearm); keep the ring, rods,
+        /// platform joints and home as the template has them.
+        #[arg(long)]
+        arms_only: bool,
         /// Random starts of the hill climb.
         #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u32).range(1..=10_000))]
         starts: u32,

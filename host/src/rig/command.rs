@@ -7,7 +7,7 @@ use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
 use ringpod_core::kinematics::RingPlatform;
 use serde::Serialize;
 
-use super::design::{design, Search, Target};
+use super::design::{design, Free, Search, Target};
 use super::{coverage, read, RigFile};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::out::Outcome;
@@ -185,10 +185,18 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
 }
 
 /// `ringpod rig design TEMPLATE`: the best dimensions found, as a rig file, with its coverage in comments.
-pub fn design_command(path: &Path, combined: bool, starts: u32, steps: u32, seed: u64) -> Result<Outcome, CliError> {
+pub fn design_command(
+    path: &Path,
+    combined: bool,
+    arms_only: bool,
+    starts: u32,
+    steps: u32,
+    seed: u64,
+) -> Result<Outcome, CliError> {
     let template = read(path)?;
     let search = Search {
         target: if combined { Target::Combined } else { Target::EachAxis },
+        free: if arms_only { Free::Arms } else { Free::All },
         starts,
         steps,
         seed,

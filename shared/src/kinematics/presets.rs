@@ -113,14 +113,14 @@ pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
 
 /// The arm of [`TRAINER_ELBOW`]'s elbow chains, in metres.
 ///
-/// Found by `examples/trainer_elbow_design.rs` (a random search over shoulder radius 0.22..0.33 m, height, upper arm,
-/// forearm and branch, scoring the arms' worst margin over the model's spec table swept axis by axis at 24 yaws) and
-/// rounded to millimetres: the shoulder 28 mm inside the ring, 17 mm above it; upper arm 105 mm, forearm 189 mm,
-/// elbow up. Over that sweep the elbow's interior angle stays 20 degrees or more inside its 25..155 degree limits,
-/// the forearm 10 degrees or more above the platform cone, the singularity index above 0.05; the shoulder needs
-/// 114..175 degrees (the upper arm points outward and up), and its travel is that plus 14..15 degrees each way
-/// (index or end switch below 100 degrees). An arm whose shoulder sits up to 0.40 m out (an outrigger) scored only
-/// a little better.
+/// Found by a random search (the example `trainer_elbow_design.rs` of commit 9a43fc1, now `ringpod rig design
+/// --arms-only`) over shoulder radius 0.22..0.33 m, height, upper arm, forearm and branch, scoring the arms' worst
+/// margin over the model's spec table swept axis by axis at 24 yaws, and rounded to millimetres: the shoulder 28 mm
+/// inside the ring, 17 mm above it; upper arm 105 mm, forearm 189 mm, elbow up. Over that sweep the elbow's interior
+/// angle stays 20 degrees or more inside its 25..155 degree limits, the forearm 10 degrees or more above the platform
+/// cone, the singularity index above 0.05; the shoulder needs 114..175 degrees (the upper arm points outward and up),
+/// and its travel is that plus 14..15 degrees each way (index or end switch below 100 degrees). An arm whose shoulder
+/// sits up to 0.40 m out (an outrigger) scored only a little better.
 pub const TRAINER_ELBOW_ARM: Elbow = Elbow {
     shoulder_radius: 0.258,
     shoulder_height: 0.017,
