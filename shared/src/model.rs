@@ -6,6 +6,7 @@
 //! ([`crate::controller::ControllerConfig::default_record`]); the configuration the firmware compiles in is
 //! [`crate::controller::ControllerConfig::trainer_model`], built from these.
 
+use crate::kinematics::AxisKind;
 use crate::motion::{AxisScale, MotionLimits};
 use crate::protocol::{HomingSettings, SwitchSettings, Toward};
 
@@ -54,6 +55,18 @@ impl AxisScale {
 pub const SHOULDER_VELOCITY: f32 = 3.0;
 /// See [`SHOULDER_VELOCITY`] (rad/s^2).
 pub const SHOULDER_ACCELERATION: f32 = 60.0;
+
+/// The velocity and acceleration limits of an actuator of `kind` on the trainer model's drives: what a rig's
+/// `[motion]` takes for an actuator it gives no limits for, and what a stored record of version 2 (which had none)
+/// is given.
+pub fn actuator_limits(kind: AxisKind) -> (f32, f32) {
+    let model = MotionLimits::TRAINER_MODEL;
+    match kind {
+        AxisKind::Ring => (model.actuator_velocity[0], model.actuator_acceleration[0]),
+        AxisKind::Linear => (model.actuator_velocity[4], model.actuator_acceleration[4]),
+        AxisKind::Angle => (SHOULDER_VELOCITY, SHOULDER_ACCELERATION),
+    }
+}
 
 /// An elbow chain's shoulder homing: an index flag at the shoulder's home-pose angle, as a carriage's, searched
 /// up to 20 degrees at 8,000 steps/s of its 64,000 per turn, backed off 2 degrees, approached at 1,000 steps/s.

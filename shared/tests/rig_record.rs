@@ -271,3 +271,63 @@ fn a_setpoint_request_read_on_its_own_is_the_request_decoded_whole() {
         assert_eq!(protocol::setpoint_request(payload), None);
     }
 }
+
+/// A record that a version-2 firmware stored (before the motion section carried the actuator limits), written here
+/// in that layout as tuples: the update reads it, keeps the builder's rig and every section it had, and gives each
+/// actuator its kind's limits, what a version-2 device drove it with: the elbow trainer's carriages 2.4 rad/s, its
+/// shoulders 3 rad/s.
+#[test]
+fn a_version_2_record_is_migrated_with_its_actuators_kinds_limits() {
+    let defaults = ControllerConfig::trainer_model();
+    let mut rig = ControllerConfig::default_record(
+        "my-elbow",
+        &ringpod_core::kinematics::presets::TRAINER_ELBOW,
+        Preset::TrainerElbow.home(),
+    );
+    rig.machine.motion.pose_velocity[5] = 1.5;
+    rig.machine.axes[1].reverse = true;
+    let m = &rig.machine;
+    let old_machine = (
+        m.axes,
+        (m.motion.pose_velocity, m.motion.pose_acceleration),
+        m.inputs,
+        m.supervisor,
+        m.homing,
+    );
+    let old_rig = (
+        rig.name,
+        rig.ring_radius,
+        rig.rod_length,
+        rig.chains,
+        rig.chain_count,
+        rig.limits,
+        rig.home,
+        old_machine,
+    );
+    let stream = StreamSettings {
+        timeout_ms: 250,
+        ..defaults.stream()
+    };
+    let mut raw = [0u8; 1024];
+    let bytes = postcard::to_slice(&(2u16, old_rig, stream, defaults.control()), &mut raw).unwrap();
+    let mut f = flash();
+    store_raw(&mut f, bytes);
+    let (config, report) = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
+    assert_eq!(report.rig, RigSource::Stored);
+    assert_eq!(report.applied, 1 + 1);
+    let limits = config.pipeline.limits;
+    assert_eq!(limits.pose_velocity[5], 1.5);
+    assert_eq!(limits.actuator_velocity, [2.4, 2.4, 2.4, 2.4, 3.0, 3.0]);
+    assert_eq!(limits.actuator_acceleration, [100.0, 100.0, 100.0, 100.0, 60.0, 60.0]);
+    assert_eq!(
+        config.rig(),
+        rig,
+        "the rig and its sections as they were, the limits as default_record gives"
+    );
+    assert_eq!(config.stream(), stream);
+    // Stored again, it is a record of this version that restores to the same configuration.
+    let mut f = flash();
+    block_on(store(&mut f, Flash::FULL_FLASH_RANGE, &config)).unwrap();
+    let again = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
+    assert_eq!((again.0, again.1.rig), (config, RigSource::Stored));
+}

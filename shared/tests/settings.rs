@@ -193,8 +193,16 @@ fn live_sections_apply_at_once_and_next_start_sections_are_stored() {
     let mut c = device::connected();
     let mut m = motion(&c);
     m.pose_velocity[2] = 0.02;
+    // A faster lead screw's motor: 0.12 m/s is 192 k steps/s at 1.6 M steps/m, inside the step generator's 200 k.
+    m.actuator_velocity[5] = 0.12;
+    m.actuator_acceleration[0] = 50.0;
     assert_eq!(set(&mut c, Settings::Motion(m)), DeviceMessage::Ack);
-    assert_eq!(c.pipeline().config().limits.pose_velocity[2], 0.02);
+    let limits = c.pipeline().config().limits;
+    assert_eq!(limits.pose_velocity[2], 0.02);
+    assert_eq!(
+        (limits.actuator_velocity[5], limits.actuator_acceleration[0]),
+        (0.12, 50.0)
+    );
     assert_eq!(
         get(&mut c, SettingsKind::Motion),
         DeviceMessage::Settings {
@@ -306,7 +314,18 @@ fn bad_sections_are_refused_and_nothing_is_stored() {
         acceleration.pose_acceleration[5] = v;
         bad.push((Settings::Motion(velocity), "motion.pose_velocity[0]".into()));
         bad.push((Settings::Motion(acceleration), "motion.pose_acceleration[5]".into()));
+        let mut velocity = m;
+        velocity.actuator_velocity[2] = v;
+        let mut acceleration = m;
+        acceleration.actuator_acceleration[4] = v;
+        bad.push((Settings::Motion(velocity), "motion.actuator_velocity[2]".into()));
+        bad.push((Settings::Motion(acceleration), "motion.actuator_acceleration[4]".into()));
     }
+    // A linear actuator at 0.13 m/s on the model's 1.6 M steps/m asks 208 k steps/s, beyond the step generator's
+    // 200 k (one step per 5 us); 0.12 m/s (192 k) is taken.
+    let mut fast = m;
+    fast.actuator_velocity[5] = 0.13;
+    bad.push((Settings::Motion(fast), "motion.actuator_velocity[5]".into()));
     for (axis, v) in [(0, 25_600.5), (4, -1.0), (4, 0.5), (1, 2e7), (2, f32::NAN)] {
         let mut x = a;
         x[axis].steps_per_unit = v;
@@ -707,12 +726,22 @@ fn any_settings() -> impl Strategy<Value = Settings> {
         });
     let control = prop::sample::select(vec![0u16, 500, 999, 1_000, 1_500, 2_000, 4_000])
         .prop_map(|tick_hz| Settings::Control(ControlSettings { tick_hz }));
-    let motion = (prop::array::uniform6(real()), prop::array::uniform6(real())).prop_map(|(v, a)| {
-        Settings::Motion(MotionSettings {
-            pose_velocity: v,
-            pose_acceleration: a.map(|x| x * 40.0),
-        })
-    });
+    // Actuator velocities up to 4 rad/s or m/s: a carriage takes any of them, a linear actuator only up to the
+    // step generator's 0.125 m/s.
+    let motion = (
+        prop::array::uniform6(real()),
+        prop::array::uniform6(real()),
+        prop::array::uniform6(real()),
+        prop::array::uniform6(real()),
+    )
+        .prop_map(|(v, a, av, aa)| {
+            Settings::Motion(MotionSettings {
+                pose_velocity: v,
+                pose_acceleration: a.map(|x| x * 40.0),
+                actuator_velocity: av.map(|x| x * 8.0),
+                actuator_acceleration: aa.map(|x| x * 200.0),
+            })
+        });
     let inputs = (any::<u16>(), 0u8..60).prop_map(|(active_low, debounce_samples)| {
         Settings::Inputs(InputConfig {
             active_low,

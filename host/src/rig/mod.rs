@@ -59,7 +59,7 @@ use std::path::Path;
 use ringpod_core::controller::ControllerConfig;
 use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, Elbow, ElbowBranch, RingGeometry, RingLimits, DEG};
 use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
-use ringpod_core::protocol::{AxisSettings, HomingSettings, MotionSettings};
+use ringpod_core::protocol::{AxisSettings, HomingSettings};
 use serde::{Deserialize, Serialize};
 
 /// A rig file as written.
@@ -88,9 +88,10 @@ pub struct RigFile {
     /// Each motor's steps per unit and direction, in actuator order (optional: the trainer model's drives).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub axes: Vec<AxisSettings>,
-    /// Pose limits (optional: the trainer model's).
+    /// Pose and actuator limits (optional: the trainer model's pose limits, and each actuator its kind's on the
+    /// trainer model's drives).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub motion: Option<MotionSettings>,
+    pub motion: Option<settings::MotionSpec>,
     /// Input wiring (optional: switches to ground with pull-ups, a normally closed e-stop chain, 3 ms debouncing).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub inputs: Option<settings::InputsSpec>,

@@ -1,11 +1,12 @@
 //! The rig file's controller sections, the device's own settings sections by their field names: `[[axes]]` (each
-//! motor's steps per unit and direction, in actuator order), `[motion]` (pose limits), `[inputs]` (which inputs are
+//! motor's steps per unit and direction, in actuator order), `[motion]` (pose limits, and the actuators' limits,
+//! each actuator its kind's on the trainer model's drives when the file gives none), `[inputs]` (which inputs are
 //! active low, by name, and debouncing), `[supervisor]` (supply sensing and sequencing delays) and `[homing]` (each
 //! axis's switch and search in the axis's units, and the order). Each is optional and takes the trainer model's
 //! values on this rig when omitted; together with the geometry they make the [`RigRecord`] a device stores.
 
 use ringpod_core::controller::{ConfigError, ControllerConfig};
-use ringpod_core::protocol::RigRecord;
+use ringpod_core::protocol::{MotionSettings, RigRecord};
 use ringpod_core::safety::debounce::{InputBit, InputConfig};
 use serde::{Deserialize, Serialize};
 
@@ -19,6 +20,45 @@ pub struct InputsSpec {
     pub active_low: Vec<String>,
     /// Equal samples, 1 ms apart, before a level counts (1-50).
     pub debounce_ms: u8,
+}
+
+/// `[motion]`: the pose limits, and optionally the actuators' (a rig that says nothing of its motors' speeds gets
+/// the trainer model's for each actuator's kind, as a device gives them).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MotionSpec {
+    /// Velocity limit per pose axis x, y, z (m/s), roll, pitch, yaw (rad/s).
+    pub pose_velocity: [f32; 6],
+    /// Acceleration limit per pose axis (m/s^2, rad/s^2).
+    pub pose_acceleration: [f32; 6],
+    /// Velocity limit per actuator in actuator order: rad/s for carriages and shoulders, m/s for linear actuators.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub actuator_velocity: Option<[f32; 6]>,
+    /// Acceleration limit per actuator (rad/s^2, m/s^2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub actuator_acceleration: Option<[f32; 6]>,
+}
+
+impl MotionSpec {
+    /// The device's section: this file's limits over `defaults` (the rig's default record's).
+    fn settings(&self, defaults: &MotionSettings) -> MotionSettings {
+        MotionSettings {
+            pose_velocity: self.pose_velocity,
+            pose_acceleration: self.pose_acceleration,
+            actuator_velocity: self.actuator_velocity.unwrap_or(defaults.actuator_velocity),
+            actuator_acceleration: self.actuator_acceleration.unwrap_or(defaults.actuator_acceleration),
+        }
+    }
+
+    /// The section written out in full.
+    fn of(m: &MotionSettings) -> Self {
+        Self {
+            pose_velocity: m.pose_velocity,
+            pose_acceleration: m.pose_acceleration,
+            actuator_velocity: Some(m.actuator_velocity),
+            actuator_acceleration: Some(m.actuator_acceleration),
+        }
+    }
 }
 
 /// Every input by its name in the file.
@@ -51,7 +91,7 @@ impl RigFile {
             *slot = *axis;
         }
         if let Some(m) = &self.motion {
-            record.machine.motion = *m;
+            record.machine.motion = m.settings(&record.machine.motion);
         }
         if let Some(spec) = &self.inputs {
             record.machine.inputs = spec.config()?;
@@ -74,7 +114,7 @@ impl RigFile {
     pub fn with_sections(mut self, record: &RigRecord) -> Self {
         let m = &record.machine;
         self.axes = m.axes.to_vec();
-        self.motion = Some(m.motion);
+        self.motion = Some(MotionSpec::of(&m.motion));
         self.inputs = Some(InputsSpec::of(&m.inputs));
         self.supervisor = Some(m.supervisor);
         self.homing = Some(m.homing);
@@ -191,6 +231,33 @@ mod tests {
         );
         let again = parse(&text).unwrap().check().unwrap().record;
         assert_eq!(again, record);
+    }
+
+    /// `[motion]` without actuator limits gives each actuator its kind's (the rig file's and the device's defaults
+    /// agree); with them, they travel to the device; beyond the step generator at the axis's steps per unit, the
+    /// device's check names the actuator.
+    #[test]
+    fn actuator_limits_default_by_kind_and_are_checked_against_the_step_rate() {
+        let text = with_sections();
+        let record = parse(&text).unwrap().check().unwrap().record;
+        let m = record.machine.motion;
+        assert_eq!(m.actuator_velocity, [2.4, 2.4, 2.4, 2.4, 0.06, 0.06]);
+        assert_eq!(m.actuator_acceleration, [100.0, 100.0, 100.0, 100.0, 5.0, 5.0]);
+        let pose = "pose_acceleration = [1, 1, 1, 10, 10, 10]\n";
+        let own = text.replace(
+            pose,
+            &format!(
+                "{pose}actuator_velocity = [3, 3, 3, 3, 0.05, 0.1]\nactuator_acceleration = [50, 50, 50, 50, 2, 2]\n"
+            ),
+        );
+        let record = parse(&own).unwrap().check().unwrap().record;
+        let m = record.machine.motion;
+        assert_eq!(m.actuator_velocity, [3.0, 3.0, 3.0, 3.0, 0.05, 0.1]);
+        assert_eq!(m.actuator_acceleration[5], 2.0);
+        // Axis 4 has 3.2 M steps/m: 0.07 m/s asks 224 k steps/s of a generator that makes 200 k.
+        let fast = own.replace("0.05, 0.1]", "0.07, 0.1]");
+        let e = parse(&fast).unwrap().check().expect_err("refused");
+        assert_eq!(e.key, "motion.actuator_velocity[4]", "{e}");
     }
 
     #[test]

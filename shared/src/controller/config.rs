@@ -9,7 +9,9 @@ use crate::kinematics::{GeometryError, RingGeometry};
 use crate::model::{self, CARRIAGE_HOMING, LINEAR_HOMING, SHOULDER_HOMING};
 use crate::motion::pulse::{PulseTiming, PulseTimingError, MAX_STEP_SLOTS, STEP_SLOT_NS};
 use crate::motion::{AxisScale, PipelineConfig, SchedulerConfig};
-use crate::protocol::{ConfigRefusal, Field, HomingSettings, RigRecord, Settings, SwitchSettings, RIG_NAME_LEN};
+use crate::protocol::{
+    ConfigRefusal, Field, FieldName, HomingSettings, RigRecord, Settings, SettingsKind, SwitchSettings, RIG_NAME_LEN,
+};
 use crate::safety::debounce::InputConfig;
 use crate::safety::homing::{HomingError, HomingPlan, RingHoming};
 use crate::safety::SupervisorConfig;
@@ -105,6 +107,21 @@ impl ControllerConfig {
         PulseTiming::new(&self.scheduler, STEP_SLOT_NS, MAX_STEP_SLOTS)
     }
 
+    /// Every actuator's velocity limit within the step generator's rate at its steps per unit: the tracker never
+    /// asks an axis for more steps a second than one per minimum step spacing.
+    fn step_rates(&self) -> Result<(), ConfigError> {
+        let most = 1e9 / self.scheduler.min_spacing_ns.max(1) as f32;
+        let limits = &self.pipeline.limits;
+        match (0..6).find(|&a| limits.actuator_velocity[a] * self.scales[a].steps_per_unit > most) {
+            Some(a) => Err(ConfigError::Value(Field::at(
+                SettingsKind::Motion,
+                a,
+                FieldName::ActuatorVelocity,
+            ))),
+            None => Ok(()),
+        }
+    }
+
     /// Whether a controller can run this configuration (what [`Controller::new`] checks).
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.check().map(|_| ())
@@ -119,6 +136,7 @@ impl ControllerConfig {
             return Err(ConfigError::Scheduler);
         }
         self.pulse_timing().map_err(ConfigError::StepTiming)?;
+        self.step_rates()?;
         super::sections::supervisor_fields(&self.supervisor)?;
         let mechanism = RingPlatform::<f32>::new(geometry);
         let home_pose = Pose::from_array(self.home).cast::<f32>();
@@ -189,6 +207,11 @@ impl ControllerConfig {
         let mut machine = model.machine();
         let carriages = axes.iter().filter(|k| **k == AxisKind::Ring).count();
         for (a, kind) in axes.iter().enumerate() {
+            // A rig's fifth carriage turns like a carriage, a shoulder like a shoulder.
+            (
+                machine.motion.actuator_velocity[a],
+                machine.motion.actuator_acceleration[a],
+            ) = model::actuator_limits(*kind);
             if *kind == AxisKind::Ring {
                 machine.axes[a].steps_per_unit = AxisScale::MODEL_CARRIAGE.steps_per_turn as f32;
                 machine.homing.axes[a] = SwitchSettings {
@@ -231,19 +254,6 @@ impl ControllerConfig {
             rig_name: record.name,
             ..Self::trainer_model()
         };
-        // Each axis's actuator limits are its kind's on the model's drives (a rig's fifth carriage turns like a
-        // carriage, a shoulder like a shoulder).
-        let model = crate::motion::MotionLimits::TRAINER_MODEL;
-        let limits = &mut config.pipeline.limits;
-        for (a, kind) in RingPlatform::<f64>::new(&geometry).axes().iter().enumerate() {
-            let (v, acc) = match kind {
-                AxisKind::Ring => (model.actuator_velocity[0], model.actuator_acceleration[0]),
-                AxisKind::Linear => (model.actuator_velocity[4], model.actuator_acceleration[4]),
-                AxisKind::Angle => (model::SHOULDER_VELOCITY, model::SHOULDER_ACCELERATION),
-            };
-            limits.actuator_velocity[a] = v;
-            limits.actuator_acceleration[a] = acc;
-        }
         let m = &record.machine;
         for section in [
             Settings::Axes(m.axes),

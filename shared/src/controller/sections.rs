@@ -5,7 +5,7 @@
 
 use super::{ConfigError, ControllerConfig};
 use crate::kinematics::{AxisKind, Mechanism, RingPlatform};
-use crate::motion::AxisScale;
+use crate::motion::{AxisScale, MotionLimits};
 use crate::protocol::{
     AxisSettings, ControlSettings, Field, FieldName, MachineSettings, MotionSettings, Settings, SettingsKind,
     StreamSettings, SwitchSettings, Toward,
@@ -76,9 +76,12 @@ impl ControllerConfig {
     }
 
     fn motion(&self) -> MotionSettings {
+        let limits = &self.pipeline.limits;
         MotionSettings {
-            pose_velocity: self.pipeline.limits.pose_velocity,
-            pose_acceleration: self.pipeline.limits.pose_acceleration,
+            pose_velocity: limits.pose_velocity,
+            pose_acceleration: limits.pose_acceleration,
+            actuator_velocity: limits.actuator_velocity,
+            actuator_acceleration: limits.actuator_acceleration,
         }
     }
 
@@ -123,13 +126,19 @@ impl ControllerConfig {
                 for (values, name) in [
                     (&s.pose_velocity, FieldName::PoseVelocity),
                     (&s.pose_acceleration, FieldName::PoseAcceleration),
+                    (&s.actuator_velocity, FieldName::ActuatorVelocity),
+                    (&s.actuator_acceleration, FieldName::ActuatorAcceleration),
                 ] {
                     if let Some(i) = values.iter().position(|x| !(x.is_finite() && *x > 0.0)) {
                         return Err(ConfigError::Value(Field::at(SettingsKind::Motion, i, name)));
                     }
                 }
-                c.limits.pose_velocity = s.pose_velocity;
-                c.limits.pose_acceleration = s.pose_acceleration;
+                c.limits = MotionLimits {
+                    pose_velocity: s.pose_velocity,
+                    pose_acceleration: s.pose_acceleration,
+                    actuator_velocity: s.actuator_velocity,
+                    actuator_acceleration: s.actuator_acceleration,
+                };
             }
             Settings::Inputs(s) => {
                 if !(1..=50).contains(&s.debounce_samples) {

@@ -29,6 +29,8 @@ pub enum FieldName {
     TickHz,
     PoseVelocity,
     PoseAcceleration,
+    ActuatorVelocity,
+    ActuatorAcceleration,
     DebounceMs,
     StepsPerUnit,
     Order,
@@ -55,6 +57,8 @@ impl FieldName {
             Self::TickHz => "tick_hz",
             Self::PoseVelocity => "pose_velocity",
             Self::PoseAcceleration => "pose_acceleration",
+            Self::ActuatorVelocity => "actuator_velocity",
+            Self::ActuatorAcceleration => "actuator_acceleration",
             Self::DebounceMs => "debounce_ms",
             Self::StepsPerUnit => "steps_per_unit",
             Self::Order => "order",
@@ -100,7 +104,13 @@ impl Field {
             FieldName::Margins => "0 to 0.1, in its check's unit",
             FieldName::TelemetryHz => "0 to 2,000 samples a second",
             FieldName::TickHz => "500, 1,000 or 2,000 ticks a second",
-            FieldName::PoseVelocity | FieldName::PoseAcceleration => "a positive number",
+            FieldName::PoseVelocity | FieldName::PoseAcceleration | FieldName::ActuatorAcceleration => {
+                "a positive number"
+            }
+            FieldName::ActuatorVelocity => {
+                "a positive number, and no more steps a second at the axis's steps per unit than the step generator \
+                 makes (one per minimum step spacing)"
+            }
             FieldName::DebounceMs => "1 to 50 ms",
             FieldName::StepsPerUnit => "1 to 16,777,216 steps, and a whole number per carriage turn",
             FieldName::Order => "every axis 0 to 5 once",

@@ -10,8 +10,8 @@ use super::Field;
 use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 use crate::safety::{Command, FaultReason, Refusal, State};
 
-/// Protocol version; host and device must agree exactly.
-pub const PROTOCOL_VERSION: u16 = 7;
+/// Protocol version; host and device must agree exactly. 8: the motion section carries the actuator limits.
+pub const PROTOCOL_VERSION: u16 = 8;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;

@@ -36,7 +36,7 @@ pub struct ControlSettings {
     pub tick_hz: u16,
 }
 
-/// Pose limits (live).
+/// Pose and actuator limits (live).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MotionSettings {
@@ -44,6 +44,13 @@ pub struct MotionSettings {
     pub pose_velocity: [f32; 6],
     /// Acceleration limit per pose axis (m/s^2, rad/s^2); each above 0.
     pub pose_acceleration: [f32; 6],
+    /// Velocity limit per actuator, in actuator order and its own unit: rad/s for carriages and shoulders, m/s for
+    /// linear actuators; each above 0, and at most what the step generator can pulse at the axis's steps per unit.
+    /// What the motor and its drive can follow without losing steps: the pose limits are the platform's, these the
+    /// motors'.
+    pub actuator_velocity: [f32; 6],
+    /// Acceleration limit per actuator (rad/s^2, m/s^2); each above 0.
+    pub actuator_acceleration: [f32; 6],
 }
 
 /// One motor (next start).

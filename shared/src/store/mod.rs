@@ -18,13 +18,16 @@ use sequential_storage::map::{fetch_item, store_item};
 use crate::controller::ControllerConfig;
 use crate::protocol::{ControlSettings, RigRecord, RigSource, Settings, StreamSettings};
 
+mod v2;
+
 /// The record's key in flash. (Keys 1-53 held the single `f32` settings of protocol versions up to 5: never read.)
 pub const CONFIG_KEY: u8 = 0xf0;
-/// Layout of the stored record; a record of another version is not read (the compiled-in defaults run and the host
-/// sees [`RigSource::Unreadable`]). Version 1 held the rig alone; 2 adds the machine's settings sections (homing
-/// among them) and the stream and control sections.
-pub const RECORD_VERSION: u16 = 2;
-/// Room for the record's postcard bytes (about 590) and the crate's header; every item read or moved passes through
+/// Layout of the stored record. Version 1 held the rig alone; 2 adds the machine's settings sections (homing among
+/// them) and the stream and control sections; 3 adds the actuator limits to the motion section. A record of
+/// version 2 is read and migrated (its actuators get their kinds' limits, what a version-2 device drove them with);
+/// one of another version is not read (the compiled-in defaults run and the host sees [`RigSource::Unreadable`]).
+pub const RECORD_VERSION: u16 = 3;
+/// Room for the record's postcard bytes (about 690 with elbow chains) and the crate's header; every item read or moved passes through
 /// a buffer of this size.
 const RECORD_BUFFER: usize = 768;
 
@@ -63,9 +66,9 @@ pub async fn restore<F: NorFlash>(
     let mut buf = [0u8; RECORD_BUFFER];
     let record = match fetch_item::<u8, &[u8], _>(flash, range, &mut NoCache::new(), &mut buf, &CONFIG_KEY).await {
         Ok(None) => return (defaults, report),
-        Ok(Some(bytes)) => match postcard::from_bytes::<Record>(bytes) {
-            Ok(record) if record.version == RECORD_VERSION => record,
-            _ => {
+        Ok(Some(bytes)) => match read(bytes) {
+            Some(record) => record,
+            None => {
                 report.rig = RigSource::Unreadable;
                 return (defaults, report);
             }
@@ -96,6 +99,24 @@ pub async fn restore<F: NorFlash>(
         config = base;
     }
     (config, report)
+}
+
+/// The record in `bytes`, of this version or migrated from version 2. The version is the first field of every
+/// version, so it is read first and decides the layout.
+fn read(bytes: &[u8]) -> Option<Record> {
+    match postcard::take_from_bytes::<u16>(bytes).ok()?.0 {
+        RECORD_VERSION => postcard::from_bytes::<Record>(bytes).ok(),
+        2 => {
+            let old = postcard::from_bytes::<v2::Record>(bytes).ok()?;
+            Some(Record {
+                version: RECORD_VERSION,
+                rig: old.rig(),
+                stream: old.stream,
+                control: old.control,
+            })
+        }
+        _ => None,
+    }
 }
 
 /// Stores `config` (what the next start is to run) as the record. On an error the previously stored record (or
