@@ -62,9 +62,9 @@ fn main() -> ExitCode {
             let _ = std::io::stdout().write_all(text.as_bytes());
             code
         }),
-        C::Monitor { port, sim, frames } => {
-            link::Target::named(port.as_deref(), *sim).and_then(|target| device::monitor(&target, *frames))
-        }
+        C::Monitor { port, sim, frames } => link::Target::named(port.as_deref(), *sim)
+            .map_err(anyhow::Error::from)
+            .and_then(|target| device::monitor(&target, *frames)),
         C::Plot {
             record,
             out,

@@ -11,9 +11,62 @@ use ringpod_core::safety::debounce::InputBit;
 use ringpod_core::kinematics::AxisKind;
 use ringpod_core::protocol::endpoints::{Buzz, Jog};
 use ringpod_core::protocol::{NackReason, Settings, SettingsKind};
-use ringpod_core::safety::State;
+use ringpod_core::safety::{FaultReason, State};
 
 use crate::link::client::{Client, ClientError, Transport};
+
+/// Why a commissioning move was not made or did not end well.
+#[derive(Debug, thiserror::Error)]
+pub enum CommissionError {
+    /// The words are not an axis (and a distance).
+    #[error("{0}")]
+    Usage(&'static str),
+    /// The distance is not a number.
+    #[error("{usage}: {text:?} is not a number")]
+    NotANumber {
+        /// How the command goes.
+        usage: &'static str,
+        /// What was given.
+        text: String,
+    },
+    /// There is no such axis.
+    #[error("axis {0} does not exist (1-6)")]
+    NoAxis(u16),
+    /// The distance is no number of steps.
+    #[error("{distance} {unit} is out of range")]
+    Unrepresentable {
+        /// The distance asked.
+        distance: f64,
+        /// Its unit.
+        unit: &'static str,
+    },
+    /// The device refused the jog as too far.
+    #[error(
+        "{distance} {unit} ({steps} steps) is further than a jog goes: a carriage at most its homing back-off, a \
+         linear actuator or a shoulder its homing search travel"
+    )]
+    TooFar {
+        /// The distance asked.
+        distance: f64,
+        /// Its unit.
+        unit: &'static str,
+        /// In motor steps.
+        steps: i32,
+    },
+    /// The move ended in a fault.
+    #[error("axis {} {what} into a fault: {reason}", axis + 1)]
+    Fault {
+        /// The axis, from 0.
+        axis: u8,
+        /// What was done.
+        what: String,
+        /// The device's fault.
+        reason: FaultReason,
+    },
+    /// The device's answer.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+}
 
 /// The inputs in bit order, with their names.
 pub fn names() -> Vec<(InputBit, String)> {
@@ -71,7 +124,7 @@ pub fn changes(before: &InputReport, now: &InputReport) -> Vec<String> {
 }
 
 /// Prints the table, then with `watch` every change until `stop` says so.
-pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn() -> bool) -> anyhow::Result<()> {
+pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn() -> bool) -> Result<(), ClientError> {
     use std::io::Write;
     let mut out = std::io::stdout();
     let mut last = client.inputs()?;
@@ -94,7 +147,7 @@ pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn()
 
 /// `device jog AXIS DISTANCE` or `device buzz AXIS`: AXIS 1-6, DISTANCE in degrees of ring for a carriage and
 /// millimetres for a linear actuator. Waits until the move is done; returns the step positions and a line to print.
-pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -> anyhow::Result<String> {
+pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -> Result<String, CommissionError> {
     let usage = if buzz {
         "usage: ringpod device buzz AXIS (1-6)"
     } else {
@@ -102,23 +155,22 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
     };
     let axis: u8 = match words.first().map(|w| w.parse::<u8>()) {
         Some(Ok(a)) if (1..=6).contains(&a) => a - 1,
-        _ => anyhow::bail!(usage),
+        _ => return Err(CommissionError::Usage(usage)),
     };
     let distance = match (buzz, words) {
         (true, [_]) => None,
-        (false, [_, distance]) => Some(
-            distance
-                .parse::<f64>()
-                .map_err(|_| anyhow::anyhow!("{usage}: {distance:?} is not a number"))?,
-        ),
-        _ => anyhow::bail!(usage),
+        (false, [_, distance]) => Some(distance.parse::<f64>().map_err(|_| CommissionError::NotANumber {
+            usage,
+            text: distance.clone(),
+        })?),
+        _ => return Err(CommissionError::Usage(usage)),
     };
     let kind = client.hello()?.axes[usize::from(axis)];
     let before = client.status()?.steps;
     let what = begin_move(client, axis, kind, distance)?;
     let status = client.wait_for(Duration::from_secs(120), |s| s.state != State::Jogging)?;
     if let State::Fault(reason, _) = status.state {
-        anyhow::bail!("axis {} {what} into a fault: {reason}", axis + 1);
+        return Err(CommissionError::Fault { axis, what, reason });
     }
     let moved = status.steps[usize::from(axis)] - before[usize::from(axis)];
     Ok(format!(
@@ -138,9 +190,9 @@ pub fn begin_move<T: Transport>(
     axis: u8,
     kind: AxisKind,
     distance: Option<f64>,
-) -> anyhow::Result<String> {
+) -> Result<String, CommissionError> {
     if axis > 5 {
-        anyhow::bail!("axis {} does not exist (1-6)", u16::from(axis) + 1);
+        return Err(CommissionError::NoAxis(u16::from(axis) + 1));
     }
     let Some(d) = distance else {
         client.call(Buzz(axis))?;
@@ -148,7 +200,7 @@ pub fn begin_move<T: Transport>(
     };
     // Motor steps per unit, signed: a reversed motor steps the other way for the same distance.
     let (Settings::Axes(axes), _) = client.settings(SettingsKind::Axes)? else {
-        anyhow::bail!("the device answered with another section");
+        return Err(ClientError::Unexpected("another section than the axes".into()).into());
     };
     let motor = axes[usize::from(axis)];
     let per_unit = f64::from(motor.steps_per_unit) * if motor.reverse { -1.0 } else { 1.0 };
@@ -158,14 +210,17 @@ pub fn begin_move<T: Transport>(
         AxisKind::Linear => (d / 1000.0 * per_unit, "mm"),
     };
     if !steps.is_finite() || steps.abs() > f64::from(i32::MAX) {
-        anyhow::bail!("{d} {unit} is out of range");
+        return Err(CommissionError::Unrepresentable { distance: d, unit });
     }
     let steps = steps.round() as i32;
     match client.call(Jog { axis, steps }) {
-        Err(ClientError::Device(NackReason::OutOfRange)) => anyhow::bail!(
-            "{d} {unit} ({steps} steps) is further than a jog goes: a carriage at most its homing back-off, a linear \
-             actuator or a shoulder its homing search travel"
-        ),
+        Err(ClientError::Device(NackReason::OutOfRange)) => {
+            return Err(CommissionError::TooFar {
+                distance: d,
+                unit,
+                steps,
+            })
+        }
         other => other?,
     }
     Ok(format!("jogged {d} {unit} ({steps} steps)"))

@@ -6,11 +6,55 @@
 use ringpod_core::protocol::{Settings, SettingsKind};
 use serde_json::Value;
 
-use crate::link::client::{Client, Transport};
-use crate::rig::InputsSpec;
+use crate::link::client::{Client, ClientError, Transport};
+use crate::rig::{InputsSpec, RigError};
+
+/// Why `device config` could not do what it was asked.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigCommandError {
+    /// The words are none of the forms.
+    #[error("usage: ringpod device config [get SECTION[.PATH] | set SECTION.PATH VALUE]")]
+    Usage,
+    /// A set names a section but no value in it.
+    #[error("{0}: give a value's path in its section, as stream.timeout_ms or axes.1.reverse")]
+    NoPath(String),
+    /// No section of that name.
+    #[error("no section {name:?}; sections: {}", SettingsKind::ALL.map(|k| k.name()).join(", "))]
+    NoSection {
+        /// The name given.
+        name: String,
+    },
+    /// The path leads nowhere in its section.
+    #[error("{path}: no {key:?} there")]
+    NoKey {
+        /// The whole path.
+        path: String,
+        /// The first key not found.
+        key: String,
+    },
+    /// The changed section is not a section of its kind (a wrong type or an unknown field).
+    #[error("{change}{section}: {source}")]
+    Section {
+        /// The change that made it, `path = value: `, or nothing.
+        change: String,
+        /// The section.
+        section: &'static str,
+        /// What serde found.
+        source: serde_json::Error,
+    },
+    /// The inputs section names an input there is not.
+    #[error("{0}")]
+    Inputs(#[from] RigError),
+    /// The device's answer.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    /// A section could not be written as JSON.
+    #[error("JSON: {0}")]
+    Json(#[from] serde_json::Error),
+}
 
 /// A section's value as JSON: its fields, the inputs by their names, every `f32` by its shortest decimal.
-fn to_json(settings: &Settings) -> anyhow::Result<Value> {
+fn to_json(settings: &Settings) -> Result<Value, serde_json::Error> {
     fn tidy(v: &mut Value) {
         match v {
             Value::Number(n) if n.is_f64() => {
@@ -38,15 +82,19 @@ fn to_json(settings: &Settings) -> anyhow::Result<Value> {
 }
 
 /// The section `kind` from its JSON value (every field, no others).
-fn from_json(kind: SettingsKind, value: Value) -> anyhow::Result<Settings> {
-    let bad = |e: serde_json::Error| anyhow::anyhow!("{}: {e}", kind.name());
+fn from_json(kind: SettingsKind, value: Value) -> Result<Settings, ConfigCommandError> {
+    let bad = |source| ConfigCommandError::Section {
+        change: String::new(),
+        section: kind.name(),
+        source,
+    };
     Ok(match kind {
         SettingsKind::Stream => Settings::Stream(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Control => Settings::Control(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Motion => Settings::Motion(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Inputs => {
             let spec: InputsSpec = serde_json::from_value(value).map_err(bad)?;
-            Settings::Inputs(spec.config().map_err(|e| anyhow::anyhow!("{e}"))?)
+            Settings::Inputs(spec.config()?)
         }
         SettingsKind::Axes => Settings::Axes(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Homing => Settings::Homing(serde_json::from_value(value).map_err(bad)?),
@@ -55,15 +103,15 @@ fn from_json(kind: SettingsKind, value: Value) -> anyhow::Result<Settings> {
 }
 
 /// The section a path starts with.
-fn kind(name: &str) -> anyhow::Result<SettingsKind> {
-    SettingsKind::ALL.into_iter().find(|k| k.name() == name).ok_or_else(|| {
-        let names: Vec<&str> = SettingsKind::ALL.iter().map(|k| k.name()).collect();
-        anyhow::anyhow!("no section {name:?}; sections: {}", names.join(", "))
-    })
+fn kind(name: &str) -> Result<SettingsKind, ConfigCommandError> {
+    SettingsKind::ALL
+        .into_iter()
+        .find(|k| k.name() == name)
+        .ok_or_else(|| ConfigCommandError::NoSection { name: name.to_owned() })
 }
 
 /// The value at `path` (object keys and array indices) inside `value`.
-fn at<'a>(value: &'a mut Value, path: &[&str], whole: &str) -> anyhow::Result<&'a mut Value> {
+fn at<'a>(value: &'a mut Value, path: &[&str], whole: &str) -> Result<&'a mut Value, ConfigCommandError> {
     let Some((first, rest)) = path.split_first() else {
         return Ok(value);
     };
@@ -73,13 +121,16 @@ fn at<'a>(value: &'a mut Value, path: &[&str], whole: &str) -> anyhow::Result<&'
         _ => None,
     };
     let Some(next) = next else {
-        anyhow::bail!("{whole}: no {first:?} there");
+        return Err(ConfigCommandError::NoKey {
+            path: whole.to_owned(),
+            key: (*first).to_owned(),
+        });
     };
     at(next, rest, whole)
 }
 
 /// A section as reported: its value, whether it is live, and whether the next start runs something else.
-fn report(settings: &Settings, pending: bool) -> anyhow::Result<Value> {
+fn report(settings: &Settings, pending: bool) -> Result<Value, serde_json::Error> {
     let kind = settings.kind();
     Ok(serde_json::json!({
         "section": kind.name(),
@@ -92,7 +143,7 @@ fn report(settings: &Settings, pending: bool) -> anyhow::Result<Value> {
 /// `device config`: every section; `device config get SECTION[.PATH]`; `device config set SECTION.PATH VALUE`
 /// (VALUE is JSON: `250`, `true`, `"direct"`, `[1, 2]`; a bare word is a string). Prints JSON; a set prints the
 /// section read back from the device.
-pub fn run<T: Transport>(client: &mut Client<T>, args: &[String]) -> anyhow::Result<Value> {
+pub fn run<T: Transport>(client: &mut Client<T>, args: &[String]) -> Result<Value, ConfigCommandError> {
     let words: Vec<&str> = args.iter().map(String::as_str).collect();
     match words.as_slice() {
         [] => {
@@ -112,7 +163,7 @@ pub fn run<T: Transport>(client: &mut Client<T>, args: &[String]) -> anyhow::Res
             let parts: Vec<&str> = path.split('.').collect();
             let (settings, pending) = client.settings(kind(parts[0])?)?;
             if parts.len() == 1 {
-                return report(&settings, pending);
+                return Ok(report(&settings, pending)?);
             }
             let mut value = to_json(&settings)?;
             let found = at(&mut value, &parts[1..], path)?.clone();
@@ -123,19 +174,26 @@ pub fn run<T: Transport>(client: &mut Client<T>, args: &[String]) -> anyhow::Res
         ["set", path, text] => {
             let parts: Vec<&str> = path.split('.').collect();
             if parts.len() < 2 {
-                anyhow::bail!("{path}: give a value's path in its section, as stream.timeout_ms or axes.1.reverse");
+                return Err(ConfigCommandError::NoPath((*path).to_owned()));
             }
             let kind = kind(parts[0])?;
             let (settings, _) = client.settings(kind)?;
             let mut value = to_json(&settings)?;
             let new = serde_json::from_str(text).unwrap_or_else(|_| Value::String((*text).to_owned()));
             *at(&mut value, &parts[1..], path)? = new;
-            let changed = from_json(kind, value).map_err(|e| anyhow::anyhow!("{path} = {text}: {e}"))?;
+            let changed = from_json(kind, value).map_err(|e| match e {
+                ConfigCommandError::Section { section, source, .. } => ConfigCommandError::Section {
+                    change: format!("{path} = {text}: "),
+                    section,
+                    source,
+                },
+                other => other,
+            })?;
             client.set_settings(changed)?;
             let (back, pending) = client.settings(kind)?;
-            report(&back, pending)
+            Ok(report(&back, pending)?)
         }
-        _ => anyhow::bail!("usage: ringpod device config [get SECTION[.PATH] | set SECTION.PATH VALUE]"),
+        _ => Err(ConfigCommandError::Usage),
     }
 }
 

@@ -5,6 +5,38 @@ pub mod client;
 pub mod pty;
 pub mod transport;
 
+use ringpod_core::controller::ConfigError;
+
+/// Why a link to a controller could not be made or kept.
+#[derive(Debug, thiserror::Error)]
+pub enum LinkError {
+    /// Neither `--port` nor `--sim` was given.
+    #[error("say where the controller is: --port PATH or --sim")]
+    NoTarget,
+    /// The serial port could not be opened.
+    #[error("{port}: {source}")]
+    Open {
+        /// The port's path.
+        port: String,
+        /// Why.
+        source: serialport::Error,
+    },
+    /// A simulated controller cannot drive the rig it was given.
+    #[error("{rig}: the controller cannot drive it: {reason}")]
+    Undrivable {
+        /// The rig's name.
+        rig: String,
+        /// The controller's check that refused it.
+        reason: ConfigError,
+    },
+    /// The pseudo-terminal could not be set up.
+    #[error("pseudo-terminal: {0}")]
+    Pty(#[from] nix::Error),
+    /// Reading or writing the link failed.
+    #[error("link: {0}")]
+    Io(#[from] std::io::Error),
+}
+
 /// Where the controller is.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Target {
@@ -16,19 +48,25 @@ pub enum Target {
 
 impl Target {
     /// The target named by `--port` or `--sim`.
-    pub fn named(port: Option<&str>, sim: bool) -> anyhow::Result<Self> {
+    pub fn named(port: Option<&str>, sim: bool) -> Result<Self, LinkError> {
         match (port, sim) {
             (Some(port), _) => Ok(Target::Port(port.to_owned())),
             (None, true) => Ok(Target::Sim),
-            (None, false) => anyhow::bail!("say where the controller is: --port PATH or --sim"),
+            (None, false) => Err(LinkError::NoTarget),
         }
     }
 }
 
 /// Opens the transport to `target`; a simulated controller runs in real time or as fast as it can.
-pub fn connect(target: &Target, realtime: bool) -> anyhow::Result<transport::AnyTransport> {
+pub fn connect(target: &Target, realtime: bool) -> Result<transport::AnyTransport, LinkError> {
     Ok(match target {
-        Target::Port(port) => transport::AnyTransport::Serial(transport::Serial::open(port)?),
+        Target::Port(port) => {
+            let serial = transport::Serial::open(port).map_err(|source| LinkError::Open {
+                port: port.clone(),
+                source,
+            })?;
+            transport::AnyTransport::Serial(serial)
+        }
         Target::Sim => transport::AnyTransport::Sim(Box::new(transport::SimDevice::new(realtime))),
     })
 }

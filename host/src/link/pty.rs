@@ -11,10 +11,11 @@ use nix::sys::termios::{cfmakeraw, tcgetattr, tcsetattr, SetArg};
 
 use crate::link::client::Transport;
 use crate::link::transport::SimDevice;
+use crate::link::LinkError;
 
 /// Opens a pseudo-terminal, prints the path of its device side, and runs the simulated controller behind it in
 /// real time (1 ms steps) until `stop` says so (a signal); returning closes the pseudo-terminal.
-pub fn serve(mut device: SimDevice, stop: &dyn Fn() -> bool) -> anyhow::Result<()> {
+pub fn serve(mut device: SimDevice, stop: &dyn Fn() -> bool) -> Result<(), LinkError> {
     let pty = openpty(None, None)?;
     // Raw mode on the device side: no echo, no line editing, no newline translation of the framed bytes.
     let mut termios = tcgetattr(&pty.slave)?;

@@ -101,11 +101,14 @@ impl SimDevice {
 
     /// A simulated ring platform of a rig file, with the trainer model's drives, switches and timings, parked as
     /// the model is (each axis a little before its switch), powered off.
-    pub fn for_rig(realtime: bool, rig: &crate::rig::Rig) -> anyhow::Result<Self> {
+    pub fn for_rig(realtime: bool, rig: &crate::rig::Rig) -> Result<Self, super::LinkError> {
         // The record a board would store: geometry, home, axes, pose limits and inputs, through the same code.
-        let config = ControllerConfig::from_record(&rig.record)
-            .map_err(|e| anyhow::anyhow!("{}: the controller cannot drive it: {e}", rig.record.name()))?;
-        let controller = Controller::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let undrivable = |reason| super::LinkError::Undrivable {
+            rig: rig.record.name().to_owned(),
+            reason,
+        };
+        let config = ControllerConfig::from_record(&rig.record).map_err(undrivable)?;
+        let controller = Controller::new(config).map_err(undrivable)?;
         Ok(Self::with(realtime, controller, Plant::for_config(&config)))
     }
 

@@ -7,17 +7,39 @@ use std::time::{Duration, Instant};
 use ringpod_core::protocol::endpoints::GetStatus;
 use ringpod_core::protocol::{NackReason, RigSource};
 
-use super::RigFile;
+use ringpod_core::kinematics::GeometryError;
+
+use super::{RigError, RigFile};
 use crate::link::client::{Client, ClientError, Transport};
+
+/// Why a rig could not be put on, read from or restarted on a device.
+#[derive(Debug, thiserror::Error)]
+pub enum DeviceRigError {
+    /// The rig file is not valid (the error names its key).
+    #[error(transparent)]
+    File(#[from] RigError),
+    /// The device's answer.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    /// The rig the device runs is not a valid geometry (a device of another version, or damaged).
+    #[error("the device's rig: {0}")]
+    DeviceGeometry(GeometryError),
+    /// The rig could not be written as TOML.
+    #[error("the device's rig as TOML: {0}")]
+    Toml(#[from] toml::ser::Error),
+    /// The device did not come back.
+    #[error("the device did not restart within 10 s")]
+    NoRestart,
+}
 
 /// `device rig load FILE`: checks the file here (every error names its key), then the device checks and stores
 /// it for the next start. Returns what to print.
-pub fn load<T: Transport>(client: &mut Client<T>, path: &Path) -> anyhow::Result<String> {
+pub fn load<T: Transport>(client: &mut Client<T>, path: &Path) -> Result<String, DeviceRigError> {
     store(client, &super::read(path)?)
 }
 
 /// Checks a rig file here, then stores it on the device for its next start. Returns what to print.
-pub fn store<T: Transport>(client: &mut Client<T>, file: &RigFile) -> anyhow::Result<String> {
+pub fn store<T: Transport>(client: &mut Client<T>, file: &RigFile) -> Result<String, DeviceRigError> {
     let record = file.check()?.record;
     if record.name() != file.name {
         eprintln!(
@@ -35,7 +57,7 @@ pub fn store<T: Transport>(client: &mut Client<T>, file: &RigFile) -> anyhow::Re
 
 /// The running rig as a rig file (with where it came from in its header), so that `device rig show > rig.toml`
 /// gives a file `device rig load` takes back.
-pub fn show<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
+pub fn show<T: Transport>(client: &mut Client<T>) -> Result<String, DeviceRigError> {
     let (record, source, pending) = client.rig()?;
     let text = as_file(&record)?;
     let mut header = format!("# running on the device: {} ({source})\n", record.name());
@@ -49,10 +71,8 @@ pub fn show<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
 }
 
 /// A rig the device runs, as a rig file.
-pub fn as_file(record: &ringpod_core::protocol::RigRecord) -> anyhow::Result<String> {
-    let geometry = record
-        .geometry()
-        .map_err(|e| anyhow::anyhow!("the device's rig: {e}"))?;
+pub fn as_file(record: &ringpod_core::protocol::RigRecord) -> Result<String, DeviceRigError> {
+    let geometry = record.geometry().map_err(DeviceRigError::DeviceGeometry)?;
     let mut file = RigFile::of(&geometry, record.home, None, Vec::new()).with_sections(record);
     file.name = record.name().to_owned();
     Ok(file.to_toml()?)
@@ -60,7 +80,7 @@ pub fn as_file(record: &ringpod_core::protocol::RigRecord) -> anyhow::Result<Str
 
 /// `device restart`: the device stores everything, then resets; waits until it answers as a new start (a
 /// request before `hello` is refused as not connected) and shows the rig it came up with.
-pub fn restart<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
+pub fn restart<T: Transport>(client: &mut Client<T>) -> Result<String, DeviceRigError> {
     client.restart()?;
     let deadline = Instant::now() + Duration::from_secs(10);
     loop {
@@ -68,7 +88,7 @@ pub fn restart<T: Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
             Err(ClientError::Device(NackReason::NotConnected)) => break,
             // A board on USB leaves: its port closes, and it comes back under the same name in a moment.
             Err(ClientError::Io(_)) => return Ok("restarting: the port closed; the board enumerates again".into()),
-            _ if Instant::now() > deadline => anyhow::bail!("the device did not restart within 10 s"),
+            _ if Instant::now() > deadline => return Err(DeviceRigError::NoRestart),
             _ => client.transport().elapse(Duration::from_millis(50)),
         }
     }
