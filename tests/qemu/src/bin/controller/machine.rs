@@ -80,6 +80,15 @@ impl Machine for Controls {
                 OutputPin::DriverEnable => w.outputs.driver_enable = on,
                 OutputPin::LogicRelay => w.outputs.logic_relay = on,
                 OutputPin::PowerRelay => w.outputs.power_relay = on,
+                OutputPin::Aux1 | OutputPin::Aux2 => {
+                    let bit = if pin == OutputPin::Aux1 { 1 } else { 2 };
+                    let was = w.outputs.aux;
+                    w.outputs.aux = if on { was | bit } else { was & !bit };
+                    if w.outputs.aux != was {
+                        // The runner follows the pins themselves, not only what the controller reports.
+                        hprintln!("AUX {}", w.outputs.aux);
+                    }
+                }
             }
         });
         CHANGED.signal(());
