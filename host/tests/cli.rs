@@ -804,7 +804,7 @@ fn a_recorded_run_has_a_row_every_10_ms_and_plots() {
     let text = std::fs::read_to_string(&record).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(header.len(), 28);
+    assert_eq!(header.len(), 30, "28 columns and aux1, aux2");
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(report["record"]["rows"].as_u64(), Some(rows.len() as u64));
     assert_eq!(report["record"]["dropped"], 0);

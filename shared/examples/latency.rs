@@ -45,6 +45,7 @@ pub fn measure(follow: FollowMode, rate_hz: u32) -> Latency {
                 seq,
                 time_us: t_us,
                 pose: goal,
+                aux: [None; 2],
             })
             .unwrap();
         }
@@ -69,6 +70,7 @@ pub fn measure(follow: FollowMode, rate_hz: u32) -> Latency {
                 seq,
                 time_us: u64::from(tick) * 1000,
                 pose,
+                aux: [None; 2],
             })
             .unwrap();
         }

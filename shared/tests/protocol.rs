@@ -11,6 +11,7 @@ fn the_largest_status_fits_a_frame() {
     let status = Status {
         state: State::Fault(FaultReason::Limit(u8::MAX), Supplies::Both),
         homed: true,
+        aux: u8::MAX,
         steps: [i64::MIN, i64::MAX, i64::MIN, i64::MAX, i64::MIN, i64::MAX],
         pose: big,
         target: big,

@@ -246,6 +246,7 @@ fn a_setpoint_request_read_on_its_own_is_the_request_decoded_whole() {
         seq: 0x1234_5678,
         time_us: 987_654_321,
         pose: Pose::from_array([0.01, -0.02, 0.23, 0.1, -0.2, 3.0]),
+        aux: [None; 2],
     };
     for id in [0, 1, 300, u32::MAX] {
         let mut raw = [0u8; 128];

@@ -5,18 +5,13 @@ use std::collections::{HashMap, HashSet};
 
 use proptest::prelude::*;
 use ringpod_core::safety::{
-    Command, Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig,
+    Aux, Command, Event, FaultReason, Motion, Outputs, Refusal, State, Supervisor, SupervisorConfig,
 };
 
 /// Every event the supervisor knows, with the time steps that matter (1 ms and each configured delay).
 fn alphabet(c: &SupervisorConfig) -> Vec<Event> {
-    let mut events = vec![
-        Event::Command(Command::Enable),
-        Event::Command(Command::Disable),
-        Event::Command(Command::Home),
-        Event::Command(Command::Start),
-        Event::Command(Command::Stop),
-        Event::Command(Command::ClearFault),
+    let mut events: Vec<Event> = Command::ALL.into_iter().map(Event::Command).collect();
+    events.extend([
         Event::Jog,
         Event::JogDone,
         Event::LogicOk(true),
@@ -34,7 +29,7 @@ fn alphabet(c: &SupervisorConfig) -> Vec<Event> {
         Event::MotionFault,
         Event::WatchdogReset,
         Event::Elapsed(1),
-    ];
+    ]);
     let mut delays = vec![
         c.logic_settle_ms,
         c.power_settle_ms,
@@ -96,6 +91,27 @@ fn check(before: &Supervisor, event: Event, after: &Supervisor, result: Result<(
     }
     if result.is_err() && before != after {
         return Err("a refused command changed the state".into());
+    }
+    if a.aux != after.aux() || a.aux & !3 != 0 {
+        return Err("outputs report other auxiliary outputs than the supervisor keeps".into());
+    }
+    if a.aux != 0 && !matches!(after.state(), State::Ready | State::Running | State::Stopping) {
+        return Err("an auxiliary output on outside Ready, Running and Stopping".into());
+    }
+    if a.aux != 0 && !a.driver_enable {
+        return Err("an auxiliary output on without the drivers enabled".into());
+    }
+    let switched_on = a.aux & !b.aux;
+    let asked = match event {
+        Event::Command(Command::Aux { output, on: true }) => output.bit(),
+        _ => 0,
+    };
+    if switched_on & !asked != 0 {
+        return Err("an auxiliary output switched on by anything but its own command".into());
+    }
+    let taken = result.is_ok() && before != after;
+    if (event == Event::StreamLost || event == Event::Command(Command::Disable)) && taken && a.aux != 0 {
+        return Err("an auxiliary output left on by a stream loss or a disable".into());
     }
     Ok(())
 }
@@ -219,7 +235,8 @@ fn power_up_home_run_stop_shut_down() {
             logic_relay: true,
             power_relay: false,
             driver_enable: false,
-            motion: Motion::None
+            motion: Motion::None,
+            aux: 0
         }
     );
     run(&mut s, &[Event::Elapsed(c.logic_settle_ms)]);
@@ -340,4 +357,135 @@ proptest! {
             prop_assert_eq!(done.handle(command), asked, "{:?} in {:?}", command, s.state());
         }
     }
+}
+
+/// Every state reachable from `Off` with `config`: the walk runs to closure (time saturates, so the set is finite).
+fn reachable(config: SupervisorConfig) -> HashSet<Supervisor> {
+    let events = alphabet(&config);
+    let mut seen: HashSet<Supervisor> = HashSet::from([Supervisor::new(config)]);
+    let mut todo = vec![Supervisor::new(config)];
+    while let Some(s) = todo.pop() {
+        for e in &events {
+            let mut t = s;
+            let _ = t.handle(*e);
+            if seen.insert(t) {
+                todo.push(t);
+            }
+        }
+    }
+    seen
+}
+
+/// Issue 26: the auxiliary outputs are off in every fault path. Over every reachable state (no depth bound) and
+/// every event, a transition into a fault, a shutdown or `Off` leaves both outputs off; and such transitions do
+/// start from states with outputs on, for every fault an operator can meet while streaming (so the check bites).
+#[test]
+fn aux_outputs_off_in_every_fault_path() {
+    for config in [
+        SupervisorConfig::default(),
+        SupervisorConfig {
+            logic_sense: false,
+            power_sense: false,
+            ..SupervisorConfig::default()
+        },
+    ] {
+        let states = reachable(config);
+        let events = alphabet(&config);
+        let mut from_on: HashSet<&'static str> = HashSet::new();
+        let mut paths = 0u64;
+        for s in &states {
+            for e in &events {
+                let mut t = *s;
+                let r = t.handle(*e);
+                check(s, *e, &t, r).unwrap_or_else(|v| panic!("{v}: {s:?} --{e:?}--> {t:?}"));
+                let down = matches!(t.state(), State::Fault(..) | State::ShuttingDown(_) | State::Off);
+                if down && t.state() != s.state() {
+                    paths += 1;
+                    assert_eq!(t.outputs().aux, 0, "{s:?} --{e:?}--> {t:?}");
+                    if s.aux() != 0 {
+                        from_on.insert(match t.state() {
+                            State::Fault(FaultReason::EStop, _) => "e-stop",
+                            State::Fault(FaultReason::Limit(_), _) => "limit",
+                            State::Fault(FaultReason::LogicLost, _) => "logic lost",
+                            State::Fault(FaultReason::PowerLost, _) => "power lost",
+                            State::Fault(FaultReason::Watchdog, _) => "watchdog",
+                            State::Fault(FaultReason::MotionFault, _) => "motion fault",
+                            State::Fault(..) => "other fault",
+                            _ => "disable",
+                        });
+                    }
+                }
+            }
+        }
+        let mut met: Vec<_> = from_on.into_iter().collect();
+        met.sort();
+        let mut expected = vec!["disable", "e-stop", "limit", "motion fault", "watchdog"];
+        if config.logic_sense {
+            expected.extend(["logic lost", "power lost"]);
+        }
+        expected.sort();
+        assert_eq!(met, expected, "the fault paths taken with an output on");
+        println!(
+            "sense {}: {} reachable states, {paths} transitions into a fault, a shutdown or Off, every one with both auxiliary outputs off",
+            config.logic_sense,
+            states.len()
+        );
+    }
+}
+
+/// Refused where it does not apply, with the supervisor's reason; off always taken.
+#[test]
+fn aux_outputs_switch_only_where_allowed() {
+    let c = SupervisorConfig {
+        logic_sense: false,
+        power_sense: false,
+        ..SupervisorConfig::default()
+    };
+    let on = |output| Event::Command(Command::Aux { output, on: true });
+    let off = |output| Event::Command(Command::Aux { output, on: false });
+    let mut s = Supervisor::new(c);
+    assert_eq!(s.handle(on(Aux::Aux1)), Err(Refusal::WrongState), "not in Off");
+    run(
+        &mut s,
+        &[
+            Event::Command(Command::Enable),
+            Event::Elapsed(1000),
+            Event::Elapsed(1000),
+        ],
+    );
+    assert_eq!(s.state(), State::PowerOn { settled: true });
+    assert_eq!(s.handle(on(Aux::Aux1)), Err(Refusal::WrongState), "not before homing");
+    run(&mut s, &[Event::Command(Command::Home)]);
+    assert_eq!(s.handle(on(Aux::Aux2)), Err(Refusal::WrongState), "not while homing");
+    run(&mut s, &[Event::HomingDone, on(Aux::Aux1)]);
+    assert_eq!((s.aux(), s.outputs().aux), (1, 1));
+    run(&mut s, &[Event::Command(Command::Start), on(Aux::Aux2), off(Aux::Aux1)]);
+    assert_eq!(s.outputs().aux, 2, "AUX2 on, AUX1 off, while running");
+    run(&mut s, &[Event::Command(Command::Stop)]);
+    assert_eq!((s.state(), s.aux()), (State::Stopping, 2), "a stop keeps them");
+    assert_eq!(
+        s.handle(on(Aux::Aux1)),
+        Err(Refusal::WrongState),
+        "none switched on while braking"
+    );
+    run(&mut s, &[Event::AtRest]);
+    assert_eq!((s.state(), s.aux()), (State::Ready, 2));
+    run(&mut s, &[Event::Command(Command::Start), Event::StreamLost]);
+    assert_eq!(
+        (s.state(), s.aux()),
+        (State::Stopping, 0),
+        "a stream loss switches them off"
+    );
+    run(&mut s, &[Event::AtRest, on(Aux::Aux1), Event::Command(Command::Home)]);
+    assert_eq!(s.aux(), 0, "homing again switches them off");
+    run(&mut s, &[Event::HomingDone, on(Aux::Aux2), Event::Limit(4, true)]);
+    assert!(matches!(s.state(), State::Fault(FaultReason::Limit(4), _)));
+    assert_eq!(s.outputs().aux, 0);
+    assert_eq!(
+        s.handle(on(Aux::Aux2)),
+        Err(Refusal::Faulted),
+        "not with a fault latched"
+    );
+    assert_eq!(s.handle(off(Aux::Aux2)), Ok(()), "off is always taken");
+    assert!(matches!(s.state(), State::Fault(..)), "and changes nothing else");
 }

@@ -34,6 +34,7 @@ fn setpoint(k: u64) -> HostMessage {
         seq: k as u32,
         time_us: k * 1000,
         pose: pose_at(k),
+        aux: [None; 2],
     })
 }
 

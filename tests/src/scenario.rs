@@ -305,6 +305,7 @@ pub fn run(scenario: &Scenario) -> Result<Report, String> {
                     seq: host.seq,
                     time_us: now * 1000,
                     pose,
+                    aux: [None; 2],
                 };
                 let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
                 let text = format!("{:?}", response.body);
@@ -338,6 +339,7 @@ pub fn run(scenario: &Scenario) -> Result<Report, String> {
                     seq: host.seq,
                     time_us: (s.next_ms * 1000.0) as u64,
                     pose,
+                    aux: [None; 2],
                 };
                 let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
                 host.accepted(&rig.controller, &response.body, pose);

@@ -71,6 +71,7 @@ fn random_request(rng: &mut Rng, seq: &mut u32) -> Request {
                 seq: *seq,
                 time_us: u64::from(*seq) * 1000,
                 pose,
+                aux: [None; 2],
             })
         }
     };

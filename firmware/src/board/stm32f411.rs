@@ -11,7 +11,7 @@
 //! | ENABLE (active low) | PB13 | | LIMIT 5, 6 (far ends) | PA7, PA8 |
 //! | LOGIC_EN relay | PB14 | | LOGIC_OK, POWER_OK | PA9, PC14 |
 //! | POWER_EN relay | PB15 | | USB D-/D+ | PA11/PA12 |
-//! | | | | USART1 TX, RX (AF7) | PA15, PA10 |
+//! | AUX1, AUX2 outputs | PC15, PC13 | | USART1 TX, RX (AF7) | PA15, PA10 |
 //!
 //! All STEP and DIR pins are on port B so that one 32-bit write to `GPIOB.BSRR` sets and clears all of them at
 //! once: the step generator is TIM1 updating every 2.5 us and DMA2 stream 5 (channel 6, TIM1_UP) copying one word
@@ -22,6 +22,11 @@
 //! isolated USB-serial adapter. USART1 is the only USART with a TX pin free on this package (PA15); its RX pins are
 //! PA10, PB3 and PB7, so POWER_OK moved from PA10 to PC14 (a plain input; the Black Pill's 32.768 kHz crystal there
 //! is unused by this firmware and passes no DC, so it only slows the edges of a debounced supply signal).
+//!
+//! The auxiliary outputs take the last two free pins, PC15 and PC13 (PB11 is not bonded out, PH0/PH1 carry the
+//! 25 MHz crystal, PA13/PA14 are SWD). They are in the backup domain: low speed only and no current sourced
+//! (RM0383/datasheet: at most 3 mA through the power switch), so each drives a relay driver's MOSFET gate; the
+//! Black Pill's blue LED on PC13 (to 3.3 V) lights while AUX2 is off.
 
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_executor::{InterruptExecutor, Spawner};
@@ -161,6 +166,7 @@ struct BlackPill {
     logic_relay: Output<'static>,
     power_relay: Output<'static>,
     driver_enable_n: Output<'static>,
+    aux: [Output<'static>; 2],
 }
 
 impl Machine for BlackPill {
@@ -170,6 +176,8 @@ impl Machine for BlackPill {
             OutputPin::DriverEnable => self.driver_enable_n.set_level(Level::from(!on)),
             OutputPin::LogicRelay => self.logic_relay.set_level(Level::from(on)),
             OutputPin::PowerRelay => self.power_relay.set_level(Level::from(on)),
+            OutputPin::Aux1 => self.aux[0].set_level(Level::from(on)),
+            OutputPin::Aux2 => self.aux[1].set_level(Level::from(on)),
         }
     }
 
@@ -361,6 +369,10 @@ pub async fn start(spawner: Spawner) {
     let driver_enable_n = Output::new(p.PB13, Level::High, Speed::Low);
     let logic_relay = Output::new(p.PB14, Level::Low, Speed::Low);
     let power_relay = Output::new(p.PB15, Level::Low, Speed::Low);
+    let aux = [
+        Output::new(p.PC15, Level::Low, Speed::Low),
+        Output::new(p.PC13, Level::Low, Speed::Low),
+    ];
     let idle = PORT_MAP.idle_word();
     let level = |pin: u8| Level::from(idle & (1 << pin) != 0);
     let _step_dir = [
@@ -438,6 +450,7 @@ pub async fn start(spawner: Spawner) {
         logic_relay,
         power_relay,
         driver_enable_n,
+        aux,
     };
     spawner.spawn(defmt::unwrap!(control_task(machine, shared)));
     spawner.spawn(defmt::unwrap!(inputs_task(switches, shared)));

@@ -223,6 +223,9 @@ pub enum DeviceAction {
     Rig,
     /// Restart the controller (supplies off) once it has stored everything: a loaded rig or setting runs.
     Restart,
+    /// `aux N on|off`: switch auxiliary output N (1 or 2: AUX1 on PC15, AUX2 on PC13). On only while homed and
+    /// holding or streaming (Ready, Running); a fault, an e-stop, a disable, homing or a jog switches both off.
+    Aux,
 }
 
 #[derive(Debug, Args)]
@@ -235,7 +238,7 @@ pub struct DeviceArgs {
     /// (pose_velocity.N, pose_acceleration.N, actuator_velocity.N, actuator_acceleration.N), inputs (active_low,
     /// debounce_ms), axes.N (steps_per_unit, reverse),
     /// homing, supervisor; N counts from 0, e.g. `set axes.4.reverse true`, `set stream.timeout_ms 200`. For
-    /// `jog`: AXIS DISTANCE; for `buzz`: AXIS; for `rig`: `load RIG.toml` or `show`.
+    /// `jog`: AXIS DISTANCE; for `buzz`: AXIS; for `rig`: `load RIG.toml` or `show`; for `aux`: N on|off.
     #[arg(allow_negative_numbers = true)]
     pub config: Vec<String>,
     /// Serial port of the board (USB CDC).

@@ -221,8 +221,8 @@ impl DeviceArgs {
     pub fn request(&self) -> anyhow::Result<(crate::link::Target, crate::device::Action)> {
         use crate::device::Action;
         use DeviceAction as A;
-        if !matches!(self.action, A::Config | A::Jog | A::Buzz | A::Rig) && !self.config.is_empty() {
-            anyhow::bail!("only `device config`, `jog`, `buzz` and `rig` take further words");
+        if !matches!(self.action, A::Config | A::Jog | A::Buzz | A::Rig | A::Aux) && !self.config.is_empty() {
+            anyhow::bail!("only `device config`, `jog`, `buzz`, `rig` and `aux` take further words");
         }
         if self.watch && self.action != A::Inputs {
             anyhow::bail!("--watch is for `device inputs`");
@@ -246,6 +246,24 @@ impl DeviceArgs {
                 _ => anyhow::bail!("`device rig load RIG.toml` or `device rig show`"),
             },
             A::Restart => Action::Restart,
+            A::Aux => {
+                let parsed = match words.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+                    [n, level] => n
+                        .parse::<u8>()
+                        .ok()
+                        .and_then(ringpod_core::safety::Aux::from_number)
+                        .zip(match *level {
+                            "on" => Some(true),
+                            "off" => Some(false),
+                            _ => None,
+                        }),
+                    _ => None,
+                };
+                let Some((output, on)) = parsed else {
+                    anyhow::bail!("usage: `device aux N on|off` with N 1 or 2");
+                };
+                Action::Aux { output, on }
+            }
         };
         Ok((crate::link::Target::named(self.port.as_deref(), self.sim)?, action))
     }

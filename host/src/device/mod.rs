@@ -41,6 +41,11 @@ pub enum Action {
     ShowRig,
     /// Restart once everything is stored.
     Restart,
+    /// Switch an auxiliary output.
+    Aux {
+        output: ringpod_core::safety::Aux,
+        on: bool,
+    },
 }
 
 /// `ringpod device ACTION`: 0 when done; a signal ends `inputs --watch` with 128 + its number.
@@ -56,6 +61,7 @@ pub fn run(target: &Target, action: &Action) -> anyhow::Result<u8> {
         Action::Start => status_after(&mut client, |c| c.start())?,
         Action::Stop => status_after(&mut client, |c| c.stop())?,
         Action::Clear => status_after(&mut client, |c| c.clear())?,
+        Action::Aux { output, on } => status_after(&mut client, |c| c.aux(*output, *on))?,
         Action::Home => status_after(&mut client, home)?,
         Action::Jog(words) => commission::jog(&mut client, words, false)?,
         Action::Buzz(words) => commission::jog(&mut client, words, true)?,

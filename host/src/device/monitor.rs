@@ -112,6 +112,10 @@ fn supplies<'a>(t: &Telemetry) -> Paragraph<'a> {
             lamp(t.outputs & 2 != 0, "POWER_EN"),
             Span::raw(" "),
             lamp(t.outputs & 4 != 0, "DRIVERS"),
+            Span::raw("  aux: "),
+            lamp(t.outputs & 8 != 0, "AUX1"),
+            Span::raw(" "),
+            lamp(t.outputs & 16 != 0, "AUX2"),
         ]),
         Line::from(vec![
             Span::raw("supply sense:       "),

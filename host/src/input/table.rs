@@ -22,6 +22,17 @@ pub type Row = (usize, Vec<f64>);
 /// must increase from row to row. Bad rows are returned with their line numbers, not fatal; a missing or wrong
 /// header is.
 pub fn read(text: &str, columns: &[&str]) -> Result<(Vec<Row>, Vec<InputError>), String> {
+    read_with_optional(text, columns, &[]).map(|(rows, errors, _)| (rows, errors))
+}
+
+/// Rows, bad rows, and which optional columns the header names.
+pub type Table = (Vec<Row>, Vec<InputError>, Vec<bool>);
+
+/// [`read`] with `optional` columns besides the required `columns` (a pose file's `aux1`, `aux2`): a row holds the
+/// required values, then one per optional column (NaN where the header does not name it); the flags say which
+/// optional columns the header names.
+pub fn read_with_optional(text: &str, columns: &[&str], optional: &[&str]) -> Result<Table, String> {
+    let mut present = vec![false; optional.len()];
     // A byte-order mark is how spreadsheets ("CSV UTF-8") start a file: not part of the first column's name.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let text = text.replace("\r\n", "\n").replace('\r', "\n");
@@ -41,14 +52,31 @@ pub fn read(text: &str, columns: &[&str]) -> Result<(Vec<Row>, Vec<InputError>),
                 .iter()
                 .map(|c| fields.iter().position(|f| f.eq_ignore_ascii_case(c)))
                 .collect();
+            let extra: Vec<Option<usize>> = optional
+                .iter()
+                .map(|c| fields.iter().position(|f| f.eq_ignore_ascii_case(c)))
+                .collect();
+            let named = columns.len() + extra.iter().flatten().count();
             match found {
-                Some(found) if fields.len() == columns.len() => order = Some(found),
+                Some(mut found) if fields.len() == named => {
+                    for (k, at) in extra.iter().enumerate() {
+                        present[k] = at.is_some();
+                        // An absent optional column reads as NaN: its index is past the row.
+                        found.push(at.unwrap_or(usize::MAX));
+                    }
+                    order = Some(found);
+                }
                 _ => {
                     // At most a line's worth of what was found: a header of megabytes is not echoed.
                     let found: String = raw.chars().take(80).collect();
                     let more = if found.len() < raw.len() { "..." } else { "" };
+                    let optional = if optional.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" and may name {}", optional.join(","))
+                    };
                     return Err(format!(
-                        "line {line}: the header must name the columns {} (in any order), found `{found}{more}`",
+                        "line {line}: the header must name the columns {}{optional} (in any order), found `{found}{more}`",
                         columns.join(",")
                     ));
                 }
@@ -56,12 +84,16 @@ pub fn read(text: &str, columns: &[&str]) -> Result<(Vec<Row>, Vec<InputError>),
             continue;
         };
         let values: Result<Vec<f64>, _> = fields.iter().map(|f| f.parse::<f64>()).collect();
+        let width = columns.len() + present.iter().filter(|p| **p).count();
         let v = match values {
-            Ok(v) if v.len() == columns.len() => order.iter().map(|k| v[*k]).collect::<Vec<f64>>(),
+            Ok(v) if v.len() == width => order
+                .iter()
+                .map(|k| v.get(*k).copied().unwrap_or(f64::NAN))
+                .collect::<Vec<f64>>(),
             Ok(v) => {
                 errors.push(InputError {
                     line,
-                    reason: format!("expected {} fields, got {}", columns.len(), v.len()),
+                    reason: format!("expected {width} fields, got {}", v.len()),
                 });
                 continue;
             }
@@ -94,5 +126,5 @@ pub fn read(text: &str, columns: &[&str]) -> Result<(Vec<Row>, Vec<InputError>),
     if order.is_none() {
         return Err(format!("no header line naming the columns {}", columns.join(",")));
     }
-    Ok((rows, errors))
+    Ok((rows, errors, present))
 }

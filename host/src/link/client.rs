@@ -278,6 +278,10 @@ impl<T: Transport> Client<T> {
     pub fn clear(&mut self) -> Result<(), ClientError> {
         self.call(Do(Command::ClearFault))
     }
+    /// Switch an auxiliary output (on only while Ready or Running; off always).
+    pub fn aux(&mut self, output: ringpod_core::safety::Aux, on: bool) -> Result<(), ClientError> {
+        self.call(Do(Command::Aux { output, on }))
+    }
 
     /// A section of settings on the device as the next start runs it (what runs now, for a live section), and
     /// whether that differs from what runs now.

@@ -57,7 +57,7 @@ pub fn check_loads(
     platform: &LoadPlatform,
 ) -> anyhow::Result<crate::analysis::demand::Preflight> {
     let rows: Vec<(usize, f64, Pose<f64>)> = match source {
-        Source::Poses(p) => p.clone(),
+        Source::Poses(p) => p.iter().map(|(line, t, pose, _)| (*line, *t, *pose)).collect(),
         Source::Motion {
             motion,
             sine,

@@ -25,7 +25,7 @@ use ringpod_core::safety::{FaultReason, State};
 
 pub use loads::{check_loads, platform as loads_platform};
 pub use report::{CaptureReport, DatagramReport, LimitedReport, RecordReport, Report};
-use session::{Stop, StreamError, Streamer};
+use session::{Stop, StreamError, Streamer, NO_AUX};
 pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source, UdpSource};
 
 pub use crate::input::table::InputError;
@@ -366,12 +366,12 @@ fn feed<T: Transport>(
             let n = (seconds * rate_hz).round() as u64;
             let mut poses = (0..=n).map(|k| {
                 let t = k as f64 / rate_hz;
-                (None, t, motion_pose(motion, sine.as_ref(), t, home, limits))
+                (None, t, motion_pose(motion, sine.as_ref(), t, home, limits), NO_AUX)
             });
             (s.timed(&mut poses, fast), None, None)
         }
         Source::Poses(p) => {
-            let mut poses = p.iter().map(|(line, t, pose)| (Some(*line), *t, *pose));
+            let mut poses = p.iter().map(|(line, t, pose, aux)| (Some(*line), *t, *pose, *aux));
             (s.timed(&mut poses, fast), None, None)
         }
         Source::Udp(udp) => {

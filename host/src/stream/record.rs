@@ -15,7 +15,11 @@ use ringpod_core::safety::State;
 
 use crate::out::plot::{self, Event, Panel, Series, TimePlot};
 
-/// The record's columns.
+/// The record's columns after [`COLUMNS`]: the auxiliary outputs (0 off, 1 on). A record is read without them, so
+/// records written before they existed still read.
+pub const AUX_COLUMNS: [&str; 2] = ["aux1", "aux2"];
+
+/// The record's columns (the ones [`parse`] needs).
 pub const COLUMNS: [&str; 28] = [
     "host_s",
     "device_s",
@@ -75,7 +79,7 @@ impl Recorder {
     /// Creates the file and writes the header.
     pub fn create(path: &Path) -> std::io::Result<Self> {
         let mut out = BufWriter::new(File::create(path)?);
-        writeln!(out, "{}", COLUMNS.join(","))?;
+        writeln!(out, "{},{}", COLUMNS.join(","), AUX_COLUMNS.join(","))?;
         Ok(Self {
             out,
             started: Instant::now(),
@@ -111,6 +115,8 @@ impl Recorder {
             t.refused,
             t.tick_cost
         );
+        // Telemetry output bits 3 and 4.
+        row += &format!(",{},{}", (t.outputs >> 3) & 1, (t.outputs >> 4) & 1);
         writeln!(self.out, "{row}")?;
         self.rows += 1;
         Ok(())

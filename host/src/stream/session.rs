@@ -8,7 +8,10 @@ use indicatif::ProgressBar;
 use ringpod_core::kinematics::{Check, Pose, RingPlatform};
 use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, RejectReason, Setpoint};
 use ringpod_core::protocol::{HostMessage, MotionSettings, Status};
-use ringpod_core::safety::State;
+use ringpod_core::safety::{AuxLevels, State};
+
+/// A setpoint that leaves the auxiliary outputs as they are (every pose but a pose file's rows with aux columns).
+pub const NO_AUX: AuxLevels = [None; 2];
 
 use super::report::{reason_name, DatagramReport, LimitedReport};
 use super::{InputError, UdpSource};
@@ -135,7 +138,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// Sends one setpoint without waiting for its answer (a round trip per setpoint would cap the rate at one
     /// per round trip: 1 kHz needs them in flight), then counts the answers that have arrived, waiting while more
     /// than [`IN_FLIGHT`] are outstanding. A device that stops streaming ends the run.
-    fn send(&mut self, pose: Pose<f64>, kind: Kind) -> Result<(), StreamError> {
+    fn send(&mut self, pose: Pose<f64>, kind: Kind, aux: AuxLevels) -> Result<(), StreamError> {
         self.seq = self.seq.wrapping_add(1);
         self.sent_all += 1;
         if let Kind::Input(_) = kind {
@@ -145,6 +148,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             seq: self.seq,
             time_us: self.clock_us,
             pose: pose.cast(),
+            aux,
         }))?;
         if pose.to_array().iter().all(|c| c.is_finite()) {
             self.last_sent = pose;
@@ -279,7 +283,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             let pose = Pose::from_array(std::array::from_fn(|i| a[i] + way[i] * f));
             self.elapse(Duration::from_millis(10))?;
             let pose = self.limit(pose);
-            self.send(pose, Kind::LeadIn)?;
+            self.send(pose, Kind::LeadIn, NO_AUX)?;
             self.lead_in += 1;
         }
         // The first pose follows the lead-in by one of its intervals.
@@ -294,7 +298,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
         let last = self.last_sent;
         for k in 1..=1000u32 {
             self.elapse(Duration::from_millis(10))?;
-            self.send(last, Kind::Settle)?;
+            self.send(last, Kind::Settle, NO_AUX)?;
             self.settle += 1;
             if k >= 25 && k % 5 == 0 {
                 self.collect(0)?;
@@ -317,11 +321,11 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// lets the platform come to rest, and the stream is led in and started again at the next pose.
     pub(super) fn timed(
         &mut self,
-        poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>)>,
+        poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>, AuxLevels)>,
         fast: bool,
     ) -> Result<(), StreamError> {
         let mut last_t: Option<f64> = None;
-        for (line, t, pose) in poses {
+        for (line, t, pose, aux) in poses {
             if (self.interrupted)() {
                 return Err(StreamError::Stop(Stop::Interrupted));
             }
@@ -344,7 +348,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
                 }
             };
             last_t = Some(t);
-            self.send(pose, Kind::Input(line))?;
+            self.send(pose, Kind::Input(line), aux)?;
             self.bar.inc(1);
         }
         if last_t.is_some() {
@@ -417,7 +421,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
                     last_idle = now;
                     if let Some(pose) = source.decoder.idle(dt, now) {
                         let pose = self.limit(pose);
-                        self.send(pose, Kind::Washout)?;
+                        self.send(pose, Kind::Washout, NO_AUX)?;
                         self.washout += 1;
                         continue;
                     }
@@ -445,7 +449,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
                 streaming = true;
                 self.start_and_lead_in(pose)?
             };
-            self.send(pose, Kind::Input(Some(number)))?;
+            self.send(pose, Kind::Input(Some(number)), NO_AUX)?;
             self.bar.inc(1);
             // The lead-in let its own time pass: the device's clock is already there.
             wall = Instant::now();

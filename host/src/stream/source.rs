@@ -5,6 +5,7 @@ use std::time::Duration;
 use ringpod_core::kinematics::presets::TRAINER_MODEL_RANGES;
 use ringpod_core::kinematics::Pose;
 use ringpod_core::protocol::MotionSettings;
+use ringpod_core::safety::AuxLevels;
 
 use super::InputError;
 
@@ -165,8 +166,8 @@ impl Sine {
     }
 }
 
-/// A pose of an input file: its line number, its time (s) and the pose.
-pub type TimedPose = (usize, f64, Pose<f64>);
+/// A pose of an input file: its line number, its time (s), the pose, and the auxiliary outputs it switches.
+pub type TimedPose = (usize, f64, Pose<f64>, AuxLevels);
 
 /// Where poses come from.
 pub enum Source {
@@ -205,16 +206,39 @@ pub struct UdpSource {
 /// The columns of a pose file.
 pub const POSE_COLUMNS: [&str; 7] = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
 
+/// The optional columns of a pose file: the auxiliary outputs, 0 (off) or 1 (on) in each row.
+pub const AUX_COLUMNS: [&str; 2] = ["aux1", "aux2"];
+
 /// Reads a pose file: `t,x,y,z,alpha,beta,gamma` named in its header in any order (seconds, metres, radians or
-/// degrees; [`crate::input::table::read`]). NaN and infinity in a pose are passed on: the device refuses them with a
-/// reason, which is the point.
+/// degrees; [`crate::input::table::read`]), and optionally `aux1`, `aux2` (0 or 1: the auxiliary outputs, switched
+/// when the row's setpoint is taken; a file without the column leaves that output as it is). NaN and infinity in a
+/// pose are passed on: the device refuses them with a reason, which is the point; an aux value other than 0 or 1
+/// makes the row an error.
 pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputError>), String> {
-    let (rows, errors) = crate::input::table::read(text, &POSE_COLUMNS)?;
+    let (rows, mut errors, present) = crate::input::table::read_with_optional(text, &POSE_COLUMNS, &AUX_COLUMNS)?;
     let a = |x: f64| if degrees { x.to_radians() } else { x };
-    let poses = rows
-        .into_iter()
-        .map(|(line, v)| (line, v[0], Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6]))))
-        .collect();
+    let mut poses = Vec::with_capacity(rows.len());
+    for (line, v) in rows {
+        let level = |k: usize, x: f64| match x {
+            _ if !present[k] => Ok(None),
+            0.0 => Ok(Some(false)),
+            1.0 => Ok(Some(true)),
+            _ => Err(x),
+        };
+        match (level(0, v[7]), level(1, v[8])) {
+            (Ok(a1), Ok(a2)) => poses.push((
+                line,
+                v[0],
+                Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6])),
+                [a1, a2],
+            )),
+            (Err(x), _) | (_, Err(x)) => errors.push(InputError {
+                line,
+                reason: format!("an aux column must be 0 or 1, not {x}"),
+            }),
+        }
+    }
+    errors.sort_by_key(|e| e.line);
     Ok((poses, errors))
 }
 
@@ -257,4 +281,38 @@ pub fn motion_pose(motion: Motion, sine: Option<&Sine>, t: f64, home: [f64; 6], 
         Motion::Sine => {}
     }
     Pose::from_array(p)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn aux_columns_are_optional_and_0_or_1() {
+        let (poses, errors) = read_csv("t,x,y,z,alpha,beta,gamma\n0,0,0,0.2,0,0,0\n", false).unwrap();
+        assert!(errors.is_empty());
+        assert_eq!(
+            poses[0].3,
+            [None, None],
+            "without the columns the outputs are left as they are"
+        );
+        let text = "aux2,t,x,y,z,alpha,beta,gamma\n1,0,0,0,0.2,0,0,0\n0,1,0,0,0.2,0,0,0\n0.5,2,0,0,0.2,0,0,0\n";
+        let (poses, errors) = read_csv(text, false).unwrap();
+        assert_eq!(
+            poses.iter().map(|p| p.3).collect::<Vec<_>>(),
+            [[None, Some(true)], [None, Some(false)]]
+        );
+        assert_eq!(poses[1].2.z, 0.2, "the pose columns read in the header's order");
+        assert_eq!(errors.len(), 1);
+        assert_eq!(errors[0].line, 4);
+        assert!(
+            errors[0].reason.contains("must be 0 or 1, not 0.5"),
+            "{}",
+            errors[0].reason
+        );
+        let short = read_csv("t,x,y,z,alpha,beta,gamma,aux1,aux2\n0,0,0,0.2,0,0,0,1\n", false).unwrap();
+        assert!(short.0.is_empty() && short.1[0].reason.contains("expected 9 fields, got 8"));
+        let unknown = read_csv("t,x,y,z,alpha,beta,gamma,aux3\n", false).unwrap_err();
+        assert!(unknown.contains("may name aux1,aux2"), "{unknown}");
+    }
 }

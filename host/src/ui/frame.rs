@@ -134,7 +134,7 @@ pub struct Frame {
     /// CPU cycles on the MCU, ns in the simulator.
     pub tick_cost: u32,
     pub inputs: u16,
-    /// Bit 0 LOGIC_EN, 1 POWER_EN, 2 driver enable.
+    /// Bit 0 LOGIC_EN, 1 POWER_EN, 2 driver enable, 3 AUX1, 4 AUX2.
     pub outputs: u8,
     pub placed: Option<Placed>,
     pub ghost: Option<Placed>,

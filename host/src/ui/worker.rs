@@ -329,7 +329,7 @@ impl Device {
     fn park(&mut self, page: u64) -> anyhow::Result<String> {
         let (record, _, _) = self.client.rig()?;
         let home = Pose::from_array(record.home);
-        let poses = vec![(1, 0.0, home), (2, 1.0, home)];
+        let poses = vec![(1, 0.0, home, [None; 2]), (2, 1.0, home, [None; 2])];
         let report = self.run(page, Source::Poses(poses), Vec::new())?;
         if report.exit_code != stream::exit::FOLLOWED {
             anyhow::bail!("park: {}", report.reason.as_deref().unwrap_or(report.outcome));

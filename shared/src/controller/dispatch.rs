@@ -8,7 +8,7 @@ use crate::kinematics::{AxisKind, Mechanism};
 use crate::motion::jog::Jog;
 use crate::motion::{Accepted, Setpoint};
 use crate::protocol::{self, DeviceMessage, HostMessage, NackReason, Request, Response, PROTOCOL_VERSION};
-use crate::safety::{Command, Event, HomingSequencer, State};
+use crate::safety::{Aux, Command, Event, HomingSequencer, State};
 
 impl Controller {
     /// Handles one request; always exactly one response.
@@ -65,11 +65,26 @@ impl Controller {
 
     /// A setpoint for the pipeline, and its answer.
     fn submit(&mut self, setpoint: &Setpoint) -> DeviceMessage {
-        match self.pipeline.submit(setpoint) {
+        match self.take_setpoint(setpoint) {
             Ok(Accepted::Applied) => DeviceMessage::Ack,
             Ok(Accepted::Limited(report)) => DeviceMessage::Limited(report),
             Err(reason) => DeviceMessage::Nack(NackReason::Rejected(reason)),
         }
+    }
+
+    /// Submits a setpoint; one the pipeline takes switches the auxiliary outputs it names, as the command would
+    /// (the pipeline takes setpoints only while `Running`, where the supervisor allows them on). They switch when the
+    /// setpoint is taken, one setpoint interval before the platform arrives at its pose: the interpolation runs a
+    /// segment behind the newest setpoint.
+    fn take_setpoint(&mut self, setpoint: &Setpoint) -> Result<Accepted, crate::motion::RejectReason> {
+        let accepted = self.pipeline.submit(setpoint)?;
+        for (output, level) in Aux::ALL.into_iter().zip(setpoint.aux) {
+            if let Some(on) = level {
+                // A refusal leaves the output as it was, and the setpoint's answer says how the pose was taken.
+                let _ = self.supervisor.handle(Event::Command(Command::Aux { output, on }));
+            }
+        }
+        Ok(accepted)
     }
 
     /// Starts a jog (`Some(steps)`) or a buzz (`None`) of `axis`, if the supervisor allows it.
@@ -160,7 +175,7 @@ impl Controller {
             return self.malformed(out);
         };
         if let (true, Some((id, setpoint))) = (self.connected, protocol::setpoint_request(payload)) {
-            let encoded = match self.pipeline.submit(&setpoint) {
+            let encoded = match self.take_setpoint(&setpoint) {
                 Ok(Accepted::Applied) => protocol::encode(
                     &Response {
                         id,

@@ -280,7 +280,7 @@ impl Controller {
             inputs: self.inputs.word(),
             outputs: {
                 let o = self.supervisor.outputs();
-                u8::from(o.logic_relay) | u8::from(o.power_relay) << 1 | u8::from(o.driver_enable) << 2
+                u8::from(o.logic_relay) | u8::from(o.power_relay) << 1 | u8::from(o.driver_enable) << 2 | o.aux << 3
             },
         }
     }
@@ -290,6 +290,7 @@ impl Controller {
         Status {
             state: self.supervisor.state(),
             homed: self.supervisor.homed(),
+            aux: self.supervisor.aux(),
             steps: self.scheduler.position(),
             pose: self.pipeline.pose(),
             target: self.pipeline.target(),

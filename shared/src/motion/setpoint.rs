@@ -2,6 +2,7 @@
 //! what it took, and the counters of both.
 
 use crate::kinematics::{Check, Pose};
+use crate::safety::AuxLevels;
 
 /// A pose setpoint from the host.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -12,6 +13,9 @@ pub struct Setpoint {
     pub time_us: u64,
     /// The pose.
     pub pose: Pose<f32>,
+    /// The auxiliary outputs this setpoint switches when it is taken (a pose file's `aux1`, `aux2` columns); `None`
+    /// leaves an output as it is. Two bytes on the wire without them.
+    pub aux: AuxLevels,
 }
 
 /// Why a setpoint was rejected.

@@ -10,7 +10,8 @@ use super::Field;
 use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 use crate::safety::{Command, FaultReason, Refusal, State};
 
-/// Protocol version; host and device must agree exactly. 8: the motion section carries the actuator limits.
+/// Protocol version; host and device must agree exactly. 8: the motion section carries the actuator limits, the
+/// operator's commands switch the auxiliary outputs and setpoints carry their levels.
 pub const PROTOCOL_VERSION: u16 = 8;
 
 /// The supervisor state, as reported.
@@ -36,8 +37,8 @@ pub enum HostMessage {
         /// The host's [`PROTOCOL_VERSION`].
         version: u16,
     },
-    /// A command to the supervisor (enable, disable, home, start, stop, clear a fault): acknowledged, or refused
-    /// with the supervisor's reason.
+    /// A command to the supervisor (enable, disable, home, start, stop, clear a fault, switch an auxiliary output):
+    /// acknowledged, or refused with the supervisor's reason.
     Command(Command),
     /// A pose setpoint.
     Setpoint(Setpoint),
@@ -175,7 +176,7 @@ pub struct Telemetry {
     pub tick_cost: u32,
     /// Every input after debouncing and polarity, a bit per `safety::debounce::InputBit` (1: active).
     pub inputs: u16,
-    /// The outputs: bit 0 LOGIC_EN relay, bit 1 POWER_EN relay, bit 2 driver enable.
+    /// The outputs: bit 0 LOGIC_EN relay, bit 1 POWER_EN relay, bit 2 driver enable, bit 3 AUX1, bit 4 AUX2.
     pub outputs: u8,
 }
 
@@ -284,6 +285,8 @@ pub struct Status {
     pub state: StateCode,
     /// Whether the axes are homed.
     pub homed: bool,
+    /// The auxiliary outputs that are on: bit 0 AUX1, bit 1 AUX2.
+    pub aux: u8,
     /// Step position of every axis.
     pub steps: [i64; 6],
     /// Commanded pose.

@@ -19,19 +19,79 @@ pub enum Command {
     Stop,
     /// Clear a latched fault.
     ClearFault,
+    /// Switch an auxiliary output (test equipment: a spindle, a pump, a valve). On only when homed and holding or
+    /// streaming (`Ready`, `Running`); off is always taken.
+    Aux {
+        /// Which output.
+        output: Aux,
+        /// `true`: on.
+        on: bool,
+    },
 }
 
 impl Command {
-    /// Every command, in wire order.
-    pub const ALL: [Command; 6] = [
+    /// Every command, in wire order (each auxiliary output on and off).
+    pub const ALL: [Command; 10] = [
         Command::Enable,
         Command::Disable,
         Command::Home,
         Command::Start,
         Command::Stop,
         Command::ClearFault,
+        Command::Aux {
+            output: Aux::Aux1,
+            on: true,
+        },
+        Command::Aux {
+            output: Aux::Aux1,
+            on: false,
+        },
+        Command::Aux {
+            output: Aux::Aux2,
+            on: true,
+        },
+        Command::Aux {
+            output: Aux::Aux2,
+            on: false,
+        },
     ];
 }
+
+/// One of the two auxiliary outputs (chapter 5.3.2's control box: two 10 A relays for test equipment).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Aux {
+    /// AUX1.
+    Aux1,
+    /// AUX2.
+    Aux2,
+}
+
+impl Aux {
+    /// Both, in order.
+    pub const ALL: [Aux; 2] = [Aux::Aux1, Aux::Aux2];
+
+    /// The output numbered `n` (1 or 2), as an operator names it.
+    pub fn from_number(n: u8) -> Option<Aux> {
+        match n {
+            1 => Some(Aux::Aux1),
+            2 => Some(Aux::Aux2),
+            _ => None,
+        }
+    }
+
+    /// Its bit in [`AuxLevels`] and in [`crate::safety::Outputs::aux`]: bit 0 AUX1, bit 1 AUX2.
+    pub const fn bit(self) -> u8 {
+        match self {
+            Aux::Aux1 => 1,
+            Aux::Aux2 => 2,
+        }
+    }
+}
+
+/// What a setpoint asks of the auxiliary outputs, one entry per output (AUX1, AUX2): `Some(level)` switches it when
+/// the setpoint is taken, `None` leaves it as it is (a pose file without that column).
+pub type AuxLevels = [Option<bool>; 2];
 
 /// An event the supervisor reacts to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

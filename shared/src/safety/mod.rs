@@ -6,7 +6,7 @@ pub mod homing;
 pub mod pins;
 pub mod supervisor;
 
-pub use events::{Command, Event, Refusal};
+pub use events::{Aux, AuxLevels, Command, Event, Refusal};
 pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};
 pub use supervisor::{FaultReason, Motion, Outputs, State, Supervisor, SupervisorConfig, Supplies};
 

@@ -9,7 +9,15 @@
 //! Invariants that hold after every transition (checked by exhaustive enumeration in the tests):
 //! power never on without logic on and settled; logic never off while power is on (power goes off first); the
 //! drivers are enabled only with power on and no fault; an e-stop or end-of-travel switch with power on lands in
-//! `Fault` in the same step; a fault is left only by `ClearFault`; no stream motion before homing.
+//! `Fault` in the same step; a fault is left only by `ClearFault`; no stream motion before homing; an auxiliary
+//! output is on only in `Ready`, `Running` or `Stopping` (so off in every fault, e-stop, disable and power-down),
+//! switched on only by its command, and off after a stream loss.
+//!
+//! The auxiliary outputs (AUX1, AUX2: chapter 5.3.2's relays for a spindle, a pump, a valve) are test equipment
+//! that works on the moving platform: they may be switched on only where the machine is homed and holding or
+//! streaming, and leaving those states for anything else (homing again, a jog, a disable, a fault) switches them
+//! off. A stream loss switches them off too: the host that switched them is gone, and equipment should not run
+//! unattended while the platform brakes.
 //!
 //! Time is milliseconds spent in the current state, advanced by [`Event::Elapsed`] and saturating just past the
 //! longest configured delay, which keeps the state space finite and enumerable.
@@ -204,6 +212,8 @@ pub struct Outputs {
     pub driver_enable: bool,
     /// What may move.
     pub motion: Motion,
+    /// The auxiliary outputs: bit 0 AUX1, bit 1 AUX2 (`Aux::bit`).
+    pub aux: u8,
 }
 
 impl Outputs {
@@ -213,7 +223,13 @@ impl Outputs {
         power_relay: false,
         driver_enable: false,
         motion: Motion::None,
+        aux: 0,
     };
+}
+
+/// The states an auxiliary output may stay on in: homed, drivers enabled, holding, streaming or braking.
+fn keeps_aux(state: State) -> bool {
+    matches!(state, State::Ready | State::Running | State::Stopping)
 }
 
 /// The interlock state machine.
@@ -225,6 +241,8 @@ pub struct Supervisor {
     homed: bool,
     /// The levels its events reported.
     inputs: Inputs,
+    /// The auxiliary outputs that are on (`Aux::bit`).
+    aux: u8,
 }
 
 impl Supervisor {
@@ -236,11 +254,13 @@ impl Supervisor {
             timer_ms: 0,
             homed: false,
             inputs: Inputs::default(),
+            aux: 0,
         }
     }
 
     /// A supervisor as its telemetry reports it: in `state` with these debounced inputs. Asked what it
-    /// [`permits`](Self::permits), it answers as the device's own would (a host shows why a button is disabled).
+    /// [`permits`](Self::permits), it answers as the device's own would (a host shows why a button is disabled;
+    /// no decision depends on which auxiliary outputs are on).
     pub fn as_reported(config: SupervisorConfig, state: State, inputs: Inputs) -> Self {
         Self {
             config,
@@ -248,6 +268,7 @@ impl Supervisor {
             timer_ms: 0,
             homed: state == State::Ready,
             inputs,
+            aux: 0,
         }
     }
 
@@ -304,13 +325,23 @@ impl Supervisor {
             power_relay: power,
             driver_enable: enable,
             motion,
+            aux: self.aux,
         }
+    }
+
+    /// Which auxiliary outputs are on (`Aux::bit`).
+    pub fn aux(&self) -> u8 {
+        self.aux
     }
 
     fn go(&mut self, state: State) {
         if state != self.state {
             self.state = state;
             self.timer_ms = 0;
+        }
+        // The one place a state changes: whatever leads out of the states that keep them, the outputs go off.
+        if !keeps_aux(state) {
+            self.aux = 0;
         }
     }
 
@@ -432,6 +463,7 @@ impl Supervisor {
             }
             Event::StreamLost => {
                 if self.state == State::Running {
+                    self.aux = 0;
                     self.go(State::Stopping);
                 }
             }
@@ -441,12 +473,18 @@ impl Supervisor {
             | Event::Command(Command::Start)
             | Event::Command(Command::Stop)
             | Event::Command(Command::ClearFault)
+            | Event::Command(Command::Aux { .. })
             | Event::Jog => return self.command(event),
         }
         Ok(())
     }
 
     fn command(&mut self, command: Event) -> Result<(), Refusal> {
+        // Switching an output off is always safe, and always taken (where it is off already, nothing changes).
+        if let Event::Command(Command::Aux { output, on: false }) = command {
+            self.aux &= !output.bit();
+            return Ok(());
+        }
         if self.is_fault() && command != Event::Command(Command::ClearFault) {
             return Err(Refusal::Faulted);
         }
@@ -476,6 +514,7 @@ impl Supervisor {
             }
             (Event::Command(Command::Stop), State::Jogging) => self.go(State::PowerOn { settled: true }),
             (Event::Command(Command::Start), State::Ready) => self.go(State::Running),
+            (Event::Command(Command::Aux { output, .. }), State::Ready | State::Running) => self.aux |= output.bit(),
             (Event::Command(Command::Stop), State::Running) => self.go(State::Stopping),
             (Event::Command(Command::Stop), State::Homing) => {
                 self.homed = false;

@@ -67,6 +67,9 @@ pub struct Plant {
     /// Bit per axis: its motor is wired or mounted the other way round, so a forward step moves the axis back
     /// (what the axes section's `reverse` corrects).
     pub reversed: u8,
+    /// The auxiliary outputs as the controller last set them (bit 0 AUX1, bit 1 AUX2): what the equipment on them
+    /// (a spindle, a pump, a valve) is doing.
+    pub aux: u8,
 }
 
 impl Plant {
@@ -93,6 +96,7 @@ impl Plant {
             steps_while_disabled: 0,
             steps_received: [0; 6],
             reversed: 0,
+            aux: 0,
         }
     }
 
@@ -167,6 +171,7 @@ impl Plant {
 
     /// Applies one period's pulses.
     pub fn apply(&mut self, out: &TickOutput) {
+        self.aux = out.outputs.aux;
         for (a, m) in out.moves.iter().enumerate() {
             if m.count > 0 && !out.outputs.driver_enable {
                 self.steps_while_disabled += u64::from(m.count);

@@ -83,6 +83,7 @@ fn host_us(n: usize) -> (f64, f64) {
                 seq: k as u32,
                 time_us: k as u64 * 10_000,
                 pose,
+                aux: [None; 2],
             }),
         };
         let len = protocol::encode(&request, &mut frame).unwrap();
@@ -105,7 +106,12 @@ fn device_us(follow: FollowMode, offset: [f32; 6]) -> Option<(f64, u32)> {
         id += 1;
         rig.controller.handle(&Request {
             id,
-            body: HostMessage::Setpoint(Setpoint { seq, time_us, pose }),
+            body: HostMessage::Setpoint(Setpoint {
+                seq,
+                time_us,
+                pose,
+                aux: [None; 2],
+            }),
         });
     };
     // Half a second of home at 100 Hz: the stream is established and the platform at rest.

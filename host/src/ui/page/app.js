@@ -121,7 +121,7 @@ function showFrame(f) {
   $("link").textContent = `telemetry ${f.rate_hz.toFixed(0)} Hz, ${f.received} samples`;
   view.show(state.rig, f.placed, f.ghost);
   $("view3d").dataset.pose = f.pose.map((v) => v.toFixed(5)).join(",");
-  $("outputs").innerHTML = lamp(f.outputs & 1, "LOGIC_EN") + lamp(f.outputs & 2, "POWER_EN") + lamp(f.outputs & 4, "DRIVERS");
+  $("outputs").innerHTML = lamp(f.outputs & 1, "LOGIC_EN") + lamp(f.outputs & 2, "POWER_EN") + lamp(f.outputs & 4, "DRIVERS") + lamp(f.outputs & 8, "AUX1") + lamp(f.outputs & 16, "AUX2");
   if (state.rig) {
     $("inputs").innerHTML = state.rig.inputs.map(([mask, name]) => {
       const on = (f.inputs & mask) !== 0;

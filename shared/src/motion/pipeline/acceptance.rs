@@ -117,7 +117,12 @@ mod tests {
     use crate::kinematics::RingPlatform;
 
     fn at(seq: u32, time_us: u64, pose: Pose<f32>) -> Setpoint {
-        Setpoint { seq, time_us, pose }
+        Setpoint {
+            seq,
+            time_us,
+            pose,
+            aux: [None; 2],
+        }
     }
 
     /// The last accepted setpoint as the pipeline keeps it: sequence number, time, pose as sent.

@@ -65,6 +65,7 @@ mod tests {
             seq,
             time_us: u64::from(seq) * 10_000,
             pose: home_plus(0, 0.002 * seq as f32),
+            aux: [None; 2],
         };
         p.submit(&sp(1)).unwrap();
         let mut events = [None; 2];
@@ -94,6 +95,7 @@ mod tests {
             seq: 1,
             time_us: 10_000,
             pose: home_plus(1, 0.01),
+            aux: [None; 2],
         })
         .unwrap();
         for _ in 0..100 {

@@ -186,6 +186,7 @@ mod tests {
             seq: 1,
             time_us: 1_000,
             pose,
+            aux: [None; 2],
         })
         .unwrap();
         let target = p.target().to_array();
@@ -243,6 +244,7 @@ mod tests {
             seq: 1,
             time_us: 1_000,
             pose: home_plus(1, 0.02),
+            aux: [None; 2],
         })
         .unwrap();
         for _ in 0..200 {

@@ -47,6 +47,7 @@ fn main() -> ! {
                 seq: k,
                 time_us: u64::from(k) * 1_000,
                 pose,
+                aux: [None; 2],
             }),
         };
         let len = protocol::encode(&request, &mut frame).unwrap_or(1);

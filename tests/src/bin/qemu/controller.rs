@@ -20,7 +20,8 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
         t.check(false, "the host CLI builds");
         return;
     }
-    let Some(emulated) = start_or_fail(t, &[]) else {
+    // `estop-on-aux2`: AUX2's contact in the e-stop chain, for the auxiliary outputs' run at the end.
+    let Some(emulated) = start_or_fail(t, &["estop-on-aux2"]) else {
         return;
     };
     let pty = emulated.pty.as_str();
@@ -208,5 +209,6 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
         problems.is_empty(),
         "every run above moved the plant by its STEP edges only, within the drivers' timing, drivers enabled",
     );
+    crate::aux::aux_on_m4f(t, &emulated);
     drop(emulated);
 }

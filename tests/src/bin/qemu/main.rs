@@ -5,7 +5,8 @@
 //! 1. `self_check`: the core's self-check on the emulated MCU: every check passes, and the digest of its output
 //!    bits equals the digest the same code computes on this host (bit identity of the f32 math); the cost of the
 //!    control path in instructions (`-icount shift=0`), printed as a table with the budget.
-//! 2. `controller`: the controller's firmware tasks on the emulated MCU, streamed through its UART.
+//! 2. `controller`: the controller's firmware tasks on the emulated MCU, streamed through its UART, and (`aux`)
+//!    the auxiliary outputs switched by a pose file's column and `device aux`, dropped by an e-stop.
 //! 3. `watchdog`: a stalled control loop reset by the watchdog. 4. `rig`: a rig of one's own loaded and run, and
 //!    the elbow trainer's and the rotopod's rig files likewise.
 //!
@@ -13,6 +14,7 @@
 //! `cargo run -p ringpod-tests --bin qemu -- --preflight` runs only that. `emulator` starts QEMU and the programs;
 //! `host_cli` drives the `ringpod` CLI against them.
 
+mod aux;
 mod controller;
 mod emulator;
 mod host_cli;

@@ -35,6 +35,10 @@ pub struct World {
     /// Each problem is reported once: the first occurrence is the one to look at.
     timing_reported: bool,
     disabled_reported: bool,
+    /// The test's wiring (`estop-on-aux2` on the command line): AUX2's relay contact is in the e-stop chain, so
+    /// switching AUX2 on opens it, as pressing the button would. The runner checks that the fault drops both
+    /// outputs (the chain closes again as AUX2 goes off).
+    pub estop_on_aux2: bool,
 }
 
 /// The world as the tasks share it (all of them run in thread mode here).
@@ -52,12 +56,14 @@ impl World {
             drivers,
             timing_reported: false,
             disabled_reported: false,
+            estop_on_aux2: false,
         }
     }
 
     /// Electrical levels of the input pins, in the `safety::debounce::InputBit` layout.
     fn levels(&self) -> u16 {
-        let inputs = self.plant.inputs(self.outputs.logic_relay, self.outputs.power_relay);
+        let mut inputs = self.plant.inputs(self.outputs.logic_relay, self.outputs.power_relay);
+        inputs.estop_open |= self.estop_on_aux2 && self.outputs.aux & 2 != 0;
         inputs.word() ^ InputConfig::default().active_low
     }
 }
@@ -80,6 +86,15 @@ impl Machine for Controls {
                 OutputPin::DriverEnable => w.outputs.driver_enable = on,
                 OutputPin::LogicRelay => w.outputs.logic_relay = on,
                 OutputPin::PowerRelay => w.outputs.power_relay = on,
+                OutputPin::Aux1 | OutputPin::Aux2 => {
+                    let bit = if pin == OutputPin::Aux1 { 1 } else { 2 };
+                    let was = w.outputs.aux;
+                    w.outputs.aux = if on { was | bit } else { was & !bit };
+                    if w.outputs.aux != was {
+                        // The runner follows the pins themselves, not only what the controller reports.
+                        hprintln!("AUX {}", w.outputs.aux);
+                    }
+                }
             }
         });
         CHANGED.signal(());

@@ -10,7 +10,8 @@
 //! - [`watchdog`]: the CMSDK watchdog, fed by the control tick.
 //!
 //! It prints `READY` over semihosting once its tasks run (`RESET watchdog` before it when the watchdog caused the
-//! reset). Its semihosting command line can hold `stall-when-homed` (see [`machine::Controls`]). What differs from
+//! reset). Its semihosting command line can hold `stall-when-homed` (see [`machine::Controls`]) and `estop-on-aux2`
+//! (see [`machine::World::estop_on_aux2`]). What differs from
 //! the STM32 build is only this board module.
 
 #![no_std]
@@ -155,7 +156,9 @@ async fn main(spawner: Spawner) {
         RigSource::Stored => Plant::for_config(&config),
         _ => Plant::trainer_model(TRAINER_MODEL_PARKED),
     };
-    let world: &'static WorldCell = WORLD.init(Mutex::new(RefCell::new(World::new(plant, drivers))));
+    let mut world = World::new(plant, drivers);
+    world.estop_on_aux2 = command_line_has(b"estop-on-aux2");
+    let world: &'static WorldCell = WORLD.init(Mutex::new(RefCell::new(world)));
     let mut pins = Pins { world, last: 0 };
     let first = ringpod_firmware::app::inputs::InputPins::read(&mut pins);
     let shared: &'static Shared = SHARED.init(Shared::new(controller, first));
