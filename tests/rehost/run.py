@@ -6,6 +6,7 @@ models, and checks what it does. Prints `PASS name: detail` / `FAIL name: detail
 """
 
 import argparse
+import json
 import os
 import re
 import sys
@@ -26,6 +27,7 @@ from models import tim as T  # noqa: E402
 from models.flash import sector_of  # noqa: E402
 from models.rcc import IWDGRSTF  # noqa: E402
 from plant import Plant  # noqa: E402
+from seqstore import used_up_page  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
 
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411.rs, SETTINGS)
@@ -123,8 +125,6 @@ def source_constant(name):
 
 
 def serial_checks(m, p, log, plant, ringpod):
-    import json
-
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -171,6 +171,45 @@ def serial_checks(m, p, log, plant, ringpod):
             f"{[w * slot_us for w in widths]} us (>= 2.5), DIR set-up {[t * slot_us for t in setups[:3]]} us (>= 5)")
     cli.run("device", "disable", *port)
     m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
+    settings_check(m, log, cli, port)
+
+
+def settings_check(m, log, cli, port):
+    """A setting stored over the link into sectors 6-7 and restored after `device restart`. Sector 6 is first
+    filled as ~200 saves leave it (written through the debug port, as a probe would), so this save closes it,
+    writes into sector 7 and erases sector 6: 2 s with the CPU stalled, under the widened watchdog."""
+    iw, fl = m.iwdg, m.flash
+    sector6 = SETTINGS[0]
+    m.uc.mem_write(sector6, used_up_page(0x20000))
+    programs, erases, resets, lines = len(fl.programs), len(fl.erases), len(m.resets), len(log.lines)
+    start = m.now
+    st = cli.run("device", "config", "set", "stream.timeout_ms", "250", *port)
+    widened = []  # the reload value while the settings task stores
+    while m.now - start < 4 * SYSCLK and not any("the configuration" in t for _, _, t in log.lines[lines:]):
+        m.run(m.now + SYSCLK // 100)
+        widened.append(iw.rlr_act)
+        log.poll()
+    stored = [t for _, _, t in log.lines[lines:] if "the configuration" in t]
+    feeds = [t for t in iw.reloads if t >= start]
+    gap = max((b - a for a, b in zip(feeds, feeds[1:])), default=0)
+    busy = fl.busy_until - fl.busy_from if fl.erases[erases:] else 0
+    rs = cli.run("device", "restart", *port)
+    got = cli.run("device", "config", "get", "stream.timeout_ms", *port)
+    try:
+        value = json.loads(got.stdout)["value"]
+    except (ValueError, KeyError):
+        value = None
+    new = fl.programs[programs:]
+    outside = [hex(a) for a, _ in new if not SETTINGS[0] <= a < SETTINGS[1]]
+    restarted = [cause for _, cause in m.resets[resets:]]
+    timeout = max(widened, default=0) * iw.tick(iw.pr_act)
+    CHECKS.check("serial-settings", st.code == 0 and stored and "stored" in stored[0] and value == 250
+                 and fl.erases[erases:] == [6] and new and not outside and not fl.rejected
+                 and restarted == ["SYSRESETREQ"] and gap < timeout,
+                 f"{st}; the settings task: {stored[0] if stored else 'nothing stored'!r}, {len(new)} words programmed, "
+                 f"sector erases {fl.erases[erases:]} (BSY and the CPU stalled for {ms(busy):.0f} ms), outside sectors 6-7: {outside or 'none'}, {len(fl.rejected)} rejected stores; "
+                 f"the watchdog widened to RLR {max(widened, default=0)} ({ms(timeout):.0f} ms), longest gap between "
+                 f"feeds {ms(gap):.0f} ms; {rs}: resets {restarted}; {got}")
 
 
 def main():
