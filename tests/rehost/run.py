@@ -26,7 +26,7 @@ from models import dma as D  # noqa: E402
 from models import tim as T  # noqa: E402
 from models.flash import sector_of  # noqa: E402
 from models.rcc import IWDGRSTF  # noqa: E402
-from plant import Plant  # noqa: E402
+from plant import FLAG_WIDTH, HOME_POSITION, SLOW_RATE, TOWARD, Plant  # noqa: E402
 from seqstore import used_up_page  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
 
@@ -172,6 +172,37 @@ def serial_checks(m, p, log, plant, ringpod):
     cli.run("device", "disable", *port)
     m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
     settings_check(m, log, cli, port)
+    homing_check(m, plant, cli, port)
+
+
+def homing_check(m, plant, cli, port):
+    """`device home` through the plant's switches: each axis approaches its switch, backs off, approaches slowly
+    and is given its home position where the debounced switch trips, then the platform moves to the home pose.
+    Where the device's count and the STEP edges put each axis then gives the plant position the device latched:
+    on the switch, past its edge by the latency of the debounce (3 ms) and the step pipeline."""
+    edges0, exti0 = list(plant.switch_edges), m.exti.edges
+    en = cli.run("device", "enable", *port)
+    m.run(m.now + int(0.6 * SYSCLK))
+    home = cli.run("device", "home", *port)
+    m.run(m.now + SYSCLK // 20)  # the steps still in the ring
+    st = cli.run("device", "status", *port)
+    try:
+        status = json.loads(st.stdout)
+    except ValueError:
+        status = {}
+    dev = status.get("steps", [0] * 6)
+    latched = [p - d + h for p, d, h in zip(plant.position, dev, HOME_POSITION)]  # the plant where it latched
+    past_ms = [round(1000 * (x - 0) * t / r, 1) for x, t, r in zip(latched, TOWARD, SLOW_RATE)]
+    on_switch = all(0 <= x < FLAG_WIDTH if a < 4 else x <= 0 for a, x in enumerate(latched))
+    edges = [b - a for a, b in zip(edges0, plant.switch_edges)]
+    CHECKS.check("serial-home", home.code == 0 and status.get("state") == "Ready" and status.get("homed")
+                 and on_switch and all(3 <= t <= 15 for t in past_ms) and all(e >= 4 for e in edges)
+                 and m.exti.edges - exti0 >= sum(edges),
+                 f"{en}; `device home` exit {home.code} after {home.sim_s:.2f} simulated s: state "
+                 f"{status.get('state')}, homed {status.get('homed')}; home switches PA1-PA6 changed {edges} times "
+                 f"(fast approach, back-off, slow approach, clear), {m.exti.edges - exti0} EXTI edges; plant at "
+                 f"{plant.position}, device counts {dev}: latched at {latched} (on the switch: {on_switch}), "
+                 f"{past_ms} ms past the switch edge at the slow approach's speed (debounce 3 ms + step pipeline)")
 
 
 def settings_check(m, log, cli, port):
