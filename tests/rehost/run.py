@@ -9,7 +9,9 @@ import argparse
 import json
 import os
 import re
+import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -173,6 +175,43 @@ def serial_checks(m, p, log, plant, ringpod):
     m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
     settings_check(m, log, cli, port)
     homing_check(m, plant, cli, port)
+    stream_check(m, plant, cli, port, ringpod)
+
+
+def stream_check(m, plant, cli, port, ringpod):
+    """`ringpod stream` of a one-second CSV (heave 4 mm and yaw 3 degrees, at rest at both ends) over the link:
+    the device's step counts, the STEP edges on GPIOB (signed by DIR) and the simulated controller
+    (`stream --sim --fast`, the same core on the host) end at the same steps. The host paces the rows by its own
+    clock and the emulated board runs many times slower than real time, so the rows arrive within about 0.2
+    simulated s: the same path, faster (still inside the device's limits), ending at the same pose."""
+    with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as f:
+        f.write("t,x,y,z,alpha,beta,gamma\n")
+        for i in range(51):
+            t = i / 50
+            s = t * t * (3 - 2 * t)  # smoothstep: at rest at both ends
+            f.write(f"{t:.2f},0,0,{0.227 + 0.004 * s:.6f},0,0,{3.0 * s:.4f}\n")  # from the home pose (z 227 mm)
+    args = ["--input", f.name, "--degrees", "--report-json", "--quiet"]
+    sim = subprocess.run([ringpod, "stream", "--sim", "--fast", *args], capture_output=True, text=True, timeout=120)
+    before = json.loads(cli.run("device", "status", *port).stdout or "{}").get("steps")
+    plant.reset_counts()
+    r = cli.run("stream", *port, *args, sim_limit_s=30)
+    m.run(m.now + SYSCLK // 20)  # the steps still in the ring
+    after = json.loads(cli.run("device", "status", *port).stdout or "{}").get("steps")
+    os.unlink(f.name)
+    try:
+        report, want = json.loads(r.stdout), json.loads(sim.stdout)["final_steps"]
+    except (ValueError, KeyError):
+        report, want = {}, None
+    moved = [b - a for a, b in zip(before, after)] if before and after else None
+    CHECKS.check("serial-stream", r.code == 0 and report.get("outcome") == "followed"
+                 and report.get("setpoints_applied") == report.get("setpoints_sent")
+                 and moved == plant.net and after == report.get("final_steps") == want,
+                 f"`ringpod stream` exit {r.code} after {r.sim_s:.2f} simulated s: {report.get('outcome')}, "
+                 f"{report.get('setpoints_sent')} setpoints sent, {report.get('setpoints_applied')} applied, limited "
+                 f"{report.get('limited', {}).get('device')} by the device; device "
+                 f"steps {before} -> {after} (moved {moved}), STEP edges on PB0-PB5 (signed by DIR) {plant.net}, the "
+                 f"report's final steps {report.get('final_steps')}, `stream --sim --fast` {want}"
+                 + ("" if r.code == 0 else f"; {r}"))
 
 
 def homing_check(m, plant, cli, port):
