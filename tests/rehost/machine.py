@@ -139,7 +139,7 @@ class Machine:
         scb = hw.entity["scb"]
         self.nvic = self.install("nvic", 0xE000_E100, Nvic(sys_priority=lambda exc: scb.instance.SHP[exc - 4]))
         scb.hook_write(self._scb_write)
-        self.flash = self.install("flash interface", 0x4002_3C00, FlashInterface(self))
+        self.flash = self.install("flash interface", 0x4002_3C00, FlashInterface(self, self.clock, SYSCLK))
         self.dma = {"dma1": self.install("dma1", 0x4002_6000, Dma("dma1", self, self.pend, DMA1_IRQS)),
                     "dma2": self.install("dma2", 0x4002_6400, Dma("dma2", self, self.pend, DMA2_IRQS))}
         self.tim = {}
@@ -167,7 +167,8 @@ class Machine:
         return int.from_bytes(self.uc.mem_read(addr, size), "little")
 
     def write(self, addr, data_or_size, value=None):
-        if value is None:  # write(addr, bytes): the flash model's array access
+        if value is None:  # write(addr, bytes): the flash model's array access (an erase)
+            self._apply_flash_fixups()  # the stores before it land first
             self.uc.mem_write(addr, bytes(data_or_size))
             return
         dev = self._find(addr)
@@ -201,7 +202,7 @@ class Machine:
         for addr, rn in self.elf.msr_primask_sites():
             uc.hook_add(UC_HOOK_CODE, self._msr_primask, rn, addr, addr)
         uc.hook_add(UC_HOOK_MEM_WRITE, self._flash_store, None, FLASH_BASE, FLASH_BASE + FLASH_SIZE - 1)
-        self.flash_fixups = []
+        self.flash_fixups = {}  # flash byte address -> what the array holds after this chunk's stores
 
     def count_instructions(self):
         """Counts every executed instruction in `self.instructions` (slow: for measuring only)."""
@@ -222,12 +223,17 @@ class Machine:
             self.uc.emu_stop()
 
     def _flash_store(self, uc, access, addr, size, value, ud):
-        # the store is about to happen: remember the old bytes, and let the flash model decide after the chunk
-        self.flash_fixups.append((addr, size, value, bytes(uc.mem_read(addr, size))))
+        # The store is about to happen (Unicorn writes the raw value into the array): the flash model decides now,
+        # with FLASH_CR as it is at this store (embassy unlocks, programs one word and locks again within a chunk),
+        # and the array gets what programming leaves (`cpu_write`) after the chunk.
+        raw = uc.mem_read(addr, size)
+        old = bytes(self.flash_fixups.get(addr + i, raw[i]) for i in range(size))
+        for i, b in enumerate(self.flash.cpu_write(addr, size, value, old)):
+            self.flash_fixups[addr + i] = b
 
     def _apply_flash_fixups(self):
-        for addr, size, value, old in self.flash_fixups:
-            self.uc.mem_write(addr, self.flash.cpu_write(addr, size, value, old))
+        for addr, b in self.flash_fixups.items():
+            self.uc.mem_write(addr, bytes([b]))
         self.flash_fixups.clear()
 
     def _watchdog_timeout(self, at):
@@ -410,7 +416,7 @@ class Machine:
         for port in self.gpio.values():
             port.instance = type(port.instance)()
         history = (self.flash.erases, self.flash.programs, self.flash.rejected)
-        self.flash.__init__(self)
+        self.flash.__init__(self, self.clock, SYSCLK)  # an erase in progress is cut short
         self.flash.erases, self.flash.programs, self.flash.rejected = history  # kept for the checks
         self.otg.__init__()
         self.dwt.__init__(self.clock)
@@ -442,6 +448,11 @@ class Machine:
                 observed = self.now
                 for observe in self.observers:
                     observe()
+            if self.flash.busy_until > self.now:
+                # RM0383 3.5: reading flash while a sector is erased stalls the bus; code and vectors are in flash,
+                # so the CPU waits (interrupts stay pending) while the peripherals and the watchdog run on
+                self.now = max(self.now + 1, min(self.next_event(), self.flash.busy_until, until))
+                continue
             try:
                 if self.sleeping is not None:
                     if self.try_take(self.sleeping):

@@ -11,6 +11,12 @@
 """
 
 TRAINER_MODEL_PARKED = [-500, -400, -300, -200, 8_000, 9_000]  # shared/src/model.rs
+# shared/src/model.rs, CARRIAGE_HOMING and LINEAR_HOMING: where the firmware puts each axis when its switch trips on
+# the slow approach (the carriages' index at 0 rad; the end switch at -66.31 mm x 1,600 steps/mm), the slow
+# approach's speed (steps/s) and its direction
+HOME_POSITION = [0, 0, 0, 0, -106_096, -106_096]
+SLOW_RATE = [500, 500, 500, 500, 4_000, 4_000]
+TOWARD = [1, 1, 1, 1, -1, -1]
 STEP = [0, 1, 2, 3, 4, 5]
 DIR = [6, 7, 8, 9, 10, 12]
 LOGIC_EN, POWER_EN = 14, 15
@@ -30,6 +36,7 @@ class Plant:
         self.widths = [set() for _ in range(6)]  # STEP high times seen, in slots
         self.setups = [set() for _ in range(6)]  # slots from a DIR change to the next STEP rise
         self.levels = {}
+        self.switch_edges = [0] * 6  # changes of each home switch
         m.gpio["b"].on_change = self._portb
         self._update()
 
@@ -67,6 +74,8 @@ class Plant:
         was = self.levels.get(key)
         self.levels[key] = level
         self.gpio["ac"[port // 2]].drive(pin, level)
+        if port == PORT_A and 1 <= pin <= 6 and was is not None:
+            self.switch_edges[pin - 1] += 1
         if was is not None and self.m.exti:
             self.m.exti.edge(port, pin, bool(level))
 

@@ -6,9 +6,12 @@ models, and checks what it does. Prints `PASS name: detail` / `FAIL name: detail
 """
 
 import argparse
+import json
 import os
 import re
+import subprocess
 import sys
+import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -25,7 +28,8 @@ from models import dma as D  # noqa: E402
 from models import tim as T  # noqa: E402
 from models.flash import sector_of  # noqa: E402
 from models.rcc import IWDGRSTF  # noqa: E402
-from plant import Plant  # noqa: E402
+from plant import FLAG_WIDTH, HOME_POSITION, SLOW_RATE, TOWARD, Plant  # noqa: E402
+from seqstore import used_up_page  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
 
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411.rs, SETTINGS)
@@ -123,8 +127,6 @@ def source_constant(name):
 
 
 def serial_checks(m, p, log, plant, ringpod):
-    import json
-
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -171,6 +173,116 @@ def serial_checks(m, p, log, plant, ringpod):
             f"{[w * slot_us for w in widths]} us (>= 2.5), DIR set-up {[t * slot_us for t in setups[:3]]} us (>= 5)")
     cli.run("device", "disable", *port)
     m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
+    settings_check(m, log, cli, port)
+    homing_check(m, plant, cli, port)
+    stream_check(m, plant, cli, port, ringpod)
+
+
+def stream_check(m, plant, cli, port, ringpod):
+    """`ringpod stream` of a one-second CSV (heave 4 mm and yaw 3 degrees, at rest at both ends) over the link:
+    the device's step counts, the STEP edges on GPIOB (signed by DIR) and the simulated controller
+    (`stream --sim --fast`, the same core on the host) end at the same steps. The host paces the rows by its own
+    clock and the emulated board runs many times slower than real time, so the rows arrive within about 0.2
+    simulated s: the same path, faster (still inside the device's limits), ending at the same pose."""
+    with tempfile.NamedTemporaryFile("w", suffix=".csv", delete=False) as f:
+        f.write("t,x,y,z,alpha,beta,gamma\n")
+        for i in range(51):
+            t = i / 50
+            s = t * t * (3 - 2 * t)  # smoothstep: at rest at both ends
+            f.write(f"{t:.2f},0,0,{0.227 + 0.004 * s:.6f},0,0,{3.0 * s:.4f}\n")  # from the home pose (z 227 mm)
+    args = ["--input", f.name, "--degrees", "--report-json", "--quiet"]
+    sim = subprocess.run([ringpod, "stream", "--sim", "--fast", *args], capture_output=True, text=True, timeout=120)
+    before = json.loads(cli.run("device", "status", *port).stdout or "{}").get("steps")
+    plant.reset_counts()
+    r = cli.run("stream", *port, *args, sim_limit_s=30)
+    m.run(m.now + SYSCLK // 20)  # the steps still in the ring
+    after = json.loads(cli.run("device", "status", *port).stdout or "{}").get("steps")
+    os.unlink(f.name)
+    try:
+        report, want = json.loads(r.stdout), json.loads(sim.stdout)["final_steps"]
+    except (ValueError, KeyError):
+        report, want = {}, None
+    moved = [b - a for a, b in zip(before, after)] if before and after else None
+    CHECKS.check("serial-stream", r.code == 0 and report.get("outcome") == "followed"
+                 and report.get("setpoints_applied") == report.get("setpoints_sent")
+                 and moved == plant.net and after == report.get("final_steps") == want,
+                 f"`ringpod stream` exit {r.code} after {r.sim_s:.2f} simulated s: {report.get('outcome')}, "
+                 f"{report.get('setpoints_sent')} setpoints sent, {report.get('setpoints_applied')} applied, limited "
+                 f"{report.get('limited', {}).get('device')} by the device; device "
+                 f"steps {before} -> {after} (moved {moved}), STEP edges on PB0-PB5 (signed by DIR) {plant.net}, the "
+                 f"report's final steps {report.get('final_steps')}, `stream --sim --fast` {want}"
+                 + ("" if r.code == 0 else f"; {r}"))
+
+
+def homing_check(m, plant, cli, port):
+    """`device home` through the plant's switches: each axis approaches its switch, backs off, approaches slowly
+    and is given its home position where the debounced switch trips, then the platform moves to the home pose.
+    Where the device's count and the STEP edges put each axis then gives the plant position the device latched:
+    on the switch, past its edge by the latency of the debounce (3 ms), the 1 ms sampling and tick and the step
+    ring's look-ahead (about 6 ms): 8-9 ms; up to 10 ms more when the edge comes between two of the inputs task's
+    waits and its 10 ms sweep finds it (firmware/src/app/inputs.rs)."""
+    edges0, exti0 = list(plant.switch_edges), m.exti.edges
+    en = cli.run("device", "enable", *port)
+    m.run(m.now + int(0.6 * SYSCLK))
+    home = cli.run("device", "home", *port)
+    m.run(m.now + SYSCLK // 20)  # the steps still in the ring
+    st = cli.run("device", "status", *port)
+    try:
+        status = json.loads(st.stdout)
+    except ValueError:
+        status = {}
+    dev = status.get("steps", [0] * 6)
+    latched = [p - d + h for p, d, h in zip(plant.position, dev, HOME_POSITION)]  # the plant where it latched
+    past_ms = [round(1000 * (x - 0) * t / r, 1) for x, t, r in zip(latched, TOWARD, SLOW_RATE)]
+    on_switch = all(0 <= x < FLAG_WIDTH if a < 4 else x <= 0 for a, x in enumerate(latched))
+    edges = [b - a for a, b in zip(edges0, plant.switch_edges)]
+    CHECKS.check("serial-home", home.code == 0 and status.get("state") == "Ready" and status.get("homed")
+                 and on_switch and all(3 <= t <= 22 for t in past_ms) and all(e >= 4 for e in edges)
+                 and m.exti.edges - exti0 >= sum(edges),
+                 f"{en}; `device home` exit {home.code} after {home.sim_s:.2f} simulated s: state "
+                 f"{status.get('state')}, homed {status.get('homed')}; home switches PA1-PA6 changed {edges} times "
+                 f"(fast approach, back-off, slow approach, clear), {m.exti.edges - exti0} EXTI edges; plant at "
+                 f"{plant.position}, device counts {dev}: latched at {latched} (on the switch: {on_switch}), "
+                 f"{past_ms} ms past the switch edge at the slow approach's speed (3-22 ms: the debounce, the step ring, "
+                 f"at most one 10 ms sweep)")
+
+
+def settings_check(m, log, cli, port):
+    """A setting stored over the link into sectors 6-7 and restored after `device restart`. Sector 6 is first
+    filled as ~200 saves leave it (written through the debug port, as a probe would), so this save closes it,
+    writes into sector 7 and erases sector 6: 2 s with the CPU stalled, under the widened watchdog."""
+    iw, fl = m.iwdg, m.flash
+    sector6 = SETTINGS[0]
+    m.uc.mem_write(sector6, used_up_page(0x20000))
+    programs, erases, resets, lines = len(fl.programs), len(fl.erases), len(m.resets), len(log.lines)
+    start = m.now
+    st = cli.run("device", "config", "set", "stream.timeout_ms", "250", *port)
+    widened = []  # the reload value while the settings task stores
+    while m.now - start < 4 * SYSCLK and not any("the configuration" in t for _, _, t in log.lines[lines:]):
+        m.run(m.now + SYSCLK // 100)
+        widened.append(iw.rlr_act)
+        log.poll()
+    stored = [t for _, _, t in log.lines[lines:] if "the configuration" in t]
+    feeds = [t for t in iw.reloads if t >= start]
+    gap = max((b - a for a, b in zip(feeds, feeds[1:])), default=0)
+    busy = fl.busy_until - fl.busy_from if fl.erases[erases:] else 0
+    rs = cli.run("device", "restart", *port)
+    got = cli.run("device", "config", "get", "stream.timeout_ms", *port)
+    try:
+        value = json.loads(got.stdout)["value"]
+    except (ValueError, KeyError):
+        value = None
+    new = fl.programs[programs:]
+    outside = [hex(a) for a, _ in new if not SETTINGS[0] <= a < SETTINGS[1]]
+    restarted = [cause for _, cause in m.resets[resets:]]
+    timeout = max(widened, default=0) * iw.tick(iw.pr_act)
+    CHECKS.check("serial-settings", st.code == 0 and stored and "stored" in stored[0] and value == 250
+                 and fl.erases[erases:] == [6] and new and not outside and not fl.rejected
+                 and restarted == ["SYSRESETREQ"] and gap < timeout,
+                 f"{st}; the settings task: {stored[0] if stored else 'nothing stored'!r}, {len(new)} words programmed, "
+                 f"sector erases {fl.erases[erases:]} (BSY and the CPU stalled for {ms(busy):.0f} ms), outside sectors 6-7: {outside or 'none'}, {len(fl.rejected)} rejected stores; "
+                 f"the watchdog widened to RLR {max(widened, default=0)} ({ms(timeout):.0f} ms), longest gap between "
+                 f"feeds {ms(gap):.0f} ms; {rs}: resets {restarted}; {got}")
 
 
 def main():

@@ -128,12 +128,21 @@ mod watchdog {
     /// LSI (32 kHz nominal) / 256 = 125 Hz: 8 ms per count, up to 32.7 s.
     fn set(timeout_us: u32) {
         let iwdg = pac::IWDG;
-        while iwdg.sr().read().pvu() || iwdg.sr().read().rvu() {}
+        wait_updated();
         iwdg.kr().write(|w| w.set_key(Key::ENABLE));
         iwdg.pr().write(|w| w.set_pr(Pr::DIVIDE_BY256));
         let counts = (timeout_us / 8_000).clamp(1, 0x0fff);
         iwdg.rlr().write(|w| w.set_rl(counts as u16));
+        // The counter lives in the VDD domain: PR and RLR reach it up to 5 LSI periods (at most 0.3 ms) after the
+        // write, while IWDG_SR's PVU/RVU read 1 (RM0383 15.4.4). A reload before then loads the old value, so a
+        // widening for a sector erase would leave 48 ms, and the erase stalls the CPU for up to 2 s.
+        wait_updated();
         pet();
+    }
+
+    fn wait_updated() {
+        let iwdg = pac::IWDG;
+        while iwdg.sr().read().pvu() || iwdg.sr().read().rvu() {}
     }
 
     /// Starts the watchdog with `timeout_us` (it cannot be stopped again).

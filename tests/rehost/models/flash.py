@@ -4,6 +4,13 @@ KEYR, SR, CR) unlock, erase sectors and program, so that what the firmware store
 Qiling's profile maps flash as RAM filled with 0x00 (an empty settings area then looks like written records) and
 its FLASH interface only stores register values. The harness fills flash with 0xFF before loading the ELF and
 routes every CPU store into flash through `cpu_write`.
+
+A sector erase takes time: BSY reads 1 until `busy_until`, and the machine stalls the CPU until then (RM0383 3.5:
+a read of the flash while it is being erased stalls the bus; the firmware's code and vector table are in flash, so
+nothing runs, not even an interrupt handler). The time is the STM32F411xC/E datasheet's (DS10314, flash memory
+programming characteristics) maximum for a 128 KiB sector at x32 parallelism, 2 s; 16 and 64 KiB sectors take a
+proportional share (not the datasheet's figures: the firmware only erases the 128 KiB sectors 6-7). Programming a
+word is instant here (16 us typical in that table).
 """
 
 from .base import Block
@@ -14,6 +21,7 @@ SECTORS = [(0x0000, 0x4000), (0x4000, 0x4000), (0x8000, 0x4000), (0xC000, 0x4000
     (0x20000 * i, 0x20000) for i in (1, 2, 3)
 ]
 FLASH_SIZE = 0x80000
+ERASE_128K_S = 2.0  # DS10314, t_ERASE128KB at x32 parallelism: 1 s typical, 2 s maximum
 KEY1, KEY2 = 0x4567_0123, 0xCDEF_89AB  # RM0383 3.5.1, FLASH_KEYR: unlock sequence
 # RM0383 ch. 3 registers, FLASH_CR
 PG, SER, MER, STRT, LOCK = 1 << 0, 1 << 1, 1 << 2, 1 << 16, 1 << 31
@@ -32,9 +40,11 @@ def sector_of(addr):
 class FlashInterface(Block):
     ACR, KEYR, OPTKEYR, SR, CR, OPTCR = 0x00, 0x04, 0x08, 0x0C, 0x10, 0x14
 
-    def __init__(self, memory):
-        """`memory.read(addr, n) -> bytes` and `memory.write(addr, data)` reach the flash array."""
-        self.memory = memory
+    def __init__(self, memory, clock=lambda: 0, cycles_per_s=96_000_000):
+        """`memory.write(addr, data)` reaches the flash array; `clock()` is the time in CPU cycles."""
+        self.memory, self.clock = memory, clock
+        self.erase_cycles_per_byte = ERASE_128K_S * cycles_per_s / 0x20000
+        self.busy_from = self.busy_until = 0  # the last erase's start and end (cycles)
         self.acr = 0
         self.sr = 0
         self.cr = LOCK  # RM0383 FLASH_CR: resets locked (0x8000_0000)
@@ -49,7 +59,7 @@ class FlashInterface(Block):
         if off == self.ACR:
             return self.acr
         if off == self.SR:
-            return self.sr  # operations complete at once: BSY never reads 1
+            return self.sr | (BSY if self.clock() < self.busy_until else 0)
         if off == self.CR:
             return self.cr
         if off == self.OPTCR:
@@ -93,6 +103,8 @@ class FlashInterface(Block):
         start, size = SECTORS[n]
         self.memory.write(FLASH_BASE + start, b"\xff" * size)
         self.erases.append(n)
+        self.busy_from = self.clock()
+        self.busy_until = self.busy_from + int(size * self.erase_cycles_per_byte)
         self.sr |= EOP
 
     def cpu_write(self, addr, size, value, old):

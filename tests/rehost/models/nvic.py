@@ -17,7 +17,9 @@ PRIO_BITS = 0xF0  # PM0214 4.2.7: the STM32F4 implements the 4 upper bits of eac
 class Nvic(Block):
     # PM0214 4.2 Table 47, offsets from 0xE000_E100
     ISER, ICER, ISPR, ICPR, IABR, IPR, STIR = 0x000, 0x080, 0x100, 0x180, 0x200, 0x300, 0xE00
-    size = 0xE04
+    # PM0214 4.2 Table 47 and 4.4 (SCB at 0xE000_ED00): the NVIC's registers are two windows, ISER-IPR and STIR,
+    # with the SCB between them; one window up to STIR would shadow the SCB (AIRCR, VTOR, SHPR) on the bus
+    region = [(0x000, 0x400), (0xE00, 0xE04)]
 
     def __init__(self, sys_priority=lambda exc: 0):
         # sys_priority(exc) gives the priority of a system exception (SCB.SHPRx, PM0214 4.4.8).

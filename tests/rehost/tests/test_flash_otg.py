@@ -1,14 +1,15 @@
 import unittest
 
-from models.flash import FLASH_BASE, LOCK, PG, SER, STRT, FlashInterface, sector_of
+from models.flash import BSY, FLASH_BASE, LOCK, PG, SER, STRT, FlashInterface, sector_of
 from models.otg import OtgFs
-from tests.helpers import Memory
+from tests.helpers import Clock, Memory
 
 
 class FlashTest(unittest.TestCase):
     def setUp(self):
         self.mem = Memory()
-        self.f = FlashInterface(self.mem)
+        self.clock = Clock()
+        self.f = FlashInterface(self.mem, self.clock, cycles_per_s=1000)
 
     def unlock(self):
         self.f.write(FlashInterface.KEYR, 4, 0x4567_0123)
@@ -33,6 +34,17 @@ class FlashTest(unittest.TestCase):
         self.assertEqual(self.mem.read(0x0804_0000, 4), 0xFFFFFFFF)
         self.assertEqual(self.mem.read(0x0805_FFFC, 4), 0xFFFFFFFF)
         self.assertNotIn(0x0806_0000, self.mem.mem)
+
+    def test_a_128k_sector_erase_is_busy_for_2_s(self):
+        # DS10314: t_ERASE128KB at x32 parallelism, 2 s maximum; BSY (FLASH_SR) reads 1 until then
+        self.unlock()
+        self.clock.now = 500
+        self.f.write(FlashInterface.CR, 4, SER | (7 << 3) | STRT)
+        self.assertEqual((self.f.busy_from, self.f.busy_until), (500, 2500))
+        self.clock.now = 2499
+        self.assertTrue(self.f.read(FlashInterface.SR, 4) & BSY)
+        self.clock.now = 2500
+        self.assertFalse(self.f.read(FlashInterface.SR, 4) & BSY)
 
     def test_program_only_clears_bits_and_needs_pg(self):
         old = b"\xff\xff\x0f\xff"

@@ -4,6 +4,14 @@ from models.nvic import Nvic
 
 
 class NvicTest(unittest.TestCase):
+    def test_the_scb_between_its_windows_is_not_the_nvics(self):
+        # PM0214 4.4: the SCB (ACTLR..., CPUID at 0xE000_ED00, AIRCR at ED0C) lies between IPR and STIR
+        scb = [0xE000_ED00 - 0xE000_E100 + off for off in (0x00, 0x08, 0x0C, 0x18, 0x20)]
+        for off in scb:
+            self.assertFalse(any(lo <= off < hi for lo, hi in Nvic().region), hex(off))
+        for off in (Nvic.ISER, Nvic.IPR + 239, Nvic.STIR):
+            self.assertTrue(any(lo <= off < hi for lo, hi in Nvic().region), hex(off))
+
     def test_stir_pends_an_interrupt(self):
         n = Nvic()
         n.write(Nvic.ISER + 8, 4, 1 << (71 - 64))  # USART6
