@@ -330,7 +330,7 @@ fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
             ),
         ],
     };
-    plot::save(path, (1000, 1000), &plot)
+    Ok(plot::save(path, (1000, 1000), &plot)?)
 }
 
 #[cfg(test)]

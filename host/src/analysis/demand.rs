@@ -478,7 +478,7 @@ fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> anyhow::Result<
         ),
         panels,
     };
-    plot::save(out, (1000, 1300), &plot)
+    Ok(plot::save(out, (1000, 1300), &plot)?)
 }
 
 #[cfg(test)]

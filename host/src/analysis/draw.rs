@@ -172,7 +172,7 @@ const JOINT: RGBColor = RGBColor(200, 30, 30);
 const PLATFORM: RGBColor = RGBColor(60, 160, 80);
 
 impl Picture for Scene {
-    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> Result<(), plot::PlotError>
     where
         DB::ErrorType: 'static,
     {
@@ -327,7 +327,7 @@ impl ToolScene {
 }
 
 impl Picture for ToolScene {
-    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> Result<(), plot::PlotError>
     where
         DB::ErrorType: 'static,
     {

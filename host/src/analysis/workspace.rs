@@ -279,7 +279,7 @@ fn draw(
         name,
         plane,
     };
-    plot::save(out, (860, 640), &picture)
+    Ok(plot::save(out, (860, 640), &picture)?)
 }
 
 /// A workspace section, coloured by the first failing check, with its legend.
@@ -292,7 +292,7 @@ struct SectionPicture<'a> {
 }
 
 impl Picture for SectionPicture<'_> {
-    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> Result<(), plot::PlotError>
     where
         DB::ErrorType: 'static,
     {

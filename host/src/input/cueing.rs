@@ -1,22 +1,41 @@
 //! Cueing files: the washout's parameters in TOML (every key optional), with named profiles, read by `cue`
 //! and by `stream --telemetry-udp` (also again while it runs, when the file changes).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use ringpod_core::cueing::CueConfig;
 
+/// Why a cueing file was not taken.
+#[derive(Debug, thiserror::Error)]
+pub enum CueingFileError {
+    /// A profile was asked for without a file to choose it from.
+    #[error("profile `{0}`: profiles are chosen from a cueing file, and none was given")]
+    ProfileWithoutFile(String),
+    /// The file could not be read, or its contents are not a configuration (the reason names the key).
+    #[error("{}: {reason}", path.display())]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: String,
+    },
+}
+
 /// Loads a washout configuration from TOML (every key optional), with a profile's overrides
 /// ([`parse_config`]); errors name the file and the key.
-pub fn load_config(path: Option<&Path>, profile: Option<&str>) -> anyhow::Result<CueConfig> {
+pub fn load_config(path: Option<&Path>, profile: Option<&str>) -> Result<CueConfig, CueingFileError> {
     let Some(path) = path else {
         if let Some(name) = profile {
-            anyhow::bail!("profile `{name}`: profiles are chosen from a cueing file, and none was given");
+            return Err(CueingFileError::ProfileWithoutFile(name.to_owned()));
         }
         return Ok(CueConfig::default());
     };
-    let text = super::files::read_text(path, super::files::CONFIG_LIMIT)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    parse_config(&text, profile).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    let in_file = |reason| CueingFileError::File {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let text = super::files::read_text(path, super::files::CONFIG_LIMIT).map_err(in_file)?;
+    parse_config(&text, profile).map_err(in_file)
 }
 
 /// A cueing file's text: the base keys, and `[profiles.NAME]` tables, each a partial override of the base. With

@@ -2,7 +2,7 @@
 //! compiled into the binary and registered with plotters' own font rasteriser, so PNG pictures carry the same
 //! labels as SVG without a system font library.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Once;
 
 use plotters::coord::Shift;
@@ -23,21 +23,40 @@ fn register_fonts() {
     });
 }
 
+/// Why a picture was not written.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// Drawing or writing it failed (plotters' error, which differs by backend, in words).
+    #[error("{}: {reason}", path.display())]
+    Draw {
+        /// The picture's file.
+        path: PathBuf,
+        /// What failed.
+        reason: String,
+    },
+    /// The file's name says no format this writes.
+    #[error("{}: a picture is .svg or .png", .0.display())]
+    Format(PathBuf),
+}
+
 /// Maps a plotting error to one that names the picture.
-pub fn failed(out: &Path) -> impl Fn(&dyn std::fmt::Display) -> anyhow::Error + '_ {
-    move |e| anyhow::anyhow!("{}: {e}", out.display())
+pub fn failed(out: &Path) -> impl Fn(&dyn std::fmt::Display) -> PlotError + '_ {
+    move |e| PlotError::Draw {
+        path: out.to_path_buf(),
+        reason: e.to_string(),
+    }
 }
 
 /// Something drawn on any plotters backend.
 pub trait Picture {
     /// Draws on `root`; `fail` names the picture in errors.
-    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> Result<(), PlotError>
     where
         DB::ErrorType: 'static;
 }
 
 /// Writes `picture` to `out`: SVG when the name ends in `.svg`, PNG when it ends in `.png`.
-pub fn save(out: &Path, size: (u32, u32), picture: &impl Picture) -> anyhow::Result<()> {
+pub fn save(out: &Path, size: (u32, u32), picture: &impl Picture) -> Result<(), PlotError> {
     register_fonts();
     let fail = failed(out);
     match out.extension().and_then(|e| e.to_str()) {
@@ -51,7 +70,7 @@ pub fn save(out: &Path, size: (u32, u32), picture: &impl Picture) -> anyhow::Res
             picture.paint(&root, out)?;
             root.present().map_err(|e| fail(&e))
         }
-        _ => anyhow::bail!("{}: a picture is .svg or .png", out.display()),
+        _ => Err(PlotError::Format(out.to_path_buf())),
     }
 }
 
@@ -153,7 +172,7 @@ impl TimePlot {
 }
 
 impl Picture for TimePlot {
-    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> anyhow::Result<()>
+    fn paint<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>, out: &Path) -> Result<(), PlotError>
     where
         DB::ErrorType: 'static,
     {

@@ -13,10 +13,11 @@ use std::net::SocketAddr;
 pub struct Token(String);
 
 impl Token {
-    /// 128 random bits from the operating system, as hex.
-    pub fn random() -> anyhow::Result<Self> {
+    /// 128 random bits from the operating system, as hex; without a random source there is no token (and no
+    /// workbench: a guessable token guards nothing).
+    pub fn random() -> Result<Self, getrandom::Error> {
         let mut bytes = [0u8; 16];
-        getrandom::fill(&mut bytes).map_err(|e| anyhow::anyhow!("no random source for the token: {e}"))?;
+        getrandom::fill(&mut bytes)?;
         Ok(Self(bytes.iter().map(|b| format!("{b:02x}")).collect()))
     }
 

@@ -78,7 +78,7 @@ impl App {
 /// Serves the workbench until a signal; exits with 128 + its number (0 when the device thread ended first).
 pub fn run(options: Options) -> anyhow::Result<u8> {
     let signals = Signals::install()?;
-    let token = Token::random()?;
+    let token = Token::random().map_err(|e| anyhow::anyhow!("no random source for the token: {e}"))?;
     let rig = Platform::rig(options.platform.as_ref())?;
     // The address first: a port in use is said before anything else starts.
     let runtime = tokio::runtime::Builder::new_multi_thread()
