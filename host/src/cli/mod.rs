@@ -97,8 +97,9 @@ pub enum Command {
     /// Loads of a tool wrench on the five-DOF tool carrier (paper 003's projection method): drive forces and
     /// torques, the X guide's bearing load, the frame pivots' forces and the constraint couple.
     Reactions(ReactionsArgs),
-    /// Scans the workspace with all checks (in parallel), draws a section coloured by the limiting check, and
-    /// prints the section's area, the reachable ranges, the volume, and whether the spec ranges are inside.
+    /// Scans the workspace of a ring platform or the tool carrier with all its checks (in parallel), draws a section
+    /// (positions, or the two tilts) coloured by the limiting check, and prints the cells inside, the reachable
+    /// ranges, the volume, each axis's range at home, and whether the spec ranges are inside.
     Workspace(WorkspaceArgs),
     /// Motion cueing: vehicle telemetry (specific force, angular rates) to platform poses by the classical washout
     /// (translation high-passed, sustained force by tilt coordination, yaw by heading), every pose limited into the
@@ -425,6 +426,10 @@ pub struct PoseArgs {
     /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
     #[arg(long, allow_hyphen_values = true)]
     pub pose: Option<String>,
+    /// The tool carrier's dyad assemblies: `minus` (q2, q4 = theta - kappa, the preset's) or `plus` (theta + kappa)
+    /// for both dyads, `B,D` for each (`minus,plus`), or `all` to print the four.
+    #[arg(long, value_parser = crate::analysis::branches::parse, value_name = "minus|plus|B,D|all")]
+    pub branch: Option<crate::analysis::branches::Assembly>,
 }
 
 #[derive(Debug, Args)]
@@ -446,11 +451,15 @@ pub struct FkArgs {
     /// naming the check it fails).
     #[arg(long)]
     pub anywhere: bool,
+    /// The tool carrier's dyad assemblies the actuators were solved on (`ik --branch`): `minus`, `plus` or `B,D`.
+    /// The answer must take them (IK at it gives the actuators back).
+    #[arg(long, value_parser = crate::analysis::branches::parse, value_name = "minus|plus|B,D")]
+    pub branch: Option<crate::analysis::branches::Assembly>,
 }
 
 #[derive(Debug, Args)]
 pub struct WorkspaceArgs {
-    /// Geometry (a ring platform).
+    /// Geometry: a ring platform or the tool carrier (tool5-ex).
     #[arg(long, short, default_value = "trainer-model")]
     pub mechanism: String,
     /// Your own ring platform: a rig file (TOML), instead of --mechanism.

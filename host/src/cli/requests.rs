@@ -78,6 +78,7 @@ impl FkArgs {
             guess: self.guess.as_deref(),
             max_iterations: self.max_iterations,
             anywhere: self.anywhere,
+            assembly: self.branch,
         }
     }
 }
