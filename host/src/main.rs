@@ -79,8 +79,15 @@ fn main() -> ExitCode {
             out,
             derivatives,
             window,
+            from,
+            to,
         } => if *derivatives {
-            analysis::derivatives::plot_command(record, out, *window)
+            analysis::derivatives::plot_command(
+                record,
+                out,
+                *window,
+                (from.unwrap_or(f64::NEG_INFINITY), to.unwrap_or(f64::INFINITY)),
+            )
         } else {
             stream::record::plot_command(record, out)
         }

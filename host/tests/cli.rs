@@ -1403,6 +1403,34 @@ fn plot_derivatives_reads_velocity_and_acceleration_from_a_record() {
         assert_eq!(out.status.code(), Some(1), "{window}");
         assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1);
     }
+    // A stretch of it: a quarter period around the heave's zero crossing at 1 s holds its peak velocity, the
+    // stretch around its crest at 1.125 s does not; an empty span or one outside the record is refused.
+    let stretch = |from: &str, to: &str| {
+        ringpod()
+            .args([
+                "plot",
+                record.to_str().unwrap(),
+                "--derivatives",
+                "--out",
+                svg.to_str().unwrap(),
+            ])
+            .args(["--from", from, "--to", to])
+            .output()
+            .unwrap()
+    };
+    let crossing = String::from_utf8(stretch("0.95", "1.05").stdout).unwrap();
+    assert!(
+        crossing.contains("drawn and measured from 0.950 to 1.050 s (11 samples)"),
+        "{crossing}"
+    );
+    let (v, _) = peaks(&crossing, "heave z");
+    assert!((v / (0.01 * w) - 1.0).abs() < 0.01, "{crossing}");
+    let crest = String::from_utf8(stretch("1.11", "1.14").stdout).unwrap();
+    let (v, _) = peaks(&crest, "heave z");
+    assert!(v < 0.2 * 0.01 * w, "{crest}");
+    for (from, to) in [("2", "1"), ("10", "20"), ("nan", "1")] {
+        assert_eq!(stretch(from, to).status.code(), Some(1), "{from} {to}");
+    }
 }
 
 /// `stream --motion sine`: chapter 5.2's 18.8 Hz at 0.008 m/s and 25 Hz at 0.001 m/s run as asked (inside the

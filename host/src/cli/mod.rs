@@ -70,6 +70,13 @@ pub enum Command {
         /// With --derivatives: the window of the fit (s).
         #[arg(long, default_value_t = 0.05, requires = "derivatives")]
         window: f64,
+        /// With --derivatives: draw and measure from this device time on (s); the fit still uses the samples
+        /// around it, so a stretch of a fast oscillation shows its waveform.
+        #[arg(long, requires = "derivatives")]
+        from: Option<f64>,
+        /// With --derivatives: draw and measure up to this device time (s).
+        #[arg(long, requires = "derivatives")]
+        to: Option<f64>,
     },
     /// A live terminal view of the device from its telemetry: state, supplies and outputs, every input, each
     /// axis's position and switches, the counters and the tick cost. q, Esc or Ctrl-C ends it.
@@ -325,6 +332,10 @@ pub struct StreamArgs {
     /// (limited, refused, held). `ringpod plot FILE` draws it.
     #[arg(long, value_name = "FILE.csv")]
     pub record: Option<std::path::PathBuf>,
+    /// With --record: the device's telemetry rate for the run (1 to 2000 Hz, at most its control rate; 1000 is a
+    /// sample every tick of the model), set back to its own afterwards. A board stores the setting both times.
+    #[arg(long, requires = "record", value_parser = clap::value_parser!(u16).range(1..=2000))]
+    pub record_hz: Option<u16>,
     /// With --udp or --telemetry-udp: capture every datagram that arrives on the socket (from any sender, readable
     /// or not) to a pcap file, as tcpdump writes one, with its arrival time; `ringpod cue --input FILE.pcap` cues it
     /// again, Wireshark shows it.

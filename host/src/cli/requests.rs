@@ -183,6 +183,7 @@ impl StreamArgs {
                 home: self.home,
                 host_limits: !self.device_limits_only,
                 telemetry: false,
+                telemetry_hz: self.record_hz,
                 quiet: self.quiet,
             },
             record: self.record.clone(),

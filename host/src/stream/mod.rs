@@ -62,6 +62,9 @@ pub struct Options {
     pub quiet: bool,
     /// Keep the device's telemetry on for someone watching (the workbench); a record turns it on anyway.
     pub telemetry: bool,
+    /// The device's telemetry rate for this run (Hz, its `stream.telemetry_hz`; set back afterwards), so that a
+    /// record can be taken at the control rate; `None` keeps the device's.
+    pub telemetry_hz: Option<u16>,
 }
 
 /// A ring platform and its home pose.
@@ -73,8 +76,31 @@ struct Platform {
     home: [f64; 6],
 }
 
-/// Brings the device to `Ready`: hello, power up, home if needed. Errors here mean the stream never started.
-fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) -> Result<Status, ClientError> {
+/// Sets the device's telemetry rate (its stream section's `telemetry_hz`, a live setting) and returns the one it
+/// had, to set back after the run; `None` when it was the rate asked already.
+fn telemetry_rate<T: Transport>(client: &mut Client<T>, hz: u16) -> Result<Option<u16>, ClientError> {
+    let (Settings::Stream(mut stream), _) = client.settings(SettingsKind::Stream)? else {
+        return Err(ClientError::Unexpected(
+            "the device answered another settings section".into(),
+        ));
+    };
+    let before = stream.telemetry_hz;
+    if before == hz {
+        return Ok(None);
+    }
+    stream.telemetry_hz = hz;
+    client.set_settings(Settings::Stream(stream))?;
+    Ok(Some(before))
+}
+
+/// Brings the device to `Ready`: hello, the telemetry rate asked (the rate it had is returned), power up, home if
+/// needed. Errors here mean the stream never started.
+fn prepare<T: Transport>(
+    client: &mut Client<T>,
+    home: bool,
+    telemetry: bool,
+    telemetry_hz: Option<u16>,
+) -> Result<(Status, Option<u16>), ClientError> {
     let device = client.hello()?;
     if device.preset != Some(Preset::TrainerModel) {
         eprintln!(
@@ -82,6 +108,20 @@ fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) ->
             device.preset.map_or("a geometry of its own", |p| p.name())
         );
     }
+    let restore = match telemetry_hz {
+        Some(hz) => telemetry_rate(client, hz)?,
+        None => None,
+    };
+    let status = ready(client, home, telemetry);
+    if let (Err(_), Some(before)) = (&status, restore) {
+        // The stream never starts: leave the device's rate as it was.
+        let _ = telemetry_rate(client, before);
+    }
+    Ok((status?, restore))
+}
+
+/// Telemetry on if asked, power up, home if needed, and `Ready`.
+fn ready<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) -> Result<Status, ClientError> {
     if telemetry {
         // From here on: the record covers powering up and homing too.
         client.telemetry(true)?;
@@ -245,7 +285,12 @@ pub fn run<T: Transport>(
         Some((r, path)) => (Some(r), Some(path)),
         None => (None, None),
     };
-    let baseline = prepare(client, options.home, recorder.is_some() || options.telemetry)?;
+    let (baseline, restore_hz) = prepare(
+        client,
+        options.home,
+        recorder.is_some() || options.telemetry,
+        options.telemetry_hz,
+    )?;
     let envelope = device_envelope(client)?;
     let home = envelope.platform.home;
     let mut source = source;
@@ -279,7 +324,19 @@ pub fn run<T: Transport>(
     };
     // The samples of the stop and the ramp to rest.
     let _ = s.record();
-    let record = record_path.map(|path| record_report(&mut s, path));
+    let mut record = record_path.map(|path| record_report(&mut s, path));
+    // The device's own telemetry rate back (a board stores it): after the record has taken its last samples.
+    let rate_error = match restore_hz {
+        Some(before) if transport.is_none() => telemetry_rate(s.client, before).err(),
+        _ => None,
+    };
+    if let (Some(r), Some(e)) = (record.as_mut(), rate_error) {
+        r.error
+            .get_or_insert(format!("the device's telemetry rate was not set back: {e}"));
+    }
+    if let Some(r) = record.as_mut() {
+        r.telemetry_hz = options.telemetry_hz;
+    }
     let (status, transport) = match (status, transport) {
         (Some(st), None) => (Some(st), None),
         (None, None) => (None, Some("the device did not answer after the stop".to_string())),
@@ -419,6 +476,7 @@ fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordR
     RecordReport {
         path,
         rows,
+        telemetry_hz: None,
         dropped,
         error,
     }
