@@ -99,6 +99,16 @@ fn main() -> ExitCode {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),
+        C::Gram { z, step, out, table } => analysis::gram::run(&analysis::gram::Options {
+            z: *z,
+            step: *step,
+            out,
+            table: table.as_deref(),
+        })
+        .map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+            0
+        }),
         C::Workspace(args) => analysis::workspace::run(&args.options()).map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0

@@ -1736,3 +1736,31 @@ fn draw_the_tool_carrier_at_the_sources_third_example() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `ringpod gram`: paper 003's slice as a picture and a table (coarse here), its statistics printed; a step or a
+/// height out of range refused.
+#[test]
+fn gram_draws_and_tabulates_the_paper_slice() {
+    let dir = std::env::temp_dir().join(format!("ringpod-gram-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (svg, md) = (dir.join("gram.svg"), dir.join("gram.md"));
+    let out = ringpod()
+        .args(["gram", "--step", "0.01", "--out"])
+        .arg(&svg)
+        .arg("--table")
+        .arg(&md)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("slice z = -0.18 m, 40 x 40 cells of 10 mm"), "{text}");
+    assert!(std::fs::read_to_string(&svg)
+        .unwrap()
+        .contains("det G_C, constraint wrenches"));
+    let table = std::fs::read_to_string(&md).unwrap();
+    assert!(table.contains("| det G | all six |"), "{table}");
+    assert!(table.contains("det M_C = -0.29281, det G_C = 0.08574"), "{table}");
+    for bad in [&["--step", "0"][..], &["--step", "nan"], &["--z", "0.5"]] {
+        ringpod().arg("gram").args(bad).arg("--out").arg(&svg).assert().code(1);
+    }
+}

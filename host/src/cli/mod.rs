@@ -104,6 +104,23 @@ pub enum Command {
     /// Loads of a tool wrench on the five-DOF tool carrier (paper 003's projection method): drive forces and
     /// torques, the X guide's bearing load, the frame pivots' forces and the constraint couple.
     Reactions(ReactionsArgs),
+    /// Paper 003's figs. 3-5: the Gram determinants of its three-DOF translational mechanism's wrenches (constraint,
+    /// actuation, all) over a slice of its workspace, drawn as four maps (with the sign of det M_C) and written as
+    /// a markdown table.
+    Gram {
+        /// The slice's height (m).
+        #[arg(long, default_value_t = ringpod_core::screws::translational::SLICE_Z, allow_hyphen_values = true)]
+        z: f64,
+        /// The grid's step (m).
+        #[arg(long, default_value_t = 0.002)]
+        step: f64,
+        /// The picture: .png or .svg.
+        #[arg(long)]
+        out: std::path::PathBuf,
+        /// Also write the statistics and a table of values every 50 mm (markdown).
+        #[arg(long, value_name = "FILE.md")]
+        table: Option<std::path::PathBuf>,
+    },
     /// Scans the workspace of a ring platform or the tool carrier with all its checks (in parallel), draws a section
     /// (positions, or the two tilts) coloured by the limiting check, and prints the cells inside, the reachable
     /// ranges, the volume, each axis's range at home, and whether the spec ranges are inside.
