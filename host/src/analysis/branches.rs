@@ -9,6 +9,7 @@ use ringpod_core::kinematics::{Mechanism, Pose, ToolCarrier};
 use serde::Serialize;
 
 use crate::analysis::kinematics::Units;
+use crate::analysis::mechanism::AnyMechanism;
 use crate::error::CliError;
 
 /// Which assemblies `ik` solves for.
@@ -58,6 +59,25 @@ pub fn parse(text: &str) -> Result<Assembly, String> {
         }
         [b, d] => Ok(Assembly::One([branch(b)?, branch(d)?])),
         _ => Err("give `all`, one branch (minus or plus) or two (B side, D side: minus,plus)".into()),
+    }
+}
+
+/// The mechanism on the assembly asked: the tool carrier rebuilt on `One`; refused for a ring platform (its rods'
+/// branches are its geometry) and for `All` (the caller answers for one assembly).
+pub(crate) fn assembled(m: AnyMechanism, assembly: Option<Assembly>) -> Result<AnyMechanism, CliError> {
+    let refused = |reason: &str| CliError::BadNumbers {
+        what: "branch",
+        reason: reason.into(),
+    };
+    match (m, assembly) {
+        (m, None) => Ok(m),
+        (AnyMechanism::Tool(tool), Some(Assembly::One(b))) => Ok(AnyMechanism::Tool(Box::new(tool.with_branches(b)))),
+        (AnyMechanism::Tool(_), Some(Assembly::All)) => Err(refused(
+            "one assembly of the tool carrier's dyads here (minus, plus or B,D)",
+        )),
+        (AnyMechanism::Ring(_), Some(_)) => Err(refused(
+            "chooses the tool carrier's dyad assemblies (tool5-ex); a ring platform's rod branches are its geometry's",
+        )),
     }
 }
 

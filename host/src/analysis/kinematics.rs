@@ -227,25 +227,14 @@ pub fn ik(
     let Selected {
         name,
         home,
-        mechanism: mut m,
+        mechanism: m,
         ..
     } = Selected::of(common.mechanism, common.geometry)?;
     let pose = pose_arg(common, home, m.characteristic_length(), pose, "pose")?;
-    match (&m, assembly) {
-        (_, None) => {}
-        (AnyMechanism::Tool(tool), Some(Assembly::All)) => {
-            return Ok(Outcome::ok(branches::all(&name, tool, &pose, &units, common.json)?));
-        }
-        (AnyMechanism::Tool(tool), Some(Assembly::One(b))) => m = AnyMechanism::Tool(Box::new(tool.with_branches(b))),
-        (AnyMechanism::Ring(_), Some(_)) => {
-            return Err(CliError::BadNumbers {
-                what: "branch",
-                reason: "chooses the tool carrier's dyad assemblies (tool5-ex); a ring platform's rod branches \
-                         are its geometry's"
-                    .into(),
-            })
-        }
+    if let (AnyMechanism::Tool(tool), Some(Assembly::All)) = (&m, assembly) {
+        return Ok(Outcome::ok(branches::all(&name, tool, &pose, &units, common.json)?));
     }
+    let m = branches::assembled(m, assembly)?;
     let assembled = match &m {
         AnyMechanism::Tool(tool) => Some(tool.branches().map(branches::name)),
         AnyMechanism::Ring(_) => None,
@@ -360,19 +349,10 @@ pub fn fk(args: &FkOptions) -> Result<Outcome, CliError> {
     let Selected {
         name,
         home,
-        mechanism: mut m,
+        mechanism: m,
         ..
     } = Selected::of(common.mechanism, common.geometry)?;
-    match (&m, args.assembly) {
-        (_, None) => {}
-        (AnyMechanism::Tool(tool), Some(Assembly::One(b))) => m = AnyMechanism::Tool(Box::new(tool.with_branches(b))),
-        (_, Some(_)) => {
-            return Err(CliError::BadNumbers {
-                what: "branch",
-                reason: "fk takes one assembly of the tool carrier's dyads (minus, plus or B,D)".into(),
-            })
-        }
-    }
+    let m = branches::assembled(m, args.assembly)?;
     let raw = numbers::six("actuators", args.actuators)?;
     let axes = m.axes();
     let q = ringpod_core::kinematics::Actuators(std::array::from_fn(|i| match axes[i] {
