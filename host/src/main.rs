@@ -37,9 +37,19 @@ fn main() -> ExitCode {
                 seed,
             } => rig::design_command(file, *combined, *arms_only, *starts, *steps, *seed),
         }),
-        C::Ik(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), false)),
+        C::Ik(args) => answer(analysis::kinematics::ik(
+            &args.common.on(),
+            args.pose.as_deref(),
+            args.branch,
+            false,
+        )),
         C::Check(args) if args.tip_over => answer(analysis::tipover::run(&args.tip_over())),
-        C::Check(args) => answer(analysis::kinematics::ik(&args.common.on(), args.pose.as_deref(), true)),
+        C::Check(args) => answer(analysis::kinematics::ik(
+            &args.common.on(),
+            args.pose.as_deref(),
+            None,
+            true,
+        )),
         C::Fk(args) => answer(analysis::kinematics::fk(&args.options())),
         C::Rates(args) => answer(analysis::rates::run(&args.options())),
         C::Structure(args) => answer(analysis::structure::run(&args.options())),
@@ -70,8 +80,15 @@ fn main() -> ExitCode {
             out,
             derivatives,
             window,
+            from,
+            to,
         } => if *derivatives {
-            analysis::derivatives::plot_command(record, out, *window)
+            analysis::derivatives::plot_command(
+                record,
+                out,
+                *window,
+                (from.unwrap_or(f64::NEG_INFINITY), to.unwrap_or(f64::INFINITY)),
+            )
         } else {
             stream::record::plot_command(record, out)
         }
@@ -80,6 +97,16 @@ fn main() -> ExitCode {
             0
         }),
         C::Draw(args) => analysis::draw::run(&args.options()).map(|text| {
+            let _ = std::io::stdout().write_all(text.as_bytes());
+            0
+        }),
+        C::Gram { z, step, out, table } => analysis::gram::run(&analysis::gram::Options {
+            z: *z,
+            step: *step,
+            out,
+            table: table.as_deref(),
+        })
+        .map(|text| {
             let _ = std::io::stdout().write_all(text.as_bytes());
             0
         }),

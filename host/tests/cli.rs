@@ -225,8 +225,178 @@ fn workspace_scan_draws_and_reports() {
         .success();
     assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
     ringpod()
-        .args(["workspace", "-m", "tool5-ex", "--out"])
+        .args(["workspace", "--section", "rotations", "--z", "0.2", "--out"])
         .arg(dir.join("x.png"))
+        .assert()
+        .code(1);
+}
+
+/// The tool carrier's workspace: the same scan gives the same counts, its x range at home is the carriage's stroke,
+/// and the pose the source solves is inside while one past the stroke is not.
+#[test]
+fn tool_carrier_workspace_is_reproducible_and_bounded_by_its_stroke() {
+    let dir = std::env::temp_dir().join(format!("ringpod-tool-ws-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |section: &str| {
+        let out = ringpod()
+            .args([
+                "workspace",
+                "-m",
+                "tool5-ex",
+                "--section",
+                section,
+                "--cells",
+                "40",
+                "--quiet",
+                "--out",
+            ])
+            .arg(dir.join(format!("{section}.svg")))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let rotations = run("rotations");
+    assert_eq!(rotations, run("rotations"));
+    let count = |text: &str| -> usize {
+        let (_, after) = text.split_once("cells): ").unwrap();
+        after.split(' ').next().unwrap().parse().unwrap()
+    };
+    // Some but not all of the tilts: the dyads give out at large roll.
+    let inside = count(&rotations);
+    assert!(inside > 400 && inside < 1600, "{rotations}");
+    assert!(
+        rotations.contains("x at home within [-0.4999, 0.4999] m"),
+        "{rotations}"
+    );
+    assert!(rotations.contains("q1 in [-0.5, 0.5] m"), "{rotations}");
+    let xy = run("xy");
+    assert!(count(&xy) > 0, "{xy}");
+    assert!(std::fs::read_to_string(dir.join("xy.svg")).unwrap().contains("<svg"));
+    // The source's third example is inside; 0.55 m along x (or 0.45 m tilted 30 deg) is past the stroke.
+    ringpod()
+        .args([
+            "check",
+            "-m",
+            "tool5-ex",
+            "--degrees",
+            "--pose=0,0,0.4,15.2167,25.3333,0",
+        ])
+        .assert()
+        .code(0);
+    for pose in ["--pose=0.55,0,0.4,0,0,0", "--pose=0.45,0,0.4,0,30,0"] {
+        ringpod()
+            .args(["check", "-m", "tool5-ex", "--degrees", pose])
+            .assert()
+            .code(3)
+            .stdout(predicate::str::contains("FAIL reach"));
+    }
+    ringpod()
+        .args(["workspace", "-m", "tool5-ex", "--cells", "5", "--out"])
+        .arg(dir.join("x.svg"))
+        .assert()
+        .code(1);
+}
+
+/// `ik --branch`: the four assemblies of the tool carrier's dyads at the source's third example, each the source's
+/// `q2` / `q2'` and `q4` / `q4'`; each closes back to the pose by `fk`, and the branches differ.
+#[test]
+fn tool_carrier_branches_round_trip_and_differ() {
+    let pose = "--pose=0,0,0.4,15.2167,25.3333,0";
+    let all = json(&["ik", "-m", "tool5-ex", "--degrees", pose, "--branch", "all", "--json"]);
+    let rows = all["assemblies"].as_array().unwrap();
+    assert_eq!(rows.len(), 4);
+    let q = |row: &serde_json::Value| -> Vec<f64> {
+        row["actuators"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    // The source's minutes: q2 65 deg 01' or 134 deg 08', q4 34 deg 22' or 169 deg 22'.
+    let want = [
+        (65.026, 34.359),
+        (65.026, 169.341),
+        (134.131, 34.359),
+        (134.131, 169.341),
+    ];
+    for (row, (q2, q4)) in rows.iter().zip(want) {
+        let q = q(row);
+        assert!((q[1] - q2).abs() < 2e-3 && (q[3] - q4).abs() < 2e-3, "{row}");
+        assert_eq!(row["all_pass"], true);
+        let actuators: Vec<String> = q.iter().map(|v| format!("{v:.9}")).collect();
+        let fk = json(&[
+            "fk",
+            "-m",
+            "tool5-ex",
+            "--degrees",
+            &format!("--actuators={}", actuators.join(",")),
+            "--guess=0.01,0.01,0.41,14,24,0",
+            &format!(
+                "--branch={}",
+                row["branches"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|b| b.as_str().unwrap())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
+            "--json",
+        ]);
+        let got: Vec<f64> = fk["pose"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        for (g, w) in got.iter().zip([0.0, 0.0, 0.4, 15.2167, 25.3333, 0.0]) {
+            assert!((g - w).abs() < 1e-6, "{row}: fk {got:?}");
+        }
+    }
+    assert_ne!(q(&rows[0]), q(&rows[3]));
+    // One assembly by name, the same as its row of `all`.
+    let one = json(&[
+        "ik",
+        "-m",
+        "tool5-ex",
+        "--degrees",
+        pose,
+        "--branch",
+        "plus,minus",
+        "--json",
+    ]);
+    assert_eq!(one["branches"], serde_json::json!(["plus", "minus"]));
+    let got: Vec<f64> = one["actuators"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert_eq!(got, q(&rows[2]));
+    // The default is the preset's (minus, minus).
+    let default = json(&["ik", "-m", "tool5-ex", "--degrees", pose, "--json"]);
+    assert_eq!(default["branches"], serde_json::json!(["minus", "minus"]));
+    ringpod().args(["ik", "--branch", "plus"]).assert().code(1);
+    ringpod()
+        .args(["ik", "-m", "tool5-ex", "--branch", "up"])
+        .assert()
+        .code(2);
+    ringpod()
+        .args(["ik", "-m", "tool5-ex", "--branch", "plus,minus,plus"])
+        .assert()
+        .code(2);
+    // FK on the preset's assembly refuses actuators of another one, and answers for one assembly only.
+    let other: Vec<String> = q(&rows[3]).iter().map(|v| format!("{v:.9}")).collect();
+    ringpod()
+        .args(["fk", "-m", "tool5-ex", "--degrees", "--guess=0,0,0.4,15,25,0"])
+        .arg(format!("--actuators={}", other.join(",")))
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("other branches"));
+    ringpod()
+        .args(["fk", "-m", "tool5-ex", "--actuators=0,1,1,1,0,1", "--branch", "all"])
         .assert()
         .code(1);
 }
@@ -1233,6 +1403,34 @@ fn plot_derivatives_reads_velocity_and_acceleration_from_a_record() {
         assert_eq!(out.status.code(), Some(1), "{window}");
         assert_eq!(String::from_utf8(out.stderr).unwrap().lines().count(), 1);
     }
+    // A stretch of it: a quarter period around the heave's zero crossing at 1 s holds its peak velocity, the
+    // stretch around its crest at 1.125 s does not; an empty span or one outside the record is refused.
+    let stretch = |from: &str, to: &str| {
+        ringpod()
+            .args([
+                "plot",
+                record.to_str().unwrap(),
+                "--derivatives",
+                "--out",
+                svg.to_str().unwrap(),
+            ])
+            .args(["--from", from, "--to", to])
+            .output()
+            .unwrap()
+    };
+    let crossing = String::from_utf8(stretch("0.95", "1.05").stdout).unwrap();
+    assert!(
+        crossing.contains("drawn and measured from 0.950 to 1.050 s (11 samples)"),
+        "{crossing}"
+    );
+    let (v, _) = peaks(&crossing, "heave z");
+    assert!((v / (0.01 * w) - 1.0).abs() < 0.01, "{crossing}");
+    let crest = String::from_utf8(stretch("1.11", "1.14").stdout).unwrap();
+    let (v, _) = peaks(&crest, "heave z");
+    assert!(v < 0.2 * 0.01 * w, "{crest}");
+    for (from, to) in [("2", "1"), ("10", "20"), ("nan", "1")] {
+        assert_eq!(stretch(from, to).status.code(), Some(1), "{from} {to}");
+    }
 }
 
 /// `stream --motion sine`: chapter 5.2's 18.8 Hz at 0.008 m/s and 25 Hz at 0.001 m/s run as asked (inside the
@@ -1591,4 +1789,32 @@ fn rig_design_moves_only_the_elbow_arms_when_asked() {
             "chains: designing the arms alone needs elbow chains",
         ));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `ringpod gram`: paper 003's slice as a picture and a table (coarse here), its statistics printed; a step or a
+/// height out of range refused.
+#[test]
+fn gram_draws_and_tabulates_the_paper_slice() {
+    let dir = std::env::temp_dir().join(format!("ringpod-gram-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (svg, md) = (dir.join("gram.svg"), dir.join("gram.md"));
+    let out = ringpod()
+        .args(["gram", "--step", "0.01", "--out"])
+        .arg(&svg)
+        .arg("--table")
+        .arg(&md)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("slice z = -0.18 m, 40 x 40 cells of 10 mm"), "{text}");
+    assert!(std::fs::read_to_string(&svg)
+        .unwrap()
+        .contains("det G_C, constraint wrenches"));
+    let table = std::fs::read_to_string(&md).unwrap();
+    assert!(table.contains("| det G | all six |"), "{table}");
+    assert!(table.contains("det M_C = -0.29281, det G_C = 0.08574"), "{table}");
+    for bad in [&["--step", "0"][..], &["--step", "nan"], &["--z", "0.5"]] {
+        ringpod().arg("gram").args(bad).arg("--out").arg(&svg).assert().code(1);
+    }
 }

@@ -1141,3 +1141,164 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
     assert!(shown.contains("ring_radius = 0.3\n"), "{shown}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Kills the simulator when the test ends, passed or failed.
+struct Simulator(std::process::Child);
+
+impl Drop for Simulator {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// A record's device times and states.
+fn record_rows(path: &std::path::Path) -> Vec<(f64, String)> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[1].parse().unwrap(), f[20].to_owned())
+        })
+        .collect()
+}
+
+/// Rows a second of device time, and the device time of the first `Running` row.
+fn rate_and_start(rows: &[(f64, String)]) -> (f64, f64) {
+    let span = rows[rows.len() - 1].0 - rows[0].0;
+    let start = rows.iter().find(|(_, s)| s == "Running").unwrap().0;
+    ((rows.len() - 1) as f64 / span, start)
+}
+
+/// `stream --record-hz 1000`: a row every millisecond of device time (the default: every 10 ms), and chapter 5.2's
+/// 18.8 Hz heave at 0.008 m/s read back from it by `plot --derivatives` over a 5 ms window at 0.008 m/s times the
+/// window's stated attenuation `1 - (pi w f)^2 / 10` (0.9913), within 1 %; a 100 Hz record cannot (5 samples a
+/// period). Over a board's link (the simulator on a pty) a record at 200 Hz, and the device's own rate set back
+/// afterwards.
+#[test]
+fn a_record_at_the_control_rate_reads_the_18_8_hz_experiment() {
+    let dir = std::env::temp_dir().join(format!("ringpod-1khz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sine = [
+        "--motion",
+        "sine",
+        "--axis",
+        "z",
+        "--frequency",
+        "18.8",
+        "--velocity-amplitude",
+        "0.008",
+    ];
+    let run = |record: &std::path::Path, extra: &[&str]| {
+        let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(["stream", "--sim", "--fast", "--quiet", "--duration", "4"])
+            .args(sine)
+            .arg("--record")
+            .arg(record)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let fast = dir.join("1khz.csv");
+    let said = run(&fast, &["--record-hz", "1000"]);
+    assert!(said.contains(" at 1000 Hz (0 dropped)"), "{said}");
+    assert!(
+        said.contains("velocity 0.008000 m/s") && said.contains("(as asked"),
+        "{said}"
+    );
+    let rows = record_rows(&fast);
+    let (rate, start) = rate_and_start(&rows);
+    assert!((rate - 1000.0).abs() < 0.5, "{rate} rows a second");
+    // Consecutive rows one tick apart, every one.
+    assert!(rows.windows(2).all(|w| ((w[1].0 - w[0].0) - 0.001).abs() < 1e-6));
+    let slow = dir.join("100hz.csv");
+    run(&slow, &[]);
+    let (rate, _) = rate_and_start(&record_rows(&slow));
+    assert!((rate - 100.0).abs() < 0.5, "{rate} rows a second by default");
+    // The full amplitude: 1 s after the ease-in, 1 s before the ease-out.
+    let (from, to) = (format!("{:.3}", start + 1.2), format!("{:.3}", start + 2.8));
+    let plot = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .arg("plot")
+        .arg(&fast)
+        .args([
+            "--derivatives",
+            "--window",
+            "0.005",
+            "--from",
+            &from,
+            "--to",
+            &to,
+            "--out",
+        ])
+        .arg(dir.join("va.svg"))
+        .output()
+        .unwrap();
+    assert!(plot.status.success(), "{}", String::from_utf8_lossy(&plot.stderr));
+    let summary = String::from_utf8(plot.stdout).unwrap();
+    let line = summary.lines().find(|l| l.starts_with("heave z")).unwrap();
+    let words: Vec<f64> = line["heave z".len()..]
+        .split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    let x = std::f64::consts::PI * 0.005 * 18.8;
+    let (v, a) = (words[0], words[1]);
+    assert!(
+        (v / (0.008 * (1.0 - x * x / 10.0)) - 1.0).abs() < 0.01,
+        "{v}\n{summary}"
+    );
+    let a_asked = 0.008 * std::f64::consts::TAU * 18.8;
+    assert!(
+        (a / (a_asked * (1.0 - x * x / 14.0)) - 1.0).abs() < 0.02,
+        "{a}\n{summary}"
+    );
+
+    // On a board's link: the rate is the device's setting, set for the run and back after it.
+    let (server, path) = simulator_on_a_pty();
+    let _simulator = Simulator(server);
+    let exe = assert_cmd::cargo::cargo_bin("ringpod");
+    let on_port = dir.join("port.csv");
+    let out = std::process::Command::new(&exe)
+        .args([
+            "stream",
+            "--port",
+            &path,
+            "--quiet",
+            "--motion",
+            "heave",
+            "--duration",
+            "0.3",
+        ])
+        .arg("--record")
+        .arg(&on_port)
+        .args(["--record-hz", "200"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (rate, _) = rate_and_start(&record_rows(&on_port));
+    assert!((rate - 200.0).abs() < 0.5, "{rate} rows a second");
+    let config = std::process::Command::new(&exe)
+        .args(["device", "config", "get", "stream.telemetry_hz", "--port", &path])
+        .output()
+        .unwrap();
+    assert!(
+        String::from_utf8_lossy(&config.stdout).contains("\"value\": 100"),
+        "{}",
+        String::from_utf8_lossy(&config.stdout)
+    );
+    // Without --record it is refused; beyond 2000 Hz too.
+    for extra in [
+        &["--record-hz", "1000"][..],
+        &["--record", "x.csv", "--record-hz", "5000"],
+    ] {
+        let out = std::process::Command::new(&exe)
+            .args(["stream", "--sim", "--fast", "--quiet", "--motion", "heave"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{extra:?}");
+    }
+}

@@ -108,6 +108,22 @@ proptest! {
         round_trip(&tool(), &pose, e)?;
     }
 
+    /// Every assembly of the tool carrier's dyads closes the pose it was solved for (FK from near it returns it),
+    /// and the branches differ in the dyad's drive unless that dyad is stretched straight.
+    #[test]
+    fn tool_every_assembly_round_trips(pose in tool_pose(), e in offsets()) {
+        use ringpod_core::kinematics::geometry::Branch::{Minus, Plus};
+        for branches in [[Minus, Minus], [Minus, Plus], [Plus, Minus], [Plus, Plus]] {
+            round_trip(&tool().with_branches(branches), &pose, e)?;
+        }
+        if let (Ok(minus), Ok(plus)) = (tool().inverse(&pose), tool().with_branches([Plus, Plus]).inverse(&pose)) {
+            for drive in [1, 3] {
+                prop_assert!((minus.0[drive] - plus.0[drive]).abs() > 1e-6, "q{} {minus:?} {plus:?}", drive + 1);
+            }
+            prop_assert_eq!(minus.0[0], plus.0[0]);
+        }
+    }
+
     /// IK solutions satisfy the constraint equations the FK and the Jacobians are built on.
     #[test]
     fn ik_solutions_zero_the_residuals(pose in trainer_pose(), rp in rotopod_pose(), tp in tool_pose()) {

@@ -259,3 +259,41 @@ fn home_checks_report_margins() {
     assert!(report.passes(Check::Reach) && report.passes(Check::JointCones) && report.passes(Check::Stability));
     assert!(report.singularity_index > 0.0 && report.singularity_index <= 1.0);
 }
+
+/// The four assemblies (each dyad on either branch) at the source's third example: `q2` from the B-side branch and
+/// `q4` from the D-side one, whatever the other dyad takes, and the drives the dyads share equal.
+#[test]
+fn tool5_mixed_branches_take_each_dyads_own() {
+    let reference: ToolFile = load("tool5-ex.json");
+    let case = &reference.cases[2];
+    let pose = Pose::new(case.x / 1e3, case.y / 1e3, case.z / 1e3, case.alpha, case.beta, 0.0);
+    let base = ToolCarrier::<f64>::new(&presets::TOOL5_EX);
+    for (kb, b) in [Branch::Minus, Branch::Plus].into_iter().enumerate() {
+        for (kd, d) in [Branch::Minus, Branch::Plus].into_iter().enumerate() {
+            let m = base.with_branches([b, d]);
+            assert_eq!(m.branches(), [b, d]);
+            let q = m.inverse(&pose).unwrap();
+            assert!((q.0[1].to_degrees() - case.q2[kb]).abs() <= reference.tolerance_deg);
+            assert!((q.0[3].to_degrees() - case.q4[kd]).abs() <= reference.tolerance_deg);
+            assert!((q.0[0] * 1e3 - case.q1).abs() <= reference.tolerance_mm);
+        }
+    }
+}
+
+/// The X carriage's stroke (`+-0.5` m, assumed) bounds `q1 = x + L1 sin(beta)`: the reach check fails past it,
+/// and a tilt moves the carriage as much as the tool.
+#[test]
+fn tool5_stroke_bounds_the_carriage() {
+    let m = ToolCarrier::<f64>::new(&presets::TOOL5_EX);
+    let at = |x: f64, beta: f64| m.inverse_checked(&Pose::new(x, 0.0, 0.4, 0.0, beta, 0.0)).unwrap().1;
+    let inside = at(0.45, 0.0);
+    assert!(inside.all_pass());
+    assert!((inside.margin(Check::Reach).unwrap() - 0.05).abs() < 1e-12);
+    let past = at(0.55, 0.0);
+    assert_eq!(past.first_failure(), Some(Check::Reach));
+    assert!((past.margin(Check::Reach).unwrap() + 0.05).abs() < 1e-12);
+    // q1 = 0.45 + 0.3 sin(30 deg) = 0.6: out, though x alone is inside.
+    assert_eq!(at(0.45, 30f64.to_radians()).first_failure(), Some(Check::Reach));
+    assert!(at(-0.45, 0.0).all_pass());
+    assert_eq!(at(-0.55, 0.0).first_failure(), Some(Check::Reach));
+}

@@ -251,3 +251,138 @@ mod paper_003 {
         );
     }
 }
+
+mod paper_003_slice {
+    //! The translational mechanism placed by its assumed layout (`screws::translational`), and the Gram
+    //! determinants of paper 003's figs. 3-5.
+
+    use nalgebra::Vector3;
+    use proptest::prelude::*;
+    use ringpod_core::screws::translational::{chain, gram, TranslationalError, MIXED, SLICE_Z};
+
+    use super::DEG;
+
+    /// SCREWS.md 4, T5: the layout and the mixed assembly give the paper's worked pose, its actuator angles and
+    /// joints.
+    #[test]
+    fn t5_the_worked_pose_from_the_layout() {
+        let f = Vector3::new(-0.25, -0.12, -0.18);
+        let theta = [-157.2695, -175.4759, -290.4576];
+        let joints = [
+            [
+                [-0.5, 0.0773, -0.1845],
+                [-0.55, 0.0025, -0.0059],
+                [-0.55, 0.0797, -0.1903],
+            ],
+            [
+                [-0.1994, -0.5, 0.0158],
+                [-0.0166, -0.42, 0.0013],
+                [-0.216, -0.42, 0.0171],
+            ],
+            [
+                [-0.1874, 0.0699, -0.5],
+                [-0.0009, 0.0004, -0.48],
+                [-0.1883, 0.0703, -0.48],
+            ],
+        ];
+        for i in 0..3 {
+            let c = chain(i, &f, MIXED[i]).unwrap();
+            let turn = (c.theta / DEG - theta[i]).rem_euclid(360.0);
+            assert!(turn.min(360.0 - turn) < 1e-3, "theta {i}: {}", c.theta / DEG);
+            for (k, want) in joints[i].iter().enumerate() {
+                let got = c.joints[k + 1];
+                for a in 0..3 {
+                    assert!(
+                        (got[a] - want[a]).abs() < 1e-4,
+                        "chain {i} joint {k}: {got} vs {want:?}"
+                    );
+                }
+            }
+            // Every link its length, E's axis through F.
+            let j = c.joints;
+            for (p, q, l) in [(0, 1, 0.2), (1, 2, 0.2), (2, 3, 0.2), (3, 4, 0.2)] {
+                assert!(((j[q] - j[p]).norm() - l).abs() < 1e-12);
+            }
+            assert!(((f - j[4]).norm() - 0.3).abs() < 1e-12);
+        }
+        let g = gram(&f, MIXED).unwrap();
+        assert!((g.det_mc + 0.29281).abs() < 1e-4, "{}", g.det_mc);
+        assert!((g.constraints - 0.29281f64.powi(2)).abs() < 1e-4, "{}", g.constraints);
+    }
+
+    #[test]
+    fn points_out_of_reach_are_refused() {
+        // cos(alpha) = (F_x + 0.2) / 0.2 > 1 past x = 0.
+        assert_eq!(
+            gram(&Vector3::new(0.05, -0.1, SLICE_Z), MIXED),
+            Err(TranslationalError::Unreachable(0))
+        );
+        assert_eq!(
+            gram(&Vector3::new(-0.2, 0.05, SLICE_Z), MIXED),
+            Err(TranslationalError::Unreachable(1))
+        );
+        assert_eq!(
+            gram(&Vector3::new(f64::NAN, -0.1, SLICE_Z), MIXED),
+            Err(TranslationalError::NonFinite)
+        );
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
+
+        /// Over the slice: `det G_C = det M_C^2`; each determinant of unit wrenches in [0, 1] (Hadamard); and
+        /// `det G <= det G_C det G_A` (Fischer), so `G` is singular wherever `G_C` is.
+        #[test]
+        fn the_slices_determinants_keep_their_invariants(x in -0.4..0.0f64, y in -0.4..0.0f64) {
+            if let Ok(g) = gram(&Vector3::new(x, y, SLICE_Z), MIXED) {
+                prop_assert!((g.constraints - g.det_mc * g.det_mc).abs() < 1e-12, "{g:?}");
+                for d in [g.constraints, g.actuation, g.all] {
+                    prop_assert!((-1e-12..=1.0 + 1e-12).contains(&d), "{g:?}");
+                }
+                prop_assert!(g.all <= g.constraints * g.actuation + 1e-12, "{g:?}");
+            }
+        }
+    }
+
+    /// Where `det M_C` changes sign on the slice (a constraint singularity, `tan t1 tan t2 tan t3 = 1`), `det G_C`
+    /// and `det G` vanish: bisected along rows of the paper's 2 mm grid, the first twenty crossings.
+    #[test]
+    fn both_vanish_at_the_constraint_singularity() {
+        let at = |x: f64, y: f64| gram(&Vector3::new(x, y, SLICE_Z), MIXED).ok();
+        let mut found = 0;
+        for row in 0..200 {
+            let y = -0.399 + 0.002 * row as f64;
+            for col in 0..199 {
+                let (x0, x1) = (-0.399 + 0.002 * col as f64, -0.397 + 0.002 * col as f64);
+                let (Some(g0), Some(g1)) = (at(x0, y), at(x1, y)) else {
+                    continue;
+                };
+                if g0.det_mc.signum() == g1.det_mc.signum() || found >= 20 {
+                    continue;
+                }
+                let (mut lo, mut hi) = (x0, x1);
+                for _ in 0..60 {
+                    let mid = 0.5 * (lo + hi);
+                    let Some(g) = at(mid, y) else { break };
+                    if g.det_mc.signum() == g0.det_mc.signum() {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let g = at(lo, y).unwrap();
+                // Zero to rounding (a determinant of unit vectors by LU: a few ulps of 1).
+                assert!(g.det_mc.abs() < 1e-12, "at ({lo}, {y}): {g:?}");
+                assert!(
+                    g.constraints.abs() < 1e-14 && g.all.abs() < 1e-14,
+                    "at ({lo}, {y}): {g:?}"
+                );
+                found += 1;
+            }
+        }
+        assert!(
+            found >= 5,
+            "{found} crossings of the constraint singularity on the slice"
+        );
+    }
+}

@@ -80,9 +80,18 @@ fn ring_geometry_errors() {
 #[test]
 fn tool_geometry_errors() {
     let t = presets::TOOL5_EX;
-    let new = |l2: f64, b: [f64; 3], d: [f64; 3]| {
-        ToolGeometry::new("t", t.l1, l2, t.l3, t.a, t.b, b, d, [Branch::Minus; 2], 0.02).map(|_| ())
+    let with_stroke = |l2: f64, b: [f64; 3], d: [f64; 3], stroke: [f64; 2]| {
+        ToolGeometry::new("t", t.l1, l2, t.l3, t.a, t.b, b, d, [Branch::Minus; 2], stroke, 0.02).map(|_| ())
     };
+    let new = |l2: f64, b: [f64; 3], d: [f64; 3]| with_stroke(l2, b, d, t.stroke);
+    assert_eq!(
+        with_stroke(0.33, t.pivot_b, t.pivot_d, [0.2, 0.2]),
+        Err(GeometryError::BadLimits)
+    );
+    assert_eq!(
+        with_stroke(0.33, t.pivot_b, t.pivot_d, [-0.2, f64::INFINITY]),
+        Err(GeometryError::NonFinite)
+    );
     assert_eq!(new(0.33, t.pivot_b, t.pivot_d), Ok(()));
     assert_eq!(new(0.0, t.pivot_b, t.pivot_d), Err(GeometryError::NonPositiveLength));
     assert_eq!(new(0.33, t.pivot_b, t.pivot_b), Err(GeometryError::CoincidentPoints));

@@ -56,20 +56,45 @@ pub fn local_quadratic(t: &[f64], y: &[f64], window: f64) -> Vec<(f64, f64)> {
     out
 }
 
+/// The sample times drawn.
+struct Span {
+    t: Vec<f64>,
+}
+
 const AXES: [&str; 6] = ["surge x", "sway y", "heave z", "roll alpha", "pitch beta", "yaw gamma"];
 
-/// Draws the derivatives of a record's followed pose; returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path, window: f64) -> anyhow::Result<String> {
+/// Draws the derivatives of a record's followed pose over the device times `span` (`[from, to]`, s; the fit takes
+/// the samples around its ends too); returns the summary to print.
+pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> anyhow::Result<String> {
     if !(window.is_finite() && window > 0.0 && window <= 10.0) {
         anyhow::bail!("--window: {window} s; a window is more than 0 and at most 10 s");
     }
-    let run = record::read(input)?;
-    let derivatives: Vec<Vec<(f64, f64)>> = (0..6)
+    if span.0.is_nan() || span.1.is_nan() || span.0 >= span.1 {
+        anyhow::bail!("--from {} --to {}: the span is empty", span.0, span.1);
+    }
+    let whole = record::read(input)?;
+    let all: Vec<Vec<(f64, f64)>> = (0..6)
         .map(|k| {
-            let y: Vec<f64> = run.target.iter().map(|p| p[k]).collect();
-            local_quadratic(&run.t, &y, window)
+            let y: Vec<f64> = whole.target.iter().map(|p| p[k]).collect();
+            local_quadratic(&whole.t, &y, window)
         })
         .collect();
+    // The samples inside the span: drawn and measured.
+    let inside: Vec<usize> = (0..whole.t.len())
+        .filter(|&i| whole.t[i] >= span.0 && whole.t[i] <= span.1)
+        .collect();
+    if inside.len() < 2 {
+        anyhow::bail!(
+            "--from/--to: {} of the record's samples (device time {:.3} to {:.3} s) are in the span",
+            inside.len(),
+            whole.t[0],
+            whole.t[whole.t.len() - 1]
+        );
+    }
+    let run = Span {
+        t: inside.iter().map(|&i| whole.t[i]).collect(),
+    };
+    let derivatives: Vec<Vec<(f64, f64)>> = all.iter().map(|d| inside.iter().map(|&i| d[i]).collect()).collect();
     let colours = [BLUE, RED, GREEN];
     let series = |axes: std::ops::Range<usize>, second: bool| -> Vec<Series> {
         axes.enumerate()
@@ -106,12 +131,13 @@ pub fn plot_command(input: &Path, out: &Path, window: f64) -> anyhow::Result<Str
         ],
     };
     plot::save(out, (1100, 1200), &picture)?;
-    let per = (run.t.len() as f64 - 1.0) / (run.t[run.t.len() - 1] - run.t[0]).max(f64::MIN_POSITIVE);
+    let per = (whole.t.len() as f64 - 1.0) / (whole.t[whole.t.len() - 1] - whole.t[0]).max(f64::MIN_POSITIVE);
     let mut text = format!(
-        "{} rows over {:.3} s of device time; derivatives of the followed pose by a least-squares quadratic over \
-         {:.0} ms around each sample (about {:.0} samples); picture: {}\n",
-        run.t.len(),
-        run.t[run.t.len() - 1] - run.t[0],
+        "{} rows over {:.3} s of device time ({:.1} a second); derivatives of the followed pose by a least-squares \
+         quadratic over {:.0} ms around each sample (about {:.0} samples); picture: {}\n",
+        whole.t.len(),
+        whole.t[whole.t.len() - 1] - whole.t[0],
+        per,
         window * 1e3,
         2.0 * (per * window / 2.0 + 1e-9).floor() + 1.0,
         out.display()
@@ -122,6 +148,15 @@ pub fn plot_command(input: &Path, out: &Path, window: f64) -> anyhow::Result<Str
          window): the velocity within 1 % up to {:.1} Hz",
         0.1 / window
     );
+    if inside.len() < whole.t.len() {
+        let _ = writeln!(
+            text,
+            "drawn and measured from {:.3} to {:.3} s ({} samples)",
+            run.t[0],
+            run.t[run.t.len() - 1],
+            inside.len()
+        );
+    }
     let _ = writeln!(text, "axis        peak |velocity|  peak |acceleration|");
     for (k, d) in derivatives.iter().enumerate() {
         let peak = |f: fn(&(f64, f64)) -> f64| {

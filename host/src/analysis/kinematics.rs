@@ -9,6 +9,7 @@ use ringpod_core::kinematics::{
 };
 use serde::Serialize;
 
+use crate::analysis::branches::{self, Assembly};
 use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
 use crate::input::numbers;
@@ -38,6 +39,8 @@ pub struct FkOptions<'a> {
     pub max_iterations: u8,
     /// Accept a solution outside the workspace checks.
     pub anywhere: bool,
+    /// The tool carrier's dyad assemblies (`All` is refused: FK answers for one).
+    pub assembly: Option<Assembly>,
 }
 
 /// `loads`: statics at a pose, or inverse dynamics along a motion file.
@@ -57,8 +60,8 @@ pub struct LoadsOptions<'a> {
 }
 
 /// Angle conversion for `--degrees`.
-struct Units {
-    degrees: bool,
+pub(crate) struct Units {
+    pub(crate) degrees: bool,
 }
 
 impl Units {
@@ -76,7 +79,7 @@ impl Units {
             v
         }
     }
-    fn angle_unit(&self) -> &'static str {
+    pub(crate) fn angle_unit(&self) -> &'static str {
         if self.degrees {
             "deg"
         } else {
@@ -87,17 +90,17 @@ impl Units {
     fn pose_in(&self, v: [f64; 6]) -> Pose<f64> {
         Pose::from_array(std::array::from_fn(|i| if i < 3 { v[i] } else { self.angle_in(v[i]) }))
     }
-    fn pose_out(&self, p: &Pose<f64>) -> [f64; 6] {
+    pub(crate) fn pose_out(&self, p: &Pose<f64>) -> [f64; 6] {
         let v = p.to_array();
         std::array::from_fn(|i| if i < 3 { v[i] } else { self.angle_out(v[i]) })
     }
-    fn axis_unit(&self, kind: AxisKind) -> &'static str {
+    pub(crate) fn axis_unit(&self, kind: AxisKind) -> &'static str {
         match kind {
             AxisKind::Linear => "m",
             AxisKind::Ring | AxisKind::Angle => self.angle_unit(),
         }
     }
-    fn axis_out(&self, kind: AxisKind, v: f64) -> f64 {
+    pub(crate) fn axis_out(&self, kind: AxisKind, v: f64) -> f64 {
         match kind {
             AxisKind::Linear => v,
             AxisKind::Ring | AxisKind::Angle => self.angle_out(v),
@@ -167,6 +170,9 @@ struct IkJson<'a> {
     singularity_index: f64,
     singularity: &'static str,
     all_pass: bool,
+    /// The tool carrier's dyad assemblies (B side, D side).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    branches: Option<[&'static str; 2]>,
 }
 
 fn checks_json(report: &WorkspaceReport<f64>, units: &Units) -> Vec<CheckJson> {
@@ -208,7 +214,13 @@ pub(crate) fn pose_arg(
     Ok(pose)
 }
 
-pub fn ik(common: &On, pose: Option<&str>, exit_on_failed_check: bool) -> Result<Outcome, CliError> {
+/// `ik` and `check`: the actuators at a pose and its checks; `assembly` chooses the tool carrier's dyad branches.
+pub fn ik(
+    common: &On,
+    pose: Option<&str>,
+    assembly: Option<Assembly>,
+    exit_on_failed_check: bool,
+) -> Result<Outcome, CliError> {
     let units = Units {
         degrees: common.degrees,
     };
@@ -219,6 +231,14 @@ pub fn ik(common: &On, pose: Option<&str>, exit_on_failed_check: bool) -> Result
         ..
     } = Selected::of(common.mechanism, common.geometry)?;
     let pose = pose_arg(common, home, m.characteristic_length(), pose, "pose")?;
+    if let (AnyMechanism::Tool(tool), Some(Assembly::All)) = (&m, assembly) {
+        return Ok(Outcome::ok(branches::all(&name, tool, &pose, &units, common.json)?));
+    }
+    let m = branches::assembled(m, assembly)?;
+    let assembled = match &m {
+        AnyMechanism::Tool(tool) => Some(tool.branches().map(branches::name)),
+        AnyMechanism::Ring(_) => None,
+    };
     let (q, report) = m.inverse_checked(&pose).map_err(|reason| match (&m, reason) {
         (AnyMechanism::Ring(r), KinematicsError::Unreachable { .. }) => CliError::OutOfReach {
             reason,
@@ -246,6 +266,7 @@ pub fn ik(common: &On, pose: Option<&str>, exit_on_failed_check: bool) -> Result
             singularity_index: report.singularity_index,
             singularity: singularity_name(singularity),
             all_pass: report.all_pass(),
+            branches: assembled,
         };
         serde_json::to_string_pretty(&out)? + "\n"
     } else {
@@ -258,6 +279,9 @@ pub fn ik(common: &On, pose: Option<&str>, exit_on_failed_check: bool) -> Result
             shown.join(", "),
             units.angle_unit()
         );
+        if let Some([b, d]) = assembled {
+            let _ = writeln!(t, "dyad branches: B side {b}, D side {d} (--branch all shows the four)");
+        }
         if !exit_on_failed_check {
             for i in 0..6 {
                 let _ = writeln!(
@@ -328,6 +352,7 @@ pub fn fk(args: &FkOptions) -> Result<Outcome, CliError> {
         mechanism: m,
         ..
     } = Selected::of(common.mechanism, common.geometry)?;
+    let m = branches::assembled(m, args.assembly)?;
     let raw = numbers::six("actuators", args.actuators)?;
     let axes = m.axes();
     let q = ringpod_core::kinematics::Actuators(std::array::from_fn(|i| match axes[i] {

@@ -15,7 +15,7 @@ pub enum AnyMechanism {
     /// Trainer or rotopod.
     Ring(Box<RingPlatform<f64>>),
     /// Tool carrier.
-    Tool(ToolCarrier<f64>),
+    Tool(Box<ToolCarrier<f64>>),
 }
 
 /// The geometry a command works on: a preset by name, or a rig file.
@@ -63,7 +63,7 @@ impl AnyMechanism {
         let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
         let m = match preset.geometry() {
             PresetGeometry::Ring(g) => AnyMechanism::Ring(Box::new(RingPlatform::new(g))),
-            PresetGeometry::Tool(g) => AnyMechanism::Tool(ToolCarrier::new(g)),
+            PresetGeometry::Tool(g) => AnyMechanism::Tool(Box::new(ToolCarrier::new(g))),
         };
         Ok((preset, m))
     }

@@ -55,7 +55,7 @@ pub fn run(common: &On, pose: Option<&str>, wrench: &str) -> Result<Outcome, Cli
     let pose = pose_arg(
         common,
         selected.home,
-        ringpod_core::kinematics::Mechanism::characteristic_length(carrier),
+        ringpod_core::kinematics::Mechanism::characteristic_length(carrier.as_ref()),
         pose,
         "pose",
     )?;

@@ -70,6 +70,13 @@ pub enum Command {
         /// With --derivatives: the window of the fit (s).
         #[arg(long, default_value_t = 0.05, requires = "derivatives")]
         window: f64,
+        /// With --derivatives: draw and measure from this device time on (s); the fit still uses the samples
+        /// around it, so a stretch of a fast oscillation shows its waveform.
+        #[arg(long, requires = "derivatives")]
+        from: Option<f64>,
+        /// With --derivatives: draw and measure up to this device time (s).
+        #[arg(long, requires = "derivatives")]
+        to: Option<f64>,
     },
     /// A live terminal view of the device from its telemetry: state, supplies and outputs, every input, each
     /// axis's position and switches, the counters and the tick cost. q, Esc or Ctrl-C ends it.
@@ -97,8 +104,26 @@ pub enum Command {
     /// Loads of a tool wrench on the five-DOF tool carrier (paper 003's projection method): drive forces and
     /// torques, the X guide's bearing load, the frame pivots' forces and the constraint couple.
     Reactions(ReactionsArgs),
-    /// Scans the workspace with all checks (in parallel), draws a section coloured by the limiting check, and
-    /// prints the section's area, the reachable ranges, the volume, and whether the spec ranges are inside.
+    /// Paper 003's figs. 3-5: the Gram determinants of its three-DOF translational mechanism's wrenches (constraint,
+    /// actuation, all) over a slice of its workspace, drawn as four maps (with the sign of det M_C) and written as
+    /// a markdown table.
+    Gram {
+        /// The slice's height (m).
+        #[arg(long, default_value_t = ringpod_core::screws::translational::SLICE_Z, allow_hyphen_values = true)]
+        z: f64,
+        /// The grid's step (m).
+        #[arg(long, default_value_t = 0.002)]
+        step: f64,
+        /// The picture: .png or .svg.
+        #[arg(long)]
+        out: std::path::PathBuf,
+        /// Also write the statistics and a table of values every 50 mm (markdown).
+        #[arg(long, value_name = "FILE.md")]
+        table: Option<std::path::PathBuf>,
+    },
+    /// Scans the workspace of a ring platform or the tool carrier with all its checks (in parallel), draws a section
+    /// (positions, or the two tilts) coloured by the limiting check, and prints the cells inside, the reachable
+    /// ranges, the volume, each axis's range at home, and whether the spec ranges are inside.
     Workspace(WorkspaceArgs),
     /// Motion cueing: vehicle telemetry (specific force, angular rates) to platform poses by the classical washout
     /// (translation high-passed, sustained force by tilt coordination, yaw by heading), every pose limited into the
@@ -332,6 +357,10 @@ pub struct StreamArgs {
     /// (limited, refused, held). `ringpod plot FILE` draws it.
     #[arg(long, value_name = "FILE.csv")]
     pub record: Option<std::path::PathBuf>,
+    /// With --record: the device's telemetry rate for the run (1 to 2000 Hz, at most its control rate; 1000 is a
+    /// sample every tick of the model), set back to its own afterwards. A board stores the setting both times.
+    #[arg(long, requires = "record", value_parser = clap::value_parser!(u16).range(1..=2000))]
+    pub record_hz: Option<u16>,
     /// With --udp or --telemetry-udp: capture every datagram that arrives on the socket (from any sender, readable
     /// or not) to a pcap file, as tcpdump writes one, with its arrival time; `ringpod cue --input FILE.pcap` cues it
     /// again, Wireshark shows it.
@@ -433,6 +462,10 @@ pub struct PoseArgs {
     /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
     #[arg(long, allow_hyphen_values = true)]
     pub pose: Option<String>,
+    /// The tool carrier's dyad assemblies: `minus` (q2, q4 = theta - kappa, the preset's) or `plus` (theta + kappa)
+    /// for both dyads, `B,D` for each (`minus,plus`), or `all` to print the four.
+    #[arg(long, value_parser = crate::analysis::branches::parse, value_name = "minus|plus|B,D|all")]
+    pub branch: Option<crate::analysis::branches::Assembly>,
 }
 
 #[derive(Debug, Args)]
@@ -454,11 +487,15 @@ pub struct FkArgs {
     /// naming the check it fails).
     #[arg(long)]
     pub anywhere: bool,
+    /// The tool carrier's dyad assemblies the actuators were solved on (`ik --branch`): `minus`, `plus` or `B,D`.
+    /// The answer must take them (IK at it gives the actuators back).
+    #[arg(long, value_parser = crate::analysis::branches::parse, value_name = "minus|plus|B,D")]
+    pub branch: Option<crate::analysis::branches::Assembly>,
 }
 
 #[derive(Debug, Args)]
 pub struct WorkspaceArgs {
-    /// Geometry (a ring platform).
+    /// Geometry: a ring platform or the tool carrier (tool5-ex).
     #[arg(long, short, default_value = "trainer-model")]
     pub mechanism: String,
     /// Your own ring platform: a rig file (TOML), instead of --mechanism.

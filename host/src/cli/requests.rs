@@ -78,6 +78,7 @@ impl FkArgs {
             guess: self.guess.as_deref(),
             max_iterations: self.max_iterations,
             anywhere: self.anywhere,
+            assembly: self.branch,
         }
     }
 }
@@ -182,6 +183,7 @@ impl StreamArgs {
                 home: self.home,
                 host_limits: !self.device_limits_only,
                 telemetry: false,
+                telemetry_hz: self.record_hz,
                 quiet: self.quiet,
             },
             record: self.record.clone(),

@@ -295,8 +295,11 @@ fn print(report: &Report, json: bool) -> anyhow::Result<u8> {
             }
             None if !json => {
                 eprintln!(
-                    "recorded {} rows to {} ({} dropped)",
-                    record.rows, record.path, record.dropped
+                    "recorded {} rows to {}{} ({} dropped)",
+                    record.rows,
+                    record.path,
+                    record.telemetry_hz.map_or(String::new(), |hz| format!(" at {hz} Hz")),
+                    record.dropped
                 )
             }
             None => {}

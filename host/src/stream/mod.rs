@@ -8,6 +8,7 @@
 pub mod command;
 pub mod datagram;
 mod loads;
+mod prepare;
 pub mod record;
 mod report;
 mod session;
@@ -17,13 +18,13 @@ use std::collections::{BTreeMap, VecDeque};
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
-use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::EnvelopeMargins;
 use ringpod_core::protocol::{MotionSettings, RigSource, Settings, SettingsKind, Status};
 use ringpod_core::safety::{FaultReason, State};
 
 pub use loads::{check_loads, platform as loads_platform};
+use prepare::{prepare, telemetry_rate};
 pub use report::{CaptureReport, DatagramReport, LimitedReport, RecordReport, Report};
 use session::{Stop, StreamError, Streamer, NO_AUX};
 pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source, UdpSource};
@@ -62,6 +63,9 @@ pub struct Options {
     pub quiet: bool,
     /// Keep the device's telemetry on for someone watching (the workbench); a record turns it on anyway.
     pub telemetry: bool,
+    /// The device's telemetry rate for this run (Hz, its `stream.telemetry_hz`; set back afterwards), so that a
+    /// record can be taken at the control rate; `None` keeps the device's.
+    pub telemetry_hz: Option<u16>,
 }
 
 /// A ring platform and its home pose.
@@ -71,69 +75,6 @@ struct Platform {
     geometry: ringpod_core::kinematics::RingGeometry,
     /// Its home pose.
     home: [f64; 6],
-}
-
-/// Brings the device to `Ready`: hello, power up, home if needed. Errors here mean the stream never started.
-fn prepare<T: Transport>(client: &mut Client<T>, home: bool, telemetry: bool) -> Result<Status, ClientError> {
-    let device = client.hello()?;
-    if device.preset != Some(Preset::TrainerModel) {
-        eprintln!(
-            "note: the device drives {}",
-            device.preset.map_or("a geometry of its own", |p| p.name())
-        );
-    }
-    if telemetry {
-        // From here on: the record covers powering up and homing too.
-        client.telemetry(true)?;
-    }
-    let mut status = client.status()?;
-    if matches!(status.state, State::Fault(..)) {
-        return Err(ClientError::Unexpected(format!(
-            "device is in {:?}: clear the fault first",
-            status.state
-        )));
-    }
-    if matches!(status.state, State::Running | State::Stopping) {
-        client.stop()?;
-        status = client.wait_for(Duration::from_secs(10), |s| !matches!(s.state, State::Stopping))?;
-    }
-    if matches!(status.state, State::ShuttingDown(_)) {
-        // Powering down (a disable just before): it must reach Off before it can power up again.
-        status = client.wait_for(Duration::from_secs(10), |s| !matches!(s.state, State::ShuttingDown(_)))?;
-    }
-    if status.state == State::Off {
-        client.enable()?;
-    }
-    if matches!(
-        status.state,
-        State::Off | State::LogicOn | State::PowerOn { settled: false }
-    ) {
-        // Powering up (now, or by an enable just before): homing is refused until the supplies have settled.
-        status = client.wait_for(Duration::from_secs(5), |s| {
-            matches!(s.state, State::PowerOn { settled: true } | State::Fault(..))
-        })?;
-    }
-    if !status.homed || home {
-        client.home()?;
-        let homed = client.wait_for(Duration::from_secs(120), |s| {
-            matches!(s.state, State::Ready | State::Fault(..))
-        });
-        status = match homed {
-            Ok(s) => s,
-            Err(e) => {
-                // Ctrl-C or a timeout during homing: abort it before saying so.
-                let _ = client.stop();
-                return Err(e);
-            }
-        };
-    }
-    if status.state != State::Ready {
-        return Err(ClientError::Unexpected(format!(
-            "device is in {:?}, not ready",
-            status.state
-        )));
-    }
-    Ok(status)
 }
 
 /// What the device limits with and where it leads in, as the device says: its rig (geometry and home pose), its
@@ -245,7 +186,12 @@ pub fn run<T: Transport>(
         Some((r, path)) => (Some(r), Some(path)),
         None => (None, None),
     };
-    let baseline = prepare(client, options.home, recorder.is_some() || options.telemetry)?;
+    let (baseline, restore_hz) = prepare(
+        client,
+        options.home,
+        recorder.is_some() || options.telemetry,
+        options.telemetry_hz,
+    )?;
     let envelope = device_envelope(client)?;
     let home = envelope.platform.home;
     let mut source = source;
@@ -279,7 +225,19 @@ pub fn run<T: Transport>(
     };
     // The samples of the stop and the ramp to rest.
     let _ = s.record();
-    let record = record_path.map(|path| record_report(&mut s, path));
+    let mut record = record_path.map(|path| record_report(&mut s, path));
+    // The device's own telemetry rate back (a board stores it): after the record has taken its last samples.
+    let rate_error = match restore_hz {
+        Some(before) if transport.is_none() => telemetry_rate(s.client, before).err(),
+        _ => None,
+    };
+    if let (Some(r), Some(e)) = (record.as_mut(), rate_error) {
+        r.error
+            .get_or_insert(format!("the device's telemetry rate was not set back: {e}"));
+    }
+    if let Some(r) = record.as_mut() {
+        r.telemetry_hz = options.telemetry_hz;
+    }
     let (status, transport) = match (status, transport) {
         (Some(st), None) => (Some(st), None),
         (None, None) => (None, Some("the device did not answer after the stop".to_string())),
@@ -419,6 +377,7 @@ fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordR
     RecordReport {
         path,
         rows,
+        telemetry_hz: None,
         dropped,
         error,
     }

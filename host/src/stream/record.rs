@@ -1,5 +1,5 @@
 //! Run records: `stream --record run.csv` writes a row per telemetry sample (100 Hz by default: a row every 10 ms of
-//! device time), and `ringpod plot run.csv --out run.png` draws what was commanded against what the platform
+//! device time; `--record-hz 1000` a row every tick), and `ringpod plot run.csv --out run.png` draws what was commanded against what the platform
 //! followed, the actuators, and the events (limits, refusals, state changes).
 
 use std::fs::File;

@@ -98,6 +98,8 @@ pub struct RecordReport {
     pub path: String,
     /// Rows written.
     pub rows: u64,
+    /// The telemetry rate the run asked of the device (`--record-hz`), if it asked one.
+    pub telemetry_hz: Option<u16>,
     /// Telemetry samples the client dropped before they were written (none unless the host fell behind).
     pub dropped: u64,
     /// Why the file could not be written, if it could not.

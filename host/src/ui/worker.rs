@@ -400,6 +400,7 @@ impl Device {
             home: false,
             host_limits: true,
             telemetry: true,
+            telemetry_hz: None,
             quiet: true,
         };
         let report = stream::run(

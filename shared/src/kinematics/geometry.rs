@@ -341,6 +341,8 @@ pub struct ToolGeometry {
     pub branch_b: Branch,
     /// Assembly of the D-side dyad, for `q4`.
     pub branch_d: Branch,
+    /// The X carriage's travel `[min, max]` for `q1` (m): the reach check keeps `q1` inside.
+    pub stroke: [f64; 2],
     /// Minimum scale-free singularity index (sine of the transmission angles).
     pub min_singularity_index: f64,
 }
@@ -358,9 +360,12 @@ impl ToolGeometry {
         pivot_b: [f64; 3],
         pivot_d: [f64; 3],
         branches: [Branch; 2],
+        stroke: [f64; 2],
         min_singularity_index: f64,
     ) -> Result<Self, GeometryError> {
         let finite = l1.is_finite()
+            && stroke[0].is_finite()
+            && stroke[1].is_finite()
             && l2.is_finite()
             && l3.is_finite()
             && a.is_finite()
@@ -376,7 +381,7 @@ impl ToolGeometry {
         if !distinct(pivot_b, pivot_d) {
             return Err(GeometryError::CoincidentPoints);
         }
-        if !in_range(min_singularity_index, 0.0, 1.0) {
+        if !in_range(min_singularity_index, 0.0, 1.0) || stroke[0] >= stroke[1] {
             return Err(GeometryError::BadLimits);
         }
         Ok(Self {
@@ -390,6 +395,7 @@ impl ToolGeometry {
             pivot_d,
             branch_b: branches[0],
             branch_d: branches[1],
+            stroke,
             min_singularity_index,
         })
     }

@@ -64,7 +64,8 @@ pub const ROTOPOD_CH4: RingGeometry = unwrap_geometry(RingGeometry::new(
 ));
 
 /// Tool carrier of the worked position problem, in metres (`L1 = 0.3, L2 = L3 = 0.33, a = 0.4, b = 1.1`,
-/// `B = (0.155, 0.55, 0.27)`, `D = (0.155, -0.55, 0.27)`; the source's `L4 = 0.27` is the pivots' height).
+/// `B = (0.155, 0.55, 0.27)`, `D = (0.155, -0.55, 0.27)`; the source's `L4 = 0.27` is the pivots' height). The source
+/// gives no length for the X guide: the carriage's stroke of `+-0.5` m (about half the frame's width `b`) is assumed.
 pub const TOOL5_EX: ToolGeometry = unwrap_geometry(ToolGeometry::new(
     "tool5-ex",
     0.300,
@@ -75,6 +76,7 @@ pub const TOOL5_EX: ToolGeometry = unwrap_geometry(ToolGeometry::new(
     [0.155, 0.550, 0.270],
     [0.155, -0.550, 0.270],
     [Branch::Minus, Branch::Minus],
+    [-0.5, 0.5],
     0.02,
 ));
 

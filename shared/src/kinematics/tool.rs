@@ -37,6 +37,8 @@ pub struct ToolCarrier<T: Real> {
     /// `(y, z)` of the base pivots `B`, `D`.
     pivots: [(T, T); 2],
     branches: [Branch; 2],
+    /// `q1`'s travel `[min, max]` (m).
+    stroke: [T; 2],
     min_index: T,
 }
 
@@ -62,8 +64,21 @@ impl<T: Real> ToolCarrier<T> {
                 (T::of(g.pivot_d[1]), T::of(g.pivot_d[2])),
             ],
             branches: [g.branch_b, g.branch_d],
+            stroke: [T::of(g.stroke[0]), T::of(g.stroke[1])],
             min_index: T::of(g.min_singularity_index),
         }
+    }
+
+    /// The same mechanism assembled on other dyad branches (`[B side, D side]`): the closed form's `theta - kappa`
+    /// or `theta + kappa` for `q2` and `q4`. Both assemblies close the same pose; which one the machine is in is
+    /// fixed when it is built, so IK must be told.
+    pub fn with_branches(&self, branches: [Branch; 2]) -> Self {
+        Self::new(&self.geometry.with_branches(branches[0], branches[1]))
+    }
+
+    /// The dyad assemblies `[B side, D side]` this mechanism's IK takes.
+    pub fn branches(&self) -> [Branch; 2] {
+        self.branches
     }
 
     /// The geometry this mechanism was built from.
@@ -213,7 +228,7 @@ impl<T: Real> Mechanism<T> for ToolCarrier<T> {
         }
     }
 
-    /// Reach (dyad closure slack, m) and singularity (the smaller of `|sin|` of the D-dyad's elbow angle, a type-1
+    /// Reach (the smaller of the dyads' closure slack and the carriage's room to its stroke ends, m) and singularity (the smaller of `|sin|` of the D-dyad's elbow angle, a type-1
     /// boundary, and of the angle between its `L3` link and the frame, the type-2 transmission). The ring checks
     /// (spacing, crossing, cones, stability) do not apply to this mechanism.
     fn workspace(&self, pose: &Pose<T>, q: &Actuators<T>) -> WorkspaceReport<T> {
@@ -225,6 +240,7 @@ impl<T: Real> Mechanism<T> for ToolCarrier<T> {
             reach = reach.min(self.l2 + self.l3 - d).min(d - (self.l2 - self.l3).abs());
         }
         let q = &q.0;
+        reach = reach.min(q[0] - self.stroke[0]).min(self.stroke[1] - q[0]);
         let elbow = (q[5] - q[3]).sin_().abs();
         let transmission = (q[5] - pose.alpha).sin_().abs();
         let index = elbow.min(transmission);

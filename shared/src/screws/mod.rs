@@ -1,7 +1,7 @@
 //! Screws (SCREWS.md): Plücker lines, twists and wrenches as `[direction; moment]` six-vectors, their reciprocal
 //! product, paper 002's matrix method for closed loops ([`matrix`]), paper 003's generalised reactions
 //! ([`reactions`]) and the dissertation's structural analysis ([`structure`], with each mechanism's chains in
-//! [`layouts`]).
+//! [`layouts`]); paper 003's three-DOF translational mechanism and its Gram determinants ([`translational`]).
 
 pub mod chains;
 pub mod layouts;
@@ -9,6 +9,7 @@ pub mod matrix;
 pub mod reactions;
 pub mod structure;
 pub mod tool;
+pub mod translational;
 
 use nalgebra::{Vector3, Vector6};
 
