@@ -151,13 +151,15 @@ async fn until(shared: &Shared, limit_ms: u32, done: impl Fn(State) -> bool) -> 
     false
 }
 
-/// Prints the step queue's depth and the periods the step generator found it empty so far.
+/// Prints the step queue's depth, the periods the step generator found it empty so far, and the times the port
+/// fell behind and started afresh.
 fn queue(shared: &Shared, when: &str) {
     hprintln!(
-        "QUEUE {} depth {} underruns {}",
+        "QUEUE {} depth {} underruns {} port restarts {}",
         when,
         shared.steps.len(),
-        shared.step_underruns.load(Ordering::Relaxed)
+        shared.step_underruns.load(Ordering::Relaxed),
+        crate::machine::PORT_RESTARTS.load(Ordering::Relaxed)
     );
 }
 

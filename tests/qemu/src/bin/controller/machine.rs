@@ -129,6 +129,9 @@ impl InputPins for Pins {
     }
 }
 
+/// Times the port fell more than four periods behind and started afresh (the latency measurement prints it).
+pub static PORT_RESTARTS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
 /// The step port: each buffer plays over one control period, after the one before it.
 pub struct Port {
     pub world: &'static WorldCell,
@@ -146,6 +149,7 @@ impl PortOutput for Port {
         Timer::at(self.busy_until).await;
         let now = Instant::now();
         self.busy_until = if now > self.busy_until + self.period * 4 {
+            PORT_RESTARTS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
             now + self.period
         } else {
             self.busy_until + self.period
