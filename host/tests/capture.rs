@@ -11,17 +11,6 @@ fn dir(name: &str) -> PathBuf {
     d
 }
 
-/// Live for Speed's classic OutSim packet (64 bytes): time (ms), angular velocity, heading, pitch, roll,
-/// acceleration (world axes), velocity and position.
-fn outsim(time_ms: u32, rate: [f32; 3], accel: [f32; 3]) -> Vec<u8> {
-    let mut out = time_ms.to_le_bytes().to_vec();
-    for v in rate.iter().chain(&[0.0f32; 3]).chain(&accel).chain(&[0.0f32; 3]) {
-        out.extend(v.to_le_bytes());
-    }
-    out.extend([0u8; 12]);
-    out
-}
-
 /// `ringpod cue --json --input FILE ARGS`: the exit code, the summary and stderr.
 fn cue(input: &Path, out: &Path, args: &[&str]) -> (Option<i32>, serde_json::Value, String) {
     let o = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
@@ -72,7 +61,11 @@ fn a_captured_drive_cues_offline_as_it_was_cued_live() {
         } else {
             ([0.0, 0.0, 0.3], [-2.0, 0.0, 0.0])
         };
-        game.send_to(&outsim(10 * k, rate, accel), &addr).unwrap();
+        game.send_to(
+            &common::packets::outsim::packet(10 * k, rate, [0.0; 3], accel, false),
+            &addr,
+        )
+        .unwrap();
         if k == 40 {
             stranger.send_to(b"not telemetry", &addr).unwrap();
         }

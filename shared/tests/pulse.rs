@@ -240,6 +240,29 @@ fn the_driver_model_catches_every_broken_rule() {
     assert_eq!((v.rule, v.axis, v.slot), (TimingRule::LowTime, 0, good.len() as u64));
 }
 
+/// `play_all` lets idle words (no pin set or reset) pass as time only: the same state and the same first violation
+/// as playing every word.
+#[test]
+fn idle_words_only_let_time_pass() {
+    let (step, dir) = (1u32, 1u32 << 6);
+    // A correct pulse among idle words, rules broken between them, and idle words only.
+    let mut spaced = vec![0u32; 22];
+    (spaced[2], spaced[13], spaced[19]) = (dir << 16, step, step << 16);
+    let buffers = [spaced, vec![dir << 16, step, 0, 0, step << 16, 0, step, 0], vec![0; 40]];
+    for words in &buffers {
+        let mut each = DriverInputs::new(MAP, FINE_SLOT_NS, SchedulerConfig::default());
+        let first = words.iter().fold(None, |f, &w| {
+            let v = each.play(w);
+            f.or(v)
+        });
+        let mut all = DriverInputs::new(MAP, FINE_SLOT_NS, SchedulerConfig::default());
+        assert_eq!(all.play_all(words), first, "{words:?}");
+        assert_eq!(all, each, "{words:?}");
+        // Later words are judged against the same times.
+        assert_eq!(all.play(step), each.play(step));
+    }
+}
+
 #[test]
 fn the_plant_moves_by_the_edges_the_drivers_count() {
     let sched = SchedulerConfig::default();

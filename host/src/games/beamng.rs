@@ -79,17 +79,9 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testing::{close, decoded, Writer};
+    use super::super::packets::beamng::packet;
+    use super::super::testing::{close, decoded};
     use super::*;
-
-    /// A packet field by field: acceleration (car axes), up vector, roll/pitch/yaw and their rates.
-    fn packet(acc: [f32; 3], up: [f32; 3], rpy: [f32; 3], rates: [f32; 3]) -> Vec<u8> {
-        let mut w = Writer::default();
-        w.bytes(MAGIC).f32s(&[100.0, -20.0, 5.0]).f32s(&[0.0, 15.0, 0.0]);
-        w.f32s(&acc).f32s(&up).f32s(&rpy).f32s(&rates).f32s(&[0.0; 3]);
-        assert_eq!(w.0.len(), SIZE);
-        w.0
-    }
 
     const UP: [f32; 3] = [0.0, 0.0, 1.0];
 

@@ -71,26 +71,12 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testing::{close, decoded, Writer};
+    use super::super::testing::{close, decoded};
     use super::*;
 
-    /// A packet written channel by channel as extradata 3 lists them: the car's right and forward unit vectors
-    /// (world, y up) and its g-forces, everything else plausible.
+    /// A packet at 95.25 s (the shared builder).
     fn packet(right: [f32; 3], forward: [f32; 3], g_lat: f32, g_long: f32) -> Vec<u8> {
-        let mut w = Writer::default();
-        w.f32s(&[95.25, 35.0, 800.0, 800.0]); // total time, lap time, lap distance, total distance
-        w.f32s(&[10.0, 1.0, 20.0]).f32(25.0).f32s(&[0.0, 0.0, 25.0]); // position, speed, velocity
-        w.f32s(&right).f32s(&forward);
-        w.f32s(&[0.0; 4]).f32s(&[0.0; 4]).f32s(&[25.0; 4]); // suspension position, velocity, wheel speed
-        w.f32s(&[1.0, 0.0, 0.0, 0.0, 3.0]); // throttle, steer, brake, clutch, gear
-        w.f32(g_lat).f32(g_long);
-        w.f32s(&[
-            0.0, 600.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 40.0, 60.0, 0.0, 1.0, 0.0, 0.0,
-        ]);
-        w.f32s(&[300.0; 4]).f32s(&[25.0; 4]); // brake temperatures, tyre pressures
-        w.f32s(&[0.0, 1.0, 5000.0, 0.0, 800.0, 90.0, 6.0]); // team, laps, track size, last lap, max/idle rpm, gears
-        assert_eq!(w.0.len(), SIZE);
-        w.0
+        super::super::packets::codemasters::packet(95.25, right, forward, g_lat, g_long)
     }
 
     const RIGHT: [f32; 3] = [1.0, 0.0, 0.0];

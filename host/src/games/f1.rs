@@ -119,40 +119,12 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
 #[cfg(test)]
 mod tests {
     use super::super::recognise;
-    use super::super::testing::{close, decoded, Writer};
+    use super::super::testing::{close, decoded};
     use super::*;
 
-    /// One car's `CarMotionData`: forward and right unit vectors (world, y up), g-forces (lateral, longitudinal,
-    /// vertical).
-    fn car(w: &mut Writer, forward: [f32; 3], right: [f32; 3], g_lat_long_vert: [f32; 3]) {
-        w.f32s(&[100.0, 2.0, -50.0]).f32s(&[10.0, 0.0, 0.0]);
-        for v in forward.iter().chain(&right) {
-            w.i16((v * 32767.0).round() as i16);
-        }
-        w.f32s(&g_lat_long_vert).f32s(&[0.1, 0.0, 0.0]);
-    }
-
-    /// A motion packet of `format` (2023..2025) with the player in slot `player`, every other car level and
-    /// braking hard (so that reading the wrong car shows).
+    /// A packet at session time 61.5 s (the shared builder).
     fn packet(format: u16, id: u8, player: u8, forward: [f32; 3], right: [f32; 3], g: [f32; 3]) -> Vec<u8> {
-        let mut w = Writer::default();
-        w.u16(format).u8((format - 2000) as u8).u8(1).u8(5).u8(1).u8(id);
-        w.bytes(&0x1234_5678_9abc_def0u64.to_le_bytes())
-            .f32(61.5)
-            .u32(3000)
-            .u32(3000)
-            .u8(player)
-            .u8(255);
-        assert_eq!(w.0.len(), HEADER);
-        for i in 0..CARS as u8 {
-            if i == player {
-                car(&mut w, forward, right, g);
-            } else {
-                car(&mut w, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -4.0, 0.0]);
-            }
-        }
-        assert_eq!(w.0.len(), MOTION_SIZE);
-        w.0
+        super::super::packets::f1::packet(format, id, player, 61.5, forward, right, g)
     }
 
     const LEVEL_F: [f32; 3] = [0.0, 0.0, 1.0];

@@ -99,58 +99,13 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::testing::{close, decoded, Writer};
+    use super::super::testing::{close, decoded};
     use super::super::G;
     use super::*;
 
-    /// The Sled fields: race on, time 12.345 s, the car's acceleration, angular velocity and attitude (yaw,
-    /// pitch, roll), the wheel arrays and the car's identity.
-    fn sled(w: &mut Writer, race_on: i32, accel: [f32; 3], ang_vel: [f32; 3], ypr: [f32; 3]) {
-        w.i32(race_on).u32(12_345).f32s(&[8000.0, 900.0, 4000.0]);
-        w.f32s(&accel).f32s(&[0.0, 0.0, 20.0]).f32s(&ang_vel).f32s(&ypr);
-        // Normalised suspension travel, slip ratio, wheel rotation speed.
-        w.f32s(&[0.5; 4]).f32s(&[0.0; 4]).f32s(&[60.0; 4]);
-        // On rumble strip (s32), puddle depth, surface rumble, slip angle, combined slip, suspension travel (m).
-        (0..4).for_each(|_| {
-            w.i32(0);
-        });
-        w.f32s(&[0.0; 4])
-            .f32s(&[0.0; 4])
-            .f32s(&[0.0; 4])
-            .f32s(&[0.0; 4])
-            .f32s(&[0.05; 4]);
-        // Car ordinal, class, performance index, drivetrain, cylinders.
-        w.i32(2352).i32(5).i32(800).i32(1).i32(8);
-        assert_eq!(w.0.len(), SLED);
-    }
-
-    /// The Dash fields of FM7 (79 bytes).
-    fn dash(w: &mut Writer) {
-        w.f32s(&[1.0, 2.0, 3.0]).f32s(&[20.0, 1e5, 300.0]).f32s(&[80.0; 4]);
-        w.f32s(&[0.0, 40.0, 1500.0, 90.0, 91.0, 30.0, 300.0]);
-        w.u16(3).u8(1).u8(255).u8(0).u8(0).u8(0).u8(4).bytes(&[0, 0, 0]);
-    }
-
-    /// A packet of `size` with the given motion.
+    /// A packet of `size` at 12.345 s (the shared builder).
     fn packet(size: usize, race_on: i32, accel: [f32; 3], ang_vel: [f32; 3], ypr: [f32; 3]) -> Vec<u8> {
-        let mut w = Writer::default();
-        sled(&mut w, race_on, accel, ang_vel, ypr);
-        match size {
-            SLED => {}
-            DASH_FM7 => dash(&mut w),
-            HORIZON => {
-                w.zeros(12);
-                dash(&mut w);
-                w.zeros(1);
-            }
-            DASH_FM2023 => {
-                dash(&mut w);
-                w.f32s(&[0.1; 4]).i32(110);
-            }
-            _ => unreachable!(),
-        }
-        assert_eq!(w.0.len(), size);
-        w.0
+        super::super::packets::forza::packet(size, race_on, 12_345, accel, ang_vel, ypr)
     }
 
     #[test]

@@ -292,6 +292,12 @@ fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
+/// The games' packets built field by field from the published layouts: one file, also the end-to-end tests'
+/// (`host/tests/common/packets.rs`), so that the decoders and the live stream are tested with the same bytes.
+#[cfg(test)]
+#[path = "../../tests/common/packets.rs"]
+pub(crate) mod packets;
+
 #[cfg(test)]
 pub(crate) mod testing {
     //! What every format's tests check.
@@ -309,44 +315,8 @@ pub(crate) mod testing {
         decode(format, bytes).unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// A little-endian packet written field by field.
-    #[derive(Default)]
-    pub struct Writer(pub Vec<u8>);
-
-    impl Writer {
-        pub fn bytes(&mut self, b: &[u8]) -> &mut Self {
-            self.0.extend_from_slice(b);
-            self
-        }
-        pub fn f32(&mut self, v: f32) -> &mut Self {
-            self.bytes(&v.to_le_bytes())
-        }
-        pub fn f32s(&mut self, v: &[f32]) -> &mut Self {
-            v.iter().for_each(|x| {
-                self.f32(*x);
-            });
-            self
-        }
-        pub fn u32(&mut self, v: u32) -> &mut Self {
-            self.bytes(&v.to_le_bytes())
-        }
-        pub fn i32(&mut self, v: i32) -> &mut Self {
-            self.bytes(&v.to_le_bytes())
-        }
-        pub fn u16(&mut self, v: u16) -> &mut Self {
-            self.bytes(&v.to_le_bytes())
-        }
-        pub fn i16(&mut self, v: i16) -> &mut Self {
-            self.bytes(&v.to_le_bytes())
-        }
-        pub fn u8(&mut self, v: u8) -> &mut Self {
-            self.bytes(&[v])
-        }
-        pub fn zeros(&mut self, n: usize) -> &mut Self {
-            self.0.resize(self.0.len() + n, 0);
-            self
-        }
-    }
+    /// The packets of the published layouts, shared with the end-to-end tests.
+    pub use super::packets::Writer;
 }
 
 #[cfg(test)]

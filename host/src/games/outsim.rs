@@ -81,25 +81,10 @@ fn rotate_y(v: [f64; 3], a: f64) -> [f64; 3] {
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
-    use super::super::testing::{close, decoded, Writer};
+mod tests {
+    use super::super::packets::outsim::packet;
+    use super::super::testing::{close, decoded};
     use super::*;
-
-    /// `OutSimMain` (60 bytes) as LFS lays it out: angular velocity, heading, pitch, roll, acceleration (world
-    /// axes), velocity and position zero.
-    pub fn main_section(w: &mut Writer, ang_vel: [f32; 3], hpr: [f32; 3], accel: [f32; 3]) {
-        w.f32s(&ang_vel).f32s(&hpr).f32s(&accel).f32s(&[0.0; 3]).zeros(12);
-    }
-
-    fn packet(time_ms: u32, ang_vel: [f32; 3], hpr: [f32; 3], accel: [f32; 3], id: bool) -> Vec<u8> {
-        let mut w = Writer::default();
-        w.u32(time_ms);
-        main_section(&mut w, ang_vel, hpr, accel);
-        if id {
-            w.i32(7);
-        }
-        w.0
-    }
 
     #[test]
     fn classic_packets_in_vehicle_axes() {

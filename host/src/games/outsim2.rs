@@ -194,50 +194,15 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::outsim::tests::main_section;
-    use super::super::testing::{close, decoded, Writer};
+    use super::super::testing::{close, decoded};
     use super::super::G;
     use super::*;
 
-    /// A packet as LFS writes it for `opts`, every section field by field: the given motion, time 2.5 s, ID 42,
-    /// and non-zero filler in the other sections (so that a misplaced section shows).
+    /// A packet as LFS writes it for `opts` (the shared builder), at 2.5 s, of the size the layout says.
     fn packet(opts: u16, ang_vel: [f32; 3], hpr: [f32; 3], accel: [f32; 3]) -> Vec<u8> {
-        let o = Opts(opts);
-        let mut w = Writer::default();
-        if o.has(Opts::HEADER) {
-            w.bytes(b"LFST");
-        }
-        if o.has(Opts::ID) {
-            w.i32(42);
-        }
-        if o.has(Opts::TIME) {
-            w.u32(2500);
-        }
-        if o.has(Opts::MAIN) {
-            main_section(&mut w, ang_vel, hpr, accel);
-        }
-        if o.has(Opts::INPUTS) {
-            w.f32s(&[0.8, 0.1, -0.2, 0.0, 0.0]);
-        }
-        if o.has(Opts::DRIVE) {
-            w.u8(3).zeros(3).f32(600.0).f32(300.0);
-        }
-        if o.has(Opts::DISTANCE) {
-            w.f32(1234.0).f32(1230.0);
-        }
-        if o.has(Opts::WHEELS) {
-            for _ in 0..4 {
-                w.f32s(&[0.05, 0.01, 100.0, 200.0, 3000.0, 50.0, 0.0])
-                    .bytes(&[20, 0, 1, 0])
-                    .f32(0.02)
-                    .f32(0.01);
-            }
-        }
-        if o.has(Opts::EXTRA_1) {
-            w.f32(12.0).f32(0.0);
-        }
-        assert_eq!(w.0.len(), o.size());
-        w.0
+        let bytes = super::super::packets::outsim2::packet(opts, 2500, ang_vel, hpr, accel);
+        assert_eq!(bytes.len(), Opts(opts).size(), "{opts:#x}");
+        bytes
     }
 
     #[test]

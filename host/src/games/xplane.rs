@@ -93,28 +93,13 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::packets::xplane::record;
     use super::super::testing::{close, decoded, Writer};
     use super::*;
 
-    fn record(w: &mut Writer, index: i32, values: [f32; 8]) {
-        w.i32(index).f32s(&values);
-    }
-
-    /// A packet with data sets 1 (times), 4 (g-loads: normal, axial, side), 3 (speeds, not read), 16 (Q, P, R)
-    /// and 17 (attitude, not read), in X-Plane's order.
+    /// A packet at real time 812.5 s (the shared builder).
     fn packet(g_loads: [f32; 3], qpr: [f32; 3], with_rates: bool) -> Vec<u8> {
-        let mut w = Writer::default();
-        w.bytes(MAGIC).u8(b'*');
-        record(&mut w, 1, [812.5, 700.0, 300.0, 0.0, -999.0, 43200.0, 50400.0, 12.0]);
-        record(&mut w, 3, [120.0, 118.0, 121.0, 139.0, -999.0, 138.0, 159.0, 160.0]);
-        let [n, a, s] = g_loads;
-        record(&mut w, 4, [0.2, -999.0, 0.0, -999.0, n, a, s, -999.0]);
-        if with_rates {
-            let [q, p, r] = qpr;
-            record(&mut w, 16, [q, p, r, -999.0, -999.0, -999.0, -999.0, -999.0]);
-        }
-        record(&mut w, 17, [2.0, 0.0, 90.0, 88.0, -999.0, -999.0, -999.0, -999.0]);
-        w.0
+        super::super::packets::xplane::packet(812.5, g_loads, qpr, with_rates)
     }
 
     #[test]

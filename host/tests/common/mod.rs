@@ -3,6 +3,8 @@
 // Each test file is its own crate and uses a part of this.
 #![allow(dead_code)]
 
+pub mod packets;
+
 /// Starts `ringpod stream --sim --report-json --quiet ARGS` with its output piped.
 pub fn spawn_sim_stream(args: &[&str]) -> std::process::Child {
     std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))

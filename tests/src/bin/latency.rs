@@ -16,6 +16,12 @@
 //! car (the washout's pose after 10 ms at -6 m/s^2, and larger steps for comparison). The first pulse comes when
 //! the reference has moved one step: a small cue takes longer than a large one, and `interpolate` spreads the move
 //! over the setpoint's interval (10 ms at 100 Hz) where `direct` heads for it at once under the limits.
+//!
+//! Then the same on the QEMU controller (the firmware's tasks on the emulated Cortex-M4F, `tests/qemu`, program
+//! argument `latency`): device time under `-icount shift=3,sleep=off` (8 ns an instruction, idle time skipped),
+//! from the setpoint frame's last byte in the link's receive pipe to the first STEP edge the port plays, at ten
+//! phases of the control period, which takes in the wait for the tick, the tick, the step queue and the slot of
+//! the first pulse (parts 2 and 3 as the firmware does them). Skipped with a message when QEMU is missing.
 
 use std::time::Instant;
 
@@ -150,6 +156,80 @@ fn device_us(follow: FollowMode, offset: [f32; 6]) -> Option<(f64, u32)> {
     None
 }
 
+/// One setpoint measured on the QEMU controller (ns of device time), and the step queue's depth then.
+struct Emulated {
+    case: String,
+    arrival: f64,
+    tick: f64,
+    pulse: f64,
+    depth: u32,
+}
+
+/// QEMU's `-icount` shift: 2^3 = 8 ns an instruction (125 M instructions/s; the F411 runs at most 96 M/s).
+const ICOUNT_SHIFT: u32 = 3;
+
+/// Part 4: the QEMU controller in `follow` mode (`tests/qemu`, built here), or why not.
+fn emulated(direct: bool) -> Result<Vec<Emulated>, String> {
+    let qemu_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("qemu");
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let built = std::process::Command::new(cargo)
+        .current_dir(&qemu_dir)
+        .args(["build", "--release", "--bin", "ringpod-qemu-controller"])
+        .status()
+        .map_err(|e| format!("cargo: {e}"))?;
+    if !built.success() {
+        return Err("building the QEMU controller failed".into());
+    }
+    let elf = qemu_dir.join("target/thumbv7em-none-eabihf/release/ringpod-qemu-controller");
+    let args = if direct {
+        ",arg=latency,arg=direct"
+    } else {
+        ",arg=latency"
+    };
+    let out = std::process::Command::new("qemu-system-arm")
+        .args([
+            "-machine",
+            "mps2-an386",
+            "-cpu",
+            "cortex-m4",
+            "-nographic",
+            "-monitor",
+            "none",
+        ])
+        .arg("-semihosting-config")
+        .arg(format!("enable=on,target=native{args}"))
+        .arg("-icount")
+        .arg(format!("shift={ICOUNT_SHIFT},sleep=off"))
+        .args(["-serial", "null", "-kernel"])
+        .arg(elf)
+        .stdin(std::process::Stdio::null())
+        .output()
+        .map_err(|e| format!("qemu-system-arm: {e} (apt-get install qemu-system-arm)"))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    if !text.lines().any(|l| l == "LATENCY done") {
+        return Err(format!("the QEMU controller did not finish: {text}"));
+    }
+    text.lines()
+        .filter_map(|l| l.strip_prefix("LATENCY "))
+        .filter(|l| *l != "done")
+        .map(|l| {
+            let f: Vec<&str> = l.split(' ').collect();
+            let n = |i: usize| {
+                f.get(i)
+                    .and_then(|v| v.parse::<f64>().ok())
+                    .ok_or(format!("no pulse: {l}"))
+            };
+            Ok(Emulated {
+                case: f[0].to_string(),
+                arrival: n(2)?,
+                tick: n(3)?,
+                pulse: n(4)?,
+                depth: n(5)? as u32,
+            })
+        })
+        .collect()
+}
+
 fn main() {
     let n = 20_000;
     let (udp_med, udp_p99) = udp_us(n);
@@ -200,6 +280,53 @@ fn main() {
                 }
                 None => println!("| {name} | {mode} | no pulse within 1 s | | | not met |"),
             }
+        }
+    }
+    println!();
+    println!(
+        "QEMU controller (firmware tasks on the emulated M4F), device time under -icount shift={ICOUNT_SHIFT} \
+         ({} ns an instruction), ten phases of the control period each:",
+        1 << ICOUNT_SHIFT
+    );
+    println!();
+    println!("| case | follow | wait for the tick | tick to first pulse | device: arrival to first pulse, min / median / max | step queue | worst + host p99 | goal 2 ms + 1 tick |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let runs = std::thread::scope(|s| {
+        let interpolate = s.spawn(|| emulated(false));
+        let direct = s.spawn(|| emulated(true));
+        [
+            ("interpolate", interpolate.join().unwrap_or(Err("panicked".into()))),
+            ("direct", direct.join().unwrap_or(Err("panicked".into()))),
+        ]
+    });
+    let ms = |ns: f64| ns / 1e6;
+    for case in ["braking", "surge-0.1mm", "surge-1mm"] {
+        for (mode, run) in &runs {
+            let run = match run {
+                Ok(r) => r,
+                Err(e) => {
+                    println!("| {case} | {mode} | not measured: {e} | | | | | |");
+                    continue;
+                }
+            };
+            let of: Vec<&Emulated> = run.iter().filter(|m| m.case == case).collect();
+            let range = |v: Vec<f64>| {
+                let (lo, hi) = v
+                    .iter()
+                    .fold((f64::MAX, f64::MIN), |(lo, hi), x| (lo.min(*x), hi.max(*x)));
+                (lo, spread(v).0, hi)
+            };
+            let (wait_lo, _, wait_hi) = range(of.iter().map(|m| ms(m.tick - m.arrival)).collect());
+            let (run_lo, _, run_hi) = range(of.iter().map(|m| ms(m.pulse - m.tick)).collect());
+            let (lo, med, hi) = range(of.iter().map(|m| ms(m.pulse - m.arrival)).collect());
+            let depths: Vec<u32> = of.iter().map(|m| m.depth).collect();
+            let worst = hi + (udp_p99 + host_p99) / 1000.0;
+            println!(
+                "| {case} | {mode} | {wait_lo:.2}-{wait_hi:.2} ms | {run_lo:.2}-{run_hi:.2} ms | {lo:.2} / {med:.2} / {hi:.2} ms | {}-{} | {worst:.2} ms | {} |",
+                depths.iter().min().unwrap_or(&0),
+                depths.iter().max().unwrap_or(&0),
+                if worst <= goal / 1000.0 { "met" } else { "not met" }
+            );
         }
     }
 }

@@ -15,6 +15,7 @@ use embassy_sync::blocking_mutex::raw::{CriticalSectionRawMutex, ThreadModeRawMu
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Timer};
+use ringpod_core::motion::pulse::STEP_SLOT_NS;
 use ringpod_core::safety::debounce::InputConfig;
 use ringpod_core::safety::pins::OutputPin;
 use ringpod_core::safety::{Outputs, State};
@@ -101,6 +102,7 @@ impl Machine for Controls {
     }
 
     fn cycles(&self) -> u32 {
+        crate::latency::cycles_read();
         // No DWT cycle counter in QEMU: microseconds of SysTick time, in 25 MHz cycles.
         (time::now_us() * 25) as u32
     }
@@ -114,6 +116,7 @@ impl Machine for Controls {
                 cortex_m::asm::nop();
             }
         }
+        crate::latency::tick_ended();
         watchdog::feed();
     }
 }
@@ -141,9 +144,14 @@ impl InputPins for Pins {
     }
 }
 
+/// Times the port fell more than four periods behind and started afresh (the latency measurement prints it).
+pub static PORT_RESTARTS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
 /// The step port: each buffer plays over one control period, after the one before it.
 pub struct Port {
     pub world: &'static WorldCell,
+    /// The step queue, whose depth the latency measurement reports.
+    pub shared: &'static Shared,
     pub period: Duration,
     /// When the buffer being played ends.
     pub busy_until: Instant,
@@ -156,10 +164,13 @@ impl PortOutput for Port {
         Timer::at(self.busy_until).await;
         let now = Instant::now();
         self.busy_until = if now > self.busy_until + self.period * 4 {
+            PORT_RESTARTS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
             now + self.period
         } else {
             self.busy_until + self.period
         };
+        let depth = self.shared.steps.len();
+        crate::latency::played((self.busy_until - self.period).as_micros(), words, STEP_SLOT_NS, depth);
         self.world.lock(|w| {
             let w = &mut *w.borrow_mut();
             let enabled = w.outputs.driver_enable;

@@ -10,13 +10,15 @@
 //! - [`watchdog`]: the CMSDK watchdog, fed by the control tick.
 //!
 //! It prints `READY` over semihosting once its tasks run (`RESET watchdog` before it when the watchdog caused the
-//! reset). Its semihosting command line can hold `stall-when-homed` (see [`machine::Controls`]) and `estop-on-aux2`
-//! (see [`machine::World::estop_on_aux2`]). What differs from
-//! the STM32 build is only this board module.
+//! reset). Its semihosting command line can hold `stall-when-homed` (see [`machine::Controls`]), `estop-on-aux2`
+//! (see [`machine::World::estop_on_aux2`]), or `latency` (and `direct` for that follow mode): the latency
+//! measurement of [`latency`], whose host runs inside the program. What differs from the STM32 build is only this
+//! board module.
 
 #![no_std]
 #![no_main]
 
+mod latency;
 mod machine;
 mod retained;
 mod time;
@@ -34,6 +36,7 @@ use embassy_time::{Duration, Instant};
 use ringpod_core::controller::Controller;
 use ringpod_core::motion::pulse::STEP_SLOT_NS;
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
+use ringpod_core::motion::FollowMode;
 use ringpod_core::protocol::RigSource;
 use ringpod_core::sim::drivers::DriverInputs;
 use ringpod_core::sim::{Plant, TRAINER_MODEL_PARKED};
@@ -144,7 +147,11 @@ async fn main(spawner: Spawner) {
 
     // Settings as the STM32 board restores them: the compiled-in defaults with what flash holds replayed over them.
     let mut flash = retained::flash();
-    let (config, restored) = app::settings::restore(&mut flash, SETTINGS).await;
+    let (mut config, restored) = app::settings::restore(&mut flash, SETTINGS).await;
+    let measure_latency = command_line_has(b"latency");
+    if measure_latency && command_line_has(b"direct") {
+        config.pipeline.follow = FollowMode::Direct;
+    }
     let controller = Controller::new(config).unwrap_or_else(|_| fail("configuration"));
     let timing = config.pulse_timing().unwrap_or_else(|_| fail("step timing"));
     let renderer = PulseRenderer::new(PORT_MAP, timing).unwrap_or_else(|_| fail("pin map"));
@@ -182,6 +189,7 @@ async fn main(spawner: Spawner) {
     let period = Duration::from_micros(u64::from(config.pipeline.tick_us));
     let port = Port {
         world,
+        shared,
         period,
         busy_until: Instant::now(),
     };
@@ -196,6 +204,9 @@ async fn main(spawner: Spawner) {
     spawner.spawn(inputs_task(pins, shared).unwrap_or_else(|_| fail("spawn")));
     spawner.spawn(link_task(UartLink, shared).unwrap_or_else(|_| fail("spawn")));
     spawner.spawn(settings_task(flash, shared).unwrap_or_else(|_| fail("spawn")));
+    if measure_latency {
+        spawner.spawn(latency::host(shared).unwrap_or_else(|_| fail("spawn")));
+    }
     hprintln!("READY");
 }
 

@@ -4,7 +4,7 @@ use core::cell::{Cell, RefCell};
 use core::task::Waker;
 
 use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m::peripheral::SYST;
+use cortex_m::peripheral::{SCB, SYST};
 use cortex_m_rt::exception;
 use critical_section::Mutex as CsMutex;
 use embassy_time_driver::Driver;
@@ -13,6 +13,8 @@ use embassy_time_queue_utils::Queue;
 /// SysTick period: 100 us of the 25 MHz core clock.
 const TICK_US: u64 = 100;
 const SYSTICK_RELOAD: u32 = 25 * TICK_US as u32 - 1;
+/// One count of the 25 MHz clock.
+const NS_PER_COUNT: u64 = 40;
 
 /// Time in SysTick periods, and the timer queue, both touched from the SysTick exception and thread mode.
 struct SysTickDriver {
@@ -63,4 +65,21 @@ pub fn start(syst: &mut SYST) {
 /// Microseconds since start.
 pub fn now_us() -> u64 {
     DRIVER.now()
+}
+
+/// Nanoseconds since start, to one SysTick count (40 ns of the 25 MHz clock) rather than one 100 us period: the
+/// periods counted plus the count within the current one. A wrap the exception has not counted yet (it is pending
+/// while this runs with interrupts off) is counted here.
+pub fn now_ns() -> u64 {
+    critical_section::with(|cs| {
+        let before = SCB::is_pendst_pending();
+        let mut current = SYST::get_current();
+        let wrapped = SCB::is_pendst_pending();
+        if wrapped != before {
+            // It wrapped between the two looks: the count read may be from before the wrap.
+            current = SYST::get_current();
+        }
+        let periods = DRIVER.ticks.borrow(cs).get() + u64::from(wrapped);
+        periods * TICK_US * 1_000 + u64::from(SYSTICK_RELOAD - current.min(SYSTICK_RELOAD)) * NS_PER_COUNT
+    })
 }
