@@ -59,12 +59,16 @@ fn main() -> ExitCode {
             args.pose.as_deref(),
             &args.wrench,
         )),
-        C::Stream(args) => args.job().and_then(|job| stream::command::run(&job)),
+        C::Stream(args) => args
+            .job()
+            .map_err(anyhow::Error::from)
+            .and_then(|job| stream::command::run(&job)),
         C::Device(args) => args
             .request()
+            .map_err(anyhow::Error::from)
             .and_then(|(target, action)| device::run(&target, &action)),
         C::Ports => device::ports(),
-        C::Ui(args) => args.options().and_then(ui::run),
+        C::Ui(args) => args.options().map_err(anyhow::Error::from).and_then(ui::run),
         C::Simulate {
             geometry, mechanism, ..
         } => device::simulate(cli::platform(geometry, mechanism).as_ref()),

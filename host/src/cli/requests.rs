@@ -130,9 +130,38 @@ impl CueArgs {
     }
 }
 
+/// Arguments that do not go together (the combinations clap cannot express).
+#[derive(Debug, thiserror::Error)]
+pub enum RequestError {
+    /// `--capture` without a UDP source.
+    #[error("--capture records a UDP source: it needs --udp or --telemetry-udp")]
+    CaptureWithoutUdp,
+    /// `--motion sine` without all of its parameters.
+    #[error("--motion sine needs --axis, --frequency and --velocity-amplitude or --amplitude")]
+    IncompleteSine,
+    /// A sine's parameters without `--motion sine`.
+    #[error("--axis, --frequency and the amplitudes are for --motion sine")]
+    SineParametersAlone,
+    /// Words after a device action that takes none.
+    #[error("only `device config`, `jog`, `buzz`, `rig` and `aux` take further words")]
+    ExtraWords,
+    /// `--watch` with another action than `inputs`.
+    #[error("--watch is for `device inputs`")]
+    WatchAlone,
+    /// `device rig` with other words.
+    #[error("`device rig load RIG.toml` or `device rig show`")]
+    RigUsage,
+    /// `device aux` with other words.
+    #[error("usage: `device aux N on|off` with N 1 or 2")]
+    AuxUsage,
+    /// Neither `--port` nor `--sim`.
+    #[error(transparent)]
+    Target(#[from] crate::link::LinkError),
+}
+
 impl StreamArgs {
     /// The stream these arguments ask for (clap has already refused the combinations that make no sense).
-    pub fn job(&self) -> anyhow::Result<crate::stream::command::Job> {
+    pub fn job(&self) -> Result<crate::stream::command::Job, RequestError> {
         use crate::stream::command::{Datagrams, Device, Input, Job, LoadsCheck};
         let udp = |addr, holds| Input::Udp {
             addr,
@@ -141,7 +170,7 @@ impl StreamArgs {
             idle: self.udp_idle,
         };
         if self.capture.is_some() && self.udp.is_none() && self.telemetry_udp.is_none() {
-            anyhow::bail!("--capture records a UDP source: it needs --udp or --telemetry-udp");
+            return Err(RequestError::CaptureWithoutUdp);
         }
         let input = match (self.udp, self.telemetry_udp, &self.input) {
             (Some(addr), _, _) => udp(addr, Datagrams::Poses { degrees: self.degrees }),
@@ -195,7 +224,7 @@ impl StreamArgs {
 
 impl StreamArgs {
     /// `--motion sine`'s parameters: all of them for a sine, none for anything else.
-    fn sine(&self) -> anyhow::Result<Option<crate::stream::Sine>> {
+    fn sine(&self) -> Result<Option<crate::stream::Sine>, RequestError> {
         use crate::stream::{Amplitude, Motion, Sine};
         let amplitude = match (self.velocity_amplitude, self.amplitude) {
             (Some(v), _) => Some(Amplitude::Velocity(v)),
@@ -209,25 +238,23 @@ impl StreamArgs {
                 amplitude,
                 seconds: self.duration,
             })),
-            (Some(Motion::Sine), ..) => {
-                anyhow::bail!("--motion sine needs --axis, --frequency and --velocity-amplitude or --amplitude")
-            }
+            (Some(Motion::Sine), ..) => Err(RequestError::IncompleteSine),
             (_, None, None, None) => Ok(None),
-            _ => anyhow::bail!("--axis, --frequency and the amplitudes are for --motion sine"),
+            _ => Err(RequestError::SineParametersAlone),
         }
     }
 }
 
 impl DeviceArgs {
     /// The device and what to do there; words that an action does not take are refused here.
-    pub fn request(&self) -> anyhow::Result<(crate::link::Target, crate::device::Action)> {
+    pub fn request(&self) -> Result<(crate::link::Target, crate::device::Action), RequestError> {
         use crate::device::Action;
         use DeviceAction as A;
         if !matches!(self.action, A::Config | A::Jog | A::Buzz | A::Rig | A::Aux) && !self.config.is_empty() {
-            anyhow::bail!("only `device config`, `jog`, `buzz`, `rig` and `aux` take further words");
+            return Err(RequestError::ExtraWords);
         }
         if self.watch && self.action != A::Inputs {
-            anyhow::bail!("--watch is for `device inputs`");
+            return Err(RequestError::WatchAlone);
         }
         let words = self.config.clone();
         let action = match self.action {
@@ -245,7 +272,7 @@ impl DeviceArgs {
             A::Rig => match words.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
                 ["load", file] => Action::LoadRig(std::path::PathBuf::from(file)),
                 ["show"] => Action::ShowRig,
-                _ => anyhow::bail!("`device rig load RIG.toml` or `device rig show`"),
+                _ => return Err(RequestError::RigUsage),
             },
             A::Restart => Action::Restart,
             A::Aux => {
@@ -262,7 +289,7 @@ impl DeviceArgs {
                     _ => None,
                 };
                 let Some((output, on)) = parsed else {
-                    anyhow::bail!("usage: `device aux N on|off` with N 1 or 2");
+                    return Err(RequestError::AuxUsage);
                 };
                 Action::Aux { output, on }
             }
@@ -283,7 +310,7 @@ pub fn platform(geometry: &Option<std::path::PathBuf>, mechanism: &Option<String
 
 impl super::UiArgs {
     /// The workbench's options.
-    pub fn options(&self) -> anyhow::Result<crate::ui::Options> {
+    pub fn options(&self) -> Result<crate::ui::Options, RequestError> {
         Ok(crate::ui::Options {
             target: crate::link::Target::named(self.controller.port.as_deref(), self.controller.sim)?,
             platform: platform(&self.controller.geometry, &self.controller.mechanism),

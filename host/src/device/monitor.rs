@@ -16,7 +16,7 @@ use ratatui::{Frame, Terminal};
 use ringpod_core::protocol::{Telemetry, TelemetryFlags};
 use ringpod_core::safety::debounce::InputBit;
 
-use crate::link::client::{Client, Transport};
+use crate::link::client::{Client, ClientError, Transport};
 use crate::stream::record::state_name;
 
 /// What the view shows: the newest sample and how the link is doing.
@@ -188,16 +188,33 @@ fn motion<'a>(t: &Telemetry) -> Paragraph<'a> {
     .block(Block::default().borders(Borders::ALL).title(" motion (q: quit) "))
 }
 
+/// Why the monitor could not run or stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum MonitorError {
+    /// Its output is not a terminal.
+    #[error(
+        "monitor draws on a terminal, and its output is not one (`device status` or `stream --record` give the same \
+         data as text)"
+    )]
+    NotATerminal,
+    /// The device's answer.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    /// The terminal could not be drawn on.
+    #[error("terminal: {0}")]
+    Terminal(#[from] std::io::Error),
+}
+
 /// Runs the view until `q`, Esc or Ctrl-C, or for `frames` redraws. Draws ten times a second.
 pub fn run<T: Transport>(
     client: &mut Client<T>,
     source: &str,
     frames: Option<u64>,
     stop: &dyn Fn() -> bool,
-) -> anyhow::Result<()> {
+) -> Result<(), MonitorError> {
     use std::io::IsTerminal;
     if !std::io::stdout().is_terminal() {
-        anyhow::bail!("monitor draws on a terminal, and its output is not one (`device status` or `stream --record` give the same data as text)");
+        return Err(MonitorError::NotATerminal);
     }
     client.hello()?;
     client.telemetry(true)?;
@@ -220,7 +237,7 @@ fn view_loop<B: Backend, T: Transport>(
     source: &str,
     frames: Option<u64>,
     stop: &dyn Fn() -> bool,
-) -> anyhow::Result<()> {
+) -> Result<(), MonitorError> {
     let mut view = View {
         source: source.to_owned(),
         ..View::default()

@@ -6,7 +6,45 @@ use ringpod_core::protocol::MotionSettings;
 
 use super::source::{motion_pose, Source};
 use crate::link::client::{Client, ClientError, Transport};
-use crate::rig::{Drive, Rig};
+use crate::rig::{Drive, Rig, RigError};
+
+/// Why the loads could not be checked.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadsError {
+    /// The device's answer.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    /// The preset's drive data do not fit its axes.
+    #[error(transparent)]
+    Drives(#[from] RigError),
+    /// The device runs a rig of its own and no rig file was given.
+    #[error(
+        "--check-loads: the device runs {0}, whose drives this host does not know: give its rig file with --geometry"
+    )]
+    UnknownDrives(String),
+    /// A built-in motion longer than a check takes.
+    #[error(
+        "--check-loads: {} s at {} Hz is {} poses, more than the {MAX_POSES} it checks: shorten --duration or lower \
+         --rate",
+        crate::input::numbers::readable(*seconds),
+        crate::input::numbers::readable(*rate_hz),
+        crate::input::numbers::readable(*poses)
+    )]
+    TooLong {
+        /// The motion's length (s).
+        seconds: f64,
+        /// Its rate (Hz).
+        rate_hz: f64,
+        /// Poses it would take.
+        poses: f64,
+    },
+    /// A UDP source's poses are not known beforehand.
+    #[error("--check-loads needs the poses beforehand (--input or --motion)")]
+    Live,
+    /// The demand could not be computed (a pose out of reach, a bad payload).
+    #[error("--check-loads: {0}")]
+    Demand(String),
+}
 
 /// The platform whose drives are checked: the device's rig, with motor data from the rig file or the preset.
 pub struct LoadPlatform {
@@ -22,7 +60,7 @@ pub struct LoadPlatform {
 /// The platform the device runs (`GetRig`), with the drives of `rig` (the file given with `--geometry`, which the
 /// simulated device then runs) or, where the device runs a preset, the preset's. A rig of the device's own whose
 /// drives the host does not know cannot be checked: the error says to give its file.
-pub fn platform<T: Transport>(client: &mut Client<T>, rig: Option<&Rig>) -> anyhow::Result<LoadPlatform> {
+pub fn platform<T: Transport>(client: &mut Client<T>, rig: Option<&Rig>) -> Result<LoadPlatform, LoadsError> {
     let device = client.hello()?;
     let (record, _, _) = client.rig()?;
     let geometry = record
@@ -32,11 +70,7 @@ pub fn platform<T: Transport>(client: &mut Client<T>, rig: Option<&Rig>) -> anyh
     let drives = match (rig, device.preset) {
         (Some(rig), _) => rig.drives.clone(),
         (None, Some(preset)) => crate::rig::drives::check(&crate::rig::drives::of_preset(preset), &ring.axes())?,
-        (None, None) => anyhow::bail!(
-            "--check-loads: the device runs {}, whose drives this host does not know: give its rig file with \
-             --geometry",
-            record.name()
-        ),
+        (None, None) => return Err(LoadsError::UnknownDrives(record.name().to_owned())),
     };
     Ok(LoadPlatform {
         ring,
@@ -55,7 +89,7 @@ pub fn check_loads(
     source: &Source,
     payload: &Payload<f64>,
     platform: &LoadPlatform,
-) -> anyhow::Result<crate::analysis::demand::Preflight> {
+) -> Result<crate::analysis::demand::Preflight, LoadsError> {
     let rows: Vec<(usize, f64, Pose<f64>)> = match source {
         Source::Poses(p) => p.iter().map(|(line, t, pose, _)| (*line, *t, *pose)).collect(),
         Source::Motion {
@@ -66,13 +100,11 @@ pub fn check_loads(
         } => {
             let n = (seconds * rate_hz).round();
             if n > MAX_POSES as f64 {
-                anyhow::bail!(
-                    "--check-loads: {} s at {} Hz is {} poses, more than the {MAX_POSES} it checks: shorten \
-                     --duration or lower --rate",
-                    crate::input::numbers::readable(*seconds),
-                    crate::input::numbers::readable(*rate_hz),
-                    crate::input::numbers::readable(n)
-                );
+                return Err(LoadsError::TooLong {
+                    seconds: *seconds,
+                    rate_hz: *rate_hz,
+                    poses: n,
+                });
             }
             let n = n as usize;
             (0..=n)
@@ -86,8 +118,7 @@ pub fn check_loads(
                 })
                 .collect()
         }
-        Source::Udp(_) => anyhow::bail!("--check-loads needs the poses beforehand (--input or --motion)"),
+        Source::Udp(_) => return Err(LoadsError::Live),
     };
-    crate::analysis::demand::preflight(&platform.ring, &platform.drives, &rows, payload)
-        .map_err(|e| anyhow::anyhow!("--check-loads: {e}"))
+    crate::analysis::demand::preflight(&platform.ring, &platform.drives, &rows, payload).map_err(LoadsError::Demand)
 }

@@ -144,24 +144,70 @@ pub struct Run {
     pub refused: Vec<bool>,
 }
 
+/// Why a run record could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// The file could not be read.
+    #[error("{}: {reason}", path.display())]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// What is wrong with the text, in the file.
+    #[error("{}: {error}", path.display())]
+    In {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong.
+        error: Box<RecordError>,
+    },
+    /// A column of a run record is missing.
+    #[error("no column {0:?} (is it a run record?)")]
+    NoColumn(&'static str),
+    /// A row ends early.
+    #[error("line {0}: too few fields")]
+    TooFewFields(usize),
+    /// A field is not a number.
+    #[error("line {line}: {column}: not a number: {text:?}")]
+    NotANumber {
+        /// The line, from 1.
+        line: usize,
+        /// The column.
+        column: &'static str,
+        /// What it holds.
+        text: String,
+    },
+    /// There are no rows.
+    #[error("no rows")]
+    NoRows,
+}
+
 /// Reads a run record (`stream --record`).
-pub(crate) fn read(path: &Path) -> anyhow::Result<Run> {
-    let text = crate::input::files::read_text(path, crate::input::files::DATA_LIMIT)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    parse(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+pub(crate) fn read(path: &Path) -> Result<Run, RecordError> {
+    let text =
+        crate::input::files::read_text(path, crate::input::files::DATA_LIMIT).map_err(|reason| RecordError::File {
+            path: path.to_path_buf(),
+            reason,
+        })?;
+    parse(&text).map_err(|e| RecordError::In {
+        path: path.to_path_buf(),
+        error: Box::new(e),
+    })
 }
 
 /// A run record's text.
-pub fn parse(text: &str) -> anyhow::Result<Run> {
+pub fn parse(text: &str) -> Result<Run, RecordError> {
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let col = |name: &str| {
+    let col = |name: &'static str| {
         header
             .iter()
             .position(|h| h.trim() == name)
-            .ok_or_else(|| anyhow::anyhow!("no column {name:?} (is it a run record?)"))
+            .ok_or(RecordError::NoColumn(name))
     };
-    let index: Vec<usize> = COLUMNS.iter().map(|c| col(c)).collect::<anyhow::Result<_>>()?;
+    let index: Vec<usize> = COLUMNS.iter().map(|c| col(c)).collect::<Result<_, _>>()?;
     let mut run = Run {
         t: Vec::new(),
         commanded: Vec::new(),
@@ -176,15 +222,15 @@ pub fn parse(text: &str) -> anyhow::Result<Run> {
             continue;
         }
         let fields: Vec<&str> = line.split(',').collect();
-        let number = |k: usize| -> anyhow::Result<f64> {
-            let f = fields
-                .get(index[k])
-                .ok_or_else(|| anyhow::anyhow!("line {}: too few fields", n + 2))?;
-            f.trim()
-                .parse::<f64>()
-                .map_err(|_| anyhow::anyhow!("line {}: {}: not a number: {f:?}", n + 2, COLUMNS[k]))
+        let number = |k: usize| -> Result<f64, RecordError> {
+            let f = fields.get(index[k]).ok_or(RecordError::TooFewFields(n + 2))?;
+            f.trim().parse::<f64>().map_err(|_| RecordError::NotANumber {
+                line: n + 2,
+                column: COLUMNS[k],
+                text: (*f).to_owned(),
+            })
         };
-        let six = |from: usize| -> anyhow::Result<[f64; 6]> {
+        let six = |from: usize| -> Result<[f64; 6], RecordError> {
             let mut v = [0.0; 6];
             for (i, slot) in v.iter_mut().enumerate() {
                 *slot = number(from + i)?;
@@ -200,7 +246,7 @@ pub fn parse(text: &str) -> anyhow::Result<Run> {
         run.refused.push(number(22)? != 0.0);
     }
     if run.t.is_empty() {
-        anyhow::bail!("no rows");
+        return Err(RecordError::NoRows);
     }
     // The device keeps yaw within a turn and a source may wrap it too: draw each angle continuous.
     for series in [&mut run.commanded, &mut run.target] {
