@@ -139,6 +139,30 @@ pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
     Ok((text, code))
 }
 
+/// Why a drive could not be cued.
+#[derive(Debug, thiserror::Error)]
+pub enum CueError {
+    /// The washout refused its configuration.
+    #[error("{0}")]
+    Washout(cueing::ConfigError),
+    /// The input could not be read, or is not telemetry (a CSV or a packet capture).
+    #[error("{}: {reason}", path.display())]
+    Input {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        reason: String,
+    },
+    /// The poses could not be written.
+    #[error("{}: {source}", path.display())]
+    Output {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+}
+
 /// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`,
 /// every pose limited into the envelope.
 pub fn replay(
@@ -146,9 +170,9 @@ pub fn replay(
     config: cueing::CueConfig,
     mechanism: &RingPlatform<f64>,
     neutral: &Pose<f64>,
-) -> anyhow::Result<Replay> {
+) -> Result<Replay, CueError> {
     let margins = EnvelopeMargins::default();
-    let mut washout = Washout::<f64>::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut washout = Washout::<f64>::new(config).map_err(CueError::Washout)?;
     let mut errors = Vec::new();
     let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
     let mut limited = 0;
@@ -201,34 +225,38 @@ pub fn replay(
 #[allow(clippy::type_complexity)]
 fn read_input(
     args: &Options,
-) -> anyhow::Result<(
-    Vec<(usize, Vec<f64>)>,
-    Vec<InputError>,
-    Option<super::cue_capture::CaptureSummary>,
-)> {
-    let name = args.input.display();
-    let bytes = crate::input::files::read_bytes(args.input, crate::input::files::DATA_LIMIT)
-        .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+) -> Result<
+    (
+        Vec<(usize, Vec<f64>)>,
+        Vec<InputError>,
+        Option<super::cue_capture::CaptureSummary>,
+    ),
+    CueError,
+> {
+    let bad = |reason: String| CueError::Input {
+        path: args.input.to_path_buf(),
+        reason,
+    };
+    let bytes = crate::input::files::read_bytes(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
     if crate::input::capture::is_capture(&bytes) {
         let format = args
             .telemetry_format
             .unwrap_or(crate::stream::datagram::TelemetryFormat::Auto);
         let (rows, errors, summary) =
-            super::cue_capture::rows(&bytes, format, args.udp_port).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+            super::cue_capture::rows(&bytes, format, args.udp_port).map_err(|e| bad(e.to_string()))?;
         return Ok((rows, errors, Some(summary)));
     }
     if args.telemetry_format.is_some() || args.udp_port.is_some() {
-        anyhow::bail!(
-            "{name}: --telemetry-format and --udp-port are for a packet capture (pcap, pcapng); this is not one"
-        );
+        return Err(bad(
+            "--telemetry-format and --udp-port are for a packet capture (pcap, pcapng); this is not one".into(),
+        ));
     }
-    let text = crate::input::files::read_text(args.input, crate::input::files::DATA_LIMIT)
-        .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
-    let (rows, errors) = table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    let text = crate::input::files::read_text(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
+    let (rows, errors) = table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| bad(e.to_string()))?;
     Ok((rows, errors, None))
 }
 
-fn write_poses(path: &Path, cued: &[Cued]) -> anyhow::Result<()> {
+fn write_poses(path: &Path, cued: &[Cued]) -> Result<(), CueError> {
     let write = || -> std::io::Result<()> {
         let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
         writeln!(out, "t,x,y,z,alpha,beta,gamma")?;
@@ -242,7 +270,10 @@ fn write_poses(path: &Path, cued: &[Cued]) -> anyhow::Result<()> {
         }
         out.flush()
     };
-    write().map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    write().map_err(|source| CueError::Output {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The specific force the platform delivers at each sample (platform axes): its acceleration by central

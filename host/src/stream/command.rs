@@ -80,20 +80,54 @@ pub struct Job {
     pub report_json: bool,
 }
 
+/// Why a stream's source could not be opened.
+#[derive(Debug, thiserror::Error)]
+pub enum SourceError {
+    /// A number of a stream option out of its range.
+    #[error("--{name} {}: must be a number of at most {max:e}, above 0", numbers::readable(*value))]
+    Option {
+        /// The option.
+        name: &'static str,
+        /// What was given.
+        value: f64,
+        /// Its largest value.
+        max: f64,
+    },
+    /// The cueing file.
+    #[error(transparent)]
+    Cueing(#[from] crate::input::cueing::CueingFileError),
+    /// The washout refused its configuration.
+    #[error("cueing: {0}")]
+    Washout(ringpod_core::cueing::ConfigError),
+    /// The UDP address could not be bound.
+    #[error("{addr}: {source}")]
+    Bind {
+        /// The address.
+        addr: std::net::SocketAddr,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The pose file could not be read, or is not a pose file.
+    #[error("{}: {reason}", path.display())]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        reason: String,
+    },
+}
+
 /// A number of a stream option: finite, above 0 and at most `max`.
-fn positive(name: &str, v: f64, max: f64) -> anyhow::Result<f64> {
+fn positive(name: &'static str, v: f64, max: f64) -> Result<f64, SourceError> {
     if v.is_finite() && v > 0.0 && v <= max {
         Ok(v)
     } else {
-        anyhow::bail!(
-            "--{name} {}: must be a number of at most {max:e}, above 0",
-            numbers::readable(v)
-        )
+        Err(SourceError::Option { name, value: v, max })
     }
 }
 
 /// Opens the source: its poses, and the lines of a file that could not be read (already printed).
-pub(crate) fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputError>)> {
+pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), SourceError> {
     Ok(match input {
         Input::Udp {
             addr,
@@ -109,7 +143,7 @@ pub(crate) fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputErr
                     profile,
                 } => {
                     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
-                    let washout = ringpod_core::cueing::Live::new(config).map_err(|e| anyhow::anyhow!("{e}"))?;
+                    let washout = ringpod_core::cueing::Live::new(config).map_err(SourceError::Washout)?;
                     datagram::Decoder::Telemetry {
                         format: *format,
                         washout: Box::new(washout),
@@ -124,7 +158,7 @@ pub(crate) fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputErr
                 }
             };
             let idle = positive("udp-idle", *idle, 1e6)?;
-            let socket = std::net::UdpSocket::bind(addr).map_err(|e| anyhow::anyhow!("{addr}: {e}"))?;
+            let socket = std::net::UdpSocket::bind(addr).map_err(|source| SourceError::Bind { addr: *addr, source })?;
             let source = UdpSource {
                 socket,
                 decoder,
@@ -135,10 +169,12 @@ pub(crate) fn open(input: &Input) -> anyhow::Result<(Source, Vec<super::InputErr
             (Source::Udp(source), Vec::new())
         }
         Input::File { path, degrees } => {
-            let text =
-                files::read_text(path, files::DATA_LIMIT).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-            let (poses, errors) =
-                super::read_csv(&text, *degrees).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+            let in_file = |reason| SourceError::File {
+                path: path.clone(),
+                reason,
+            };
+            let text = files::read_text(path, files::DATA_LIMIT).map_err(in_file)?;
+            let (poses, errors) = super::read_csv(&text, *degrees).map_err(in_file)?;
             for e in &errors {
                 eprintln!("{}: line {}: {}", path.display(), e.line, e.reason);
             }
