@@ -166,7 +166,7 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
     let _ = std::fs::remove_file(&cue_file);
     let (signals, device) = served?;
     match device.join() {
-        Ok(Err(e)) => Err(e.context("the device")),
+        Ok(Err(e)) => Err(anyhow::Error::from(e).context("the device")),
         Err(_) => anyhow::bail!("the device thread failed"),
         Ok(Ok(())) if signals.received() => {
             eprintln!("ringpod ui: stopped by {}", signals.name());

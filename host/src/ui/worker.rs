@@ -21,6 +21,47 @@ use crate::link::{self, Target};
 use crate::stream::command::{self as job, Datagrams, Input};
 use crate::stream::{self, Motion, Source};
 
+/// Why the device thread could not start, or a page's request was not done (sent back to the page in words).
+#[derive(Debug, thiserror::Error)]
+pub enum WorkerError {
+    /// The device's answer.
+    #[error(transparent)]
+    Client(#[from] ClientError),
+    /// No link to the device.
+    #[error(transparent)]
+    Link(#[from] crate::link::LinkError),
+    /// A jog or buzz.
+    #[error(transparent)]
+    Commission(#[from] crate::device::commission::CommissionError),
+    /// A stream's source.
+    #[error(transparent)]
+    Source(#[from] crate::stream::command::SourceError),
+    /// A rig file from the page.
+    #[error(transparent)]
+    Rig(#[from] crate::rig::RigError),
+    /// Loading the rig onto the device.
+    #[error(transparent)]
+    DeviceRig(#[from] crate::rig::device::DeviceRigError),
+    /// A message for the pages.
+    #[error("JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    /// The rig the device runs is not a valid geometry.
+    #[error("the device's rig does not check: {0}")]
+    DeviceGeometry(ringpod_core::kinematics::GeometryError),
+    /// The stream could not be started.
+    #[error("the stream did not start: {0}")]
+    NotStarted(ClientError),
+    /// The page named something there is not (an axis, a motion, a format, what a UDP session holds).
+    #[error("{0}")]
+    NoSuch(String),
+    /// A rig is loaded only with the supplies off.
+    #[error("a rig is loaded with the supplies off: Disable first")]
+    NotOff,
+    /// A stream or a park that did not end at the pose asked: its report's words.
+    #[error("{0}")]
+    Ended(String),
+}
+
 /// Frames a page is sent per second at most (a browser draws at 60; telemetry may come at 1 kHz).
 pub const FRAME_HZ: f64 = 50.0;
 
@@ -158,7 +199,7 @@ pub fn run(
     rig: Option<crate::rig::Rig>,
     hub: Arc<Hub>,
     jobs: mpsc::Receiver<Job>,
-) -> anyhow::Result<()> {
+) -> Result<(), WorkerError> {
     let transport = match (&target, &rig) {
         (_, Some(r)) => AnyTransport::Sim(Box::new(SimDevice::for_rig(true, r)?)),
         _ => link::connect(&target, true)?,
@@ -206,19 +247,18 @@ pub fn run(
 }
 
 /// Reads the rig the device runs, tells the pages, and gives its mechanism.
-fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> anyhow::Result<RingPlatform<f64>> {
+fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlatform<f64>, WorkerError> {
     let (record, source, _) = client.rig()?;
     if let RigSource::Refused(_) | RigSource::Unreadable = source {
         eprintln!("warning: {source}");
     }
-    let geometry = record
-        .geometry()
-        .map_err(|e| anyhow::anyhow!("the device's rig does not check: {e}"))?;
+    let geometry = record.geometry().map_err(WorkerError::DeviceGeometry)?;
     let view = RigView::of(&geometry, record.home, source.to_string());
     let mut message = serde_json::to_value(view)?;
     message["type"] = json!("rig");
-    *hub.rig.lock().map_err(|_| anyhow::anyhow!("rig lock poisoned"))? = Some(message.to_string());
-    *hub.record.lock().map_err(|_| anyhow::anyhow!("rig lock poisoned"))? = Some(record);
+    // A poisoned lock only means a page's thread panicked while holding it: the value is still the rig's.
+    *hub.rig.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(message.to_string());
+    *hub.record.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(record);
     hub.publish(&message);
     Ok(RingPlatform::new(&geometry))
 }
@@ -255,12 +295,12 @@ impl Device {
                 seconds,
                 rate_hz,
             } => clap::ValueEnum::from_str(motion, true)
-                .map_err(|e| anyhow::anyhow!("motion {motion:?}: {e}"))
+                .map_err(|e| WorkerError::NoSuch(format!("motion {motion:?}: {e}")))
                 .and_then(|motion: Motion| {
                     if motion == Motion::Sine {
-                        anyhow::bail!(
-                            "the sine needs its axis, frequency and amplitude: `ringpod stream --motion sine`"
-                        );
+                        return Err(WorkerError::NoSuch(
+                            "the sine needs its axis, frequency and amplitude: `ringpod stream --motion sine`".into(),
+                        ));
                     }
                     self.stream(
                         job.page,
@@ -295,7 +335,7 @@ impl Device {
     }
 
     /// STOP: ends a stream (its owner already saw the flag), ramps whatever moves to rest, powers down.
-    fn halt(&mut self) -> anyhow::Result<String> {
+    fn halt(&mut self) -> Result<String, WorkerError> {
         self.hub.halt.store(false, Ordering::SeqCst);
         let status = self.client.status()?;
         if matches!(status.state, State::Running | State::Homing | State::Jogging) {
@@ -313,26 +353,30 @@ impl Device {
         Ok("stopped and powering down".to_owned())
     }
 
-    fn commission(&mut self, axis: u8, distance: Option<f64>) -> anyhow::Result<String> {
+    fn commission(&mut self, axis: u8, distance: Option<f64>) -> Result<String, WorkerError> {
         if !(1..=6).contains(&axis) {
-            anyhow::bail!("axis {axis} does not exist (1-6)");
+            return Err(WorkerError::NoSuch(format!("axis {axis} does not exist (1-6)")));
         }
-        let kind = match self.mechanism.lock() {
-            Ok(m) => m.axes()[usize::from(axis - 1)],
-            Err(_) => anyhow::bail!("the mechanism is not known"),
-        };
+        let kind = self
+            .mechanism
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .axes()[usize::from(axis - 1)];
         let what = crate::device::commission::begin_move(&mut self.client, axis - 1, kind, distance)?;
         Ok(format!("axis {axis} {what}; home again before streaming"))
     }
 
     /// To the home pose (powering up and homing first if needed), then powered down.
-    fn park(&mut self, page: u64) -> anyhow::Result<String> {
+    fn park(&mut self, page: u64) -> Result<String, WorkerError> {
         let (record, _, _) = self.client.rig()?;
         let home = Pose::from_array(record.home);
         let poses = vec![(1, 0.0, home, [None; 2]), (2, 1.0, home, [None; 2])];
         let report = self.run(page, Source::Poses(poses), Vec::new())?;
         if report.exit_code != stream::exit::FOLLOWED {
-            anyhow::bail!("park: {}", report.reason.as_deref().unwrap_or(report.outcome));
+            return Err(WorkerError::Ended(format!(
+                "park: {}",
+                report.reason.as_deref().unwrap_or(report.outcome)
+            )));
         }
         self.client.disable()?;
         Ok("parked at home and powering down".to_owned())
@@ -346,16 +390,20 @@ impl Device {
         format: Option<&str>,
         degrees: bool,
         idle: f64,
-    ) -> anyhow::Result<String> {
+    ) -> Result<String, WorkerError> {
         let holds = match holds {
             "poses" => Datagrams::Poses { degrees },
             "telemetry" => Datagrams::Telemetry {
                 format: clap::ValueEnum::from_str(format.unwrap_or("auto"), true)
-                    .map_err(|e| anyhow::anyhow!("telemetry format: {e}"))?,
+                    .map_err(|e| WorkerError::NoSuch(format!("telemetry format: {e}")))?,
                 cue_config: Some(self.hub.cue_file.clone()),
                 profile: None,
             },
-            other => anyhow::bail!("a UDP session holds `poses` or `telemetry`, not {other:?}"),
+            other => {
+                return Err(WorkerError::NoSuch(format!(
+                    "a UDP session holds `poses` or `telemetry`, not {other:?}"
+                )))
+            }
         };
         self.stream(
             page,
@@ -368,7 +416,7 @@ impl Device {
         )
     }
 
-    fn stream(&mut self, page: u64, input: &Input) -> anyhow::Result<String> {
+    fn stream(&mut self, page: u64, input: &Input) -> Result<String, WorkerError> {
         let (source, errors) = job::open(input)?;
         let report = self.run(page, source, errors)?;
         let text = format!(
@@ -386,12 +434,17 @@ impl Device {
         if report.exit_code == stream::exit::FOLLOWED || report.exit_code == stream::exit::INTERRUPTED {
             Ok(text)
         } else {
-            anyhow::bail!(text)
+            Err(WorkerError::Ended(text))
         }
     }
 
     /// Runs a stream as `ringpod stream` does (powering up and homing first if needed), owned by `page`.
-    fn run(&mut self, page: u64, source: Source, errors: Vec<stream::InputError>) -> anyhow::Result<stream::Report> {
+    fn run(
+        &mut self,
+        page: u64,
+        source: Source,
+        errors: Vec<stream::InputError>,
+    ) -> Result<stream::Report, WorkerError> {
         self.hub.halt.store(false, Ordering::SeqCst);
         self.hub.streaming.store(page, Ordering::SeqCst);
         self.client.cancel = Some(self.hub.halt.clone());
@@ -416,13 +469,13 @@ impl Device {
         self.hub.streaming.store(0, Ordering::SeqCst);
         // Telemetry stays on for the pages whatever the stream did with it.
         self.client.telemetry(true)?;
-        report.map_err(|e: ClientError| anyhow::anyhow!("the stream did not start: {e}"))
+        report.map_err(WorkerError::NotStarted)
     }
 
-    fn load_rig(&mut self, text: &str) -> anyhow::Result<String> {
+    fn load_rig(&mut self, text: &str) -> Result<String, WorkerError> {
         let file = crate::rig::parse(text)?;
         if self.client.status()?.state != State::Off {
-            anyhow::bail!("a rig is loaded with the supplies off: Disable first");
+            return Err(WorkerError::NotOff);
         }
         crate::rig::device::store(&mut self.client, &file)?;
         let restarted = crate::rig::device::restart(&mut self.client)?;
