@@ -444,7 +444,7 @@ pub fn run(job: &Job, json: bool) -> Result<Outcome, CliError> {
 }
 
 /// Each axis's demand against what its drive gives at the speed it turns.
-fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> anyhow::Result<()> {
+fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> Result<(), plot::PlotError> {
     let panels = (0..6)
         .map(|k| {
             let mut series = vec![Series::new(
@@ -478,7 +478,7 @@ fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> anyhow::Result<
         ),
         panels,
     };
-    Ok(plot::save(out, (1000, 1300), &plot)?)
+    plot::save(out, (1000, 1300), &plot)
 }
 
 #[cfg(test)]

@@ -6,7 +6,6 @@ mod picture;
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use ringpod_core::kinematics::geometry::DEG;
-use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 
 use crate::analysis::mechanism::AnyMechanism;
@@ -74,7 +73,7 @@ struct Scanned {
 }
 
 /// A rig file's ring platform or a preset's mechanism.
-fn scanned(args: &Options) -> anyhow::Result<Scanned> {
+fn scanned(args: &Options) -> Result<Scanned, crate::error::CliError> {
     if let Some(path) = args.geometry {
         let rig = crate::rig::load_platform(path)?;
         let m = RingPlatform::new(&rig.geometry);
@@ -86,9 +85,7 @@ fn scanned(args: &Options) -> anyhow::Result<Scanned> {
             ranges: rig.ranges,
         });
     }
-    let preset =
-        Preset::from_name(args.mechanism).ok_or_else(|| anyhow::anyhow!("unknown mechanism `{}`", args.mechanism))?;
-    let (_, m) = AnyMechanism::by_name(args.mechanism)?;
+    let (preset, m) = AnyMechanism::by_name(args.mechanism)?;
     let bounds = match &m {
         AnyMechanism::Ring(r) => ring_bounds(r),
         AnyMechanism::Tool(t) => tool_bounds(t.geometry()),
