@@ -143,7 +143,7 @@ pub enum Platform {
 
 impl Platform {
     /// The rig to simulate: none for the trainer model (compiled in).
-    pub fn rig(platform: Option<&Platform>) -> anyhow::Result<Option<crate::rig::Rig>> {
+    pub fn rig(platform: Option<&Platform>) -> Result<Option<crate::rig::Rig>, crate::error::CliError> {
         Ok(match platform {
             None => None,
             Some(Platform::File(path)) => Some(crate::rig::load(path)?),

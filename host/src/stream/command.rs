@@ -218,7 +218,7 @@ fn loads_keep_up<T: client::Transport>(
     source: &Source,
     client: &mut client::Client<T>,
     rig: Option<&crate::rig::Rig>,
-) -> anyhow::Result<bool> {
+) -> Result<bool, super::loads::LoadsError> {
     let payload = ringpod_core::kinematics::Payload {
         mass: numbers::mass(check.mass)?,
         inertia: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::from(numbers::inertia(

@@ -41,6 +41,9 @@ pub enum LoadsError {
     /// A UDP source's poses are not known beforehand.
     #[error("--check-loads needs the poses beforehand (--input or --motion)")]
     Live,
+    /// The payload's mass or inertia.
+    #[error(transparent)]
+    Payload(#[from] crate::input::numbers::BadNumber),
     /// The demand could not be computed (a pose out of reach, a bad payload).
     #[error("--check-loads: {0}")]
     Demand(String),
