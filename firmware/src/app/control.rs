@@ -29,17 +29,6 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
     let mut n = 0u32;
     loop {
         ticker.next().await;
-        // After a hold-up longer than a period (a flash erase, a burst of link traffic) the ticker catches up the
-        // ticks it missed at once, while the step generator played those periods empty: the catch-up moves would
-        // then wait in the queue, every later tick's moves behind them, for the rest of the session (measured on
-        // the QEMU controller: 4 periods queued, 6-7 ms from a setpoint to its first step instead of 1-2). A tick
-        // that finds the queue `AHEAD` is skipped instead: the controller's clock gives up that period (its
-        // timers run a period late), nothing it has computed is lost, and the queue drains to its steady depth.
-        if shared.steps.len() >= super::AHEAD {
-            shared.skipped_ticks.fetch_add(1, Ordering::Relaxed);
-            machine.feed_watchdog();
-            continue;
-        }
         let inputs = Inputs::from_word(shared.inputs.load(Ordering::Relaxed));
         let step_fault = shared.step_fault.swap(false, Ordering::Relaxed);
         let start = machine.cycles();
@@ -67,14 +56,7 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
         worst = worst.max(cost);
         n = n.wrapping_add(1);
         if n.is_multiple_of(5_000) {
-            defmt::info!(
-                "tick: {} cycles (worst {}), step queue {}, {} ticks skipped, {} periods empty",
-                cost,
-                worst,
-                depth,
-                shared.skipped_ticks.load(Ordering::Relaxed),
-                shared.step_underruns.load(Ordering::Relaxed)
-            );
+            defmt::info!("tick: {} cycles (worst {}), step queue {}", cost, worst, depth);
         }
         machine.feed_watchdog();
     }

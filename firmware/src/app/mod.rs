@@ -29,11 +29,6 @@ pub const LINKS: usize = 2;
 /// Periods of step moves the control tick may run ahead of the step generator.
 pub const STEP_QUEUE: usize = 4;
 
-/// Periods queued at a control tick from which the tick is skipped, so that the step generator drains the queue
-/// back (see [`control::run`]). In steady state the tick finds at most one period queued whatever the phase of the
-/// two clocks (one move is added and one played each period), so only a burst after a hold-up reaches two.
-pub const AHEAD: usize = 2;
-
 /// What the tasks share. The controller is only touched from thread mode (link, control, inputs, settings),
 /// briefly and never across an `.await`; the step queue crosses to the step generator's interrupt priority.
 pub struct Shared {
@@ -50,8 +45,6 @@ pub struct Shared {
     pub inputs: AtomicU16,
     /// Periods the step generator had to fill with no steps because the queue was empty.
     pub step_underruns: AtomicU32,
-    /// Control ticks skipped because the queue was [`AHEAD`] periods ahead of the step generator.
-    pub skipped_ticks: AtomicU32,
     /// The step generator found its buffer overrun (the DMA lapped it): a fault for the control tick to latch.
     pub step_fault: core::sync::atomic::AtomicBool,
 }
@@ -68,7 +61,6 @@ impl Shared {
             steps: Channel::new(),
             inputs: AtomicU16::new(inputs),
             step_underruns: AtomicU32::new(0),
-            skipped_ticks: AtomicU32::new(0),
             step_fault: core::sync::atomic::AtomicBool::new(false),
         }
     }
