@@ -29,6 +29,12 @@ pub const LINKS: usize = 2;
 /// Periods of step moves the control tick may run ahead of the step generator.
 pub const STEP_QUEUE: usize = 4;
 
+/// Periods queued at a control tick from which the period is passed (`control::pass`), so that the step
+/// generator drains the queue back. A tick held before the generator's boundary (`motion::phase`) finds the queue
+/// empty: the previous tick's moves were taken at the boundary between them. Only a catch-up after a hold-up, or
+/// the one period a phase correction gives two ticks, finds a period queued.
+pub const AHEAD: usize = 1;
+
 /// What the tasks share. The controller is only touched from thread mode (link, control, inputs, settings),
 /// briefly and never across an `.await`; the step queue crosses to the step generator's interrupt priority.
 pub struct Shared {
@@ -45,6 +51,13 @@ pub struct Shared {
     pub inputs: AtomicU16,
     /// Periods the step generator had to fill with no steps because the queue was empty.
     pub step_underruns: AtomicU32,
+    /// Control periods passed because the queue was [`AHEAD`] periods ahead of the step generator.
+    pub passes: AtomicU32,
+    /// When the step generator last took a period from the queue (device microseconds, wrapping): its period
+    /// boundary, which the control tick keeps its phase to.
+    pub boundary_us: AtomicU32,
+    /// Control ticks moved to their phase (`motion::phase`): once at start, and after a hold-up.
+    pub rephased: AtomicU32,
     /// The step generator found its buffer overrun (the DMA lapped it): a fault for the control tick to latch.
     pub step_fault: core::sync::atomic::AtomicBool,
 }
@@ -61,6 +74,9 @@ impl Shared {
             steps: Channel::new(),
             inputs: AtomicU16::new(inputs),
             step_underruns: AtomicU32::new(0),
+            passes: AtomicU32::new(0),
+            boundary_us: AtomicU32::new(0),
+            rephased: AtomicU32::new(0),
             step_fault: core::sync::atomic::AtomicBool::new(false),
         }
     }

@@ -4,6 +4,7 @@
 
 use core::sync::atomic::Ordering;
 
+use embassy_time::Instant;
 use ringpod_core::motion::pulse::PulseRenderer;
 use ringpod_core::motion::pulse::MAX_STEP_SLOTS;
 use ringpod_core::motion::{AxisMove, Direction};
@@ -18,6 +19,13 @@ pub struct Overrun;
 pub trait PortOutput {
     /// Queues one period of words; waits until the hardware has room.
     async fn write(&mut self, words: &[u32]) -> Result<(), Overrun>;
+
+    /// When the hardware last made room for a period (a period boundary), if the port knows it better than the
+    /// moment `write` returned; a port whose `write` wakes at interrupt priority and does nothing after the wait
+    /// leaves it to that moment.
+    fn boundary(&self) -> Option<Instant> {
+        None
+    }
 }
 
 /// Feeds the port forever. An empty queue becomes a period without steps (counted, never a lost step: the
@@ -34,6 +42,11 @@ pub async fn run(port: &mut impl PortOutput, mut renderer: PulseRenderer, shared
     }; 6];
     let mut words = [0u32; MAX_STEP_SLOTS];
     loop {
+        // The previous write returned when the hardware had room: a period boundary.
+        let boundary = port.boundary().unwrap_or_else(Instant::now);
+        shared
+            .boundary_us
+            .store(super::control::micros(boundary), Ordering::Relaxed);
         let moves = match shared.steps.try_receive() {
             Ok(m) => m,
             Err(_) => {

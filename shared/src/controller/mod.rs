@@ -307,14 +307,7 @@ impl Controller {
 
     /// One control period.
     pub fn tick(&mut self) -> TickOutput {
-        let tick_us = self.pipeline.config().tick_us;
-        self.telemetry_tick(tick_us);
-        self.elapsed_us = self.elapsed_us.saturating_add(tick_us);
-        if self.elapsed_us >= 1000 {
-            let ms = self.elapsed_us / 1000;
-            self.elapsed_us %= 1000;
-            self.event(Event::Elapsed(ms));
-        }
+        let tick_us = self.advance_clock();
         let position = self.scheduler.position();
         let outputs = self.supervisor.outputs();
         let targets = match outputs.motion {
@@ -346,6 +339,32 @@ impl Controller {
             moves: self.scheduler.plan(&targets),
             outputs,
         }
+    }
+
+    /// A control period that plans no motion, for a firmware whose step generator is already far enough ahead:
+    /// after a hold-up of the control loop (a flash erase, a burst of link traffic) the periods it missed are
+    /// caught up at once, while the step generator played them empty. Ticking them would queue their moves behind
+    /// each other and every later period's behind those, for the rest of the session. A pass keeps the clocks
+    /// (device time, the supervisor's timers, telemetry) as [`Controller::tick`] would, so a supply sequence or a
+    /// power-down ends when it is due; motion is not advanced, because the motors did not move in the periods the
+    /// hold-up cost: the pipeline, homing and jogging continue from where they were, one period later. Returns
+    /// the outputs, which a timer may have changed.
+    pub fn pass(&mut self) -> Outputs {
+        self.advance_clock();
+        self.supervisor.outputs()
+    }
+
+    /// Advances device time and the supervisor's timers by one period; returns the period (us).
+    fn advance_clock(&mut self) -> u32 {
+        let tick_us = self.pipeline.config().tick_us;
+        self.telemetry_tick(tick_us);
+        self.elapsed_us = self.elapsed_us.saturating_add(tick_us);
+        if self.elapsed_us >= 1000 {
+            let ms = self.elapsed_us / 1000;
+            self.elapsed_us %= 1000;
+            self.event(Event::Elapsed(ms));
+        }
+        tick_us
     }
 
     /// Advances device time; a telemetry sample falls due every `tick rate / telemetry rate` ticks while the

@@ -5,6 +5,7 @@
 pub mod envelope;
 pub mod jog;
 pub mod limits;
+pub mod phase;
 pub mod pipeline;
 pub mod pulse;
 pub mod scheduler;

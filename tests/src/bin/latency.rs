@@ -32,6 +32,7 @@ use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::{envelope, EnvelopeMargins, FollowMode, Setpoint};
 use ringpod_core::protocol::{self, HostMessage, Request};
 use ringpod_core::selfcheck;
+use ringpod_tests::emulator;
 
 /// Median and 99th percentile.
 fn spread(mut v: Vec<f64>) -> (f64, f64) {
@@ -169,39 +170,12 @@ struct Emulated {
 const ICOUNT_SHIFT: u32 = 3;
 
 /// Part 4: the QEMU controller in `follow` mode (`tests/qemu`, built here), or why not.
-fn emulated(direct: bool) -> Result<Vec<Emulated>, String> {
-    let qemu_dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("qemu");
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let built = std::process::Command::new(cargo)
-        .current_dir(&qemu_dir)
-        .args(["build", "--release", "--bin", "ringpod-qemu-controller"])
-        .status()
-        .map_err(|e| format!("cargo: {e}"))?;
-    if !built.success() {
-        return Err("building the QEMU controller failed".into());
-    }
-    let elf = qemu_dir.join("target/thumbv7em-none-eabihf/release/ringpod-qemu-controller");
-    let args = if direct {
-        ",arg=latency,arg=direct"
-    } else {
-        ",arg=latency"
-    };
-    let out = std::process::Command::new("qemu-system-arm")
-        .args([
-            "-machine",
-            "mps2-an386",
-            "-cpu",
-            "cortex-m4",
-            "-nographic",
-            "-monitor",
-            "none",
-        ])
-        .arg("-semihosting-config")
-        .arg(format!("enable=on,target=native{args}"))
-        .arg("-icount")
-        .arg(format!("shift={ICOUNT_SHIFT},sleep=off"))
-        .args(["-serial", "null", "-kernel"])
-        .arg(elf)
+/// Returns the measurements and the program's `QUEUE` lines (the step queue and its counters at each stage).
+fn emulated(direct: bool) -> Result<(Vec<Emulated>, Vec<String>), String> {
+    let elf = emulator::build("ringpod-qemu-controller")?;
+    let args: &[&str] = if direct { &["latency", "direct"] } else { &["latency"] };
+    let out = emulator::qemu(&elf, Some(&format!("shift={ICOUNT_SHIFT},sleep=off")), args)
+        .args(["-serial", "null"])
         .stdin(std::process::Stdio::null())
         .output()
         .map_err(|e| format!("qemu-system-arm: {e} (apt-get install qemu-system-arm)"))?;
@@ -209,7 +183,13 @@ fn emulated(direct: bool) -> Result<Vec<Emulated>, String> {
     if !text.lines().any(|l| l == "LATENCY done") {
         return Err(format!("the QEMU controller did not finish: {text}"));
     }
-    text.lines()
+    let queue = text
+        .lines()
+        .filter(|l| l.starts_with("QUEUE "))
+        .map(str::to_string)
+        .collect();
+    let measured = text
+        .lines()
         .filter_map(|l| l.strip_prefix("LATENCY "))
         .filter(|l| *l != "done")
         .map(|l| {
@@ -227,7 +207,8 @@ fn emulated(direct: bool) -> Result<Vec<Emulated>, String> {
                 depth: n(5)? as u32,
             })
         })
-        .collect()
+        .collect::<Result<_, String>>()?;
+    Ok((measured, queue))
 }
 
 fn main() {
@@ -303,7 +284,7 @@ fn main() {
     for case in ["braking", "surge-0.1mm", "surge-1mm"] {
         for (mode, run) in &runs {
             let run = match run {
-                Ok(r) => r,
+                Ok((r, _)) => r,
                 Err(e) => {
                     println!("| {case} | {mode} | not measured: {e} | | | | | |");
                     continue;
@@ -327,6 +308,14 @@ fn main() {
                 depths.iter().max().unwrap_or(&0),
                 if worst <= goal / 1000.0 { "met" } else { "not met" }
             );
+        }
+    }
+    println!();
+    for (mode, run) in &runs {
+        if let Ok((_, queue)) = run {
+            for line in queue {
+                println!("{mode}: {line}");
+            }
         }
     }
 }

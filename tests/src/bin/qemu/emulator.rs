@@ -2,8 +2,11 @@
 //! end under a time limit, or starting the controller program with its UART on a pseudo-terminal.
 
 use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::path::Path;
+use std::process::Stdio;
+
+pub(crate) use ringpod_tests::emulator::build;
+use ringpod_tests::emulator::qemu;
 use std::time::{Duration, Instant};
 
 use crate::Tally;
@@ -11,54 +14,9 @@ use crate::Tally;
 /// Longest a QEMU run may take before it is killed and counted as failed.
 pub(crate) const QEMU_LIMIT: Duration = Duration::from_secs(240);
 
-pub(crate) fn qemu_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("qemu")
-}
-
-/// Builds the `tests/qemu` workspace for the M4F (its own `.cargo/config.toml` selects the target, so cargo runs
-/// in that folder).
-pub(crate) fn build(bin: &str) -> Result<PathBuf, String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(qemu_dir())
-        .args(["build", "--release", "--bin", bin])
-        .status()
-        .map_err(|e| format!("cargo: {e}"))?;
-    if !status.success() {
-        return Err(format!("building {bin} failed"));
-    }
-    Ok(qemu_dir().join("target/thumbv7em-none-eabihf/release").join(bin))
-}
-
-/// QEMU's command line for an ELF on mps2-an386 with semihosting; `args` are the program's semihosting command line.
-/// With `icount`, virtual time advances one nanosecond per instruction (the instruction counter of the cost table);
-/// without, it follows the host's clock, which a controller streamed in real time needs.
-pub(crate) fn qemu(elf: &Path, icount: bool, args: &[&str]) -> Command {
-    let mut c = Command::new("qemu-system-arm");
-    c.args([
-        "-machine",
-        "mps2-an386",
-        "-cpu",
-        "cortex-m4",
-        "-nographic",
-        "-monitor",
-        "none",
-    ])
-    .arg("-semihosting-config")
-    .arg(
-        args.iter()
-            .fold("enable=on,target=native".to_string(), |c, a| c + ",arg=" + a),
-    );
-    if icount {
-        c.args(["-icount", "shift=0"]);
-    }
-    c.arg("-kernel").arg(elf);
-    c
-}
-
 /// Runs a program to its end (or the limit) and returns what it printed.
 pub(crate) fn run_to_end(elf: &Path) -> Result<String, String> {
-    let mut child = qemu(elf, true, &[])
+    let mut child = qemu(elf, Some("shift=0"), &[])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
@@ -143,7 +101,7 @@ pub(crate) fn start_or_fail(t: &mut Tally, args: &[&str]) -> Option<Emulated> {
 
 /// Starts the controller program with the semihosting command line `args` and waits for its pty and its `READY`.
 pub(crate) fn start_controller(elf: &Path, args: &[&str]) -> Result<Emulated, String> {
-    let mut child = qemu(elf, false, args)
+    let mut child = qemu(elf, None, args)
         .args(["-serial", "pty"])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())

@@ -152,14 +152,16 @@ async fn until(shared: &Shared, limit_ms: u32, done: impl Fn(State) -> bool) -> 
     false
 }
 
-/// Prints the step queue's depth, the periods the step generator found it empty so far, and the times the port
-/// fell behind and started afresh.
+/// Prints the step queue's depth, the periods the step generator found it empty so far, the control periods
+/// passed and re-phased (`app::control`), and the times the port fell behind and started afresh.
 fn queue(shared: &Shared, when: &str) {
     hprintln!(
-        "QUEUE {} depth {} underruns {} port restarts {}",
+        "QUEUE {} depth {} underruns {} passes {} re-phased {} port restarts {}",
         when,
         shared.steps.len(),
         shared.step_underruns.load(Ordering::Relaxed),
+        shared.passes.load(Ordering::Relaxed),
+        shared.rephased.load(Ordering::Relaxed),
         crate::machine::PORT_RESTARTS.load(Ordering::Relaxed)
     );
 }

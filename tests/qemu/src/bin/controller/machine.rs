@@ -192,4 +192,10 @@ impl PortOutput for Port {
         CHANGED.signal(());
         Ok(())
     }
+
+    /// The start of the period just written: the plant's work above comes after the wait and would make the
+    /// moment `write` returned a late boundary.
+    fn boundary(&self) -> Option<Instant> {
+        self.busy_until.checked_sub(self.period)
+    }
 }
