@@ -218,8 +218,10 @@ def homing_check(m, plant, cli, port):
     """`device home` through the plant's switches: each axis approaches its switch, backs off, approaches slowly
     and is given its home position where the debounced switch trips, then the platform moves to the home pose.
     Where the device's count and the STEP edges put each axis then gives the plant position the device latched:
-    on the switch, past its edge by the latency of the debounce (3 ms), the 1 ms sampling and tick and the step
-    ring's look-ahead (about 6 ms): 8-9 ms; up to 10 ms more when the edge comes between two of the inputs task's
+    on the switch, past its edge by the debounce (3 ms) and the 1 ms sampling and tick, less the periods the device
+    has planned but the pins not yet played (the step ring's one period and the queued one): 2-4 ms, a step or two
+    at the slow approach's rate (it was 8-9 ms with a six-period ring); up to 10 ms more when the edge comes between
+    two of the inputs task's
     waits and its 10 ms sweep finds it (firmware/src/app/inputs.rs)."""
     edges0, exti0 = list(plant.switch_edges), m.exti.edges
     en = cli.run("device", "enable", *port)
@@ -237,13 +239,13 @@ def homing_check(m, plant, cli, port):
     on_switch = all(0 <= x < FLAG_WIDTH if a < 4 else x <= 0 for a, x in enumerate(latched))
     edges = [b - a for a, b in zip(edges0, plant.switch_edges)]
     CHECKS.check("serial-home", home.code == 0 and status.get("state") == "Ready" and status.get("homed")
-                 and on_switch and all(3 <= t <= 22 for t in past_ms) and all(e >= 4 for e in edges)
+                 and on_switch and all(0 < t <= 22 for t in past_ms) and all(e >= 4 for e in edges)
                  and m.exti.edges - exti0 >= sum(edges),
                  f"{en}; `device home` exit {home.code} after {home.sim_s:.2f} simulated s: state "
                  f"{status.get('state')}, homed {status.get('homed')}; home switches PA1-PA6 changed {edges} times "
                  f"(fast approach, back-off, slow approach, clear), {m.exti.edges - exti0} EXTI edges; plant at "
                  f"{plant.position}, device counts {dev}: latched at {latched} (on the switch: {on_switch}), "
-                 f"{past_ms} ms past the switch edge at the slow approach's speed (3-22 ms: the debounce, the step ring, "
+                 f"{past_ms} ms past the switch edge at the slow approach's speed (more than 0, at most 22 ms: the debounce, "
                  f"at most one 10 ms sweep)")
 
 
@@ -357,7 +359,8 @@ def main():
     # -- the step generator: TIM1 update -> DMA2 stream 5 channel 6 -> GPIOB.BSRR --
     tim1, st = m.tim["tim1"], m.dma["dma2"].streams[5]
     slot_ns = source_constant("STEP_SLOT_NS")
-    ring = 3 * source_constant("MAX_STEP_SLOTS")
+    # Two periods of the 1 kHz control tick: the half-transfer and transfer-complete interrupts are the boundaries.
+    ring = 2 * (1_000_000 // slot_ns)
     # The ring is a static of the board module (wherever its set-up function lives).
     ring_buf = m.elf.one(r"board::(\w+::)*(\{\{closure\}\}::)?RING_BUF$")[1]
     arr = SYSCLK * slot_ns // 1_000_000_000 - 1

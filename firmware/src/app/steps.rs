@@ -15,17 +15,14 @@ use super::Shared;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, defmt::Format)]
 pub struct Overrun;
 
-/// Where rendered words go: a DMA ring into the port's set/reset register on a board.
+/// Where rendered words go: a DMA ring into the port's set/reset register on a board, two periods long, so that
+/// the period written at a boundary plays right after the one that has just started.
 pub trait PortOutput {
-    /// Queues one period of words; waits until the hardware has room.
-    async fn write(&mut self, words: &[u32]) -> Result<(), Overrun>;
-
-    /// When the hardware last made room for a period (a period boundary), if the port knows it better than the
-    /// moment `write` returned; a port whose `write` wakes at interrupt priority and does nothing after the wait
-    /// leaves it to that moment.
-    fn boundary(&self) -> Option<Instant> {
-        None
-    }
+    /// Waits until the hardware has room for a period of `words` words, and returns when it made it: a period
+    /// boundary, which the control tick keeps its phase to.
+    async fn room(&mut self, words: usize) -> Result<Instant, Overrun>;
+    /// Writes one period into the room [`PortOutput::room`] found; does not wait.
+    fn write(&mut self, words: &[u32]) -> Result<(), Overrun>;
 }
 
 /// Feeds the port forever. An empty queue becomes a period without steps (counted, never a lost step: the
@@ -42,8 +39,15 @@ pub async fn run(port: &mut impl PortOutput, mut renderer: PulseRenderer, shared
     }; 6];
     let mut words = [0u32; MAX_STEP_SLOTS];
     loop {
-        // The previous write returned when the hardware had room: a period boundary.
-        let boundary = port.boundary().unwrap_or_else(Instant::now);
+        // The queue is read at the boundary, not before: the moves the control tick queued just before it play in
+        // the next period, one period after the tick rather than two.
+        let boundary = match port.room(slots).await {
+            Ok(at) => at,
+            Err(Overrun) => {
+                shared.step_fault.store(true, Ordering::Relaxed);
+                Instant::now()
+            }
+        };
         shared
             .boundary_us
             .store(super::control::micros(boundary), Ordering::Relaxed);
@@ -54,7 +58,7 @@ pub async fn run(port: &mut impl PortOutput, mut renderer: PulseRenderer, shared
                 idle
             }
         };
-        if renderer.render(&moves, &mut words).is_none() || port.write(&words[..slots]).await.is_err() {
+        if renderer.render(&moves, &mut words).is_none() || port.write(&words[..slots]).is_err() {
             shared.step_fault.store(true, Ordering::Relaxed);
         }
     }

@@ -28,6 +28,9 @@
 //! (RM0383/datasheet: at most 3 mA through the power switch), so each drives a relay driver's MOSFET gate; the
 //! Black Pill's blue LED on PC13 (to 3.3 V) lights while AUX2 is off.
 
+use core::future::poll_fn;
+use core::task::Poll;
+
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_executor::{InterruptExecutor, Spawner};
 use embassy_stm32::dma::{self, TransferOptions, WritableRingBuffer};
@@ -42,6 +45,7 @@ use embassy_stm32::timer::UpDma;
 use embassy_stm32::usart::{self, BufferedUart};
 use embassy_stm32::usb::{self, Driver};
 use embassy_stm32::{bind_interrupts, pac, peripherals, rcc, Config, Peri};
+use embassy_time::Instant;
 use embassy_usb::class::cdc_acm::{CdcAcmClass, State};
 use embassy_usb::{Builder, UsbDevice};
 use ringpod_core::controller::Controller;
@@ -90,8 +94,10 @@ const WATCHDOG_US: u32 = 50_000;
 /// While a settings write may erase a 128 KiB sector (up to 2 s at 3.3 V with x32 parallelism): supplies are off.
 const WATCHDOG_FLASH_US: u32 = 4_000_000;
 
-/// The step generator's DMA ring: three periods of the longest buffer, so the renderer is always a period ahead.
-const RING: usize = 3 * MAX_STEP_SLOTS;
+/// The step generator's DMA ring: room for two periods of the longest buffer. It runs over two periods of the
+/// configured one, so that its half-transfer and transfer-complete interrupts fall on the period boundaries: the
+/// renderer is one period ahead of the pins, no more (a longer ring would hold setpoints back by its length).
+const RING: usize = 2 * MAX_STEP_SLOTS;
 
 /// Clock tree from the 25 MHz HSE crystal. USB needs exactly 48 MHz from the same PLL as the core, and no VCO
 /// frequency gives both 100 MHz (PLLP) and 48 MHz (PLLQ), so the core runs at 96 MHz:
@@ -304,8 +310,32 @@ struct DmaPort {
 }
 
 impl PortOutput for DmaPort {
-    async fn write(&mut self, words: &[u32]) -> Result<(), Overrun> {
-        self.ring.write_exact(words).await.map(|_| ()).map_err(|_| Overrun)
+    async fn room(&mut self, words: usize) -> Result<Instant, Overrun> {
+        // The ring is two periods: its half-transfer and transfer-complete interrupts are the period boundaries,
+        // and wake this (at the step executor's priority, so the instant is the boundary's to a few cycles).
+        let free = poll_fn(|cx| {
+            self.ring.set_waker(cx.waker());
+            match self.ring.len() {
+                Ok(free) if free < words => Poll::Pending,
+                other => Poll::Ready(other),
+            }
+        })
+        .await;
+        match free {
+            Ok(_) => Ok(Instant::now()),
+            Err(_) => {
+                // Lapped: start the ring afresh (the step generator's fault is latched by the caller).
+                self.ring.clear();
+                Err(Overrun)
+            }
+        }
+    }
+
+    fn write(&mut self, words: &[u32]) -> Result<(), Overrun> {
+        match self.ring.write(words) {
+            Ok((written, _)) if written == words.len() => Ok(()),
+            _ => Err(Overrun),
+        }
     }
 }
 
@@ -444,7 +474,7 @@ pub async fn start(spawner: Spawner) {
         shared.with(|c| c.watchdog_reset());
     }
 
-    let ring = step_generator(p.DMA2_CH5, p.TIM1);
+    let ring = step_generator(p.DMA2_CH5, p.TIM1, 2 * renderer.timing().slots);
 
     interrupt::USART6.set_priority(Priority::P1);
     let high = STEP_EXECUTOR.start(interrupt::USART6);
@@ -539,9 +569,10 @@ fn usart1(
 fn step_generator(
     channel: Peri<'static, peripherals::DMA2_CH5>,
     tim: Peri<'static, peripherals::TIM1>,
+    words: usize,
 ) -> WritableRingBuffer<'static, u32> {
     static RING_BUF: StaticCell<[u32; RING]> = StaticCell::new();
-    let ring_buf = RING_BUF.init([0; RING]);
+    let ring_buf = &mut RING_BUF.init([0; RING])[..words.min(RING)];
     let request = channel.request();
     let bsrr = pac::GPIOB.bsrr().as_ptr() as *mut u32;
     // SAFETY: the ring buffer owns the channel and its memory for the life of the program; the peripheral address

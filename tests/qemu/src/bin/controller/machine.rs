@@ -15,7 +15,7 @@ use embassy_sync::blocking_mutex::raw::{CriticalSectionRawMutex, ThreadModeRawMu
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::signal::Signal;
 use embassy_time::{Duration, Instant, Timer};
-use ringpod_core::motion::pulse::STEP_SLOT_NS;
+use ringpod_core::motion::pulse::{MAX_STEP_SLOTS, STEP_SLOT_NS};
 use ringpod_core::safety::debounce::InputConfig;
 use ringpod_core::safety::pins::OutputPin;
 use ringpod_core::safety::{Outputs, State};
@@ -147,30 +147,54 @@ impl InputPins for Pins {
 /// Times the port fell more than four periods behind and started afresh (the latency measurement prints it).
 pub static PORT_RESTARTS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
 
-/// The step port: each buffer plays over one control period, after the one before it.
+/// The step port, as a board's two-period DMA ring: the period written at a boundary plays from the next one,
+/// after the period that has just started (the plant takes each period's words when it starts).
 pub struct Port {
     pub world: &'static WorldCell,
     /// The step queue, whose depth the latency measurement reports.
     pub shared: &'static Shared,
     pub period: Duration,
-    /// When the buffer being played ends.
+    /// When the period playing now ends: the next boundary.
     pub busy_until: Instant,
+    /// The period written at the last boundary, waiting for the next.
+    pub pending: [u32; MAX_STEP_SLOTS],
+    pub pending_len: usize,
 }
 
 impl PortOutput for Port {
-    async fn write(&mut self, words: &[u32]) -> Result<(), Overrun> {
-        // A board's DMA takes the buffer when the previous one has played out. Should the emulator have been held
-        // up for longer than the queue covers, start afresh rather than play a burst (a board would have underrun).
+    async fn room(&mut self, _words: usize) -> Result<Instant, Overrun> {
+        // The boundary: the period written at the last one starts. Should the emulator have been held up for
+        // longer than the queue covers, start afresh rather than play a burst (a board would have underrun).
         Timer::at(self.busy_until).await;
         let now = Instant::now();
-        self.busy_until = if now > self.busy_until + self.period * 4 {
+        let start = if now > self.busy_until + self.period * 4 {
             PORT_RESTARTS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
-            now + self.period
+            now
         } else {
-            self.busy_until + self.period
+            self.busy_until
         };
+        self.busy_until = start + self.period;
+        let len = core::mem::take(&mut self.pending_len);
+        if len > 0 {
+            self.play(start, len);
+        }
+        Ok(start)
+    }
+
+    fn write(&mut self, words: &[u32]) -> Result<(), Overrun> {
+        let to = self.pending.get_mut(..words.len()).ok_or(Overrun)?;
+        to.copy_from_slice(words);
+        self.pending_len = words.len();
+        Ok(())
+    }
+}
+
+impl Port {
+    /// The plant takes a period's words as it starts to play.
+    fn play(&mut self, start: Instant, len: usize) {
+        let words = &self.pending[..len];
         let depth = self.shared.steps.len();
-        crate::latency::played((self.busy_until - self.period).as_micros(), words, STEP_SLOT_NS, depth);
+        crate::latency::played(start.as_micros(), words, STEP_SLOT_NS, depth);
         self.world.lock(|w| {
             let w = &mut *w.borrow_mut();
             let enabled = w.outputs.driver_enable;
@@ -190,12 +214,5 @@ impl PortOutput for Port {
             }
         });
         CHANGED.signal(());
-        Ok(())
-    }
-
-    /// The start of the period just written: the plant's work above comes after the wait and would make the
-    /// moment `write` returned a late boundary.
-    fn boundary(&self) -> Option<Instant> {
-        self.busy_until.checked_sub(self.period)
     }
 }

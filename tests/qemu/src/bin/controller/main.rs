@@ -34,8 +34,8 @@ use embassy_executor::Spawner;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_time::{Duration, Instant};
 use ringpod_core::controller::Controller;
-use ringpod_core::motion::pulse::STEP_SLOT_NS;
 use ringpod_core::motion::pulse::{PortMap, PulseRenderer};
+use ringpod_core::motion::pulse::{MAX_STEP_SLOTS, STEP_SLOT_NS};
 use ringpod_core::motion::FollowMode;
 use ringpod_core::protocol::RigSource;
 use ringpod_core::sim::drivers::DriverInputs;
@@ -192,6 +192,8 @@ async fn main(spawner: Spawner) {
         shared,
         period,
         busy_until: Instant::now(),
+        pending: [0; MAX_STEP_SLOTS],
+        pending_len: 0,
     };
     let controls = Controls {
         world,
