@@ -13,14 +13,6 @@ pub enum CliError {
     /// `--mechanism` names no preset.
     #[error("unknown mechanism `{0}`; `ringpod presets` lists them")]
     UnknownMechanism(String),
-    /// A list of numbers could not be read.
-    #[error("--{what}: {reason}")]
-    BadNumbers {
-        /// The option.
-        what: &'static str,
-        /// What is wrong.
-        reason: String,
-    },
     /// The kinematics have no answer.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),
@@ -47,6 +39,47 @@ pub enum CliError {
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),
+    /// Options that do not go together.
+    #[error(transparent)]
+    Request(#[from] crate::cli::requests::RequestError),
+    /// A picture was not written.
+    #[error(transparent)]
+    Plot(#[from] crate::out::plot::PlotError),
+    /// A run record could not be read.
+    #[error(transparent)]
+    Record(#[from] crate::stream::record::RecordError),
+    /// A drive could not be cued.
+    #[error(transparent)]
+    Cue(#[from] crate::analysis::cue::CueError),
+    /// The cueing file.
+    #[error(transparent)]
+    Cueing(#[from] crate::input::cueing::CueingFileError),
+    /// A command for ring platforms was given another mechanism.
+    #[error("cueing moves a ring platform; {0} is not one")]
+    NotARing(String),
+    /// A file could not be written.
+    #[error("{}: {reason}", path.display())]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        reason: String,
+    },
+}
+
+impl CliError {
+    /// `--what: reason`: an option's value the command cannot use.
+    pub fn bad(what: &'static str, reason: String) -> Self {
+        Self::Number(crate::input::numbers::BadNumber::new(what, reason))
+    }
+
+    /// `path: reason`: a file that could not be written.
+    pub fn file(path: &std::path::Path, reason: impl std::fmt::Display) -> Self {
+        Self::File {
+            path: path.to_owned(),
+            reason: reason.to_string(),
+        }
+    }
 }
 
 impl From<ringpod_core::kinematics::TipOverError> for CliError {

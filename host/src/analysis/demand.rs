@@ -123,7 +123,7 @@ pub struct Profile {
 
 /// Inverse dynamics along the pose CSV at `input`.
 pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -> Result<Profile, CliError> {
-    let bad = |reason: String| CliError::BadNumbers { what: "input", reason };
+    let bad = |reason: String| CliError::bad("input", reason);
     let text = crate::input::files::read_text(input, crate::input::files::DATA_LIMIT)
         .map_err(|e| bad(format!("{}: {e}", input.display())))?;
     let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
@@ -368,10 +368,7 @@ pub fn run(job: &Job, json: bool) -> Result<Outcome, CliError> {
     let margins: [Option<MarginJson>; 6] = std::array::from_fn(|k| job.drives[k].as_ref().map(|d| margin(d, &p, k)));
     let keep_up = margins.iter().flatten().all(|m| m.rows_over == 0);
     if let Some(out) = job.plot {
-        draw(job, &p, units, out).map_err(|e| CliError::BadNumbers {
-            what: "plot",
-            reason: e.to_string(),
-        })?;
+        draw(job, &p, units, out).map_err(|e| CliError::bad("plot", e.to_string()))?;
     }
     let code = if p.errors.is_empty() && keep_up {
         0

@@ -15,6 +15,9 @@ use std::path::Path;
 
 use plotters::style::colors::{BLUE, GREEN, RED};
 
+use crate::error::CliError;
+use crate::input::numbers::BadNumber;
+
 use crate::out::plot::{self, Panel, Series, TimePlot};
 use crate::stream::record;
 
@@ -65,12 +68,16 @@ const AXES: [&str; 6] = ["surge x", "sway y", "heave z", "roll alpha", "pitch be
 
 /// Draws the derivatives of a record's followed pose over the device times `span` (`[from, to]`, s; the fit takes
 /// the samples around its ends too); returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> anyhow::Result<String> {
+pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> Result<String, CliError> {
     if !(window.is_finite() && window > 0.0 && window <= 10.0) {
-        anyhow::bail!("--window: {window} s; a window is more than 0 and at most 10 s");
+        return Err(BadNumber::new(
+            "window",
+            format!("{window} s; a window is more than 0 and at most 10 s"),
+        )
+        .into());
     }
     if span.0.is_nan() || span.1.is_nan() || span.0 >= span.1 {
-        anyhow::bail!("--from {} --to {}: the span is empty", span.0, span.1);
+        return Err(BadNumber::given("from", format!("{} --to {}", span.0, span.1), "the span is empty").into());
     }
     let whole = record::read(input)?;
     let all: Vec<Vec<(f64, f64)>> = (0..6)
@@ -84,12 +91,16 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
         .filter(|&i| whole.t[i] >= span.0 && whole.t[i] <= span.1)
         .collect();
     if inside.len() < 2 {
-        anyhow::bail!(
-            "--from/--to: {} of the record's samples (device time {:.3} to {:.3} s) are in the span",
-            inside.len(),
-            whole.t[0],
-            whole.t[whole.t.len() - 1]
-        );
+        return Err(BadNumber::new(
+            "from/--to",
+            format!(
+                "{} of the record's samples (device time {:.3} to {:.3} s) are in the span",
+                inside.len(),
+                whole.t[0],
+                whole.t[whole.t.len() - 1]
+            ),
+        )
+        .into());
     }
     let run = Span {
         t: inside.iter().map(|&i| whole.t[i]).collect(),

@@ -427,7 +427,7 @@ fn in_units(on: &On, m: &AnyMechanism, pose: [f64; 6], q: [f64; 6]) -> ([f64; 6]
 }
 
 /// Draws the platform at the pose into `--out` and says what it drew.
-pub fn run(o: &Options) -> anyhow::Result<String> {
+pub fn run(o: &Options) -> Result<String, CliError> {
     let Selected {
         name, home, mechanism, ..
     } = Selected::of(o.on.mechanism, o.on.geometry)?;

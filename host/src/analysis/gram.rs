@@ -15,6 +15,9 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use ringpod_core::screws::translational::{gram, GramDeterminants, MIXED};
 
+use crate::error::CliError;
+use crate::input::numbers::BadNumber;
+
 use crate::out::plot::{self, Picture};
 
 /// What `gram` is asked to do.
@@ -115,12 +118,12 @@ const PICKS: [(&str, &str, Pick); 3] = [
     ("det G", "all six", |g| g.all),
 ];
 
-pub fn run(args: &Options) -> anyhow::Result<String> {
+pub fn run(args: &Options) -> Result<String, CliError> {
     if !(args.step.is_finite() && (0.0005..=0.05).contains(&args.step)) {
-        anyhow::bail!("--step {}: the grid's step is 0.0005 to 0.05 m", args.step);
+        return Err(BadNumber::given("step", args.step, "the grid's step is 0.0005 to 0.05 m").into());
     }
     if !(args.z.is_finite() && (-0.4..=0.0).contains(&args.z)) {
-        anyhow::bail!("--z {}: the mechanism reaches heights from -0.4 to 0 m", args.z);
+        return Err(BadNumber::given("z", args.z, "the mechanism reaches heights from -0.4 to 0 m").into());
     }
     let slice = scan(args.z, args.step);
     plot::save(args.out, (1200, 1060), &SlicePicture { slice: &slice })?;
@@ -147,7 +150,7 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
     }
     let _ = writeln!(text, "picture: {}", args.out.display());
     if let Some(path) = args.table {
-        std::fs::write(path, table(&slice, &all_stats)).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        std::fs::write(path, table(&slice, &all_stats)).map_err(|e| CliError::file(path, e))?;
         let _ = writeln!(text, "table: {}", path.display());
     }
     Ok(text)

@@ -366,15 +366,15 @@ pub fn fk(args: &FkOptions) -> Result<Outcome, CliError> {
             AxisKind::Ring | AxisKind::Angle => numbers::MAX_TURNING,
         };
         if !v.is_finite() || v.abs() > limit {
-            return Err(CliError::BadNumbers {
-                what: "actuators",
-                reason: format!(
+            return Err(CliError::bad(
+                "actuators",
+                format!(
                     "value {} ({}) is out of range (at most {} either way)",
                     i + 1,
                     numbers::readable(*v),
                     numbers::readable(limit)
                 ),
-            });
+            ));
         }
     }
     // Without a guess: home turned by the yaw the carriages show, accepted within a tilt range of it.
@@ -444,10 +444,7 @@ pub fn loads(args: &LoadsOptions) -> Result<Outcome, CliError> {
         drives,
     } = Selected::of(common.mechanism, common.geometry)?;
     let AnyMechanism::Ring(ring) = &m else {
-        return Err(CliError::BadNumbers {
-            what: "mechanism",
-            reason: "statics are for ring platforms".into(),
-        });
+        return Err(CliError::bad("mechanism", "statics are for ring platforms".into()));
     };
     numbers::mass(args.mass)?;
     let names = m.axis_names();

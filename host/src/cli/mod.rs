@@ -1,6 +1,6 @@
 //! Command-line interface definition.
 
-mod requests;
+pub mod requests;
 
 pub use requests::platform;
 

@@ -18,10 +18,7 @@ const AXES: [&str; 5] = ["surge", "sway", "heave", "roll", "pitch"];
 /// `ringpod presets --export NAME`: the preset as a rig file, to start one's own from.
 pub fn export(name: &str) -> Result<Outcome, CliError> {
     let (preset, file) = preset_file(name, "export")?;
-    let body = file.to_toml().map_err(|e| CliError::BadNumbers {
-        what: "export",
-        reason: e.to_string(),
-    })?;
+    let body = file.to_toml().map_err(|e| CliError::bad("export", e.to_string()))?;
     let header = format!(
         "# {name}: {}\n# Lengths in metres, angles of [limits] and [spec] in degrees, home = [x, y, z, roll, pitch, yaw]\n\
          # (m, rad). Chains counter-clockwise around the ring; actuators: every carriage in chain order, then every\n\
@@ -35,10 +32,10 @@ pub fn export(name: &str) -> Result<Outcome, CliError> {
 fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), CliError> {
     let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
     let PresetGeometry::Ring(g) = preset.geometry() else {
-        return Err(CliError::BadNumbers {
+        return Err(CliError::bad(
             what,
-            reason: format!("{name} is not a ring platform; rig files describe ring platforms"),
-        });
+            format!("{name} is not a ring platform; rig files describe ring platforms"),
+        ));
     };
     let ranges = preset.spec_ranges();
     Ok((
@@ -243,10 +240,10 @@ pub fn design_command(
             false
         }
     };
-    let body = found.file.to_toml().map_err(|e| CliError::BadNumbers {
-        what: "design",
-        reason: e.to_string(),
-    })?;
+    let body = found
+        .file
+        .to_toml()
+        .map_err(|e| CliError::bad("design", e.to_string()))?;
     Ok(Outcome {
         text: out + &body,
         code: if covers { 0 } else { EXIT_CHECK_FAILED },

@@ -9,6 +9,9 @@ use ringpod_core::kinematics::geometry::DEG;
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 
 use crate::analysis::mechanism::AnyMechanism;
+use crate::cli::requests::RequestError;
+use crate::error::CliError;
+use crate::input::numbers::BadNumber;
 
 /// What limits a grid point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -192,17 +195,17 @@ impl Plane {
     }
 }
 
-pub fn run(args: &Options) -> anyhow::Result<String> {
+pub fn run(args: &Options) -> Result<String, CliError> {
     let s = scanned(args)?;
     let length = s.m.characteristic_length();
     let n = args.cells;
     if args.z.is_some() && args.section != Section::Xy {
-        anyhow::bail!("--z is the height of the xy section; the other sections span every height or none");
+        return Err(RequestError::SectionHeight.into());
     }
     let z0 = args.z.unwrap_or(s.home[2]);
     crate::input::numbers::length_in_range("z", z0, length)?;
     if !(10..=2000).contains(&args.cells) {
-        anyhow::bail!("--cells {} is out of range (10 to 2000)", args.cells);
+        return Err(BadNumber::new("cells", format!("{} is out of range (10 to 2000)", args.cells)).into());
     }
     let plane = Plane::of(args.section, &s, z0);
     let (u, v) = (plane.u, plane.v);
