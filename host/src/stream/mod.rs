@@ -7,6 +7,7 @@
 
 pub mod command;
 pub mod datagram;
+mod feed;
 mod loads;
 mod prepare;
 pub mod record;
