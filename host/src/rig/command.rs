@@ -3,10 +3,12 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use ringpod_core::kinematics::geometry::RingGeometry;
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
 use ringpod_core::kinematics::RingPlatform;
 use serde::Serialize;
 
+use super::coverage::Coverage;
 use super::design::{design, Free, Search, Target};
 use super::{coverage, read, RigFile};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
@@ -121,8 +123,21 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
             code,
         });
     }
+    Ok(Outcome {
+        text: check_text(&rig.geometry, &drivable, cover.as_ref(), covered),
+        code,
+    })
+}
+
+/// `rig check`'s verdict as text: analysable, drivable or why not, and the spec coverage axis by axis.
+fn check_text(
+    g: &RingGeometry,
+    drivable: &Result<(), String>,
+    cover: Option<&([f64; 5], Coverage)>,
+    covered: Option<bool>,
+) -> String {
+    let name = g.name;
     let mut t = String::new();
-    let g = &rig.geometry;
     let _ = writeln!(
         t,
         "{name}: analysable: yes ({} chains, ring radius {} m, rod {} m)",
@@ -130,14 +145,14 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
         g.ring_radius,
         g.rod_length
     );
-    let _ = match &drivable {
+    let _ = match drivable {
         Ok(()) => writeln!(
             t,
             "drivable: yes (the home pose is inside every check; homing plan and step timing accepted)"
         ),
         Err(why) => writeln!(t, "drivable: no, because {why}"),
     };
-    match &cover {
+    match cover {
         None => {
             let _ = writeln!(t, "no [spec] ranges: add them to measure the coverage");
         }
@@ -178,7 +193,7 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
             );
         }
     }
-    Ok(Outcome { text: t, code })
+    t
 }
 
 /// `ringpod rig design TEMPLATE`: the best dimensions found, as a rig file, with its coverage in comments.

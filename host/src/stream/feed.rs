@@ -7,9 +7,11 @@ use indicatif::ProgressBar;
 use ringpod_core::kinematics::Pose;
 use ringpod_core::safety::AuxLevels;
 
-use super::report::DatagramReport;
+use ringpod_core::protocol::MotionSettings;
+
+use super::report::{CaptureReport, DatagramReport};
 use super::session::{Kind, Stop, StreamError, Streamer, NO_AUX};
-use super::{InputError, UdpSource};
+use super::{motion_pose, InputError, Source, UdpSource};
 use crate::link::client::{ClientError, Transport};
 
 impl<T: Transport> Streamer<'_, T> {
@@ -177,6 +179,52 @@ fn read(
             bar.suspend(|| eprintln!("datagram {number}: {reason}"));
             errors.push(InputError { line: number, reason });
             None
+        }
+    }
+}
+
+/// Sends the source's poses: timed ones (a motion, a file) on their clock, a live source as it arrives; a live
+/// source's datagram counts and capture come back with the outcome.
+pub(super) fn feed<T: Transport>(
+    s: &mut Streamer<'_, T>,
+    source: &mut Source,
+    fast: bool,
+    home: [f64; 6],
+    limits: &MotionSettings,
+    input_errors: &mut Vec<InputError>,
+) -> (Result<(), StreamError>, Option<DatagramReport>, Option<CaptureReport>) {
+    match source {
+        Source::Motion {
+            motion,
+            sine,
+            seconds,
+            rate_hz,
+        } => {
+            let (motion, sine, seconds, rate_hz) = (*motion, *sine, *seconds, *rate_hz);
+            if let Some(sine) = &sine {
+                eprintln!("{}", sine.describe(limits));
+            }
+            let n = (seconds * rate_hz).round() as u64;
+            let mut poses = (0..=n).map(|k| {
+                let t = k as f64 / rate_hz;
+                (None, t, motion_pose(motion, sine.as_ref(), t, home, limits), NO_AUX)
+            });
+            (s.timed(&mut poses, fast), None, None)
+        }
+        Source::Poses(p) => {
+            let mut poses = p.iter().map(|(line, t, pose, aux)| (Some(*line), *t, *pose, *aux));
+            (s.timed(&mut poses, fast), None, None)
+        }
+        Source::Udp(udp) => {
+            let mut d = DatagramReport::default();
+            let r = s.live(udp, &mut d, input_errors);
+            d.telemetry_gaps = udp.decoder.gaps();
+            (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
+            let capture = udp.capture.take().map(|(writer, path)| {
+                let (packets, error) = writer.finish();
+                CaptureReport { path, packets, error }
+            });
+            (r, Some(d), capture)
         }
     }
 }

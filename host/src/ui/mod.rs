@@ -129,26 +129,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
                 "note: listening on {local}, not only on this machine: anyone with the URL can move the platform"
             );
         }
-        // Every route but the static scripts and style passes the token, origin and host check, once, here.
-        let checked = Router::new()
-            .route("/", get(page))
-            .route("/ws", get(socket))
-            .route("/api/cue/defaults", get(cue_defaults))
-            .route("/api/cue", post(cue))
-            .route("/api/cue/apply", post(cue_apply))
-            .route("/api/rig/check", post(rig_check))
-            .route("/api/rig/current", get(rig_current))
-            .route("/api/run", post(run_record))
-            .route_layer(axum::middleware::from_fn_with_state(app.clone(), admitted));
-        let asset =
-            |kind: &'static str, body: &'static str| get(move || async move { ([(header::CONTENT_TYPE, kind)], body) });
-        let router = Router::new()
-            .merge(checked)
-            .route("/app.js", asset("text/javascript", SCRIPT))
-            .route("/chart.js", asset("text/javascript", CHART))
-            .route("/view3d.js", asset("text/javascript", VIEW3D))
-            .route("/style.css", asset("text/css", STYLE))
-            .with_state(app.clone());
+        let router = routes(&app);
         let stop = {
             let hub = hub.clone();
             async move {
@@ -179,6 +160,30 @@ pub fn run(options: Options) -> Result<u8, UiError> {
         }
         Ok(Ok(())) => Ok(0),
     }
+}
+
+/// The workbench's routes: every one but the static scripts and style passes the token, origin and host check.
+fn routes(app: &Arc<App>) -> Router {
+    // The check, once, here.
+    let checked = Router::new()
+        .route("/", get(page))
+        .route("/ws", get(socket))
+        .route("/api/cue/defaults", get(cue_defaults))
+        .route("/api/cue", post(cue))
+        .route("/api/cue/apply", post(cue_apply))
+        .route("/api/rig/check", post(rig_check))
+        .route("/api/rig/current", get(rig_current))
+        .route("/api/run", post(run_record))
+        .route_layer(axum::middleware::from_fn_with_state(app.clone(), admitted));
+    let asset =
+        |kind: &'static str, body: &'static str| get(move || async move { ([(header::CONTENT_TYPE, kind)], body) });
+    Router::new()
+        .merge(checked)
+        .route("/app.js", asset("text/javascript", SCRIPT))
+        .route("/chart.js", asset("text/javascript", CHART))
+        .route("/view3d.js", asset("text/javascript", VIEW3D))
+        .route("/style.css", asset("text/css", STYLE))
+        .with_state(app.clone())
 }
 
 async fn page() -> Response {

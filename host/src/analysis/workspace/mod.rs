@@ -217,6 +217,7 @@ pub fn run(args: &Options) -> Result<String, CliError> {
         classify(&s.m, &plane.pose(args.section, s.home, z0, a, b))
     });
     let applies = applying_checks(&s);
+    // The picture, then what it shows in words.
     picture::draw(
         args.out,
         &picture::Section {
@@ -232,7 +233,6 @@ pub fn run(args: &Options) -> Result<String, CliError> {
             applies: &applies,
         },
     )?;
-
     let inside: Vec<(f64, f64)> = grid
         .iter()
         .enumerate()
@@ -261,6 +261,15 @@ pub fn run(args: &Options) -> Result<String, CliError> {
     ) {
         text += &format!("  reachable {un} in [{umin:.4}, {umax:.4}] {unit}, {vn} in [{vmin:.4}, {vmax:.4}] {unit}\n");
     }
+    text += &mechanism_summary(&s, length);
+    text += &format!("picture: {}\n", args.out.display());
+    Ok(text)
+}
+
+/// What holds whatever the section: the volume at zero orientation, each axis's range from home, the spec ranges'
+/// coverage (a ring platform's, when given) and a tool carrier's checks.
+fn mechanism_summary(s: &Scanned, length: f64) -> String {
+    let mut text = String::new();
     text += &format!(
         "volume at zero orientation: {:.6} m^3 (60^3 grid)\n",
         volume(&s.m, s.bounds)
@@ -299,8 +308,7 @@ pub fn run(args: &Options) -> Result<String, CliError> {
             crate::analysis::branches::name(g.branch_d)
         );
     }
-    text += &format!("picture: {}\n", args.out.display());
-    Ok(text)
+    text
 }
 
 /// The checks that have a margin for this mechanism (the others do not apply), from its home pose.
