@@ -177,7 +177,6 @@ impl Picture for Scene {
         DB::ErrorType: 'static,
     {
         let fail = plot::failed(out);
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
         let view = self.view(root.dim_in_pixel());
         let font = |size: u32| (plot::FONT, size).into_font();
         let p = &self.pose;
@@ -191,33 +190,15 @@ impl Picture for Scene {
             p[4].to_degrees(),
             p[5].to_degrees()
         );
-        root.draw(&Text::new(title, (16, 12), font(18))).map_err(|e| fail(&e))?;
         let legend =
             "ring (grey), carriages B (blue), rods and elbow arms (black), radial actuators (orange), platform joints A (red)";
-        root.draw(&Text::new(legend, (16, 36), font(13)))
-            .map_err(|e| fail(&e))?;
         // Base axes, with the ring plane's centre O.
-        let origin = view.at([0.0; 3]);
-        for (name, end) in self.axes() {
-            let e = view.at(end);
-            root.draw(&PathElement::new(vec![origin, e], RING.mix(0.8).stroke_width(1)))
-                .map_err(|e| fail(&e))?;
-            root.draw(&Text::new(name, (e.0 + 4, e.1 - 8), font(16)))
-                .map_err(|e| fail(&e))?;
-        }
-        root.draw(&Text::new("O", (origin.0 + 4, origin.1 + 2), font(13)))
-            .map_err(|e| fail(&e))?;
+        let origin = ground(root, out, &view, [&title, legend], self.axes())?;
         let ring: Vec<(i32, i32)> = ring_points(self.ring_radius).map(|q| view.at(q)).collect();
         root.draw(&PathElement::new(ring, RING.stroke_width(3)))
             .map_err(|e| fail(&e))?;
         // The platform polygon, its joints in chain order.
-        let platform: Vec<(i32, i32)> = self.joints.iter().map(|a| view.at(*a)).collect();
-        root.draw(&Polygon::new(platform.clone(), PLATFORM.mix(0.25)))
-            .map_err(|e| fail(&e))?;
-        let mut closed = platform.clone();
-        closed.extend(platform.first());
-        root.draw(&PathElement::new(closed, PLATFORM.stroke_width(2)))
-            .map_err(|e| fail(&e))?;
+        outlined(root, out, self.joints.iter().map(|a| view.at(*a)).collect())?;
         // The platform centre.
         let c = [p[0], p[1], p[2]];
         let cp = view.at(c);
@@ -332,7 +313,6 @@ impl Picture for ToolScene {
         DB::ErrorType: 'static,
     {
         let fail = plot::failed(out);
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
         let view = self.view(root.dim_in_pixel());
         let font = |size: u32| (plot::FONT, size).into_font();
         let p = &self.pose;
@@ -345,20 +325,8 @@ impl Picture for ToolScene {
             p[3].to_degrees(),
             p[4].to_degrees()
         );
-        root.draw(&Text::new(title, (16, 12), font(18))).map_err(|e| fail(&e))?;
         let legend = "X guide (grey), carriage beam (blue), links L2 and L3 (black), frame (green), tool L1 (orange)";
-        root.draw(&Text::new(legend, (16, 36), font(13)))
-            .map_err(|e| fail(&e))?;
-        let origin = view.at([0.0; 3]);
-        for (name, end) in self.axes() {
-            let e = view.at(end);
-            root.draw(&PathElement::new(vec![origin, e], RING.mix(0.8).stroke_width(1)))
-                .map_err(|e| fail(&e))?;
-            root.draw(&Text::new(name, (e.0 + 4, e.1 - 8), font(16)))
-                .map_err(|e| fail(&e))?;
-        }
-        root.draw(&Text::new("O", (origin.0 + 4, origin.1 + 2), font(13)))
-            .map_err(|e| fail(&e))?;
+        ground(root, out, &view, [&title, legend], self.axes())?;
         for rail in self.rails() {
             root.draw(&PathElement::new(
                 rail.map(|r| view.at(r)).to_vec(),
@@ -369,13 +337,7 @@ impl Picture for ToolScene {
         let beam = vec![view.at(self.bases[0]), view.at(self.bases[1])];
         root.draw(&PathElement::new(beam, CARRIAGE.stroke_width(3)))
             .map_err(|e| fail(&e))?;
-        let frame: Vec<(i32, i32)> = self.frame.iter().map(|c| view.at(*c)).collect();
-        root.draw(&Polygon::new(frame.clone(), PLATFORM.mix(0.25)))
-            .map_err(|e| fail(&e))?;
-        let mut closed = frame.clone();
-        closed.extend(frame.first());
-        root.draw(&PathElement::new(closed, PLATFORM.stroke_width(2)))
-            .map_err(|e| fail(&e))?;
+        outlined(root, out, self.frame.iter().map(|c| view.at(*c)).collect())?;
         let (centre, tool) = (view.at(self.centre()), view.at(self.tool));
         root.draw(&PathElement::new(vec![centre, tool], RADIAL.stroke_width(3)))
             .map_err(|e| fail(&e))?;
@@ -398,6 +360,56 @@ impl Picture for ToolScene {
         }
         Ok(())
     }
+}
+
+/// What both scenes draw first: a white ground, the title and the legend (`text`), and the base axes from the
+/// origin O, labelled. Returns the origin's pixel.
+fn ground<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    out: &Path,
+    view: &View,
+    text: [&str; 2],
+    axes: [(&'static str, [f64; 3]); 3],
+) -> Result<(i32, i32), plot::PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    let fail = plot::failed(out);
+    let font = |size: u32| (plot::FONT, size).into_font();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    root.draw(&Text::new(text[0], (16, 12), font(18)))
+        .map_err(|e| fail(&e))?;
+    root.draw(&Text::new(text[1], (16, 36), font(13)))
+        .map_err(|e| fail(&e))?;
+    let origin = view.at([0.0; 3]);
+    for (name, end) in axes {
+        let e = view.at(end);
+        root.draw(&PathElement::new(vec![origin, e], RING.mix(0.8).stroke_width(1)))
+            .map_err(|e| fail(&e))?;
+        root.draw(&Text::new(name, (e.0 + 4, e.1 - 8), font(16)))
+            .map_err(|e| fail(&e))?;
+    }
+    root.draw(&Text::new("O", (origin.0 + 4, origin.1 + 2), font(13)))
+        .map_err(|e| fail(&e))?;
+    Ok(origin)
+}
+
+/// A polygon filled light and outlined: the ring platform, the tool carrier's frame.
+fn outlined<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    out: &Path,
+    corners: Vec<(i32, i32)>,
+) -> Result<(), plot::PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    let fail = plot::failed(out);
+    root.draw(&Polygon::new(corners.clone(), PLATFORM.mix(0.25)))
+        .map_err(|e| fail(&e))?;
+    let mut closed = corners.clone();
+    closed.extend(corners.first());
+    root.draw(&PathElement::new(closed, PLATFORM.stroke_width(2)))
+        .map_err(|e| fail(&e))
 }
 
 /// Where a label of the point `p` goes: away from `from`, its text's top left corner.
