@@ -294,32 +294,25 @@ impl SlicePicture<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let fail = plot::failed(out);
         let s = self.slice;
-        let mut chart = ChartBuilder::on(area)
-            .margin(12)
-            .caption(caption, (plot::FONT, 15))
-            .x_label_area_size(36)
-            .y_label_area_size(56)
-            .build_cartesian_2d(SPAN.0..SPAN.1, SPAN.0..SPAN.1)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("x (m)")
-            .y_desc("y (m)")
-            .label_style((plot::FONT, 11))
-            .disable_mesh()
-            .draw()
-            .map_err(|e| fail(&e))?;
         let half = s.step / 2.0;
-        chart
-            .draw_series((0..s.n * s.n).map(|k| {
+        let map = plot::CellMap {
+            caption: (caption, 15),
+            margin: 12,
+            label_areas: (36, 56),
+            axes: ("x (m)", "y (m)", 11),
+            u: SPAN,
+            v: SPAN,
+        };
+        map.draw(
+            area,
+            out,
+            (0..s.n * s.n).map(|k| {
                 let (x, y) = (s.centre(k % s.n), s.centre(k / s.n));
                 let c = s.at(k % s.n, k / s.n).map_or(RGBColor(235, 235, 235), colour);
-                Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
-            }))
-            .map_err(|e| fail(&e))?;
-        Ok(())
+                ([(x - half, y - half), (x + half, y + half)], c)
+            }),
+        )
     }
 }
 

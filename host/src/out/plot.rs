@@ -117,6 +117,56 @@ pub struct Panel {
     pub events: Vec<Event>,
 }
 
+/// A map of coloured cells over `u` x `v` (the workspace's sections, the Gram slices): a chart with its caption and
+/// labelled axes and no mesh (the cells are the picture), each cell a filled rectangle.
+pub struct CellMap<'a> {
+    /// The caption and its font size.
+    pub caption: (&'a str, u32),
+    /// Around the chart (pixels).
+    pub margin: u32,
+    /// Room for the x and the y labels (pixels).
+    pub label_areas: (u32, u32),
+    /// The x and y axes' names, and their labels' font size.
+    pub axes: (&'a str, &'a str, u32),
+    /// The ranges drawn.
+    pub u: (f64, f64),
+    pub v: (f64, f64),
+}
+
+impl CellMap<'_> {
+    /// Draws the chart and the cells (corners, colour) on `area`.
+    pub fn draw<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        out: &Path,
+        cells: impl Iterator<Item = ([(f64, f64); 2], RGBColor)>,
+    ) -> Result<(), PlotError>
+    where
+        DB::ErrorType: 'static,
+    {
+        let fail = failed(out);
+        let mut chart = ChartBuilder::on(area)
+            .margin(self.margin)
+            .caption(self.caption.0, (FONT, self.caption.1))
+            .x_label_area_size(self.label_areas.0)
+            .y_label_area_size(self.label_areas.1)
+            .build_cartesian_2d(self.u.0..self.u.1, self.v.0..self.v.1)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(self.axes.0)
+            .y_desc(self.axes.1)
+            .label_style((FONT, self.axes.2))
+            .disable_mesh()
+            .draw()
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(cells.map(|(corners, c)| Rectangle::new(corners, c.filled())))
+            .map_err(|e| fail(&e))?;
+        Ok(())
+    }
+}
+
 /// Panels stacked over one time axis, under a title.
 pub struct TimePlot {
     /// Title of the picture.
