@@ -87,3 +87,37 @@ impl From<ringpod_core::kinematics::TipOverError> for CliError {
         Self::TipOver(e)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// The errors that say their cause in their own words give no `source()`: `main` prints an error with its
+    /// chain (`{:#}`), and a cause given both ways was printed twice (`/dev/x: No such file: No such file`).
+    #[test]
+    fn a_cause_in_the_words_is_not_also_a_source() {
+        let io = || std::io::Error::new(std::io::ErrorKind::NotFound, "not there");
+        let json = serde_json::from_str::<u8>("x").unwrap_err();
+        let errors: [Box<dyn std::error::Error>; 4] = [
+            Box::new(crate::link::LinkError::Open {
+                port: "/dev/x".into(),
+                reason: serialport::Error::new(serialport::ErrorKind::NoDevice, "not there"),
+            }),
+            Box::new(crate::stream::command::SourceError::Bind {
+                addr: "127.0.0.1:9".parse().unwrap(),
+                reason: io(),
+            }),
+            Box::new(crate::analysis::cue::CueError::Output {
+                path: "/x.csv".into(),
+                reason: io(),
+            }),
+            Box::new(crate::device::settings::ConfigCommandError::Section {
+                change: None,
+                section: "stream",
+                reason: json,
+            }),
+        ];
+        for e in errors {
+            assert!(e.source().is_none(), "{e}");
+            assert!(e.to_string().contains(": "), "{e}");
+        }
+    }
+}

@@ -156,12 +156,12 @@ pub enum CueError {
         reason: String,
     },
     /// The poses could not be written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {reason}", path.display())]
     Output {
         /// The file.
         path: std::path::PathBuf,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
 }
 
@@ -272,9 +272,9 @@ fn write_poses(path: &Path, cued: &[Cued]) -> Result<(), CueError> {
         }
         out.flush()
     };
-    write().map_err(|source| CueError::Output {
+    write().map_err(|reason| CueError::Output {
         path: path.to_path_buf(),
-        source,
+        reason,
     })
 }
 

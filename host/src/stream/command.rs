@@ -94,12 +94,12 @@ pub enum SourceError {
     #[error("cueing: {0}")]
     Washout(ringpod_core::cueing::ConfigError),
     /// The UDP address could not be bound.
-    #[error("{addr}: {source}")]
+    #[error("{addr}: {reason}")]
     Bind {
         /// The address.
         addr: std::net::SocketAddr,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// The pose file could not be read, or is not a pose file.
     #[error("{}: {reason}", path.display())]
@@ -180,7 +180,7 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
                 }
             };
             let idle = positive("udp-idle", *idle, 1e6)?;
-            let socket = std::net::UdpSocket::bind(addr).map_err(|source| SourceError::Bind { addr: *addr, source })?;
+            let socket = std::net::UdpSocket::bind(addr).map_err(|reason| SourceError::Bind { addr: *addr, reason })?;
             let source = UdpSource {
                 socket,
                 decoder,

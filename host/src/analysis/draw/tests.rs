@@ -1,4 +1,3 @@
-
 use super::*;
 use ringpod_core::kinematics::presets;
 

@@ -1,4 +1,3 @@
-
 use super::*;
 
 /// Live for Speed's classic OutSim packet: time (ms), angular velocity, heading, pitch, roll, acceleration
