@@ -13,14 +13,6 @@ pub enum CliError {
     /// `--mechanism` names no preset.
     #[error("unknown mechanism `{0}`; `ringpod presets` lists them")]
     UnknownMechanism(String),
-    /// A list of numbers could not be read.
-    #[error("--{what}: {reason}")]
-    BadNumbers {
-        /// The option.
-        what: &'static str,
-        /// What is wrong.
-        reason: String,
-    },
     /// The kinematics have no answer.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),
@@ -47,10 +39,85 @@ pub enum CliError {
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),
+    /// Options that do not go together.
+    #[error(transparent)]
+    Request(#[from] crate::cli::requests::RequestError),
+    /// A picture was not written.
+    #[error(transparent)]
+    Plot(#[from] crate::out::plot::PlotError),
+    /// A run record could not be read.
+    #[error(transparent)]
+    Record(#[from] crate::stream::record::RecordError),
+    /// A drive could not be cued.
+    #[error(transparent)]
+    Cue(#[from] crate::analysis::cue::CueError),
+    /// The cueing file.
+    #[error(transparent)]
+    Cueing(#[from] crate::input::cueing::CueingFileError),
+    /// A command for ring platforms was given another mechanism.
+    #[error("cueing moves a ring platform; {0} is not one")]
+    NotARing(String),
+    /// A file could not be written.
+    #[error("{}: {reason}", path.display())]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        reason: String,
+    },
+}
+
+impl CliError {
+    /// `--what: reason`: an option's value the command cannot use.
+    pub fn bad(what: &'static str, reason: String) -> Self {
+        Self::Number(crate::input::numbers::BadNumber::new(what, reason))
+    }
+
+    /// `path: reason`: a file that could not be written.
+    pub fn file(path: &std::path::Path, reason: impl std::fmt::Display) -> Self {
+        Self::File {
+            path: path.to_owned(),
+            reason: reason.to_string(),
+        }
+    }
 }
 
 impl From<ringpod_core::kinematics::TipOverError> for CliError {
     fn from(e: ringpod_core::kinematics::TipOverError) -> Self {
         Self::TipOver(e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    /// The errors that say their cause in their own words give no `source()`: `main` prints an error with its
+    /// chain (`{:#}`), and a cause given both ways was printed twice (`/dev/x: No such file: No such file`).
+    #[test]
+    fn a_cause_in_the_words_is_not_also_a_source() {
+        let io = || std::io::Error::new(std::io::ErrorKind::NotFound, "not there");
+        let json = serde_json::from_str::<u8>("x").unwrap_err();
+        let errors: [Box<dyn std::error::Error>; 4] = [
+            Box::new(crate::link::LinkError::Open {
+                port: "/dev/x".into(),
+                reason: serialport::Error::new(serialport::ErrorKind::NoDevice, "not there"),
+            }),
+            Box::new(crate::stream::command::SourceError::Bind {
+                addr: "127.0.0.1:9".parse().unwrap(),
+                reason: io(),
+            }),
+            Box::new(crate::analysis::cue::CueError::Output {
+                path: "/x.csv".into(),
+                reason: io(),
+            }),
+            Box::new(crate::device::settings::ConfigCommandError::Section {
+                change: None,
+                section: "stream",
+                reason: json,
+            }),
+        ];
+        for e in errors {
+            assert!(e.source().is_none(), "{e}");
+            assert!(e.to_string().contains(": "), "{e}");
+        }
     }
 }

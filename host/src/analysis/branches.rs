@@ -65,10 +65,7 @@ pub fn parse(text: &str) -> Result<Assembly, String> {
 /// The mechanism on the assembly asked: the tool carrier rebuilt on `One`; refused for a ring platform (its rods'
 /// branches are its geometry) and for `All` (the caller answers for one assembly).
 pub(crate) fn assembled(m: AnyMechanism, assembly: Option<Assembly>) -> Result<AnyMechanism, CliError> {
-    let refused = |reason: &str| CliError::BadNumbers {
-        what: "branch",
-        reason: reason.into(),
-    };
+    let refused = |reason: &str| CliError::bad("branch", reason.into());
     match (m, assembly) {
         (m, None) => Ok(m),
         (AnyMechanism::Tool(tool), Some(Assembly::One(b))) => Ok(AnyMechanism::Tool(Box::new(tool.with_branches(b)))),

@@ -11,8 +11,10 @@ use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
 use crate::analysis::mechanism::{AnyMechanism, Selected};
+use crate::error::CliError;
 use crate::input::cueing::load_config;
 use crate::input::table::{self, InputError};
+use crate::out::plot::PlotError;
 use crate::out::plot::{self, Panel, Series, TimePlot};
 
 /// The columns of a telemetry file.
@@ -83,12 +85,12 @@ pub struct Options<'a> {
 }
 
 /// Runs the command; returns the summary as text and the exit code.
-pub fn run(args: &Options) -> anyhow::Result<(String, u8)> {
+pub fn run(args: &Options) -> Result<(String, u8), CliError> {
     let config = load_config(args.config, args.profile)?;
     let (rows, mut errors, capture) = read_input(args)?;
     let selected = Selected::of(args.mechanism, args.geometry)?;
     let AnyMechanism::Ring(mechanism) = selected.mechanism else {
-        anyhow::bail!("cueing moves a ring platform; {} is not one", selected.name);
+        return Err(CliError::NotARing(selected.name));
     };
     let neutral = Pose::from_array(selected.home);
     let Replay {
@@ -154,12 +156,12 @@ pub enum CueError {
         reason: String,
     },
     /// The poses could not be written.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {reason}", path.display())]
     Output {
         /// The file.
         path: std::path::PathBuf,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
 }
 
@@ -270,9 +272,9 @@ fn write_poses(path: &Path, cued: &[Cued]) -> Result<(), CueError> {
         }
         out.flush()
     };
-    write().map_err(|source| CueError::Output {
+    write().map_err(|reason| CueError::Output {
         path: path.to_path_buf(),
-        source,
+        reason,
     })
 }
 
@@ -296,7 +298,7 @@ pub fn delivered_forces(cued: &[Cued]) -> Vec<[f64; 3]> {
 
 /// Draws the cues: per axis the specific force asked (scaled as the washout scales it) and delivered, and the
 /// angular rates asked and delivered (SVG or PNG).
-fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
+fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> Result<(), PlotError> {
     let delivered = delivered_forces(cued);
     let rates: Vec<[f64; 3]> = (0..cued.len())
         .map(|k| {
@@ -361,7 +363,7 @@ fn draw(path: &Path, cued: &[Cued], neutral: &Pose<f64>) -> anyhow::Result<()> {
             ),
         ],
     };
-    Ok(plot::save(path, (1000, 1000), &plot)?)
+    plot::save(path, (1000, 1000), &plot)
 }
 
 #[cfg(test)]

@@ -123,7 +123,7 @@ pub struct Profile {
 
 /// Inverse dynamics along the pose CSV at `input`.
 pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -> Result<Profile, CliError> {
-    let bad = |reason: String| CliError::BadNumbers { what: "input", reason };
+    let bad = |reason: String| CliError::bad("input", reason);
     let text = crate::input::files::read_text(input, crate::input::files::DATA_LIMIT)
         .map_err(|e| bad(format!("{}: {e}", input.display())))?;
     let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
@@ -368,10 +368,7 @@ pub fn run(job: &Job, json: bool) -> Result<Outcome, CliError> {
     let margins: [Option<MarginJson>; 6] = std::array::from_fn(|k| job.drives[k].as_ref().map(|d| margin(d, &p, k)));
     let keep_up = margins.iter().flatten().all(|m| m.rows_over == 0);
     if let Some(out) = job.plot {
-        draw(job, &p, units, out).map_err(|e| CliError::BadNumbers {
-            what: "plot",
-            reason: e.to_string(),
-        })?;
+        draw(job, &p, units, out).map_err(|e| CliError::bad("plot", e.to_string()))?;
     }
     let code = if p.errors.is_empty() && keep_up {
         0
@@ -482,26 +479,4 @@ fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> Result<(), plot
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_wrapped_yaw_is_followed_the_short_way() {
-        let mut yaw = [6.0, 6.2, 0.1, 0.3, 6.2];
-        unwrap(&mut yaw);
-        let tau = std::f64::consts::TAU;
-        let want = [6.0, 6.2, 0.1 + tau, 0.3 + tau, 6.2];
-        assert!(yaw.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12), "{yaw:?}");
-    }
-
-    #[test]
-    fn three_point_derivatives_are_exact_for_a_parabola_on_uneven_steps() {
-        let t = [0.0, 0.1, 0.25, 0.3, 0.5];
-        let v: Vec<f64> = t.iter().map(|t| 3.0 * t * t - t + 2.0).collect();
-        for i in 1..4 {
-            let (rate, accel) = derivatives(&t, &v, i);
-            assert!((rate - (6.0 * t[i] - 1.0)).abs() < 1e-12, "{i}");
-            assert!((accel - 6.0).abs() < 1e-9, "{i}");
-        }
-    }
-}
+mod tests;

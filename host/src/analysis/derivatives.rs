@@ -15,6 +15,9 @@ use std::path::Path;
 
 use plotters::style::colors::{BLUE, GREEN, RED};
 
+use crate::error::CliError;
+use crate::input::numbers::BadNumber;
+
 use crate::out::plot::{self, Panel, Series, TimePlot};
 use crate::stream::record;
 
@@ -56,23 +59,38 @@ pub fn local_quadratic(t: &[f64], y: &[f64], window: f64) -> Vec<(f64, f64)> {
     out
 }
 
-/// The sample times drawn.
-struct Span {
+/// The derivatives over the span asked: its samples' times, and per axis (velocity, acceleration) at each.
+struct Measured {
     t: Vec<f64>,
+    derivatives: Vec<Vec<(f64, f64)>>,
 }
 
 const AXES: [&str; 6] = ["surge x", "sway y", "heave z", "roll alpha", "pitch beta", "yaw gamma"];
 
 /// Draws the derivatives of a record's followed pose over the device times `span` (`[from, to]`, s; the fit takes
 /// the samples around its ends too); returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> anyhow::Result<String> {
+pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> Result<String, CliError> {
     if !(window.is_finite() && window > 0.0 && window <= 10.0) {
-        anyhow::bail!("--window: {window} s; a window is more than 0 and at most 10 s");
+        return Err(BadNumber::new(
+            "window",
+            format!("{window} s; a window is more than 0 and at most 10 s"),
+        )
+        .into());
     }
     if span.0.is_nan() || span.1.is_nan() || span.0 >= span.1 {
-        anyhow::bail!("--from {} --to {}: the span is empty", span.0, span.1);
+        return Err(BadNumber::given("from", format!("{} --to {}", span.0, span.1), "the span is empty").into());
     }
     let whole = record::read(input)?;
+    let measured = measure(&whole, window, span)?;
+    let name = input
+        .file_name()
+        .map_or(String::new(), |f| f.to_string_lossy().into_owned());
+    plot::save(out, (1100, 1200), &picture(&name, window, &measured))?;
+    Ok(summary(&whole.t, &measured, window, out))
+}
+
+/// Fits the whole record (so that the span's ends have their neighbours) and keeps the samples inside the span.
+fn measure(whole: &record::Run, window: f64, span: (f64, f64)) -> Result<Measured, CliError> {
     let all: Vec<Vec<(f64, f64)>> = (0..6)
         .map(|k| {
             let y: Vec<f64> = whole.target.iter().map(|p| p[k]).collect();
@@ -84,27 +102,34 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
         .filter(|&i| whole.t[i] >= span.0 && whole.t[i] <= span.1)
         .collect();
     if inside.len() < 2 {
-        anyhow::bail!(
-            "--from/--to: {} of the record's samples (device time {:.3} to {:.3} s) are in the span",
-            inside.len(),
-            whole.t[0],
-            whole.t[whole.t.len() - 1]
-        );
+        return Err(BadNumber::new(
+            "from/--to",
+            format!(
+                "{} of the record's samples (device time {:.3} to {:.3} s) are in the span",
+                inside.len(),
+                whole.t[0],
+                whole.t[whole.t.len() - 1]
+            ),
+        )
+        .into());
     }
-    let run = Span {
+    Ok(Measured {
         t: inside.iter().map(|&i| whole.t[i]).collect(),
-    };
-    let derivatives: Vec<Vec<(f64, f64)>> = all.iter().map(|d| inside.iter().map(|&i| d[i]).collect()).collect();
+        derivatives: all.iter().map(|d| inside.iter().map(|&i| d[i]).collect()).collect(),
+    })
+}
+
+/// Four panels: velocity and acceleration, translation and rotation, three axes each.
+fn picture(name: &str, window: f64, m: &Measured) -> TimePlot {
     let colours = [BLUE, RED, GREEN];
     let series = |axes: std::ops::Range<usize>, second: bool| -> Vec<Series> {
         axes.enumerate()
             .map(|(n, k)| {
-                let points = run
-                    .t
-                    .iter()
-                    .zip(&derivatives[k])
-                    .map(|(t, (v, a))| (*t, if second { *a } else { *v }))
-                    .collect();
+                let points =
+                    m.t.iter()
+                        .zip(&m.derivatives[k])
+                        .map(|(t, (v, a))| (*t, if second { *a } else { *v }))
+                        .collect();
                 Series::new(AXES[k], points, colours[n % 3])
             })
             .collect()
@@ -115,10 +140,7 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
         series,
         events: Vec::new(),
     };
-    let name = input
-        .file_name()
-        .map_or(String::new(), |f| f.to_string_lossy().into_owned());
-    let picture = TimePlot {
+    TimePlot {
         title: format!(
             "ringpod run {name}: velocity and acceleration of the followed pose (local quadratic over {:.0} ms)",
             window * 1e3
@@ -129,14 +151,18 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
             panel("acceleration: translation", "m/s^2", series(0..3, true)),
             panel("acceleration: rotation", "rad/s^2", series(3..6, true)),
         ],
-    };
-    plot::save(out, (1100, 1200), &picture)?;
-    let per = (whole.t.len() as f64 - 1.0) / (whole.t[whole.t.len() - 1] - whole.t[0]).max(f64::MIN_POSITIVE);
+    }
+}
+
+/// What was drawn: the record's rate, the fit's window and what it attenuates, the span, each axis's peaks.
+fn summary(all_t: &[f64], m: &Measured, window: f64, out: &Path) -> String {
+    let (first, last) = (all_t[0], all_t[all_t.len() - 1]);
+    let per = (all_t.len() as f64 - 1.0) / (last - first).max(f64::MIN_POSITIVE);
     let mut text = format!(
         "{} rows over {:.3} s of device time ({:.1} a second); derivatives of the followed pose by a least-squares \
          quadratic over {:.0} ms around each sample (about {:.0} samples); picture: {}\n",
-        whole.t.len(),
-        whole.t[whole.t.len() - 1] - whole.t[0],
+        all_t.len(),
+        last - first,
         per,
         window * 1e3,
         2.0 * (per * window / 2.0 + 1e-9).floor() + 1.0,
@@ -148,17 +174,17 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
          window): the velocity within 1 % up to {:.1} Hz",
         0.1 / window
     );
-    if inside.len() < whole.t.len() {
+    if m.t.len() < all_t.len() {
         let _ = writeln!(
             text,
             "drawn and measured from {:.3} to {:.3} s ({} samples)",
-            run.t[0],
-            run.t[run.t.len() - 1],
-            inside.len()
+            m.t[0],
+            m.t[m.t.len() - 1],
+            m.t.len()
         );
     }
     let _ = writeln!(text, "axis        peak |velocity|  peak |acceleration|");
-    for (k, d) in derivatives.iter().enumerate() {
+    for (k, d) in m.derivatives.iter().enumerate() {
         let peak = |f: fn(&(f64, f64)) -> f64| {
             d.iter()
                 .map(f)
@@ -176,7 +202,7 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
             unit.1
         );
     }
-    Ok(text)
+    text
 }
 
 #[cfg(test)]

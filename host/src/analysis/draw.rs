@@ -177,7 +177,6 @@ impl Picture for Scene {
         DB::ErrorType: 'static,
     {
         let fail = plot::failed(out);
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
         let view = self.view(root.dim_in_pixel());
         let font = |size: u32| (plot::FONT, size).into_font();
         let p = &self.pose;
@@ -191,33 +190,15 @@ impl Picture for Scene {
             p[4].to_degrees(),
             p[5].to_degrees()
         );
-        root.draw(&Text::new(title, (16, 12), font(18))).map_err(|e| fail(&e))?;
         let legend =
             "ring (grey), carriages B (blue), rods and elbow arms (black), radial actuators (orange), platform joints A (red)";
-        root.draw(&Text::new(legend, (16, 36), font(13)))
-            .map_err(|e| fail(&e))?;
         // Base axes, with the ring plane's centre O.
-        let origin = view.at([0.0; 3]);
-        for (name, end) in self.axes() {
-            let e = view.at(end);
-            root.draw(&PathElement::new(vec![origin, e], RING.mix(0.8).stroke_width(1)))
-                .map_err(|e| fail(&e))?;
-            root.draw(&Text::new(name, (e.0 + 4, e.1 - 8), font(16)))
-                .map_err(|e| fail(&e))?;
-        }
-        root.draw(&Text::new("O", (origin.0 + 4, origin.1 + 2), font(13)))
-            .map_err(|e| fail(&e))?;
+        let origin = ground(root, out, &view, [&title, legend], self.axes())?;
         let ring: Vec<(i32, i32)> = ring_points(self.ring_radius).map(|q| view.at(q)).collect();
         root.draw(&PathElement::new(ring, RING.stroke_width(3)))
             .map_err(|e| fail(&e))?;
         // The platform polygon, its joints in chain order.
-        let platform: Vec<(i32, i32)> = self.joints.iter().map(|a| view.at(*a)).collect();
-        root.draw(&Polygon::new(platform.clone(), PLATFORM.mix(0.25)))
-            .map_err(|e| fail(&e))?;
-        let mut closed = platform.clone();
-        closed.extend(platform.first());
-        root.draw(&PathElement::new(closed, PLATFORM.stroke_width(2)))
-            .map_err(|e| fail(&e))?;
+        outlined(root, out, self.joints.iter().map(|a| view.at(*a)).collect())?;
         // The platform centre.
         let c = [p[0], p[1], p[2]];
         let cp = view.at(c);
@@ -332,7 +313,6 @@ impl Picture for ToolScene {
         DB::ErrorType: 'static,
     {
         let fail = plot::failed(out);
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
         let view = self.view(root.dim_in_pixel());
         let font = |size: u32| (plot::FONT, size).into_font();
         let p = &self.pose;
@@ -345,20 +325,8 @@ impl Picture for ToolScene {
             p[3].to_degrees(),
             p[4].to_degrees()
         );
-        root.draw(&Text::new(title, (16, 12), font(18))).map_err(|e| fail(&e))?;
         let legend = "X guide (grey), carriage beam (blue), links L2 and L3 (black), frame (green), tool L1 (orange)";
-        root.draw(&Text::new(legend, (16, 36), font(13)))
-            .map_err(|e| fail(&e))?;
-        let origin = view.at([0.0; 3]);
-        for (name, end) in self.axes() {
-            let e = view.at(end);
-            root.draw(&PathElement::new(vec![origin, e], RING.mix(0.8).stroke_width(1)))
-                .map_err(|e| fail(&e))?;
-            root.draw(&Text::new(name, (e.0 + 4, e.1 - 8), font(16)))
-                .map_err(|e| fail(&e))?;
-        }
-        root.draw(&Text::new("O", (origin.0 + 4, origin.1 + 2), font(13)))
-            .map_err(|e| fail(&e))?;
+        ground(root, out, &view, [&title, legend], self.axes())?;
         for rail in self.rails() {
             root.draw(&PathElement::new(
                 rail.map(|r| view.at(r)).to_vec(),
@@ -369,13 +337,7 @@ impl Picture for ToolScene {
         let beam = vec![view.at(self.bases[0]), view.at(self.bases[1])];
         root.draw(&PathElement::new(beam, CARRIAGE.stroke_width(3)))
             .map_err(|e| fail(&e))?;
-        let frame: Vec<(i32, i32)> = self.frame.iter().map(|c| view.at(*c)).collect();
-        root.draw(&Polygon::new(frame.clone(), PLATFORM.mix(0.25)))
-            .map_err(|e| fail(&e))?;
-        let mut closed = frame.clone();
-        closed.extend(frame.first());
-        root.draw(&PathElement::new(closed, PLATFORM.stroke_width(2)))
-            .map_err(|e| fail(&e))?;
+        outlined(root, out, self.frame.iter().map(|c| view.at(*c)).collect())?;
         let (centre, tool) = (view.at(self.centre()), view.at(self.tool));
         root.draw(&PathElement::new(vec![centre, tool], RADIAL.stroke_width(3)))
             .map_err(|e| fail(&e))?;
@@ -398,6 +360,56 @@ impl Picture for ToolScene {
         }
         Ok(())
     }
+}
+
+/// What both scenes draw first: a white ground, the title and the legend (`text`), and the base axes from the
+/// origin O, labelled. Returns the origin's pixel.
+fn ground<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    out: &Path,
+    view: &View,
+    text: [&str; 2],
+    axes: [(&'static str, [f64; 3]); 3],
+) -> Result<(i32, i32), plot::PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    let fail = plot::failed(out);
+    let font = |size: u32| (plot::FONT, size).into_font();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    root.draw(&Text::new(text[0], (16, 12), font(18)))
+        .map_err(|e| fail(&e))?;
+    root.draw(&Text::new(text[1], (16, 36), font(13)))
+        .map_err(|e| fail(&e))?;
+    let origin = view.at([0.0; 3]);
+    for (name, end) in axes {
+        let e = view.at(end);
+        root.draw(&PathElement::new(vec![origin, e], RING.mix(0.8).stroke_width(1)))
+            .map_err(|e| fail(&e))?;
+        root.draw(&Text::new(name, (e.0 + 4, e.1 - 8), font(16)))
+            .map_err(|e| fail(&e))?;
+    }
+    root.draw(&Text::new("O", (origin.0 + 4, origin.1 + 2), font(13)))
+        .map_err(|e| fail(&e))?;
+    Ok(origin)
+}
+
+/// A polygon filled light and outlined: the ring platform, the tool carrier's frame.
+fn outlined<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    out: &Path,
+    corners: Vec<(i32, i32)>,
+) -> Result<(), plot::PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    let fail = plot::failed(out);
+    root.draw(&Polygon::new(corners.clone(), PLATFORM.mix(0.25)))
+        .map_err(|e| fail(&e))?;
+    let mut closed = corners.clone();
+    closed.extend(corners.first());
+    root.draw(&PathElement::new(closed, PLATFORM.stroke_width(2)))
+        .map_err(|e| fail(&e))
 }
 
 /// Where a label of the point `p` goes: away from `from`, its text's top left corner.
@@ -427,7 +439,7 @@ fn in_units(on: &On, m: &AnyMechanism, pose: [f64; 6], q: [f64; 6]) -> ([f64; 6]
 }
 
 /// Draws the platform at the pose into `--out` and says what it drew.
-pub fn run(o: &Options) -> anyhow::Result<String> {
+pub fn run(o: &Options) -> Result<String, CliError> {
     let Selected {
         name, home, mechanism, ..
     } = Selected::of(o.on.mechanism, o.on.geometry)?;
@@ -485,106 +497,4 @@ pub fn run(o: &Options) -> anyhow::Result<String> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use ringpod_core::kinematics::presets;
-
-    /// The centres of the SVG's circles.
-    fn circles(svg: &str) -> Vec<(f64, f64)> {
-        let attr = |s: &str, name: &str| -> Option<f64> {
-            let k = s.find(&format!(" {name}=\""))? + name.len() + 3;
-            s[k..].split('"').next()?.parse().ok()
-        };
-        svg.split("<circle")
-            .skip(1)
-            .filter_map(|c| Some((attr(c, "cx")?, attr(c, "cy")?)))
-            .collect()
-    }
-
-    /// The drawing's joints and carriages are where IK puts them: each platform joint `R a + p` (computed here
-    /// from the geometry's points) and each carriage `Rr (cos q, sin q, 0)` (from IK's angles) has a circle on
-    /// its projected pixel, and nowhere else are circles drawn.
-    #[test]
-    fn the_drawn_joints_are_iks() {
-        for (geometry, pose) in [
-            (presets::TRAINER_CH5, [0.1, -0.05, 1.0, 0.05, -0.03, 0.4]),
-            (presets::ROTOPOD_CH4, [0.02, 0.0, 0.7, 0.0, 0.04, 1.0]),
-        ] {
-            let ring = RingPlatform::<f64>::new(&geometry);
-            let pose = Pose::from_array(pose);
-            let scene = Scene::of("test", &ring, &pose).unwrap();
-            let mut svg = String::new();
-            {
-                let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-                scene.paint(&root, Path::new("test.svg")).unwrap();
-                root.present().unwrap();
-            }
-            let drawn = circles(&svg);
-            let view = scene.view(SIZE);
-            let q = ring.inverse(&pose).unwrap();
-            let r = pose.rotation();
-            let n = geometry.chains().len();
-            assert_eq!(drawn.len(), 2 * n);
-            for (i, c) in geometry.chains().iter().enumerate() {
-                let a = r * nalgebra::Vector3::from(c.platform_point) + pose.position();
-                let rr = geometry.ring_radius;
-                let b = [rr * q.0[i].cos(), rr * q.0[i].sin(), 0.0];
-                for p in [[a.x, a.y, a.z], b] {
-                    let (x, y) = view.pixel(p);
-                    assert!(
-                        drawn.iter().any(|d| (d.0 - x).abs() <= 0.5 && (d.1 - y).abs() <= 0.5),
-                        "no circle at {p:?} ({x}, {y}): {drawn:?}"
-                    );
-                }
-                assert!((scene.joints[i][0] - a.x).abs() < 1e-12 && (scene.joints[i][2] - a.z).abs() < 1e-12);
-            }
-        }
-    }
-
-    /// The tool carrier's dyads close where IK says: each elbow `L2` from its base pivot at `q2` / `q4`, each
-    /// frame pivot `L3` from its elbow along `q3` / `q6`, in the plane `x = q1`; the tool `L1` below the frame's
-    /// centre; and a circle drawn on each frame pivot's pixel.
-    #[test]
-    fn the_drawn_tool_carrier_is_iks() {
-        let g = presets::TOOL5_EX;
-        let tool = ToolCarrier::<f64>::new(&g);
-        for pose in [[0.0, 0.0, 0.4, 0.0, 0.0, 0.0], [0.03, -0.02, 0.42, 0.2656, 0.4421, 0.0]] {
-            let pose = Pose::from_array(pose);
-            let scene = ToolScene::of("test", &tool, &pose).unwrap();
-            let q = tool.inverse(&pose).unwrap().0;
-            for (k, (drive, link)) in [(1, 2), (3, 5)].into_iter().enumerate() {
-                let (b, e, a) = (scene.bases[k], scene.elbows[k], scene.pivots[k]);
-                let dist = |u: [f64; 3], v: [f64; 3]| (0..3).map(|i| (u[i] - v[i]).powi(2)).sum::<f64>().sqrt();
-                assert!((dist(b, e) - g.l2).abs() < 1e-9);
-                assert!((dist(e, a) - g.l3).abs() < 1e-9, "{} vs {}", dist(e, a), g.l3);
-                assert!(((e[2] - b[2]).atan2(e[1] - b[1]) - q[drive]).abs() < 1e-9);
-                assert!(((a[2] - e[2]).atan2(a[1] - e[1]) - q[link]).abs() < 1e-9);
-                assert!((a[0] - q[0]).abs() < 1e-12 && (b[0] - q[0]).abs() < 1e-12);
-            }
-            let c = scene.centre();
-            let to_tool: f64 = (0..3).map(|i| (c[i] - scene.tool[i]).powi(2)).sum::<f64>().sqrt();
-            assert!((to_tool - g.l1).abs() < 1e-9);
-            let mut svg = String::new();
-            {
-                let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-                scene.paint(&root, Path::new("test.svg")).unwrap();
-                root.present().unwrap();
-            }
-            let drawn = circles(&svg);
-            let view = scene.view(SIZE);
-            for a in scene.pivots {
-                let (x, y) = view.pixel(a);
-                assert!(drawn.iter().any(|d| (d.0 - x).abs() <= 0.5 && (d.1 - y).abs() <= 0.5));
-            }
-        }
-    }
-
-    #[test]
-    fn isometric_axes() {
-        // Seen from (1, 1, 1): X and Y go down and apart, Z straight up, all foreshortened alike.
-        let (x, y, z) = (iso([1.0, 0.0, 0.0]), iso([0.0, 1.0, 0.0]), iso([0.0, 0.0, 1.0]));
-        assert!(x.0 < 0.0 && x.1 < 0.0 && y.0 > 0.0 && y.1 < 0.0 && z.0 == 0.0 && z.1 > 0.0);
-        let len = |p: (f64, f64)| p.0.hypot(p.1);
-        assert!((len(x) - len(z)).abs() < 1e-12 && (len(y) - len(z)).abs() < 1e-12);
-    }
-}
+mod tests;

@@ -15,6 +15,9 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use ringpod_core::screws::translational::{gram, GramDeterminants, MIXED};
 
+use crate::error::CliError;
+use crate::input::numbers::BadNumber;
+
 use crate::out::plot::{self, Picture};
 
 /// What `gram` is asked to do.
@@ -115,12 +118,12 @@ const PICKS: [(&str, &str, Pick); 3] = [
     ("det G", "all six", |g| g.all),
 ];
 
-pub fn run(args: &Options) -> anyhow::Result<String> {
+pub fn run(args: &Options) -> Result<String, CliError> {
     if !(args.step.is_finite() && (0.0005..=0.05).contains(&args.step)) {
-        anyhow::bail!("--step {}: the grid's step is 0.0005 to 0.05 m", args.step);
+        return Err(BadNumber::given("step", args.step, "the grid's step is 0.0005 to 0.05 m").into());
     }
     if !(args.z.is_finite() && (-0.4..=0.0).contains(&args.z)) {
-        anyhow::bail!("--z {}: the mechanism reaches heights from -0.4 to 0 m", args.z);
+        return Err(BadNumber::given("z", args.z, "the mechanism reaches heights from -0.4 to 0 m").into());
     }
     let slice = scan(args.z, args.step);
     plot::save(args.out, (1200, 1060), &SlicePicture { slice: &slice })?;
@@ -147,7 +150,7 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
     }
     let _ = writeln!(text, "picture: {}", args.out.display());
     if let Some(path) = args.table {
-        std::fs::write(path, table(&slice, &all_stats)).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        std::fs::write(path, table(&slice, &all_stats)).map_err(|e| CliError::file(path, e))?;
         let _ = writeln!(text, "table: {}", path.display());
     }
     Ok(text)
@@ -291,32 +294,25 @@ impl SlicePicture<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let fail = plot::failed(out);
         let s = self.slice;
-        let mut chart = ChartBuilder::on(area)
-            .margin(12)
-            .caption(caption, (plot::FONT, 15))
-            .x_label_area_size(36)
-            .y_label_area_size(56)
-            .build_cartesian_2d(SPAN.0..SPAN.1, SPAN.0..SPAN.1)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc("x (m)")
-            .y_desc("y (m)")
-            .label_style((plot::FONT, 11))
-            .disable_mesh()
-            .draw()
-            .map_err(|e| fail(&e))?;
         let half = s.step / 2.0;
-        chart
-            .draw_series((0..s.n * s.n).map(|k| {
+        let map = plot::CellMap {
+            caption: (caption, 15),
+            margin: 12,
+            label_areas: (36, 56),
+            axes: ("x (m)", "y (m)", 11),
+            u: SPAN,
+            v: SPAN,
+        };
+        map.draw(
+            area,
+            out,
+            (0..s.n * s.n).map(|k| {
                 let (x, y) = (s.centre(k % s.n), s.centre(k / s.n));
                 let c = s.at(k % s.n, k / s.n).map_or(RGBColor(235, 235, 235), colour);
-                Rectangle::new([(x - half, y - half), (x + half, y + half)], c.filled())
-            }))
-            .map_err(|e| fail(&e))?;
-        Ok(())
+                ([(x - half, y - half), (x + half, y + half)], c)
+            }),
+        )
     }
 }
 

@@ -159,6 +159,7 @@ struct CheckJson {
     pass: bool,
 }
 
+/// `ik`'s and `check`'s answer: written as JSON, or read out by [`ik_text`].
 #[derive(Serialize)]
 struct IkJson<'a> {
     mechanism: &'a str,
@@ -255,82 +256,67 @@ pub fn ik(
     } else {
         0
     };
+    let answer = IkJson {
+        mechanism: &name,
+        pose: units.pose_out(&pose),
+        axes: &names,
+        units: std::array::from_fn(|i| units.axis_unit(axes[i])),
+        actuators,
+        checks: checks_json(&report, &units),
+        singularity_index: report.singularity_index,
+        singularity: singularity_name(singularity),
+        all_pass: report.all_pass(),
+        branches: assembled,
+    };
     let text = if common.json {
-        let out = IkJson {
-            mechanism: &name,
-            pose: units.pose_out(&pose),
-            axes: &names,
-            units: std::array::from_fn(|i| units.axis_unit(axes[i])),
-            actuators,
-            checks: checks_json(&report, &units),
-            singularity_index: report.singularity_index,
-            singularity: singularity_name(singularity),
-            all_pass: report.all_pass(),
-            branches: assembled,
-        };
-        serde_json::to_string_pretty(&out)? + "\n"
+        serde_json::to_string_pretty(&answer)? + "\n"
     } else {
-        let mut t = String::new();
-        let shown: Vec<String> = units.pose_out(&pose).iter().map(|v| format!("{v:.6}")).collect();
-        let _ = writeln!(
-            t,
-            "{} at pose x,y,z,alpha,beta,gamma = {} (m, {})",
-            name,
-            shown.join(", "),
-            units.angle_unit()
-        );
-        if let Some([b, d]) = assembled {
-            let _ = writeln!(t, "dyad branches: B side {b}, D side {d} (--branch all shows the four)");
-        }
-        if !exit_on_failed_check {
-            for i in 0..6 {
-                let _ = writeln!(
-                    t,
-                    "  {:<4} {:>14.9} {}",
-                    names[i],
-                    actuators[i],
-                    units.axis_unit(axes[i])
-                );
-            }
-        }
-        let _ = writeln!(t, "checks (margin > 0 is inside):");
-        for (c, margin) in report.iter() {
-            let verdict = if report.passes(c) { "ok  " } else { "FAIL" };
-            match margin {
-                Some(v) => {
-                    let _ = writeln!(
-                        t,
-                        "  {verdict} {:<17} {:>12.6} {}",
-                        c.name(),
-                        units.margin_out(c, v),
-                        units.margin_unit(c)
-                    );
-                }
-                None => {
-                    let _ = writeln!(t, "  n/a  {:<17}", c.name());
-                }
-            }
-        }
-        let _ = writeln!(
-            t,
-            "singularity index {:.4} ({})",
-            report.singularity_index,
-            singularity_name(singularity)
-        );
-        if exit_on_failed_check {
-            let _ = writeln!(
-                t,
-                "{}",
-                if report.all_pass() {
-                    "inside the workspace"
-                } else {
-                    "OUTSIDE the workspace"
-                }
-            );
-        }
-        t
+        ik_text(&answer, units.angle_unit(), exit_on_failed_check)
     };
     Ok(Outcome { text, code })
+}
+
+/// `ik`'s and `check`'s answer as text: the pose, the actuators (`ik`), each check's margin, the singularity, and
+/// for `check` the verdict.
+fn ik_text(a: &IkJson, angle_unit: &str, check: bool) -> String {
+    let mut t = String::new();
+    let shown: Vec<String> = a.pose.iter().map(|v| format!("{v:.6}")).collect();
+    let _ = writeln!(
+        t,
+        "{} at pose x,y,z,alpha,beta,gamma = {} (m, {angle_unit})",
+        a.mechanism,
+        shown.join(", "),
+    );
+    if let Some([b, d]) = a.branches {
+        let _ = writeln!(t, "dyad branches: B side {b}, D side {d} (--branch all shows the four)");
+    }
+    if !check {
+        for i in 0..6 {
+            let _ = writeln!(t, "  {:<4} {:>14.9} {}", a.axes[i], a.actuators[i], a.units[i]);
+        }
+    }
+    let _ = writeln!(t, "checks (margin > 0 is inside):");
+    for c in &a.checks {
+        let verdict = if c.pass { "ok  " } else { "FAIL" };
+        match c.margin {
+            Some(v) => {
+                let _ = writeln!(t, "  {verdict} {:<17} {:>12.6} {}", c.name, v, c.unit);
+            }
+            None => {
+                let _ = writeln!(t, "  n/a  {:<17}", c.name);
+            }
+        }
+    }
+    let _ = writeln!(t, "singularity index {:.4} ({})", a.singularity_index, a.singularity);
+    if check {
+        let verdict = if a.all_pass {
+            "inside the workspace"
+        } else {
+            "OUTSIDE the workspace"
+        };
+        let _ = writeln!(t, "{verdict}");
+    }
+    t
 }
 
 #[derive(Serialize)]
@@ -366,15 +352,15 @@ pub fn fk(args: &FkOptions) -> Result<Outcome, CliError> {
             AxisKind::Ring | AxisKind::Angle => numbers::MAX_TURNING,
         };
         if !v.is_finite() || v.abs() > limit {
-            return Err(CliError::BadNumbers {
-                what: "actuators",
-                reason: format!(
+            return Err(CliError::bad(
+                "actuators",
+                format!(
                     "value {} ({}) is out of range (at most {} either way)",
                     i + 1,
                     numbers::readable(*v),
                     numbers::readable(limit)
                 ),
-            });
+            ));
         }
     }
     // Without a guess: home turned by the yaw the carriages show, accepted within a tilt range of it.
@@ -444,10 +430,7 @@ pub fn loads(args: &LoadsOptions) -> Result<Outcome, CliError> {
         drives,
     } = Selected::of(common.mechanism, common.geometry)?;
     let AnyMechanism::Ring(ring) = &m else {
-        return Err(CliError::BadNumbers {
-            what: "mechanism",
-            reason: "statics are for ring platforms".into(),
-        });
+        return Err(CliError::bad("mechanism", "statics are for ring platforms".into()));
     };
     numbers::mass(args.mass)?;
     let names = m.axis_names();

@@ -45,12 +45,12 @@ const UNITS: [&str; 5] = ["N", "N m", "N m", "N m", "N m"];
 pub fn run(common: &On, pose: Option<&str>, wrench: &str) -> Result<Outcome, CliError> {
     let selected = Selected::of(common.mechanism, common.geometry)?;
     let AnyMechanism::Tool(carrier) = &selected.mechanism else {
-        return Err(CliError::BadNumbers {
-            what: "mechanism",
-            reason: "a ring platform has six degrees of freedom and no constraint reactions: its drive loads are \
+        return Err(CliError::bad(
+            "mechanism",
+            "a ring platform has six degrees of freedom and no constraint reactions: its drive loads are \
                      `ringpod loads`"
                 .into(),
-        });
+        ));
     };
     let pose = pose_arg(
         common,
@@ -61,10 +61,10 @@ pub fn run(common: &On, pose: Option<&str>, wrench: &str) -> Result<Outcome, Cli
     )?;
     let wrench = numbers::six("wrench", wrench)?;
     if let Some(i) = wrench.iter().position(|v| !(v.is_finite() && v.abs() <= 1e9)) {
-        return Err(CliError::BadNumbers {
-            what: "wrench",
-            reason: format!("value {} is not a finite number of at most 1e9", i + 1),
-        });
+        return Err(CliError::bad(
+            "wrench",
+            format!("value {} is not a finite number of at most 1e9", i + 1),
+        ));
     }
     let l: ToolLoads = tool_loads(carrier, &pose, &wrench)?;
     let text = if common.json {

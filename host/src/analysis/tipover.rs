@@ -87,7 +87,7 @@ struct TipOverJson<'a> {
 
 /// Parses `what` as `N` comma-separated finite numbers.
 fn list<const N: usize>(what: &'static str, text: &str) -> Result<[f64; N], numbers::BadNumber> {
-    let bad = |reason: String| numbers::BadNumber { what, reason };
+    let bad = |reason: String| numbers::BadNumber::new(what, reason);
     let values: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>().map_err(|e| bad(format!("`{}`: {e}", s.trim()))))
@@ -107,10 +107,10 @@ pub fn run(o: &Options) -> Result<Outcome, CliError> {
         name, home, mechanism, ..
     } = Selected::of(o.on.mechanism, o.on.geometry)?;
     let AnyMechanism::Ring(ring) = &mechanism else {
-        return Err(CliError::BadNumbers {
-            what: "tip-over",
-            reason: "the support polygon is the carriages' on the ring: ring platforms only".into(),
-        });
+        return Err(CliError::bad(
+            "tip-over",
+            "the support polygon is the carriages' on the ring: ring platforms only".into(),
+        ));
     };
     let length = mechanism.characteristic_length();
     let pose = pose_arg(&o.on, home, length, o.pose, "pose")?;
@@ -128,13 +128,13 @@ pub fn run(o: &Options) -> Result<Outcome, CliError> {
         Some(text) => {
             let a = list::<2>("accel", text)?;
             if let Some(v) = a.iter().find(|v| v.abs() > MAX_ACCEL) {
-                return Err(CliError::BadNumbers {
-                    what: "accel",
-                    reason: format!(
+                return Err(CliError::bad(
+                    "accel",
+                    format!(
                         "{} m/s^2 is out of range (at most {MAX_ACCEL:e} either way)",
                         numbers::readable(*v)
                     ),
-                });
+                ));
             }
             Some(a)
         }

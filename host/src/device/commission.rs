@@ -181,6 +181,14 @@ pub fn jog<T: Transport>(client: &mut Client<T>, words: &[String], buzz: bool) -
     ))
 }
 
+/// An axis as people number it (1-6) to the index the device takes (0-5).
+pub fn axis_index(axis: u8) -> Result<u8, CommissionError> {
+    match axis {
+        1..=6 => Ok(axis - 1),
+        _ => Err(CommissionError::NoAxis(u16::from(axis))),
+    }
+}
+
 /// Starts a commissioning move of `axis` (0-5) without waiting for its end: a jog by `distance` (degrees of ring
 /// for a carriage, mm for a linear actuator), turned into steps with the device's own steps per unit, or a buzz
 /// (`None`). `kind` is what the axis measures, as the device's hello said. Returns what was done ("jogged 5 deg
@@ -229,6 +237,19 @@ pub fn begin_move<T: Transport>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn axes_are_numbered_1_to_6_and_others_are_refused_by_number() {
+        assert_eq!(
+            (1..=6).map(|a| axis_index(a).ok()).collect::<Vec<_>>(),
+            (0..6).map(Some).collect::<Vec<_>>()
+        );
+        for a in [0, 7, 255] {
+            let e = axis_index(a).unwrap_err();
+            assert!(matches!(e, CommissionError::NoAxis(n) if n == u16::from(a)), "{e:?}");
+            assert_eq!(e.to_string(), format!("axis {a} does not exist (1-6)"));
+        }
+    }
 
     #[test]
     fn a_switch_change_is_one_line_and_the_table_names_every_input() {

@@ -1,6 +1,7 @@
 //! Talking to one controller: `device ACTION`, `monitor`, `simulate --pty` and `ports`.
 
 pub mod commission;
+mod error;
 pub mod monitor;
 pub mod settings;
 
@@ -12,6 +13,7 @@ use ringpod_core::safety::State;
 
 use crate::link::{self, client::Client, transport, Target};
 use crate::signals::Signals;
+pub use error::DeviceError;
 
 /// What `ringpod device` does.
 #[derive(Debug, Clone, PartialEq)]
@@ -49,7 +51,7 @@ pub enum Action {
 }
 
 /// `ringpod device ACTION`: 0 when done; a signal ends `inputs --watch` with 128 + its number.
-pub fn run(target: &Target, action: &Action) -> anyhow::Result<u8> {
+pub fn run(target: &Target, action: &Action) -> Result<u8, DeviceError> {
     let mut client = Client::new(link::connect(target, false)?);
     client.hello()?;
     let mut out = std::io::stdout();
@@ -102,14 +104,14 @@ fn home<T: link::client::Transport>(client: &mut Client<T>) -> Result<(), link::
 fn status_after<T: link::client::Transport>(
     client: &mut Client<T>,
     command: impl FnOnce(&mut Client<T>) -> Result<(), link::client::ClientError>,
-) -> anyhow::Result<String> {
+) -> Result<String, DeviceError> {
     command(client)?;
     status(client)
 }
 
 /// The status as JSON, and the rig the board runs: where it came from and whether another waits for the next
 /// start (a refused or unreadable stored rig is warned about on stderr).
-fn status<T: link::client::Transport>(client: &mut Client<T>) -> anyhow::Result<String> {
+fn status<T: link::client::Transport>(client: &mut Client<T>) -> Result<String, DeviceError> {
     let status = client.status()?;
     let (rig, source, pending) = client.rig()?;
     if let RigSource::Refused(_) | RigSource::Unreadable = source {
@@ -121,7 +123,7 @@ fn status<T: link::client::Transport>(client: &mut Client<T>) -> anyhow::Result<
 }
 
 /// `ringpod monitor`: until `frames` frames are drawn or a signal (then 128 + its number).
-pub fn monitor(target: &Target, frames: Option<u64>) -> anyhow::Result<u8> {
+pub fn monitor(target: &Target, frames: Option<u64>) -> Result<u8, DeviceError> {
     let mut client = Client::new(link::connect(target, true)?);
     let source = match target {
         Target::Port(port) => port.clone(),
@@ -154,7 +156,7 @@ impl Platform {
 
 /// `ringpod simulate --pty [--geometry RIG.toml | --mechanism PRESET]`: serves until a signal, and exits with
 /// 128 + its number.
-pub fn simulate(platform: Option<&Platform>) -> anyhow::Result<u8> {
+pub fn simulate(platform: Option<&Platform>) -> Result<u8, DeviceError> {
     let device = match Platform::rig(platform)? {
         Some(rig) => transport::SimDevice::for_rig(true, &rig)?,
         None => transport::SimDevice::new(true),
@@ -166,7 +168,7 @@ pub fn simulate(platform: Option<&Platform>) -> anyhow::Result<u8> {
 }
 
 /// `ringpod ports`: the serial ports this machine has, and what each is.
-pub fn ports() -> anyhow::Result<u8> {
+pub fn ports() -> Result<u8, DeviceError> {
     let ports = serialport::available_ports()?;
     let mut out = std::io::stdout();
     if ports.is_empty() {

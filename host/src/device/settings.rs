@@ -33,14 +33,14 @@ pub enum ConfigCommandError {
         key: String,
     },
     /// The changed section is not a section of its kind (a wrong type or an unknown field).
-    #[error("{change}{section}: {source}")]
+    #[error("{}{section}: {reason}", change.as_ref().map_or(String::new(), |c| format!("{c}: ")))]
     Section {
-        /// The change that made it, `path = value: `, or nothing.
-        change: String,
+        /// The change that made it (`path = value`), when one did (`device config set`).
+        change: Option<String>,
         /// The section.
         section: &'static str,
         /// What serde found.
-        source: serde_json::Error,
+        reason: serde_json::Error,
     },
     /// The inputs section names an input there is not.
     #[error("{0}")]
@@ -83,10 +83,10 @@ fn to_json(settings: &Settings) -> Result<Value, serde_json::Error> {
 
 /// The section `kind` from its JSON value (every field, no others).
 fn from_json(kind: SettingsKind, value: Value) -> Result<Settings, ConfigCommandError> {
-    let bad = |source| ConfigCommandError::Section {
-        change: String::new(),
+    let bad = |reason| ConfigCommandError::Section {
+        change: None,
         section: kind.name(),
-        source,
+        reason,
     };
     Ok(match kind {
         SettingsKind::Stream => Settings::Stream(serde_json::from_value(value).map_err(bad)?),
@@ -182,10 +182,10 @@ pub fn run<T: Transport>(client: &mut Client<T>, args: &[String]) -> Result<Valu
             let new = serde_json::from_str(text).unwrap_or_else(|_| Value::String((*text).to_owned()));
             *at(&mut value, &parts[1..], path)? = new;
             let changed = from_json(kind, value).map_err(|e| match e {
-                ConfigCommandError::Section { section, source, .. } => ConfigCommandError::Section {
-                    change: format!("{path} = {text}: "),
+                ConfigCommandError::Section { section, reason, .. } => ConfigCommandError::Section {
+                    change: Some(format!("{path} = {text}")),
                     section,
-                    source,
+                    reason,
                 },
                 other => other,
             })?;
@@ -232,9 +232,18 @@ mod tests {
         assert!(e.to_string().contains("\"6\""), "{e}");
         let mut stream = to_json(&config.settings(SettingsKind::Stream)).unwrap();
         stream["timeout"] = serde_json::json!(5);
-        assert!(
-            from_json(SettingsKind::Stream, stream).is_err(),
-            "an unknown field is refused"
-        );
+        let e = from_json(SettingsKind::Stream, stream).expect_err("an unknown field is refused");
+        // Read back from a device, the section names itself; after a set, the change comes first.
+        assert!(matches!(e, ConfigCommandError::Section { change: None, .. }), "{e:?}");
+        assert!(e.to_string().starts_with("stream: "), "{e}");
+        let ConfigCommandError::Section { section, reason, .. } = e else {
+            unreachable!()
+        };
+        let set = ConfigCommandError::Section {
+            change: Some("stream.timeout = 5".into()),
+            section,
+            reason,
+        };
+        assert!(set.to_string().starts_with("stream.timeout = 5: stream: "), "{set}");
     }
 }

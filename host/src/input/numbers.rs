@@ -12,7 +12,7 @@ pub fn as_written(f: f64) -> f64 {
 
 /// Parses `a,b,c,d,e,f` into six finite numbers.
 pub fn six(what: &'static str, text: &str) -> Result<[f64; 6], BadNumber> {
-    let bad = |reason: String| BadNumber { what, reason };
+    let bad = |reason: String| BadNumber::new(what, reason);
     let values: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>().map_err(|e| bad(format!("`{}`: {e}", s.trim()))))
@@ -31,14 +31,37 @@ pub const MAX_TILT: f64 = std::f64::consts::TAU;
 /// Yaw and ring-carriage angles up to 10,000 rad (about 1,600 turns): far beyond any session, and where an `f32`
 /// angle on the controller still resolves its steps. Beyond is a broken number (1e308 came back as 300 digits).
 pub const MAX_TURNING: f64 = 1e4;
-/// A number given on the command line that cannot be used: the option and why.
+/// A value given on the command line that cannot be used: the option (and the value, when the words put it
+/// beside the option) and why. Every command's "option out of range" takes this one shape.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("--{what}: {reason}")]
+#[error("--{what}{}: {reason}", given.as_ref().map_or(String::new(), |g| format!(" {g}")))]
 pub struct BadNumber {
     /// The option.
     pub what: &'static str,
+    /// The value as given, said right after the option (`--step 0.1: ...`); none when `reason` says it.
+    pub given: Option<String>,
     /// What is wrong.
     pub reason: String,
+}
+
+impl BadNumber {
+    /// `--what: reason`.
+    pub fn new(what: &'static str, reason: impl Into<String>) -> Self {
+        Self {
+            what,
+            given: None,
+            reason: reason.into(),
+        }
+    }
+
+    /// `--what given: reason`.
+    pub fn given(what: &'static str, given: impl std::fmt::Display, reason: impl Into<String>) -> Self {
+        Self {
+            what,
+            given: Some(given.to_string()),
+            reason: reason.into(),
+        }
+    }
 }
 
 /// Lengths up to 100 times the mechanism's characteristic length (its ring radius).
@@ -56,7 +79,7 @@ pub fn readable(v: f64) -> String {
 /// Checks a pose given on the command line (SI units) against sane ranges for a mechanism of characteristic
 /// length `length`.
 pub fn pose_in_range(what: &'static str, pose: &[f64; 6], length: f64) -> Result<(), BadNumber> {
-    let bad = |reason: String| Err(BadNumber { what, reason });
+    let bad = |reason: String| Err(BadNumber::new(what, reason));
     let names = ["x", "y", "z", "alpha", "beta", "gamma"];
     for (i, v) in pose.iter().enumerate() {
         let (limit, unit) = match i {
@@ -82,14 +105,14 @@ pub fn length_in_range(what: &'static str, value: f64, length: f64) -> Result<()
     if value.is_finite() && value.abs() <= limit {
         Ok(())
     } else {
-        Err(BadNumber {
+        Err(BadNumber::new(
             what,
-            reason: format!(
+            format!(
                 "{} m is out of range (a finite number, at most {} m either way)",
                 readable(value),
                 readable(limit)
             ),
-        })
+        ))
     }
 }
 
@@ -98,20 +121,17 @@ pub fn mass(kg: f64) -> Result<f64, BadNumber> {
     if kg.is_finite() && (0.0..=1e6).contains(&kg) {
         Ok(kg)
     } else {
-        Err(BadNumber {
-            what: "mass",
-            reason: format!("{} kg is out of range (0 to 1e6 kg)", readable(kg)),
-        })
+        Err(BadNumber::new(
+            "mass",
+            format!("{} kg is out of range (0 to 1e6 kg)", readable(kg)),
+        ))
     }
 }
 
 /// `--inertia=Ixx,Iyy,Izz` (kg m^2, each 0 to 1e6); none is a point mass.
 pub fn inertia(text: Option<&str>) -> Result<[f64; 3], BadNumber> {
     let Some(text) = text else { return Ok([0.0; 3]) };
-    let bad = |reason: String| BadNumber {
-        what: "inertia",
-        reason,
-    };
+    let bad = |reason: String| BadNumber::new("inertia", reason);
     let v: Vec<f64> = text
         .split(',')
         .map(|s| s.trim().parse::<f64>())

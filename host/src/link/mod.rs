@@ -14,12 +14,12 @@ pub enum LinkError {
     #[error("say where the controller is: --port PATH or --sim")]
     NoTarget,
     /// The serial port could not be opened.
-    #[error("{port}: {source}")]
+    #[error("{port}: {reason}")]
     Open {
         /// The port's path.
         port: String,
         /// Why.
-        source: serialport::Error,
+        reason: serialport::Error,
     },
     /// A simulated controller cannot drive the rig it was given.
     #[error("{rig}: the controller cannot drive it: {reason}")]
@@ -61,9 +61,9 @@ impl Target {
 pub fn connect(target: &Target, realtime: bool) -> Result<transport::AnyTransport, LinkError> {
     Ok(match target {
         Target::Port(port) => {
-            let serial = transport::Serial::open(port).map_err(|source| LinkError::Open {
+            let serial = transport::Serial::open(port).map_err(|reason| LinkError::Open {
                 port: port.clone(),
-                source,
+                reason,
             })?;
             transport::AnyTransport::Serial(serial)
         }

@@ -117,6 +117,56 @@ pub struct Panel {
     pub events: Vec<Event>,
 }
 
+/// A map of coloured cells over `u` x `v` (the workspace's sections, the Gram slices): a chart with its caption and
+/// labelled axes and no mesh (the cells are the picture), each cell a filled rectangle.
+pub struct CellMap<'a> {
+    /// The caption and its font size.
+    pub caption: (&'a str, u32),
+    /// Around the chart (pixels).
+    pub margin: u32,
+    /// Room for the x and the y labels (pixels).
+    pub label_areas: (u32, u32),
+    /// The x and y axes' names, and their labels' font size.
+    pub axes: (&'a str, &'a str, u32),
+    /// The ranges drawn.
+    pub u: (f64, f64),
+    pub v: (f64, f64),
+}
+
+impl CellMap<'_> {
+    /// Draws the chart and the cells (corners, colour) on `area`.
+    pub fn draw<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        out: &Path,
+        cells: impl Iterator<Item = ([(f64, f64); 2], RGBColor)>,
+    ) -> Result<(), PlotError>
+    where
+        DB::ErrorType: 'static,
+    {
+        let fail = failed(out);
+        let mut chart = ChartBuilder::on(area)
+            .margin(self.margin)
+            .caption(self.caption.0, (FONT, self.caption.1))
+            .x_label_area_size(self.label_areas.0)
+            .y_label_area_size(self.label_areas.1)
+            .build_cartesian_2d(self.u.0..self.u.1, self.v.0..self.v.1)
+            .map_err(|e| fail(&e))?;
+        chart
+            .configure_mesh()
+            .x_desc(self.axes.0)
+            .y_desc(self.axes.1)
+            .label_style((FONT, self.axes.2))
+            .disable_mesh()
+            .draw()
+            .map_err(|e| fail(&e))?;
+        chart
+            .draw_series(cells.map(|(corners, c)| Rectangle::new(corners, c.filled())))
+            .map_err(|e| fail(&e))?;
+        Ok(())
+    }
+}
+
 /// Panels stacked over one time axis, under a title.
 pub struct TimePlot {
     /// Title of the picture.
@@ -128,6 +178,9 @@ pub struct TimePlot {
 /// The largest value an axis reaches either way.
 const AXIS_LIMIT: f64 = 1e300;
 
+/// A panel's value axis: its values with 8 % room each way. Values that are all the same (an axis that did not
+/// move) get one unit either way, or a tenth of the value when that is more: a width of a millionth would
+/// label every tick with the same rounded number ("0.0" down a panel of zeros).
 fn value_range(panel: &Panel) -> (f64, f64) {
     let (lo, hi) = panel
         .series
@@ -135,6 +188,12 @@ fn value_range(panel: &Panel) -> (f64, f64) {
         .flat_map(|s| s.points.iter().map(|p| p.1))
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    let size = lo.abs().max(hi.abs()).max(1.0);
+    if lo.is_finite() && hi.is_finite() && hi - lo <= 1e-6 * size {
+        let centre = (lo / 2.0 + hi / 2.0).clamp(-AXIS_LIMIT, AXIS_LIMIT);
+        let half = (0.1 * centre.abs()).max(1.0);
+        return (centre - half, centre + half);
+    }
     match widened(lo, hi, 1e-6) {
         // 8 % of the span each way; half-spans, so that values near f64's limits do not overflow to infinity
         // (an infinite axis made the tick loop endless).
@@ -264,6 +323,39 @@ mod tests {
                 }],
             }],
         }
+    }
+
+    fn panel_of(values: &[f64]) -> Panel {
+        Panel {
+            title: "p".into(),
+            unit: "m/s".into(),
+            series: vec![Series::new(
+                "s",
+                values.iter().enumerate().map(|(i, v)| (i as f64, *v)).collect(),
+                BLUE,
+            )],
+            events: Vec::new(),
+        }
+    }
+
+    /// A panel whose values are all the same spans a unit either way (a tenth of the value when more), so its
+    /// tick labels differ; before, a panel of zeros spanned 1e-6 and every label read "0.0".
+    #[test]
+    fn a_constant_panel_spans_a_unit_either_way() {
+        for (value, half) in [(0.0, 1.0), (0.227, 1.0), (-3.0, 1.0), (5e6, 5e5), (-1e300, 1e299)] {
+            let (lo, hi) = value_range(&panel_of(&[value; 50]));
+            assert!(lo < value && value < hi, "{value}: {lo}..{hi}");
+            let width = hi - lo;
+            assert!((width - 2.0 * half).abs() <= 1e-9 * width, "{value}: {lo}..{hi}");
+            // Labels to one decimal (plotters' for a span of 2) differ from the bottom tick to the top one.
+            if half == 1.0 {
+                assert_ne!(format!("{lo:.1}"), format!("{hi:.1}"));
+            }
+        }
+        // Values that vary keep their own range with 8 % room each way; none at all, -1..1.
+        let (lo, hi) = value_range(&panel_of(&[0.0, 1.0]));
+        assert!((lo + 0.08).abs() < 1e-12 && (hi - 1.08).abs() < 1e-12, "{lo}..{hi}");
+        assert_eq!(value_range(&panel_of(&[f64::NAN])), (-1.0, 1.0));
     }
 
     #[test]

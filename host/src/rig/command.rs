@@ -3,10 +3,12 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use ringpod_core::kinematics::geometry::RingGeometry;
 use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
 use ringpod_core::kinematics::RingPlatform;
 use serde::Serialize;
 
+use super::coverage::Coverage;
 use super::design::{design, Free, Search, Target};
 use super::{coverage, read, RigFile};
 use crate::error::{CliError, EXIT_CHECK_FAILED};
@@ -18,10 +20,7 @@ const AXES: [&str; 5] = ["surge", "sway", "heave", "roll", "pitch"];
 /// `ringpod presets --export NAME`: the preset as a rig file, to start one's own from.
 pub fn export(name: &str) -> Result<Outcome, CliError> {
     let (preset, file) = preset_file(name, "export")?;
-    let body = file.to_toml().map_err(|e| CliError::BadNumbers {
-        what: "export",
-        reason: e.to_string(),
-    })?;
+    let body = file.to_toml().map_err(|e| CliError::bad("export", e.to_string()))?;
     let header = format!(
         "# {name}: {}\n# Lengths in metres, angles of [limits] and [spec] in degrees, home = [x, y, z, roll, pitch, yaw]\n\
          # (m, rad). Chains counter-clockwise around the ring; actuators: every carriage in chain order, then every\n\
@@ -35,10 +34,10 @@ pub fn export(name: &str) -> Result<Outcome, CliError> {
 fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), CliError> {
     let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
     let PresetGeometry::Ring(g) = preset.geometry() else {
-        return Err(CliError::BadNumbers {
+        return Err(CliError::bad(
             what,
-            reason: format!("{name} is not a ring platform; rig files describe ring platforms"),
-        });
+            format!("{name} is not a ring platform; rig files describe ring platforms"),
+        ));
     };
     let ranges = preset.spec_ranges();
     Ok((
@@ -124,8 +123,21 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
             code,
         });
     }
+    Ok(Outcome {
+        text: check_text(&rig.geometry, &drivable, cover.as_ref(), covered),
+        code,
+    })
+}
+
+/// `rig check`'s verdict as text: analysable, drivable or why not, and the spec coverage axis by axis.
+fn check_text(
+    g: &RingGeometry,
+    drivable: &Result<(), String>,
+    cover: Option<&([f64; 5], Coverage)>,
+    covered: Option<bool>,
+) -> String {
+    let name = g.name;
     let mut t = String::new();
-    let g = &rig.geometry;
     let _ = writeln!(
         t,
         "{name}: analysable: yes ({} chains, ring radius {} m, rod {} m)",
@@ -133,14 +145,14 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
         g.ring_radius,
         g.rod_length
     );
-    let _ = match &drivable {
+    let _ = match drivable {
         Ok(()) => writeln!(
             t,
             "drivable: yes (the home pose is inside every check; homing plan and step timing accepted)"
         ),
         Err(why) => writeln!(t, "drivable: no, because {why}"),
     };
-    match &cover {
+    match cover {
         None => {
             let _ = writeln!(t, "no [spec] ranges: add them to measure the coverage");
         }
@@ -181,7 +193,7 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
             );
         }
     }
-    Ok(Outcome { text: t, code })
+    t
 }
 
 /// `ringpod rig design TEMPLATE`: the best dimensions found, as a rig file, with its coverage in comments.
@@ -243,10 +255,10 @@ pub fn design_command(
             false
         }
     };
-    let body = found.file.to_toml().map_err(|e| CliError::BadNumbers {
-        what: "design",
-        reason: e.to_string(),
-    })?;
+    let body = found
+        .file
+        .to_toml()
+        .map_err(|e| CliError::bad("design", e.to_string()))?;
     Ok(Outcome {
         text: out + &body,
         code: if covers { 0 } else { EXIT_CHECK_FAILED },

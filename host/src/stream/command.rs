@@ -7,6 +7,7 @@ use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
 use super::{datagram, exit, Motion, Options, Report, Source, UdpSource};
+use crate::error::CliError;
 use crate::input::{files, numbers};
 use crate::link::{self, client};
 use crate::signals::Signals;
@@ -84,15 +85,8 @@ pub struct Job {
 #[derive(Debug, thiserror::Error)]
 pub enum SourceError {
     /// A number of a stream option out of its range.
-    #[error("--{name} {}: must be a number of at most {max:e}, above 0", numbers::readable(*value))]
-    Option {
-        /// The option.
-        name: &'static str,
-        /// What was given.
-        value: f64,
-        /// Its largest value.
-        max: f64,
-    },
+    #[error(transparent)]
+    Option(#[from] numbers::BadNumber),
     /// The cueing file.
     #[error(transparent)]
     Cueing(#[from] crate::input::cueing::CueingFileError),
@@ -100,12 +94,12 @@ pub enum SourceError {
     #[error("cueing: {0}")]
     Washout(ringpod_core::cueing::ConfigError),
     /// The UDP address could not be bound.
-    #[error("{addr}: {source}")]
+    #[error("{addr}: {reason}")]
     Bind {
         /// The address.
         addr: std::net::SocketAddr,
         /// Why.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// The pose file could not be read, or is not a pose file.
     #[error("{}: {reason}", path.display())]
@@ -117,12 +111,40 @@ pub enum SourceError {
     },
 }
 
+/// Why a stream did not run (a stream that ran and ended badly says so in its report and exit code instead).
+#[derive(Debug, thiserror::Error)]
+pub enum JobError {
+    /// The source.
+    #[error(transparent)]
+    Source(#[from] SourceError),
+    /// No link to the device.
+    #[error(transparent)]
+    Link(#[from] link::LinkError),
+    /// The platform to simulate, or a capture or record file that could not be created.
+    #[error(transparent)]
+    Cli(#[from] CliError),
+    /// `--check-loads`.
+    #[error(transparent)]
+    Loads(#[from] super::loads::LoadsError),
+    /// The signal handlers or the UDP socket.
+    #[error(transparent)]
+    Io(#[from] std::io::Error),
+    /// The report as JSON.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
 /// A number of a stream option: finite, above 0 and at most `max`.
 fn positive(name: &'static str, v: f64, max: f64) -> Result<f64, SourceError> {
     if v.is_finite() && v > 0.0 && v <= max {
         Ok(v)
     } else {
-        Err(SourceError::Option { name, value: v, max })
+        Err(numbers::BadNumber::given(
+            name,
+            numbers::readable(v),
+            format!("must be a number of at most {max:e}, above 0"),
+        )
+        .into())
     }
 }
 
@@ -158,7 +180,7 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
                 }
             };
             let idle = positive("udp-idle", *idle, 1e6)?;
-            let socket = std::net::UdpSocket::bind(addr).map_err(|source| SourceError::Bind { addr: *addr, source })?;
+            let socket = std::net::UdpSocket::bind(addr).map_err(|reason| SourceError::Bind { addr: *addr, reason })?;
             let source = UdpSource {
                 socket,
                 decoder,
@@ -232,13 +254,12 @@ fn loads_keep_up<T: client::Transport>(
 }
 
 /// Runs a stream: the exit codes of [`exit`].
-pub fn run(job: &Job) -> anyhow::Result<u8> {
+pub fn run(job: &Job) -> Result<u8, JobError> {
     let signals = Signals::install()?;
     let (mut source, input_errors) = open(&job.input)?;
     if let (Some(path), Source::Udp(udp)) = (&job.capture, &mut source) {
         let local = udp.socket.local_addr()?;
-        let writer = crate::input::capture::CaptureWriter::create(path, local)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let writer = crate::input::capture::CaptureWriter::create(path, local).map_err(|e| CliError::file(path, e))?;
         udp.capture = Some((Box::new(writer), path.display().to_string()));
     }
     let (rig, fast) = match &job.device {
@@ -261,7 +282,7 @@ pub fn run(job: &Job) -> anyhow::Result<u8> {
     }
     let recorder = match &job.record {
         Some(path) => Some((
-            super::record::Recorder::create(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?,
+            super::record::Recorder::create(path).map_err(|e| CliError::file(path, e))?,
             path.display().to_string(),
         )),
         None => None,
@@ -295,7 +316,7 @@ pub fn run(job: &Job) -> anyhow::Result<u8> {
 }
 
 /// Prints the report (the bar drew on stderr; the report goes to stdout) and gives the run's exit code.
-fn print(report: &Report, json: bool) -> anyhow::Result<u8> {
+fn print(report: &Report, json: bool) -> Result<u8, JobError> {
     // A closed stdout (`| head -c1`) loses the summary, not the run's exit code.
     let mut out = std::io::stdout();
     if json {

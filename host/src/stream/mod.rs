@@ -7,6 +7,8 @@
 
 pub mod command;
 pub mod datagram;
+mod ending;
+mod feed;
 mod loads;
 mod prepare;
 pub mod record;
@@ -21,12 +23,11 @@ use indicatif::{ProgressBar, ProgressStyle};
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::EnvelopeMargins;
 use ringpod_core::protocol::{MotionSettings, RigSource, Settings, SettingsKind, Status};
-use ringpod_core::safety::{FaultReason, State};
 
 pub use loads::{check_loads, platform as loads_platform};
-use prepare::{prepare, telemetry_rate};
-pub use report::{CaptureReport, DatagramReport, LimitedReport, RecordReport, Report};
-use session::{Stop, StreamError, Streamer, NO_AUX};
+use prepare::prepare;
+pub use report::{LimitedReport, Report};
+use session::Streamer;
 pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source, UdpSource};
 
 pub use crate::input::table::InputError;
@@ -210,72 +211,10 @@ pub fn run<T: Transport>(
         recorder,
     );
     let mut input_errors = input_errors;
-    let (outcome, datagrams, capture) = feed(&mut s, &mut source, fast, home, &limits, &mut input_errors);
+    let (outcome, datagrams, capture) = feed::feed(&mut s, &mut source, fast, home, &limits, &mut input_errors);
     s.bar.finish_and_clear();
-    // Stop, and wait for rest (also after Ctrl-C or a device that stopped by itself).
-    let (stop, transport) = match outcome {
-        Ok(()) => (None, None),
-        Err(StreamError::Stop(stop)) => (Some(stop), None),
-        Err(StreamError::Client(e)) => (None, Some(e)),
-    };
-    let status = if transport.is_none() {
-        stop_and_rest(&mut s)
-    } else {
-        None
-    };
-    // The samples of the stop and the ramp to rest.
-    let _ = s.record();
-    let mut record = record_path.map(|path| record_report(&mut s, path));
-    // The device's own telemetry rate back (a board stores it): after the record has taken its last samples.
-    let rate_error = match restore_hz {
-        Some(before) if transport.is_none() => telemetry_rate(s.client, before).err(),
-        _ => None,
-    };
-    if let (Some(r), Some(e)) = (record.as_mut(), rate_error) {
-        r.error
-            .get_or_insert(format!("the device's telemetry rate was not set back: {e}"));
-    }
-    if let Some(r) = record.as_mut() {
-        r.telemetry_hz = options.telemetry_hz;
-    }
-    let (status, transport) = match (status, transport) {
-        (Some(st), None) => (Some(st), None),
-        (None, None) => (None, Some("the device did not answer after the stop".to_string())),
-        (_, Some(e)) => (None, Some(e.to_string())),
-    };
-    let refused: u32 = s.rejected.values().sum();
-    let (outcome, reason, code) = verdict(transport, stop.as_ref(), refused, &input_errors, s.input_sent);
-    let counts_agree = status.as_ref().is_some_and(|st| {
-        let b = &s.baseline;
-        st.applied.wrapping_sub(b.applied) == s.applied_all
-            && st.rejected.total().wrapping_sub(b.rejected.total()) == s.rejected_all
-            && st.limited.count.wrapping_sub(b.limited.count) == s.device_limited
-            && s.sent_all == s.applied_all + s.rejected_all
-    });
-    s.limited.device = s.device_limited;
-    Ok(Report {
-        outcome,
-        reason,
-        exit_code: code,
-        state: status.as_ref().map_or("unknown".into(), |st| format!("{:?}", st.state)),
-        setpoints_sent: s.input_sent,
-        setpoints_applied: s.input_applied,
-        limited: s.limited,
-        rejected: s.rejected,
-        refusals: s.refusals,
-        lead_in_sent: s.lead_in,
-        settle_sent: s.settle,
-        washout_sent: s.washout,
-        restarts: s.restarts,
-        final_steps: status.as_ref().map_or([0; 6], |st| st.steps),
-        faults: s.client.faults.iter().map(|f: &FaultReason| f.to_string()).collect(),
-        input_errors,
-        datagrams,
-        last_applied_pose: s.last_applied.map(|p| p.to_array()),
-        counts_agree,
-        record,
-        capture,
-    })
+    let ending = ending::wind_down(&mut s, outcome, record_path, restore_hz, options.telemetry_hz);
+    Ok(ending::report(s, ending, input_errors, datagrams, capture))
 }
 
 /// A bar of setpoints for a source of known length, a spinner for a live one (on stderr, hidden without a
@@ -298,129 +237,4 @@ fn progress_bar(source: &Source, quiet: bool) -> ProgressBar {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar
-}
-
-/// Sends the source's poses: timed ones (a motion, a file) on their clock, a live source as it arrives; a live
-/// source's datagram counts and capture come back with the outcome.
-fn feed<T: Transport>(
-    s: &mut Streamer<'_, T>,
-    source: &mut Source,
-    fast: bool,
-    home: [f64; 6],
-    limits: &MotionSettings,
-    input_errors: &mut Vec<InputError>,
-) -> (Result<(), StreamError>, Option<DatagramReport>, Option<CaptureReport>) {
-    match source {
-        Source::Motion {
-            motion,
-            sine,
-            seconds,
-            rate_hz,
-        } => {
-            let (motion, sine, seconds, rate_hz) = (*motion, *sine, *seconds, *rate_hz);
-            if let Some(sine) = &sine {
-                eprintln!("{}", sine.describe(limits));
-            }
-            let n = (seconds * rate_hz).round() as u64;
-            let mut poses = (0..=n).map(|k| {
-                let t = k as f64 / rate_hz;
-                (None, t, motion_pose(motion, sine.as_ref(), t, home, limits), NO_AUX)
-            });
-            (s.timed(&mut poses, fast), None, None)
-        }
-        Source::Poses(p) => {
-            let mut poses = p.iter().map(|(line, t, pose, aux)| (Some(*line), *t, *pose, *aux));
-            (s.timed(&mut poses, fast), None, None)
-        }
-        Source::Udp(udp) => {
-            let mut d = DatagramReport::default();
-            let r = s.live(udp, &mut d, input_errors);
-            d.telemetry_gaps = udp.decoder.gaps();
-            (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
-            let capture = udp.capture.take().map(|(writer, path)| {
-                let (packets, error) = writer.finish();
-                CaptureReport { path, packets, error }
-            });
-            (r, Some(d), capture)
-        }
-    }
-}
-
-/// Collects the answers still in flight (a device that stopped streaming has refused them), stops, and waits up
-/// to 10 s for rest; the status at rest, or none when the device did not answer.
-fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
-    while !s.in_flight.is_empty() {
-        if let Err(StreamError::Client(_)) = s.collect(0) {
-            break;
-        }
-    }
-    let _ = s.client.stop();
-    // The wait for rest runs to its end even after a signal: the platform is brought to rest, then reported.
-    let cancel = s.client.cancel.take();
-    let status = s.client.wait_for(Duration::from_secs(10), |st| {
-        !matches!(st.state, State::Running | State::Stopping)
-    });
-    s.client.cancel = cancel;
-    status.ok()
-}
-
-/// What `--record` wrote: its rows, the samples dropped, and why it stopped writing, if it did.
-fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordReport {
-    let dropped = s.client.telemetry_dropped;
-    let (rows, error) = match (s.recorder.take(), s.record_error.take()) {
-        (Some(r), None) => {
-            let rows = r.rows;
-            (rows, r.finish().err().map(|e| e.to_string()))
-        }
-        (r, e) => (r.map_or(0, |r| r.rows), e),
-    };
-    RecordReport {
-        path,
-        rows,
-        telemetry_hz: None,
-        dropped,
-        error,
-    }
-}
-
-/// The run's outcome, its reason and exit code: the most serious of a lost link, a device that stopped, a
-/// signal, refusals, input errors, no input at all; else followed.
-fn verdict(
-    transport: Option<String>,
-    stop: Option<&Stop>,
-    refused: u32,
-    input_errors: &[InputError],
-    input_sent: u32,
-) -> (&'static str, Option<String>, u8) {
-    if let Some(t) = transport {
-        ("transport_lost", Some(t), exit::TRANSPORT_LOST)
-    } else if let Some(Stop::Device(why)) = stop {
-        ("device_stopped", Some(why.clone()), exit::DEVICE_STOPPED)
-    } else if let Some(Stop::Interrupted) = stop {
-        (
-            "interrupted",
-            Some("interrupted (a signal, or STOP in the workbench)".to_string()),
-            exit::INTERRUPTED,
-        )
-    } else if refused > 0 {
-        (
-            "refused",
-            Some(format!("the device refused {refused} setpoints")),
-            exit::REFUSED,
-        )
-    } else if !input_errors.is_empty() {
-        (
-            "input_errors",
-            Some(format!("{} input lines could not be read", input_errors.len())),
-            exit::INPUT_ERRORS,
-        )
-    } else if input_sent == 0 {
-        (
-            "input_errors",
-            Some("no pose in the input".to_string()),
-            exit::INPUT_ERRORS,
-        )
-    } else {
-        ("followed", None, exit::FOLLOWED)
-    }
 }

@@ -13,6 +13,8 @@ use ringpod_core::kinematics::Pose;
 use ringpod_core::protocol::{Telemetry, TelemetryFlags};
 use ringpod_core::safety::State;
 
+use crate::error::CliError;
+
 use crate::out::plot::{self, Event, Panel, Series, TimePlot};
 
 /// The record's columns after [`COLUMNS`]: the auxiliary outputs (0 off, 1 on). A record is read without them, so
@@ -279,7 +281,7 @@ fn onsets(t: &[f64], flags: &[bool], kind: &str, colour: RGBColor) -> Vec<Event>
 }
 
 /// `ringpod plot RUN.csv --out FILE`: returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path) -> anyhow::Result<String> {
+pub fn plot_command(input: &Path, out: &Path) -> Result<String, CliError> {
     let run = read(input)?;
     let mut events = onsets(
         &run.t,

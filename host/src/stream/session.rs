@@ -2,7 +2,7 @@
 //! lead-in, settle and washout setpoints, and everything counted for the report.
 
 use std::collections::{BTreeMap, VecDeque};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use indicatif::ProgressBar;
 use ringpod_core::kinematics::{Check, Pose, RingPlatform};
@@ -13,8 +13,8 @@ use ringpod_core::safety::{AuxLevels, State};
 /// A setpoint that leaves the auxiliary outputs as they are (every pose but a pose file's rows with aux columns).
 pub const NO_AUX: AuxLevels = [None; 2];
 
-use super::report::{reason_name, DatagramReport, LimitedReport};
-use super::{InputError, UdpSource};
+use super::report::{reason_name, LimitedReport};
+use super::InputError;
 use crate::link::client::{setpoint_answer, Client, ClientError, Transport};
 use crate::stream::record::Recorder;
 
@@ -98,7 +98,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     }
 
     /// Lets `dt` pass on the device's clock, in slices so that Ctrl-C is seen within 50 ms.
-    fn elapse(&mut self, dt: Duration) -> Result<(), Stop> {
+    pub(super) fn elapse(&mut self, dt: Duration) -> Result<(), Stop> {
         let mut left = dt;
         while !left.is_zero() {
             if (self.interrupted)() {
@@ -115,7 +115,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     }
 
     /// Limits a pose into the envelope (host side, f64) on the ray from the centre, as the device does.
-    fn limit(&mut self, pose: Pose<f64>) -> Pose<f64> {
+    pub(super) fn limit(&mut self, pose: Pose<f64>) -> Pose<f64> {
         if !self.host_limits || !pose.to_array().iter().all(|c| c.is_finite()) {
             // Garbage goes to the device as it is, to be refused with its reason.
             return pose;
@@ -129,7 +129,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
         limited.pose
     }
 
-    fn count_limit(&mut self, check: Check, translation_m: f64, rotation_rad: f64) {
+    pub(super) fn count_limit(&mut self, check: Check, translation_m: f64, rotation_rad: f64) {
         *self.limited.by_check.entry(check.name().to_string()).or_default() += 1;
         self.limited.largest_mm = self.limited.largest_mm.max(translation_m * 1e3);
         self.limited.largest_deg = self.limited.largest_deg.max(rotation_rad.to_degrees());
@@ -138,7 +138,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// Sends one setpoint without waiting for its answer (a round trip per setpoint would cap the rate at one
     /// per round trip: 1 kHz needs them in flight), then counts the answers that have arrived, waiting while more
     /// than [`IN_FLIGHT`] are outstanding. A device that stops streaming ends the run.
-    fn send(&mut self, pose: Pose<f64>, kind: Kind, aux: AuxLevels) -> Result<(), StreamError> {
+    pub(super) fn send(&mut self, pose: Pose<f64>, kind: Kind, aux: AuxLevels) -> Result<(), StreamError> {
         self.seq = self.seq.wrapping_add(1);
         self.sent_all += 1;
         if let Kind::Input(_) = kind {
@@ -190,7 +190,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     }
 
     /// Counts one answer; `number` is an input setpoint's line or datagram number (`None`: lead-in or settle).
-    fn answered(
+    pub(super) fn answered(
         &mut self,
         answer: Result<Accepted, RejectReason>,
         number: Option<usize>,
@@ -249,7 +249,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
 
     /// Starts the stream (the device must be `Ready`) and leads the platform from where it is to `first` at a
     /// quarter of the speed limits, at 100 Hz. Returns `first` as limited.
-    fn start_and_lead_in(&mut self, first: Pose<f64>) -> Result<Pose<f64>, StreamError> {
+    pub(super) fn start_and_lead_in(&mut self, first: Pose<f64>) -> Result<Pose<f64>, StreamError> {
         self.collect(0)?;
         let status = self.client.wait_for(Duration::from_secs(10), |s| {
             !matches!(s.state, State::Running | State::Stopping)
@@ -294,7 +294,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// Holds the last pose until the platform has arrived there (the device's commanded pose equals its target),
     /// at least 250 ms and at most 10 s: a platform slowed by its limits can be far behind its source when the
     /// source ends, and stopping before it arrives would leave it wherever braking ends.
-    fn settle(&mut self) -> Result<(), StreamError> {
+    pub(super) fn settle(&mut self) -> Result<(), StreamError> {
         let last = self.last_sent;
         for k in 1..=1000u32 {
             self.elapse(Duration::from_millis(10))?;
@@ -315,173 +315,6 @@ impl<'a, T: Transport> Streamer<'a, T> {
             }
         }
         Ok(())
-    }
-
-    /// Streams timed poses (a file or a motion): each at its own time; a gap longer than the stream timeout
-    /// lets the platform come to rest, and the stream is led in and started again at the next pose.
-    pub(super) fn timed(
-        &mut self,
-        poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>, AuxLevels)>,
-        fast: bool,
-    ) -> Result<(), StreamError> {
-        let mut last_t: Option<f64> = None;
-        for (line, t, pose, aux) in poses {
-            if (self.interrupted)() {
-                return Err(StreamError::Stop(Stop::Interrupted));
-            }
-            let gap = last_t.map_or(0.0, |l| (t - l).max(0.0));
-            let pose = match last_t {
-                None => self.start_and_lead_in(pose)?,
-                Some(_) if gap > self.stream_timeout.as_secs_f64() => {
-                    // The device brakes to rest by itself; nothing happens after that, so a fast run does not
-                    // compute the rest of the gap.
-                    let wait = if fast { gap.min(3.0) } else { gap };
-                    self.elapse(Duration::from_secs_f64(wait))?;
-                    self.restarts += 1;
-                    self.bar
-                        .suspend(|| eprintln!("{gap:.3} s gap in the input: the platform rests, then leads in again"));
-                    self.start_and_lead_in(pose)?
-                }
-                Some(_) => {
-                    self.elapse(Duration::from_secs_f64(gap))?;
-                    self.limit(pose)
-                }
-            };
-            last_t = Some(t);
-            self.send(pose, Kind::Input(line), aux)?;
-            self.bar.inc(1);
-        }
-        if last_t.is_some() {
-            self.settle()?;
-        }
-        self.collect(0)
-    }
-
-    /// Streams datagrams as they arrive: the platform waits where it is for the first one, leads in and starts;
-    /// a pause longer than the stream timeout brakes it to rest, and the next datagram leads in and starts again;
-    /// `idle` without a datagram ends the session.
-    pub(super) fn live(
-        &mut self,
-        source: &mut UdpSource,
-        report: &mut DatagramReport,
-        errors: &mut Vec<InputError>,
-    ) -> Result<(), StreamError> {
-        source
-            .socket
-            .set_read_timeout(Some(Duration::from_millis(1)))
-            .map_err(ClientError::Io)?;
-        self.bar.suspend(|| {
-            eprintln!(
-                "streaming: send datagrams to {}",
-                source.socket.local_addr().map_or("?".into(), |a| a.to_string())
-            )
-        });
-        // The largest UDP payload: no datagram is ever cut.
-        let mut buf = vec![0u8; 65_536];
-        let mut wall = Instant::now();
-        let mut last_pose = Instant::now();
-        let mut last_idle = Instant::now();
-        let mut streaming = false;
-        loop {
-            if (self.interrupted)() {
-                return Err(StreamError::Stop(Stop::Interrupted));
-            }
-            let got = source.socket.recv_from(&mut buf);
-            let now = Instant::now();
-            if let (Ok((n, from)), Some((capture, _))) = (&got, source.capture.as_mut()) {
-                capture.write(&buf[..*n], *from, std::time::SystemTime::now());
-            }
-            // A changed cueing file takes over here, between two samples.
-            source.decoder.poll_config(now);
-            self.elapse(now - wall)?;
-            wall = now;
-            let datagram = match got {
-                Ok(got) => Some(got),
-                // A signal (Ctrl-C) interrupts the wait: nothing arrived, and the loop then sees the flag.
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
-                    ) =>
-                {
-                    None
-                }
-                Err(e) => return Err(ClientError::Io(e).into()),
-            };
-            // Only a readable datagram of the source counts as the source being there: a stranger's datagrams and
-            // unreadable ones (a flood of them included) leave the pause logic below running.
-            let Some((number, pose)) =
-                datagram.and_then(|(n, from)| read(source, &buf[..n], from, now, report, errors, &self.bar))
-            else {
-                let quiet = now - last_pose;
-                // Telemetry that pauses washes out: the vehicle at rest, through the washout, every 10 ms
-                // from half the stream timeout on, so the platform glides back to neutral.
-                if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= Duration::from_millis(10) {
-                    let dt = (now - last_idle).min(Duration::from_millis(20)).as_secs_f64();
-                    last_idle = now;
-                    if let Some(pose) = source.decoder.idle(dt, now) {
-                        let pose = self.limit(pose);
-                        self.send(pose, Kind::Washout, NO_AUX)?;
-                        self.washout += 1;
-                        continue;
-                    }
-                }
-                if streaming && quiet > self.stream_timeout && !source.decoder.washes_out() {
-                    // The source paused (a game's menu): the device brakes to rest by itself.
-                    streaming = false;
-                    if self.last_applied.is_some() {
-                        self.bar.suspend(|| eprintln!("the source paused: the platform rests"));
-                    }
-                }
-                if quiet >= source.idle {
-                    return self.collect(0);
-                }
-                continue;
-            };
-            last_pose = now;
-            last_idle = now;
-            let pose = if streaming {
-                self.limit(pose)
-            } else {
-                if self.last_applied.is_some() {
-                    report.resumed += 1;
-                }
-                streaming = true;
-                self.start_and_lead_in(pose)?
-            };
-            self.send(pose, Kind::Input(Some(number)), NO_AUX)?;
-            self.bar.inc(1);
-            // The lead-in let its own time pass: the device's clock is already there.
-            wall = Instant::now();
-        }
-    }
-}
-
-/// One datagram of the UDP source: counted, and decoded into its number and pose, or reported as unreadable (or
-/// ignored as a stranger's) with `None`.
-fn read(
-    source: &mut UdpSource,
-    bytes: &[u8],
-    from: std::net::SocketAddr,
-    now: Instant,
-    report: &mut DatagramReport,
-    errors: &mut Vec<InputError>,
-    bar: &ProgressBar,
-) -> Option<(usize, ringpod_core::kinematics::Pose<f64>)> {
-    if source.from.is_some_and(|ip| ip != from.ip()) {
-        report.other_senders += 1;
-        return None;
-    }
-    report.received += 1;
-    let number = report.received as usize;
-    match source.decoder.decode(bytes, now) {
-        Ok(pose) => Some((number, pose)),
-        Err(reason) => {
-            report.unreadable += 1;
-            bar.suspend(|| eprintln!("datagram {number}: {reason}"));
-            errors.push(InputError { line: number, reason });
-            None
-        }
     }
 }
 

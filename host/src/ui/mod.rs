@@ -3,6 +3,7 @@
 //! typed, and run records. The page and its one WebSocket (`/ws`) carry the per-run token; see [`guard`].
 
 mod api;
+mod error;
 mod frame;
 pub mod guard;
 mod worker;
@@ -23,6 +24,7 @@ use serde_json::{json, Value};
 use crate::device::Platform;
 use crate::link::Target;
 use crate::signals::Signals;
+pub use error::UiError;
 use guard::Token;
 use worker::{Hub, Job, Request};
 
@@ -76,9 +78,9 @@ impl App {
 }
 
 /// Serves the workbench until a signal; exits with 128 + its number (0 when the device thread ended first).
-pub fn run(options: Options) -> anyhow::Result<u8> {
+pub fn run(options: Options) -> Result<u8, UiError> {
     let signals = Signals::install()?;
-    let token = Token::random().map_err(|e| anyhow::anyhow!("no random source for the token: {e}"))?;
+    let token = Token::random().map_err(UiError::Random)?;
     let rig = Platform::rig(options.platform.as_ref())?;
     // The address first: a port in use is said before anything else starts.
     let runtime = tokio::runtime::Builder::new_multi_thread()
@@ -87,11 +89,14 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
         .build()?;
     let listener = runtime
         .block_on(tokio::net::TcpListener::bind(options.listen))
-        .map_err(|e| anyhow::anyhow!("--listen {}: {e}", options.listen))?;
+        .map_err(|reason| UiError::Listen {
+            addr: options.listen,
+            reason,
+        })?;
     let (out, _) = tokio::sync::broadcast::channel(256);
     let cue_file = std::env::temp_dir().join(format!("ringpod-ui-{}-cueing.toml", std::process::id()));
     std::fs::write(&cue_file, toml::to_string(&ringpod_core::cueing::CueConfig::default())?)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", cue_file.display()))?;
+        .map_err(|e| crate::error::CliError::file(&cue_file, e))?;
     let hub = Arc::new(Hub {
         out,
         halt: Arc::new(AtomicBool::new(false)),
@@ -124,26 +129,7 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
                 "note: listening on {local}, not only on this machine: anyone with the URL can move the platform"
             );
         }
-        // Every route but the static scripts and style passes the token, origin and host check, once, here.
-        let checked = Router::new()
-            .route("/", get(page))
-            .route("/ws", get(socket))
-            .route("/api/cue/defaults", get(cue_defaults))
-            .route("/api/cue", post(cue))
-            .route("/api/cue/apply", post(cue_apply))
-            .route("/api/rig/check", post(rig_check))
-            .route("/api/rig/current", get(rig_current))
-            .route("/api/run", post(run_record))
-            .route_layer(axum::middleware::from_fn_with_state(app.clone(), admitted));
-        let asset =
-            |kind: &'static str, body: &'static str| get(move || async move { ([(header::CONTENT_TYPE, kind)], body) });
-        let router = Router::new()
-            .merge(checked)
-            .route("/app.js", asset("text/javascript", SCRIPT))
-            .route("/chart.js", asset("text/javascript", CHART))
-            .route("/view3d.js", asset("text/javascript", VIEW3D))
-            .route("/style.css", asset("text/css", STYLE))
-            .with_state(app.clone());
+        let router = routes(&app);
         let stop = {
             let hub = hub.clone();
             async move {
@@ -161,19 +147,43 @@ pub fn run(options: Options) -> anyhow::Result<u8> {
             let _ = tx.send(ended);
         };
         axum::serve(listener, router).with_graceful_shutdown(shutdown).await?;
-        rx.await.map_err(|_| anyhow::anyhow!("the server ended without a stop"))
+        rx.await.map_err(|_| UiError::NoStop)
     });
     let _ = std::fs::remove_file(&cue_file);
     let (signals, device) = served?;
     match device.join() {
-        Ok(Err(e)) => Err(anyhow::Error::from(e).context("the device")),
-        Err(_) => anyhow::bail!("the device thread failed"),
+        Ok(Err(e)) => Err(UiError::Device(e)),
+        Err(_) => Err(UiError::DeviceThread),
         Ok(Ok(())) if signals.received() => {
             eprintln!("ringpod ui: stopped by {}", signals.name());
             Ok(signals.exit_code())
         }
         Ok(Ok(())) => Ok(0),
     }
+}
+
+/// The workbench's routes: every one but the static scripts and style passes the token, origin and host check.
+fn routes(app: &Arc<App>) -> Router {
+    // The check, once, here.
+    let checked = Router::new()
+        .route("/", get(page))
+        .route("/ws", get(socket))
+        .route("/api/cue/defaults", get(cue_defaults))
+        .route("/api/cue", post(cue))
+        .route("/api/cue/apply", post(cue_apply))
+        .route("/api/rig/check", post(rig_check))
+        .route("/api/rig/current", get(rig_current))
+        .route("/api/run", post(run_record))
+        .route_layer(axum::middleware::from_fn_with_state(app.clone(), admitted));
+    let asset =
+        |kind: &'static str, body: &'static str| get(move || async move { ([(header::CONTENT_TYPE, kind)], body) });
+    Router::new()
+        .merge(checked)
+        .route("/app.js", asset("text/javascript", SCRIPT))
+        .route("/chart.js", asset("text/javascript", CHART))
+        .route("/view3d.js", asset("text/javascript", VIEW3D))
+        .route("/style.css", asset("text/css", STYLE))
+        .with_state(app.clone())
 }
 
 async fn page() -> Response {

@@ -51,7 +51,7 @@ pub enum WorkerError {
     /// The stream could not be started.
     #[error("the stream did not start: {0}")]
     NotStarted(ClientError),
-    /// The page named something there is not (an axis, a motion, a format, what a UDP session holds).
+    /// The page named something there is not (a motion, a format, what a UDP session holds).
     #[error("{0}")]
     NoSuch(String),
     /// A rig is loaded only with the supplies off.
@@ -354,15 +354,13 @@ impl Device {
     }
 
     fn commission(&mut self, axis: u8, distance: Option<f64>) -> Result<String, WorkerError> {
-        if !(1..=6).contains(&axis) {
-            return Err(WorkerError::NoSuch(format!("axis {axis} does not exist (1-6)")));
-        }
+        let index = crate::device::commission::axis_index(axis)?;
         let kind = self
             .mechanism
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .axes()[usize::from(axis - 1)];
-        let what = crate::device::commission::begin_move(&mut self.client, axis - 1, kind, distance)?;
+            .axes()[usize::from(index)];
+        let what = crate::device::commission::begin_move(&mut self.client, index, kind, distance)?;
         Ok(format!("axis {axis} {what}; home again before streaming"))
     }
 

@@ -9,6 +9,9 @@ use ringpod_core::kinematics::geometry::DEG;
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 
 use crate::analysis::mechanism::AnyMechanism;
+use crate::cli::requests::RequestError;
+use crate::error::CliError;
+use crate::input::numbers::BadNumber;
 
 /// What limits a grid point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -192,17 +195,17 @@ impl Plane {
     }
 }
 
-pub fn run(args: &Options) -> anyhow::Result<String> {
+pub fn run(args: &Options) -> Result<String, CliError> {
     let s = scanned(args)?;
     let length = s.m.characteristic_length();
     let n = args.cells;
     if args.z.is_some() && args.section != Section::Xy {
-        anyhow::bail!("--z is the height of the xy section; the other sections span every height or none");
+        return Err(RequestError::SectionHeight.into());
     }
     let z0 = args.z.unwrap_or(s.home[2]);
     crate::input::numbers::length_in_range("z", z0, length)?;
     if !(10..=2000).contains(&args.cells) {
-        anyhow::bail!("--cells {} is out of range (10 to 2000)", args.cells);
+        return Err(BadNumber::new("cells", format!("{} is out of range (10 to 2000)", args.cells)).into());
     }
     let plane = Plane::of(args.section, &s, z0);
     let (u, v) = (plane.u, plane.v);
@@ -214,6 +217,7 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
         classify(&s.m, &plane.pose(args.section, s.home, z0, a, b))
     });
     let applies = applying_checks(&s);
+    // The picture, then what it shows in words.
     picture::draw(
         args.out,
         &picture::Section {
@@ -229,7 +233,6 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
             applies: &applies,
         },
     )?;
-
     let inside: Vec<(f64, f64)> = grid
         .iter()
         .enumerate()
@@ -258,6 +261,15 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
     ) {
         text += &format!("  reachable {un} in [{umin:.4}, {umax:.4}] {unit}, {vn} in [{vmin:.4}, {vmax:.4}] {unit}\n");
     }
+    text += &mechanism_summary(&s, length);
+    text += &format!("picture: {}\n", args.out.display());
+    Ok(text)
+}
+
+/// What holds whatever the section: the volume at zero orientation, each axis's range from home, the spec ranges'
+/// coverage (a ring platform's, when given) and a tool carrier's checks.
+fn mechanism_summary(s: &Scanned, length: f64) -> String {
+    let mut text = String::new();
     text += &format!(
         "volume at zero orientation: {:.6} m^3 (60^3 grid)\n",
         volume(&s.m, s.bounds)
@@ -296,8 +308,7 @@ pub fn run(args: &Options) -> anyhow::Result<String> {
             crate::analysis::branches::name(g.branch_d)
         );
     }
-    text += &format!("picture: {}\n", args.out.display());
-    Ok(text)
+    text
 }
 
 /// The checks that have a margin for this mechanism (the others do not apply), from its home pose.

@@ -63,32 +63,25 @@ impl Picture for Section<'_> {
         let n = grid.len().max(1);
         let (du, dv) = ((u.1 - u.0) / n as f64, (v.1 - v.0) / n as f64);
         let (area, side) = root.split_horizontally(root.dim_in_pixel().0.saturating_sub(200));
-        let mut chart = ChartBuilder::on(&area)
-            .margin(20)
-            .caption(
-                format!("{}: workspace, {} (first failing check)", self.name, self.title),
-                (plot::FONT, 18),
-            )
-            .x_label_area_size(40)
-            .y_label_area_size(64)
-            .build_cartesian_2d(u.0..u.1, v.0..v.1)
-            .map_err(|e| fail(&e))?;
-        chart
-            .configure_mesh()
-            .x_desc(self.axes.0.as_str())
-            .y_desc(self.axes.1.as_str())
-            .label_style((plot::FONT, 12))
-            .disable_mesh()
-            .draw()
-            .map_err(|e| fail(&e))?;
-        chart
-            .draw_series(grid.iter().enumerate().flat_map(|(j, row)| {
+        let caption = format!("{}: workspace, {} (first failing check)", self.name, self.title);
+        let map = plot::CellMap {
+            caption: (&caption, 18),
+            margin: 20,
+            label_areas: (40, 64),
+            axes: (self.axes.0.as_str(), self.axes.1.as_str(), 12),
+            u,
+            v,
+        };
+        map.draw(
+            &area,
+            out,
+            grid.iter().enumerate().flat_map(|(j, row)| {
                 row.iter().enumerate().map(move |(i, c)| {
                     let (x0, y0) = (u.0 + i as f64 * du, v.0 + j as f64 * dv);
-                    Rectangle::new([(x0, y0), (x0 + du, y0 + dv)], colour(*c).filled())
+                    ([(x0, y0), (x0 + du, y0 + dv)], colour(*c))
                 })
-            }))
-            .map_err(|e| fail(&e))?;
+            }),
+        )?;
         // The legend beside the section, one entry per colour.
         let legend = [
             (Cell::Inside(0.3), "inside, index 0.3+"),

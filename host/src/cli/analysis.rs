@@ -1,0 +1,251 @@
+//! Arguments of the commands that compute on a platform: `rig`, `ik`, `fk`, `check`, `loads`, `reactions`,
+//! `rates`, `structure`, `draw`, `workspace`, `cue`.
+
+use clap::{Args, Subcommand};
+
+#[derive(Debug, Subcommand)]
+pub enum RigAction {
+    /// Checks a rig file (every key, the home pose inside every check) and measures its spec coverage: each axis
+    /// over its range alone, and the share of the combined box inside. Exits 0 when the rig is valid and its spec
+    /// ranges (if given) are covered axis by axis, 3 when they are not, 1 when the file is invalid.
+    Check {
+        /// The rig file.
+        file: std::path::PathBuf,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Searches dimensions (ring radius, rod length, home height, every platform joint, every elbow chain's arm) for
+    /// a template rig's chains, joint limits and [spec] ranges, and prints the best as a rig file with its coverage.
+    /// Exits 0 when it covers the spec, 3 when the best found does not.
+    Design {
+        /// The template rig file (its [spec] ranges are the target).
+        file: std::path::PathBuf,
+        /// Cover all spec axes at once (the combined box), not each axis over its range alone.
+        #[arg(long)]
+        combined: bool,
+        /// Move only the elbow chains' arms (shoulder radius and height, upper arm, forearm); keep the ring, rods,
+        /// platform joints and home as the template has them.
+        #[arg(long)]
+        arms_only: bool,
+        /// Random starts of the hill climb.
+        #[arg(long, default_value_t = 40, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+        starts: u32,
+        /// Steps from each start.
+        #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        steps: u32,
+        /// Seed of the search (the same seed gives the same design).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+}
+
+#[derive(Debug, Args)]
+pub struct LoadsArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// Payload mass (kg), at the geometry's centre of mass: with --input, the whole moving mass.
+    #[arg(long)]
+    pub mass: f64,
+    /// A motion (pose CSV as `stream --input` reads: t,x,y,z,alpha,beta,gamma): report the peak drive demand of each
+    /// axis along it (inverse dynamics: gravity and the payload's inertia; the chains massless).
+    #[arg(long, conflicts_with = "pose")]
+    pub input: Option<std::path::PathBuf>,
+    /// Payload inertia about its centre of mass, platform frame: Ixx,Iyy,Izz (kg m^2). Default: none (a point mass).
+    #[arg(long, allow_hyphen_values = true, requires = "input")]
+    pub inertia: Option<String>,
+    /// With --input: draw each axis's demand against what its drive gives at that speed (.svg or .png).
+    #[arg(long, requires = "input", value_name = "FILE")]
+    pub plot: Option<std::path::PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ReactionsArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees; gamma 0). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// Wrench on the tool at its point, base frame: fx,fy,fz (N),mx,my,mz (N m).
+    #[arg(long, allow_hyphen_values = true)]
+    pub wrench: String,
+}
+
+#[derive(Debug, Args)]
+pub struct Common {
+    /// Geometry: trainer-model, trainer-elbow, trainer-ch5, rotopod-ch4, tool5-ex (see `ringpod presets`).
+    #[arg(long, short, default_value = "trainer-model")]
+    pub mechanism: String,
+    /// Your own ring platform: a rig file (TOML; see `ringpod rig check`), instead of --mechanism.
+    #[arg(long, value_name = "RIG.toml")]
+    pub geometry: Option<std::path::PathBuf>,
+    /// Angles in degrees, on input and output (default radians).
+    #[arg(long)]
+    pub degrees: bool,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct RatesArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// x',y',z',alpha',beta',gamma' (m/s; rad/s, or deg/s with --degrees): print the actuator rates.
+    #[arg(long, allow_hyphen_values = true, required_unless_present = "actuator_rates")]
+    pub pose_rates: Option<String>,
+    /// Six actuator rates (rad/s or m/s; deg/s for angles with --degrees): print the pose rates.
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "pose_rates")]
+    pub actuator_rates: Option<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct StructureArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// One of the source's single chains at its coordinates, instead of a mechanism.
+    #[arg(long, value_enum, conflicts_with_all = ["pose", "geometry", "mechanism"])]
+    pub chain: Option<crate::analysis::structure::SourceChain>,
+}
+
+#[derive(Debug, Args)]
+pub struct DrawArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// The picture: .svg or .png.
+    #[arg(long)]
+    pub out: std::path::PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct CheckArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// Tip-over instead of the workspace checks (ring platforms): the largest lateral acceleration in each
+    /// direction before the payload's centre of mass, projected along g - a onto the ring plane, leaves the
+    /// carriages' polygon, and the weakest over all directions.
+    #[arg(long)]
+    pub tip_over: bool,
+    /// With --tip-over: the payload's centre of mass X,Y,Z in the platform frame (m). Default: the geometry's.
+    #[arg(long, allow_hyphen_values = true, requires = "tip_over", value_name = "X,Y,Z")]
+    pub payload_com: Option<String>,
+    /// With --tip-over: a lateral acceleration AX,AY of the platform (m/s^2, base frame): does it tip, by what
+    /// margin.
+    #[arg(long, allow_hyphen_values = true, requires = "tip_over", value_name = "AX,AY")]
+    pub accel: Option<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct PoseArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Pose x,y,z,alpha,beta,gamma (metres; radians unless --degrees). Default: the preset's home pose.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pose: Option<String>,
+    /// The tool carrier's dyad assemblies: `minus` (q2, q4 = theta - kappa, the preset's) or `plus` (theta + kappa)
+    /// for both dyads, `B,D` for each (`minus,plus`), or `all` to print the four.
+    #[arg(long, value_parser = crate::analysis::branches::parse, value_name = "minus|plus|B,D|all")]
+    pub branch: Option<crate::analysis::branches::Assembly>,
+}
+
+#[derive(Debug, Args)]
+pub struct FkArgs {
+    #[command(flatten)]
+    pub common: Common,
+    /// Six actuator values in the mechanism's order (see `ringpod ik`): angles in radians unless --degrees.
+    #[arg(long, allow_hyphen_values = true)]
+    pub actuators: String,
+    /// Starting pose x,y,z,alpha,beta,gamma for the iteration (the platform's last known pose): the answer must be
+    /// within half a ring radius and half a radian of it. Default: the preset's home pose turned by the yaw the
+    /// carriages show, and the answer within a ring radius and a radian of that.
+    #[arg(long, allow_hyphen_values = true)]
+    pub guess: Option<String>,
+    /// Maximum Newton iterations (1 to 255).
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u8).range(1..))]
+    pub max_iterations: u8,
+    /// Also answer with a pose outside the workspace checks (the math alone; by default such a pose is an error
+    /// naming the check it fails).
+    #[arg(long)]
+    pub anywhere: bool,
+    /// The tool carrier's dyad assemblies the actuators were solved on (`ik --branch`): `minus`, `plus` or `B,D`.
+    /// The answer must take them (IK at it gives the actuators back).
+    #[arg(long, value_parser = crate::analysis::branches::parse, value_name = "minus|plus|B,D")]
+    pub branch: Option<crate::analysis::branches::Assembly>,
+}
+
+#[derive(Debug, Args)]
+pub struct WorkspaceArgs {
+    /// Geometry: a ring platform or the tool carrier (tool5-ex).
+    #[arg(long, short, default_value = "trainer-model")]
+    pub mechanism: String,
+    /// Your own ring platform: a rig file (TOML), instead of --mechanism.
+    #[arg(long, value_name = "RIG.toml")]
+    pub geometry: Option<std::path::PathBuf>,
+    /// The plane.
+    #[arg(long, value_enum, default_value = "xy")]
+    pub section: crate::analysis::workspace::Section,
+    /// Height of the xy section (m). Default: the preset's home height.
+    #[arg(long)]
+    pub z: Option<f64>,
+    /// Grid cells along each side of the section.
+    #[arg(long, default_value_t = 240)]
+    pub cells: usize,
+    /// Output picture: .svg (with labels) or .png.
+    #[arg(long)]
+    pub out: std::path::PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct CueArgs {
+    /// Telemetry CSV with the header t,ax,ay,az,wx,wy,wz (s; specific force in m/s^2 in the vehicle frame, x
+    /// forward, y left, z up, +9.81 on z at rest; angular rates in rad/s), or a packet capture (pcap, pcapng) of a
+    /// game's telemetry datagrams (see --telemetry-format).
+    #[arg(long)]
+    pub input: std::path::PathBuf,
+    /// Output pose CSV (t,x,y,z,alpha,beta,gamma in s, m, rad).
+    #[arg(long)]
+    pub out: std::path::PathBuf,
+    /// Washout parameters (TOML; every key optional, see the README).
+    #[arg(long)]
+    pub config: Option<std::path::PathBuf>,
+    /// A profile of the --config file (its `[profiles.NAME]` table overrides the base keys).
+    #[arg(long, requires = "config")]
+    pub profile: Option<String>,
+    /// A plot of the cues (SVG): per axis the specific force asked and delivered, and the angular rates.
+    #[arg(long)]
+    pub plot: Option<std::path::PathBuf>,
+    /// The platform cued for (a ring platform): its home is the neutral pose, its envelope limits the cues.
+    #[arg(long, short, default_value = "trainer-model")]
+    pub mechanism: String,
+    /// Your own ring platform: a rig file (TOML), instead of --mechanism.
+    #[arg(long, value_name = "RIG.toml")]
+    pub geometry: Option<std::path::PathBuf>,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// With a packet capture as --input (pcap or pcapng, from `stream --capture`, tcpdump or Wireshark): the
+    /// datagrams' format, as for `stream --telemetry-format`; `auto` without.
+    #[arg(long, value_enum)]
+    pub telemetry_format: Option<crate::stream::datagram::TelemetryFormat>,
+    /// With a packet capture as --input: its UDP datagrams to this port only (a capture of several flows).
+    #[arg(long)]
+    pub udp_port: Option<u16>,
+}

@@ -1,0 +1,107 @@
+//! Arguments of `ringpod stream`: the source, the device, the checks and the report.
+
+use clap::Args;
+
+use super::ControllerArgs;
+
+#[derive(Debug, Args)]
+pub struct StreamArgs {
+    /// The controller.
+    #[command(flatten)]
+    pub controller: ControllerArgs,
+    /// With --sim: run as fast as possible instead of in real time.
+    #[arg(long, requires = "sim")]
+    pub fast: bool,
+    /// Built-in motion.
+    #[arg(long, value_enum, conflicts_with = "input")]
+    pub motion: Option<crate::stream::Motion>,
+    /// Length of a built-in motion (s).
+    #[arg(long, default_value_t = 20.0)]
+    pub duration: f64,
+    /// With --motion sine: the pose axis.
+    #[arg(long, value_enum)]
+    pub axis: Option<crate::stream::Axis>,
+    /// With --motion sine: the frequency (Hz).
+    #[arg(long)]
+    pub frequency: Option<f64>,
+    /// With --motion sine: the velocity amplitude (m/s; rad/s for roll, pitch and yaw).
+    #[arg(long, conflicts_with = "amplitude")]
+    pub velocity_amplitude: Option<f64>,
+    /// With --motion sine: the position amplitude (m; rad for roll, pitch and yaw).
+    #[arg(long)]
+    pub amplitude: Option<f64>,
+    /// CSV file with header t,x,y,z,alpha,beta,gamma (s, m, rad unless --degrees).
+    #[arg(long, conflicts_with = "udp")]
+    pub input: Option<std::path::PathBuf>,
+    /// Receive poses from motion-simulator software: one datagram = one text line of six numbers
+    /// `x y z alpha beta gamma` (spaces, commas or semicolons; m and rad unless --degrees), sent as they arrive.
+    #[arg(long, conflicts_with = "motion")]
+    pub udp: Option<std::net::SocketAddr>,
+    /// Receive vehicle telemetry from simulator software and cue it with the classical washout (as `ringpod cue`
+    /// does with a file): one datagram per sample, in --telemetry-format.
+    #[arg(long, conflicts_with_all = ["udp", "input", "motion"])]
+    pub telemetry_udp: Option<std::net::SocketAddr>,
+    /// With --telemetry-udp: `text` (`[t] ax ay az wx wy wz`, the units of `ringpod cue`), a game's own format
+    /// (`outsim`, `outsim2`, `beamng`, `codemasters`, `f1`, `forza`, `xplane`: the README's games table), or `auto`
+    /// (the first datagram a game's format recognises names it, said on stderr).
+    #[arg(long, value_enum, default_value = "text")]
+    pub telemetry_format: crate::stream::datagram::TelemetryFormat,
+    /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`). The file is watched while
+    /// the stream runs: a changed, valid file takes over within a second, blended in; an invalid one is refused.
+    #[arg(long, requires = "telemetry_udp", conflicts_with_all = ["udp", "input", "motion"])]
+    pub cue_config: Option<std::path::PathBuf>,
+    /// With --cue-config: a profile of the cueing file (its `[profiles.NAME]` table overrides the base keys).
+    #[arg(long, requires = "cue_config")]
+    pub profile: Option<String>,
+    /// With --udp or --telemetry-udp: take datagrams from this sender only (others are counted and ignored).
+    #[arg(long, conflicts_with_all = ["input", "motion"])]
+    pub udp_from: Option<std::net::IpAddr>,
+    /// With --udp or --telemetry-udp: end the stream after this many seconds without a readable datagram (a source
+    /// that sends only what cannot be read is as good as none).
+    #[arg(long, default_value_t = 2.0)]
+    pub udp_idle: f64,
+    /// Angles of --input or --udp in degrees.
+    #[arg(long)]
+    pub degrees: bool,
+    /// Setpoints per second for built-in motions.
+    #[arg(long, default_value_t = 1000.0)]
+    pub rate: f64,
+    /// Home even if the device is homed.
+    #[arg(long)]
+    pub home: bool,
+    /// Send poses as they come, without limiting them into the envelope on the host first: the device limits them
+    /// (it always does; this shows it doing all of it, as a board streamed by other software would).
+    #[arg(long)]
+    pub device_limits_only: bool,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Print one JSON report at the end.
+    #[arg(long)]
+    pub report_json: bool,
+    /// Record the run: a CSV row per telemetry sample (every 10 ms at the default 100 Hz): host and device time,
+    /// the pose commanded, the pose followed (after limiting), the actuator steps, the state and the flags
+    /// (limited, refused, held). `ringpod plot FILE` draws it.
+    #[arg(long, value_name = "FILE.csv")]
+    pub record: Option<std::path::PathBuf>,
+    /// With --record: the device's telemetry rate for the run (1 to 2000 Hz, at most its control rate; 1000 is a
+    /// sample every tick of the model), set back to its own afterwards. A board stores the setting both times.
+    #[arg(long, requires = "record", value_parser = clap::value_parser!(u16).range(1..=2000))]
+    pub record_hz: Option<u16>,
+    /// With --udp or --telemetry-udp: capture every datagram that arrives on the socket (from any sender, readable
+    /// or not) to a pcap file, as tcpdump writes one, with its arrival time; `ringpod cue --input FILE.pcap` cues it
+    /// again, Wireshark shows it.
+    #[arg(long, value_name = "FILE.pcap", conflicts_with_all = ["input", "motion"])]
+    pub capture: Option<std::path::PathBuf>,
+    /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics) on the platform
+    /// the device runs, against its drives (the --geometry file's `[[drives]]`, or the preset's motor data) for a
+    /// payload of --mass kg; where it exceeds the motors, say where and do not stream (exit 1).
+    #[arg(long, requires = "mass", conflicts_with_all = ["udp", "telemetry_udp"])]
+    pub check_loads: bool,
+    /// With --check-loads: the moving mass (kg) at the platform's centre of mass.
+    #[arg(long, requires = "check_loads")]
+    pub mass: Option<f64>,
+    /// With --check-loads: its inertia Ixx,Iyy,Izz (kg m^2) about the centre of mass.
+    #[arg(long, allow_hyphen_values = true, requires = "check_loads")]
+    pub inertia: Option<String>,
+}

@@ -1,0 +1,194 @@
+//! The end of a run: the stop and the wait for rest, the record and the telemetry rate closed, and the report with
+//! its outcome and exit code.
+
+use std::time::Duration;
+
+use ringpod_core::protocol::Status;
+use ringpod_core::safety::{FaultReason, State};
+
+use super::prepare::telemetry_rate;
+use super::report::{CaptureReport, DatagramReport, RecordReport, Report};
+use super::session::{Stop, StreamError, Streamer};
+use super::{exit, InputError};
+use crate::link::client::Transport;
+
+/// How a run ended: why it stopped early, the device's status at rest, a lost link in words, what `--record`
+/// wrote.
+pub(super) struct Ending {
+    stop: Option<Stop>,
+    status: Option<Status>,
+    transport: Option<String>,
+    record: Option<RecordReport>,
+}
+
+/// Stops and waits for rest (also after Ctrl-C or a device that stopped by itself), closes the record and sets the
+/// device's telemetry rate back.
+pub(super) fn wind_down<T: Transport>(
+    s: &mut Streamer<'_, T>,
+    outcome: Result<(), StreamError>,
+    record_path: Option<String>,
+    restore_hz: Option<u16>,
+    telemetry_hz: Option<u16>,
+) -> Ending {
+    let (stop, transport) = match outcome {
+        Ok(()) => (None, None),
+        Err(StreamError::Stop(stop)) => (Some(stop), None),
+        Err(StreamError::Client(e)) => (None, Some(e)),
+    };
+    let status = if transport.is_none() { stop_and_rest(s) } else { None };
+    // The samples of the stop and the ramp to rest.
+    let _ = s.record();
+    let mut record = record_path.map(|path| record_report(s, path));
+    // The device's own telemetry rate back (a board stores it): after the record has taken its last samples.
+    let rate_error = match restore_hz {
+        Some(before) if transport.is_none() => telemetry_rate(s.client, before).err(),
+        _ => None,
+    };
+    if let (Some(r), Some(e)) = (record.as_mut(), rate_error) {
+        r.error
+            .get_or_insert(format!("the device's telemetry rate was not set back: {e}"));
+    }
+    if let Some(r) = record.as_mut() {
+        r.telemetry_hz = telemetry_hz;
+    }
+    let (status, transport) = match (status, transport) {
+        (Some(st), None) => (Some(st), None),
+        (None, None) => (None, Some("the device did not answer after the stop".to_string())),
+        (_, Some(e)) => (None, Some(e.to_string())),
+    };
+    Ending {
+        stop,
+        status,
+        transport,
+        record,
+    }
+}
+
+/// The report of a run: the verdict, the counts (checked against the device's), what was sent of each kind.
+pub(super) fn report<T: Transport>(
+    mut s: Streamer<'_, T>,
+    ending: Ending,
+    input_errors: Vec<InputError>,
+    datagrams: Option<DatagramReport>,
+    capture: Option<CaptureReport>,
+) -> Report {
+    let refused: u32 = s.rejected.values().sum();
+    let (outcome, reason, code) = verdict(
+        ending.transport,
+        ending.stop.as_ref(),
+        refused,
+        &input_errors,
+        s.input_sent,
+    );
+    let status = ending.status;
+    let counts_agree = status.as_ref().is_some_and(|st| {
+        let b = &s.baseline;
+        st.applied.wrapping_sub(b.applied) == s.applied_all
+            && st.rejected.total().wrapping_sub(b.rejected.total()) == s.rejected_all
+            && st.limited.count.wrapping_sub(b.limited.count) == s.device_limited
+            && s.sent_all == s.applied_all + s.rejected_all
+    });
+    s.limited.device = s.device_limited;
+    Report {
+        outcome,
+        reason,
+        exit_code: code,
+        state: status.as_ref().map_or("unknown".into(), |st| format!("{:?}", st.state)),
+        setpoints_sent: s.input_sent,
+        setpoints_applied: s.input_applied,
+        limited: s.limited,
+        rejected: s.rejected,
+        refusals: s.refusals,
+        lead_in_sent: s.lead_in,
+        settle_sent: s.settle,
+        washout_sent: s.washout,
+        restarts: s.restarts,
+        final_steps: status.as_ref().map_or([0; 6], |st| st.steps),
+        faults: s.client.faults.iter().map(|f: &FaultReason| f.to_string()).collect(),
+        input_errors,
+        datagrams,
+        last_applied_pose: s.last_applied.map(|p| p.to_array()),
+        counts_agree,
+        record: ending.record,
+        capture,
+    }
+}
+
+/// Collects the answers still in flight (a device that stopped streaming has refused them), stops, and waits up
+/// to 10 s for rest; the status at rest, or none when the device did not answer.
+fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
+    while !s.in_flight.is_empty() {
+        if let Err(StreamError::Client(_)) = s.collect(0) {
+            break;
+        }
+    }
+    let _ = s.client.stop();
+    // The wait for rest runs to its end even after a signal: the platform is brought to rest, then reported.
+    let cancel = s.client.cancel.take();
+    let status = s.client.wait_for(Duration::from_secs(10), |st| {
+        !matches!(st.state, State::Running | State::Stopping)
+    });
+    s.client.cancel = cancel;
+    status.ok()
+}
+
+/// What `--record` wrote: its rows, the samples dropped, and why it stopped writing, if it did.
+fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordReport {
+    let dropped = s.client.telemetry_dropped;
+    let (rows, error) = match (s.recorder.take(), s.record_error.take()) {
+        (Some(r), None) => {
+            let rows = r.rows;
+            (rows, r.finish().err().map(|e| e.to_string()))
+        }
+        (r, e) => (r.map_or(0, |r| r.rows), e),
+    };
+    RecordReport {
+        path,
+        rows,
+        telemetry_hz: None,
+        dropped,
+        error,
+    }
+}
+
+/// The run's outcome, its reason and exit code: the most serious of a lost link, a device that stopped, a
+/// signal, refusals, input errors, no input at all; else followed.
+fn verdict(
+    transport: Option<String>,
+    stop: Option<&Stop>,
+    refused: u32,
+    input_errors: &[InputError],
+    input_sent: u32,
+) -> (&'static str, Option<String>, u8) {
+    if let Some(t) = transport {
+        ("transport_lost", Some(t), exit::TRANSPORT_LOST)
+    } else if let Some(Stop::Device(why)) = stop {
+        ("device_stopped", Some(why.clone()), exit::DEVICE_STOPPED)
+    } else if let Some(Stop::Interrupted) = stop {
+        (
+            "interrupted",
+            Some("interrupted (a signal, or STOP in the workbench)".to_string()),
+            exit::INTERRUPTED,
+        )
+    } else if refused > 0 {
+        (
+            "refused",
+            Some(format!("the device refused {refused} setpoints")),
+            exit::REFUSED,
+        )
+    } else if !input_errors.is_empty() {
+        (
+            "input_errors",
+            Some(format!("{} input lines could not be read", input_errors.len())),
+            exit::INPUT_ERRORS,
+        )
+    } else if input_sent == 0 {
+        (
+            "input_errors",
+            Some("no pose in the input".to_string()),
+            exit::INPUT_ERRORS,
+        )
+    } else {
+        ("followed", None, exit::FOLLOWED)
+    }
+}
