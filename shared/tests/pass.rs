@@ -110,3 +110,15 @@ fn a_pass_moves_nothing_and_homing_resumes_where_it_was() {
     assert!(steps(&next.moves) > 0, "the next tick goes on homing");
     assert_ne!(c.steps(), before);
 }
+
+#[test]
+fn the_status_carries_the_boards_step_counters() {
+    // The firmware counts periods its step generator played empty and periods it passed; the status is where a
+    // host sees them (`device status`), so they are not only in a log nobody reads.
+    let mut c = connected();
+    let s = c.status();
+    assert_eq!((s.idle_periods, s.passed_periods), (0, 0));
+    c.set_step_counters(3, 5);
+    let s = c.status();
+    assert_eq!((s.idle_periods, s.passed_periods), (3, 5));
+}

@@ -36,6 +36,8 @@ fn the_largest_status_fits_a_frame() {
         bad_frames: u32::MAX,
         tick_cost: u32::MAX,
         queue_depth: u16::MAX,
+        idle_periods: u32::MAX,
+        passed_periods: u32::MAX,
     };
     let response = Response {
         id: u32::MAX,

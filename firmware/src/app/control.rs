@@ -64,7 +64,13 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
         // Waits while the step generator's queue is full: the queue paces the loop as much as the timer does.
         shared.steps.send(out.moves).await;
         let depth = shared.steps.len() as u16;
-        shared.with(|c| c.set_platform_stats(cost, depth));
+        shared.with(|c| {
+            c.set_platform_stats(cost, depth);
+            c.set_step_counters(
+                shared.step_underruns.load(Ordering::Relaxed),
+                shared.passes.load(Ordering::Relaxed),
+            );
+        });
         if let Some(m) = message {
             shared.post(m);
         }

@@ -53,6 +53,8 @@ pub struct Controller {
     bad_frames: u32,
     tick_cost: u32,
     queue_depth: u16,
+    idle_periods: u32,
+    passed_periods: u32,
     pending_fault: bool,
     telemetry: TelemetryClock,
     /// Electrical input levels as the board sampled them, if it does.
@@ -110,6 +112,8 @@ impl Controller {
             bad_frames: 0,
             tick_cost: 0,
             queue_depth: 0,
+            idle_periods: 0,
+            passed_periods: 0,
             pending_fault: false,
             telemetry: TelemetryClock::default(),
             raw_inputs: None,
@@ -139,6 +143,13 @@ impl Controller {
     pub fn set_platform_stats(&mut self, tick_cost: u32, queue_depth: u16) {
         self.tick_cost = tick_cost;
         self.queue_depth = queue_depth;
+    }
+
+    /// The board's step generator's counters, for the status: periods it played empty, and control periods
+    /// passed (see [`Controller::pass`]).
+    pub fn set_step_counters(&mut self, idle_periods: u32, passed_periods: u32) {
+        self.idle_periods = idle_periods;
+        self.passed_periods = passed_periods;
     }
 
     /// Reports a watchdog reset (once, at boot).
@@ -302,6 +313,8 @@ impl Controller {
             bad_frames: self.bad_frames,
             tick_cost: self.tick_cost,
             queue_depth: self.queue_depth,
+            idle_periods: self.idle_periods,
+            passed_periods: self.passed_periods,
         }
     }
 

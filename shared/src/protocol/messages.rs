@@ -11,8 +11,9 @@ use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Se
 use crate::safety::{Command, FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly. 8: the motion section carries the actuator limits, the
-/// operator's commands switch the auxiliary outputs and setpoints carry their levels.
-pub const PROTOCOL_VERSION: u16 = 8;
+/// operator's commands switch the auxiliary outputs and setpoints carry their levels. 9: the status counts the
+/// periods the step generator played empty and the control periods passed.
+pub const PROTOCOL_VERSION: u16 = 9;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -310,4 +311,10 @@ pub struct Status {
     pub tick_cost: u32,
     /// Step-queue depth of the pulse generator.
     pub queue_depth: u16,
+    /// Periods the step generator played without moves because the queue was empty: a tick that came late (the
+    /// axes paused for a period, no step lost).
+    pub idle_periods: u32,
+    /// Control periods passed rather than ticked because a period was still queued: the catch-up after a hold-up
+    /// of the control loop (the clocks ran on, the motion resumed a period later).
+    pub passed_periods: u32,
 }
