@@ -1,8 +1,8 @@
 //! Board: STM32F411CE "Black Pill" (25 MHz crystal, USB-C, 512 KiB flash, 128 KiB RAM).
 //!
-//! Everything specific to this chip is in this folder: clocks, the pin map, interrupt bindings, USB CDC-ACM and the USART1
-//! link, the TIM1 + DMA2 step generator, EXTI switch inputs, the independent watchdog and the settings flash. Another STM32
-//! (F446, G474, H743) is another module like this one plus its `memory.x`; `app` stays as it is.
+//! Everything specific to this chip is in this folder: clocks, the pin map, interrupt bindings, USB CDC-ACM and the
+//! USART1 link, the TIM1 + DMA2 step generator, EXTI switch inputs, the independent watchdog and the settings flash.
+//! Another STM32 (F446, G474, H743) is another folder like this one plus its `memory.x`; `app` stays as it is.
 //!
 //! | signal | pin | | signal | pin |
 //! |---|---|---|---|---|
@@ -26,6 +26,7 @@
 //! The auxiliary outputs take the last two free pins, PC15 and PC13 (PB11 is not bonded out, PH0/PH1 carry the
 //! 25 MHz crystal, PA13/PA14 are SWD). They are in the backup domain: low speed only and no current sourced
 //! (RM0383/datasheet: at most 3 mA through the power switch), so each drives a relay driver's MOSFET gate; the
+//! Black Pill's blue LED on PC13 (to 3.3 V) lights while AUX2 is off.
 //!
 //! One file a job: `resources` (the pin map as code: which peripherals each step takes, the interrupt bindings),
 //! `clocks`, `outputs` (relays, enable, auxiliary outputs, STEP/DIR at their idle levels), `switches` (EXTI
