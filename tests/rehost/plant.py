@@ -1,6 +1,6 @@
 """The machine on the board's pins, as the QEMU board's `sim::Plant` (trainer model, parked) but in Python.
 
-- Each STEP rising edge on PB0-PB5 (board::PORT_MAP) moves its axis one step, forward when its DIR pin
+- Each STEP rising edge on PB0-PB5 (board::resources::PORT_MAP) moves its axis one step, forward when its DIR pin
   (PB6-PB10, PB12) is high (`dir_forward_low` 0); the edges are seen word by word as the DMA writes GPIOB.BSRR,
   so pulse widths and DIR set-up times are measured in TIM1 slots (2.5 us).
 - Switches at positions, as `Plant::trainer_model`: carriages 1-4 have an index flag 60 steps wide from 0, the

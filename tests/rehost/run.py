@@ -32,10 +32,10 @@ from plant import FLAG_WIDTH, HOME_POSITION, SLOW_RATE, TOWARD, Plant  # noqa: E
 from seqstore import used_up_page  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
 
-SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411.rs, SETTINGS)
+SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411/settings.rs, SETTINGS)
 GPIOB_BSRR = 0x4002_0418
 TIM5_IRQ = 50
-STEP_PINS, ENABLE_N, LOGIC_RELAY, POWER_RELAY = range(6), 13, 14, 15  # board::PORT_MAP, pin table
+STEP_PINS, ENABLE_N, LOGIC_RELAY, POWER_RELAY = range(6), 13, 14, 15  # board::resources::PORT_MAP, pin table
 
 
 class Checks:

@@ -1,0 +1,98 @@
+//! The pin map as code: which peripherals each bring-up step takes (embassy's `Peripherals` split by job with
+//! `assign_resources!`), the interrupts the drivers bind, and the STEP/DIR bits of port B.
+
+use assign_resources::assign_resources;
+use embassy_stm32::{bind_interrupts, dma, exti, interrupt, peripherals, usart, usb, Peri};
+use ringpod_core::motion::pulse::PortMap;
+
+bind_interrupts!(pub struct Irqs {
+    OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
+    USART1 => usart::BufferedInterruptHandler<peripherals::USART1>;
+    DMA2_STREAM5 => dma::InterruptHandler<peripherals::DMA2_CH5>;
+    EXTI0 => exti::InterruptHandler<interrupt::typelevel::EXTI0>;
+    EXTI1 => exti::InterruptHandler<interrupt::typelevel::EXTI1>;
+    EXTI2 => exti::InterruptHandler<interrupt::typelevel::EXTI2>;
+    EXTI3 => exti::InterruptHandler<interrupt::typelevel::EXTI3>;
+    EXTI4 => exti::InterruptHandler<interrupt::typelevel::EXTI4>;
+    EXTI9_5 => exti::InterruptHandler<interrupt::typelevel::EXTI9_5>;
+    EXTI15_10 => exti::InterruptHandler<interrupt::typelevel::EXTI15_10>;
+});
+
+/// STEP on PB0-PB5, DIR on PB6-PB10 and PB12 (PB11 is not bonded out on the F411CE's package).
+pub const PORT_MAP: PortMap = PortMap {
+    step: [0, 1, 2, 3, 4, 5],
+    dir: [6, 7, 8, 9, 10, 12],
+    dir_forward_low: 0,
+};
+
+assign_resources! {
+    /// Driver enable (active low), the two supply relays and the auxiliary outputs.
+    outputs: OutputPins {
+        driver_enable_n: PB13,
+        logic_relay: PB14,
+        power_relay: PB15,
+        aux1: PC15,
+        aux2: PC13,
+    }
+    /// STEP 1-6 and DIR 1-6, all on port B ([`PORT_MAP`]).
+    step_dir: StepDirPins {
+        step1: PB0,
+        step2: PB1,
+        step3: PB2,
+        step4: PB3,
+        step5: PB4,
+        step6: PB5,
+        dir1: PB6,
+        dir2: PB7,
+        dir3: PB8,
+        dir4: PB9,
+        dir5: PB10,
+        dir6: PB12,
+    }
+    /// The switches and supply senses, each with its EXTI line (the order of `switches::SWITCH_BITS`).
+    switches: SwitchPins {
+        estop: PA0,
+        estop_line: EXTI0,
+        home1: PA1,
+        home1_line: EXTI1,
+        home2: PA2,
+        home2_line: EXTI2,
+        home3: PA3,
+        home3_line: EXTI3,
+        home4: PA4,
+        home4_line: EXTI4,
+        home5: PA5,
+        home5_line: EXTI5,
+        home6: PA6,
+        home6_line: EXTI6,
+        limit5: PA7,
+        limit5_line: EXTI7,
+        limit6: PA8,
+        limit6_line: EXTI8,
+        logic_ok: PA9,
+        logic_ok_line: EXTI9,
+        power_ok: PC14,
+        power_ok_line: EXTI14,
+    }
+    /// The step generator: TIM1's update paces DMA2 stream 5 into GPIOB's BSRR.
+    step_generator: StepGeneratorParts {
+        dma: DMA2_CH5,
+        timer: TIM1,
+    }
+    /// USB OTG FS on PA12 (D+) and PA11 (D-).
+    usb: UsbParts {
+        otg: USB_OTG_FS,
+        dp: PA12,
+        dm: PA11,
+    }
+    /// USART1 on RX PA10 and TX PA15.
+    uart: UartParts {
+        usart: USART1,
+        rx: PA10,
+        tx: PA15,
+    }
+    /// The flash controller (settings in sectors 6 and 7).
+    settings: SettingsParts {
+        flash: FLASH,
+    }
+}
