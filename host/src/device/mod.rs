@@ -187,3 +187,20 @@ pub fn ports() -> Result<u8, DeviceError> {
     }
     Ok(0)
 }
+
+/// A state as one word (a run record's CSV field, the monitor, the web page): its name, and a fault's reason after
+/// a colon (no commas).
+pub fn state_name(state: State) -> String {
+    match state {
+        State::Off => "Off".into(),
+        State::LogicOn => "LogicOn".into(),
+        State::PowerOn { .. } => "PowerOn".into(),
+        State::Homing => "Homing".into(),
+        State::Ready => "Ready".into(),
+        State::Running => "Running".into(),
+        State::Jogging => "Jogging".into(),
+        State::Stopping => "Stopping".into(),
+        State::Fault(reason, _) => format!("Fault: {reason}").replace(',', ";"),
+        State::ShuttingDown(_) => "ShuttingDown".into(),
+    }
+}

@@ -17,7 +17,7 @@ use ringpod_core::protocol::{Telemetry, TelemetryFlags};
 use ringpod_core::safety::debounce::InputBit;
 
 use crate::link::client::{Client, ClientError, Transport};
-use crate::stream::record::state_name;
+use super::state_name;
 
 /// What the view shows: the newest sample and how the link is doing.
 #[derive(Debug, Clone, Default)]

@@ -11,8 +11,8 @@ use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
 use plotters::style::RGBColor;
 use ringpod_core::kinematics::Pose;
 use ringpod_core::protocol::{Telemetry, TelemetryFlags};
-use ringpod_core::safety::State;
 
+use crate::device::state_name;
 use crate::error::CliError;
 
 use crate::out::plot::{self, Event, Panel, Series, TimePlot};
@@ -52,22 +52,6 @@ pub const COLUMNS: [&str; 28] = [
     "refused_total",
     "tick_cost",
 ];
-
-/// A state as one CSV field: its name, and a fault's reason after a colon (no commas).
-pub fn state_name(state: State) -> String {
-    match state {
-        State::Off => "Off".into(),
-        State::LogicOn => "LogicOn".into(),
-        State::PowerOn { .. } => "PowerOn".into(),
-        State::Homing => "Homing".into(),
-        State::Ready => "Ready".into(),
-        State::Running => "Running".into(),
-        State::Jogging => "Jogging".into(),
-        State::Stopping => "Stopping".into(),
-        State::Fault(reason, _) => format!("Fault: {reason}").replace(',', ";"),
-        State::ShuttingDown(_) => "ShuttingDown".into(),
-    }
-}
 
 /// Writes a run record.
 pub struct Recorder {
