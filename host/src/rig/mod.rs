@@ -44,7 +44,6 @@ mod checks;
 mod command;
 mod coverage;
 mod design;
-pub mod device;
 pub mod drives;
 pub mod error;
 mod file;
