@@ -39,9 +39,9 @@ pub enum CliError {
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),
-    /// Options that do not go together.
-    #[error(transparent)]
-    Request(#[from] crate::cli::requests::RequestError),
+    /// `workspace --z` with a section that is not at one height.
+    #[error("--z is the height of the xy section; the other sections span every height or none")]
+    SectionHeight,
     /// A picture was not written.
     #[error(transparent)]
     Plot(#[from] crate::out::plot::PlotError),
