@@ -92,7 +92,7 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
             window,
             from,
             to,
-        } => say(analysis::derivatives::plot_command(
+        } => say(stream::derivatives::plot_command(
             record,
             out,
             *window,

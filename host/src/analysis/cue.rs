@@ -65,7 +65,7 @@ pub struct Options<'a> {
     /// The telemetry CSV, or a packet capture (pcap, pcapng) of a game's telemetry.
     pub input: &'a Path,
     /// A capture's telemetry format (`auto` without).
-    pub telemetry_format: Option<crate::stream::datagram::TelemetryFormat>,
+    pub telemetry_format: Option<crate::games::TelemetryFormat>,
     /// A capture: its datagrams to this UDP port only.
     pub udp_port: Option<u16>,
     /// The pose CSV to write.
@@ -243,7 +243,7 @@ fn read_input(
     if crate::input::capture::is_capture(&bytes) {
         let format = args
             .telemetry_format
-            .unwrap_or(crate::stream::datagram::TelemetryFormat::Auto);
+            .unwrap_or(crate::games::TelemetryFormat::Auto);
         let (rows, errors, summary) =
             super::cue_capture::rows(&bytes, format, args.udp_port).map_err(|e| bad(e.to_string()))?;
         return Ok((rows, errors, Some(summary)));

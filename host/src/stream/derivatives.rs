@@ -19,7 +19,7 @@ use crate::error::CliError;
 use crate::input::numbers::BadNumber;
 
 use crate::out::plot::{self, Panel, Series, TimePlot};
-use crate::stream::record;
+use super::record;
 
 /// Velocity and acceleration at each sample of `y(t)` from a local quadratic over `window` seconds centred on it;
 /// `NaN` where the window holds fewer than three distinct times. `t` must not decrease.
