@@ -48,9 +48,6 @@ pub enum CliError {
     /// A run record could not be read.
     #[error(transparent)]
     Record(#[from] crate::stream::record::RecordError),
-    /// A drive could not be cued.
-    #[error(transparent)]
-    Cue(#[from] crate::analysis::cue::CueError),
     /// The cueing file.
     #[error(transparent)]
     Cueing(#[from] crate::input::cueing::CueingFileError),
