@@ -45,9 +45,6 @@ pub enum CliError {
     /// A picture was not written.
     #[error(transparent)]
     Plot(#[from] crate::out::plot::PlotError),
-    /// A run record could not be read.
-    #[error(transparent)]
-    Record(#[from] crate::stream::record::RecordError),
     /// The cueing file.
     #[error(transparent)]
     Cueing(#[from] crate::input::cueing::CueingFileError),

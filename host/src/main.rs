@@ -123,7 +123,7 @@ fn answer(outcome: Result<out::Outcome, error::CliError>) -> Result<u8, error::C
 }
 
 /// Prints a command's text: it ran, so it exits with 0.
-fn say(text: Result<String, error::CliError>) -> Result<u8, error::CliError> {
+fn say<E>(text: Result<String, E>) -> Result<u8, E> {
     print(&text?);
     Ok(0)
 }

@@ -244,9 +244,7 @@ fn read_input(
     };
     let bytes = crate::input::files::read_bytes(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
     if crate::input::capture::is_capture(&bytes) {
-        let format = args
-            .telemetry_format
-            .unwrap_or(crate::games::TelemetryFormat::Auto);
+        let format = args.telemetry_format.unwrap_or(crate::games::TelemetryFormat::Auto);
         let (rows, errors, summary) =
             super::cue_capture::rows(&bytes, format, args.udp_port).map_err(|e| bad(e.to_string()))?;
         return Ok((rows, errors, Some(summary)));

@@ -13,9 +13,9 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::games;
+use crate::games::TelemetryFormat;
 use crate::input::capture;
 use crate::input::table::InputError;
-use crate::games::TelemetryFormat;
 
 /// What a capture held, in `cue`'s summary.
 #[derive(Debug, Serialize)]

@@ -9,8 +9,8 @@ use ringpod_core::protocol::{NackReason, RigSource};
 
 use ringpod_core::kinematics::GeometryError;
 
-use crate::rig::{RigError, RigFile};
 use crate::link::client::{Client, ClientError, Transport};
+use crate::rig::{RigError, RigFile};
 
 /// Why a rig could not be put on, read from or restarted on a device.
 #[derive(Debug, thiserror::Error)]

@@ -13,7 +13,6 @@ use ringpod_core::kinematics::Pose;
 use ringpod_core::protocol::{Telemetry, TelemetryFlags};
 
 use crate::device::state_name;
-use crate::error::CliError;
 
 use crate::out::plot::{self, Event, Panel, Series, TimePlot};
 
@@ -170,6 +169,20 @@ pub enum RecordError {
     NoRows,
 }
 
+/// Why `ringpod plot` (and `plot --derivatives`) drew nothing.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotCommandError {
+    /// The record could not be read.
+    #[error(transparent)]
+    Record(#[from] RecordError),
+    /// A window or span that cannot be used.
+    #[error(transparent)]
+    Number(#[from] crate::input::numbers::BadNumber),
+    /// The picture was not written.
+    #[error(transparent)]
+    Plot(#[from] plot::PlotError),
+}
+
 /// Reads a run record (`stream --record`).
 pub(crate) fn read(path: &Path) -> Result<Run, RecordError> {
     let text =
@@ -265,7 +278,7 @@ fn onsets(t: &[f64], flags: &[bool], kind: &str, colour: RGBColor) -> Vec<Event>
 }
 
 /// `ringpod plot RUN.csv --out FILE`: returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path) -> Result<String, CliError> {
+pub fn plot_command(input: &Path, out: &Path) -> Result<String, PlotCommandError> {
     let run = read(input)?;
     let mut events = onsets(
         &run.t,
