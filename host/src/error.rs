@@ -2,17 +2,12 @@
 
 use ringpod_core::kinematics::KinematicsError;
 
-/// Exit code of a run that failed (bad input, no kinematic solution).
-pub const EXIT_ERROR: u8 = 1;
-/// Exit code of `check` when the pose has a solution but a workspace check fails.
-pub const EXIT_CHECK_FAILED: u8 = 3;
-
 /// Why a command could not produce its answer.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
     /// `--mechanism` names no preset.
-    #[error("unknown mechanism `{0}`; `ringpod presets` lists them")]
-    UnknownMechanism(String),
+    #[error(transparent)]
+    UnknownMechanism(#[from] crate::rig::UnknownMechanism),
     /// The kinematics have no answer.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),
@@ -72,6 +67,19 @@ impl CliError {
         Self::File {
             path: path.to_owned(),
             reason: reason.to_string(),
+        }
+    }
+}
+
+/// A rig command's error is said as the command line's own of the same kind.
+impl From<crate::rig::CommandError> for CliError {
+    fn from(e: crate::rig::CommandError) -> Self {
+        use crate::rig::CommandError as E;
+        match e {
+            E::UnknownMechanism(e) => Self::UnknownMechanism(e),
+            E::Number(e) => Self::Number(e),
+            E::Rig(e) => Self::Rig(e),
+            E::Json(e) => Self::Json(e),
         }
     }
 }
