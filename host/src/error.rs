@@ -1,4 +1,7 @@
-//! Errors of the command line.
+//! Errors of the command line: the ones the analysis commands, and the stream, device and ui commands' platform,
+//! share. It sits low (it wraps only rig's, input's and out's errors, and the core's): a command module returns it,
+//! and a command's own error that carries more (`CueError`, `PlotCommandError`, `DeviceError`, `UiError`) wraps it
+//! from above.
 
 use ringpod_core::kinematics::KinematicsError;
 
