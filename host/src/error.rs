@@ -1,18 +1,16 @@
-//! Errors of the command line.
+//! Errors of the command line: the ones the analysis commands, and the stream, device and ui commands' platform,
+//! share. It sits low (it wraps only rig's, input's and out's errors, and the core's): a command module returns it,
+//! and a command's own error that carries more (`CueError`, `PlotCommandError`, `DeviceError`, `UiError`) wraps it
+//! from above.
 
 use ringpod_core::kinematics::KinematicsError;
-
-/// Exit code of a run that failed (bad input, no kinematic solution).
-pub const EXIT_ERROR: u8 = 1;
-/// Exit code of `check` when the pose has a solution but a workspace check fails.
-pub const EXIT_CHECK_FAILED: u8 = 3;
 
 /// Why a command could not produce its answer.
 #[derive(Debug, thiserror::Error)]
 pub enum CliError {
     /// `--mechanism` names no preset.
-    #[error("unknown mechanism `{0}`; `ringpod presets` lists them")]
-    UnknownMechanism(String),
+    #[error(transparent)]
+    UnknownMechanism(#[from] crate::rig::UnknownMechanism),
     /// The kinematics have no answer.
     #[error(transparent)]
     Kinematics(#[from] KinematicsError),
@@ -39,18 +37,12 @@ pub enum CliError {
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),
-    /// Options that do not go together.
-    #[error(transparent)]
-    Request(#[from] crate::cli::requests::RequestError),
+    /// `workspace --z` with a section that is not at one height.
+    #[error("--z is the height of the xy section; the other sections span every height or none")]
+    SectionHeight,
     /// A picture was not written.
     #[error(transparent)]
     Plot(#[from] crate::out::plot::PlotError),
-    /// A run record could not be read.
-    #[error(transparent)]
-    Record(#[from] crate::stream::record::RecordError),
-    /// A drive could not be cued.
-    #[error(transparent)]
-    Cue(#[from] crate::analysis::cue::CueError),
     /// The cueing file.
     #[error(transparent)]
     Cueing(#[from] crate::input::cueing::CueingFileError),
@@ -78,6 +70,19 @@ impl CliError {
         Self::File {
             path: path.to_owned(),
             reason: reason.to_string(),
+        }
+    }
+}
+
+/// A rig command's error is said as the command line's own of the same kind.
+impl From<crate::rig::CommandError> for CliError {
+    fn from(e: crate::rig::CommandError) -> Self {
+        use crate::rig::CommandError as E;
+        match e {
+            E::UnknownMechanism(e) => Self::UnknownMechanism(e),
+            E::Number(e) => Self::Number(e),
+            E::Rig(e) => Self::Rig(e),
+            E::Json(e) => Self::Json(e),
         }
     }
 }

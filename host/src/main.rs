@@ -23,7 +23,7 @@ fn main() -> ExitCode {
         Ok(code) => ExitCode::from(code),
         Err(e) => {
             eprintln!("ringpod: {e:#}");
-            ExitCode::from(error::EXIT_ERROR)
+            ExitCode::from(out::EXIT_ERROR)
         }
     }
 }
@@ -33,7 +33,7 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
     use cli::Command as C;
     Ok(match command {
         C::Presets { json, export } => answer(match export {
-            Some(name) => rig::export(name),
+            Some(name) => rig::export(name).map_err(error::CliError::from),
             None => analysis::kinematics::presets(*json),
         })?,
         C::Rig { action } => answer(match action {
@@ -92,7 +92,7 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
             window,
             from,
             to,
-        } => say(analysis::derivatives::plot_command(
+        } => say(stream::derivatives::plot_command(
             record,
             out,
             *window,
@@ -116,14 +116,14 @@ fn print(text: &str) {
 }
 
 /// Prints a kinematics command's text and passes on its exit code.
-fn answer(outcome: Result<out::Outcome, error::CliError>) -> Result<u8, error::CliError> {
+fn answer<E>(outcome: Result<out::Outcome, E>) -> Result<u8, E> {
     let outcome = outcome?;
     print(&outcome.text);
     Ok(outcome.code)
 }
 
 /// Prints a command's text: it ran, so it exits with 0.
-fn say(text: Result<String, error::CliError>) -> Result<u8, error::CliError> {
+fn say<E>(text: Result<String, E>) -> Result<u8, E> {
     print(&text?);
     Ok(0)
 }

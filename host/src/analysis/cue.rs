@@ -65,7 +65,7 @@ pub struct Options<'a> {
     /// The telemetry CSV, or a packet capture (pcap, pcapng) of a game's telemetry.
     pub input: &'a Path,
     /// A capture's telemetry format (`auto` without).
-    pub telemetry_format: Option<crate::stream::datagram::TelemetryFormat>,
+    pub telemetry_format: Option<crate::games::TelemetryFormat>,
     /// A capture: its datagrams to this UDP port only.
     pub udp_port: Option<u16>,
     /// The pose CSV to write.
@@ -85,12 +85,12 @@ pub struct Options<'a> {
 }
 
 /// Runs the command; returns the summary as text and the exit code.
-pub fn run(args: &Options) -> Result<(String, u8), CliError> {
-    let config = load_config(args.config, args.profile)?;
+pub fn run(args: &Options) -> Result<(String, u8), CueError> {
+    let config = load_config(args.config, args.profile).map_err(CliError::from)?;
     let (rows, mut errors, capture) = read_input(args)?;
     let selected = Selected::of(args.mechanism, args.geometry)?;
     let AnyMechanism::Ring(mechanism) = selected.mechanism else {
-        return Err(CliError::NotARing(selected.name));
+        return Err(CliError::NotARing(selected.name).into());
     };
     let neutral = Pose::from_array(selected.home);
     let Replay {
@@ -102,7 +102,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CliError> {
     errors.sort_by_key(|e| e.line);
     write_poses(args.out, &cued)?;
     if let Some(plot) = &args.plot {
-        draw(plot, &cued, &neutral)?;
+        draw(plot, &cued, &neutral).map_err(CliError::from)?;
     }
     let summary = Summary {
         rows: rows.len(),
@@ -117,7 +117,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CliError> {
         EXIT_INPUT_ERRORS
     };
     let text = if args.json {
-        serde_json::to_string_pretty(&summary)? + "\n"
+        serde_json::to_string_pretty(&summary).map_err(CliError::from)? + "\n"
     } else {
         let mut s = format!(
             "{} rows, {} poses written to {} ({} limited into the envelope)\n",
@@ -163,6 +163,9 @@ pub enum CueError {
         /// Why.
         reason: std::io::Error,
     },
+    /// The command's other errors: the mechanism, the cueing file, the picture, the JSON.
+    #[error(transparent)]
+    Cli(#[from] CliError),
 }
 
 /// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`,
@@ -241,9 +244,7 @@ fn read_input(
     };
     let bytes = crate::input::files::read_bytes(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
     if crate::input::capture::is_capture(&bytes) {
-        let format = args
-            .telemetry_format
-            .unwrap_or(crate::stream::datagram::TelemetryFormat::Auto);
+        let format = args.telemetry_format.unwrap_or(crate::games::TelemetryFormat::Auto);
         let (rows, errors, summary) =
             super::cue_capture::rows(&bytes, format, args.udp_port).map_err(|e| bad(e.to_string()))?;
         return Ok((rows, errors, Some(summary)));

@@ -13,9 +13,9 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::games;
+use crate::games::TelemetryFormat;
 use crate::input::capture;
 use crate::input::table::InputError;
-use crate::stream::datagram::{self, TelemetryFormat};
 
 /// What a capture held, in `cue`'s summary.
 #[derive(Debug, Serialize)]
@@ -69,7 +69,7 @@ pub fn rows(
         summary.datagrams += 1;
         *summary.senders.entry(d.from.to_string()).or_default() += 1;
         let decoded = match format {
-            TelemetryFormat::Text => datagram::parse_telemetry(&d.payload),
+            TelemetryFormat::Text => games::parse_telemetry(&d.payload),
             TelemetryFormat::Game(f) => games::decode(f, &d.payload)
                 .map(|s| (s.time, s.telemetry))
                 .map_err(|e| e.to_string()),

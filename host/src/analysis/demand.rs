@@ -9,10 +9,11 @@ use plotters::style::colors::{BLUE, RED};
 use ringpod_core::kinematics::{AxisKind, Mechanism, MotionState, MultiTurn, Payload, Pose, RingPlatform};
 use serde::Serialize;
 
-use crate::error::{CliError, EXIT_CHECK_FAILED};
+use crate::error::CliError;
 use crate::input::table::{self, InputError};
 use crate::out::plot::{self, Panel, Series, TimePlot};
 use crate::out::Outcome;
+use crate::out::EXIT_CHECK_FAILED;
 use crate::rig::Drive;
 
 /// What `loads --input` works on.

@@ -11,9 +11,10 @@ use serde::Serialize;
 
 use crate::analysis::branches::{self, Assembly};
 use crate::analysis::mechanism::{AnyMechanism, Selected};
-use crate::error::{CliError, EXIT_CHECK_FAILED};
+use crate::error::CliError;
 use crate::input::numbers;
 pub use crate::out::Outcome;
+use crate::out::EXIT_CHECK_FAILED;
 
 /// What every analysis command is asked about: the platform (a preset by name, or a rig file) and how to answer.
 pub struct On<'a> {

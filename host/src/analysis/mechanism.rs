@@ -60,7 +60,7 @@ impl Selected {
 impl AnyMechanism {
     /// The mechanism of a preset name.
     pub fn by_name(name: &str) -> Result<(Preset, Self), CliError> {
-        let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
+        let preset = Preset::from_name(name).ok_or_else(|| crate::rig::UnknownMechanism(name.to_owned()))?;
         let m = match preset.geometry() {
             PresetGeometry::Ring(g) => AnyMechanism::Ring(Box::new(RingPlatform::new(g))),
             PresetGeometry::Tool(g) => AnyMechanism::Tool(Box::new(ToolCarrier::new(g))),

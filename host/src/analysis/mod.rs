@@ -1,14 +1,12 @@
 //! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`; `branches`: the tool carrier's
 //! assemblies for `ik --branch`), `rates`, `structure`, `reactions`,
 //! paper 003's Gram determinants over a slice (`gram`), tip-over (`check --tip-over`), the drawing of a platform at a pose (`draw`),
-//! the derivatives of a run record (`plot --derivatives`),
 //! `workspace` and `cue`, each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
 pub mod branches;
 pub mod cue;
 pub mod cue_capture;
 pub mod demand;
-pub mod derivatives;
 pub mod draw;
 pub mod gram;
 pub mod kinematics;

@@ -11,9 +11,10 @@ use serde::Serialize;
 
 use super::kinematics::{pose_arg, On};
 use super::mechanism::{AnyMechanism, Selected};
-use crate::error::{CliError, EXIT_CHECK_FAILED};
+use crate::error::CliError;
 use crate::input::numbers;
 use crate::out::Outcome;
+use crate::out::EXIT_CHECK_FAILED;
 
 /// Accelerations beyond this (m/s^2, about 1000 g) are a mistake, not a load.
 const MAX_ACCEL: f64 = 1e4;

@@ -244,7 +244,7 @@ pub struct CueArgs {
     /// With a packet capture as --input (pcap or pcapng, from `stream --capture`, tcpdump or Wireshark): the
     /// datagrams' format, as for `stream --telemetry-format`; `auto` without.
     #[arg(long, value_enum)]
-    pub telemetry_format: Option<crate::stream::datagram::TelemetryFormat>,
+    pub telemetry_format: Option<crate::games::TelemetryFormat>,
     /// With a packet capture as --input: its UDP datagrams to this port only (a capture of several flows).
     #[arg(long)]
     pub udp_port: Option<u16>,

@@ -154,9 +154,6 @@ pub enum RequestError {
     /// `device aux` with other words.
     #[error("usage: `device aux N on|off` with N 1 or 2")]
     AuxUsage,
-    /// `workspace --z` with a section that is not at one height.
-    #[error("--z is the height of the xy section; the other sections span every height or none")]
-    SectionHeight,
     /// Neither `--port` nor `--sim`.
     #[error(transparent)]
     Target(#[from] crate::link::LinkError),

@@ -45,7 +45,7 @@ pub struct StreamArgs {
     /// (`outsim`, `outsim2`, `beamng`, `codemasters`, `f1`, `forza`, `xplane`: the README's games table), or `auto`
     /// (the first datagram a game's format recognises names it, said on stderr).
     #[arg(long, value_enum, default_value = "text")]
-    pub telemetry_format: crate::stream::datagram::TelemetryFormat,
+    pub telemetry_format: crate::games::TelemetryFormat,
     /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`). The file is watched while
     /// the stream runs: a changed, valid file takes over within a second, blended in; an invalid one is refused.
     #[arg(long, requires = "telemetry_udp", conflicts_with_all = ["udp", "input", "motion"])]

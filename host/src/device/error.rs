@@ -17,7 +17,7 @@ pub enum DeviceError {
     Config(#[from] super::settings::ConfigCommandError),
     /// `device rig`, `device restart`.
     #[error(transparent)]
-    Rig(#[from] crate::rig::device::DeviceRigError),
+    Rig(#[from] crate::device::rig::DeviceRigError),
     /// The monitor's terminal.
     #[error(transparent)]
     Monitor(#[from] super::monitor::MonitorError),

@@ -3,6 +3,7 @@
 pub mod commission;
 mod error;
 pub mod monitor;
+pub mod rig;
 pub mod settings;
 
 use std::io::Write;
@@ -77,9 +78,9 @@ pub fn run(target: &Target, action: &Action) -> Result<u8, DeviceError> {
             commission::inputs(&mut client, false, &|| false)?;
             return Ok(0);
         }
-        Action::LoadRig(file) => crate::rig::device::load(&mut client, file)?,
-        Action::ShowRig => crate::rig::device::show(&mut client)?,
-        Action::Restart => crate::rig::device::restart(&mut client)?,
+        Action::LoadRig(file) => rig::load(&mut client, file)?,
+        Action::ShowRig => rig::show(&mut client)?,
+        Action::Restart => rig::restart(&mut client)?,
         Action::Config(words) => serde_json::to_string_pretty(&settings::run(&mut client, words)?)?,
     };
     let _ = writeln!(out, "{text}");
@@ -186,4 +187,21 @@ pub fn ports() -> Result<u8, DeviceError> {
         let _ = writeln!(out, "{}  {kind}", p.port_name);
     }
     Ok(0)
+}
+
+/// A state as one word (a run record's CSV field, the monitor, the web page): its name, and a fault's reason after
+/// a colon (no commas).
+pub fn state_name(state: State) -> String {
+    match state {
+        State::Off => "Off".into(),
+        State::LogicOn => "LogicOn".into(),
+        State::PowerOn { .. } => "PowerOn".into(),
+        State::Homing => "Homing".into(),
+        State::Ready => "Ready".into(),
+        State::Running => "Running".into(),
+        State::Jogging => "Jogging".into(),
+        State::Stopping => "Stopping".into(),
+        State::Fault(reason, _) => format!("Fault: {reason}").replace(',', ";"),
+        State::ShuttingDown(_) => "ShuttingDown".into(),
+    }
 }

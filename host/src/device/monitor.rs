@@ -16,8 +16,8 @@ use ratatui::{Frame, Terminal};
 use ringpod_core::protocol::{Telemetry, TelemetryFlags};
 use ringpod_core::safety::debounce::InputBit;
 
+use super::state_name;
 use crate::link::client::{Client, ClientError, Transport};
-use crate::stream::record::state_name;
 
 /// What the view shows: the newest sample and how the link is doing.
 #[derive(Debug, Clone, Default)]

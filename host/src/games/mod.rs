@@ -47,7 +47,10 @@ pub mod f1;
 pub mod forza;
 pub mod outsim;
 pub mod outsim2;
+mod telemetry;
 pub mod xplane;
+
+pub use telemetry::{numbers, parse_telemetry, TelemetryFormat};
 
 use ringpod_core::cueing::{Telemetry, G};
 
@@ -333,8 +336,8 @@ mod tests {
         for format in Format::ALL {
             assert!(decode(format, &[]).is_err(), "{format}");
             assert_eq!(
-                <crate::stream::datagram::TelemetryFormat as clap::ValueEnum>::from_str(format.name(), false),
-                Ok(crate::stream::datagram::TelemetryFormat::Game(format)),
+                <crate::games::TelemetryFormat as clap::ValueEnum>::from_str(format.name(), false),
+                Ok(crate::games::TelemetryFormat::Game(format)),
                 "{format}"
             );
         }

@@ -2,6 +2,11 @@
 
 pub mod plot;
 
+/// Exit code of a run that failed (bad input, no kinematic solution).
+pub const EXIT_ERROR: u8 = 1;
+/// Exit code of `check` when the pose has a solution but a workspace check fails.
+pub const EXIT_CHECK_FAILED: u8 = 3;
+
 /// What a command prints and its exit code.
 pub struct Outcome {
     pub text: String,

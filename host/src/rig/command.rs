@@ -10,17 +10,41 @@ use serde::Serialize;
 
 use super::coverage::Coverage;
 use super::design::{design, Free, Search, Target};
+use super::RigError;
 use super::{coverage, read, RigFile};
-use crate::error::{CliError, EXIT_CHECK_FAILED};
-use crate::out::Outcome;
+use crate::input::numbers::BadNumber;
+use crate::out::{Outcome, EXIT_CHECK_FAILED};
+
+/// A `--mechanism` (or `presets --export`) name that is no preset.
+#[derive(Debug, thiserror::Error)]
+#[error("unknown mechanism `{0}`; `ringpod presets` lists them")]
+pub struct UnknownMechanism(pub String);
+
+/// Why `rig check`, `rig design` or `presets --export` had no answer, or a preset has no rig; `CliError` says each
+/// as its variant of the same name does.
+#[derive(Debug, thiserror::Error)]
+pub enum CommandError {
+    /// No preset of that name.
+    #[error(transparent)]
+    UnknownMechanism(#[from] UnknownMechanism),
+    /// A preset that is no ring platform, or a rig file that cannot be written.
+    #[error(transparent)]
+    Number(#[from] BadNumber),
+    /// The rig file is not valid.
+    #[error(transparent)]
+    Rig(#[from] RigError),
+    /// JSON output failed.
+    #[error("JSON output: {0}")]
+    Json(#[from] serde_json::Error),
+}
 
 /// The axes of the spec ranges, in their order.
 const AXES: [&str; 5] = ["surge", "sway", "heave", "roll", "pitch"];
 
 /// `ringpod presets --export NAME`: the preset as a rig file, to start one's own from.
-pub fn export(name: &str) -> Result<Outcome, CliError> {
+pub fn export(name: &str) -> Result<Outcome, CommandError> {
     let (preset, file) = preset_file(name, "export")?;
-    let body = file.to_toml().map_err(|e| CliError::bad("export", e.to_string()))?;
+    let body = file.to_toml().map_err(|e| BadNumber::new("export", e.to_string()))?;
     let header = format!(
         "# {name}: {}\n# Lengths in metres, angles of [limits] and [spec] in degrees, home = [x, y, z, roll, pitch, yaw]\n\
          # (m, rad). Chains counter-clockwise around the ring; actuators: every carriage in chain order, then every\n\
@@ -31,13 +55,14 @@ pub fn export(name: &str) -> Result<Outcome, CliError> {
 }
 
 /// A preset ring platform as the rig file `presets --export` writes.
-fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), CliError> {
-    let preset = Preset::from_name(name).ok_or_else(|| CliError::UnknownMechanism(name.to_owned()))?;
+fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), CommandError> {
+    let preset = Preset::from_name(name).ok_or_else(|| UnknownMechanism(name.to_owned()))?;
     let PresetGeometry::Ring(g) = preset.geometry() else {
-        return Err(CliError::bad(
+        return Err(BadNumber::new(
             what,
             format!("{name} is not a ring platform; rig files describe ring platforms"),
-        ));
+        )
+        .into());
     };
     let ranges = preset.spec_ranges();
     Ok((
@@ -49,7 +74,7 @@ fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), CliE
 /// The rig a simulated controller runs for a preset (`stream --sim --mechanism`, `simulate --mechanism`): none for
 /// the trainer model, whose configuration is compiled in; for another ring platform, its rig file with the trainer
 /// model's drives and switches, checked as `--geometry` checks a file.
-pub fn preset(name: &str) -> Result<Option<super::Rig>, CliError> {
+pub fn preset(name: &str) -> Result<Option<super::Rig>, CommandError> {
     let (preset, file) = preset_file(name, "--mechanism")?;
     if preset == Preset::TrainerModel {
         return Ok(None);
@@ -80,7 +105,7 @@ struct CheckJson<'a> {
 }
 
 /// `ringpod rig check FILE`: the verdict, and the spec coverage when the file gives spec ranges.
-pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CliError> {
+pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CommandError> {
     let file = read(path)?;
     // Not a mechanism at all: an error, as for every command. A mechanism that cannot be driven is a verdict.
     let rig = file.platform().map_err(|e| e.in_file(path))?;
@@ -204,7 +229,7 @@ pub fn design_command(
     starts: u32,
     steps: u32,
     seed: u64,
-) -> Result<Outcome, CliError> {
+) -> Result<Outcome, CommandError> {
     let template = read(path)?;
     let search = Search {
         target: if combined { Target::Combined } else { Target::EachAxis },
@@ -258,7 +283,7 @@ pub fn design_command(
     let body = found
         .file
         .to_toml()
-        .map_err(|e| CliError::bad("design", e.to_string()))?;
+        .map_err(|e| BadNumber::new("design", e.to_string()))?;
     Ok(Outcome {
         text: out + &body,
         code: if covers { 0 } else { EXIT_CHECK_FAILED },

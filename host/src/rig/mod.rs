@@ -44,13 +44,12 @@ mod checks;
 mod command;
 mod coverage;
 mod design;
-pub mod device;
 pub mod drives;
 pub mod error;
 mod file;
 mod settings;
 
-pub use command::{check_command, design_command, export, preset};
+pub use command::{check_command, design_command, export, preset, CommandError, UnknownMechanism};
 pub use coverage::coverage;
 pub use drives::{Drive, DriveSpec};
 pub use error::RigError;

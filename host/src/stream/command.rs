@@ -43,7 +43,7 @@ pub enum Datagrams {
     Poses { degrees: bool },
     /// Vehicle telemetry in a format, cued by the washout of a cueing file (or the defaults).
     Telemetry {
-        format: datagram::TelemetryFormat,
+        format: crate::games::TelemetryFormat,
         cue_config: Option<PathBuf>,
         /// A profile of the cueing file.
         profile: Option<String>,

@@ -4,56 +4,10 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
 
-use clap::builder::PossibleValue;
 use ringpod_core::cueing::{self, Live, SampleError, Telemetry, G};
 use ringpod_core::kinematics::Pose;
 
-use crate::games::{self, Format};
-
-/// The telemetry formats `stream --telemetry-udp` reads: a text line, a game's own format, or whichever of the
-/// games' formats the first readable datagram is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TelemetryFormat {
-    /// One text line `t ax ay az wx wy wz` (or without `t`: the arrival time), separated by spaces, commas or
-    /// semicolons; the units and axes of `ringpod cue`.
-    Text,
-    /// A game's own packet.
-    Game(Format),
-    /// The first datagram that one of the games' formats recognises names the format for the rest of the run.
-    Auto,
-}
-
-impl TelemetryFormat {
-    const ALL: [TelemetryFormat; 9] = [
-        TelemetryFormat::Text,
-        TelemetryFormat::Game(Format::Outsim),
-        TelemetryFormat::Game(Format::Outsim2),
-        TelemetryFormat::Game(Format::Beamng),
-        TelemetryFormat::Game(Format::Codemasters),
-        TelemetryFormat::Game(Format::F1),
-        TelemetryFormat::Game(Format::Forza),
-        TelemetryFormat::Game(Format::Xplane),
-        TelemetryFormat::Auto,
-    ];
-}
-
-impl clap::ValueEnum for TelemetryFormat {
-    fn value_variants<'a>() -> &'a [Self] {
-        &Self::ALL
-    }
-
-    fn to_possible_value(&self) -> Option<PossibleValue> {
-        Some(match self {
-            TelemetryFormat::Text => {
-                PossibleValue::new("text").help("`[t] ax ay az wx wy wz`, the units of `ringpod cue`")
-            }
-            TelemetryFormat::Auto => {
-                PossibleValue::new("auto").help("the first game format recognised, said on stderr")
-            }
-            TelemetryFormat::Game(f) => PossibleValue::new(f.name()).help(f.games()),
-        })
-    }
-}
+use crate::games::{self, numbers, parse_telemetry, Format, TelemetryFormat};
 
 /// Turns datagrams into poses.
 pub enum Decoder {
@@ -152,15 +106,6 @@ impl Watch {
     }
 }
 
-/// Six or seven numbers separated by spaces, commas or semicolons.
-fn numbers(bytes: &[u8]) -> Result<Vec<f64>, String> {
-    let text = std::str::from_utf8(bytes).map_err(|_| "not text".to_string())?;
-    text.split(|c: char| c.is_whitespace() || c == ',' || c == ';')
-        .filter(|s| !s.is_empty())
-        .map(|s| s.parse::<f64>().map_err(|e| format!("`{s}`: {e}")))
-        .collect()
-}
-
 /// Parses one pose datagram: six numbers.
 pub fn parse_pose(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
     let v = numbers(bytes)?;
@@ -182,34 +127,6 @@ pub fn parse_pose(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
         ));
     }
     Ok(Pose::from_array(pose))
-}
-
-/// Parses a text telemetry datagram: `[t] ax ay az wx wy wz`.
-pub fn parse_telemetry(bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), String> {
-    let v = numbers(bytes)?;
-    let (t, v) = match v.len() {
-        7 => (Some(v[0]), &v[1..]),
-        6 => (None, &v[..]),
-        n => return Err(format!("expected 6 or 7 numbers, got {n}")),
-    };
-    // A time that is not a time would become the reference of every later sample's interval, and a value that is
-    // not finite would reach the filters on a first sample: both are unreadable.
-    if t.is_some_and(|t| !t.is_finite() || t.abs() > crate::input::table::MAX_TIME_S) {
-        return Err(format!(
-            "its time is not a time (a finite number of seconds, at most {} either way)",
-            crate::input::numbers::readable(crate::input::table::MAX_TIME_S)
-        ));
-    }
-    if v.iter().any(|x| !x.is_finite()) {
-        return Err("a value is not finite".into());
-    }
-    Ok((
-        t,
-        Telemetry {
-            force: [v[0], v[1], v[2]],
-            rate: [v[3], v[4], v[5]],
-        },
-    ))
 }
 
 /// A game's packet: its time, if it sends one, and the telemetry.

@@ -3,10 +3,12 @@
 //! Every pose is limited into the envelope on the host first, by the core's own `motion::envelope::limit` in `f64` with
 //! the device's margins, so that a board sees few setpoints it has to limit itself; the device limits what is left
 //! and refuses only garbage. The run ends with a stop, a wait for rest and a report whose outcome and exit code say
-//! whether the input was followed.
+//! whether the input was followed. The run record it writes is drawn by `plot` (`record`), its pose's velocity and
+//! acceleration by `plot --derivatives` (`derivatives`).
 
 pub mod command;
 pub mod datagram;
+pub mod derivatives;
 mod ending;
 mod feed;
 mod loads;

@@ -11,9 +11,8 @@ use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
 use plotters::style::RGBColor;
 use ringpod_core::kinematics::Pose;
 use ringpod_core::protocol::{Telemetry, TelemetryFlags};
-use ringpod_core::safety::State;
 
-use crate::error::CliError;
+use crate::device::state_name;
 
 use crate::out::plot::{self, Event, Panel, Series, TimePlot};
 
@@ -52,22 +51,6 @@ pub const COLUMNS: [&str; 28] = [
     "refused_total",
     "tick_cost",
 ];
-
-/// A state as one CSV field: its name, and a fault's reason after a colon (no commas).
-pub fn state_name(state: State) -> String {
-    match state {
-        State::Off => "Off".into(),
-        State::LogicOn => "LogicOn".into(),
-        State::PowerOn { .. } => "PowerOn".into(),
-        State::Homing => "Homing".into(),
-        State::Ready => "Ready".into(),
-        State::Running => "Running".into(),
-        State::Jogging => "Jogging".into(),
-        State::Stopping => "Stopping".into(),
-        State::Fault(reason, _) => format!("Fault: {reason}").replace(',', ";"),
-        State::ShuttingDown(_) => "ShuttingDown".into(),
-    }
-}
 
 /// Writes a run record.
 pub struct Recorder {
@@ -186,6 +169,20 @@ pub enum RecordError {
     NoRows,
 }
 
+/// Why `ringpod plot` (and `plot --derivatives`) drew nothing.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotCommandError {
+    /// The record could not be read.
+    #[error(transparent)]
+    Record(#[from] RecordError),
+    /// A window or span that cannot be used.
+    #[error(transparent)]
+    Number(#[from] crate::input::numbers::BadNumber),
+    /// The picture was not written.
+    #[error(transparent)]
+    Plot(#[from] plot::PlotError),
+}
+
 /// Reads a run record (`stream --record`).
 pub(crate) fn read(path: &Path) -> Result<Run, RecordError> {
     let text =
@@ -281,7 +278,7 @@ fn onsets(t: &[f64], flags: &[bool], kind: &str, colour: RGBColor) -> Vec<Event>
 }
 
 /// `ringpod plot RUN.csv --out FILE`: returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path) -> Result<String, CliError> {
+pub fn plot_command(input: &Path, out: &Path) -> Result<String, PlotCommandError> {
     let run = read(input)?;
     let mut events = onsets(
         &run.t,

@@ -7,8 +7,7 @@ use ringpod_core::safety::{Command, Event, Inputs, Supervisor, SupervisorConfig}
 use serde::Serialize;
 
 use crate::analysis::placement::{place, Placed};
-use crate::device::commission;
-use crate::stream::record::state_name;
+use crate::device::{commission, state_name};
 
 /// The rig the device runs, as the page draws it.
 #[derive(Debug, Clone, Serialize)]

@@ -321,7 +321,7 @@ async fn rig_current(State(app): State<Arc<App>>) -> Response {
     answer(
         record
             .ok_or_else(|| "the device's rig is not known yet".to_owned())
-            .and_then(|r| crate::rig::device::as_file(&r).map_err(|e| format!("{e:#}")))
+            .and_then(|r| crate::device::rig::as_file(&r).map_err(|e| format!("{e:#}")))
             .map(|text| json!({ "text": text })),
     )
 }

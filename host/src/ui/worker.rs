@@ -41,7 +41,7 @@ pub enum WorkerError {
     Rig(#[from] crate::rig::RigError),
     /// Loading the rig onto the device.
     #[error(transparent)]
-    DeviceRig(#[from] crate::rig::device::DeviceRigError),
+    DeviceRig(#[from] crate::device::rig::DeviceRigError),
     /// A message for the pages.
     #[error("JSON: {0}")]
     Json(#[from] serde_json::Error),
@@ -475,8 +475,8 @@ impl Device {
         if self.client.status()?.state != State::Off {
             return Err(WorkerError::NotOff);
         }
-        crate::rig::device::store(&mut self.client, &file)?;
-        let restarted = crate::rig::device::restart(&mut self.client)?;
+        crate::device::rig::store(&mut self.client, &file)?;
+        let restarted = crate::device::rig::restart(&mut self.client)?;
         self.client.telemetry(true)?;
         let m = announce_rig(&mut self.client, &self.hub)?;
         if let Ok(mut mechanism) = self.mechanism.lock() {

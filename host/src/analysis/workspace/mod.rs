@@ -9,7 +9,6 @@ use ringpod_core::kinematics::geometry::DEG;
 use ringpod_core::kinematics::{Check, Mechanism, Pose, RingPlatform};
 
 use crate::analysis::mechanism::AnyMechanism;
-use crate::cli::requests::RequestError;
 use crate::error::CliError;
 use crate::input::numbers::BadNumber;
 
@@ -200,7 +199,7 @@ pub fn run(args: &Options) -> Result<String, CliError> {
     let length = s.m.characteristic_length();
     let n = args.cells;
     if args.z.is_some() && args.section != Section::Xy {
-        return Err(RequestError::SectionHeight.into());
+        return Err(CliError::SectionHeight);
     }
     let z0 = args.z.unwrap_or(s.home[2]);
     crate::input::numbers::length_in_range("z", z0, length)?;

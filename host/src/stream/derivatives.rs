@@ -15,11 +15,10 @@ use std::path::Path;
 
 use plotters::style::colors::{BLUE, GREEN, RED};
 
-use crate::error::CliError;
 use crate::input::numbers::BadNumber;
 
+use super::record::{self, PlotCommandError};
 use crate::out::plot::{self, Panel, Series, TimePlot};
-use crate::stream::record;
 
 /// Velocity and acceleration at each sample of `y(t)` from a local quadratic over `window` seconds centred on it;
 /// `NaN` where the window holds fewer than three distinct times. `t` must not decrease.
@@ -69,7 +68,7 @@ const AXES: [&str; 6] = ["surge x", "sway y", "heave z", "roll alpha", "pitch be
 
 /// Draws the derivatives of a record's followed pose over the device times `span` (`[from, to]`, s; the fit takes
 /// the samples around its ends too); returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> Result<String, CliError> {
+pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> Result<String, PlotCommandError> {
     if !(window.is_finite() && window > 0.0 && window <= 10.0) {
         return Err(BadNumber::new(
             "window",
@@ -90,7 +89,7 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
 }
 
 /// Fits the whole record (so that the span's ends have their neighbours) and keeps the samples inside the span.
-fn measure(whole: &record::Run, window: f64, span: (f64, f64)) -> Result<Measured, CliError> {
+fn measure(whole: &record::Run, window: f64, span: (f64, f64)) -> Result<Measured, BadNumber> {
     let all: Vec<Vec<(f64, f64)>> = (0..6)
         .map(|k| {
             let y: Vec<f64> = whole.target.iter().map(|p| p[k]).collect();
@@ -110,8 +109,7 @@ fn measure(whole: &record::Run, window: f64, span: (f64, f64)) -> Result<Measure
                 whole.t[0],
                 whole.t[whole.t.len() - 1]
             ),
-        )
-        .into());
+        ));
     }
     Ok(Measured {
         t: inside.iter().map(|&i| whole.t[i]).collect(),

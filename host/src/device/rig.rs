@@ -9,8 +9,8 @@ use ringpod_core::protocol::{NackReason, RigSource};
 
 use ringpod_core::kinematics::GeometryError;
 
-use super::{RigError, RigFile};
 use crate::link::client::{Client, ClientError, Transport};
+use crate::rig::{RigError, RigFile};
 
 /// Why a rig could not be put on, read from or restarted on a device.
 #[derive(Debug, thiserror::Error)]
@@ -35,7 +35,7 @@ pub enum DeviceRigError {
 /// `device rig load FILE`: checks the file here (every error names its key), then the device checks and stores
 /// it for the next start. Returns what to print.
 pub fn load<T: Transport>(client: &mut Client<T>, path: &Path) -> Result<String, DeviceRigError> {
-    store(client, &super::read(path)?)
+    store(client, &crate::rig::read(path)?)
 }
 
 /// Checks a rig file here, then stores it on the device for its next start. Returns what to print.
