@@ -2,21 +2,17 @@
 //! drains back. Time goes on in it exactly as in a tick (supply sequencing, power-down, telemetry); motion does
 //! not, and resumes from where it was.
 
-use ringpod_core::controller::{Controller, ControllerConfig};
+#[path = "common/device.rs"]
+mod device;
+
+use ringpod_core::controller::Controller;
 use ringpod_core::motion::AxisMove;
-use ringpod_core::protocol::{DeviceMessage, HostMessage, Request, Response, Telemetry, PROTOCOL_VERSION};
+use ringpod_core::protocol::{DeviceMessage, HostMessage, Request, Response, Telemetry};
 use ringpod_core::safety::{Command, Inputs, State};
 
 /// The trainer model's controller, greeted, subscribed to telemetry, its supplies reporting good.
 fn connected() -> Controller {
-    let mut c = Controller::new(ControllerConfig::trainer_model()).unwrap();
-    let hello = c.handle(&Request {
-        id: 1,
-        body: HostMessage::Hello {
-            version: PROTOCOL_VERSION,
-        },
-    });
-    assert!(matches!(hello.body, DeviceMessage::Hello { .. }));
+    let mut c = device::connected();
     let telemetry = c.handle(&Request {
         id: 2,
         body: HostMessage::Telemetry(true),
