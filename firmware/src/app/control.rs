@@ -40,29 +40,41 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
         let scheduled = due;
         let on_time = Instant::now() < due + period;
         due += period;
-        if shared.steps.len() >= super::AHEAD {
-            pass(machine, shared);
-            continue;
-        }
+        // A period still queued (only after a hold-up, or the one period a phase correction gives two ticks) is
+        // passed rather than ticked; see `Controller::pass`. Inputs and faults reach the supervisor either way.
+        let ahead = shared.steps.len() >= super::AHEAD;
         let inputs = Inputs::from_word(shared.inputs.load(Ordering::Relaxed));
         let step_fault = shared.step_fault.swap(false, Ordering::Relaxed);
         let start = machine.cycles();
-        let (out, message) = shared.with(|c| {
+        let (outputs, moves, message) = shared.with(|c| {
             if step_fault {
                 c.step_generator_fault();
             }
             c.set_inputs(inputs);
-            let out = c.tick();
-            (out, c.unsolicited())
+            let (outputs, moves) = if ahead {
+                (c.pass(), None)
+            } else {
+                let out = c.tick();
+                (out.outputs, Some(out.moves))
+            };
+            (outputs, moves, c.unsolicited())
         });
         let cost = machine.cycles().wrapping_sub(start);
         // Outputs first: a fault's disable reaches the drivers before anything else happens; the order of the
         // writes keeps the interlocks between them (`safety::pins`).
-        for (pin, on) in writes(&out.outputs) {
+        for (pin, on) in writes(&outputs) {
             machine.write(pin, on);
         }
+        if let Some(m) = message {
+            shared.post(m);
+        }
+        let Some(moves) = moves else {
+            shared.passes.fetch_add(1, Ordering::Relaxed);
+            machine.feed_watchdog();
+            continue;
+        };
         // Waits while the step generator's queue is full: the queue paces the loop as much as the timer does.
-        shared.steps.send(out.moves).await;
+        shared.steps.send(moves).await;
         let depth = shared.steps.len() as u16;
         shared.with(|c| {
             c.set_platform_stats(cost, depth);
@@ -71,9 +83,6 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
                 shared.passes.load(Ordering::Relaxed),
             );
         });
-        if let Some(m) = message {
-            shared.post(m);
-        }
         let boundary = shared.boundary_us.load(Ordering::Relaxed);
         if let Some(delay) = phase
             .filter(|_| on_time)
@@ -102,22 +111,4 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
 /// Device time in microseconds, wrapping (the step generator records its boundaries so).
 pub fn micros(t: Instant) -> u32 {
     t.as_micros() as u32
-}
-
-/// A period the step generator does not need (see [`super::AHEAD`]): after a hold-up longer than a period (a flash
-/// erase, a burst of link traffic) the ticker catches up the periods it missed at once, while the step generator
-/// played them empty. Ticking them would queue their moves behind each other, and every later period's behind
-/// those, for the rest of the session (measured on the QEMU controller: 4 periods queued, 6-7 ms from a setpoint
-/// to its first step). The controller's clocks still advance (`Controller::pass`), so the supply
-/// sequence and a power-down end when they are due; the outputs a timer changed are written as in a tick.
-fn pass(machine: &mut impl Machine, shared: &Shared) {
-    let (outputs, message) = shared.with(|c| (c.pass(), c.unsolicited()));
-    for (pin, on) in writes(&outputs) {
-        machine.write(pin, on);
-    }
-    if let Some(m) = message {
-        shared.post(m);
-    }
-    shared.passes.fetch_add(1, Ordering::Relaxed);
-    machine.feed_watchdog();
 }

@@ -29,8 +29,8 @@ pub const LINKS: usize = 2;
 /// Periods of step moves the control tick may run ahead of the step generator.
 pub const STEP_QUEUE: usize = 4;
 
-/// Periods queued at a control tick from which the period is passed (`control::pass`), so that the step
-/// generator drains the queue back. A tick held before the generator's boundary (`motion::phase`) finds the queue
+/// Periods queued at a control tick from which the period is passed (`Controller::pass`, in `control::run`), so
+/// that the step generator drains the queue back. A tick held before the generator's boundary (`motion::phase`) finds the queue
 /// empty: the previous tick's moves were taken at the boundary between them. Only a catch-up after a hold-up, or
 /// the one period a phase correction gives two ticks, finds a period queued.
 pub const AHEAD: usize = 1;
