@@ -49,5 +49,10 @@ impl Drop for Busy {
 
 /// The machine's one-minute load average (`/proc/loadavg`), where the system has one.
 pub fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }

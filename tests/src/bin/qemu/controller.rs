@@ -199,7 +199,10 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
     std::thread::sleep(Duration::from_secs(4));
     let _ = streaming.kill();
     let _ = streaming.wait();
-    std::thread::sleep(Duration::from_millis(1_500));
+    // The stream timeout, then braking to rest.
+    std::thread::sleep(Duration::from_millis(
+        u64::from(crate::emulator::STREAM_TIMEOUT_MS) + 2_000,
+    ));
     let after = ringpod_json(&["device", "status", "--port", pty]);
     t.check(
         after
@@ -225,6 +228,69 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
         problems.is_empty(),
         "every run above moved the plant by its STEP edges only, within the drivers' timing, drivers enabled",
     );
+    hold_up_mid_stream(t, &emulated);
     crate::aux::aux_on_m4f(t, &emulated);
     drop(emulated);
+}
+
+/// A hold-up of the emulated MCU mid-stream (QEMU stopped for 0.05, 0.5 and 2 s, longer than the stream timeout):
+/// the firmware's control loop lets the link read what arrived first and passes the periods it is far behind, so
+/// the stream goes on: every setpoint applied, no restart, and the periods passed counted in the status.
+fn hold_up_mid_stream(t: &mut Tally, emulated: &crate::emulator::Emulated) {
+    let pty = emulated.pty.as_str();
+    let passed = |s: &serde_json::Value| s["passed_periods"].as_u64().unwrap_or(0);
+    for stall_ms in [50u64, 500, 2_000] {
+        let before = ringpod_json(&["device", "status", "--port", pty])
+            .map(|s| passed(&s))
+            .unwrap_or(0);
+        let streaming = Command::new(ringpod())
+            .args([
+                "stream",
+                "--port",
+                pty,
+                "--motion",
+                "demo",
+                "--duration",
+                "6",
+                "--quiet",
+                "--report-json",
+            ])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn();
+        let Ok(streaming) = streaming else {
+            t.check(false, "a stream starts");
+            return;
+        };
+        std::thread::sleep(Duration::from_secs(3));
+        let held = emulated.hold_up(Duration::from_millis(stall_ms));
+        let report = streaming
+            .wait_with_output()
+            .ok()
+            .and_then(|o| serde_json::from_slice::<serde_json::Value>(&o.stdout).ok());
+        let after = ringpod_json(&["device", "status", "--port", pty])
+            .map(|s| passed(&s))
+            .unwrap_or(0);
+        if let Some(r) = &report {
+            println!(
+                "a hold-up of {stall_ms} ms: {}, {} of {} applied, {} restarts, {} periods passed",
+                r["outcome"],
+                r["setpoints_applied"],
+                r["setpoints_sent"],
+                r["restarts"],
+                after.saturating_sub(before)
+            );
+        }
+        t.check(
+            held.is_ok()
+                && report.is_some_and(|r| {
+                    r["outcome"] == "followed" && r["restarts"] == 0 && r["setpoints_applied"] == r["setpoints_sent"]
+                })
+                && after.saturating_sub(before) + 20 >= stall_ms,
+            &format!(
+                "a stream goes on through a {stall_ms} ms hold-up of the emulated MCU, the periods it cost passed"
+            ),
+        );
+    }
 }

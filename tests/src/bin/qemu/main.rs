@@ -95,7 +95,10 @@ fn main() -> ExitCode {
     rotopod_on_m4f(&mut t);
     if let Some(load) = load {
         let average = load_average().map_or("unknown".into(), |l| format!("{l:.1}"));
-        println!("the suite ran beside {} busy threads; load average {average}", load.threads());
+        println!(
+            "the suite ran beside {} busy threads; load average {average}",
+            load.threads()
+        );
     }
     println!("{} passed, {} failed", t.passed, t.failed);
     if t.failed == 0 {
