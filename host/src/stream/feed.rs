@@ -219,6 +219,7 @@ pub(super) fn feed<T: Transport>(
             let mut d = DatagramReport::default();
             let r = s.live(udp, &mut d, input_errors);
             d.telemetry_gaps = udp.decoder.gaps();
+            d.telemetry_format_locks = udp.decoder.locks();
             (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
             let capture = udp.capture.take().map(|(writer, path)| {
                 let (packets, error) = writer.finish();

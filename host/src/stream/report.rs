@@ -35,6 +35,10 @@ pub struct DatagramReport {
     pub resumed: u32,
     /// Telemetry: pauses of more than a second after which the washout started again at neutral.
     pub telemetry_gaps: u32,
+    /// Telemetry in `auto`: the format locked onto and the datagram at which (a format dropped after refusing many
+    /// datagrams in a row is a lock to none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub telemetry_format_locks: Vec<crate::games::Lock>,
     /// Telemetry: changes of the `--cue-config` file that took effect while streaming (each blended in over a
     /// second).
     pub cue_reloads: u32,
