@@ -27,8 +27,10 @@ pub struct LimitedReport {
 pub struct DatagramReport {
     /// Datagrams received from the source.
     pub received: u32,
-    /// Datagrams that did not parse (also in `input_errors`).
+    /// Datagrams that did not parse (the first few of each kind also in `input_errors`).
     pub unreadable: u32,
+    /// The unreadable datagrams by the kind of their reason (its numbers as `#`): they add up to `unreadable`.
+    pub unreadable_by_kind: std::collections::BTreeMap<String, u64>,
     /// Datagrams from other senders than `--udp-from`, ignored.
     pub other_senders: u32,
     /// Times the source paused longer than the stream timeout and the stream was led in and started again.
