@@ -16,7 +16,7 @@ fn dir(name: &str) -> std::path::PathBuf {
 #[test]
 fn a_flood_of_the_largest_unreadable_datagrams_keeps_bounded_memory() {
     use std::io::Read;
-    let (mut child, mut stderr, addr) = common::spawn_live_stream(&[
+    let (child, mut stderr, addr) = common::spawn_live_stream(&[
         "--fast",
         "--telemetry-udp",
         "127.0.0.1:0",
@@ -29,7 +29,11 @@ fn a_flood_of_the_largest_unreadable_datagrams_keeps_bounded_memory() {
     let words = "x".repeat(65_507);
     let numbers = format!("1 2 3 {}", "4".repeat(65_500));
     for k in 0..1_500 {
-        let payload = if k % 2 == 0 { words.as_bytes() } else { numbers.as_bytes() };
+        let payload = if k % 2 == 0 {
+            words.as_bytes()
+        } else {
+            numbers.as_bytes()
+        };
         game.send_to(payload, &addr).unwrap();
         if k % 20 == 0 {
             std::thread::sleep(Duration::from_millis(2));
@@ -44,11 +48,19 @@ fn a_flood_of_the_largest_unreadable_datagrams_keeps_bounded_memory() {
     let d = &report["datagrams"];
     let unreadable = d["unreadable"].as_u64().unwrap();
     assert!(unreadable > 100, "{d}");
-    let by_kind: u64 = d["unreadable_by_kind"].as_object().unwrap().values().map(|v| v.as_u64().unwrap()).sum();
+    let by_kind: u64 = d["unreadable_by_kind"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
     assert_eq!(by_kind, unreadable, "{d}");
     let kept = report["input_errors"].as_array().unwrap();
     assert!(kept.len() <= 10, "{}", kept.len());
-    assert!(kept.iter().all(|e| e["reason"].as_str().unwrap().len() <= 130), "{kept:?}");
+    assert!(
+        kept.iter().all(|e| e["reason"].as_str().unwrap().len() <= 130),
+        "{kept:?}"
+    );
     assert!(err.contains("unreadable datagrams:"), "{err}");
     assert_eq!(out.status.code(), Some(3));
 }
@@ -132,7 +144,11 @@ fn a_cueing_file_replaced_by_a_fifo_does_not_stop_the_stream() {
     let mut err = String::new();
     stderr.read_to_string(&mut err).unwrap();
     let out = child.wait_with_output().unwrap();
-    assert!(started.elapsed() < Duration::from_secs(10), "SIGINT took {:?}", started.elapsed());
+    assert!(
+        started.elapsed() < Duration::from_secs(10),
+        "SIGINT took {:?}",
+        started.elapsed()
+    );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(report["outcome"], "interrupted", "{report}");
     assert!(report["datagrams"]["cue_refused"].as_u64().unwrap() >= 1, "{report}");

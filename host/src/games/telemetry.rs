@@ -57,7 +57,10 @@ pub fn numbers(bytes: &[u8]) -> Result<Vec<f64>, String> {
     text.split(|c: char| c.is_whitespace() || c == ',' || c == ';')
         .filter(|s| !s.is_empty())
         // A word of the datagram, cut: a datagram can be 64 KiB of one word.
-        .map(|s| s.parse::<f64>().map_err(|e| format!("`{}`: {e}", crate::input::unreadable::cut(s, 40))))
+        .map(|s| {
+            s.parse::<f64>()
+                .map_err(|e| format!("`{}`: {e}", crate::input::unreadable::cut(s, 40)))
+        })
         .collect()
 }
 

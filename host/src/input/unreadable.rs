@@ -69,7 +69,11 @@ mod tests {
             let reason = match i % 3 {
                 0 => format!("not forza: {i} bytes, where forza has 232"),
                 1 => format!("`{long}`: invalid float literal"),
-                _ => format!("kind {} {}", char::from(b'a' + (i % 26) as u8), char::from(b'a' + (i / 26 % 26) as u8)),
+                _ => format!(
+                    "kind {} {}",
+                    char::from(b'a' + (i % 26) as u8),
+                    char::from(b'a' + (i / 26 % 26) as u8)
+                ),
             };
             kept.extend(tally(&mut counts, i + 1, &reason));
         }

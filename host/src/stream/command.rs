@@ -170,7 +170,7 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
                     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
                     let washout = ringpod_core::cueing::Live::new(config).map_err(SourceError::Washout)?;
                     datagram::Decoder::Telemetry {
-                        reader: crate::games::Reader::new(*format, *outsim_opts),
+                        reader: Box::new(crate::games::Reader::new(*format, *outsim_opts)),
                         washout: Box::new(washout),
                         // The device's home pose, once the stream has asked for its rig.
                         neutral: None,

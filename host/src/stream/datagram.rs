@@ -19,7 +19,7 @@ pub enum Decoder {
     /// Vehicle telemetry through the washout.
     Telemetry {
         /// The datagrams' format, and `auto`'s lock.
-        reader: games::Reader,
+        reader: Box<games::Reader>,
         /// The washout, retuned live when its file changes.
         washout: Box<Live<f64>>,
         /// The platform's neutral pose: the home pose of the rig the device runs, set by the stream once it knows it

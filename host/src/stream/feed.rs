@@ -224,8 +224,14 @@ pub(super) fn feed<T: Transport>(
             d.telemetry_gaps = udp.decoder.gaps();
             d.telemetry_format_locks = udp.decoder.locks();
             // Some were counted and not printed: the counts, once.
-            if d.unreadable_by_kind.values().any(|n| *n > crate::input::unreadable::KEPT_PER_KIND) {
-                eprintln!("unreadable datagrams: {} in all, by kind: {:?}", d.unreadable, d.unreadable_by_kind);
+            if d.unreadable_by_kind
+                .values()
+                .any(|n| *n > crate::input::unreadable::KEPT_PER_KIND)
+            {
+                eprintln!(
+                    "unreadable datagrams: {} in all, by kind: {:?}",
+                    d.unreadable, d.unreadable_by_kind
+                );
             }
             (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
             let capture = udp.capture.take().map(|(writer, path)| {

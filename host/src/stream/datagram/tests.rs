@@ -14,7 +14,7 @@ fn outsim(time_ms: u32, accel: [f32; 3]) -> Vec<u8> {
 
 fn decoder(format: TelemetryFormat) -> Decoder {
     Decoder::Telemetry {
-        reader: games::Reader::new(format, None),
+        reader: Box::new(games::Reader::new(format, None)),
         washout: Box::new(Live::new(ringpod_core::cueing::CueConfig::default()).unwrap()),
         neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
         last: None,
@@ -91,7 +91,7 @@ fn a_telemetry_stream_is_cued_and_a_pause_washes_out() {
     let washout = Live::new(ringpod_core::cueing::CueConfig::default()).unwrap();
     let neutral = Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0);
     let mut d = Decoder::Telemetry {
-        reader: games::Reader::new(TelemetryFormat::Text, None),
+        reader: Box::new(games::Reader::new(TelemetryFormat::Text, None)),
         washout: Box::new(washout),
         neutral: Some(neutral),
         last: None,
@@ -124,7 +124,7 @@ fn reload_run(name: &str, initial: &str, change: Option<&str>) -> ([f64; 6], Dec
     std::fs::write(&path, initial).unwrap();
     let config = crate::input::cueing::load_config(Some(&path), None).unwrap();
     let mut d = Decoder::Telemetry {
-        reader: games::Reader::new(TelemetryFormat::Text, None),
+        reader: Box::new(games::Reader::new(TelemetryFormat::Text, None)),
         washout: Box::new(Live::new(config).unwrap()),
         neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
         last: None,
