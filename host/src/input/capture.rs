@@ -406,15 +406,11 @@ fn ip_of(link: DataLink, data: &[u8]) -> Result<&[u8], String> {
         }
         DataLink::NULL | DataLink::LOOP => {
             let word: [u8; 4] = data.get(..4).ok_or_else(short)?.try_into().unwrap_or_default();
-            let big = u32::from_be_bytes(word);
-            // LOOP's family is in network byte order; NULL's in the capturing host's, which a file read on another
-            // machine does not tell (tcpdump.org's link-layer header types; Wireshark's NullLoopback page). The
-            // families are small numbers, so of NULL's two readings the smaller is the one written.
-            let family = if link == DataLink::LOOP {
-                big
-            } else {
-                big.min(u32::from_le_bytes(word))
-            };
+            // LOOP's family is in network byte order; NULL's in the capturing host's, which a file read elsewhere
+            // does not tell (tcpdump.org's link-layer header types; Wireshark's NullLoopback page). The families
+            // are small numbers: of NULL's two readings the smaller is the one written.
+            let (big, little) = (u32::from_be_bytes(word), u32::from_le_bytes(word));
+            let family = if link == DataLink::LOOP { big } else { big.min(little) };
             match family {
                 2 | 24 | 28 | 30 => Ok(&data[4..]),
                 other => Err(format!("not IP (loopback family {other})")),
