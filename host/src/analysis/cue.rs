@@ -68,6 +68,8 @@ pub struct Options<'a> {
     pub telemetry_format: Option<crate::games::TelemetryFormat>,
     /// A capture: its datagrams to this UDP port only.
     pub udp_port: Option<u16>,
+    /// A capture: Live for Speed's `OutSim Opts`, when given.
+    pub outsim_opts: Option<crate::games::outsim2::Opts>,
     /// The pose CSV to write.
     pub out: &'a Path,
     /// Washout parameters (TOML); the defaults without.
@@ -245,13 +247,14 @@ fn read_input(
     let bytes = crate::input::files::read_bytes(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
     if crate::input::capture::is_capture(&bytes) {
         let format = args.telemetry_format.unwrap_or(crate::games::TelemetryFormat::Auto);
-        let (rows, errors, summary) =
-            super::cue_capture::rows(&bytes, format, args.udp_port).map_err(|e| bad(e.to_string()))?;
+        let (rows, errors, summary) = super::cue_capture::rows(&bytes, format, args.udp_port, args.outsim_opts)
+            .map_err(|e| bad(e.to_string()))?;
         return Ok((rows, errors, Some(summary)));
     }
-    if args.telemetry_format.is_some() || args.udp_port.is_some() {
+    if args.telemetry_format.is_some() || args.udp_port.is_some() || args.outsim_opts.is_some() {
         return Err(bad(
-            "--telemetry-format and --udp-port are for a packet capture (pcap, pcapng); this is not one".into(),
+            "--telemetry-format, --udp-port and --outsim-opts are for a packet capture (pcap, pcapng); this is not one"
+                .into(),
         ));
     }
     let text = crate::input::files::read_text(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
@@ -454,6 +457,7 @@ mod tests {
         let options = Options {
             input: &input,
             telemetry_format: None,
+            outsim_opts: None,
             udp_port: None,
             out: &out,
             config: None,

@@ -2,7 +2,9 @@
 //! as the telemetry rows `cue` reads from a CSV, so a drive recorded once is cued again with other parameters.
 //!
 //! Each UDP datagram (to `--udp-port` only, when given) is decoded in `--telemetry-format` (`auto` when not given:
-//! the first datagram a game's format recognises names it). A row's time is the game's own time when its format
+//! the format of the capture's first run of [`games::reader::LOCK_AFTER`] datagrams that one game's format recognises and
+//! decodes, named in the summary with the packet the run starts at), `OutSimPack2` with `--outsim-opts` when
+//! given. A row's time is the game's own time when its format
 //! carries one, as the live path (`stream --telemetry-udp`) takes it, else the packet's capture time (from the first
 //! datagram taken), the live path's arrival time. A datagram the format cannot read, or whose time is not after the
 //! last one's, is an input error named by its packet number (as the live path counts an unreadable datagram);
@@ -13,6 +15,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use crate::games;
+use crate::games::outsim2::Opts;
 use crate::games::TelemetryFormat;
 use crate::input::capture;
 use crate::input::table::InputError;
@@ -28,6 +31,9 @@ pub struct CaptureSummary {
     pub datagrams: usize,
     /// The telemetry format they were read as (`auto` when none was recognised).
     pub telemetry_format: String,
+    /// `auto`: the packet from which the format's run of datagrams started.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub recognised_from_packet: Option<usize>,
     /// The UDP destination ports in the file and their datagrams (to choose `--udp-port` when there are several).
     pub ports: BTreeMap<u16, usize>,
     /// The senders of the datagrams taken (address and port) and their datagrams.
@@ -44,6 +50,7 @@ pub fn rows(
     bytes: &[u8],
     format: TelemetryFormat,
     port: Option<u16>,
+    outsim_opts: Option<Opts>,
 ) -> Result<(Vec<Row>, Vec<InputError>, CaptureSummary), String> {
     let cap = capture::read(bytes)?;
     let mut summary = CaptureSummary {
@@ -51,15 +58,12 @@ pub fn rows(
         packets: cap.packets,
         datagrams: 0,
         telemetry_format: String::new(),
+        recognised_from_packet: None,
         ports: BTreeMap::new(),
         senders: BTreeMap::new(),
         skipped: cap.skipped,
     };
-    let mut format = format;
-    let mut rows = Vec::new();
-    let mut errors = Vec::new();
-    let mut first: Option<std::time::Duration> = None;
-    let mut last_t: Option<f64> = None;
+    let mut taken = Vec::new();
     for d in &cap.datagrams {
         *summary.ports.entry(d.to.port()).or_default() += 1;
         if port.is_some_and(|p| p != d.to.port()) {
@@ -68,43 +72,56 @@ pub fn rows(
         }
         summary.datagrams += 1;
         *summary.senders.entry(d.from.to_string()).or_default() += 1;
-        let decoded = match format {
-            TelemetryFormat::Text => games::parse_telemetry(&d.payload),
-            TelemetryFormat::Game(f) => games::decode(f, &d.payload)
-                .map(|s| (s.time, s.telemetry))
-                .map_err(|e| e.to_string()),
-            TelemetryFormat::Auto => match games::recognise(&d.payload) {
-                Some(f) => {
-                    let decoded = games::decode(f, &d.payload)
-                        .map(|s| (s.time, s.telemetry))
-                        .map_err(|e| e.to_string());
-                    if decoded.is_ok() {
-                        eprintln!("telemetry: the datagrams are {f} ({})", f.games());
-                        format = TelemetryFormat::Game(f);
-                    }
-                    decoded
-                }
-                None => Err(games::Unreadable::Unrecognised(d.payload.len()).to_string()),
-            },
-        };
-        let (time, telemetry) = match decoded {
-            Ok(ok) => ok,
+        taken.push(d);
+    }
+    // Offline, the whole capture is there: the format is chosen once, and every datagram read in it.
+    let format = match format {
+        TelemetryFormat::Auto => match games::detect(taken.iter().map(|d| d.payload.as_slice()), outsim_opts) {
+            Some((f, i)) => {
+                summary.recognised_from_packet = Some(taken[i].number);
+                eprintln!(
+                    "telemetry: the datagrams are {f} ({}), from packet {}",
+                    f.games(),
+                    taken[i].number
+                );
+                TelemetryFormat::Game(f)
+            }
+            None => TelemetryFormat::Auto,
+        },
+        named => named,
+    };
+    let mut reader = games::Reader::new(format, outsim_opts);
+    let mut rows = Vec::new();
+    let mut errors = Vec::new();
+    let mut first: Option<std::time::Duration> = None;
+    let mut last_t: Option<f64> = None;
+    for d in taken {
+        let mut refuse = |reason: String| errors.push(InputError { line: d.number, reason });
+        let sample = match reader.read(&d.payload) {
+            Ok(sample) => sample,
             Err(reason) => {
-                errors.push(InputError { line: d.number, reason });
+                refuse(reason);
                 continue;
             }
         };
-        let t = time.unwrap_or_else(|| (d.time - *first.get_or_insert(d.time)).as_secs_f64());
+        // Capture times need not rise (a capture merged from two interfaces, a clock set back).
+        let t = match sample.time {
+            Some(t) => t,
+            None => match d.time.checked_sub(*first.get_or_insert(d.time)) {
+                Some(since) => since.as_secs_f64(),
+                None => {
+                    refuse("its capture time is before the first datagram's".into());
+                    continue;
+                }
+            },
+        };
         if last_t.is_some_and(|l| t <= l) {
-            errors.push(InputError {
-                line: d.number,
-                reason: "its time is not after the last one's".into(),
-            });
+            refuse("its time is not after the last one's".into());
             continue;
         }
         last_t = Some(t);
-        let [ax, ay, az] = telemetry.force;
-        let [wx, wy, wz] = telemetry.rate;
+        let [ax, ay, az] = sample.telemetry.force;
+        let [wx, wy, wz] = sample.telemetry.rate;
         rows.push((d.number, vec![t, ax, ay, az, wx, wy, wz]));
     }
     if cap.cut_short {
@@ -121,3 +138,6 @@ pub fn rows(
     };
     Ok((rows, errors, summary))
 }
+
+#[cfg(test)]
+mod tests;

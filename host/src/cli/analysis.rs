@@ -248,4 +248,8 @@ pub struct CueArgs {
     /// With a packet capture as --input: its UDP datagrams to this port only (a capture of several flows).
     #[arg(long)]
     pub udp_port: Option<u16>,
+    /// With a packet capture as --input: Live for Speed's `OutSim Opts` (hexadecimal, as in its cfg.txt), which
+    /// an `outsim2` packet's size alone does not always tell.
+    #[arg(long, value_name = "HEX", value_parser = crate::games::outsim2::Opts::parse_hex)]
+    pub outsim_opts: Option<crate::games::outsim2::Opts>,
 }

@@ -124,6 +124,7 @@ impl CueArgs {
             json: self.json,
             telemetry_format: self.telemetry_format,
             udp_port: self.udp_port,
+            outsim_opts: self.outsim_opts,
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
         }
@@ -180,6 +181,7 @@ impl StreamArgs {
                     format: self.telemetry_format,
                     cue_config: self.cue_config.clone(),
                     profile: self.profile.clone(),
+                    outsim_opts: self.outsim_opts,
                 },
             ),
             (None, None, Some(path)) => Input::File {

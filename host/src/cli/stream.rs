@@ -46,6 +46,10 @@ pub struct StreamArgs {
     /// (the first datagram a game's format recognises names it, said on stderr).
     #[arg(long, value_enum, default_value = "text")]
     pub telemetry_format: crate::games::TelemetryFormat,
+    /// With --telemetry-udp: Live for Speed's `OutSim Opts` (hexadecimal, as in its cfg.txt), which an `outsim2`
+    /// packet's size alone does not always tell.
+    #[arg(long, value_name = "HEX", requires = "telemetry_udp", value_parser = crate::games::outsim2::Opts::parse_hex)]
+    pub outsim_opts: Option<crate::games::outsim2::Opts>,
     /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`). The file is watched while
     /// the stream runs: a changed, valid file takes over within a second, blended in; an invalid one is refused.
     #[arg(long, requires = "telemetry_udp", conflicts_with_all = ["udp", "input", "motion"])]

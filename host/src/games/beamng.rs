@@ -21,24 +21,27 @@
 //!
 //! ## Conversion
 //!
-//! The page gives the fields, not their senses. From the sender: `acc` is the negated acceleration sensor,
-//! `rollPos` and `yawPos` are negated ("seems like that is the standard for motion sims"), the rates are not.
-//! ringpod takes: `accX` lateral positive to the right, `accY` longitudinal positive forwards, `accZ` up (as
-//! motion software maps them: sway, surge, heave); `pitchPos` positive nose up, `rollPos` positive left side down;
-//! the rates in BeamNG's right-handed z-up sense: roll positive right side down, pitch positive nose up, yaw
-//! positive to the left. Gravity's reaction is added (the acceleration has none):
+//! The page gives the fields, not their senses; the sender and BeamNG's vehicle axes give them. The sender fills
+//! `acc` with the vehicle's acceleration sensor negated alike on all three axes (`accX = -sensorX`, `accY =
+//! -sensorY`, `accZ = -sensorZ`), negates `rollPos` and `yawPos` ("seems like that is the standard for motion sims")
+//! and sends the rates as `getRollPitchYawAngularVelocity` gives them. The sensor reads in the vehicle's own axes,
+//! which BeamNG's "Refnodes" page (documentation.beamng.com/modding/vehicle/sections/refnodes) defines as x to the
+//! left, y to the back, z up; negated, `accX` is positive to the right, `accY` forward and `accZ` **down**. So a
+//! bump (the car pushed up) is a negative `accZ`, and ringpod's up is `-accZ`. Gravity's reaction is added (the
+//! acceleration has none):
 //!
-//! | ringpod | from |
-//! |---|---|
-//! | force x | `accY + g sin(pitchPos)` |
-//! | force y | `-accX + g cos(pitchPos) sin(-rollPos)` |
-//! | force z | `accZ + g * upVecZ` |
-//! | rate roll | `rollRate` |
-//! | rate pitch | `-pitchRate` |
-//! | rate yaw | `yawRate` |
-//! | time | none: the arrival time is used |
+//! | ringpod | from | sign |
+//! |---|---|---|
+//! | force x | `accY + g sin(pitchPos)` | derived: sensor y is back (refnodes), negated by the sender |
+//! | force y | `-accX + g cos(pitchPos) sin(-rollPos)` | derived: sensor x is left, negated by the sender |
+//! | force z | `-accZ + g * upVecZ` | derived: sensor z is up, negated by the sender; `upVecZ` published ("pointing up relative to the car") |
+//! | rate roll | `rollRate` | derived: BeamNG's right-handed z-up sense, not negated by the sender |
+//! | rate pitch | `-pitchRate` | derived, as roll |
+//! | rate yaw | `yawRate` | derived, as roll |
+//! | time | none: the arrival time is used | published: the packet has no time |
 //!
-//! These senses are assumed from the sender, not published: check them with a capture.
+//! No sign is published as such: each is read from the sender's code against the refnodes' axes; a capture of a
+//! drive in the game is the check.
 
 use super::{gravity_from_attitude, Format, Le, Sample, Telemetry, Unreadable, G};
 
@@ -71,7 +74,7 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
     Ok(Sample {
         time: None,
         telemetry: Telemetry {
-            force: [ay + gravity[0], -ax + gravity[1], az + G * up_z],
+            force: [ay + gravity[0], -ax + gravity[1], -az + G * up_z],
             rate: [roll_rate, -pitch_rate, yaw_rate],
         },
     })
@@ -113,6 +116,9 @@ mod tests {
         assert!(close(s.telemetry.force, [g * sp, 0.0, g * cp]), "{s:?}");
         // Pitching up is a negative pitch rate about ringpod's left axis.
         assert!(close(s.telemetry.rate, [0.0, -0.2, 0.0]), "{s:?}");
+        // A bump: the car pushed up at 4 m/s^2, its sensor reading +4 on its up axis, sent negated.
+        let s = decoded(Format::Beamng, &packet([0.0, 0.0, -4.0], UP, [0.0; 3], [0.0; 3]));
+        assert!(close(s.telemetry.force, [0.0, 0.0, g + 4.0]), "more than 1 g: {s:?}");
         // Right side down 10 degrees (rollPos negative, its sense being left side down): the seat pushes left.
         let s = decoded(
             Format::Beamng,

@@ -47,9 +47,11 @@ pub mod f1;
 pub mod forza;
 pub mod outsim;
 pub mod outsim2;
+pub mod reader;
 mod telemetry;
 pub mod xplane;
 
+pub use reader::{detect, Lock, Reader};
 pub use telemetry::{numbers, parse_telemetry, TelemetryFormat};
 
 use ringpod_core::cueing::{Telemetry, G};
@@ -168,6 +170,14 @@ pub enum Unreadable {
         /// Why.
         why: String,
     },
+    /// The size fits several layouts of the format that read differently, and the packet does not say which.
+    #[error("{format}: {why}")]
+    Ambiguous {
+        /// The format.
+        format: Format,
+        /// The layouts and what tells them apart.
+        why: String,
+    },
     /// `auto` recognised no format.
     #[error("no format recognised in {0} bytes")]
     Unrecognised(usize),
@@ -177,11 +187,17 @@ pub enum Unreadable {
 /// would become the reference of every later sample's interval.
 const MAX_TIME_S: f64 = 1e7;
 
-/// Decodes one datagram of `format`.
+/// Decodes one datagram of `format` (an `OutSimPack2` without its `OutSim Opts`).
+#[cfg(test)]
 pub fn decode(format: Format, bytes: &[u8]) -> Result<Sample, Unreadable> {
+    decode_with(format, bytes, None)
+}
+
+/// Decodes one datagram of `format`, an `OutSimPack2` with the `OutSim Opts` when given.
+pub fn decode_with(format: Format, bytes: &[u8], outsim_opts: Option<outsim2::Opts>) -> Result<Sample, Unreadable> {
     let sample = match format {
         Format::Outsim => outsim::decode(bytes),
-        Format::Outsim2 => outsim2::decode(bytes),
+        Format::Outsim2 => outsim2::decode(bytes, outsim_opts),
         Format::Beamng => beamng::decode(bytes),
         Format::Codemasters => codemasters::decode(bytes),
         Format::F1 => f1::decode(bytes),

@@ -23,15 +23,15 @@
 //! ## Which sections, when only the bytes are known
 //!
 //! The packet does not say which bits were set, and sizes do not tell them apart: 4-byte `ID` and `Time`, 8-byte
-//! `OSO_DISTANCE` and `OSO_EXTRA_1`, 20-byte inputs against drive plus distance, all trade places. [`parse`] takes
-//! the `OutSim Opts` value and is exact. [`decode`] (the `outsim2` format without a value) needs the header (bit 1,
-//! so that it is recognisable at all) and the main section (bit 8, or there is no motion), and of the sections
-//! before `OSMain` only whether `ID` and `Time` are there changes what cueing reads; so among the bit sets that fit
-//! the size it takes, deliberately: both `ID` and `Time` if some fitting set has both, else `Time` alone, else `ID`
-//! alone, else neither. That is exact for `ff`, `1ff` and every set with both `ID` and `Time`, and for header plus
-//! main alone (64 bytes, or 224 with wheels); a set with only one of `ID` and `Time` can be taken for the other
-//! (an `ID` read as a time that never advances makes every sample after the first "not after the last one"), so
-//! set both, or give the value.
+//! `ID` + `Time`, `OSO_DISTANCE` and `OSO_EXTRA_1`, 20-byte `OSO_INPUTS` against `ID` + `Time` + `OSO_DRIVE`, all
+//! trade places (`ff` and `1f9` are both 272 bytes). Cueing reads `OSMain`, placed by whether `ID` and `Time` come
+//! before it, and `Time`. [`parse`] takes the `OutSim Opts` value (`--outsim-opts HEX`, [`Opts::parse_hex`]) and
+//! is exact for every set. [`decode`] without it needs the header (bit 1, or the packet is not recognisable) and
+//! decodes a packet only when every set with the header bit that has its size agrees on `ID` and `Time` (no set
+//! without the main section has the size of one with it: 8 to 60 or 164 to 220 bytes against 64 to 120 or 224 to
+//! 280), so it is exact whenever it answers (`1ff`, header plus main, 64 bytes, and others); for a size that
+//! several placements fit it refuses, naming them and `--outsim-opts`, rather than read another section as the
+//! time.
 
 use super::outsim;
 use super::{Format, Le, Sample, Telemetry, Unreadable};
@@ -101,19 +101,80 @@ impl Opts {
         self.layout().0.into_iter().find(|(b, _)| *b == bit).map(|(_, at)| at)
     }
 
-    /// The bit set [`decode`] takes for a packet of `len` bytes with the header and the main section (the rule is
-    /// in the module's documentation), or `None` when no such set has that size.
-    pub fn infer(len: usize) -> Option<Opts> {
-        let rank = |o: Opts| match (o.has(Self::ID), o.has(Self::TIME)) {
-            (true, true) => 0,
-            (false, true) => 1,
-            (true, false) => 2,
-            (false, false) => 3,
-        };
-        (0..0x200u16)
+    /// Every bit LFS defines.
+    pub const ALL: u16 = 0x1ff;
+
+    /// The sets with the header bit that make a packet of `len` bytes, by whether they have `ID` and `Time` (the
+    /// placements of what cueing reads), each placement with its smallest set.
+    fn fitting(len: usize) -> Vec<((bool, bool), Opts)> {
+        let mut found: Vec<((bool, bool), Opts)> = Vec::new();
+        for o in (0..=Self::ALL)
             .map(Opts)
-            .filter(|o| o.has(Self::HEADER) && o.has(Self::MAIN) && o.size() == len)
-            .min_by_key(|o| (rank(*o), o.0))
+            .filter(|o| o.has(Self::HEADER) && o.size() == len)
+        {
+            let placement = (o.has(Self::ID), o.has(Self::TIME));
+            if !found.iter().any(|(p, _)| *p == placement) {
+                found.push((placement, o));
+            }
+        }
+        found
+    }
+
+    /// The set [`decode`] reads a packet of `len` bytes with: one whose placement of `ID` and `Time` every fitting
+    /// set shares, or why there is none (no fitting set, or several placements).
+    pub fn infer(len: usize) -> Result<Opts, Unreadable> {
+        let fitting = Self::fitting(len);
+        match fitting.as_slice() {
+            [] => Err(Unreadable::Size {
+                format: Format::Outsim2,
+                got: len,
+                expected: "the size of a header, the main section and other sections (64 to 120, or 224 to 280, bytes)",
+            }),
+            [(_, o)] => Ok(*o),
+            several => {
+                let named: Vec<String> = several
+                    .iter()
+                    .map(|((id, time), o)| {
+                        let what = match (id, time) {
+                            (true, true) => "ID and Time",
+                            (false, true) => "Time only",
+                            (true, false) => "ID only",
+                            (false, false) => "neither ID nor Time",
+                        };
+                        format!("{:x} ({what})", o.0)
+                    })
+                    .collect();
+                Err(Unreadable::Ambiguous {
+                    format: Format::Outsim2,
+                    why: format!(
+                        "{len} bytes fit OutSim Opts that place the time differently: {}; give the OutSim Opts of \
+                         LFS's cfg.txt with --outsim-opts HEX",
+                        named.join(", ")
+                    ),
+                })
+            }
+        }
+    }
+
+    /// `OutSim Opts` as LFS's `cfg.txt` writes it, hexadecimal (`1ff`, `0x1ff`): bits LFS defines only, and the
+    /// main section's among them (without it a packet carries no motion).
+    pub fn parse_hex(text: &str) -> Result<Opts, String> {
+        let digits = text.trim();
+        let digits = digits
+            .strip_prefix("0x")
+            .or_else(|| digits.strip_prefix("0X"))
+            .unwrap_or(digits);
+        let shown: String = text.chars().take(20).collect();
+        let value = u16::from_str_radix(digits, 16)
+            .ok()
+            .filter(|v| *v <= Self::ALL && !digits.is_empty() && digits.len() <= 4)
+            .ok_or_else(|| format!("OutSim Opts `{shown}` is not a hexadecimal number from 0 to 1ff"))?;
+        if value & Self::MAIN == 0 {
+            return Err(format!(
+                "OutSim Opts {value:x} has no main section (bit 8): its packets carry no motion"
+            ));
+        }
+        Ok(Opts(value))
     }
 }
 
@@ -167,20 +228,19 @@ pub fn parse(bytes: &[u8], opts: Opts) -> Result<Packet, Unreadable> {
     Ok(packet)
 }
 
-/// Reads a packet whose `OutSim Opts` are not known: with the header, the main section, and the sections the
-/// module's rule infers from its size.
-pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
-    if !bytes.starts_with(b"LFST") {
-        return Err(Unreadable::Header {
-            format: Format::Outsim2,
-            why: "no LFST header (set bit 1 of OutSim Opts, e.g. OutSim Opts ff)".into(),
-        });
-    }
-    let opts = Opts::infer(bytes.len()).ok_or(Unreadable::Size {
-        format: Format::Outsim2,
-        got: bytes.len(),
-        expected: "the size of a header, the main section and other sections (64 to 120, or 224 to 280, bytes)",
-    })?;
+/// Reads a packet sent with `opts` when given, else one whose sections its size tells (the module's rule): its
+/// time and motion.
+pub fn decode(bytes: &[u8], opts: Option<Opts>) -> Result<Sample, Unreadable> {
+    let opts = match opts {
+        Some(opts) => opts,
+        None if !bytes.starts_with(b"LFST") => {
+            return Err(Unreadable::Header {
+                format: Format::Outsim2,
+                why: "no LFST header (set bit 1 of OutSim Opts, e.g. OutSim Opts 1ff, or give --outsim-opts)".into(),
+            });
+        }
+        None => Opts::infer(bytes.len())?,
+    };
     let packet = parse(bytes, opts)?;
     let telemetry = packet.motion.ok_or_else(|| Unreadable::NoMotion {
         format: Format::Outsim2,
@@ -213,13 +273,33 @@ mod tests {
         assert_eq!(Opts(0xff).offset(Opts::MAIN), Some(12));
         assert_eq!(Opts(0xff).offset(Opts::WHEELS), Some(112));
         assert_eq!(Opts(0x1ff).offset(Opts::EXTRA_1), Some(272));
-        assert_eq!(Opts::infer(272), Some(Opts(0xff)));
-        assert_eq!(Opts::infer(280), Some(Opts(0x1ff)));
-        assert_eq!(Opts::infer(64), Some(Opts(0x09)));
-        // 68: ID or Time; Time is taken.
-        assert_eq!(Opts::infer(68), Some(Opts(0x0d)));
-        assert_eq!(Opts::infer(63), None);
-        assert_eq!(Opts::infer(300), None);
+        assert_eq!(Opts(0x1f9).size(), 272);
+        assert_eq!(Opts::infer(280), Ok(Opts(0x1ff)));
+        assert_eq!(Opts::infer(64), Ok(Opts(0x09)));
+        // The sizes of the sets the issue of exactness is about: each fits a set with ID and Time too.
+        for (opts, len) in [
+            (0x19, 84),
+            (0x49, 72),
+            (0x109, 72),
+            (0x1f9, 272),
+            (0xff, 272),
+            (0x0d, 68),
+        ] {
+            assert_eq!(Opts(opts).size(), len);
+            let e = Opts::infer(len).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("{len} bytes")) && e.contains("--outsim-opts"),
+                "{e}"
+            );
+        }
+        assert!(matches!(Opts::infer(63), Err(Unreadable::Size { .. })));
+        assert!(matches!(Opts::infer(300), Err(Unreadable::Size { .. })));
+        // No set without the main section has the size of one with it.
+        for a in (0..=Opts::ALL).filter(|o| o & Opts::MAIN == 0) {
+            for b in (0..=Opts::ALL).filter(|o| o & Opts::MAIN != 0) {
+                assert!(Opts(a).size() != Opts(b).size() || a & 1 != b & 1, "{a:x} {b:x}");
+            }
+        }
     }
 
     #[test]
@@ -244,45 +324,86 @@ mod tests {
         assert_eq!(parse(&bytes, Opts(0xf7)).unwrap().motion, None);
     }
 
+    /// Every one of the 512 `OutSim Opts` sets (the 256 with the main section among them), packets built field by
+    /// field: with the value given, each set with the main section decodes exactly (its time, or none, and its
+    /// motion) and each without is refused as carrying no motion; without the value, a set with the header decodes
+    /// exactly or is refused naming the ambiguity and `--outsim-opts`, never read wrongly.
     #[test]
-    fn all_sections_decode_without_the_opts() {
+    fn every_option_set_decodes_exactly_or_is_refused_by_name() {
         let g = G;
-        for opts in [0xff, 0x1ff, 0x0f, 0x8f, 0x09] {
-            // At rest, level.
-            let s = decoded(Format::Outsim2, &packet(opts, [0.0; 3], [1.0, 0.0, 0.0], [0.0; 3]));
-            assert!(close(s.telemetry.force, [0.0, 0.0, g]), "{opts:#x}: {s:?}");
-            assert_eq!(s.time, (opts & Opts::TIME != 0).then_some(2.5));
-            // Accelerating forward at 3 m/s^2 facing world y.
-            let s = decoded(Format::Outsim2, &packet(opts, [0.0; 3], [0.0; 3], [0.0, 3.0, 0.0]));
-            assert!(close(s.telemetry.force, [3.0, 0.0, g]), "{opts:#x}: {s:?}");
-            // A left turn: centripetal acceleration to world -x (the car's left), yaw rate up.
-            let s = decoded(
-                Format::Outsim2,
-                &packet(opts, [0.0, 0.0, 0.5], [0.0; 3], [-4.0, 0.0, 0.0]),
-            );
-            assert!(close(s.telemetry.force, [0.0, 4.0, g]), "{opts:#x}: {s:?}");
-            assert!(close(s.telemetry.rate, [0.0, 0.0, 0.5]), "{opts:#x}: {s:?}");
-            // Nose up 10 degrees at rest: pushed back as when accelerating.
-            let p = 10f32.to_radians();
-            let s = decoded(Format::Outsim2, &packet(opts, [0.0; 3], [0.0, p, 0.0], [0.0; 3]));
-            assert!(s.telemetry.force[0] > 1.6, "{opts:#x}: {s:?}");
+        let (mut exact, mut ambiguous) = (0, 0);
+        for opts in 0..=Opts::ALL {
+            // Accelerating forward at 3 m/s^2 facing world y, turning left at 0.5 rad/s.
+            let bytes = packet(opts, [0.0, 0.0, 0.5], [0.0; 3], [0.0, 3.0, 0.0]);
+            let time = (opts & Opts::TIME != 0).then_some(2.5);
+            let given = decode(&bytes, Some(Opts(opts)));
+            if opts & Opts::MAIN == 0 {
+                assert!(matches!(given, Err(Unreadable::NoMotion { .. })), "{opts:x}: {given:?}");
+                assert!(Opts::parse_hex(&format!("{opts:x}")).is_err(), "{opts:x}");
+                continue;
+            }
+            assert_eq!(Opts::parse_hex(&format!("{opts:x}")), Ok(Opts(opts)));
+            let s = given.unwrap_or_else(|e| panic!("{opts:x}: {e}"));
+            assert_eq!(s.time, time, "{opts:x}");
+            assert!(close(s.telemetry.force, [3.0, 0.0, g]), "{opts:x}: {s:?}");
+            assert!(close(s.telemetry.rate, [0.0, 0.0, 0.5]), "{opts:x}: {s:?}");
+            if opts & Opts::HEADER == 0 {
+                assert!(
+                    matches!(decode(&bytes, None), Err(Unreadable::Header { .. })),
+                    "{opts:x}"
+                );
+                continue;
+            }
+            match decode(&bytes, None) {
+                Ok(inferred) => {
+                    exact += 1;
+                    assert_eq!(inferred, s, "{opts:x}");
+                    assert_eq!(decoded(Format::Outsim2, &bytes), s, "{opts:x}");
+                }
+                Err(e) => {
+                    ambiguous += 1;
+                    let text = e.to_string();
+                    assert!(matches!(e, Unreadable::Ambiguous { .. }), "{opts:x}: {text}");
+                    assert!(text.contains(&format!("{} bytes", bytes.len())), "{text}");
+                    assert!(
+                        text.contains(&format!("{opts:x} (")) || text.contains("--outsim-opts"),
+                        "{text}"
+                    );
+                }
+            }
         }
+        // 1ff, 09 and the other sizes one placement has are read without the value.
+        assert_eq!(exact + ambiguous, 128);
+        assert!(exact >= 2, "{exact}");
+        // A packet of another set's size is refused with the value given, not misread.
+        let bytes = packet(0xff, [0.0; 3], [0.0; 3], [0.0; 3]);
+        assert!(decode(&bytes, Some(Opts(0x1ff))).is_err());
+    }
+
+    #[test]
+    fn option_values_are_read_as_cfg_txt_writes_them() {
+        assert_eq!(Opts::parse_hex("1ff"), Ok(Opts(0x1ff)));
+        assert_eq!(Opts::parse_hex(" 0x1F9 "), Ok(Opts(0x1f9)));
+        for bad in ["", "0x", "200", "ffff", "g", "-1", "1ff1", "7"] {
+            assert!(Opts::parse_hex(bad).is_err(), "{bad}");
+        }
+        assert!(Opts::parse_hex(&"9".repeat(300)).unwrap_err().len() < 120);
     }
 
     #[test]
     fn wrong_packets_are_refused() {
         let mut bytes = packet(0xff, [0.0; 3], [0.0; 3], [0.0; 3]);
-        assert!(decode(&bytes[..271]).is_err());
+        assert!(decode(&bytes[..271], None).is_err());
         bytes[0] = b'X';
-        assert!(matches!(decode(&bytes), Err(Unreadable::Header { .. })));
+        assert!(matches!(decode(&bytes, None), Err(Unreadable::Header { .. })));
         // No header bit: not readable without the opts, readable with them.
         let bytes = packet(0xfe, [0.0; 3], [0.0; 3], [0.0; 3]);
-        assert!(decode(&bytes).is_err());
+        assert!(decode(&bytes, None).is_err());
         assert!(parse(&bytes, Opts(0xfe)).unwrap().motion.is_some());
         // A header and no main section.
         let bytes = packet(0x07, [0.0; 3], [0.0; 3], [0.0; 3]);
-        assert!(decode(&bytes).is_err());
-        let mut nan = packet(0xff, [0.0; 3], [0.0; 3], [0.0; 3]);
+        assert!(decode(&bytes, None).is_err());
+        let mut nan = packet(0x1ff, [0.0; 3], [0.0; 3], [0.0; 3]);
         nan[12 + 24..12 + 28].copy_from_slice(&f32::NAN.to_le_bytes());
         assert!(matches!(
             super::super::decode(Format::Outsim2, &nan),

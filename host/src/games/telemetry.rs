@@ -56,7 +56,11 @@ pub fn numbers(bytes: &[u8]) -> Result<Vec<f64>, String> {
     let text = std::str::from_utf8(bytes).map_err(|_| "not text".to_string())?;
     text.split(|c: char| c.is_whitespace() || c == ',' || c == ';')
         .filter(|s| !s.is_empty())
-        .map(|s| s.parse::<f64>().map_err(|e| format!("`{s}`: {e}")))
+        // A word of the datagram, cut: a datagram can be 64 KiB of one word.
+        .map(|s| {
+            s.parse::<f64>()
+                .map_err(|e| format!("`{}`: {e}", crate::input::unreadable::cut(s, 40)))
+        })
         .collect()
 }
 

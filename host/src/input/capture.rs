@@ -270,11 +270,11 @@ fn read_pcap(bytes: &[u8]) -> Result<Capture, String> {
 }
 
 /// An interface's time: its `if_tsresol` (10^-n s, or 2^-n s with the high bit; microseconds without) and
-/// `if_tsoffset` (s).
-fn pcapng_time(units: u128, tsresol: u8, offset_s: u64) -> Duration {
+/// `if_tsoffset` (s), or `None` when the sum is beyond what a [`Duration`] holds (an offset of 2^64 - 1 s).
+fn pcapng_time(units: u128, tsresol: u8, offset_s: u64) -> Option<Duration> {
     let nanos = if tsresol & 0x80 != 0 {
         let shift = u32::from(tsresol & 0x7f).min(127);
-        (units * 1_000_000_000) >> shift
+        units.checked_mul(1_000_000_000)? >> shift
     } else {
         let n = u32::from(tsresol).min(30);
         if n <= 9 {
@@ -283,9 +283,12 @@ fn pcapng_time(units: u128, tsresol: u8, offset_s: u64) -> Duration {
             units / 10u128.pow(n - 9)
         }
     };
-    let nanos = u64::try_from(nanos).unwrap_or(u64::MAX);
-    Duration::from_nanos(nanos) + Duration::from_secs(offset_s)
+    let nanos = u64::try_from(nanos).ok()?;
+    Duration::from_nanos(nanos).checked_add(Duration::from_secs(offset_s))
 }
+
+/// Why a pcapng packet whose time cannot be a time is skipped.
+const TIME_OVERFLOWS: &str = "its time, with its interface's if_tsoffset, is beyond any time (about 5.8e11 years)";
 
 fn read_pcapng(bytes: &[u8]) -> Result<Capture, String> {
     let (mut rest, mut parser) = PcapNgParser::new(bytes).map_err(|e| match e {
@@ -328,7 +331,10 @@ fn read_pcapng(bytes: &[u8]) -> Result<Capture, String> {
                 }
                 // pcap-file 2 takes the timestamp's units for nanoseconds whatever the interface says: the units
                 // back, then the interface's resolution.
-                let time = pcapng_time(epb.timestamp.as_nanos(), tsresol, offset);
+                let Some(time) = pcapng_time(epb.timestamp.as_nanos(), tsresol, offset) else {
+                    *capture.skipped.entry(TIME_OVERFLOWS.into()).or_default() += 1;
+                    continue;
+                };
                 let cut = (epb.data.len() as u32) < epb.original_len;
                 capture.take(number, time, idb.linktype, &epb.data, cut);
             }
@@ -399,10 +405,12 @@ fn ip_of(link: DataLink, data: &[u8]) -> Result<&[u8], String> {
             data.get(20..).ok_or_else(short)
         }
         DataLink::NULL | DataLink::LOOP => {
-            let family = data.get(..4).ok_or_else(short)?;
-            // In the capturing host's byte order (NULL) or big endian (LOOP): either way one byte is not zero.
-            let family = u32::from_le_bytes(family.try_into().unwrap_or_default())
-                .max(u32::from_be_bytes(family.try_into().unwrap_or_default()));
+            let word: [u8; 4] = data.get(..4).ok_or_else(short)?.try_into().unwrap_or_default();
+            // LOOP's family is in network byte order; NULL's in the capturing host's, which a file read elsewhere
+            // does not tell (tcpdump.org's link-layer header types; Wireshark's NullLoopback page). The families
+            // are small numbers: of NULL's two readings the smaller is the one written.
+            let (big, little) = (u32::from_be_bytes(word), u32::from_le_bytes(word));
+            let family = if link == DataLink::LOOP { big } else { big.min(little) };
             match family {
                 2 | 24 | 28 | 30 => Ok(&data[4..]),
                 other => Err(format!("not IP (loopback family {other})")),
@@ -487,5 +495,8 @@ fn udp_of(link: DataLink, data: &[u8], cut: bool) -> Result<(SocketAddr, SocketA
     Ok((from, to, &udp[8..len]))
 }
 
+/// Captures built byte by byte from the file formats' specifications, for the tests.
+#[cfg(test)]
+pub(crate) mod spec;
 #[cfg(test)]
 mod tests;

@@ -16,12 +16,35 @@ pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
     String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (byte {} is not)", e.utf8_error().valid_up_to() + 1))
 }
 
-/// The bytes of the file at `path` (a packet capture), at most `limit`, or why not, without the path.
-pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
-    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
-    if file.metadata().is_ok_and(|m| m.is_dir()) {
+/// Opens `path` to read, without waiting: on Unix non-blocking, so that a FIFO with no writer does not hold the
+/// caller in `open` (where no signal reaches a command's loop), and a FIFO or socket is then refused: a file
+/// named where a file is read must be one that ends. A device reads as a file does (`/dev/zero` up to the limit).
+fn open(path: &Path) -> Result<std::fs::File, String> {
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(nix::libc::O_NONBLOCK);
+    }
+    let file = options.open(path).map_err(|e| e.to_string())?;
+    let kind = file.metadata().map_err(|e| e.to_string())?.file_type();
+    if kind.is_dir() {
         return Err("is a directory, not a file".into());
     }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() || kind.is_socket() {
+            return Err("is a FIFO (named pipe) or a socket, not a file: it may never end, or never begin".into());
+        }
+    }
+    Ok(file)
+}
+
+/// The bytes of the file at `path` (a packet capture), at most `limit`, or why not, without the path.
+pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
+    let file = open(path)?;
     let mut bytes = Vec::new();
     // One byte more than allowed tells "too large" from "exactly the limit".
     file.take(limit + 1)

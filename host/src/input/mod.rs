@@ -6,3 +6,4 @@ pub mod cueing;
 pub mod files;
 pub mod numbers;
 pub mod table;
+pub mod unreadable;

@@ -131,6 +131,11 @@ impl RigFile {
         if self.name.is_empty() || self.name.chars().count() > 32 {
             return err("name", "between 1 and 32 characters");
         }
+        // A name is printed in reports and stored on the device: a line break or a control character would break
+        // the lines it is printed in.
+        if self.name.chars().any(char::is_control) {
+            return err("name", "no line breaks, tabs or other control characters");
+        }
         // The core's geometry carries a static name; a rig is loaded once per command.
         self.geometry_named(Box::leak(self.name.clone().into_boxed_str()))
     }
@@ -193,6 +198,17 @@ impl RigFile {
                 ),
             );
         }
+        if elbows == 0 {
+            if let Some(key) = [
+                ("limits.shoulder_angle_deg", self.limits.shoulder_angle_deg.is_some()),
+                ("limits.elbow_angle_deg", self.limits.elbow_angle_deg.is_some()),
+            ]
+            .iter()
+            .find_map(|(k, given)| given.then_some(*k))
+            {
+                return err(key, "only elbow chains have it (this rig has none)");
+            }
+        }
         if elbows > 0 && shoulder.is_none() {
             return err(
                 "limits.shoulder_angle_deg",
@@ -230,6 +246,7 @@ impl RigFile {
     fn limits(&self, radial: usize) -> Result<RingLimits, RigError> {
         let l = &self.limits;
         let stroke = match (l.stroke, radial) {
+            (Some(_), 0) => return err("limits.stroke", "only radial chains have a stroke (this rig has none)"),
             (Some(s), _) => {
                 finite("limits.stroke", &s)?;
                 if !(s[0] >= 0.0 && s[0] < s[1]) {

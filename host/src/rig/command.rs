@@ -109,7 +109,12 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CommandError> {
     let file = read(path)?;
     // Not a mechanism at all: an error, as for every command. A mechanism that cannot be driven is a verdict.
     let rig = file.platform().map_err(|e| e.in_file(path))?;
-    let drivable = file.check().map(|_| ()).map_err(|e| e.to_string());
+    // Drivable: the controller accepts the rig and homes it, in the simulated machine, within a bounded time.
+    let drivable = file.check().map_err(|e| e.to_string()).and_then(|rig| {
+        super::homing::homing_time(&rig.record)
+            .map(|_| ())
+            .map_err(|why| format!("it does not home: {why}"))
+    });
     let m = RingPlatform::<f64>::new(&rig.geometry);
     let cover = rig.ranges.map(|r| (r, coverage(&m, &rig.home, &r)));
     let covered = cover
@@ -173,7 +178,8 @@ fn check_text(
     let _ = match drivable {
         Ok(()) => writeln!(
             t,
-            "drivable: yes (the home pose is inside every check; homing plan and step timing accepted)"
+            "drivable: yes (the home pose is inside every check; homing plan and step timing accepted; it homes in \
+             the simulated machine)"
         ),
         Err(why) => writeln!(t, "drivable: no, because {why}"),
     };
@@ -231,6 +237,9 @@ pub fn design_command(
     seed: u64,
 ) -> Result<Outcome, CommandError> {
     let template = read(path)?;
+    // A template that is no mechanism (a length not a positive finite number, a chain without its keys) is refused
+    // by its key, as `rig check` refuses it, before the search scales anything by it.
+    template.platform().map_err(|e| e.in_file(path))?;
     let search = Search {
         target: if combined { Target::Combined } else { Target::EachAxis },
         free: if arms_only { Free::Arms } else { Free::All },
@@ -275,9 +284,17 @@ pub fn design_command(
                 false
             }
         }
+        // Only a rig that `rig check` would call drivable is printed.
         Err(e) => {
-            let _ = writeln!(out, "# the best candidate is not a valid rig: {e}");
-            false
+            return Err(RigError::new(
+                e.key,
+                format!(
+                    "the best candidate found is not a drivable rig, so none is printed: {}",
+                    e.why
+                ),
+            )
+            .in_file(path)
+            .into())
         }
     };
     let body = found

@@ -208,6 +208,7 @@ fn rounded(file: &RigFile) -> RigFile {
 
 /// Searches dimensions for the template's topology, limits and spec ranges.
 pub fn design(template: &RigFile, search: &Search) -> Result<Found, RigError> {
+    template.platform()?;
     let Some(spec) = &template.spec else {
         return Err(RigError {
             key: "spec".into(),
@@ -371,5 +372,23 @@ mod tests {
         t.spec = None;
         let e = design(&t, &quick(Target::EachAxis, 1)).err().expect("refused");
         assert_eq!(e.key, "spec");
+    }
+
+    /// A template whose ring radius is no length (NaN, infinite, negative) or another invalid mechanism is refused
+    /// by key before the search scales anything by it (NaN reached `f64::clamp`, which panics).
+    #[test]
+    fn an_invalid_template_is_refused_by_key_not_searched() {
+        for radius in [f64::NAN, f64::INFINITY, -0.2, 0.0] {
+            let mut t = template();
+            t.ring_radius = radius;
+            let e = design(&t, &quick(Target::EachAxis, 1)).err().expect("refused");
+            assert_eq!(e.key, "ring_radius", "{radius}");
+        }
+        let mut t = template();
+        t.chains[0].branch = None;
+        assert_eq!(
+            design(&t, &quick(Target::EachAxis, 1)).err().expect("refused").key,
+            "chains[0].branch"
+        );
     }
 }

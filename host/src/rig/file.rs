@@ -19,6 +19,7 @@ pub struct RigFile {
     /// Rod length of the rod chains (m).
     pub rod_length: f64,
     /// Home pose x, y, z (m), roll, pitch, yaw (rad): where homing leaves the platform; inside every check.
+    #[serde(deserialize_with = "super::exact::array")]
     pub home: [f64; 6],
     /// The chains, counter-clockwise around the ring.
     pub chains: Vec<ChainSpec>,
@@ -77,6 +78,7 @@ pub struct ChainSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elbow: Option<ElbowSpec>,
     /// The platform joint in the platform frame (m).
+    #[serde(deserialize_with = "super::exact::array")]
     pub platform_point: [f64; 3],
 }
 
@@ -145,16 +147,17 @@ pub enum BranchSpec {
 #[serde(deny_unknown_fields, default)]
 pub struct LimitsSpec {
     /// Linear-actuator length range (m); required when there are radial chains.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "super::exact::option")]
     pub stroke: Option<[f64; 2]>,
     /// The travel of elbow chains' shoulders (deg, the angle from the horizontal toward the ring axis, up
     /// positive); required when there are elbow chains.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "super::exact::option")]
     pub shoulder_angle_deg: Option<[f64; 2]>,
     /// Allowed interior angle at elbow chains' elbows (deg, 0 folded, 180 stretched); 10 to 170 by default.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(skip_serializing_if = "Option::is_none", deserialize_with = "super::exact::option")]
     pub elbow_angle_deg: Option<[f64; 2]>,
     /// Allowed central angle between neighbouring carriages (deg).
+    #[serde(deserialize_with = "super::exact::array")]
     pub carriage_spacing_deg: [f64; 2],
     /// Least angle of a chain to the base plane (deg).
     pub base_cone_deg: f64,
@@ -163,6 +166,7 @@ pub struct LimitsSpec {
     /// Least singularity index of the wrench matrix.
     pub min_singularity_index: f64,
     /// Centre of mass of platform and payload in the platform frame (m).
+    #[serde(deserialize_with = "super::exact::array")]
     pub centre_of_mass: [f64; 3],
 }
 
@@ -249,9 +253,22 @@ pub fn read(path: &Path) -> Result<RigFile, RigError> {
 /// A rig file's text, read but not checked (the workbench's editor checks as the user types).
 pub fn parse(text: &str) -> Result<RigFile, RigError> {
     toml::from_str(text).or_else(|e| {
-        // toml names the key and the line; keep its words.
-        err("", e.message().trim().to_owned() + &span_of(text, e.span()))
+        // toml names the line; keep its words, and name the key written on that line.
+        err(
+            key_at(text, e.span()).unwrap_or_default(),
+            e.message().trim().to_owned() + &span_of(text, e.span()),
+        )
     })
+}
+
+/// The key of the `key = value` line where `span` starts, if it is one.
+fn key_at(text: &str, span: Option<std::ops::Range<usize>>) -> Option<String> {
+    let start = span?.start.min(text.len());
+    let line = text[..start].rsplit('\n').next()?;
+    let (key, _) = line.split_once('=')?;
+    let key = key.trim();
+    let bare = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '-' || c == '.';
+    (!key.is_empty() && key.chars().all(bare)).then(|| key.to_owned())
 }
 
 fn span_of(text: &str, span: Option<std::ops::Range<usize>>) -> String {

@@ -46,7 +46,9 @@ mod coverage;
 mod design;
 pub mod drives;
 pub mod error;
+mod exact;
 mod file;
+pub mod homing;
 mod settings;
 
 pub use command::{check_command, design_command, export, preset, CommandError, UnknownMechanism};

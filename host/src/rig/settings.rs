@@ -28,14 +28,24 @@ pub struct InputsSpec {
 #[serde(deny_unknown_fields)]
 pub struct MotionSpec {
     /// Velocity limit per pose axis x, y, z (m/s), roll, pitch, yaw (rad/s).
+    #[serde(deserialize_with = "super::exact::array")]
     pub pose_velocity: [f32; 6],
     /// Acceleration limit per pose axis (m/s^2, rad/s^2).
+    #[serde(deserialize_with = "super::exact::array")]
     pub pose_acceleration: [f32; 6],
     /// Velocity limit per actuator in actuator order: rad/s for carriages and shoulders, m/s for linear actuators.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::exact::option"
+    )]
     pub actuator_velocity: Option<[f32; 6]>,
     /// Acceleration limit per actuator (rad/s^2, m/s^2).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::exact::option"
+    )]
     pub actuator_acceleration: Option<[f32; 6]>,
 }
 

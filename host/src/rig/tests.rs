@@ -356,3 +356,96 @@ proptest! {
         }
     }
 }
+
+/// A list longer than its key takes is refused at that key (serde would read the first elements and drop the rest),
+/// reading no further than one element past the length.
+#[test]
+fn lists_of_the_wrong_length_are_refused_by_key() {
+    let text = trainer_file().to_toml().unwrap();
+    let home = text.lines().find(|l| l.starts_with("home = ")).unwrap().to_owned();
+    let seven = parse(&text.replace(&home, "home = [0, 0, 0.227, 0, 0, 0, 1]")).unwrap_err();
+    assert_eq!(seven.key, "home", "{seven}");
+    assert!(seven.why.contains("more than 6"), "{seven}");
+    let five = parse(&text.replace(&home, "home = [0, 0, 0.227, 0, 0]")).unwrap_err();
+    assert_eq!(five.key, "home", "{five}");
+    let point = text
+        .lines()
+        .find(|l| l.starts_with("platform_point = "))
+        .unwrap()
+        .to_owned();
+    let huge = format!("platform_point = [{}]", vec!["0.1"; 100_000].join(", "));
+    let e = parse(&text.replacen(&point, &huge, 1)).unwrap_err();
+    assert_eq!(e.key, "platform_point", "{e}");
+    assert!(e.why.contains("more than 3"), "{e}");
+    let e = parse(&text.replace("stroke = [", "stroke = [0.2, ")).unwrap_err();
+    assert_eq!(e.key, "stroke", "{e}");
+}
+
+/// A name is printed on lines of its own: a line break or a control character is refused by key.
+#[test]
+fn a_name_with_control_characters_is_refused() {
+    for name in ["a\nb", "tab\there", "bell\u{7}", "\r"] {
+        let mut f = trainer_file();
+        f.name = name.into();
+        let e = f.check().unwrap_err();
+        assert_eq!(e.key, "name", "{name:?}: {e}");
+    }
+    let mut f = trainer_file();
+    f.name = "my rig (ü)".into();
+    assert!(f.check().is_ok());
+}
+
+/// Keys of chains the rig does not have: a stroke without radial chains, arm limits without elbow chains.
+#[test]
+fn limits_of_chains_the_rig_has_not_are_refused_by_key() {
+    let mut f = trainer_file();
+    let r = 0.1;
+    f.chains = (0..6)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / 6.0 + 0.3;
+            let mut c = f.chains[0].clone();
+            c.branch = Some(if i % 2 == 0 {
+                BranchSpec::Plus
+            } else {
+                BranchSpec::Minus
+            });
+            c.platform_point = [r * a.cos(), r * a.sin(), 0.0];
+            c
+        })
+        .collect();
+    assert!(f.chains.iter().all(|c| c.kind == KindSpec::Rod));
+    let e = f.check().unwrap_err();
+    assert_eq!(e.key, "limits.stroke", "{e}");
+    let mut f = trainer_file();
+    f.limits.shoulder_angle_deg = Some([100.0, 190.0]);
+    assert_eq!(f.check().unwrap_err().key, "limits.shoulder_angle_deg");
+    let mut f = trainer_file();
+    f.limits.elbow_angle_deg = Some([25.0, 155.0]);
+    assert_eq!(f.check().unwrap_err().key, "limits.elbow_angle_deg");
+}
+
+/// `rig check`'s "drivable" homes the rig in the simulated machine: the trainer model homes within the bound; a
+/// home yaw of 1e6 or 1e10 rad ends in a homing fault, a pose velocity of 1e-30 in a move that never ends. Each is
+/// seen in well under a second of the check's time.
+#[test]
+fn a_rig_that_cannot_home_is_not_drivable() {
+    let rig = trainer_file().check().unwrap();
+    let t = homing::homing_time(&rig.record).unwrap();
+    assert!(t > 0.5 && t < homing::HOMING_LIMIT_S, "{t}");
+    for yaw in [1e6, 1e10] {
+        let mut f = trainer_file();
+        f.home[5] = yaw;
+        let rig = f.check().unwrap();
+        let e = homing::homing_time(&rig.record).unwrap_err();
+        assert!(e.contains("HomingFailed"), "{yaw}: {e}");
+    }
+    let mut f = trainer_file().with_sections(&rig.record);
+    if let Some(m) = &mut f.motion {
+        m.pose_velocity = [1e-30; 6];
+    }
+    let rig = f.check().unwrap();
+    let started = std::time::Instant::now();
+    let e = homing::homing_time(&rig.record).unwrap_err();
+    assert!(e.contains("stalls"), "{e}");
+    assert!(started.elapsed() < std::time::Duration::from_secs(20));
+}

@@ -47,6 +47,8 @@ pub enum Datagrams {
         cue_config: Option<PathBuf>,
         /// A profile of the cueing file.
         profile: Option<String>,
+        /// Live for Speed's `OutSim Opts`, when given.
+        outsim_opts: Option<crate::games::outsim2::Opts>,
     },
 }
 
@@ -163,11 +165,12 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
                     format,
                     cue_config,
                     profile,
+                    outsim_opts,
                 } => {
                     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
                     let washout = ringpod_core::cueing::Live::new(config).map_err(SourceError::Washout)?;
                     datagram::Decoder::Telemetry {
-                        format: *format,
+                        reader: Box::new(crate::games::Reader::new(*format, *outsim_opts)),
                         washout: Box::new(washout),
                         // The device's home pose, once the stream has asked for its rig.
                         neutral: None,

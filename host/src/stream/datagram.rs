@@ -7,7 +7,7 @@ use std::time::{Duration, Instant, SystemTime};
 use ringpod_core::cueing::{self, Live, SampleError, Telemetry, G};
 use ringpod_core::kinematics::Pose;
 
-use crate::games::{self, numbers, parse_telemetry, Format, TelemetryFormat};
+use crate::games::{self, numbers};
 
 /// Turns datagrams into poses.
 pub enum Decoder {
@@ -18,8 +18,8 @@ pub enum Decoder {
     },
     /// Vehicle telemetry through the washout.
     Telemetry {
-        /// The format.
-        format: TelemetryFormat,
+        /// The datagrams' format, and `auto`'s lock.
+        reader: Box<games::Reader>,
         /// The washout, retuned live when its file changes.
         washout: Box<Live<f64>>,
         /// The platform's neutral pose: the home pose of the rig the device runs, set by the stream once it knows it
@@ -129,19 +129,13 @@ pub fn parse_pose(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
     Ok(Pose::from_array(pose))
 }
 
-/// A game's packet: its time, if it sends one, and the telemetry.
-fn game(format: Format, bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), String> {
-    let sample = games::decode(format, bytes).map_err(|e| e.to_string())?;
-    Ok((sample.time, sample.telemetry))
-}
-
 impl Decoder {
     /// The pose a datagram asks for, arriving at `now`.
     pub fn decode(&mut self, bytes: &[u8], now: Instant) -> Result<Pose<f64>, String> {
         match self {
             Decoder::Poses { degrees } => parse_pose(bytes, *degrees),
             Decoder::Telemetry {
-                format,
+                reader,
                 washout,
                 neutral,
                 last,
@@ -149,19 +143,15 @@ impl Decoder {
                 ..
             } => {
                 let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
-                let (t, sample) = match *format {
-                    TelemetryFormat::Text => parse_telemetry(bytes)?,
-                    TelemetryFormat::Game(f) => game(f, bytes)?,
-                    TelemetryFormat::Auto => {
-                        let f =
-                            games::recognise(bytes).ok_or(games::Unreadable::Unrecognised(bytes.len()).to_string())?;
-                        let sample = game(f, bytes)?;
-                        // Said once: every later datagram is read as this format.
-                        eprintln!("telemetry: the datagrams are {f} ({})", f.games());
-                        *format = TelemetryFormat::Game(f);
-                        sample
-                    }
-                };
+                let read = reader.read(bytes);
+                // `auto`'s lock, or its lock dropped: said once.
+                if let Some(news) = reader.news() {
+                    eprintln!("telemetry: {news}");
+                }
+                let games::Sample {
+                    time: t,
+                    telemetry: sample,
+                } = read?;
                 let dt = match *last {
                     None => None,
                     Some((Some(t0), _)) if t.is_some() => t.map(|t| t - t0),
@@ -238,6 +228,14 @@ impl Decoder {
         match self {
             Decoder::Telemetry { watch: Some(w), .. } => (w.reloads, w.refused),
             _ => (0, 0),
+        }
+    }
+
+    /// `auto`'s changes of format (telemetry only).
+    pub fn locks(&self) -> Vec<games::Lock> {
+        match self {
+            Decoder::Poses { .. } => Vec::new(),
+            Decoder::Telemetry { reader, .. } => reader.locks().to_vec(),
         }
     }
 

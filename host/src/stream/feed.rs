@@ -176,8 +176,11 @@ fn read(
         Ok(pose) => Some((number, pose)),
         Err(reason) => {
             report.unreadable += 1;
-            bar.suspend(|| eprintln!("datagram {number}: {reason}"));
-            errors.push(InputError { line: number, reason });
+            // The first few of each kind, cut to a line: a source can send anything, for as long as it likes.
+            if let Some(kept) = crate::input::unreadable::tally(&mut report.unreadable_by_kind, number, &reason) {
+                bar.suspend(|| eprintln!("datagram {number}: {}", kept.reason));
+                errors.push(kept);
+            }
             None
         }
     }
@@ -219,6 +222,17 @@ pub(super) fn feed<T: Transport>(
             let mut d = DatagramReport::default();
             let r = s.live(udp, &mut d, input_errors);
             d.telemetry_gaps = udp.decoder.gaps();
+            d.telemetry_format_locks = udp.decoder.locks();
+            // Some were counted and not printed: the counts, once.
+            if d.unreadable_by_kind
+                .values()
+                .any(|n| *n > crate::input::unreadable::KEPT_PER_KIND)
+            {
+                eprintln!(
+                    "unreadable datagrams: {} in all, by kind: {:?}",
+                    d.unreadable, d.unreadable_by_kind
+                );
+            }
             (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
             let capture = udp.capture.take().map(|(writer, path)| {
                 let (packets, error) = writer.finish();

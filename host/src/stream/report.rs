@@ -27,14 +27,20 @@ pub struct LimitedReport {
 pub struct DatagramReport {
     /// Datagrams received from the source.
     pub received: u32,
-    /// Datagrams that did not parse (also in `input_errors`).
+    /// Datagrams that did not parse (the first few of each kind also in `input_errors`).
     pub unreadable: u32,
+    /// The unreadable datagrams by the kind of their reason (its numbers as `#`): they add up to `unreadable`.
+    pub unreadable_by_kind: std::collections::BTreeMap<String, u64>,
     /// Datagrams from other senders than `--udp-from`, ignored.
     pub other_senders: u32,
     /// Times the source paused longer than the stream timeout and the stream was led in and started again.
     pub resumed: u32,
     /// Telemetry: pauses of more than a second after which the washout started again at neutral.
     pub telemetry_gaps: u32,
+    /// Telemetry in `auto`: the format locked onto and the datagram at which (a format dropped after refusing many
+    /// datagrams in a row is a lock to none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub telemetry_format_locks: Vec<crate::games::Lock>,
     /// Telemetry: changes of the `--cue-config` file that took effect while streaming (each blended in over a
     /// second).
     pub cue_reloads: u32,

@@ -396,6 +396,7 @@ impl Device {
                     .map_err(|e| WorkerError::NoSuch(format!("telemetry format: {e}")))?,
                 cue_config: Some(self.hub.cue_file.clone()),
                 profile: None,
+                outsim_opts: None,
             },
             other => {
                 return Err(WorkerError::NoSuch(format!(

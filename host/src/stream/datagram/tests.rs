@@ -1,4 +1,5 @@
 use super::*;
+use crate::games::{parse_telemetry, Format, TelemetryFormat};
 
 /// Live for Speed's classic OutSim packet: time (ms), angular velocity, heading, pitch, roll, acceleration
 /// (world axes), velocity and position zero.
@@ -13,7 +14,7 @@ fn outsim(time_ms: u32, accel: [f32; 3]) -> Vec<u8> {
 
 fn decoder(format: TelemetryFormat) -> Decoder {
     Decoder::Telemetry {
-        format,
+        reader: Box::new(games::Reader::new(format, None)),
         washout: Box::new(Live::new(ringpod_core::cueing::CueConfig::default()).unwrap()),
         neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
         last: None,
@@ -28,25 +29,15 @@ fn auto_names_the_format_once_and_holds_to_it() {
     let mut d = decoder(TelemetryFormat::Auto);
     // Not any game's: unreadable, and still auto.
     assert!(d.decode(b"1 2 3 4 5 6", now).is_err());
-    assert!(matches!(
-        d,
-        Decoder::Telemetry {
-            format: TelemetryFormat::Auto,
-            ..
-        }
-    ));
+    assert!(matches!(&d, Decoder::Telemetry { reader, .. } if reader.format() == TelemetryFormat::Auto));
     // Braking at 6 m/s^2 (heading 0 faces world +y): the platform moves back, as with the text format.
     let mut pose = None;
     for k in 0..100 {
         pose = Some(d.decode(&outsim(k * 10, [0.0, -6.0, 0.0]), now).unwrap());
     }
-    assert!(matches!(
-        d,
-        Decoder::Telemetry {
-            format: TelemetryFormat::Game(Format::Outsim),
-            ..
-        }
-    ));
+    assert!(
+        matches!(&d, Decoder::Telemetry { reader, .. } if reader.format() == TelemetryFormat::Game(Format::Outsim))
+    );
     assert!(pose.is_some_and(|p| p.x < 0.0 && p.beta > 0.0), "{pose:?}");
     // Named: a text line is now unreadable, not taken as another format.
     assert!(d.decode(format!("1.01 0 0 {G} 0 0 0").as_bytes(), now).is_err());
@@ -100,7 +91,7 @@ fn a_telemetry_stream_is_cued_and_a_pause_washes_out() {
     let washout = Live::new(ringpod_core::cueing::CueConfig::default()).unwrap();
     let neutral = Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0);
     let mut d = Decoder::Telemetry {
-        format: TelemetryFormat::Text,
+        reader: Box::new(games::Reader::new(TelemetryFormat::Text, None)),
         washout: Box::new(washout),
         neutral: Some(neutral),
         last: None,
@@ -133,7 +124,7 @@ fn reload_run(name: &str, initial: &str, change: Option<&str>) -> ([f64; 6], Dec
     std::fs::write(&path, initial).unwrap();
     let config = crate::input::cueing::load_config(Some(&path), None).unwrap();
     let mut d = Decoder::Telemetry {
-        format: TelemetryFormat::Text,
+        reader: Box::new(games::Reader::new(TelemetryFormat::Text, None)),
         washout: Box::new(Live::new(config).unwrap()),
         neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
         last: None,

@@ -1,0 +1,109 @@
+use super::*;
+use crate::games::packets;
+use crate::input::capture::{spec, udp_packet};
+use proptest::prelude::*;
+
+const RAW: u32 = 101;
+
+/// A raw-IP frame of `payload` from a game to port 4123.
+fn frame(payload: &[u8]) -> Vec<u8> {
+    udp_packet(
+        "10.0.0.2:5000".parse().unwrap(),
+        "10.0.0.1:4123".parse().unwrap(),
+        payload,
+    )
+}
+
+/// Text telemetry (a format without its own time) whose capture times go backwards: the datagram is named, the
+/// others cued, nothing panics.
+#[test]
+fn capture_times_that_go_backwards_are_input_errors() {
+    let line = |s: &str| frame(s.as_bytes());
+    let frames = [
+        (2_000_000, line("0 0 9.8 0 0 0")),
+        (1_000_000, line("0 0 9.8 0 0 0")),
+        (2_500_000, line("0 0 9.8 0 0 0")),
+        (2_400_000, line("0 0 9.8 0 0 0")),
+    ];
+    let (rows, errors, summary) = rows(&spec::pcap(false, RAW, &frames), TelemetryFormat::Text, None, None).unwrap();
+    assert_eq!(rows.iter().map(|r| r.0).collect::<Vec<_>>(), [1, 3]);
+    assert_eq!((errors[0].line, errors[1].line), (2, 4), "{errors:?}");
+    assert!(errors[0].reason.contains("before the first"), "{errors:?}");
+    assert!(errors[1].reason.contains("not after the last"), "{errors:?}");
+    assert_eq!(summary.datagrams, 4);
+}
+
+/// A stray 64-byte datagram before F1's: the capture is read as F1 from packet 2, only the stray refused.
+#[test]
+fn auto_reads_a_capture_in_its_first_run_of_one_format() {
+    let mut frames = vec![(0, frame(&[0; 64]))];
+    for k in 0..20u64 {
+        let f1 = packets::f1::packet(2024, 0, 3, k as f32 / 20.0, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0; 3]);
+        frames.push((k * 50_000, frame(&f1)));
+    }
+    let (rows, errors, summary) = rows(&spec::pcap(true, RAW, &frames), TelemetryFormat::Auto, None, None).unwrap();
+    assert_eq!((rows.len(), errors.len()), (20, 1), "{errors:?}");
+    assert_eq!(errors[0].line, 1);
+    assert_eq!(summary.telemetry_format, "f1");
+    assert_eq!(summary.recognised_from_packet, Some(2));
+}
+
+/// The captures the fuzz run mutates: pcap in both byte orders, pcapng with time options, on three link types,
+/// holding game packets and text, and a telemetry CSV.
+fn bases() -> Vec<Vec<u8>> {
+    let outsim = packets::outsim::packet(10, [0.0; 3], [0.0; 3], [0.0, -3.0, 0.0], false);
+    let text = b"1.5 0 0 9.8 0 0 0".to_vec();
+    let frames: Vec<(u64, Vec<u8>)> = (0..4u64)
+        .map(|k| (1_000 * k, frame(if k % 2 == 0 { &outsim } else { &text })))
+        .collect();
+    let loop_frames: Vec<(u64, Vec<u8>)> = frames
+        .iter()
+        .map(|(t, f)| (*t, spec::loopback_frame(spec::LINKTYPE_NULL, false, false, f)))
+        .collect();
+    vec![
+        spec::pcap(false, RAW, &frames),
+        spec::pcap(true, spec::LINKTYPE_NULL, &loop_frames),
+        spec::pcapng(false, RAW, Some(9), Some(1 << 33), &frames),
+        spec::pcapng(true, spec::LINKTYPE_NULL, Some(0x86), None, &loop_frames),
+        b"t,ax,ay,az,wx,wy,wz\n0,0,0,9.8,0,0,0\n0.01,1,0,9.8,0,0,0.1\n".to_vec(),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
+
+    /// Mutated captures and files (bytes overwritten, with the large and small values that move lengths, times and
+    /// offsets, then cut anywhere): each is read or refused without a panic, and what is kept is bounded by the
+    /// file (no more datagrams, payload bytes, rows, errors or skip reasons than it has room for, no reason longer
+    /// than a line).
+    #[test]
+    fn mutated_captures_never_panic_and_stay_bounded(
+        base in 0usize..5,
+        edits in prop::collection::vec((any::<prop::sample::Index>(), prop::sample::select(vec![0u8, 1, 0x7f, 0x80, 0xfe, 0xff]), any::<u8>(), any::<bool>()), 1..8),
+        cut in any::<prop::sample::Index>(),
+        format in prop::sample::select(vec![TelemetryFormat::Auto, TelemetryFormat::Text, TelemetryFormat::Game(crate::games::Format::Outsim)]),
+    ) {
+        let mut bytes = bases().swap_remove(base);
+        for (at, special, random, use_special) in edits {
+            let i = at.index(bytes.len());
+            bytes[i] = if use_special { special } else { random };
+        }
+        let len = bytes.len();
+        for bytes in [&bytes[..], &bytes[..cut.index(len + 1)]] {
+            if let Ok(cap) = capture::read(bytes) {
+                prop_assert!(cap.datagrams.len() <= bytes.len() / 16);
+                prop_assert!(cap.datagrams.iter().map(|d| d.payload.len()).sum::<usize>() <= bytes.len());
+                prop_assert!(cap.skipped.len() <= cap.packets.max(1));
+            }
+            if let Ok((rows, errors, summary)) = rows(bytes, format, None, None) {
+                prop_assert!(rows.len() + errors.len() <= summary.packets + 1);
+                prop_assert!(errors.iter().all(|e| e.reason.len() <= 300), "{errors:?}");
+            }
+            if let Ok(text) = std::str::from_utf8(bytes) {
+                if let Ok((rows, errors)) = crate::input::table::read(text, &crate::analysis::cue::TELEMETRY_COLUMNS) {
+                    prop_assert!(rows.len() + errors.len() <= text.lines().count());
+                }
+            }
+        }
+    }
+}
