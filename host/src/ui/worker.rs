@@ -459,7 +459,6 @@ impl Device {
             source,
             errors,
             &options,
-            false,
             &|| halt.load(Ordering::SeqCst),
             None,
         );
