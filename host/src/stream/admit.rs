@@ -87,11 +87,11 @@ impl Admission {
             (off > self.window[i]).then(|| {
                 let (scale, unit) = if i < 3 { (1e3, "mm") } else { (1f64.to_degrees(), "deg") };
                 format!(
-                    "the first pose is {} {unit} outside the envelope in {}, more than the {} {unit} the platform \
-                     moves in the device's gross-jump window: refused (the stream starts at the next pose)",
-                    readable(off * scale),
+                    "the first pose is {:.1} {unit} outside the envelope in {}, more than the {:.1} {unit} the \
+                     platform moves in the device's gross-jump window: refused (the stream starts at the next pose)",
+                    off * scale,
                     NAMES[i],
-                    readable(self.window[i] * scale)
+                    self.window[i] * scale
                 )
             })
         })
@@ -141,7 +141,7 @@ mod tests {
         let mut far = home;
         far[0] = 1.0;
         let why = a.first(&Pose::from_array(far)).unwrap();
-        assert!(why.contains("outside the envelope in x") && why.contains("25 mm"), "{why}");
+        assert!(why.contains("outside the envelope in x") && why.contains("25.0 mm"), "{why}");
         // Just beyond the edge along x: limited by less than the window, so a stream may start there.
         let edge = a.limited(&Pose::from_array(far)).to_array();
         let mut near = home;
