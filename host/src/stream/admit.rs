@@ -15,7 +15,7 @@ pub(super) struct Admission {
     reach: f64,
     /// How far any axis moves at its velocity limit within the device's gross-jump window (m, rad): the device
     /// refuses a setpoint further than this from the one before.
-    window: [f64; 6],
+    pub(super) window: [f64; 6],
     mechanism: RingPlatform<f64>,
     centre: Pose<f64>,
     margins: EnvelopeMargins,

@@ -308,7 +308,7 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
         None => None,
     };
     let stopped = || signals.received() || console::has_failed();
-    let report = match super::run(&mut client, source, input_errors, &job.options, &stopped, recorder) {
+    let report = match super::run(&mut client, source, input_errors, &job.options, fast, &stopped, recorder) {
         Ok(report) => report,
         Err(client::ClientError::Interrupted) if console::has_failed() => return Ok(crate::out::EXIT_OUTPUT),
         Err(client::ClientError::Interrupted) => {

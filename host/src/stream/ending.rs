@@ -105,6 +105,7 @@ pub(super) fn report<T: Transport>(
         settle_sent: s.settle,
         washout_sent: s.washout,
         interpolated_sent: s.interpolated,
+        restarts: s.restarts,
         held_sent: s.held,
         held_s: s.held_s,
         held_gaps: s.held_gaps,
@@ -192,16 +193,20 @@ fn verdict(
             Some(format!("the device refused {refused} setpoints")),
             exit::REFUSED,
         )
+    } else if input_sent == 0 {
+        let unread = match input_errors.len() {
+            0 => String::new(),
+            n => format!(" ({n} input lines could not be read)"),
+        };
+        (
+            "input_errors",
+            Some(format!("no pose in the input{unread}")),
+            exit::INPUT_ERRORS,
+        )
     } else if !input_errors.is_empty() {
         (
             "input_errors",
             Some(format!("{} input lines could not be read", input_errors.len())),
-            exit::INPUT_ERRORS,
-        )
-    } else if input_sent == 0 {
-        (
-            "input_errors",
-            Some("no pose in the input".to_string()),
             exit::INPUT_ERRORS,
         )
     } else {

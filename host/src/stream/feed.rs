@@ -15,13 +15,35 @@ use super::{motion_pose, InputError, Source, UdpSource};
 use crate::link::client::{ClientError, Transport};
 use crate::out::console;
 
+/// Rows further apart than this (s) are not samples of one motion: the platform rests between them.
+const LONGEST_GAP: f64 = 60.0;
+
 impl<T: Transport> Streamer<'_, T> {
+    /// Stops the stream and lets the platform come to rest for a gap of `gap` seconds between two rows (a fast
+    /// run does not compute more than 3 s of a device at rest).
+    fn rest(&mut self, gap: f64, fast: bool) -> Result<(), StreamError> {
+        self.collect(0)?;
+        self.client.stop()?;
+        let wait = if fast { gap.min(3.0) } else { gap };
+        self.elapse(Duration::from_secs_f64(wait))?;
+        self.restarts += 1;
+        self.bar.suspend(|| {
+            console::err(&format!(
+                "{gap:.3} s between two rows: the stream stops, the platform rests, then leads in again"
+            ))
+        });
+        Ok(())
+    }
+
     /// Streams timed poses (a file or a motion): each at its own time, rows further apart than a quarter of the
-    /// stream timeout joined by interpolated setpoints ([`Streamer::between`]). Garbage is refused here, named and
-    /// counted in `errors`, never sent; the first pose must be one a stream can lead in to.
+    /// stream timeout joined by interpolated setpoints ([`Streamer::between`]); rows more than [`LONGEST_GAP`]
+    /// apart are not one motion: the stream stops, the platform rests, and leads in again at the next row
+    /// (`restarts`). Garbage is refused here, named and counted in `errors`, never sent; the pose a stream leads
+    /// in to must be one it can.
     pub(super) fn timed(
         &mut self,
         poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>, AuxLevels)>,
+        fast: bool,
         errors: &mut Vec<InputError>,
     ) -> Result<(), StreamError> {
         // The last row sent: its time and its pose as sent.
@@ -30,9 +52,10 @@ impl<T: Transport> Streamer<'_, T> {
             if (self.interrupted)() {
                 return Err(StreamError::Stop(Stop::Interrupted));
             }
+            let resting = last.is_some_and(|(l, _)| t - l > LONGEST_GAP);
             let refused = match last {
-                None => self.admission.first(&pose),
-                Some(_) => self.admission.garbage(&pose),
+                Some(_) if !resting => self.admission.garbage(&pose),
+                _ => self.admission.first(&pose),
             };
             if let Some(reason) = refused {
                 let line = line.unwrap_or(self.input_sent as usize + 1);
@@ -42,6 +65,10 @@ impl<T: Transport> Streamer<'_, T> {
             }
             let pose = match last {
                 None => self.start_and_lead_in(pose)?,
+                Some((l, _)) if resting => {
+                    self.rest(t - l, fast)?;
+                    self.start_and_lead_in(pose)?
+                }
                 Some((l, from)) => {
                     let to = self.limit(pose);
                     self.between(&from, &to, (t - l).max(0.0))?;
@@ -205,6 +232,7 @@ fn read(
 pub(super) fn feed<T: Transport>(
     s: &mut Streamer<'_, T>,
     source: &mut Source,
+    fast: bool,
     home: [f64; 6],
     limits: &MotionSettings,
     input_errors: &mut Vec<InputError>,
@@ -225,11 +253,11 @@ pub(super) fn feed<T: Transport>(
                 let t = k as f64 / rate_hz;
                 (None, t, motion_pose(motion, sine.as_ref(), t, home, limits), NO_AUX)
             });
-            (s.timed(&mut poses, input_errors), None, None)
+            (s.timed(&mut poses, fast, input_errors), None, None)
         }
         Source::Poses(p) => {
             let mut poses = p.iter().map(|(line, t, pose, aux)| (Some(*line), *t, *pose, *aux));
-            (s.timed(&mut poses, input_errors), None, None)
+            (s.timed(&mut poses, fast, input_errors), None, None)
         }
         Source::Udp(udp) => {
             let mut d = DatagramReport::default();

@@ -151,6 +151,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             settle: 0,
             washout: 0,
             interpolated: 0,
+            restarts: 0,
             held: 0,
             held_s: 0.0,
             held_gaps: 0,
@@ -208,6 +209,7 @@ pub fn run<T: Transport>(
     source: Source,
     input_errors: Vec<InputError>,
     options: &Options,
+    fast: bool,
     interrupted: &dyn Fn() -> bool,
     recorder: Option<(Recorder, String)>,
 ) -> Result<Report, ClientError> {
@@ -263,7 +265,7 @@ pub fn run<T: Transport>(
         baseline,
         recorder,
     );
-    let (outcome, datagrams, capture) = feed::feed(&mut s, &mut source, home, &limits, &mut input_errors);
+    let (outcome, datagrams, capture) = feed::feed(&mut s, &mut source, fast, home, &limits, &mut input_errors);
     s.bar.finish_and_clear();
     let ending = ending::wind_down(&mut s, outcome, record_path, restore_hz, options.telemetry_hz);
     Ok(ending::report(s, ending, input_errors, datagrams, capture))

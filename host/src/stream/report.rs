@@ -75,6 +75,9 @@ pub struct Report {
     /// Setpoints interpolated between a file's rows further apart than a quarter of the stream timeout (one every
     /// 10 ms), so that the stream lives through the gap.
     pub interpolated_sent: u32,
+    /// Rows more than a minute apart (not one motion): the stream stopped, the platform rested, and was led in
+    /// again at the next row.
+    pub restarts: u32,
     /// A live pose source's last pose sent again while it paused (every 10 ms from half the stream timeout on).
     pub held_sent: u32,
     /// Seconds a live source's pauses were bridged (its last pose held, or telemetry washed out), from half the

@@ -97,6 +97,7 @@ pub(super) struct Streamer<'a, T: Transport> {
     pub(super) settle: u32,
     pub(super) washout: u32,
     pub(super) interpolated: u32,
+    pub(super) restarts: u32,
     pub(super) held: u32,
     /// Seconds a paused live source's last pose was held, and the pauses.
     pub(super) held_s: f64,
@@ -333,9 +334,13 @@ impl<'a, T: Transport> Streamer<'a, T> {
         };
         let step = Duration::from_secs_f64(dt / n as f64);
         let way = way(from, to);
+        // A row the device would refuse as a gross jump is not made one by interpolating towards it: the last
+        // pose is held through the gap and the device judges the row.
+        let jump = (0..6).any(|i| way[i].abs() > self.admission.window[i]);
         for k in 1..n {
             self.elapse(step)?;
-            let pose = self.limit(along(from, &way, k as f64 / n as f64));
+            let f = if jump { 0.0 } else { k as f64 / n as f64 };
+            let pose = self.limit(along(from, &way, f));
             self.send(pose, Kind::Interpolated, NO_AUX)?;
             self.interpolated += 1;
         }

@@ -459,6 +459,7 @@ impl Device {
             source,
             errors,
             &options,
+            false,
             &|| halt.load(Ordering::SeqCst),
             None,
         );
