@@ -52,11 +52,18 @@ fn an_input_without_a_pose_moves_nothing() {
     let empty = dir.join("empty.csv");
     std::fs::write(&empty, "t,x,y,z,alpha,beta,gamma\n").unwrap();
     let garbage = dir.join("garbage.csv");
-    std::fs::write(&garbage, "t,x,y,z,alpha,beta,gamma\n0,nan,0,0.227,0,0,0\n1,0,0,inf,0,0,0\n").unwrap();
+    std::fs::write(
+        &garbage,
+        "t,x,y,z,alpha,beta,gamma\n0,nan,0,0.227,0,0,0\n1,0,0,inf,0,0,0\n",
+    )
+    .unwrap();
     for file in [&empty, &garbage] {
         let (code, report, stderr) = stream(&["--input", file.to_str().unwrap()]);
         assert_eq!(code, 3, "{stderr}");
-        assert!(report["reason"].as_str().unwrap().starts_with("no pose in the input"), "{report}");
+        assert!(
+            report["reason"].as_str().unwrap().starts_with("no pose in the input"),
+            "{report}"
+        );
         // The simulated controller starts Off: nothing powered up, homed or led in.
         assert_eq!(report["state"], "Off", "{report}");
         assert_eq!(report["lead_in_sent"], 0);
@@ -99,10 +106,16 @@ fn a_bad_first_row_is_refused_by_name_and_the_rest_followed() {
             let reason = report["input_errors"][0]["reason"].as_str().unwrap();
             assert!(reason.contains(words), "{row}: {reason}");
             assert!(stderr.contains("line 2:"), "{row}: said on stderr: {stderr}");
-            assert_eq!(report["setpoints_applied"], 199, "{row} {mode:?}: every other row followed: {report}");
+            assert_eq!(
+                report["setpoints_applied"], 199,
+                "{row} {mode:?}: every other row followed: {report}"
+            );
             assert_eq!(report["rejected"], serde_json::json!({}), "{row} {mode:?}");
             // The lead-in is bounded by the envelope: from home, a few hundred setpoints at most.
-            assert!(report["lead_in_sent"].as_u64().unwrap() < 500, "{row} {mode:?}: {report}");
+            assert!(
+                report["lead_in_sent"].as_u64().unwrap() < 500,
+                "{row} {mode:?}: {report}"
+            );
             assert!(started.elapsed() < Duration::from_secs(30), "{row} {mode:?}");
         }
     }
@@ -123,14 +136,26 @@ fn garbage_anywhere_in_a_file_is_refused_by_the_rule_of_every_source() {
         let (code, report, stderr) = stream(&["--input", file.to_str().unwrap()]);
         assert_eq!(code, 3, "{row}: {stderr}");
         assert_eq!(report["input_errors"][0]["line"], 102, "{row}: {report}");
-        assert!(report["input_errors"][0]["reason"].as_str().unwrap().contains(words), "{report}");
+        assert!(
+            report["input_errors"][0]["reason"].as_str().unwrap().contains(words),
+            "{report}"
+        );
         assert_eq!(report["setpoints_applied"], 199, "{row}: {report}");
-        assert_eq!(report["limited"]["largest_mm"].as_f64().unwrap(), 0.0, "{row}: nothing taken as a pose");
+        assert_eq!(
+            report["limited"]["largest_mm"].as_f64().unwrap(),
+            0.0,
+            "{row}: nothing taken as a pose"
+        );
     }
     // The same numbers over UDP are refused the same way, and counted.
     let (child, _stderr, addr) = spawn_live_stream(&["--udp", "127.0.0.1:0", "--udp-idle", "0.5", "--fast"]);
     let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
-    for text in ["0 0 0.227 0 0 0", "0 0 -500 0 0 0", "0 0 0.227 0 0 1e6", "0 0 0.228 0 0 0"] {
+    for text in [
+        "0 0 0.227 0 0 0",
+        "0 0 -500 0 0 0",
+        "0 0 0.227 0 0 1e6",
+        "0 0 0.228 0 0 0",
+    ] {
         socket.send_to(text.as_bytes(), &addr).unwrap();
         std::thread::sleep(Duration::from_millis(30));
     }
@@ -229,7 +254,7 @@ fn a_live_source_that_pauses_is_held() {
     // Each pause held from half the stream timeout (50 ms) on: 0.15 + 0.95 + 4.95 + 5.95 s, within the
     // machine's scheduling.
     assert!((11.0..12.6).contains(&held), "held {held} s: {report}");
-    assert_eq!(report["lead_in_sent"].as_u64().unwrap() > 0, true);
+    assert!(report["lead_in_sent"].as_u64().unwrap() > 0);
     assert_eq!(report["counts_agree"], true, "{report}");
     assert_eq!(report["rejected"], serde_json::json!({}), "{report}");
 }
@@ -267,7 +292,14 @@ fn a_closed_stderr_ends_the_run_as_a_stop_does() {
     let file = dir.join("jumps.csv");
     std::fs::write(&file, poses(&jumps)).unwrap();
     let mut child = Command::new(bin())
-        .args(["stream", "--sim", "--quiet", "--report-json", "--input", file.to_str().unwrap()])
+        .args([
+            "stream",
+            "--sim",
+            "--quiet",
+            "--report-json",
+            "--input",
+            file.to_str().unwrap(),
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -281,7 +313,10 @@ fn a_closed_stderr_ends_the_run_as_a_stop_does() {
     assert_eq!(status.code(), Some(141), "{report}");
     assert_eq!(report["exit_code"], 141);
     assert_eq!(report["state"], "Ready", "{report}");
-    assert!(report["setpoints_sent"].as_u64().unwrap() < 150, "ended at the write that failed: {report}");
+    assert!(
+        report["setpoints_sent"].as_u64().unwrap() < 150,
+        "ended at the write that failed: {report}"
+    );
 }
 
 /// Runs `ringpod ARGS` with standard output on /dev/full.
@@ -298,11 +333,24 @@ fn output_that_cannot_be_written_is_a_failure_named() {
         &["device", "rig", "show", "--sim"],
         &["ik", "--json", "--pose", "0,0,0.227,0,0,0"],
         &["presets"],
-        &["stream", "--sim", "--fast", "--motion", "heave", "--duration", "0.3", "--quiet", "--report-json"],
+        &[
+            "stream",
+            "--sim",
+            "--fast",
+            "--motion",
+            "heave",
+            "--duration",
+            "0.3",
+            "--quiet",
+            "--report-json",
+        ],
     ] {
         let (code, stderr) = to_dev_full(args);
         assert_eq!(code, Some(141), "{args:?}: {stderr}");
-        assert!(stderr.contains("standard output: No space left on device"), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("standard output: No space left on device"),
+            "{args:?}: {stderr}"
+        );
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
 }
@@ -327,9 +375,16 @@ fn files_are_written_whole_or_not_at_all() {
         let (code, stderr) = with_small_files(&dir, &format!("draw --out {picture}"));
         assert_eq!(code, Some(1), "{picture}: {stderr}");
         assert!(stderr.contains("File too large"), "{picture}: {stderr}");
-        assert_eq!(std::fs::read_to_string(dir.join(picture)).unwrap(), "before", "{picture}");
+        assert_eq!(
+            std::fs::read_to_string(dir.join(picture)).unwrap(),
+            "before",
+            "{picture}"
+        );
     }
-    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
     assert_eq!(leftovers.len(), 2, "no temporary file left behind: {leftovers:?}");
     // A record that cannot be written: exit 7, and the report's exit code says the same.
     let out = Command::new("sh")

@@ -129,11 +129,19 @@ fn bad_lines_are_reported_and_counts_add_up() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     let errors = report["input_errors"].as_array().unwrap();
     let lines: Vec<u64> = errors.iter().map(|e| e["line"].as_u64().unwrap()).collect();
-    assert_eq!(lines, [4, 5, 6, 8], "malformed number, short line, not finite, time not increasing");
+    assert_eq!(
+        lines,
+        [4, 5, 6, 8],
+        "malformed number, short line, not finite, time not increasing"
+    );
     assert!(stderr.contains("line 6: z = NaN is not a finite number"), "{stderr}");
     // 27 cm up in 10 ms: a gross jump; the host's limiting brought it inside, so it is not outside as well.
     assert!(stderr.contains("line 7: refused by the device: gross_jump"), "{stderr}");
-    assert_eq!(report["rejected"], serde_json::json!({"gross_jump": 1}), "garbage is not sent");
+    assert_eq!(
+        report["rejected"],
+        serde_json::json!({"gross_jump": 1}),
+        "garbage is not sent"
+    );
     // Every refusal with its line, in the report as on stderr.
     let refusals: Vec<(u64, String)> = report["refusals"]
         .as_array()
@@ -170,7 +178,10 @@ fn a_gap_in_the_stream_is_interpolated_and_a_long_one_rests() {
     let (report, out) = stream(&[], Some(csv));
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(report["restarts"], 0);
-    assert!((37..=39).contains(&report["interpolated_sent"].as_u64().unwrap()), "{report}");
+    assert!(
+        (37..=39).contains(&report["interpolated_sent"].as_u64().unwrap()),
+        "{report}"
+    );
     assert_eq!(report["setpoints_applied"], 4);
     assert_eq!(report["rejected"], serde_json::json!({}));
     assert_eq!(report["state"], "Ready");
@@ -614,7 +625,7 @@ fn a_live_sources_garbage_is_unreadable_and_the_session_goes_on() {
     );
     // The spell of garbage is a pause of the source: its last pose held, the stream alive.
     assert!(report["held_gaps"].as_u64().unwrap() >= 1, "{said}");
-    assert_eq!(report["lead_in_sent"].as_u64().unwrap() > 0, true);
+    assert!(report["lead_in_sent"].as_u64().unwrap() > 0);
     assert!(said.contains("datagram 1: value 1 is not a finite number"), "{said}");
     assert!(said.contains("datagram 4: value 6 is not a finite number"), "{said}");
 

@@ -24,13 +24,12 @@ use pcap_file::{DataLink, PcapError, TsResolution};
 
 /// The datagrams of a live source written to a pcap file as they arrive.
 pub struct CaptureWriter {
-    /// Unbuffered: a packet counted is in the file.
     writer: PcapWriter<std::fs::File>,
     /// The file beside the target, renamed to it by [`CaptureWriter::finish`].
     pending: crate::out::file::Pending,
     /// The socket's address (the packets' destination).
     local: SocketAddr,
-    /// Packets written to the file.
+    /// Packets written to the file (unbuffered: a packet counted is in it).
     pub packets: u64,
     /// The first write error: nothing more is written after it.
     pub error: Option<String>,
@@ -38,7 +37,11 @@ pub struct CaptureWriter {
 
 /// A pcap error in words: an I/O error says its own (pcap-file calls every one "Error reading bytes").
 fn words(e: PcapError) -> String {
-    if let PcapError::IoError(e) = e { e.to_string() } else { e.to_string() }
+    if let PcapError::IoError(e) = e {
+        e.to_string()
+    } else {
+        e.to_string()
+    }
 }
 
 impl CaptureWriter {

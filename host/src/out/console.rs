@@ -20,7 +20,11 @@ fn fail(stream: &str, e: &std::io::Error) {
     let mut first = FAILED.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     first.get_or_insert_with(|| format!("{stream}: {e}"));
     ANY.store(true, Ordering::SeqCst);
-    if let Some(flag) = NOTIFY.lock().unwrap_or_else(std::sync::PoisonError::into_inner).as_ref() {
+    if let Some(flag) = NOTIFY
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
+        .as_ref()
+    {
         flag.store(true, Ordering::SeqCst);
     }
 }

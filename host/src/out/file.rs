@@ -25,7 +25,9 @@ impl Pending {
     /// Opens a temporary file beside `target` (named after it, with its extension: some writers choose the
     /// format by the extension).
     pub fn beside(target: &Path) -> std::io::Result<Self> {
-        let name = target.file_name().map_or("out".into(), |n| n.to_string_lossy().into_owned());
+        let name = target
+            .file_name()
+            .map_or("out".into(), |n| n.to_string_lossy().into_owned());
         let suffix = target
             .extension()
             .map_or(String::new(), |e| format!(".{}", e.to_string_lossy()));
@@ -100,8 +102,16 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
         let pending = Pending::beside(&target).unwrap();
         drop(pending);
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "an abandoned write leaves nothing");
-        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new", "and the target as it was");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "an abandoned write leaves nothing"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&target).unwrap(),
+            "new",
+            "and the target as it was"
+        );
     }
 
     #[test]
@@ -114,6 +124,9 @@ mod tests {
         let linked = dir.path().join("b.csv");
         std::fs::hard_link(&a, &linked).unwrap();
         assert!(same_file(&linked, &a), "a hard link is the same file");
-        assert!(not_an_input(&dir.path().join("c.csv"), &[&a]).is_ok(), "a new file is no input");
+        assert!(
+            not_an_input(&dir.path().join("c.csv"), &[&a]).is_ok(),
+            "a new file is no input"
+        );
     }
 }

@@ -105,7 +105,13 @@ mod tests {
 
     fn admission() -> Admission {
         let velocity = [0.05, 0.05, 0.05, 1.0, 1.0, 1.0];
-        Admission::new(&TRAINER_MODEL, Preset::TrainerModel.home(), EnvelopeMargins::default(), velocity, 500)
+        Admission::new(
+            &TRAINER_MODEL,
+            Preset::TrainerModel.home(),
+            EnvelopeMargins::default(),
+            velocity,
+            500,
+        )
     }
 
     #[test]
@@ -131,7 +137,11 @@ mod tests {
         }
         let mut turning = home;
         turning[5] = -9_999.0;
-        assert_eq!(a.garbage(&Pose::from_array(turning)), None, "many turns of yaw are a pose");
+        assert_eq!(
+            a.garbage(&Pose::from_array(turning)),
+            None,
+            "many turns of yaw are a pose"
+        );
     }
 
     #[test]
@@ -141,7 +151,10 @@ mod tests {
         let mut far = home;
         far[0] = 1.0;
         let why = a.first(&Pose::from_array(far)).unwrap();
-        assert!(why.contains("outside the envelope in x") && why.contains("25.0 mm"), "{why}");
+        assert!(
+            why.contains("outside the envelope in x") && why.contains("25.0 mm"),
+            "{why}"
+        );
         // Just beyond the edge along x: limited by less than the window, so a stream may start there.
         let edge = a.limited(&Pose::from_array(far)).to_array();
         let mut near = home;

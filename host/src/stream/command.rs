@@ -308,7 +308,15 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
         None => None,
     };
     let stopped = || signals.received() || console::has_failed();
-    let report = match super::run(&mut client, source, input_errors, &job.options, fast, &stopped, recorder) {
+    let report = match super::run(
+        &mut client,
+        source,
+        input_errors,
+        &job.options,
+        fast,
+        &stopped,
+        recorder,
+    ) {
         Ok(report) => report,
         Err(client::ClientError::Interrupted) if console::has_failed() => return Ok(crate::out::EXIT_OUTPUT),
         Err(client::ClientError::Interrupted) => {
@@ -354,7 +362,10 @@ fn print(mut report: Report, json: bool, signals: &Signals) -> Result<u8, JobErr
     if !json {
         if let Some(r) = report.record.as_ref().filter(|r| r.error.is_none()) {
             let hz = r.telemetry_hz.map_or(String::new(), |hz| format!(" at {hz} Hz"));
-            notes.push(format!("recorded {} rows to {}{hz} ({} dropped)", r.rows, r.path, r.dropped));
+            notes.push(format!(
+                "recorded {} rows to {}{hz} ({} dropped)",
+                r.rows, r.path, r.dropped
+            ));
         }
         if let Some(c) = report.capture.as_ref().filter(|c| c.error.is_none()) {
             notes.push(format!("captured {} datagrams to {}", c.packets, c.path));

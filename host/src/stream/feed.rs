@@ -99,7 +99,8 @@ impl<T: Transport> Streamer<'_, T> {
             .set_read_timeout(Some(Duration::from_millis(1)))
             .map_err(ClientError::Io)?;
         let addr = source.socket.local_addr().map_or("?".into(), |a| a.to_string());
-        self.bar.suspend(|| console::err(&format!("streaming: send datagrams to {addr}")));
+        self.bar
+            .suspend(|| console::err(&format!("streaming: send datagrams to {addr}")));
         // The largest UDP payload: no datagram is ever cut.
         let mut buf = vec![0u8; 65_536];
         let mut wall = Instant::now();
@@ -136,26 +137,11 @@ impl<T: Transport> Streamer<'_, T> {
             // Only a readable datagram of the source counts as the source being there: a stranger's datagrams and
             // unreadable ones (a flood of them included) leave the pause logic below running.
             let readable = datagram.and_then(|(n, from)| read(source, &buf[..n], from, now, report, errors, &self.bar));
-            let admitted = readable.and_then(|(number, pose)| {
-                let refused = if streaming {
-                    self.admission.garbage(&pose)
-                } else {
-                    self.admission.first(&pose)
-                };
-                match refused {
-                    None => Some((number, pose)),
-                    Some(reason) => {
-                        report.unreadable += 1;
-                        self.bar.suspend(|| console::err(&format!("datagram {number}: {reason}")));
-                        errors.push(InputError { line: number, reason });
-                        None
-                    }
-                }
-            });
+            let admitted =
+                readable.and_then(|(n, pose)| self.admit(n, pose, streaming, report, errors).map(|p| (n, p)));
             let Some((number, pose)) = admitted else {
                 let quiet = now - last_pose;
-                // A pause: from half the stream timeout on, a setpoint every 10 ms keeps the stream alive, the
-                // vehicle at rest through the washout (the platform glides back to neutral) or the last pose held.
+                // A pause: from half the stream timeout on, a setpoint every 10 ms keeps the stream alive.
                 if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= KEEP_ALIVE {
                     let dt = (now - last_idle).min(2 * KEEP_ALIVE);
                     last_idle = now;
@@ -163,19 +149,7 @@ impl<T: Transport> Streamer<'_, T> {
                         pausing = true;
                         self.held_gaps += 1;
                     }
-                    self.held_s += dt.as_secs_f64();
-                    match source.decoder.idle(dt.as_secs_f64(), now) {
-                        Some(pose) => {
-                            let pose = self.limit(pose);
-                            self.send(pose, Kind::Washout, NO_AUX)?;
-                            self.washout += 1;
-                        }
-                        None => {
-                            let last = self.last_sent;
-                            self.send(last, Kind::Held, NO_AUX)?;
-                            self.held += 1;
-                        }
-                    }
+                    self.bridge(source, dt, now)?;
                 }
                 if quiet >= source.idle {
                     return self.collect(0);
@@ -196,6 +170,52 @@ impl<T: Transport> Streamer<'_, T> {
             // The lead-in let its own time pass: the device's clock is already there.
             wall = Instant::now();
         }
+    }
+}
+
+impl<T: Transport> Streamer<'_, T> {
+    /// A readable datagram's pose if it may be sent: garbage, or a pose to lead in to that is too far outside, is
+    /// refused with its number and counted as unreadable.
+    fn admit(
+        &mut self,
+        number: usize,
+        pose: Pose<f64>,
+        streaming: bool,
+        report: &mut DatagramReport,
+        errors: &mut Vec<InputError>,
+    ) -> Option<Pose<f64>> {
+        let refused = if streaming {
+            self.admission.garbage(&pose)
+        } else {
+            self.admission.first(&pose)
+        };
+        let Some(reason) = refused else {
+            return Some(pose);
+        };
+        report.unreadable += 1;
+        self.bar
+            .suspend(|| console::err(&format!("datagram {number}: {reason}")));
+        errors.push(InputError { line: number, reason });
+        None
+    }
+
+    /// One setpoint `dt` into a pause of a live source, keeping the stream alive: the vehicle at rest through the
+    /// washout (the platform glides back to neutral), or a pose source's last pose held.
+    fn bridge(&mut self, source: &mut UdpSource, dt: Duration, now: Instant) -> Result<(), StreamError> {
+        self.held_s += dt.as_secs_f64();
+        match source.decoder.idle(dt.as_secs_f64(), now) {
+            Some(pose) => {
+                let pose = self.limit(pose);
+                self.send(pose, Kind::Washout, NO_AUX)?;
+                self.washout += 1;
+            }
+            None => {
+                let last = self.last_sent;
+                self.send(last, Kind::Held, NO_AUX)?;
+                self.held += 1;
+            }
+        }
+        Ok(())
     }
 }
 

@@ -216,7 +216,11 @@ fn a_cueing_file_caught_half_way_through_a_save_is_ignored_until_whole() {
     let old = "tilt_limit_deg = 12\n";
     let (steady, _) = reload_run("steady", old, None);
     // An editor's truncate-then-write seen after the truncate, and seen cut short: neither is all defaults.
-    for (name, caught) in [("empty", ""), ("blank", "\n  \n"), ("cut", "tilt_limit_deg = 12\ntranslation_scale = [0.15, 0.")] {
+    for (name, caught) in [
+        ("empty", ""),
+        ("blank", "\n  \n"),
+        ("cut", "tilt_limit_deg = 12\ntranslation_scale = [0.15, 0."),
+    ] {
         let (kept, d) = reload_run(name, old, Some(caught));
         assert_eq!(d.reloads(), (0, 0, 1), "{name}: ignored, not refused and not taken");
         let Decoder::Telemetry { washout, .. } = &d else {
@@ -236,7 +240,8 @@ fn a_cueing_file_caught_half_way_through_a_save_is_ignored_until_whole() {
     for (k, text) in ["", "tilt_limit_deg = 8\n"].iter().enumerate() {
         std::fs::write(&path, text).unwrap();
         let f = std::fs::File::options().write(true).open(&path).unwrap();
-        f.set_modified(SystemTime::now() + Duration::from_secs(5 + k as u64)).unwrap();
+        f.set_modified(SystemTime::now() + Duration::from_secs(5 + k as u64))
+            .unwrap();
         watch.poll(start + WATCH_EVERY * (k as u32 + 1), &mut washout);
     }
     assert_eq!((watch.reloads, watch.refused, watch.ignored), (1, 0, 1));
