@@ -13,18 +13,26 @@ mod signals;
 mod stream;
 mod ui;
 
-use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
 
 fn main() -> ExitCode {
-    match run(&cli::Cli::parse().command) {
-        Ok(code) => ExitCode::from(code),
+    let code = match run(&cli::Cli::parse().command) {
+        Ok(code) => code,
         Err(e) => {
-            eprintln!("ringpod: {e:#}");
-            ExitCode::from(out::EXIT_ERROR)
+            out::console::err(&format!("ringpod: {e:#}"));
+            out::EXIT_ERROR
         }
+    };
+    // What a command printed is flushed and checked here, for every command: output that could not be written
+    // (a full disk, a closed pipe) is a failure, named, not an exit 0 with an empty file.
+    match out::console::finish() {
+        Some(failed) => {
+            out::console::err(&format!("ringpod: {failed}"));
+            ExitCode::from(out::EXIT_OUTPUT)
+        }
+        None => ExitCode::from(code),
     }
 }
 
@@ -110,9 +118,9 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
     })
 }
 
-/// Prints a command's text; a closed pipe (`| head`) is not an error of ours.
+/// Prints a command's text (a failure is kept and decides the exit code in `main`).
 fn print(text: &str) {
-    let _ = std::io::stdout().write_all(text.as_bytes());
+    out::console::out(text);
 }
 
 /// Prints a kinematics command's text and passes on its exit code.

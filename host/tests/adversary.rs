@@ -423,9 +423,9 @@ fn an_option_that_would_be_ignored_is_refused() {
 #[test]
 fn huge_and_tiny_numbers_are_said_readably() {
     for args in [
-        vec!["stream", "--sim", "--duration=1e308"],
-        vec!["stream", "--sim", "--rate=1e308"],
-        vec!["stream", "--sim", "--duration=-1e-320"],
+        vec!["stream", "--sim", "--motion", "demo", "--duration=1e308"],
+        vec!["stream", "--sim", "--motion", "demo", "--rate=1e308"],
+        vec!["stream", "--sim", "--motion", "demo", "--duration=-1e-320"],
         vec!["stream", "--sim", "--udp", "127.0.0.1:0", "--udp-idle=1e308"],
     ] {
         let (code, _, stderr) = run(&args);

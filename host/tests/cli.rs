@@ -1504,7 +1504,9 @@ fn sine_experiments_run_as_asked_or_say_how_they_were_limited() {
     assert!((a / (0.3 * std::f64::consts::TAU) - 1.0).abs() < 0.05, "{a}\n{summary}");
     // Parameters without a sine, a sine without them: exit 1 in one line.
     for args in [
-        &["stream", "--sim", "--fast", "--quiet", "--axis", "z"][..],
+        &[
+            "stream", "--sim", "--fast", "--quiet", "--motion", "heave", "--axis", "z",
+        ][..],
         &[
             "stream",
             "--sim",

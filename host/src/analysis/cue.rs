@@ -88,6 +88,11 @@ pub struct Options<'a> {
 
 /// Runs the command; returns the summary as text and the exit code.
 pub fn run(args: &Options) -> Result<(String, u8), CueError> {
+    // An output that is the input (or the cueing file) would destroy it: refused before anything is read.
+    let inputs: Vec<&Path> = [Some(args.input), args.config].into_iter().flatten().collect();
+    for out in [Some(args.out), args.plot].into_iter().flatten() {
+        crate::out::file::not_an_input(out, &inputs).map_err(|e| CliError::file(out, e))?;
+    }
     let config = load_config(args.config, args.profile).map_err(CliError::from)?;
     let (rows, mut errors, capture) = read_input(args)?;
     let selected = Selected::of(args.mechanism, args.geometry)?;
@@ -263,8 +268,10 @@ fn read_input(
 }
 
 fn write_poses(path: &Path, cued: &[Cued]) -> Result<(), CueError> {
+    // Written whole beside the target and renamed over it: a failure leaves the target as it was.
     let write = || -> std::io::Result<()> {
-        let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let mut pending = crate::out::file::Pending::beside(path)?;
+        let mut out = std::io::BufWriter::new(pending.file());
         writeln!(out, "t,x,y,z,alpha,beta,gamma")?;
         for c in cued {
             let p = c.pose.to_array();
@@ -274,7 +281,9 @@ fn write_poses(path: &Path, cued: &[Cued]) -> Result<(), CueError> {
                 c.t, p[0], p[1], p[2], p[3], p[4], p[5]
             )?;
         }
-        out.flush()
+        out.flush()?;
+        drop(out);
+        pending.commit()
     };
     write().map_err(|reason| CueError::Output {
         path: path.to_path_buf(),

@@ -150,7 +150,7 @@ pub fn run(args: &Options) -> Result<String, CliError> {
     }
     let _ = writeln!(text, "picture: {}", args.out.display());
     if let Some(path) = args.table {
-        std::fs::write(path, table(&slice, &all_stats)).map_err(|e| CliError::file(path, e))?;
+        crate::out::file::write(path, table(&slice, &all_stats).as_bytes()).map_err(|e| CliError::file(path, e))?;
         let _ = writeln!(text, "table: {}", path.display());
     }
     Ok(text)

@@ -57,9 +57,11 @@ pub enum Command {
     /// A labelled isometric drawing of a mechanism at a pose (ring, carriages, chains, platform, axes; the tool
     /// carrier's guide, dyads, frame and tool), every point from its inverse kinematics, as SVG or PNG.
     Draw(DrawArgs),
-    /// Streams poses to the controller (a board on --port, or the simulated controller with --sim): connects,
-    /// powers up and homes if needed, streams (poses outside the envelope limited into it), then stops and waits for
-    /// rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
+    /// Streams poses to the controller (a board on --port, or the simulated controller with --sim) from one source,
+    /// which must be given (there is no default): --input FILE.csv, --motion NAME, --udp ADDR or --telemetry-udp
+    /// ADDR. Checks the input's first pose, connects, powers up and homes if needed, streams (poses outside the
+    /// envelope limited into it; a file's rows interpolated every 10 ms across longer gaps, a live source's last
+    /// pose held while it pauses), then stops and waits for rest. Exit codes: 0 every pose followed (limited ones included), 1 the stream could not start, 3 input
     /// lines that could not be read, 4 setpoints the device refused, 5 the device stopped streaming or faulted,
     /// 6 the link was lost, 7 the --record or --capture file could not be written, 128 + the signal when stopped by one (130 Ctrl-C, 143 SIGTERM).
     Stream(Box<StreamArgs>),

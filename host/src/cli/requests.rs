@@ -137,6 +137,9 @@ pub enum RequestError {
     /// `--capture` without a UDP source.
     #[error("--capture records a UDP source: it needs --udp or --telemetry-udp")]
     CaptureWithoutUdp,
+    /// `stream` without a source (clap requires one; this is the same rule for a request built otherwise).
+    #[error("stream needs a source: --input FILE.csv, --motion NAME, --udp ADDR or --telemetry-udp ADDR")]
+    NoSource,
     /// `--motion sine` without all of its parameters.
     #[error("--motion sine needs --axis, --frequency and --velocity-amplitude or --amplitude")]
     IncompleteSine,
@@ -189,7 +192,7 @@ impl StreamArgs {
                 degrees: self.degrees,
             },
             (None, None, None) => Input::Motion {
-                motion: self.motion.unwrap_or(crate::stream::Motion::Demo),
+                motion: self.motion.ok_or(RequestError::NoSource)?,
                 sine: self.sine()?,
                 seconds: self.duration,
                 rate_hz: self.rate,

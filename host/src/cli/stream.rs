@@ -4,7 +4,10 @@ use clap::Args;
 
 use super::ControllerArgs;
 
+/// The source is required: no default motion, so that a script whose arguments came out empty, or a command typed
+/// without one, never moves a platform.
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["input", "motion", "udp", "telemetry_udp"])))]
 pub struct StreamArgs {
     /// The controller.
     #[command(flatten)]
@@ -12,7 +15,7 @@ pub struct StreamArgs {
     /// With --sim: run as fast as possible instead of in real time.
     #[arg(long, requires = "sim")]
     pub fast: bool,
-    /// Built-in motion.
+    /// A built-in motion (one source is required: --input, --motion, --udp or --telemetry-udp).
     #[arg(long, value_enum, conflicts_with = "input")]
     pub motion: Option<crate::stream::Motion>,
     /// Length of a built-in motion (s).

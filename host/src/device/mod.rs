@@ -55,8 +55,6 @@ pub enum Action {
 pub fn run(target: &Target, action: &Action) -> Result<u8, DeviceError> {
     let mut client = Client::new(link::connect(target, false)?);
     client.hello()?;
-    let mut out = std::io::stdout();
-    // A closed stdout (`| head`) is not an error of the device's.
     let text = match action {
         Action::Status => status(&mut client)?,
         Action::Enable => status_after(&mut client, |c| c.enable())?,
@@ -83,7 +81,8 @@ pub fn run(target: &Target, action: &Action) -> Result<u8, DeviceError> {
         Action::Restart => rig::restart(&mut client)?,
         Action::Config(words) => serde_json::to_string_pretty(&settings::run(&mut client, words)?)?,
     };
-    let _ = writeln!(out, "{text}");
+    // A failed write decides the exit code in `main`.
+    crate::out::console::out(&format!("{text}\n"));
     Ok(0)
 }
 

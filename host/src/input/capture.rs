@@ -14,7 +14,6 @@
 //! UDP, fragments of IP datagrams (not reassembled) and packets cut short by the snap length are skipped and counted.
 
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::net::{IpAddr, Ipv4Addr, Ipv6Addr, SocketAddr};
 use std::time::{Duration, SystemTime};
 
@@ -25,27 +24,40 @@ use pcap_file::{DataLink, PcapError, TsResolution};
 
 /// The datagrams of a live source written to a pcap file as they arrive.
 pub struct CaptureWriter {
-    writer: PcapWriter<std::io::BufWriter<std::fs::File>>,
+    writer: PcapWriter<std::fs::File>,
+    /// The file beside the target, renamed to it by [`CaptureWriter::finish`].
+    pending: crate::out::file::Pending,
     /// The socket's address (the packets' destination).
     local: SocketAddr,
-    /// Packets written.
+    /// Packets written to the file (unbuffered: a packet counted is in it).
     pub packets: u64,
     /// The first write error: nothing more is written after it.
     pub error: Option<String>,
 }
 
+/// A pcap error in words: an I/O error says its own (pcap-file calls every one "Error reading bytes").
+fn words(e: PcapError) -> String {
+    if let PcapError::IoError(e) = e {
+        e.to_string()
+    } else {
+        e.to_string()
+    }
+}
+
 impl CaptureWriter {
-    /// Creates the file (its header written) for datagrams arriving at `local`.
+    /// Opens a file beside `path` (its header written; `path` replaced when finished) for datagrams to `local`.
     pub fn create(path: &std::path::Path, local: SocketAddr) -> Result<Self, String> {
-        let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+        let mut pending = crate::out::file::Pending::beside(path).map_err(|e| e.to_string())?;
+        let file = pending.file().try_clone().map_err(|e| e.to_string())?;
         let header = PcapHeader {
             datalink: DataLink::RAW,
             ts_resolution: TsResolution::MicroSecond,
             ..PcapHeader::default()
         };
-        let writer = PcapWriter::with_header(std::io::BufWriter::new(file), header).map_err(|e| e.to_string())?;
+        let writer = PcapWriter::with_header(file, header).map_err(words)?;
         Ok(Self {
             writer,
+            pending,
             local,
             packets: 0,
             error: None,
@@ -59,25 +71,22 @@ impl CaptureWriter {
         }
         let data = udp_packet(from, self.local, payload);
         let time = at.duration_since(SystemTime::UNIX_EPOCH).unwrap_or_default();
-        match self
-            .writer
-            .write_packet(&PcapPacket::new(time, data.len() as u32, &data))
-        {
+        let packet = PcapPacket::new(time, data.len() as u32, &data);
+        match self.writer.write_packet(&packet).map_err(words) {
             Ok(_) => self.packets += 1,
-            Err(e) => self.error = Some(e.to_string()),
+            Err(e) => self.error = Some(e),
         }
     }
 
-    /// Flushes the file: the packets written, or the first error.
+    /// Puts the file in place: the packets written, or the first error (the target then left as it was).
     pub fn finish(self) -> (u64, Option<String>) {
-        let packets = self.packets;
         if let Some(e) = self.error {
-            return (packets, Some(e));
+            return (0, Some(e));
         }
-        let mut file = self.writer.into_writer();
-        match file.flush().and_then(|()| file.get_ref().sync_all()) {
-            Ok(()) => (packets, None),
-            Err(e) => (packets, Some(e.to_string())),
+        drop(self.writer);
+        match self.pending.commit() {
+            Ok(()) => (self.packets, None),
+            Err(e) => (0, Some(e.to_string())),
         }
     }
 }

@@ -38,6 +38,18 @@ pub fn load_config(path: Option<&Path>, profile: Option<&str>) -> Result<CueConf
     parse_config(&text, profile).map_err(in_file)
 }
 
+/// Whether a cueing file's text is whole: not empty (an editor truncates before it writes; an empty file is not
+/// a configuration of all defaults, which a file with only a comment still is) and TOML (a file cut short
+/// half-way through a key is not). What it says is checked by [`parse_config`].
+pub fn whole(text: &str) -> Result<(), String> {
+    if text.trim().is_empty() {
+        return Err("empty".into());
+    }
+    toml::from_str::<toml::Table>(text)
+        .map(|_| ())
+        .map_err(|e| format!("not TOML: {}", e.message()))
+}
+
 /// A cueing file's text: the base keys, and `[profiles.NAME]` tables, each a partial override of the base. With
 /// `profile`, that profile's keys replace the base's, each key as a whole (a `[profiles.NAME.smoothing]` table
 /// replaces `[smoothing]`, a per-axis list replaces the list); an unknown profile is refused naming the known

@@ -55,23 +55,42 @@ pub trait Picture {
         DB::ErrorType: 'static;
 }
 
-/// Writes `picture` to `out`: SVG when the name ends in `.svg`, PNG when it ends in `.png`.
+/// Writes `picture` to `out`: SVG when the name ends in `.svg`, PNG when it ends in `.png`. It is drawn in memory
+/// and written whole ([`super::file::write`]): a full disk leaves no partial picture behind, and is an error.
 pub fn save(out: &Path, size: (u32, u32), picture: &impl Picture) -> Result<(), PlotError> {
     register_fonts();
     let fail = failed(out);
-    match out.extension().and_then(|e| e.to_str()) {
+    let bytes = match out.extension().and_then(|e| e.to_str()) {
         Some("svg") => {
-            let root = SVGBackend::new(out, size).into_drawing_area();
-            picture.paint(&root, out)?;
-            root.present().map_err(|e| fail(&e))
+            let mut text = String::new();
+            {
+                let root = SVGBackend::with_string(&mut text, size).into_drawing_area();
+                picture.paint(&root, out)?;
+                root.present().map_err(|e| fail(&e))?;
+            }
+            text.into_bytes()
         }
         Some("png") => {
-            let root = BitMapBackend::new(out, size).into_drawing_area();
-            picture.paint(&root, out)?;
-            root.present().map_err(|e| fail(&e))
+            let mut pixels = vec![0u8; size.0 as usize * size.1 as usize * 3];
+            {
+                let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
+                picture.paint(&root, out)?;
+                root.present().map_err(|e| fail(&e))?;
+            }
+            let mut png = Vec::new();
+            image::ImageEncoder::write_image(
+                image::codecs::png::PngEncoder::new(&mut png),
+                &pixels,
+                size.0,
+                size.1,
+                image::ColorType::Rgb8,
+            )
+            .map_err(|e| fail(&e))?;
+            png
         }
-        _ => Err(PlotError::Format(out.to_path_buf())),
-    }
+        _ => return Err(PlotError::Format(out.to_path_buf())),
+    };
+    super::file::write(out, &bytes).map_err(|e| fail(&e))
 }
 
 /// One line of a time panel.

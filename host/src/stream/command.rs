@@ -2,7 +2,6 @@
 //! the end is reported. The command line builds a [`Job`]; [`run`] opens the source and the device, checks loads,
 //! streams and prints the report, and its exit code is [`super::exit`]'s.
 
-use std::io::Write;
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
@@ -10,6 +9,7 @@ use super::{datagram, exit, Motion, Options, Report, Source, UdpSource};
 use crate::error::CliError;
 use crate::input::{files, numbers};
 use crate::link::{self, client};
+use crate::out::console;
 use crate::signals::Signals;
 
 /// Where a stream's poses come from.
@@ -201,7 +201,7 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
             let text = files::read_text(path, files::DATA_LIMIT).map_err(in_file)?;
             let (poses, errors) = super::read_csv(&text, *degrees).map_err(in_file)?;
             for e in &errors {
-                eprintln!("{}: line {}: {}", path.display(), e.line, e.reason);
+                console::err(&format!("{}: line {}: {}", path.display(), e.line, e.reason));
             }
             (Source::Poses(poses), errors)
         }
@@ -252,13 +252,33 @@ fn loads_keep_up<T: client::Transport>(
     };
     let platform = super::loads_platform(client, rig)?;
     let check = super::check_loads(source, &payload, &platform)?;
-    eprint!("{}", check.text);
+    console::err(check.text.trim_end());
     Ok(check.keeps_up)
+}
+
+/// The files a stream reads (a pose file, a cueing file): none may be written by it.
+fn inputs(input: &Input) -> Vec<&std::path::Path> {
+    match input {
+        Input::File { path, .. } => vec![path.as_path()],
+        Input::Udp {
+            holds: Datagrams::Telemetry {
+                cue_config: Some(path), ..
+            },
+            ..
+        } => vec![path.as_path()],
+        _ => Vec::new(),
+    }
 }
 
 /// Runs a stream: the exit codes of [`exit`].
 pub fn run(job: &Job) -> Result<u8, JobError> {
     let signals = Signals::install()?;
+    // A closed or full standard output or error ends the run as a stop does (and wakes any wait for the device).
+    console::on_failure(signals.flag());
+    let read = inputs(&job.input);
+    for out in [&job.record, &job.capture].into_iter().flatten() {
+        crate::out::file::not_an_input(out, &read).map_err(|e| CliError::file(out, e))?;
+    }
     let (mut source, input_errors) = open(&job.input)?;
     if let (Some(path), Source::Udp(udp)) = (&job.capture, &mut source) {
         let local = udp.socket.local_addr()?;
@@ -279,7 +299,7 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
     // Checked on the platform the device runs, before it powers up.
     if let Some(check) = &job.check_loads {
         if !loads_keep_up(check, &source, &mut client, rig.as_ref())? {
-            eprintln!("ringpod: the motion asks more than the drives give (--check-loads): not streamed");
+            console::err("ringpod: the motion asks more than the drives give (--check-loads): not streamed");
             return Ok(exit::NOT_STARTED);
         }
     }
@@ -290,45 +310,85 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
         )),
         None => None,
     };
+    let stopped = || signals.received() || console::has_failed();
     let report = match super::run(
         &mut client,
         source,
         input_errors,
         &job.options,
         fast,
-        &|| signals.received(),
+        &stopped,
         recorder,
     ) {
-        Ok(mut report) => {
-            if report.exit_code == exit::INTERRUPTED {
-                report.exit_code = signals.exit_code();
-                report.reason = Some(format!("interrupted by {}", signals.name()));
-            }
-            report
-        }
+        Ok(report) => report,
+        Err(client::ClientError::Interrupted) if console::has_failed() => return Ok(crate::out::EXIT_OUTPUT),
         Err(client::ClientError::Interrupted) => {
-            eprintln!("ringpod: interrupted by {} before the stream started", signals.name());
+            console::err(&format!(
+                "ringpod: interrupted by {} before the stream started",
+                signals.name()
+            ));
             return Ok(signals.exit_code());
         }
         Err(e) => {
-            eprintln!("ringpod: the stream could not start: {e}");
+            console::err(&format!("ringpod: the stream could not start: {e}"));
             return Ok(exit::NOT_STARTED);
         }
     };
-    print(&report, job.report_json)
+    print(report, job.report_json, &signals)
 }
 
-/// Prints the report (the bar drew on stderr; the report goes to stdout) and gives the run's exit code.
-fn print(report: &Report, json: bool) -> Result<u8, JobError> {
-    // A closed stdout (`| head -c1`) loses the summary, not the run's exit code.
-    let mut out = std::io::stdout();
-    if json {
-        let _ = writeln!(out, "{}", serde_json::to_string_pretty(report)?);
+/// Settles the report's exit code (a signal's, a closed output's, a record that failed), says on stderr what went
+/// wrong, then prints the report on stdout: the report's `exit_code` is the process's.
+fn print(mut report: Report, json: bool, signals: &Signals) -> Result<u8, JobError> {
+    if report.exit_code == exit::INTERRUPTED {
+        report.exit_code = signals.exit_code();
+        report.reason = Some(format!("interrupted by {}", signals.name()));
+    }
+    let mut notes = Vec::new();
+    if let Some(reason) = &report.reason {
+        notes.push(format!("ringpod: {reason}"));
+    }
+    for (what, path, error) in [
+        report.record.as_ref().map(|r| ("record", &r.path, &r.error)),
+        report.capture.as_ref().map(|c| ("capture", &c.path, &c.error)),
+    ]
+    .into_iter()
+    .flatten()
+    {
+        if let Some(e) = error {
+            notes.push(format!("ringpod: the {what} {path} could not be written: {e}"));
+            if report.exit_code == exit::FOLLOWED {
+                report.exit_code = exit::RECORD_FAILED;
+            }
+        }
+    }
+    if !json {
+        if let Some(r) = report.record.as_ref().filter(|r| r.error.is_none()) {
+            let hz = r.telemetry_hz.map_or(String::new(), |hz| format!(" at {hz} Hz"));
+            notes.push(format!(
+                "recorded {} rows to {}{hz} ({} dropped)",
+                r.rows, r.path, r.dropped
+            ));
+        }
+        if let Some(c) = report.capture.as_ref().filter(|c| c.error.is_none()) {
+            notes.push(format!("captured {} datagrams to {}", c.packets, c.path));
+        }
+    }
+    for note in notes {
+        console::err(&note);
+    }
+    // Standard error closed or full (during the run or just now): the run ended as a stop does, and says so.
+    if let Some(failed) = console::failed() {
+        report.outcome = "output_failed";
+        report.reason = Some(format!("{failed}: the run ended as a stop does"));
+        report.exit_code = crate::out::EXIT_OUTPUT;
+    }
+    let text = if json {
+        format!("{}\n", serde_json::to_string_pretty(&report)?)
     } else {
         let rejected: u32 = report.rejected.values().sum();
-        let _ = writeln!(
-            out,
-            "{}: {} setpoints sent, {} applied ({} limited on the host, {} on the device), {} refused; final state {}; steps {:?}",
+        let mut text = format!(
+            "{}: {} setpoints sent, {} applied ({} limited on the host, {} on the device), {} refused; final state {}; steps {:?}\n",
             report.outcome,
             report.setpoints_sent,
             report.setpoints_applied,
@@ -339,43 +399,11 @@ fn print(report: &Report, json: bool) -> Result<u8, JobError> {
             report.final_steps
         );
         for (reason, n) in &report.rejected {
-            let _ = writeln!(out, "  refused {reason}: {n}");
+            text += &format!("  refused {reason}: {n}\n");
         }
-    }
-    if let Some(reason) = &report.reason {
-        eprintln!("ringpod: {reason}");
-    }
-    if let Some(record) = &report.record {
-        match &record.error {
-            Some(e) => {
-                eprintln!("ringpod: the record {} could not be written: {e}", record.path);
-                if report.exit_code == exit::FOLLOWED {
-                    return Ok(exit::RECORD_FAILED);
-                }
-            }
-            None if !json => {
-                eprintln!(
-                    "recorded {} rows to {}{} ({} dropped)",
-                    record.rows,
-                    record.path,
-                    record.telemetry_hz.map_or(String::new(), |hz| format!(" at {hz} Hz")),
-                    record.dropped
-                )
-            }
-            None => {}
-        }
-    }
-    if let Some(capture) = &report.capture {
-        match &capture.error {
-            Some(e) => {
-                eprintln!("ringpod: the capture {} could not be written: {e}", capture.path);
-                if report.exit_code == exit::FOLLOWED {
-                    return Ok(exit::RECORD_FAILED);
-                }
-            }
-            None if !json => eprintln!("captured {} datagrams to {}", capture.packets, capture.path),
-            None => {}
-        }
-    }
+        text
+    };
+    // A closed stdout loses the report; `main` then exits with the code for a lost output.
+    console::out(&text);
     Ok(report.exit_code)
 }

@@ -8,6 +8,7 @@ use ringpod_core::cueing::{self, Live, SampleError, Telemetry, G};
 use ringpod_core::kinematics::Pose;
 
 use crate::games::{self, numbers};
+use crate::out::console;
 
 /// Turns datagrams into poses.
 pub enum Decoder {
@@ -51,8 +52,11 @@ pub struct Watch {
     polled: Option<Instant>,
     /// Changes that took effect.
     pub reloads: u32,
-    /// Changes refused (unreadable, or a key out of range).
+    /// Changes refused (a key out of range, an unknown profile).
     pub refused: u32,
+    /// Reads ignored as not yet whole: empty, unreadable or not TOML (an editor's truncate-then-write caught
+    /// half-way); the running configuration stays and the file is read again at its next change.
+    pub ignored: u32,
 }
 
 fn stamp(path: &std::path::Path) -> Option<(SystemTime, u64)> {
@@ -70,6 +74,7 @@ impl Watch {
             polled: None,
             reloads: 0,
             refused: 0,
+            ignored: 0,
         }
     }
 
@@ -88,19 +93,32 @@ impl Watch {
         }
         self.seen = Some(stamp);
         let shown = self.path.display();
-        let config = crate::input::files::read_text(&self.path, crate::input::files::CONFIG_LIMIT)
-            .and_then(|text| crate::input::cueing::parse_config(&text, self.profile.as_deref()))
+        // A file caught half-way through a save (empty, cut short: not TOML) is not a configuration of all
+        // defaults: ignored until it is whole.
+        let text = crate::input::files::read_text(&self.path, crate::input::files::CONFIG_LIMIT)
+            .and_then(|text| crate::input::cueing::whole(&text).map(|()| text));
+        let text = match text {
+            Ok(text) => text,
+            Err(e) => {
+                self.ignored += 1;
+                console::err(&format!(
+                    "{shown}: changed but not whole ({e}): the running cueing stays, read again at its next change"
+                ));
+                return;
+            }
+        };
+        let config = crate::input::cueing::parse_config(&text, self.profile.as_deref())
             .and_then(|config| washout.retune(config).map_err(|e| e.to_string()));
         match config {
             Ok(true) => {
                 self.reloads += 1;
-                eprintln!("{shown}: changed, the new cueing blends in over a second");
+                console::err(&format!("{shown}: changed, the new cueing blends in over a second"));
             }
             // The same parameters (a save without a change): nothing to do.
             Ok(false) => {}
             Err(e) => {
                 self.refused += 1;
-                eprintln!("{shown}: changed but refused, the running cueing stays: {e}");
+                console::err(&format!("{shown}: changed but refused, the running cueing stays: {e}"));
             }
         }
     }
@@ -146,7 +164,7 @@ impl Decoder {
                 let read = reader.read(bytes);
                 // `auto`'s lock, or its lock dropped: said once.
                 if let Some(news) = reader.news() {
-                    eprintln!("telemetry: {news}");
+                    console::err(&format!("telemetry: {news}"));
                 }
                 let games::Sample {
                     time: t,
@@ -205,11 +223,6 @@ impl Decoder {
         }
     }
 
-    /// Whether a pause of the source washes out (telemetry) rather than letting the platform rest where it is.
-    pub fn washes_out(&self) -> bool {
-        matches!(self, Decoder::Telemetry { .. })
-    }
-
     /// Looks at the cueing file (every [`WATCH_EVERY`]) and retunes the washout if it changed: call it from the
     /// stream's loop.
     pub fn poll_config(&mut self, now: Instant) {
@@ -223,11 +236,11 @@ impl Decoder {
         }
     }
 
-    /// Cueing-file changes that took effect, and that were refused.
-    pub fn reloads(&self) -> (u32, u32) {
+    /// Cueing-file changes that took effect, that were refused, and reads ignored as not yet whole.
+    pub fn reloads(&self) -> (u32, u32, u32) {
         match self {
-            Decoder::Telemetry { watch: Some(w), .. } => (w.reloads, w.refused),
-            _ => (0, 0),
+            Decoder::Telemetry { watch: Some(w), .. } => (w.reloads, w.refused, w.ignored),
+            _ => (0, 0, 0),
         }
     }
 

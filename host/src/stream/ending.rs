@@ -73,6 +73,8 @@ pub(super) fn report<T: Transport>(
     capture: Option<CaptureReport>,
 ) -> Report {
     let refused: u32 = s.rejected.values().sum();
+    let mut input_errors = input_errors;
+    input_errors.sort_by_key(|e| e.line);
     let (outcome, reason, code) = verdict(
         ending.transport,
         ending.stop.as_ref(),
@@ -102,7 +104,11 @@ pub(super) fn report<T: Transport>(
         lead_in_sent: s.lead_in,
         settle_sent: s.settle,
         washout_sent: s.washout,
+        interpolated_sent: s.interpolated,
         restarts: s.restarts,
+        held_sent: s.held,
+        held_s: s.held_s,
+        held_gaps: s.held_gaps,
         final_steps: status.as_ref().map_or([0; 6], |st| st.steps),
         faults: s.client.faults.iter().map(|f: &FaultReason| f.to_string()).collect(),
         input_errors,
@@ -132,15 +138,16 @@ fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
     status.ok()
 }
 
-/// What `--record` wrote: its rows, the samples dropped, and why it stopped writing, if it did.
+/// What `--record` wrote: its rows (in the file under its name: a record that failed is not put there), the
+/// samples dropped, and why it failed, if it did.
 fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordReport {
     let dropped = s.client.telemetry_dropped;
     let (rows, error) = match (s.recorder.take(), s.record_error.take()) {
-        (Some(r), None) => {
-            let rows = r.rows;
-            (rows, r.finish().err().map(|e| e.to_string()))
-        }
-        (r, e) => (r.map_or(0, |r| r.rows), e),
+        (Some(r), None) => match r.finish() {
+            Ok(rows) => (rows, None),
+            Err(e) => (0, Some(e.to_string())),
+        },
+        (_, e) => (0, e),
     };
     RecordReport {
         path,
@@ -148,6 +155,16 @@ fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordR
         telemetry_hz: None,
         dropped,
         error,
+    }
+}
+
+/// A run that never moved (its input had no pose to lead in to): the device's status as it is.
+pub(super) fn unmoved(status: Status) -> Ending {
+    Ending {
+        stop: None,
+        status: Some(status),
+        transport: None,
+        record: None,
     }
 }
 
@@ -176,16 +193,20 @@ fn verdict(
             Some(format!("the device refused {refused} setpoints")),
             exit::REFUSED,
         )
+    } else if input_sent == 0 {
+        let unread = match input_errors.len() {
+            0 => String::new(),
+            n => format!(" ({n} input lines could not be read)"),
+        };
+        (
+            "input_errors",
+            Some(format!("no pose in the input{unread}")),
+            exit::INPUT_ERRORS,
+        )
     } else if !input_errors.is_empty() {
         (
             "input_errors",
             Some(format!("{} input lines could not be read", input_errors.len())),
-            exit::INPUT_ERRORS,
-        )
-    } else if input_sent == 0 {
-        (
-            "input_errors",
-            Some("no pose in the input".to_string()),
             exit::INPUT_ERRORS,
         )
     } else {

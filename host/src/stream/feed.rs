@@ -10,54 +10,84 @@ use ringpod_core::safety::AuxLevels;
 use ringpod_core::protocol::MotionSettings;
 
 use super::report::{CaptureReport, DatagramReport};
-use super::session::{Kind, Stop, StreamError, Streamer, NO_AUX};
+use super::session::{Kind, Stop, StreamError, Streamer, KEEP_ALIVE, NO_AUX};
 use super::{motion_pose, InputError, Source, UdpSource};
 use crate::link::client::{ClientError, Transport};
+use crate::out::console;
+
+/// Rows further apart than this (s) are not samples of one motion: the platform rests between them.
+const LONGEST_GAP: f64 = 60.0;
 
 impl<T: Transport> Streamer<'_, T> {
-    /// Streams timed poses (a file or a motion): each at its own time; a gap longer than the stream timeout
-    /// lets the platform come to rest, and the stream is led in and started again at the next pose.
+    /// Stops the stream and lets the platform come to rest for a gap of `gap` seconds between two rows (a fast
+    /// run does not compute more than 3 s of a device at rest).
+    fn rest(&mut self, gap: f64, fast: bool) -> Result<(), StreamError> {
+        self.collect(0)?;
+        self.client.stop()?;
+        let wait = if fast { gap.min(3.0) } else { gap };
+        self.elapse(Duration::from_secs_f64(wait))?;
+        self.restarts += 1;
+        self.bar.suspend(|| {
+            console::err(&format!(
+                "{gap:.3} s between two rows: the stream stops, the platform rests, then leads in again"
+            ))
+        });
+        Ok(())
+    }
+
+    /// Streams timed poses (a file or a motion): each at its own time, rows further apart than a quarter of the
+    /// stream timeout joined by interpolated setpoints ([`Streamer::between`]); rows more than [`LONGEST_GAP`]
+    /// apart are not one motion: the stream stops, the platform rests, and leads in again at the next row
+    /// (`restarts`). Garbage is refused here, named and counted in `errors`, never sent; the pose a stream leads
+    /// in to must be one it can.
     pub(super) fn timed(
         &mut self,
         poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>, AuxLevels)>,
         fast: bool,
+        errors: &mut Vec<InputError>,
     ) -> Result<(), StreamError> {
-        let mut last_t: Option<f64> = None;
+        // The last row sent: its time and its pose as sent.
+        let mut last: Option<(f64, Pose<f64>)> = None;
         for (line, t, pose, aux) in poses {
             if (self.interrupted)() {
                 return Err(StreamError::Stop(Stop::Interrupted));
             }
-            let gap = last_t.map_or(0.0, |l| (t - l).max(0.0));
-            let pose = match last_t {
+            let resting = last.is_some_and(|(l, _)| t - l > LONGEST_GAP);
+            let refused = match last {
+                Some(_) if !resting => self.admission.garbage(&pose),
+                _ => self.admission.first(&pose),
+            };
+            if let Some(reason) = refused {
+                let line = line.unwrap_or(self.input_sent as usize + 1);
+                self.bar.suspend(|| console::err(&format!("line {line}: {reason}")));
+                errors.push(InputError { line, reason });
+                continue;
+            }
+            let pose = match last {
                 None => self.start_and_lead_in(pose)?,
-                Some(_) if gap > self.stream_timeout.as_secs_f64() => {
-                    // The device brakes to rest by itself; nothing happens after that, so a fast run does not
-                    // compute the rest of the gap.
-                    let wait = if fast { gap.min(3.0) } else { gap };
-                    self.elapse(Duration::from_secs_f64(wait))?;
-                    self.restarts += 1;
-                    self.bar
-                        .suspend(|| eprintln!("{gap:.3} s gap in the input: the platform rests, then leads in again"));
+                Some((l, _)) if resting => {
+                    self.rest(t - l, fast)?;
                     self.start_and_lead_in(pose)?
                 }
-                Some(_) => {
-                    self.elapse(Duration::from_secs_f64(gap))?;
-                    self.limit(pose)
+                Some((l, from)) => {
+                    let to = self.limit(pose);
+                    self.between(&from, &to, (t - l).max(0.0))?;
+                    to
                 }
             };
-            last_t = Some(t);
+            last = Some((t, pose));
             self.send(pose, Kind::Input(line), aux)?;
             self.bar.inc(1);
         }
-        if last_t.is_some() {
+        if last.is_some() {
             self.settle()?;
         }
         self.collect(0)
     }
 
     /// Streams datagrams as they arrive: the platform waits where it is for the first one, leads in and starts;
-    /// a pause longer than the stream timeout brakes it to rest, and the next datagram leads in and starts again;
-    /// `idle` without a datagram ends the session.
+    /// while the source pauses, the stream stays alive (telemetry washes out to neutral, a pose source's last pose
+    /// is held, counted in `held_s` and `held_gaps`); `idle` without a datagram ends the session.
     pub(super) fn live(
         &mut self,
         source: &mut UdpSource,
@@ -68,18 +98,16 @@ impl<T: Transport> Streamer<'_, T> {
             .socket
             .set_read_timeout(Some(Duration::from_millis(1)))
             .map_err(ClientError::Io)?;
-        self.bar.suspend(|| {
-            eprintln!(
-                "streaming: send datagrams to {}",
-                source.socket.local_addr().map_or("?".into(), |a| a.to_string())
-            )
-        });
+        let addr = source.socket.local_addr().map_or("?".into(), |a| a.to_string());
+        self.bar
+            .suspend(|| console::err(&format!("streaming: send datagrams to {addr}")));
         // The largest UDP payload: no datagram is ever cut.
         let mut buf = vec![0u8; 65_536];
         let mut wall = Instant::now();
         let mut last_pose = Instant::now();
         let mut last_idle = Instant::now();
         let mut streaming = false;
+        let mut pausing = false;
         loop {
             if (self.interrupted)() {
                 return Err(StreamError::Stop(Stop::Interrupted));
@@ -108,28 +136,20 @@ impl<T: Transport> Streamer<'_, T> {
             };
             // Only a readable datagram of the source counts as the source being there: a stranger's datagrams and
             // unreadable ones (a flood of them included) leave the pause logic below running.
-            let Some((number, pose)) =
-                datagram.and_then(|(n, from)| read(source, &buf[..n], from, now, report, errors, &self.bar))
-            else {
+            let readable = datagram.and_then(|(n, from)| read(source, &buf[..n], from, now, report, errors, &self.bar));
+            let admitted =
+                readable.and_then(|(n, pose)| self.admit(n, pose, streaming, report, errors).map(|p| (n, p)));
+            let Some((number, pose)) = admitted else {
                 let quiet = now - last_pose;
-                // Telemetry that pauses washes out: the vehicle at rest, through the washout, every 10 ms
-                // from half the stream timeout on, so the platform glides back to neutral.
-                if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= Duration::from_millis(10) {
-                    let dt = (now - last_idle).min(Duration::from_millis(20)).as_secs_f64();
+                // A pause: from half the stream timeout on, a setpoint every 10 ms keeps the stream alive.
+                if streaming && quiet > self.stream_timeout / 2 && now - last_idle >= KEEP_ALIVE {
+                    let dt = (now - last_idle).min(2 * KEEP_ALIVE);
                     last_idle = now;
-                    if let Some(pose) = source.decoder.idle(dt, now) {
-                        let pose = self.limit(pose);
-                        self.send(pose, Kind::Washout, NO_AUX)?;
-                        self.washout += 1;
-                        continue;
+                    if !pausing {
+                        pausing = true;
+                        self.held_gaps += 1;
                     }
-                }
-                if streaming && quiet > self.stream_timeout && !source.decoder.washes_out() {
-                    // The source paused (a game's menu): the device brakes to rest by itself.
-                    streaming = false;
-                    if self.last_applied.is_some() {
-                        self.bar.suspend(|| eprintln!("the source paused: the platform rests"));
-                    }
+                    self.bridge(source, dt, now)?;
                 }
                 if quiet >= source.idle {
                     return self.collect(0);
@@ -138,12 +158,10 @@ impl<T: Transport> Streamer<'_, T> {
             };
             last_pose = now;
             last_idle = now;
+            pausing = false;
             let pose = if streaming {
                 self.limit(pose)
             } else {
-                if self.last_applied.is_some() {
-                    report.resumed += 1;
-                }
                 streaming = true;
                 self.start_and_lead_in(pose)?
             };
@@ -152,6 +170,52 @@ impl<T: Transport> Streamer<'_, T> {
             // The lead-in let its own time pass: the device's clock is already there.
             wall = Instant::now();
         }
+    }
+}
+
+impl<T: Transport> Streamer<'_, T> {
+    /// A readable datagram's pose if it may be sent: garbage, or a pose to lead in to that is too far outside, is
+    /// refused with its number and counted as unreadable.
+    fn admit(
+        &mut self,
+        number: usize,
+        pose: Pose<f64>,
+        streaming: bool,
+        report: &mut DatagramReport,
+        errors: &mut Vec<InputError>,
+    ) -> Option<Pose<f64>> {
+        let refused = if streaming {
+            self.admission.garbage(&pose)
+        } else {
+            self.admission.first(&pose)
+        };
+        let Some(reason) = refused else {
+            return Some(pose);
+        };
+        report.unreadable += 1;
+        self.bar
+            .suspend(|| console::err(&format!("datagram {number}: {reason}")));
+        errors.push(InputError { line: number, reason });
+        None
+    }
+
+    /// One setpoint `dt` into a pause of a live source, keeping the stream alive: the vehicle at rest through the
+    /// washout (the platform glides back to neutral), or a pose source's last pose held.
+    fn bridge(&mut self, source: &mut UdpSource, dt: Duration, now: Instant) -> Result<(), StreamError> {
+        self.held_s += dt.as_secs_f64();
+        match source.decoder.idle(dt.as_secs_f64(), now) {
+            Some(pose) => {
+                let pose = self.limit(pose);
+                self.send(pose, Kind::Washout, NO_AUX)?;
+                self.washout += 1;
+            }
+            None => {
+                let last = self.last_sent;
+                self.send(last, Kind::Held, NO_AUX)?;
+                self.held += 1;
+            }
+        }
+        Ok(())
     }
 }
 
@@ -178,7 +242,7 @@ fn read(
             report.unreadable += 1;
             // The first few of each kind, cut to a line: a source can send anything, for as long as it likes.
             if let Some(kept) = crate::input::unreadable::tally(&mut report.unreadable_by_kind, number, &reason) {
-                bar.suspend(|| eprintln!("datagram {number}: {}", kept.reason));
+                bar.suspend(|| console::err(&format!("datagram {number}: {}", kept.reason)));
                 errors.push(kept);
             }
             None
@@ -205,18 +269,18 @@ pub(super) fn feed<T: Transport>(
         } => {
             let (motion, sine, seconds, rate_hz) = (*motion, *sine, *seconds, *rate_hz);
             if let Some(sine) = &sine {
-                eprintln!("{}", sine.describe(limits));
+                console::err(&sine.describe(limits));
             }
             let n = (seconds * rate_hz).round() as u64;
             let mut poses = (0..=n).map(|k| {
                 let t = k as f64 / rate_hz;
                 (None, t, motion_pose(motion, sine.as_ref(), t, home, limits), NO_AUX)
             });
-            (s.timed(&mut poses, fast), None, None)
+            (s.timed(&mut poses, fast, input_errors), None, None)
         }
         Source::Poses(p) => {
             let mut poses = p.iter().map(|(line, t, pose, aux)| (Some(*line), *t, *pose, *aux));
-            (s.timed(&mut poses, fast), None, None)
+            (s.timed(&mut poses, fast, input_errors), None, None)
         }
         Source::Udp(udp) => {
             let mut d = DatagramReport::default();
@@ -228,12 +292,12 @@ pub(super) fn feed<T: Transport>(
                 .values()
                 .any(|n| *n > crate::input::unreadable::KEPT_PER_KIND)
             {
-                eprintln!(
+                console::err(&format!(
                     "unreadable datagrams: {} in all, by kind: {:?}",
                     d.unreadable, d.unreadable_by_kind
-                );
+                ));
             }
-            (d.cue_reloads, d.cue_refused) = udp.decoder.reloads();
+            (d.cue_reloads, d.cue_refused, d.cue_ignored) = udp.decoder.reloads();
             let capture = udp.capture.take().map(|(writer, path)| {
                 let (packets, error) = writer.finish();
                 CaptureReport { path, packets, error }

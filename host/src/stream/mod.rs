@@ -6,6 +6,7 @@
 //! whether the input was followed. The run record it writes is drawn by `plot` (`record`), its pose's velocity and
 //! acceleration by `plot --derivatives` (`derivatives`).
 
+mod admit;
 pub mod command;
 pub mod datagram;
 pub mod derivatives;
@@ -27,13 +28,14 @@ use ringpod_core::motion::EnvelopeMargins;
 use ringpod_core::protocol::{MotionSettings, RigSource, Settings, SettingsKind, Status};
 
 pub use loads::{check_loads, platform as loads_platform};
-use prepare::prepare;
+use prepare::{greet, prepare};
 pub use report::{LimitedReport, Report};
 use session::Streamer;
 pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source, UdpSource};
 
 pub use crate::input::table::InputError;
 use crate::link::client::{Client, ClientError, Transport};
+use crate::out::console;
 use crate::stream::record::Recorder;
 
 /// Exit codes of `ringpod stream` (the most serious applies).
@@ -88,6 +90,22 @@ struct DeviceEnvelope {
     margins: EnvelopeMargins,
     stream_timeout: Duration,
     limits: MotionSettings,
+    /// The device's gross-jump window (ms) and telemetry rate (Hz), from its stream settings.
+    gross_jump_ms: u16,
+    telemetry_hz: u16,
+}
+
+impl DeviceEnvelope {
+    /// The rules an input pose must pass on this device.
+    fn admission(&self) -> admit::Admission {
+        admit::Admission::new(
+            &self.platform.geometry,
+            self.platform.home,
+            self.margins,
+            self.limits.pose_velocity,
+            self.gross_jump_ms,
+        )
+    }
 }
 
 impl<'a, T: Transport> Streamer<'a, T> {
@@ -101,11 +119,13 @@ impl<'a, T: Transport> Streamer<'a, T> {
         baseline: Status,
         recorder: Option<Recorder>,
     ) -> Self {
+        let admission = envelope.admission();
         let DeviceEnvelope {
             platform,
             margins,
             stream_timeout,
             limits,
+            ..
         } = envelope;
         Self {
             client,
@@ -130,7 +150,12 @@ impl<'a, T: Transport> Streamer<'a, T> {
             lead_in: 0,
             settle: 0,
             washout: 0,
+            interpolated: 0,
             restarts: 0,
+            held: 0,
+            held_s: 0.0,
+            held_gaps: 0,
+            admission,
             rejected: BTreeMap::new(),
             refusals: Vec::new(),
             limited: LimitedReport::default(),
@@ -148,7 +173,7 @@ fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelop
     let (rig, source, _) = client.rig()?;
     if let RigSource::Refused(_) | RigSource::Unreadable = source {
         // The board runs its compiled-in rig: said before anything moves, not found out from the motion.
-        eprintln!("warning: {source}");
+        console::err(&format!("warning: {source}"));
     }
     let geometry = rig
         .geometry()
@@ -171,11 +196,14 @@ fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelop
         margins,
         stream_timeout: Duration::from_secs_f64(f64::from(timeout_ms) / 1000.0),
         limits,
+        gross_jump_ms: stream.gross_jump_ms,
+        telemetry_hz: stream.telemetry_hz,
     })
 }
 
 /// Streams a source and returns the report (also for runs that ended early: its outcome says how). `Err` only
-/// when the stream could not start.
+/// when the stream could not start. Nothing moves before the input is checked: a pose file whose rows hold no pose
+/// to lead in to is reported with the device as it was.
 pub fn run<T: Transport>(
     client: &mut Client<T>,
     source: Source,
@@ -189,15 +217,40 @@ pub fn run<T: Transport>(
         Some((r, path)) => (Some(r), Some(path)),
         None => (None, None),
     };
+    greet(client)?;
+    let envelope = device_envelope(client)?;
+    if recorder.is_some() && options.telemetry_hz.unwrap_or(envelope.telemetry_hz) == 0 {
+        return Err(ClientError::Unexpected(
+            "the device's telemetry is off (stream.telemetry_hz 0): a record would have no rows; give --record-hz \
+             or set the device's rate"
+                .into(),
+        ));
+    }
+    let mut input_errors = input_errors;
+    let mut source = source;
+    if let Source::Poses(poses) = &mut source {
+        lead_rows(poses, &envelope.admission(), &mut input_errors);
+        if poses.is_empty() {
+            let status = client.status()?;
+            let s = Streamer::new(
+                client,
+                interrupted,
+                ProgressBar::hidden(),
+                envelope,
+                options.host_limits,
+                status,
+                None,
+            );
+            return Ok(ending::report(s, ending::unmoved(status), input_errors, None, None));
+        }
+    }
     let (baseline, restore_hz) = prepare(
         client,
         options.home,
         recorder.is_some() || options.telemetry,
         options.telemetry_hz,
     )?;
-    let envelope = device_envelope(client)?;
     let home = envelope.platform.home;
-    let mut source = source;
     if let Source::Udp(udp) = &mut source {
         udp.decoder.centre_on(Pose::from_array(home));
     }
@@ -212,11 +265,24 @@ pub fn run<T: Transport>(
         baseline,
         recorder,
     );
-    let mut input_errors = input_errors;
     let (outcome, datagrams, capture) = feed::feed(&mut s, &mut source, fast, home, &limits, &mut input_errors);
     s.bar.finish_and_clear();
     let ending = ending::wind_down(&mut s, outcome, record_path, restore_hz, options.telemetry_hz);
     Ok(ending::report(s, ending, input_errors, datagrams, capture))
+}
+
+/// Drops a pose file's rows before the first one a stream can lead in to (garbage, or far outside the envelope:
+/// [`admit::Admission::first`]), each an input error said with its line.
+fn lead_rows(poses: &mut Vec<source::TimedPose>, admission: &admit::Admission, errors: &mut Vec<InputError>) {
+    let refusals: Vec<(usize, String)> = poses
+        .iter()
+        .map_while(|(line, _, pose, _)| admission.first(pose).map(|why| (*line, why)))
+        .collect();
+    poses.drain(..refusals.len());
+    for (line, reason) in refusals {
+        console::err(&format!("line {line}: {reason}"));
+        errors.push(InputError { line, reason });
+    }
 }
 
 /// A bar of setpoints for a source of known length, a spinner for a live one (on stderr, hidden without a

@@ -1,5 +1,5 @@
-//! Before a stream: the device brought to `Ready` (hello, power, homing), and its telemetry rate set for a record
-//! taken at another rate (`--record-hz`), to be set back after the run.
+//! Before a stream: the device greeted (nothing moves until the input is checked), then brought to `Ready` (power,
+//! homing), and its telemetry rate set for a record taken at another rate (`--record-hz`), set back after the run.
 
 use std::time::Duration;
 
@@ -8,6 +8,7 @@ use ringpod_core::protocol::{Settings, SettingsKind, Status};
 use ringpod_core::safety::State;
 
 use crate::link::client::{Client, ClientError, Transport};
+use crate::out::console;
 
 /// Sets the device's telemetry rate (its stream section's `telemetry_hz`, a live setting) and returns the one it
 /// had, to set back after the run; `None` when it was the rate asked already.
@@ -26,7 +27,20 @@ pub(super) fn telemetry_rate<T: Transport>(client: &mut Client<T>, hz: u16) -> R
     Ok(Some(before))
 }
 
-/// Brings the device to `Ready`: hello, the telemetry rate asked (the rate it had is returned), power up, home if
+/// Greets the device (the protocol version checked) and says which platform it drives when it is not the trainer
+/// model. Nothing moves.
+pub(super) fn greet<T: Transport>(client: &mut Client<T>) -> Result<(), ClientError> {
+    let device = client.hello()?;
+    if device.preset != Some(Preset::TrainerModel) {
+        console::err(&format!(
+            "note: the device drives {}",
+            device.preset.map_or("a geometry of its own", |p| p.name())
+        ));
+    }
+    Ok(())
+}
+
+/// Brings the greeted device to `Ready`: the telemetry rate asked (the rate it had is returned), power up, home if
 /// needed. Errors here mean the stream never started.
 pub(super) fn prepare<T: Transport>(
     client: &mut Client<T>,
@@ -34,13 +48,6 @@ pub(super) fn prepare<T: Transport>(
     telemetry: bool,
     telemetry_hz: Option<u16>,
 ) -> Result<(Status, Option<u16>), ClientError> {
-    let device = client.hello()?;
-    if device.preset != Some(Preset::TrainerModel) {
-        eprintln!(
-            "note: the device drives {}",
-            device.preset.map_or("a geometry of its own", |p| p.name())
-        );
-    }
     let restore = match telemetry_hz {
         Some(hz) => telemetry_rate(client, hz)?,
         None => None,

@@ -52,27 +52,34 @@ pub const COLUMNS: [&str; 28] = [
     "tick_cost",
 ];
 
-/// Writes a run record.
+/// Writes a run record: to a file beside the target, renamed to it when the run ends ([`Recorder::finish`]), so
+/// that a run that never starts leaves an existing file as it was.
 pub struct Recorder {
     out: BufWriter<File>,
+    pending: crate::out::file::Pending,
     started: Instant,
-    /// Rows written.
+    /// Rows written to the file (flushed).
     pub rows: u64,
+    /// Rows formatted but still in the buffer.
+    buffered: u64,
 }
 
 impl Recorder {
-    /// Creates the file and writes the header.
+    /// Opens the file beside `path` and writes the header.
     pub fn create(path: &Path) -> std::io::Result<Self> {
-        let mut out = BufWriter::new(File::create(path)?);
+        let mut pending = crate::out::file::Pending::beside(path)?;
+        let mut out = BufWriter::new(pending.file().try_clone()?);
         writeln!(out, "{},{}", COLUMNS.join(","), AUX_COLUMNS.join(","))?;
         Ok(Self {
             out,
+            pending,
             started: Instant::now(),
             rows: 0,
+            buffered: 0,
         })
     }
 
-    /// One row: the pose the host commanded last, and the device's sample.
+    /// One row: the pose the host commanded last, and the device's sample (counted once flushed).
     pub fn write(&mut self, commanded: &Pose<f64>, t: &Telemetry) -> std::io::Result<()> {
         let mut row = format!(
             "{:.6},{:.6}",
@@ -103,13 +110,25 @@ impl Recorder {
         // Telemetry output bits 3 and 4.
         row += &format!(",{},{}", (t.outputs >> 3) & 1, (t.outputs >> 4) & 1);
         writeln!(self.out, "{row}")?;
-        self.rows += 1;
+        self.buffered += 1;
         Ok(())
     }
 
-    /// Flushes the file.
+    /// Writes the buffered rows to the file: then they count as written.
+    pub fn flush(&mut self) -> std::io::Result<()> {
+        if self.buffered > 0 {
+            self.out.flush()?;
+            self.rows += std::mem::take(&mut self.buffered);
+        }
+        Ok(())
+    }
+
+    /// Flushes the file and puts it in place under its name: the rows written.
     pub fn finish(mut self) -> std::io::Result<u64> {
+        self.flush()?;
         self.out.flush()?;
+        drop(self.out);
+        self.pending.commit()?;
         Ok(self.rows)
     }
 }

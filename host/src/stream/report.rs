@@ -33,8 +33,6 @@ pub struct DatagramReport {
     pub unreadable_by_kind: std::collections::BTreeMap<String, u64>,
     /// Datagrams from other senders than `--udp-from`, ignored.
     pub other_senders: u32,
-    /// Times the source paused longer than the stream timeout and the stream was led in and started again.
-    pub resumed: u32,
     /// Telemetry: pauses of more than a second after which the washout started again at neutral.
     pub telemetry_gaps: u32,
     /// Telemetry in `auto`: the format locked onto and the datagram at which (a format dropped after refusing many
@@ -44,15 +42,19 @@ pub struct DatagramReport {
     /// Telemetry: changes of the `--cue-config` file that took effect while streaming (each blended in over a
     /// second).
     pub cue_reloads: u32,
-    /// Telemetry: changes of the `--cue-config` file refused (unreadable, or a key out of range; the running
-    /// configuration stayed).
+    /// Telemetry: changes of the `--cue-config` file refused (a key out of range; the running configuration
+    /// stayed).
     pub cue_refused: u32,
+    /// Telemetry: reads of the changed `--cue-config` file ignored as not yet whole (empty, cut short: not TOML,
+    /// as an editor's truncate-then-write leaves it for a moment); read again at its next change.
+    pub cue_ignored: u32,
 }
 
 /// The end-of-run report (`--report-json`).
 #[derive(Debug, Serialize)]
 pub struct Report {
-    /// `followed`, `input_errors`, `refused`, `device_stopped`, `transport_lost` or `interrupted`.
+    /// `followed`, `input_errors`, `refused`, `device_stopped`, `transport_lost`, `interrupted` or
+    /// `output_failed` (standard output or error could not be written: the run ended as a stop does).
     pub outcome: &'static str,
     /// Why the run ended as it did, when not simply followed.
     pub reason: Option<String>,
@@ -76,9 +78,19 @@ pub struct Report {
     pub settle_sent: u32,
     /// Telemetry: setpoints of the washout to neutral while the source paused.
     pub washout_sent: u32,
-    /// Times a gap in the input longer than the stream timeout let the platform come to rest and the stream was
-    /// started again.
+    /// Setpoints interpolated between a file's rows further apart than a quarter of the stream timeout (one every
+    /// 10 ms), so that the stream lives through the gap.
+    pub interpolated_sent: u32,
+    /// Rows more than a minute apart (not one motion): the stream stopped, the platform rested, and was led in
+    /// again at the next row.
     pub restarts: u32,
+    /// A live pose source's last pose sent again while it paused (every 10 ms from half the stream timeout on).
+    pub held_sent: u32,
+    /// Seconds a live source's pauses were bridged (its last pose held, or telemetry washed out), from half the
+    /// stream timeout into each pause.
+    pub held_s: f64,
+    /// The pauses of a live source that were bridged so.
+    pub held_gaps: u32,
     /// Step position of each axis at the end.
     pub final_steps: [i64; 6],
     /// Faults the device reported.

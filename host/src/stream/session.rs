@@ -16,6 +16,7 @@ pub const NO_AUX: AuxLevels = [None; 2];
 use super::report::{reason_name, LimitedReport};
 use super::InputError;
 use crate::link::client::{setpoint_answer, Client, ClientError, Transport};
+use crate::out::console;
 use crate::stream::record::Recorder;
 
 /// Setpoints sent ahead of their answers: 16 ms of a 1 kHz stream, far more than a USB or pty round trip.
@@ -38,6 +39,34 @@ pub(super) enum Kind {
     Settle,
     /// A telemetry source paused: the washout of a vehicle at rest.
     Washout,
+    /// Between two rows of a file further apart than [`KEEP_ALIVE`]: the straight line between them.
+    Interpolated,
+    /// A pose source paused: its last pose again.
+    Held,
+}
+
+/// The longest a stream goes without a setpoint while its input lasts: a file's rows further apart are joined by
+/// interpolated setpoints this far apart, a paused live source's last pose is held at this rate. The device's
+/// stream timeout (100 ms by default) is for a host that is gone, not for a pause in what it streams.
+pub(super) const KEEP_ALIVE: Duration = Duration::from_millis(10);
+
+/// The way from `a` to `b` on each pose axis, yaw the short way round (as the device measures a jump).
+pub(super) fn way(a: &Pose<f64>, b: &Pose<f64>) -> [f64; 6] {
+    let (a, b) = (a.to_array(), b.to_array());
+    std::array::from_fn(|i| {
+        let d = b[i] - a[i];
+        if i == 5 {
+            (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+        } else {
+            d
+        }
+    })
+}
+
+/// The pose `f` of the way from `a` along `way`.
+fn along(a: &Pose<f64>, way: &[f64; 6], f: f64) -> Pose<f64> {
+    let a = a.to_array();
+    Pose::from_array(std::array::from_fn(|i| a[i] + way[i] * f))
 }
 
 /// One run: the client, the host's clock and envelope, and everything counted.
@@ -67,7 +96,14 @@ pub(super) struct Streamer<'a, T: Transport> {
     pub(super) lead_in: u32,
     pub(super) settle: u32,
     pub(super) washout: u32,
+    pub(super) interpolated: u32,
     pub(super) restarts: u32,
+    pub(super) held: u32,
+    /// Seconds a paused live source's last pose was held, and the pauses.
+    pub(super) held_s: f64,
+    pub(super) held_gaps: u32,
+    /// The rules an input pose must pass to be sent.
+    pub(super) admission: super::admit::Admission,
     pub(super) rejected: BTreeMap<String, u32>,
     pub(super) refusals: Vec<InputError>,
     pub(super) limited: LimitedReport,
@@ -87,11 +123,12 @@ impl<'a, T: Transport> Streamer<'a, T> {
     pub(super) fn record(&mut self) -> Result<(), ClientError> {
         let samples = self.client.take_telemetry()?;
         if let (Some(r), None) = (self.recorder.as_mut(), &self.record_error) {
-            for t in &samples {
-                if let Err(e) = r.write(&self.last_sent, t) {
-                    self.record_error = Some(e.to_string());
-                    break;
-                }
+            let written = samples
+                .iter()
+                .try_for_each(|t| r.write(&self.last_sent, t))
+                .and_then(|()| r.flush());
+            if let Err(e) = written {
+                self.record_error = Some(e.to_string());
             }
         }
         Ok(())
@@ -215,7 +252,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
                 if let Some(number) = number {
                     *self.rejected.entry(name.clone()).or_default() += 1;
                     self.bar
-                        .suspend(|| eprintln!("line {number}: refused by the device: {name}"));
+                        .suspend(|| console::err(&format!("line {number}: refused by the device: {name}")));
                     self.refusals.push(InputError {
                         line: number,
                         reason: name.clone(),
@@ -263,24 +300,18 @@ impl<'a, T: Transport> Streamer<'a, T> {
         self.client.start()?;
         let now = status.pose.cast::<f64>();
         self.last_sent = now;
+        // Led in to the first pose as limited, also when the device is left to limit what is sent: the lead-in is
+        // bounded by the envelope, and the first pose (admitted: limiting moves it by less than a gross jump)
+        // follows it without one.
+        let target = self.admission.limited(&first);
         let first = self.limit(first);
-        let (a, b) = (now.to_array(), first.to_array());
-        // The way from here to the first pose; yaw the short way round.
-        let way: [f64; 6] = std::array::from_fn(|i| {
-            let d = b[i] - a[i];
-            if i == 5 {
-                (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
-            } else {
-                d
-            }
-        });
+        let way = way(&now, &target);
         let seconds = (0..6).fold(0.0f64, |m, i| {
             m.max(way[i].abs() / (0.25 * f64::from(self.limits.pose_velocity[i])))
         });
         let n = (seconds * 100.0).ceil() as usize;
         for k in 1..=n {
-            let f = k as f64 / n as f64;
-            let pose = Pose::from_array(std::array::from_fn(|i| a[i] + way[i] * f));
+            let pose = along(&now, &way, k as f64 / n as f64);
             self.elapse(Duration::from_millis(10))?;
             let pose = self.limit(pose);
             self.send(pose, Kind::LeadIn, NO_AUX)?;
@@ -289,6 +320,32 @@ impl<'a, T: Transport> Streamer<'a, T> {
         // The first pose follows the lead-in by one of its intervals.
         self.elapse(Duration::from_millis(10))?;
         Ok(first)
+    }
+
+    /// Lets `dt` pass between two input poses as sent. Further apart than a quarter of the stream timeout, a
+    /// setpoint every [`KEEP_ALIVE`] on the straight line from `from` to `to` (each limited as any pose): the
+    /// stream lives through a gap of any length, and the platform moves as the rows, samples of a motion, describe
+    /// it (the device interpolates the same line between two setpoints). `to` itself is the caller's to send.
+    pub(super) fn between(&mut self, from: &Pose<f64>, to: &Pose<f64>, dt: f64) -> Result<(), StreamError> {
+        let n = if dt <= self.stream_timeout.as_secs_f64() / 4.0 {
+            1
+        } else {
+            (dt / KEEP_ALIVE.as_secs_f64()).ceil() as u64
+        };
+        let step = Duration::from_secs_f64(dt / n as f64);
+        let way = way(from, to);
+        // A row the device would refuse as a gross jump is not made one by interpolating towards it: the last
+        // pose is held through the gap and the device judges the row.
+        let jump = (0..6).any(|i| way[i].abs() > self.admission.window[i]);
+        for k in 1..n {
+            self.elapse(step)?;
+            let f = if jump { 0.0 } else { k as f64 / n as f64 };
+            let pose = self.limit(along(from, &way, f));
+            self.send(pose, Kind::Interpolated, NO_AUX)?;
+            self.interpolated += 1;
+        }
+        self.elapse(step)?;
+        Ok(())
     }
 
     /// Holds the last pose until the platform has arrived there (the device's commanded pose equals its target),

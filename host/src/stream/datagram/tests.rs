@@ -167,10 +167,10 @@ fn a_changed_cueing_file_blends_in_and_a_bad_one_is_refused() {
                    tilt_scale = [0.3, 0.8]\n[smoothing]\nkind = \"median\"\nwindow = 5\n";
     let old = "tilt_limit_deg = 12\n";
     let (steady, d) = reload_run("none", old, None);
-    assert_eq!(d.reloads(), (0, 0));
+    assert_eq!(d.reloads(), (0, 0, 0));
     let (steady_new, _) = reload_run("new", new, None);
     let (reloaded, d) = reload_run("valid", old, Some(new));
-    assert_eq!(d.reloads(), (1, 0));
+    assert_eq!(d.reloads(), (1, 0, 0));
     let Decoder::Telemetry { washout, .. } = &d else {
         unreachable!()
     };
@@ -194,10 +194,48 @@ fn a_changed_cueing_file_blends_in_and_a_bad_one_is_refused() {
     }
     // Refused: a key out of range, the old configuration kept, the steps as without the change.
     let (kept, d) = reload_run("invalid", old, Some("tilt_limit_deg = 90\n"));
-    assert_eq!(d.reloads(), (0, 1));
+    assert_eq!(d.reloads(), (0, 1, 0));
     let Decoder::Telemetry { washout, .. } = &d else {
         unreachable!()
     };
     assert_eq!(washout.config().tilt_limit_deg, [12.0; 2]);
     assert_eq!(kept, steady);
+}
+
+#[test]
+fn a_cueing_file_caught_half_way_through_a_save_is_ignored_until_whole() {
+    let old = "tilt_limit_deg = 12\n";
+    let (steady, _) = reload_run("steady", old, None);
+    // An editor's truncate-then-write seen after the truncate, and seen cut short: neither is all defaults.
+    for (name, caught) in [
+        ("empty", ""),
+        ("blank", "\n  \n"),
+        ("cut", "tilt_limit_deg = 12\ntranslation_scale = [0.15, 0."),
+    ] {
+        let (kept, d) = reload_run(name, old, Some(caught));
+        assert_eq!(d.reloads(), (0, 0, 1), "{name}: ignored, not refused and not taken");
+        let Decoder::Telemetry { washout, .. } = &d else {
+            unreachable!()
+        };
+        assert_eq!(washout.config().tilt_limit_deg, [12.0; 2], "{name}");
+        assert_eq!(kept, steady, "{name}: the motion as without the change");
+    }
+    // The save completes: the whole file is taken at its next change.
+    let dir = std::env::temp_dir().join(format!("ringpod-reload-whole-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("cue.toml");
+    std::fs::write(&path, old).unwrap();
+    let mut washout = Live::new(crate::input::cueing::load_config(Some(&path), None).unwrap()).unwrap();
+    let mut watch = Watch::new(path.clone(), None);
+    let start = Instant::now();
+    for (k, text) in ["", "tilt_limit_deg = 8\n"].iter().enumerate() {
+        std::fs::write(&path, text).unwrap();
+        let f = std::fs::File::options().write(true).open(&path).unwrap();
+        f.set_modified(SystemTime::now() + Duration::from_secs(5 + k as u64))
+            .unwrap();
+        watch.poll(start + WATCH_EVERY * (k as u32 + 1), &mut washout);
+    }
+    assert_eq!((watch.reloads, watch.refused, watch.ignored), (1, 0, 1));
+    assert_eq!(washout.config().tilt_limit_deg, [8.0; 2]);
+    std::fs::remove_dir_all(&dir).unwrap();
 }

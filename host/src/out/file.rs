@@ -1,0 +1,132 @@
+//! Files a command writes, whole or not at all: written to a temporary file beside the target and renamed over it
+//! when complete (`tempfile`'s `NamedTempFile::persist`, a rename on the same file system), so that a full disk, an
+//! error or a stop half-way leaves the target as it was (or absent), never a partial file under its name. A file
+//! that is one of the command's inputs is refused before anything runs.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// A file being written: a temporary file in the target's folder, renamed to the target by [`Pending::commit`];
+/// dropped without it, it is removed and the target is untouched.
+pub struct Pending {
+    temp: tempfile::NamedTempFile,
+    target: PathBuf,
+}
+
+/// The folder a file is written in (the current one for a bare name).
+fn folder(target: &Path) -> &Path {
+    match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    }
+}
+
+impl Pending {
+    /// Opens a temporary file beside `target` (named after it, with its extension: some writers choose the
+    /// format by the extension).
+    pub fn beside(target: &Path) -> std::io::Result<Self> {
+        let name = target
+            .file_name()
+            .map_or("out".into(), |n| n.to_string_lossy().into_owned());
+        let suffix = target
+            .extension()
+            .map_or(String::new(), |e| format!(".{}", e.to_string_lossy()));
+        let temp = tempfile::Builder::new()
+            .prefix(&format!(".{name}."))
+            .suffix(&suffix)
+            .tempfile_in(folder(target))?;
+        Ok(Self {
+            temp,
+            target: target.to_path_buf(),
+        })
+    }
+
+    /// The open temporary file.
+    pub fn file(&mut self) -> &mut std::fs::File {
+        self.temp.as_file_mut()
+    }
+
+    /// Flushes the file to the disk and renames it to the target.
+    pub fn commit(self) -> std::io::Result<()> {
+        self.temp.as_file().sync_all()?;
+        self.temp.persist(&self.target).map_err(|e| e.error)?;
+        Ok(())
+    }
+}
+
+/// Writes `bytes` to `target` whole, or leaves it as it was.
+pub fn write(target: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut pending = Pending::beside(target)?;
+    pending.file().write_all(bytes)?;
+    pending.commit()
+}
+
+/// Whether `output` is the same file as `input` (by the file's identity where both exist: a hard link or another
+/// spelling of the path is the same file; by the canonical path otherwise).
+pub fn same_file(output: &Path, input: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        if let (Ok(a), Ok(b)) = (std::fs::metadata(output), std::fs::metadata(input)) {
+            return a.dev() == b.dev() && a.ino() == b.ino();
+        }
+    }
+    match (output.canonicalize(), input.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Refuses an output that is one of the inputs: writing it would destroy what is being read.
+pub fn not_an_input(output: &Path, inputs: &[&Path]) -> Result<(), String> {
+    match inputs.iter().find(|i| same_file(output, i)) {
+        Some(i) => Err(format!(
+            "{} is also an input ({}): writing it would destroy what is read; name another file",
+            output.display(),
+            i.display()
+        )),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_write_replaces_the_target_whole_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("x.txt");
+        std::fs::write(&target, "old").unwrap();
+        write(&target, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&target).unwrap(), "new");
+        let pending = Pending::beside(&target).unwrap();
+        drop(pending);
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "an abandoned write leaves nothing"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&target).unwrap(),
+            "new",
+            "and the target as it was"
+        );
+    }
+
+    #[test]
+    fn the_same_file_is_found_under_another_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = dir.path().join("a.csv");
+        std::fs::write(&a, "x").unwrap();
+        let spelled = dir.path().join(".").join("a.csv");
+        assert!(not_an_input(&spelled, &[&a]).is_err());
+        let linked = dir.path().join("b.csv");
+        std::fs::hard_link(&a, &linked).unwrap();
+        assert!(same_file(&linked, &a), "a hard link is the same file");
+        assert!(
+            not_an_input(&dir.path().join("c.csv"), &[&a]).is_ok(),
+            "a new file is no input"
+        );
+    }
+}
