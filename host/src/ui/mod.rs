@@ -6,10 +6,12 @@ mod api;
 mod error;
 mod frame;
 pub mod guard;
+mod hub;
+mod request;
 mod worker;
 
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
 use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
@@ -26,7 +28,8 @@ use crate::link::Target;
 use crate::signals::Signals;
 pub use error::UiError;
 use guard::Token;
-use worker::{Hub, Job, Request};
+use hub::Hub;
+use request::Job;
 
 /// What `ringpod ui` is asked to do.
 pub struct Options {
@@ -97,15 +100,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
     let cue_file = std::env::temp_dir().join(format!("ringpod-ui-{}-cueing.toml", std::process::id()));
     std::fs::write(&cue_file, toml::to_string(&ringpod_core::cueing::CueConfig::default())?)
         .map_err(|e| crate::error::CliError::file(&cue_file, e))?;
-    let hub = Arc::new(Hub {
-        out,
-        halt: Arc::new(AtomicBool::new(false)),
-        streaming: AtomicU64::new(0),
-        rig: Mutex::new(None),
-        record: Mutex::new(None),
-        cue_file: cue_file.clone(),
-        closing: AtomicBool::new(false),
-    });
+    let hub = Arc::new(Hub::new(out, cue_file.clone()));
     let (jobs, inbox) = mpsc::channel();
     let device = {
         let hub = hub.clone();
@@ -137,7 +132,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
                     tokio::time::sleep(std::time::Duration::from_millis(100)).await;
                 }
                 hub.closing.store(true, Ordering::SeqCst);
-                hub.halt.store(true, Ordering::SeqCst);
+                hub.stop_everything();
                 (signals, device)
             }
         };
@@ -232,43 +227,49 @@ async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
     }
     if app.hub.streaming.load(Ordering::SeqCst) == page {
         // The page that started the stream is gone: nobody watches it any more.
-        app.hub.halt.store(true, Ordering::SeqCst);
+        app.hub.cancel_current();
     }
 }
 
 /// A page's request: queued for the device, or answered at once when it cannot be taken (unreadable, or not
-/// STOP while a stream runs). STOP also ends a running stream right away.
+/// STOP while a stream runs). STOP is answered here, never queued behind what the device thread does: it ends
+/// what runs and cancels every request sent before it (see [`hub`]); the device thread then brings the platform
+/// to rest and says so.
 fn take(app: &App, page: u64, text: &str) -> Option<Value> {
-    #[derive(Deserialize)]
-    struct Numbered {
-        id: u64,
-        #[serde(flatten)]
-        request: Value,
-    }
-    let (id, request) = match serde_json::from_str::<Numbered>(text) {
-        Ok(n) => (n.id, serde_json::from_value::<Request>(n.request)),
-        Err(e) => return Some(json!({ "type": "reply", "page": page, "id": 0, "ok": false, "text": e.to_string() })),
+    let answer = |id: u64, ok: bool, text: String| {
+        Some(json!({ "type": "reply", "page": page, "id": id, "ok": ok, "text": text }))
     };
-    let reply =
-        |ok: bool, text: String| Some(json!({ "type": "reply", "page": page, "id": id, "ok": ok, "text": text }));
-    let request = match request {
+    let (id, request) = match request::parse(text) {
         Ok(r) => r,
-        Err(e) => return reply(false, format!("not a request: {e}")),
+        Err(e) => return answer(e.id, false, e.why),
     };
-    if request == Request::Halt {
-        app.hub.halt.store(true, Ordering::SeqCst);
+    let epoch = if request.is_halt() {
+        let epoch = app.hub.stop_everything();
+        app.hub.reply(
+            page,
+            id,
+            true,
+            "STOP: what ran has ended and every request sent before is cancelled; coming to rest and powering down",
+        );
+        epoch
     } else if app.hub.streaming.load(Ordering::SeqCst) != 0 {
-        return reply(false, "a stream is running: STOP ends it".into());
-    }
-    let sent = app
-        .jobs
-        .lock()
-        .ok()
-        .map(|jobs| jobs.send(Job { page, id, request }).is_ok());
+        return answer(id, false, "a stream is running: STOP ends it".into());
+    } else {
+        app.hub.epoch()
+    };
+    let sent = app.jobs.lock().ok().map(|jobs| {
+        jobs.send(Job {
+            page,
+            id,
+            epoch,
+            request,
+        })
+        .is_ok()
+    });
     if sent == Some(true) {
         None
     } else {
-        reply(false, "the device thread has ended".into())
+        answer(id, false, "the device thread has ended".into())
     }
 }
 

@@ -38,6 +38,7 @@ function connect() {
     else if (m.type === "rig") showRig(m);
     else if (m.type === "frame") showFrame(m);
     else if (m.type === "reply") showReply(m);
+    else if (m.type === "halted") { state.halted = m; log(m.text); }
     else if (m.type === "report") log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
   };
 }

@@ -1,0 +1,93 @@
+//! What the pages and the device thread share, and STOP.
+//!
+//! STOP never waits behind the device thread's queue: it is taken where the page's message arrives. It advances
+//! the STOP generation, which every queued request carries from when it was sent, so that a request sent before
+//! a STOP is answered as cancelled instead of run; and it raises the cancel flag of whatever the device thread
+//! runs now (a stream, its powering up and homing), which ends it at once. The device thread then brings the
+//! platform to rest and powers down.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+
+use ringpod_core::protocol::RigRecord;
+use serde_json::json;
+
+use super::request::Job;
+
+/// What the pages and the device thread share.
+pub struct Hub {
+    /// Every message to the pages (JSON text).
+    pub out: tokio::sync::broadcast::Sender<String>,
+    /// The STOP generation: how many STOPs were pressed.
+    epoch: AtomicU64,
+    /// The cancel flag of what the device thread runs now (a fresh one per request).
+    cancel: Mutex<Arc<AtomicBool>>,
+    /// The page whose stream runs (0: none).
+    pub streaming: AtomicU64,
+    /// The newest rig message, for a page that connects later.
+    pub rig: Mutex<Option<String>>,
+    /// The rig the device runs, for the computations and the Rig panel.
+    pub record: Mutex<Option<RigRecord>>,
+    /// The cueing file a telemetry session reloads when it changes (the Cueing panel's "apply live").
+    pub cue_file: PathBuf,
+    /// Set when the server ends: the device thread powers down and returns.
+    pub closing: AtomicBool,
+}
+
+impl Hub {
+    /// A hub with no page and no STOP yet.
+    pub fn new(out: tokio::sync::broadcast::Sender<String>, cue_file: PathBuf) -> Self {
+        Self {
+            out,
+            epoch: AtomicU64::new(0),
+            cancel: Mutex::new(Arc::new(AtomicBool::new(false))),
+            streaming: AtomicU64::new(0),
+            rig: Mutex::new(None),
+            record: Mutex::new(None),
+            cue_file,
+            closing: AtomicBool::new(false),
+        }
+    }
+
+    /// Sends a message to every page (none listening is not an error).
+    pub fn publish(&self, message: &serde_json::Value) {
+        let _ = self.out.send(message.to_string());
+    }
+
+    /// A reply to a page's request, seen by every page.
+    pub fn reply(&self, page: u64, id: u64, ok: bool, text: impl Into<String>) {
+        self.publish(&json!({ "type": "reply", "page": page, "id": id, "ok": ok, "text": text.into() }));
+    }
+
+    /// The STOP generation a request sent now belongs to.
+    pub fn epoch(&self) -> u64 {
+        self.epoch.load(Ordering::SeqCst)
+    }
+
+    /// STOP: every request sent before now is cancelled and what runs now ends. Gives the new generation.
+    pub fn stop_everything(&self) -> u64 {
+        let epoch = self.epoch.fetch_add(1, Ordering::SeqCst) + 1;
+        // After the generation: a request the device thread began before it sees this flag, one it begins after
+        // it sees the new generation (see `begin`).
+        self.cancel_current();
+        epoch
+    }
+
+    /// Ends what the device thread runs now (a stream whose page went away, the server's end), sparing the queue.
+    pub fn cancel_current(&self) {
+        self.cancel
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .store(true, Ordering::SeqCst);
+    }
+
+    /// The device thread begins `job`: its cancel flag, or `None` when a STOP came after the job was sent (the
+    /// job is then not run). A STOP is begun only when no later STOP supersedes it.
+    pub fn begin(&self, job: &Job) -> Option<Arc<AtomicBool>> {
+        let flag = Arc::new(AtomicBool::new(false));
+        *self.cancel.lock().unwrap_or_else(PoisonError::into_inner) = flag.clone();
+        // Read after the flag is in place: a STOP that this read misses raises the flag.
+        (self.epoch() == job.epoch).then_some(flag)
+    }
+}
