@@ -13,6 +13,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use ringpod_core::protocol::RigRecord;
 use serde_json::json;
 
+use super::presence::Presence;
 use super::request::Job;
 
 /// What the pages and the device thread share.
@@ -33,6 +34,8 @@ pub struct Hub {
     pub cue_file: PathBuf,
     /// Set when the server ends: the device thread powers down and returns.
     pub closing: AtomicBool,
+    /// The pages connected now.
+    pub presence: Presence,
 }
 
 impl Hub {
@@ -47,6 +50,7 @@ impl Hub {
             record: Mutex::new(None),
             cue_file,
             closing: AtomicBool::new(false),
+            presence: Presence::default(),
         }
     }
 
@@ -82,12 +86,22 @@ impl Hub {
             .store(true, Ordering::SeqCst);
     }
 
-    /// The device thread begins `job`: its cancel flag, or `None` when a STOP came after the job was sent (the
-    /// job is then not run). A STOP is begun only when no later STOP supersedes it.
-    pub fn begin(&self, job: &Job) -> Option<Arc<AtomicBool>> {
+    /// The device thread begins `job`: its cancel flag, or why it is not run: a STOP came after it was sent, or
+    /// its page has gone (nobody would watch what it does). A STOP is begun only when no later STOP supersedes it.
+    pub fn begin(&self, job: &Job) -> Result<Arc<AtomicBool>, &'static str> {
         let flag = Arc::new(AtomicBool::new(false));
         *self.cancel.lock().unwrap_or_else(PoisonError::into_inner) = flag.clone();
         // Read after the flag is in place: a STOP that this read misses raises the flag.
-        (self.epoch() == job.epoch).then_some(flag)
+        if self.epoch() != job.epoch {
+            return Err(if job.request.is_halt() {
+                "STOP: taken over by a later STOP"
+            } else {
+                "cancelled: STOP was pressed after it was sent"
+            });
+        }
+        if !job.request.is_halt() && !self.presence.is_open(job.page) {
+            return Err("cancelled: its page has gone");
+        }
+        Ok(flag)
     }
 }

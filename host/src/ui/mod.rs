@@ -7,14 +7,15 @@ mod error;
 mod frame;
 pub mod guard;
 mod hub;
+mod presence;
 mod request;
+mod socket;
 mod worker;
 
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
-use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::extract::{Query, State};
 use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -125,6 +126,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
             );
         }
         let router = routes(&app);
+        tokio::spawn(socket::watch_presence(app.clone()));
         let stop = {
             let hub = hub.clone();
             async move {
@@ -162,7 +164,7 @@ fn routes(app: &Arc<App>) -> Router {
     // The check, once, here.
     let checked = Router::new()
         .route("/", get(page))
-        .route("/ws", get(socket))
+        .route("/ws", get(socket::socket))
         .route("/api/cue/defaults", get(cue_defaults))
         .route("/api/cue", post(cue))
         .route("/api/cue/apply", post(cue_apply))
@@ -183,94 +185,6 @@ fn routes(app: &Arc<App>) -> Router {
 
 async fn page() -> Response {
     ([(header::CONTENT_TYPE, "text/html; charset=utf-8")], PAGE).into_response()
-}
-
-async fn socket(State(app): State<Arc<App>>, upgrade: WebSocketUpgrade) -> Response {
-    let page = app.pages.fetch_add(1, Ordering::SeqCst) + 1;
-    upgrade.on_upgrade(move |ws| serve_page(app, page, ws))
-}
-
-/// One page: the pages' messages out, its requests in. When it goes, a stream it started stops.
-async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
-    let mut out = app.hub.out.subscribe();
-    let hello = json!({ "type": "hello", "page": page });
-    let rig = app.hub.rig.lock().ok().and_then(|r| r.clone());
-    for text in [Some(hello.to_string()), rig].into_iter().flatten() {
-        if ws.send(Message::Text(text.into())).await.is_err() {
-            return;
-        }
-    }
-    loop {
-        tokio::select! {
-            message = out.recv() => match message {
-                Ok(text) => {
-                    if ws.send(Message::Text(text.into())).await.is_err() {
-                        break;
-                    }
-                }
-                // A slow page misses frames, never replies: frames are many, replies follow them.
-                Err(tokio::sync::broadcast::error::RecvError::Lagged(_)) => continue,
-                Err(tokio::sync::broadcast::error::RecvError::Closed) => break,
-            },
-            incoming = ws.recv() => match incoming {
-                Some(Ok(Message::Text(text))) => {
-                    if let Some(answer) = take(&app, page, &text) {
-                        if ws.send(Message::Text(answer.to_string().into())).await.is_err() {
-                            break;
-                        }
-                    }
-                }
-                Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
-                Some(Ok(_)) => {}
-            },
-        }
-    }
-    if app.hub.streaming.load(Ordering::SeqCst) == page {
-        // The page that started the stream is gone: nobody watches it any more.
-        app.hub.cancel_current();
-    }
-}
-
-/// A page's request: queued for the device, or answered at once when it cannot be taken (unreadable, or not
-/// STOP while a stream runs). STOP is answered here, never queued behind what the device thread does: it ends
-/// what runs and cancels every request sent before it (see [`hub`]); the device thread then brings the platform
-/// to rest and says so.
-fn take(app: &App, page: u64, text: &str) -> Option<Value> {
-    let answer = |id: u64, ok: bool, text: String| {
-        Some(json!({ "type": "reply", "page": page, "id": id, "ok": ok, "text": text }))
-    };
-    let (id, request) = match request::parse(text) {
-        Ok(r) => r,
-        Err(e) => return answer(e.id, false, e.why),
-    };
-    let epoch = if request.is_halt() {
-        let epoch = app.hub.stop_everything();
-        app.hub.reply(
-            page,
-            id,
-            true,
-            "STOP: what ran has ended and every request sent before is cancelled; coming to rest and powering down",
-        );
-        epoch
-    } else if app.hub.streaming.load(Ordering::SeqCst) != 0 {
-        return answer(id, false, "a stream is running: STOP ends it".into());
-    } else {
-        app.hub.epoch()
-    };
-    let sent = app.jobs.lock().ok().map(|jobs| {
-        jobs.send(Job {
-            page,
-            id,
-            epoch,
-            request,
-        })
-        .is_ok()
-    });
-    if sent == Some(true) {
-        None
-    } else {
-        answer(id, false, "the device thread has ended".into())
-    }
 }
 
 async fn admitted(

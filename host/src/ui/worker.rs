@@ -181,13 +181,9 @@ struct Device {
 
 impl Device {
     fn serve(&mut self, job: &Job) {
-        let Some(cancel) = self.hub.begin(job) else {
-            let text = if job.request.is_halt() {
-                "STOP: taken over by a later STOP"
-            } else {
-                "cancelled: STOP was pressed after it was sent"
-            };
-            return self.hub.reply(job.page, job.id, !job.request.is_halt(), text);
+        let cancel = match self.hub.begin(job) {
+            Ok(flag) => flag,
+            Err(why) => return self.hub.reply(job.page, job.id, job.request.is_halt(), why),
         };
         self.cancel = cancel;
         let result = match &job.request {

@@ -115,3 +115,77 @@ fn a_stream_asked_just_before_stop_never_moves() {
         "the platform ran after STOP was answered"
     );
 }
+
+/// The first frame a page sees.
+fn first_frame(page: &mut Page) -> Value {
+    page.until(Duration::from_secs(10), |m| m["type"] == "frame").unwrap()
+}
+
+#[test]
+fn a_page_closed_mid_stream_leaves_the_platform_at_rest_and_powered_down() {
+    let bench = Workbench::start(&[]);
+    let mut a = bench.page();
+    homed(&mut a);
+    a.send(json!({ "do": "motion", "motion": "demo", "seconds": 60, "rate_hz": 100 }));
+    a.until(Duration::from_secs(30), |m| {
+        m["type"] == "frame" && state(m) == Some("Running")
+    })
+    .unwrap();
+    a.close();
+    // Past the grace and the ramp to rest, another page finds the supplies off.
+    std::thread::sleep(Duration::from_secs(5));
+    let mut b = bench.page();
+    let f = first_frame(&mut b);
+    assert_eq!(state(&f), Some("Off"), "{f}");
+    assert_eq!(
+        f["outputs"].as_u64().unwrap() & 0b111,
+        0,
+        "supplies and drivers off: {f}"
+    );
+}
+
+#[test]
+fn a_page_killed_during_homing_leaves_the_platform_powered_down() {
+    let bench = Workbench::start(&[]);
+    let mut a = bench.page();
+    a.send(json!({ "do": "enable" }));
+    a.until(Duration::from_secs(20), |m| {
+        m["type"] == "frame" && m["gates"]["home"].is_null()
+    })
+    .unwrap();
+    a.send(json!({ "do": "home" }));
+    a.until(Duration::from_secs(20), |m| state(m) == Some("Homing"))
+        .unwrap();
+    // A killed browser: the connection ends with no close frame.
+    drop(a);
+    std::thread::sleep(Duration::from_secs(5));
+    let mut b = bench.page();
+    let f = first_frame(&mut b);
+    assert_eq!(state(&f), Some("Off"), "{f}");
+}
+
+#[test]
+fn a_reload_within_the_grace_keeps_the_platform_powered() {
+    let bench = Workbench::start(&[]);
+    let mut a = bench.page();
+    homed(&mut a);
+    a.send(json!({ "do": "motion", "motion": "heave", "seconds": 60, "rate_hz": 100 }));
+    a.until(Duration::from_secs(30), |m| state(m) == Some("Running"))
+        .unwrap();
+    a.close();
+    std::thread::sleep(Duration::from_millis(500));
+    let mut b = bench.page();
+    // The stream of the page that left ends at once; the platform stays powered, at rest, for the new page.
+    b.until(Duration::from_secs(15), |m| {
+        m["type"] == "frame" && state(m) == Some("Ready") && m["streaming"] == false
+    })
+    .unwrap();
+    let watched = b.watch(Duration::from_secs(4));
+    assert!(
+        watched
+            .iter()
+            .filter(|m| m["type"] == "frame")
+            .all(|m| state(m) == Some("Ready")),
+        "powered down although a page was back within the grace"
+    );
+}

@@ -60,11 +60,6 @@ impl Workbench {
         }
         Page { ws, next: 1 }
     }
-
-    /// Whether the server still runs.
-    pub fn running(&mut self) -> bool {
-        self.child.try_wait().unwrap().is_none()
-    }
 }
 
 /// One connected page.
