@@ -6,6 +6,8 @@
 //! runs now (a stream, its powering up and homing), which ends it at once. The device thread then brings the
 //! platform to rest and powers down.
 
+use std::collections::BTreeMap;
+use std::net::IpAddr;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -13,13 +15,14 @@ use std::sync::{Arc, Mutex, PoisonError};
 use ringpod_core::protocol::RigRecord;
 use serde_json::json;
 
+use super::outbox::Outbox;
 use super::presence::Presence;
 use super::request::Job;
 
 /// What the pages and the device thread share.
 pub struct Hub {
-    /// Every message to the pages (JSON text).
-    pub out: tokio::sync::broadcast::Sender<String>,
+    /// What waits to be sent to each connected page.
+    outboxes: Mutex<BTreeMap<u64, Arc<Outbox>>>,
     /// The STOP generation: how many STOPs were pressed.
     epoch: AtomicU64,
     /// The cancel flag of what the device thread runs now (a fresh one per request).
@@ -36,13 +39,17 @@ pub struct Hub {
     pub closing: AtomicBool,
     /// The pages connected now.
     pub presence: Presence,
+    /// The address the workbench listens on: a UDP session of a page binds it too (loopback stays loopback).
+    pub bind: IpAddr,
+    /// The directory whose files a page may stream by name (`ringpod ui --files`).
+    pub files: Option<PathBuf>,
 }
 
 impl Hub {
     /// A hub with no page and no STOP yet.
-    pub fn new(out: tokio::sync::broadcast::Sender<String>, cue_file: PathBuf) -> Self {
+    pub fn new(cue_file: PathBuf, bind: IpAddr, files: Option<PathBuf>) -> Self {
         Self {
-            out,
+            outboxes: Mutex::new(BTreeMap::new()),
             epoch: AtomicU64::new(0),
             cancel: Mutex::new(Arc::new(AtomicBool::new(false))),
             streaming: AtomicU64::new(0),
@@ -51,12 +58,43 @@ impl Hub {
             cue_file,
             closing: AtomicBool::new(false),
             presence: Presence::default(),
+            bind,
+            files,
         }
     }
 
-    /// Sends a message to every page (none listening is not an error).
+    fn outboxes(&self) -> Vec<Arc<Outbox>> {
+        let o = self.outboxes.lock().unwrap_or_else(PoisonError::into_inner);
+        o.values().cloned().collect()
+    }
+
+    /// A page's outbox, from when it connects.
+    pub fn open_outbox(&self, page: u64) -> Arc<Outbox> {
+        let outbox = Arc::new(Outbox::default());
+        let mut o = self.outboxes.lock().unwrap_or_else(PoisonError::into_inner);
+        o.insert(page, outbox.clone());
+        outbox
+    }
+
+    /// The page has gone.
+    pub fn close_outbox(&self, page: u64) {
+        let mut o = self.outboxes.lock().unwrap_or_else(PoisonError::into_inner);
+        o.remove(&page);
+    }
+
+    /// Sends a message to every page, never dropped (none listening is not an error).
     pub fn publish(&self, message: &serde_json::Value) {
-        let _ = self.out.send(message.to_string());
+        let text = message.to_string();
+        for o in self.outboxes() {
+            o.push(text.clone());
+        }
+    }
+
+    /// Sends a telemetry frame to every page: a page that has not taken the last one gets this one instead.
+    pub fn publish_frame(&self, frame: &serde_json::Value) {
+        for o in self.outboxes() {
+            o.frame(frame);
+        }
     }
 
     /// A reply to a page's request, seen by every page.

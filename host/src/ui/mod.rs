@@ -4,9 +4,11 @@
 
 mod api;
 mod error;
+mod files;
 mod frame;
 pub mod guard;
 mod hub;
+mod outbox;
 mod presence;
 mod request;
 mod socket;
@@ -40,6 +42,8 @@ pub struct Options {
     pub platform: Option<Platform>,
     /// Where to listen.
     pub listen: SocketAddr,
+    /// The directory whose pose files a page may stream by name (otherwise only the files the user picks).
+    pub files: Option<std::path::PathBuf>,
 }
 
 /// The page, its scripts and its style, compiled in.
@@ -97,11 +101,15 @@ pub fn run(options: Options) -> Result<u8, UiError> {
             addr: options.listen,
             reason,
         })?;
-    let (out, _) = tokio::sync::broadcast::channel(256);
-    let cue_file = std::env::temp_dir().join(format!("ringpod-ui-{}-cueing.toml", std::process::id()));
-    std::fs::write(&cue_file, toml::to_string(&ringpod_core::cueing::CueConfig::default())?)
-        .map_err(|e| crate::error::CliError::file(&cue_file, e))?;
-    let hub = Arc::new(Hub::new(out, cue_file.clone()));
+    // The live cueing file lives in a directory of its own that only this user can enter (removed at the end).
+    let private = files::private_dir()?;
+    let cue_file = private.path().join("cueing.toml");
+    files::write_whole(
+        &cue_file,
+        &toml::to_string(&ringpod_core::cueing::CueConfig::default())?,
+    )
+    .map_err(|e| crate::error::CliError::file(&cue_file, e))?;
+    let hub = Arc::new(Hub::new(cue_file.clone(), listener.local_addr()?.ip(), options.files));
     let (jobs, inbox) = mpsc::channel();
     let device = {
         let hub = hub.clone();
@@ -146,7 +154,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
         axum::serve(listener, router).with_graceful_shutdown(shutdown).await?;
         rx.await.map_err(|_| UiError::NoStop)
     });
-    let _ = std::fs::remove_file(&cue_file);
+    drop(private);
     let (signals, device) = served?;
     match device.join() {
         Ok(Err(e)) => Err(UiError::Device(e)),
@@ -225,7 +233,8 @@ async fn cue(State(app): State<Arc<App>>, Json(request): Json<api::CueRequest>) 
 async fn cue_apply(State(app): State<Arc<App>>, Json(request): Json<api::CueRequest>) -> Response {
     let written = api::cue_config(&request.config).and_then(|config| {
         let text = toml::to_string(&config).map_err(|e| e.to_string())?;
-        std::fs::write(&app.hub.cue_file, text).map_err(|e| format!("{}: {e}", app.hub.cue_file.display()))
+        // Whole or not at all: a telemetry session never reads a half-written file.
+        files::write_whole(&app.hub.cue_file, &text).map_err(|e| format!("{}: {e}", app.hub.cue_file.display()))
     });
     answer(written.map(|()| json!({ "applied": app.hub.cue_file.display().to_string() })))
 }
@@ -242,6 +251,7 @@ async fn rig_current(State(app): State<Arc<App>>) -> Response {
 }
 
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct TextBody {
     text: String,
 }

@@ -32,9 +32,12 @@ pub enum Request {
         seconds: f64,
         rate_hz: f64,
     },
-    /// A pose CSV on this machine.
+    /// A pose CSV: the text of a file the user picked in the page (`text`, named `name`), or without `text` the
+    /// file `name` under the directory `ringpod ui --files` names.
     File {
-        path: String,
+        name: String,
+        #[serde(default)]
+        text: Option<String>,
         #[serde(default)]
         degrees: bool,
     },
@@ -50,6 +53,9 @@ pub enum Request {
         /// Seconds without a datagram after which the session ends.
         #[serde(default = "default_idle")]
         idle: f64,
+        /// Only datagrams from this sender's address count (as the CLI's `--from`).
+        #[serde(default)]
+        from: Option<std::net::IpAddr>,
     },
     /// A rig file's text, stored on the device (it must be `Off`), then the device restarted to run it.
     LoadRig {
@@ -121,6 +127,8 @@ mod tests {
     #[test]
     fn requests_are_read_with_their_numbers_and_defaults() {
         assert_eq!(parse(r#"{"id":3,"do":"halt"}"#), Ok((3, Request::Halt)));
+        let (_, file) = parse(r#"{"id":5,"do":"file","name":"a.csv","text":"t,x\n"}"#).unwrap();
+        assert!(matches!(file, Request::File { text: Some(_), .. }), "{file:?}");
         let (id, udp) = parse(r#"{"id":4,"do":"udp","port":4444,"holds":"poses"}"#).unwrap();
         assert_eq!(id, 4);
         assert_eq!(
@@ -131,6 +139,7 @@ mod tests {
                 format: None,
                 degrees: false,
                 idle: 30.0,
+                from: None,
             }
         );
     }
@@ -142,7 +151,7 @@ mod tests {
             (r#"{"id":1,"do":"halt","now":true}"#, "now"),
             (r#"{"id":1,"do":"park","to":"home"}"#, "to"),
             (r#"{"id":1,"do":"jog","axis":1,"distance":1,"speed":9}"#, "speed"),
-            (r#"{"id":1,"do":"file","path":"a","text":"x"}"#, "text"),
+            (r#"{"id":1,"do":"file","name":"a","path":"/etc/shadow"}"#, "path"),
             (
                 r#"{"id":1,"do":"udp","port":1,"holds":"poses","bind":"0.0.0.0"}"#,
                 "bind",

@@ -3,84 +3,137 @@
 
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use axum::extract::ws::{CloseFrame, Message, WebSocket, WebSocketUpgrade};
 use axum::extract::State;
 use axum::response::Response;
 use serde_json::{json, Value};
 
+use super::outbox::{Next, Outbox, MOST_WAITING};
 use super::presence::{HEARD_WITHIN, PING_EVERY};
 use super::request::{self, Job, Request};
 use super::App;
 
+/// The largest message a page may send: a pose file the user picks comes whole in one (larger files go under
+/// `ringpod ui --files`). A larger one closes the connection with code 1009 and says so. A frame is read whole up
+/// to twice this before it is refused, so that the page, done sending, reads the close frame; a frame larger
+/// still is refused at its header (the close frame is sent, though a client still sending may see a reset).
+pub const MOST_BYTES: usize = 16 << 20;
+
+/// How long one message may take to reach a page before it is taken as unable to keep up.
+const SEND_WITHIN: Duration = HEARD_WITHIN;
+
 pub async fn socket(State(app): State<Arc<App>>, upgrade: WebSocketUpgrade) -> Response {
     let page = app.pages.fetch_add(1, Ordering::SeqCst) + 1;
-    upgrade.on_upgrade(move |ws| serve_page(app, page, ws))
+    upgrade
+        .max_message_size(MOST_BYTES)
+        .max_frame_size(2 * MOST_BYTES)
+        .on_upgrade(move |ws| serve_page(app, page, ws))
 }
 
-/// Closes a page's connection with a reason (`1001` going away: a page not heard from).
-async fn close(ws: &mut WebSocket, code: u16, reason: &str) {
-    let frame = CloseFrame {
-        code,
-        reason: reason.into(),
-    };
-    let _ = ws.send(Message::Close(Some(frame))).await;
+/// Why a page's connection ends.
+enum End {
+    /// The page closed it, or it broke.
+    Gone,
+    /// Closed by the workbench with a close code and a reason.
+    Close(u16, String),
 }
 
-/// One page: the pages' messages out, its requests in. When it goes, a stream it started stops.
-async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
-    let mut out = app.hub.out.subscribe();
-    app.hub.presence.arrive(page);
-    let hello = json!({ "type": "hello", "page": page });
-    let rig = app.hub.rig.lock().ok().and_then(|r| r.clone());
-    let mut greeted = true;
-    for text in [Some(hello.to_string()), rig].into_iter().flatten() {
-        greeted &= ws.send(Message::Text(text.into())).await.is_ok();
+/// Sends one message within [`SEND_WITHIN`].
+async fn send(ws: &mut WebSocket, message: Message) -> Result<(), End> {
+    match tokio::time::timeout(SEND_WITHIN, ws.send(message)).await {
+        Ok(Ok(())) => Ok(()),
+        Ok(Err(_)) => Err(End::Gone),
+        Err(_) => Err(End::Close(
+            1013,
+            "this page did not take its messages: reload it".into(),
+        )),
     }
+}
+
+/// What the page's connection says: its close code for an error (a message too large, a broken frame).
+fn close_for(error: axum::Error) -> End {
+    match error.into_inner().downcast_ref::<tungstenite::Error>() {
+        Some(tungstenite::Error::Capacity(e)) => {
+            End::Close(1009, format!("{e}: a message is at most {MOST_BYTES} bytes"))
+        }
+        Some(tungstenite::Error::Protocol(e)) => End::Close(1002, e.to_string()),
+        _ => End::Gone,
+    }
+}
+
+/// One page: its outbox out, its requests in, pings. When it goes, a stream it started stops.
+async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
+    let outbox = app.hub.open_outbox(page);
+    app.hub.presence.arrive(page);
+    outbox.push(json!({ "type": "hello", "page": page }).to_string());
+    if let Some(rig) = app.hub.rig.lock().ok().and_then(|r| r.clone()) {
+        outbox.push(rig);
+    }
+    let end = converse(&app, page, &outbox, &mut ws).await;
+    app.hub.close_outbox(page);
+    app.hub.presence.leave(page, Instant::now());
+    if app.hub.streaming.load(Ordering::SeqCst) == page {
+        // The page that started the stream is gone: nobody watches it any more.
+        app.hub.cancel_current();
+    }
+    if let End::Close(code, reason) = end {
+        let frame = CloseFrame {
+            code,
+            reason: reason.into(),
+        };
+        let _ = tokio::time::timeout(PING_EVERY, ws.send(Message::Close(Some(frame)))).await;
+    }
+}
+
+async fn converse(app: &App, page: u64, outbox: &Outbox, ws: &mut WebSocket) -> End {
     let mut ping = tokio::time::interval(PING_EVERY);
     let mut heard = Instant::now();
-    while greeted {
+    loop {
         tokio::select! {
-            message = out.recv() => match message {
-                Ok(text) => {
-                    if ws.send(Message::Text(text.into())).await.is_err() {
-                        break;
+            next = outbox.next() => match next {
+                Next::Send(messages, frame) => {
+                    for text in messages {
+                        if let Err(end) = send(ws, Message::Text(text.into())).await {
+                            return end;
+                        }
+                    }
+                    if let Some(frame) = frame {
+                        if let Err(end) = send(ws, Message::Text(frame.to_string().into())).await {
+                            return end;
+                        }
                     }
                 }
-                // A slow page misses frames, never replies: frames are many, replies follow them.
-                Err(tokio::sync::broadcast::error::RecvError::Lagged(_)) => continue,
-                Err(tokio::sync::broadcast::error::RecvError::Closed) => break,
+                Next::Overrun => {
+                    return End::Close(1013, format!("this page fell {MOST_WAITING} messages behind: reload it"));
+                }
             },
             _ = ping.tick() => {
                 if heard.elapsed() > HEARD_WITHIN {
-                    close(&mut ws, 1001, "no answer to the pings: taken as gone").await;
-                    break;
+                    return End::Close(1001, "no answer to the pings: taken as gone".into());
                 }
-                if ws.send(Message::Ping(Default::default())).await.is_err() {
-                    break;
+                if let Err(end) = send(ws, Message::Ping(Default::default())).await {
+                    return end;
                 }
             },
             incoming = ws.recv() => {
                 heard = Instant::now();
                 match incoming {
                     Some(Ok(Message::Text(text))) => {
-                        if let Some(answer) = take(&app, page, &text) {
-                            if ws.send(Message::Text(answer.to_string().into())).await.is_err() {
-                                break;
-                            }
+                        if let Some(answer) = take(app, page, &text) {
+                            outbox.push(answer.to_string());
                         }
                     }
-                    Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
+                    Some(Ok(Message::Binary(_))) => {
+                        return End::Close(1003, "the workbench takes text messages (JSON) only".into());
+                    }
+                    Some(Ok(Message::Close(_))) | None => return End::Gone,
+                    Some(Err(e)) => return close_for(e),
                     Some(Ok(_)) => {}
                 }
             },
         }
-    }
-    app.hub.presence.leave(page, Instant::now());
-    if app.hub.streaming.load(Ordering::SeqCst) == page {
-        // The page that started the stream is gone: nobody watches it any more.
-        app.hub.cancel_current();
     }
 }
 

@@ -3,7 +3,6 @@
 //! `stream::run` as the CLI. Its telemetry tap publishes frames to every page at [`FRAME_HZ`], also while a
 //! stream runs; a stream ends when STOP is pressed or the page that started it goes away.
 
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -13,6 +12,7 @@ use ringpod_core::protocol::{RigSource, Telemetry};
 use ringpod_core::safety::State;
 use serde_json::json;
 
+use super::files;
 use super::frame::{self, LinkCounts, RigView};
 use super::hub::Hub;
 use super::request::{Job, Request};
@@ -58,6 +58,9 @@ pub enum WorkerError {
     /// A rig is loaded only with the supplies off.
     #[error("a rig is loaded with the supplies off: Disable first")]
     NotOff,
+    /// A pose file the page may not read, or that is not one.
+    #[error("{0}")]
+    File(String),
     /// A stream or a park that did not end at the pose asked: its report's words.
     #[error("{0}")]
     Ended(String),
@@ -96,7 +99,7 @@ impl Publisher {
         let frame = frame::frame(&m, sample, self.counts, streaming);
         let mut message = serde_json::to_value(frame).unwrap_or_default();
         message["type"] = json!("frame");
-        self.hub.publish(&message);
+        self.hub.publish_frame(&message);
     }
 }
 
@@ -232,20 +235,15 @@ impl Device {
                         },
                     )
                 }),
-            Request::File { path, degrees } => self.stream(
-                job.page,
-                &Input::File {
-                    path: PathBuf::from(path),
-                    degrees: *degrees,
-                },
-            ),
+            Request::File { name, text, degrees } => self.file(job.page, name, text.as_deref(), *degrees),
             Request::Udp {
                 port,
                 holds,
                 format,
                 degrees,
                 idle,
-            } => self.udp(job.page, *port, holds, format.as_deref(), *degrees, *idle),
+                from,
+            } => self.udp(job.page, *port, holds, format.as_deref(), *degrees, *idle, *from),
             Request::LoadRig { text } => self.load_rig(text),
         };
         match result {
@@ -301,6 +299,24 @@ impl Device {
         Ok("parked at home and powering down".to_owned())
     }
 
+    /// A pose file: the text of one the user picked in the page, or one under `ringpod ui --files`. A refusal
+    /// names the file and never quotes what it holds.
+    fn file(&mut self, page: u64, name: &str, text: Option<&str>, degrees: bool) -> Result<String, WorkerError> {
+        let refused = |reason: String| WorkerError::File(format!("{name}: {}", files::reason_without_content(&reason)));
+        let text = match text {
+            Some(t) => t.to_owned(),
+            None => {
+                let path = files::under(self.hub.files.as_deref(), name).map_err(WorkerError::File)?;
+                crate::input::files::read_text(&path, crate::input::files::DATA_LIMIT).map_err(refused)?
+            }
+        };
+        let (poses, errors) = stream::read_csv(&text, degrees).map_err(refused)?;
+        self.follow(page, Source::Poses(poses), errors)
+    }
+
+    /// A UDP session on the workbench's own address (loopback when it listens on loopback), taking datagrams
+    /// only from `from` when given.
+    #[allow(clippy::too_many_arguments)]
     fn udp(
         &mut self,
         page: u64,
@@ -309,6 +325,7 @@ impl Device {
         format: Option<&str>,
         degrees: bool,
         idle: f64,
+        from: Option<std::net::IpAddr>,
     ) -> Result<String, WorkerError> {
         let holds = match holds {
             "poses" => Datagrams::Poses { degrees },
@@ -327,9 +344,9 @@ impl Device {
         self.stream(
             page,
             &Input::Udp {
-                addr: std::net::SocketAddr::from(([0, 0, 0, 0], port)),
+                addr: std::net::SocketAddr::new(self.hub.bind, port),
                 holds,
-                from: None,
+                from,
                 idle,
             },
         )
@@ -337,6 +354,11 @@ impl Device {
 
     fn stream(&mut self, page: u64, input: &Input) -> Result<String, WorkerError> {
         let (source, errors) = job::open(input)?;
+        self.follow(page, source, errors)
+    }
+
+    /// Runs a stream and tells the pages its report.
+    fn follow(&mut self, page: u64, source: Source, errors: Vec<stream::InputError>) -> Result<String, WorkerError> {
         let report = self.run(page, source, errors)?;
         let text = format!(
             "{}: {} setpoints sent, {} applied, {} limited, {} refused{}",

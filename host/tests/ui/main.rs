@@ -1,5 +1,6 @@
 //! `ringpod ui --sim` driven over its WebSocket and HTTP as a page (or a hostile client) drives it.
 
+mod requests;
 mod workbench;
 
 use std::time::{Duration, Instant};
@@ -7,16 +8,16 @@ use std::time::{Duration, Instant};
 use serde_json::{json, Value};
 use workbench::{Page, Workbench};
 
-fn state(m: &Value) -> Option<&str> {
+pub fn state(m: &Value) -> Option<&str> {
     (m["type"] == "frame").then(|| m["state"].as_str()).flatten()
 }
 
-fn is_reply(m: &Value, id: u64) -> bool {
+pub fn is_reply(m: &Value, id: u64) -> bool {
     m["type"] == "reply" && m["id"] == id
 }
 
 /// Powers up and homes from the Control panel's buttons, and waits for `Ready`.
-fn homed(page: &mut Page) {
+pub fn homed(page: &mut Page) {
     page.send(json!({ "do": "enable" }));
     page.until(Duration::from_secs(20), |m| {
         m["type"] == "frame" && m["gates"]["home"].is_null()

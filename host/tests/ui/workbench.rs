@@ -25,9 +25,12 @@ impl Drop for Workbench {
 }
 
 impl Workbench {
-    /// `ringpod ui --sim --listen 127.0.0.1:0 ARGS`, once it printed its URL.
+    /// `ringpod ui --sim --listen 127.0.0.1:0 ARGS`, once it printed its URL. `RINGPOD_UI_BIN` names another
+    /// build to try the tests on (an older one, to see them fail).
     pub fn start(args: &[&str]) -> Self {
-        let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        let bin =
+            std::env::var_os("RINGPOD_UI_BIN").map_or_else(|| assert_cmd::cargo::cargo_bin("ringpod"), Into::into);
+        let mut child = Command::new(bin)
             .args(["ui", "--sim", "--listen", "127.0.0.1:0"])
             .args(args)
             .stdout(Stdio::piped())
@@ -133,4 +136,31 @@ impl Page {
         let _ = self.ws.close(None);
         let _ = self.ws.flush();
     }
+}
+
+/// One HTTP/1.1 request by hand (to choose its `Host`): the status code and the body.
+pub fn http(addr: &str, method: &str, path: &str, host: &str, body: Option<&Value>) -> (u16, String) {
+    use std::io::{Read, Write};
+    let mut s = TcpStream::connect(addr).unwrap();
+    s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+    let body = body.map(Value::to_string).unwrap_or_default();
+    write!(
+        s,
+        "{method} {path} HTTP/1.1\r\nHost: {host}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\
+         Connection: close\r\n\r\n{body}",
+        body.len()
+    )
+    .unwrap();
+    let mut answer = String::new();
+    s.read_to_string(&mut answer).unwrap();
+    let status = answer
+        .split_whitespace()
+        .nth(1)
+        .and_then(|c| c.parse().ok())
+        .unwrap_or(0);
+    let body = answer
+        .split_once("\r\n\r\n")
+        .map(|(_, b)| b.to_owned())
+        .unwrap_or_default();
+    (status, body)
 }

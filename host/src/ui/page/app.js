@@ -175,10 +175,17 @@ $("buzz").addEventListener("click", () => send({ do: "buzz", axis: +$("jog-axis"
 $("run-motion").addEventListener("click", () => send({
   do: "motion", motion: $("motion").value, seconds: +$("motion-seconds").value, rate_hz: +$("motion-rate").value,
 }));
-$("stream-file").addEventListener("click", () => send({ do: "file", path: $("file-path").value, degrees: $("file-degrees").checked }));
-$("run-udp").addEventListener("click", () => send({
-  do: "udp", port: +$("udp-port").value, holds: $("udp-holds").value, format: $("udp-format").value, idle: +$("udp-idle").value,
-}));
+// A picked file goes as its text (the workbench reads no path the page gives, but under `ui --files DIR`).
+$("stream-file").addEventListener("click", async () => {
+  const degrees = $("file-degrees").checked, picked = $("file-pick").files[0];
+  if (picked) send({ do: "file", name: picked.name, text: await picked.text(), degrees });
+  else send({ do: "file", name: $("file-name").value, degrees });
+});
+$("run-udp").addEventListener("click", () => {
+  const request = { do: "udp", port: +$("udp-port").value, holds: $("udp-holds").value, format: $("udp-format").value, idle: +$("udp-idle").value };
+  if ($("udp-from").value.trim()) request.from = $("udp-from").value.trim();
+  send(request);
+});
 $("park").addEventListener("click", () => send({ do: "park" }));
 
 // ---- Cueing ----
