@@ -141,18 +141,17 @@ async fn converse(app: &App, page: u64, outbox: &Outbox, ws: &mut WebSocket) -> 
 /// and queues the bringing to rest. Whether the device thread took it.
 fn stop(app: &App, page: u64, id: u64) -> bool {
     let epoch = app.hub.stop_everything();
-    queue(
-        app,
-        Job {
-            page,
-            id,
-            epoch,
-            request: Request::Halt,
-        },
-    )
+    queue(app, page, id, epoch, Request::Halt)
 }
 
-fn queue(app: &App, job: Job) -> bool {
+/// Queues a request for the device thread, of the STOP generation `epoch`: whether the thread took it.
+fn queue(app: &App, page: u64, id: u64, epoch: u64, request: Request) -> bool {
+    let job = Job {
+        page,
+        id,
+        epoch,
+        request,
+    };
     app.jobs.lock().ok().is_some_and(|jobs| jobs.send(job).is_ok())
 }
 
@@ -196,16 +195,7 @@ fn take(app: &App, page: u64, text: &str) -> Option<Value> {
     } else if app.hub.streaming.load(Ordering::SeqCst) != 0 {
         return answer(id, false, "a stream is running: STOP ends it");
     } else {
-        let epoch = app.hub.epoch();
-        queue(
-            app,
-            Job {
-                page,
-                id,
-                epoch,
-                request,
-            },
-        )
+        queue(app, page, id, app.hub.epoch(), request)
     };
     if taken {
         None

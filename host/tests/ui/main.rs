@@ -16,14 +16,19 @@ pub fn is_reply(m: &Value, id: u64) -> bool {
     m["type"] == "reply" && m["id"] == id
 }
 
-/// Powers up and homes from the Control panel's buttons, and waits for `Ready`.
-pub fn homed(page: &mut Page) {
+/// Powers up and asks for homing from the Control panel's buttons.
+fn homing(page: &mut Page) {
     page.send(json!({ "do": "enable" }));
     page.until(Duration::from_secs(20), |m| {
         m["type"] == "frame" && m["gates"]["home"].is_null()
     })
     .unwrap();
     page.send(json!({ "do": "home" }));
+}
+
+/// Powers up and homes from the Control panel's buttons, and waits for `Ready`.
+fn homed(page: &mut Page) {
+    homing(page);
     page.until(Duration::from_secs(60), |m| state(m) == Some("Ready"))
         .unwrap();
 }
@@ -149,12 +154,7 @@ fn a_page_closed_mid_stream_leaves_the_platform_at_rest_and_powered_down() {
 fn a_page_killed_during_homing_leaves_the_platform_powered_down() {
     let bench = Workbench::start(&[]);
     let mut a = bench.page();
-    a.send(json!({ "do": "enable" }));
-    a.until(Duration::from_secs(20), |m| {
-        m["type"] == "frame" && m["gates"]["home"].is_null()
-    })
-    .unwrap();
-    a.send(json!({ "do": "home" }));
+    homing(&mut a);
     a.until(Duration::from_secs(20), |m| state(m) == Some("Homing"))
         .unwrap();
     // A killed browser: the connection ends with no close frame.

@@ -5,7 +5,7 @@ use std::time::Duration;
 use serde_json::{json, Value};
 
 use super::workbench::{http, Workbench};
-use super::{homed, is_reply, state};
+use super::{is_reply, state};
 
 fn reply(page: &mut super::workbench::Page, request: Value, within: Duration) -> Value {
     let id = page.send(request);
