@@ -164,7 +164,11 @@ fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlat
         eprintln!("warning: {source}");
     }
     let geometry = record.geometry().map_err(WorkerError::DeviceGeometry)?;
-    let view = RigView::of(&geometry, record.home, source.to_string());
+    let mut view = RigView::of(&geometry, record.home, source.to_string());
+    // The name the user gave the rig (its file's `name`), not the geometry's generic one.
+    if !record.name().trim().is_empty() {
+        record.name().clone_into(&mut view.name);
+    }
     let mut message = serde_json::to_value(view)?;
     message["type"] = json!("rig");
     // A poisoned lock only means a page's thread panicked while holding it: the value is still the rig's.
