@@ -8,15 +8,31 @@ use crate::emulator::start_or_fail;
 use crate::host_cli::{ringpod, ringpod_json, send_garbage, write_beyond_envelope, write_input};
 use crate::Tally;
 
-/// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
-pub(crate) fn controller_on_m4f(t: &mut Tally) {
-    println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
+/// Builds the host CLI the runs drive.
+fn build_cli() -> Result<(), String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let cli = Command::new(&cargo)
         .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         .args(["build", "--release", "-p", "ringpod"])
         .status();
-    if !cli.is_ok_and(|s| s.success()) {
+    if cli.is_ok_and(|s| s.success()) {
+        Ok(())
+    } else {
+        Err("the host CLI does not build".into())
+    }
+}
+
+/// Builds everything the suite runs: the host CLI and both Cortex-M4F programs.
+pub(crate) fn build_all() -> Result<(), String> {
+    build_cli()?;
+    crate::emulator::build("ringpod-qemu")?;
+    crate::emulator::build("ringpod-qemu-controller").map(|_| ())
+}
+
+/// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
+pub(crate) fn controller_on_m4f(t: &mut Tally) {
+    println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
+    if build_cli().is_err() {
         t.check(false, "the host CLI builds");
         return;
     }
