@@ -72,6 +72,9 @@ pub struct UiArgs {
     /// token in the printed URL is all that keeps them out.
     #[arg(long, default_value = "127.0.0.1:8080")]
     pub listen: std::net::SocketAddr,
+    /// Let the page stream pose files under DIR by name. Without it the page streams only the files picked in it.
+    #[arg(long, value_name = "DIR")]
+    pub files: Option<std::path::PathBuf>,
 }
 
 /// Which controller a command drives: a board on a serial port, or the simulated controller in this process (of the

@@ -320,6 +320,7 @@ impl super::UiArgs {
             target: crate::link::Target::named(self.controller.port.as_deref(), self.controller.sim)?,
             platform: platform(&self.controller.geometry, &self.controller.mechanism),
             listen: self.listen,
+            files: self.files.clone(),
         })
     }
 }

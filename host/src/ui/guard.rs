@@ -39,8 +39,10 @@ impl Token {
 pub enum Refused {
     /// No token, or the wrong one.
     Token,
-    /// A page of another origin (or a `Host` this server is not).
+    /// A page of another origin.
     Origin,
+    /// A `Host` this server is not (a name rebound to this machine), or none.
+    Host,
 }
 
 impl std::fmt::Display for Refused {
@@ -48,15 +50,17 @@ impl std::fmt::Display for Refused {
         f.write_str(match self {
             Self::Token => "open the URL `ringpod ui` printed: this one has no token or the wrong one",
             Self::Origin => "refused: the request comes from a page of another origin",
+            Self::Host => "refused: the request names another host than this workbench",
         })
     }
 }
 
-/// Checks one request: its token, and the `Origin` and `Host` headers a browser sends with it.
+/// Checks one request: its token, its `Host` (every HTTP/1.1 request has one), and the `Origin` a browser sends.
 ///
 /// On a loopback address only the names of this machine are accepted as `Host` (`127.0.0.1`, `localhost`,
-/// `[::1]` with the port), which keeps rebinding sites out even before the token; on another address the `Host`
-/// is whatever name the user reached it by. An `Origin`, when sent, must be `http://` and that `Host`.
+/// `[::1]` with the port), on every request, with an `Origin` or without: a rebinding site is kept out even if
+/// its page got the token. On another address the `Host` is whatever name the user reached it by. An `Origin`,
+/// when sent, must be `http://` and that `Host`.
 pub fn check(
     listen: SocketAddr,
     token: &Token,
@@ -81,10 +85,11 @@ pub fn check(
         .iter()
         .any(|ok| ok.eq_ignore_ascii_case(h))
     };
-    match (origin, host) {
-        (None, _) => Ok(()),
-        (Some(origin), Some(host)) if host_ok(host) && origin.eq_ignore_ascii_case(&format!("http://{host}")) => Ok(()),
-        _ => Err(Refused::Origin),
+    let host = host.filter(|h| host_ok(h)).ok_or(Refused::Host)?;
+    match origin {
+        None => Ok(()),
+        Some(origin) if origin.eq_ignore_ascii_case(&format!("http://{host}")) => Ok(()),
+        Some(_) => Err(Refused::Origin),
     }
 }
 
@@ -131,12 +136,16 @@ mod tests {
         assert_eq!(page(Some("https://127.0.0.1:8080"), Some(LOOP)), Err(Refused::Origin));
         assert_eq!(page(Some("http://127.0.0.1:9090"), Some(LOOP)), Err(Refused::Origin));
         assert_eq!(page(Some("null"), Some(LOOP)), Err(Refused::Origin));
-        // A site whose name was rebound to this machine: its own origin and Host agree, but the Host is not ours.
+        // A site whose name was rebound to this machine: its own origin and Host agree, but the Host is not ours;
+        // the same without an Origin (a client that is not a browser, or one that omits it).
         assert_eq!(
             page(Some("http://rebound.example:8080"), Some("rebound.example:8080")),
-            Err(Refused::Origin)
+            Err(Refused::Host)
         );
-        assert_eq!(page(Some("http://127.0.0.1:8080"), None), Err(Refused::Origin));
+        assert_eq!(page(None, Some("rebound.example:8080")), Err(Refused::Host));
+        assert_eq!(page(None, Some("127.0.0.1:9090")), Err(Refused::Host));
+        assert_eq!(page(Some("http://127.0.0.1:8080"), None), Err(Refused::Host));
+        assert_eq!(page(None, None), Err(Refused::Host));
         // The token first, whatever the origin.
         assert_eq!(
             check(listen, &t, Some("wrong"), Some("http://127.0.0.1:8080"), Some(LOOP)),

@@ -4,15 +4,20 @@
 
 mod api;
 mod error;
+mod files;
 mod frame;
 pub mod guard;
+mod hub;
+mod outbox;
+mod presence;
+mod request;
+mod socket;
 mod worker;
 
 use std::net::SocketAddr;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 
-use axum::extract::ws::{Message, WebSocket, WebSocketUpgrade};
 use axum::extract::{Query, State};
 use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::{IntoResponse, Response};
@@ -26,7 +31,8 @@ use crate::link::Target;
 use crate::signals::Signals;
 pub use error::UiError;
 use guard::Token;
-use worker::{Hub, Job, Request};
+use hub::Hub;
+use request::Job;
 
 /// What `ringpod ui` is asked to do.
 pub struct Options {
@@ -36,6 +42,8 @@ pub struct Options {
     pub platform: Option<Platform>,
     /// Where to listen.
     pub listen: SocketAddr,
+    /// The directory whose pose files a page may stream by name (otherwise only the files the user picks).
+    pub files: Option<std::path::PathBuf>,
 }
 
 /// The page, its scripts and its style, compiled in.
@@ -93,19 +101,15 @@ pub fn run(options: Options) -> Result<u8, UiError> {
             addr: options.listen,
             reason,
         })?;
-    let (out, _) = tokio::sync::broadcast::channel(256);
-    let cue_file = std::env::temp_dir().join(format!("ringpod-ui-{}-cueing.toml", std::process::id()));
-    std::fs::write(&cue_file, toml::to_string(&ringpod_core::cueing::CueConfig::default())?)
-        .map_err(|e| crate::error::CliError::file(&cue_file, e))?;
-    let hub = Arc::new(Hub {
-        out,
-        halt: Arc::new(AtomicBool::new(false)),
-        streaming: AtomicU64::new(0),
-        rig: Mutex::new(None),
-        record: Mutex::new(None),
-        cue_file: cue_file.clone(),
-        closing: AtomicBool::new(false),
-    });
+    // The live cueing file lives in a directory of its own that only this user can enter (removed at the end).
+    let private = files::private_dir()?;
+    let cue_file = private.path().join("cueing.toml");
+    files::write_whole(
+        &cue_file,
+        &toml::to_string(&ringpod_core::cueing::CueConfig::default())?,
+    )
+    .map_err(|e| crate::error::CliError::file(&cue_file, e))?;
+    let hub = Arc::new(Hub::new(cue_file.clone(), listener.local_addr()?.ip(), options.files));
     let (jobs, inbox) = mpsc::channel();
     let device = {
         let hub = hub.clone();
@@ -130,6 +134,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
             );
         }
         let router = routes(&app);
+        tokio::spawn(socket::watch_presence(app.clone()));
         let stop = {
             let hub = hub.clone();
             async move {
@@ -137,7 +142,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
                     tokio::time::sleep(std::time::Duration::from_millis(100)).await;
                 }
                 hub.closing.store(true, Ordering::SeqCst);
-                hub.halt.store(true, Ordering::SeqCst);
+                hub.stop_everything();
                 (signals, device)
             }
         };
@@ -149,7 +154,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
         axum::serve(listener, router).with_graceful_shutdown(shutdown).await?;
         rx.await.map_err(|_| UiError::NoStop)
     });
-    let _ = std::fs::remove_file(&cue_file);
+    drop(private);
     let (signals, device) = served?;
     match device.join() {
         Ok(Err(e)) => Err(UiError::Device(e)),
@@ -167,7 +172,7 @@ fn routes(app: &Arc<App>) -> Router {
     // The check, once, here.
     let checked = Router::new()
         .route("/", get(page))
-        .route("/ws", get(socket))
+        .route("/ws", get(socket::socket))
         .route("/api/cue/defaults", get(cue_defaults))
         .route("/api/cue", post(cue))
         .route("/api/cue/apply", post(cue_apply))
@@ -188,88 +193,6 @@ fn routes(app: &Arc<App>) -> Router {
 
 async fn page() -> Response {
     ([(header::CONTENT_TYPE, "text/html; charset=utf-8")], PAGE).into_response()
-}
-
-async fn socket(State(app): State<Arc<App>>, upgrade: WebSocketUpgrade) -> Response {
-    let page = app.pages.fetch_add(1, Ordering::SeqCst) + 1;
-    upgrade.on_upgrade(move |ws| serve_page(app, page, ws))
-}
-
-/// One page: the pages' messages out, its requests in. When it goes, a stream it started stops.
-async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
-    let mut out = app.hub.out.subscribe();
-    let hello = json!({ "type": "hello", "page": page });
-    let rig = app.hub.rig.lock().ok().and_then(|r| r.clone());
-    for text in [Some(hello.to_string()), rig].into_iter().flatten() {
-        if ws.send(Message::Text(text.into())).await.is_err() {
-            return;
-        }
-    }
-    loop {
-        tokio::select! {
-            message = out.recv() => match message {
-                Ok(text) => {
-                    if ws.send(Message::Text(text.into())).await.is_err() {
-                        break;
-                    }
-                }
-                // A slow page misses frames, never replies: frames are many, replies follow them.
-                Err(tokio::sync::broadcast::error::RecvError::Lagged(_)) => continue,
-                Err(tokio::sync::broadcast::error::RecvError::Closed) => break,
-            },
-            incoming = ws.recv() => match incoming {
-                Some(Ok(Message::Text(text))) => {
-                    if let Some(answer) = take(&app, page, &text) {
-                        if ws.send(Message::Text(answer.to_string().into())).await.is_err() {
-                            break;
-                        }
-                    }
-                }
-                Some(Ok(Message::Close(_))) | None | Some(Err(_)) => break,
-                Some(Ok(_)) => {}
-            },
-        }
-    }
-    if app.hub.streaming.load(Ordering::SeqCst) == page {
-        // The page that started the stream is gone: nobody watches it any more.
-        app.hub.halt.store(true, Ordering::SeqCst);
-    }
-}
-
-/// A page's request: queued for the device, or answered at once when it cannot be taken (unreadable, or not
-/// STOP while a stream runs). STOP also ends a running stream right away.
-fn take(app: &App, page: u64, text: &str) -> Option<Value> {
-    #[derive(Deserialize)]
-    struct Numbered {
-        id: u64,
-        #[serde(flatten)]
-        request: Value,
-    }
-    let (id, request) = match serde_json::from_str::<Numbered>(text) {
-        Ok(n) => (n.id, serde_json::from_value::<Request>(n.request)),
-        Err(e) => return Some(json!({ "type": "reply", "page": page, "id": 0, "ok": false, "text": e.to_string() })),
-    };
-    let reply =
-        |ok: bool, text: String| Some(json!({ "type": "reply", "page": page, "id": id, "ok": ok, "text": text }));
-    let request = match request {
-        Ok(r) => r,
-        Err(e) => return reply(false, format!("not a request: {e}")),
-    };
-    if request == Request::Halt {
-        app.hub.halt.store(true, Ordering::SeqCst);
-    } else if app.hub.streaming.load(Ordering::SeqCst) != 0 {
-        return reply(false, "a stream is running: STOP ends it".into());
-    }
-    let sent = app
-        .jobs
-        .lock()
-        .ok()
-        .map(|jobs| jobs.send(Job { page, id, request }).is_ok());
-    if sent == Some(true) {
-        None
-    } else {
-        reply(false, "the device thread has ended".into())
-    }
 }
 
 async fn admitted(
@@ -310,7 +233,8 @@ async fn cue(State(app): State<Arc<App>>, Json(request): Json<api::CueRequest>) 
 async fn cue_apply(State(app): State<Arc<App>>, Json(request): Json<api::CueRequest>) -> Response {
     let written = api::cue_config(&request.config).and_then(|config| {
         let text = toml::to_string(&config).map_err(|e| e.to_string())?;
-        std::fs::write(&app.hub.cue_file, text).map_err(|e| format!("{}: {e}", app.hub.cue_file.display()))
+        // Whole or not at all: a telemetry session never reads a half-written file.
+        files::write_whole(&app.hub.cue_file, &text).map_err(|e| format!("{}: {e}", app.hub.cue_file.display()))
     });
     answer(written.map(|()| json!({ "applied": app.hub.cue_file.display().to_string() })))
 }
@@ -327,6 +251,7 @@ async fn rig_current(State(app): State<Arc<App>>) -> Response {
 }
 
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 struct TextBody {
     text: String,
 }

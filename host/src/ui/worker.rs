@@ -3,18 +3,19 @@
 //! `stream::run` as the CLI. Its telemetry tap publishes frames to every page at [`FRAME_HZ`], also while a
 //! stream runs; a stream ends when STOP is pressed or the page that started it goes away.
 
-use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
-use ringpod_core::protocol::{RigRecord, RigSource, Telemetry};
+use ringpod_core::protocol::{RigSource, Telemetry};
 use ringpod_core::safety::State;
-use serde::Deserialize;
 use serde_json::json;
 
+use super::files;
 use super::frame::{self, LinkCounts, RigView};
+use super::hub::Hub;
+use super::request::{Job, Request};
 use crate::link::client::{Client, ClientError, Transport};
 use crate::link::transport::{AnyTransport, SimDevice};
 use crate::link::{self, Target};
@@ -57,6 +58,9 @@ pub enum WorkerError {
     /// A rig is loaded only with the supplies off.
     #[error("a rig is loaded with the supplies off: Disable first")]
     NotOff,
+    /// A pose file the page may not read, or that is not one.
+    #[error("{0}")]
+    File(String),
     /// A stream or a park that did not end at the pose asked: its report's words.
     #[error("{0}")]
     Ended(String),
@@ -64,100 +68,6 @@ pub enum WorkerError {
 
 /// Frames a page is sent per second at most (a browser draws at 60; telemetry may come at 1 kHz).
 pub const FRAME_HZ: f64 = 50.0;
-
-/// What a page asks the device to do.
-#[derive(Debug, Clone, Deserialize, PartialEq)]
-#[serde(tag = "do", rename_all = "snake_case", deny_unknown_fields)]
-pub enum Request {
-    Enable,
-    Disable,
-    Home,
-    Start,
-    Stop,
-    Clear,
-    /// The STOP button: ends a stream, stops whatever moves, and powers down.
-    Halt,
-    /// Axis 1-6; degrees of ring for a carriage, mm for a linear actuator.
-    Jog {
-        axis: u8,
-        distance: f64,
-    },
-    Buzz {
-        axis: u8,
-    },
-    /// To the home pose, then power down.
-    Park,
-    /// A built-in motion (`demo`, `heave`, `yaw`, `vibration`).
-    Motion {
-        motion: String,
-        seconds: f64,
-        rate_hz: f64,
-    },
-    /// A pose CSV on this machine.
-    File {
-        path: String,
-        #[serde(default)]
-        degrees: bool,
-    },
-    /// Poses (`holds = "poses"`) or a game's telemetry (`holds = "telemetry"`, cued by the workbench's live
-    /// cueing file) on a UDP port.
-    Udp {
-        port: u16,
-        holds: String,
-        #[serde(default)]
-        format: Option<String>,
-        #[serde(default)]
-        degrees: bool,
-        /// Seconds without a datagram after which the session ends.
-        #[serde(default = "default_idle")]
-        idle: f64,
-    },
-    /// A rig file's text, stored on the device (it must be `Off`), then the device restarted to run it.
-    LoadRig {
-        text: String,
-    },
-}
-
-fn default_idle() -> f64 {
-    30.0
-}
-
-/// A request of one page (its connection number) with the number the page gave it.
-pub struct Job {
-    pub page: u64,
-    pub id: u64,
-    pub request: Request,
-}
-
-/// What the pages and the device thread share.
-pub struct Hub {
-    /// Every message to the pages (JSON text).
-    pub out: tokio::sync::broadcast::Sender<String>,
-    /// Set by STOP (and by the loss of the page that started a stream): ends the stream at once.
-    pub halt: Arc<AtomicBool>,
-    /// The page whose stream runs (0: none).
-    pub streaming: AtomicU64,
-    /// The newest rig message, for a page that connects later.
-    pub rig: Mutex<Option<String>>,
-    /// The rig the device runs, for the computations and the Rig panel.
-    pub record: Mutex<Option<RigRecord>>,
-    /// The cueing file a telemetry session reloads when it changes (the Cueing panel's "apply live").
-    pub cue_file: PathBuf,
-    /// Set when the server ends: the device thread powers down and returns.
-    pub closing: AtomicBool,
-}
-
-impl Hub {
-    /// Sends a message to every page (none listening is not an error).
-    pub fn publish(&self, message: &serde_json::Value) {
-        let _ = self.out.send(message.to_string());
-    }
-
-    /// A reply to a page's request, seen by every page.
-    fn reply(&self, job: &Job, ok: bool, text: impl Into<String>) {
-        self.publish(&json!({ "type": "reply", "page": job.page, "id": job.id, "ok": ok, "text": text.into() }));
-    }
-}
 
 /// Makes frames of the telemetry the client sees, at most [`FRAME_HZ`] a second.
 struct Publisher {
@@ -189,7 +99,7 @@ impl Publisher {
         let frame = frame::frame(&m, sample, self.counts, streaming);
         let mut message = serde_json::to_value(frame).unwrap_or_default();
         message["type"] = json!("frame");
-        self.hub.publish(&message);
+        self.hub.publish_frame(&message);
     }
 }
 
@@ -225,6 +135,7 @@ pub fn run(
         client,
         hub: hub.clone(),
         mechanism,
+        cancel: Arc::new(AtomicBool::new(false)),
     };
     let mut last_sample = Instant::now();
     while !hub.closing.load(Ordering::SeqCst) {
@@ -253,7 +164,11 @@ fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlat
         eprintln!("warning: {source}");
     }
     let geometry = record.geometry().map_err(WorkerError::DeviceGeometry)?;
-    let view = RigView::of(&geometry, record.home, source.to_string());
+    let mut view = RigView::of(&geometry, record.home, source.to_string());
+    // The name the user gave the rig (its file's `name`), not the geometry's generic one.
+    if !record.name().trim().is_empty() {
+        record.name().clone_into(&mut view.name);
+    }
     let mut message = serde_json::to_value(view)?;
     message["type"] = json!("rig");
     // A poisoned lock only means a page's thread panicked while holding it: the value is still the rig's.
@@ -267,10 +182,17 @@ struct Device {
     client: Client<AnyTransport>,
     hub: Arc<Hub>,
     mechanism: Arc<Mutex<RingPlatform<f64>>>,
+    /// The cancel flag of the request being served.
+    cancel: Arc<AtomicBool>,
 }
 
 impl Device {
     fn serve(&mut self, job: &Job) {
+        let cancel = match self.hub.begin(job) {
+            Ok(flag) => flag,
+            Err(why) => return self.hub.reply(job.page, job.id, job.request.is_halt(), why),
+        };
+        self.cancel = cancel;
         let result = match &job.request {
             Request::Enable => self.client.enable().map(|()| "enabling".to_owned()).map_err(Into::into),
             Request::Disable => self
@@ -286,7 +208,12 @@ impl Device {
                 .clear()
                 .map(|()| "fault cleared".to_owned())
                 .map_err(Into::into),
-            Request::Halt => self.halt(),
+            Request::Halt => self.halt().map(|text| {
+                // The STOP was answered when it arrived; this says the platform is at rest.
+                self.hub
+                    .publish(&json!({ "type": "halted", "page": job.page, "id": job.id, "text": text }));
+                text
+            }),
             Request::Jog { axis, distance } => self.commission(*axis, Some(*distance)),
             Request::Buzz { axis } => self.commission(*axis, None),
             Request::Park => self.park(job.page),
@@ -312,31 +239,27 @@ impl Device {
                         },
                     )
                 }),
-            Request::File { path, degrees } => self.stream(
-                job.page,
-                &Input::File {
-                    path: PathBuf::from(path),
-                    degrees: *degrees,
-                },
-            ),
+            Request::File { name, text, degrees } => self.file(job.page, name, text.as_deref(), *degrees),
             Request::Udp {
                 port,
                 holds,
                 format,
                 degrees,
                 idle,
-            } => self.udp(job.page, *port, holds, format.as_deref(), *degrees, *idle),
+                from,
+            } => self.udp(job.page, *port, holds, format.as_deref(), *degrees, *idle, *from),
             Request::LoadRig { text } => self.load_rig(text),
         };
         match result {
-            Ok(text) => self.hub.reply(job, true, text),
-            Err(e) => self.hub.reply(job, false, format!("{e:#}")),
+            Ok(_) if job.request.is_halt() => {}
+            Ok(text) => self.hub.reply(job.page, job.id, true, text),
+            Err(e) => self.hub.reply(job.page, job.id, false, format!("{e:#}")),
         }
     }
 
-    /// STOP: ends a stream (its owner already saw the flag), ramps whatever moves to rest, powers down.
+    /// STOP: the stream already ended (its cancel flag was raised when STOP arrived); ramps whatever moves to
+    /// rest and powers down.
     fn halt(&mut self) -> Result<String, WorkerError> {
-        self.hub.halt.store(false, Ordering::SeqCst);
         let status = self.client.status()?;
         if matches!(status.state, State::Running | State::Homing | State::Jogging) {
             self.client.stop()?;
@@ -380,6 +303,24 @@ impl Device {
         Ok("parked at home and powering down".to_owned())
     }
 
+    /// A pose file: the text of one the user picked in the page, or one under `ringpod ui --files`. A refusal
+    /// names the file and never quotes what it holds.
+    fn file(&mut self, page: u64, name: &str, text: Option<&str>, degrees: bool) -> Result<String, WorkerError> {
+        let refused = |reason: String| WorkerError::File(format!("{name}: {}", files::reason_without_content(&reason)));
+        let text = match text {
+            Some(t) => t.to_owned(),
+            None => {
+                let path = files::under(self.hub.files.as_deref(), name).map_err(WorkerError::File)?;
+                crate::input::files::read_text(&path, crate::input::files::DATA_LIMIT).map_err(refused)?
+            }
+        };
+        let (poses, errors) = stream::read_csv(&text, degrees).map_err(refused)?;
+        self.follow(page, Source::Poses(poses), errors)
+    }
+
+    /// A UDP session on the workbench's own address (loopback when it listens on loopback), taking datagrams
+    /// only from `from` when given.
+    #[allow(clippy::too_many_arguments)]
     fn udp(
         &mut self,
         page: u64,
@@ -388,6 +329,7 @@ impl Device {
         format: Option<&str>,
         degrees: bool,
         idle: f64,
+        from: Option<std::net::IpAddr>,
     ) -> Result<String, WorkerError> {
         let holds = match holds {
             "poses" => Datagrams::Poses { degrees },
@@ -407,9 +349,9 @@ impl Device {
         self.stream(
             page,
             &Input::Udp {
-                addr: std::net::SocketAddr::from(([0, 0, 0, 0], port)),
+                addr: std::net::SocketAddr::new(self.hub.bind, port),
                 holds,
-                from: None,
+                from,
                 idle,
             },
         )
@@ -417,6 +359,11 @@ impl Device {
 
     fn stream(&mut self, page: u64, input: &Input) -> Result<String, WorkerError> {
         let (source, errors) = job::open(input)?;
+        self.follow(page, source, errors)
+    }
+
+    /// Runs a stream and tells the pages its report.
+    fn follow(&mut self, page: u64, source: Source, errors: Vec<stream::InputError>) -> Result<String, WorkerError> {
         let report = self.run(page, source, errors)?;
         let text = format!(
             "{}: {} setpoints sent, {} applied, {} limited, {} refused{}",
@@ -444,10 +391,11 @@ impl Device {
         source: Source,
         errors: Vec<stream::InputError>,
     ) -> Result<stream::Report, WorkerError> {
-        self.hub.halt.store(false, Ordering::SeqCst);
         self.hub.streaming.store(page, Ordering::SeqCst);
-        self.client.cancel = Some(self.hub.halt.clone());
-        let halt = self.hub.halt.clone();
+        // STOP, the loss of its page or the server's end raise the flag: the waits for powering up and homing end,
+        // and the stream ends, as Ctrl-C ends `ringpod stream`.
+        self.client.cancel = Some(self.cancel.clone());
+        let halt = self.cancel.clone();
         let options = stream::Options {
             home: false,
             host_limits: true,

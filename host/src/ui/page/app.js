@@ -12,10 +12,14 @@ const HISTORY_S = 10;
 const state = { rig: null, frame: null, frames: 0, page: 0, nextId: 1, replies: [], connected: false };
 window.ringpod = state;
 
-// ---- tabs ----
+// ---- tabs: each keeps its own scroll position ----
+const scrolled = {};
 document.querySelectorAll(".tab").forEach((b) => b.addEventListener("click", () => {
+  const was = document.querySelector(".tab.active");
+  if (was) scrolled[was.dataset.panel] = window.scrollY;
   document.querySelectorAll(".tab").forEach((t) => t.classList.toggle("active", t === b));
   document.querySelectorAll(".panel").forEach((p) => p.classList.toggle("active", p.id === "panel-" + b.dataset.panel));
+  window.scrollTo(0, scrolled[b.dataset.panel] || 0);
   if (b.dataset.panel === "rig" && !$("rig-text").value) loadDeviceRig();
   if (b.dataset.panel === "cueing" && !cue.config) loadCueDefaults();
 }));
@@ -25,12 +29,20 @@ let ws = null;
 function connect() {
   const scheme = location.protocol === "https:" ? "wss" : "ws";
   ws = new WebSocket(`${scheme}://${location.host}/ws?token=${encodeURIComponent(token)}`);
-  ws.onopen = () => { state.connected = true; $("link").textContent = "connected"; };
-  ws.onclose = () => {
+  ws.onopen = () => { state.connected = true; document.body.classList.remove("offline"); $("link").textContent = "connected"; };
+  ws.onclose = (e) => {
     state.connected = false;
     if (leaving) return;
-    $("link").textContent = "connection lost: reconnecting…";
-    setTimeout(connect, 1000);
+    // What is on screen is no longer the platform: the pose and the STOP are greyed and the header says so.
+    document.body.classList.add("offline");
+    $("link").textContent = `connection lost${e.reason ? ` (${e.reason})` : ""}: the pose shown is the last one received; reconnecting…`;
+    // A workbench started again has a new token: this tab's URL will never connect.
+    fetch(api("/")).then((r) => {
+      if (r.status === 403) {
+        state.restarted = true;
+        $("link").textContent = "the workbench was restarted: open the new URL `ringpod ui` printed";
+      } else setTimeout(connect, 1000);
+    }).catch(() => setTimeout(connect, 1000));
   };
   ws.onmessage = (e) => {
     const m = JSON.parse(e.data);
@@ -38,6 +50,7 @@ function connect() {
     else if (m.type === "rig") showRig(m);
     else if (m.type === "frame") showFrame(m);
     else if (m.type === "reply") showReply(m);
+    else if (m.type === "halted") { state.halted = m; log(m.text); }
     else if (m.type === "report") log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
   };
 }
@@ -95,10 +108,11 @@ function showRig(rig) {
   rig.axes.forEach((kind, i) => {
     const o = document.createElement("option");
     o.value = i + 1;
-    o.textContent = `${i + 1} (${kind === "ring" ? "carriage" : kind})`;
+    o.textContent = `${i + 1} (${kind === "ring" ? "carriage" : kind === "angle" ? "shoulder" : kind})`;
     axis.appendChild(o);
   });
-  axis.onchange = () => { $("jog-unit").textContent = rig.axes[axis.value - 1] === "ring" ? "deg" : "mm"; };
+  // Degrees of ring for a carriage and of a shoulder's angle, mm for a linear actuator (as `device jog`).
+  axis.onchange = () => { $("jog-unit").textContent = rig.axes[axis.value - 1] === "linear" ? "mm" : "deg"; };
   axis.onchange();
   const charts = $("live-charts");
   charts.innerHTML = "";
@@ -111,6 +125,9 @@ function showRig(rig) {
 function lamp(on, label, alarm) {
   return `<span class="lamp ${on ? (alarm ? "alarm" : "on") : ""}">${label}</span>`;
 }
+
+// A pose value as the table shows it: mm for a position, degrees for an angle.
+const show = (v, i) => (i < 3 ? v * 1000 : v * 180 / Math.PI).toFixed(2);
 
 function showFrame(f) {
   state.frame = f;
@@ -132,7 +149,8 @@ function showFrame(f) {
   const rows = [["applied", f.applied], ["limited", f.limited], ["refused", f.refused], ["tick cost", f.tick_cost],
     ["device time", f.t.toFixed(2) + " s"], ["streaming", f.streaming ? "yes" : "no"]];
   $("counters").innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td id="count-${k.replace(" ", "-")}">${v}</td></tr>`).join("");
-  $("pose").innerHTML = AXES.map((a, i) => `<tr><td>${a}</td><td>${f.pose[i].toFixed(4)}</td><td class="muted">${f.target[i].toFixed(4)}</td></tr>`).join("");
+  $("pose").innerHTML = `<tr><th>axis</th><th>followed</th><th>commanded</th></tr>` +
+    AXES.map((a, i) => `<tr><td>${a} (${i < 3 ? "mm" : "deg"})</td><td>${show(f.pose[i], i)}</td><td class="muted">${show(f.target[i], i)}</td></tr>`).join("");
   // The rolling history.
   history.t.push(f.t); history.pose.push(f.pose); history.target.push(f.target); history.cost.push(f.tick_cost);
   while (history.t.length && history.t[0] < f.t - HISTORY_S) {
@@ -174,11 +192,19 @@ $("buzz").addEventListener("click", () => send({ do: "buzz", axis: +$("jog-axis"
 $("run-motion").addEventListener("click", () => send({
   do: "motion", motion: $("motion").value, seconds: +$("motion-seconds").value, rate_hz: +$("motion-rate").value,
 }));
-$("stream-file").addEventListener("click", () => send({ do: "file", path: $("file-path").value, degrees: $("file-degrees").checked }));
-$("run-udp").addEventListener("click", () => send({
-  do: "udp", port: +$("udp-port").value, holds: $("udp-holds").value, format: $("udp-format").value, idle: +$("udp-idle").value,
-}));
+// A picked file goes as its text (the workbench reads no path the page gives, but under `ui --files DIR`).
+$("stream-file").addEventListener("click", async () => {
+  const degrees = $("file-degrees").checked, picked = $("file-pick").files[0];
+  if (picked) send({ do: "file", name: picked.name, text: await picked.text(), degrees });
+  else send({ do: "file", name: $("file-name").value, degrees });
+});
+$("run-udp").addEventListener("click", () => {
+  const request = { do: "udp", port: +$("udp-port").value, holds: $("udp-holds").value, format: $("udp-format").value, idle: +$("udp-idle").value };
+  if ($("udp-from").value.trim()) request.from = $("udp-from").value.trim();
+  send(request);
+});
 $("park").addEventListener("click", () => send({ do: "park" }));
+$("start-help").textContent = "Start lets the device follow setpoints: it waits for a stream (Run motion, Stream file, Start session), which starts by itself.";
 
 // ---- Cueing ----
 const cue = { config: null, drive: null, charts: [], timer: null };
@@ -275,6 +301,8 @@ async function recue() {
     document.querySelectorAll("#cue-controls input").forEach((i) => i.classList.remove("bad"));
   } catch (e) {
     status.className = "small msg bad"; status.textContent = e.message;
+    // The plots were of other parameters: not shown as if they were of these.
+    cue.charts.forEach((c) => c.set([]));
   }
 }
 
@@ -316,7 +344,12 @@ async function checkRig() {
   if (j.analysable) m.push(`<div class="msg ok">analysable: yes</div>`);
   if (j.analysable) m.push(j.drivable ? `<div class="msg ok">drivable: yes</div>` : `<div class="msg warn">drivable: no, because ${escapeHtml(j.why)}</div>`);
   $("rig-messages").innerHTML = m.join("");
-  if (!j.analysable) return;
+  if (!j.analysable) {
+    // The drawings were of the last file that read: cleared, not left as if they were of this one.
+    ["rig-view", "rig-section"].forEach((id) => $(id).getContext("2d").clearRect(0, 0, $(id).width, $(id).height));
+    $("rig-legend").textContent = ""; $("rig-coverage").innerHTML = "";
+    return;
+  }
   const v = new View3d($("rig-view"));
   v.pitch = 0.35;
   v.show(j.rig, j.at_home, null);
@@ -354,6 +387,7 @@ $("run-file").addEventListener("change", async (e) => {
     showRun(await post("/api/run", { text: await file.text() }), file.name);
   } catch (err) {
     $("run-status").className = "small msg bad"; $("run-status").textContent = `${file.name}: ${err.message}`;
+    $("run-charts").innerHTML = "";
   }
 });
 

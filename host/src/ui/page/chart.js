@@ -76,19 +76,19 @@ class Chart {
       const h = Math.max(Math.abs(y0) * 0.05, 1e-3);
       y0 -= h; y1 += h;
     }
-    const pad = (y1 - y0) * 0.08; y0 -= pad; y1 += pad;
+    const pad = (y1 - y0) * 0.08;
+    // A quantity that is never negative (a cost, a count) keeps its axis at zero and above.
+    y0 = y0 >= 0 ? Math.max(0, y0 - pad) : y0 - pad; y1 += pad;
     const X = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
     const Y = (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
     g.strokeStyle = "#e5e7eb"; g.lineWidth = 1; g.fillStyle = "#6b7280"; g.font = "17px system-ui";
-    for (let k = 0; k <= 4; k++) {
-      const y = y0 + (y1 - y0) * k / 4;
+    const yt = ticks(y0, y1, 4);
+    for (const y of yt.at) {
       g.beginPath(); g.moveTo(L, Y(y)); g.lineTo(W - R, Y(y)); g.stroke();
-      g.fillText(fmt(y) + this.unit, 2, Y(y) + 5);
+      g.fillText(y.toFixed(yt.decimals) + this.unit, 2, Y(y) + 5);
     }
-    for (let k = 0; k <= 5; k++) {
-      const x = x0 + (x1 - x0) * k / 5;
-      g.fillText(fmt(x) + " s", X(x) - 16, H - 8);
-    }
+    const xt = ticks(x0, x1, 5);
+    for (const x of xt.at) g.fillText(x.toFixed(xt.decimals) + " s", X(x) - 16, H - 8);
     for (const e of this.events) {
       if (e.x < x0 || e.x > x1) continue;
       g.strokeStyle = e.colour; g.beginPath(); g.moveTo(X(e.x), T); g.lineTo(X(e.x), H - B); g.stroke();
@@ -110,11 +110,13 @@ class Chart {
   }
 }
 
-function fmt(v) {
-  const a = Math.abs(v);
-  if (a === 0) return "0";
-  if (a >= 1000) return v.toFixed(0);
-  if (a >= 10) return v.toFixed(1);
-  if (a >= 0.1) return v.toFixed(2);
-  return v.toPrecision(2);
+// Round tick values over [a, b], about n of them, a step of 1, 2 or 5 times a power of ten, with the decimals
+// that step needs: each label differs from the next, none shows more digits than the step.
+function ticks(a, b, n) {
+  const raw = (b - a) / n, p = Math.pow(10, Math.floor(Math.log10(raw)));
+  const step = [1, 2, 5, 10].map((m) => m * p).find((s) => s >= raw);
+  const decimals = Math.max(0, -Math.floor(Math.log10(step) + 1e-9));
+  const at = [];
+  for (let v = Math.ceil(a / step) * step; v <= b + step * 1e-9; v += step) at.push(Math.abs(v) < step * 1e-9 ? 0 : v);
+  return { at, decimals };
 }

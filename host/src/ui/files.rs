@@ -1,0 +1,109 @@
+//! The files the workbench touches for a page: pose files it reads only from the directory `ringpod ui --files`
+//! names (a file the user picks in the page comes as its text instead), and the live cueing file, in a directory
+//! of its own that only this user can enter, replaced whole on every write.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The file `name` under `dir`, or why the page may not read it: no directory was named, or the name leads out of
+/// it (an absolute path, `..`, a symbolic link that points elsewhere). The reason never holds the file's content.
+pub fn under(dir: Option<&Path>, name: &str) -> Result<PathBuf, String> {
+    let Some(dir) = dir else {
+        return Err(format!(
+            "{name}: the workbench reads no file by name: pick it in the page, or start `ringpod ui --files DIR` \
+             to stream files under DIR"
+        ));
+    };
+    let dir = dir
+        .canonicalize()
+        .map_err(|e| format!("--files {}: {e}", dir.display()))?;
+    let outside = || {
+        format!(
+            "{name}: not a file under {} (the directory `ringpod ui --files` names)",
+            dir.display()
+        )
+    };
+    // A name that does not resolve is refused as one outside: whether a path exists elsewhere is not told.
+    let path = dir.join(name).canonicalize().map_err(|_| outside())?;
+    if path.starts_with(&dir) && path.is_file() {
+        Ok(path)
+    } else {
+        Err(outside())
+    }
+}
+
+/// Why a pose file was refused, without what it holds: the table reader quotes a header it does not understand,
+/// which for a file the page named could be any file's first line.
+pub fn reason_without_content(reason: &str) -> &str {
+    reason.split(", found `").next().unwrap_or(reason)
+}
+
+/// A directory only this user can enter (created 0700 on Unix, not changed after), removed when dropped.
+pub fn private_dir() -> std::io::Result<tempfile::TempDir> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix("ringpod-ui-");
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o700));
+    builder.tempdir()
+}
+
+/// Replaces `path` with `text` whole: written to a new file beside it, then renamed over it. A reader sees the old
+/// file or the new one, never a part; a symbolic link planted at `path` is replaced, never followed.
+pub fn write_whole(path: &Path, text: &str) -> std::io::Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut file = tempfile::NamedTempFile::new_in(dir)?;
+    file.write_all(text.as_bytes())?;
+    file.as_file().sync_all()?;
+    file.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[cfg(unix)]
+    #[test]
+    fn only_files_under_the_named_directory_are_read() {
+        let root = private_dir().unwrap();
+        let dir = root.path().join("files");
+        std::fs::create_dir(&dir).unwrap();
+        std::fs::write(dir.join("poses.csv"), "t,x,y,z,alpha,beta,gamma\n").unwrap();
+        std::fs::write(root.path().join("secret.txt"), "hunter2\n").unwrap();
+        std::os::unix::fs::symlink(root.path().join("secret.txt"), dir.join("link.csv")).unwrap();
+        let ok = under(Some(&dir), "poses.csv").unwrap();
+        assert!(ok.ends_with("files/poses.csv"), "{}", ok.display());
+        for name in ["../secret.txt", "/etc/passwd", "link.csv", "missing.csv", ".", ""] {
+            let e = under(Some(&dir), name).unwrap_err();
+            assert!(e.contains("not a file under"), "{name}: {e}");
+        }
+        assert!(under(None, "poses.csv").unwrap_err().contains("--files"));
+    }
+
+    #[test]
+    fn a_header_is_not_quoted_back() {
+        let r = "line 1: the header must name the columns t,x (in any order), found `root:x:0:0`";
+        assert_eq!(
+            reason_without_content(r),
+            "line 1: the header must name the columns t,x (in any order)"
+        );
+        assert_eq!(reason_without_content("no header line"), "no header line");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_write_replaces_a_planted_link_and_leaves_its_target_alone() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = private_dir().unwrap();
+        let mode = std::fs::metadata(dir.path()).unwrap().permissions().mode();
+        assert_eq!(mode & 0o777, 0o700, "only this user enters");
+        let victim = dir.path().join("victim");
+        std::fs::write(&victim, "keep").unwrap();
+        let path = dir.path().join("cueing.toml");
+        std::os::unix::fs::symlink(&victim, &path).unwrap();
+        write_whole(&path, "a = 1\n").unwrap();
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "keep");
+        assert!(!std::fs::symlink_metadata(&path).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "a = 1\n");
+    }
+}

@@ -1,0 +1,181 @@
+//! What a page may ask of the device over the WebSocket, read strictly: one JSON object with the page's number for
+//! the request (`id`), what to do (`do`) and that request's fields, nothing else.
+
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+
+/// What a page asks the device to do.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(tag = "do", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Request {
+    Enable,
+    Disable,
+    Home,
+    Start,
+    Stop,
+    Clear,
+    /// The STOP button: ends a stream, cancels every request sent before it, stops whatever moves, powers down.
+    Halt,
+    /// Axis 1-6; degrees of ring for a carriage or of a shoulder, mm for a linear actuator.
+    Jog {
+        axis: u8,
+        distance: f64,
+    },
+    Buzz {
+        axis: u8,
+    },
+    /// To the home pose, then power down.
+    Park,
+    /// A built-in motion (`demo`, `heave`, `yaw`, `vibration`).
+    Motion {
+        motion: String,
+        seconds: f64,
+        rate_hz: f64,
+    },
+    /// A pose CSV: the text of a file the user picked in the page (`text`, named `name`), or without `text` the
+    /// file `name` under the directory `ringpod ui --files` names.
+    File {
+        name: String,
+        #[serde(default)]
+        text: Option<String>,
+        #[serde(default)]
+        degrees: bool,
+    },
+    /// Poses (`holds = "poses"`) or a game's telemetry (`holds = "telemetry"`, cued by the workbench's live
+    /// cueing file) on a UDP port of the address the workbench listens on.
+    Udp {
+        port: u16,
+        holds: String,
+        #[serde(default)]
+        format: Option<String>,
+        #[serde(default)]
+        degrees: bool,
+        /// Seconds without a datagram after which the session ends.
+        #[serde(default = "default_idle")]
+        idle: f64,
+        /// Only datagrams from this sender's address count (as the CLI's `--from`).
+        #[serde(default)]
+        from: Option<std::net::IpAddr>,
+    },
+    /// A rig file's text, stored on the device (it must be `Off`), then the device restarted to run it.
+    LoadRig {
+        text: String,
+    },
+}
+
+fn default_idle() -> f64 {
+    30.0
+}
+
+impl Request {
+    /// Whether the request may still run after a STOP sent after it: only the STOP itself.
+    pub fn is_halt(&self) -> bool {
+        *self == Self::Halt
+    }
+}
+
+/// A request of one page (its connection number) with the number the page gave it, and the STOP generation it
+/// was sent in: a later STOP cancels it.
+pub struct Job {
+    pub page: u64,
+    pub id: u64,
+    pub epoch: u64,
+    pub request: Request,
+}
+
+/// Why a page's message is not a request: the words for its reply, and the number it gave (0 when none).
+#[derive(Debug, PartialEq)]
+pub struct Unreadable {
+    pub id: u64,
+    pub why: String,
+}
+
+/// Reads a page's message. Every command refuses a field it does not have, by name (serde's `deny_unknown_fields`
+/// does not reach the commands without fields of an internally tagged enum, so the keys are compared here too).
+pub fn parse(text: &str) -> Result<(u64, Request), Unreadable> {
+    let unreadable = |id: u64, why: String| Unreadable { id, why };
+    let mut object = match serde_json::from_str::<Value>(text) {
+        Ok(Value::Object(o)) => o,
+        Ok(_) => return Err(unreadable(0, "a request is a JSON object".into())),
+        Err(e) => return Err(unreadable(0, format!("not JSON: {e}"))),
+    };
+    let id = match object.remove("id") {
+        Some(v) => v
+            .as_u64()
+            .ok_or_else(|| unreadable(0, "`id` is a whole number".into()))?,
+        None => return Err(unreadable(0, "a request has an `id`".into())),
+    };
+    let given: Vec<String> = object.keys().cloned().collect();
+    let request: Request =
+        serde_json::from_value(Value::Object(object)).map_err(|e| unreadable(id, format!("not a request: {e}")))?;
+    // The request's own fields, defaults included: a key beyond them is refused.
+    let known = serde_json::to_value(&request).map_err(|e| unreadable(id, e.to_string()))?;
+    if let Some(extra) = given.iter().find(|k| known.get(k.as_str()).is_none()) {
+        let what = known["do"].as_str().unwrap_or("?");
+        return Err(unreadable(
+            id,
+            format!("not a request: `{what}` has no field `{extra}`"),
+        ));
+    }
+    Ok((id, request))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn requests_are_read_with_their_numbers_and_defaults() {
+        assert_eq!(parse(r#"{"id":3,"do":"halt"}"#), Ok((3, Request::Halt)));
+        let (_, file) = parse(r#"{"id":5,"do":"file","name":"a.csv","text":"t,x\n"}"#).unwrap();
+        assert!(matches!(file, Request::File { text: Some(_), .. }), "{file:?}");
+        let (id, udp) = parse(r#"{"id":4,"do":"udp","port":4444,"holds":"poses"}"#).unwrap();
+        assert_eq!(id, 4);
+        assert_eq!(
+            udp,
+            Request::Udp {
+                port: 4444,
+                holds: "poses".into(),
+                format: None,
+                degrees: false,
+                idle: 30.0,
+                from: None,
+            }
+        );
+    }
+
+    #[test]
+    fn an_unknown_field_is_refused_by_every_command() {
+        for (text, extra) in [
+            (r#"{"id":1,"do":"enable","axis":2}"#, "axis"),
+            (r#"{"id":1,"do":"halt","now":true}"#, "now"),
+            (r#"{"id":1,"do":"park","to":"home"}"#, "to"),
+            (r#"{"id":1,"do":"jog","axis":1,"distance":1,"speed":9}"#, "speed"),
+            (r#"{"id":1,"do":"file","name":"a","path":"/etc/shadow"}"#, "path"),
+            (
+                r#"{"id":1,"do":"udp","port":1,"holds":"poses","bind":"0.0.0.0"}"#,
+                "bind",
+            ),
+        ] {
+            let e = parse(text).unwrap_err();
+            assert_eq!(e.id, 1, "{text}");
+            assert!(e.why.contains(extra), "{text}: {}", e.why);
+        }
+    }
+
+    #[test]
+    fn garbage_is_refused_with_a_reason() {
+        for text in [
+            "",
+            "[]",
+            "3",
+            r#"{"do":"halt"}"#,
+            r#"{"id":-1,"do":"halt"}"#,
+            r#"{"id":1,"do":"fly"}"#,
+        ] {
+            let e = parse(text).unwrap_err();
+            assert!(!e.why.is_empty(), "{text}");
+        }
+        assert_eq!(parse(r#"{"id":7,"do":"fly"}"#).unwrap_err().id, 7);
+    }
+}

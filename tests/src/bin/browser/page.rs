@@ -1,0 +1,77 @@
+//! Driving the page: JavaScript in it, waiting for a condition, clicks, tabs, screenshots.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use fantoccini::{Client, Locator};
+use serde_json::{json, Value};
+
+/// Evaluates a JavaScript expression in the page.
+pub async fn js(c: &Client, expression: &str) -> Result<Value, String> {
+    c.execute(&format!("return ({expression});"), vec![])
+        .await
+        .map_err(|e| format!("{expression}: {e}"))
+}
+
+/// Polls `expression` until it is truthy; returns its value, or says what it was last.
+pub async fn until(c: &Client, expression: &str, within: Duration) -> Result<Value, String> {
+    let deadline = Instant::now() + within;
+    loop {
+        let v = js(c, expression).await?;
+        let truthy = !matches!(v, Value::Null | Value::Bool(false)) && v != json!(0) && v != json!("");
+        if truthy {
+            return Ok(v);
+        }
+        if Instant::now() > deadline {
+            let state = js(
+                c,
+                "window.ringpod && window.ringpod.frame && window.ringpod.frame.state",
+            )
+            .await
+            .unwrap_or(Value::Null);
+            return Err(format!(
+                "`{expression}` not true within {within:?} (device state {state})"
+            ));
+        }
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+}
+
+pub async fn click(c: &Client, css: &str) -> Result<(), String> {
+    c.find(Locator::Css(css))
+        .await
+        .map_err(|e| format!("{css}: {e}"))?
+        .click()
+        .await
+        .map_err(|e| format!("click {css}: {e}"))
+}
+
+pub async fn tab(c: &Client, panel: &str) -> Result<(), String> {
+    click(c, &format!(".tab[data-panel={panel}]")).await
+}
+
+pub async fn screenshot(c: &Client, dir: Option<&Path>, name: &str) -> Result<(), String> {
+    let Some(dir) = dir else { return Ok(()) };
+    let png = c.screenshot().await.map_err(|e| format!("screenshot: {e}"))?;
+    std::fs::create_dir_all(dir).map_err(|e| e.to_string())?;
+    std::fs::write(dir.join(format!("{name}.png")), png).map_err(|e| e.to_string())
+}
+
+pub const STATE: &str = "window.ringpod.frame && window.ringpod.frame.state";
+
+/// Every panel at the two screen sizes a newcomer has, as `PANEL-WxH.png`.
+pub async fn sizes(c: &Client, dir: &Path) -> Result<String, String> {
+    let mut saved = 0;
+    for (w, h) in [(1366, 768), (1920, 1080)] {
+        c.set_window_size(w, h)
+            .await
+            .map_err(|e| format!("window {w}x{h}: {e}"))?;
+        for panel in ["live", "control", "cueing", "rig", "runs"] {
+            tab(c, panel).await?;
+            tokio::time::sleep(Duration::from_millis(600)).await;
+            screenshot(c, Some(dir), &format!("{panel}-{w}x{h}")).await?;
+            saved += 1;
+        }
+    }
+    Ok(format!("{saved} pictures in {}", dir.display()))
+}

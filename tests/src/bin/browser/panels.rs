@@ -1,0 +1,101 @@
+//! The Rig, Cueing and Runs panels.
+
+use std::path::Path;
+use std::time::Duration;
+
+use fantoccini::{Client, Locator};
+use serde_json::json;
+
+use crate::page::{js, screenshot, tab, until};
+
+pub async fn rig_editor(c: &Client, url: &str, shots: Option<&Path>) -> Result<String, String> {
+    c.goto(url).await.map_err(|e| e.to_string())?;
+    until(c, "window.ringpod && window.ringpod.rig", Duration::from_secs(20)).await?;
+    tab(c, "rig").await?;
+    until(
+        c,
+        "document.getElementById('rig-messages').textContent.includes('drivable: yes')",
+        Duration::from_secs(20),
+    )
+    .await?;
+    screenshot(c, shots, "rig").await?;
+    js(
+        c,
+        "(() => { const t = document.getElementById('rig-text'); \
+         t.value = t.value.replace('ring_radius', 'ring_raduis'); \
+         t.dispatchEvent(new Event('input')); return true; })()",
+    )
+    .await?;
+    let message = until(
+        c,
+        "document.querySelector('.rig-error') && document.querySelector('.rig-error').textContent",
+        Duration::from_secs(10),
+    )
+    .await?;
+    if !message.as_str().is_some_and(|m| m.contains("ring_raduis")) {
+        return Err(format!("the message does not name the key: {message}"));
+    }
+    Ok(format!("valid rig drawn; the typo says: {message}"))
+}
+
+pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> {
+    tab(c, "cueing").await?;
+    until(c, "window.ringpod.cueRuns >= 1", Duration::from_secs(20)).await?;
+    let first = js(c, "[window.ringpod.cueRuns, window.ringpod.cuePeak]").await?;
+    screenshot(c, shots, "cueing").await?;
+    // Three times the surge scale: the replay runs again and delivers more surge at its peak.
+    let changed = js(
+        c,
+        "(() => { const i = document.querySelector('[data-path=\"translation_scale.0\"]'); if (!i) return false; \
+         i.value = '0.3'; i.dispatchEvent(new Event('input')); return true; })()",
+    )
+    .await?;
+    if changed != json!(true) {
+        return Err("no control for translation_scale.0".into());
+    }
+    let runs = first[0].as_u64().unwrap_or(0);
+    until(c, &format!("window.ringpod.cueRuns > {runs}"), Duration::from_secs(20)).await?;
+    let second = js(c, "[window.ringpod.cueRuns, window.ringpod.cuePeak]").await?;
+    let (p1, p2) = (first[1].as_f64().unwrap_or(0.0), second[1].as_f64().unwrap_or(0.0));
+    // The peak is mostly tilt coordination (the sustained braking); the onset the scale cues adds to it.
+    if p2 <= p1 * 1.02 {
+        return Err(format!("the delivered surge did not grow with its scale: {p1} -> {p2}"));
+    }
+    js(
+        c,
+        "(() => { const i = document.querySelector('[data-path=\"translation_scale.0\"]'); \
+         i.value = '-5'; i.dispatchEvent(new Event('input')); return true; })()",
+    )
+    .await?;
+    let refused = until(
+        c,
+        "document.getElementById('cue-status').className.includes('bad') && document.getElementById('cue-status').textContent",
+        Duration::from_secs(10),
+    )
+    .await?;
+    Ok(format!(
+        "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; -5 refused: {refused}"
+    ))
+}
+
+pub async fn runs(c: &Client, record: &Path, shots: Option<&Path>) -> Result<String, String> {
+    tab(c, "runs").await?;
+    let input = c.find(Locator::Css("#run-file")).await.map_err(|e| e.to_string())?;
+    let path = record.canonicalize().map_err(|e| e.to_string())?;
+    input
+        .send_keys(&path.display().to_string())
+        .await
+        .map_err(|e| e.to_string())?;
+    let status = until(
+        c,
+        "document.getElementById('run-status').textContent.includes('rows') && document.getElementById('run-status').textContent",
+        Duration::from_secs(20),
+    )
+    .await?;
+    let charts = js(c, "document.querySelectorAll('#run-charts canvas').length").await?;
+    if charts != json!(12) {
+        return Err(format!("{charts} charts instead of 12"));
+    }
+    screenshot(c, shots, "runs").await?;
+    Ok(format!("{status}"))
+}
