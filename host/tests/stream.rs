@@ -4,6 +4,7 @@ mod common;
 
 use assert_cmd::Command;
 use common::{spawn_live_stream, spawn_sim_stream};
+#[cfg(unix)]
 use nix::sys::signal::Signal;
 use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
 use ringpod_core::motion::{AxisScale, StepConverter};
@@ -44,11 +45,13 @@ fn steps_at(pose: [f64; 6]) -> [i64; 6] {
 }
 
 /// Starts `ringpod simulate --pty` and returns it with the path of its pseudo-terminal.
+#[cfg(unix)]
 fn simulator_on_a_pty() -> (std::process::Child, String) {
     simulator_on_a_pty_with(&[])
 }
 
 /// [`simulator_on_a_pty`] with further arguments to `simulate` (`--mechanism trainer-elbow`).
+#[cfg(unix)]
 fn simulator_on_a_pty_with(args: &[&str]) -> (std::process::Child, String) {
     use std::io::BufRead;
     let mut server = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
@@ -324,6 +327,7 @@ fn garbage_input_gets_a_clear_answer() {
 /// A built-in motion of a very long duration is generated as it is sent, not built in memory first; Ctrl-C ends
 /// it with a stop, a report, and an exit code that is not success.
 #[test]
+#[cfg(unix)]
 fn long_motions_start_at_once_and_stop_on_ctrl_c() {
     let interrupt_after = |args: &[&str], ms: u64| {
         let child = spawn_sim_stream(args);
@@ -354,6 +358,7 @@ fn long_motions_start_at_once_and_stop_on_ctrl_c() {
 /// A second stream to the same device: its counters are this run's, and it agrees with the device's. Garbage
 /// on the line does not break the next request.
 #[test]
+#[cfg(unix)]
 fn a_second_stream_to_the_same_device_agrees() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let (mut server, path) = simulator_on_a_pty();
@@ -419,6 +424,7 @@ fn stream_needs_a_device() {
 /// `ringpod simulate --pty` serves the simulated controller on a pseudo-terminal; `stream --port` reaches it
 /// through the real serial transport, in real time.
 #[test]
+#[cfg(unix)]
 fn stream_through_a_pseudo_terminal() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let (mut server, path) = simulator_on_a_pty();
@@ -498,6 +504,7 @@ fn stream_from_udp_datagrams() {
 /// Ctrl-C (SIGINT) or SIGTERM in the middle of a stream ends it with a stop and a wait for rest, still reports, and
 /// exits with 128 + the signal (130, 143) as a shell or a service manager expects.
 #[test]
+#[cfg(unix)]
 fn a_signal_stops_and_reports() {
     for (signal, code) in [(Signal::SIGINT, 130), (Signal::SIGTERM, 143)] {
         // UDP source: the stream is then certainly running (it announces itself) when the signal comes.
@@ -527,6 +534,7 @@ fn a_signal_stops_and_reports() {
 /// `simulate --pty` started the way a script starts it (`ringpod simulate --pty &`, where the shell sets SIGINT to
 /// ignored): SIGINT and SIGTERM still stop it, and it exits with 128 + the signal, closing its pseudo-terminal.
 #[test]
+#[cfg(unix)]
 fn the_simulator_stops_on_sigint_and_sigterm_even_started_with_sigint_ignored() {
     use std::io::BufRead;
     use std::os::unix::process::CommandExt;
