@@ -12,6 +12,7 @@ mod rig;
 mod signals;
 mod stream;
 mod ui;
+mod vr;
 
 use std::io::Write;
 use std::process::ExitCode;

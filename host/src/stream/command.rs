@@ -79,6 +79,8 @@ pub struct Job {
     pub capture: Option<PathBuf>,
     /// One JSON report instead of the summary line.
     pub report_json: bool,
+    /// Write the followed pose for VR motion compensation.
+    pub motion_compensation: Option<crate::vr::Tracker>,
 }
 
 /// Why a stream's source could not be opened.
@@ -132,6 +134,9 @@ pub enum JobError {
     /// The report as JSON.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
+    /// `--motion-compensation`.
+    #[error(transparent)]
+    Vr(#[from] crate::vr::VrError),
 }
 
 /// A number of a stream option: finite, above 0 and at most `max`.
@@ -273,6 +278,9 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
     };
     let mut client = client::Client::new(transport);
     client.cancel = Some(signals.flag());
+    if let Some(tracker) = job.motion_compensation {
+        client.tap = Some(crate::vr::tap(tracker, rig.as_ref())?);
+    }
     // Checked on the platform the device runs, before it powers up.
     if let Some(check) = &job.check_loads {
         if !loads_keep_up(check, &source, &mut client, rig.as_ref())? {
