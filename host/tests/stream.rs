@@ -3,7 +3,9 @@
 mod common;
 
 use assert_cmd::Command;
-use common::{spawn_live_stream, spawn_sim_stream};
+use common::spawn_live_stream;
+#[cfg(unix)]
+use common::spawn_sim_stream;
 #[cfg(unix)]
 use nix::sys::signal::Signal;
 use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
@@ -691,6 +693,7 @@ fn a_live_session_starts_late_pauses_and_resumes() {
 /// The link dies mid-stream (the board unplugged; here the simulator's process killed): the run ends with a
 /// report that says so and exit code 6.
 #[test]
+#[cfg(unix)]
 fn a_lost_link_ends_with_a_report() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let (mut server, path) = simulator_on_a_pty();
@@ -762,6 +765,7 @@ fn telemetry_over_udp_is_cued_live() {
 /// `device jog` of an elbow chain's shoulder takes degrees, as a carriage's: 2 degrees of its 64,000 steps per turn
 /// are 356 steps.
 #[test]
+#[cfg(unix)]
 fn device_jog_turns_a_shoulder_by_degrees() {
     let (mut server, path) = simulator_on_a_pty_with(&["--mechanism", "trainer-elbow"]);
     let device = |words: &[&str]| {
@@ -790,6 +794,7 @@ fn device_jog_turns_a_shoulder_by_degrees() {
 /// Commissioning over the serial transport: `device jog` is refused unpowered; powered, a linear actuator jogs
 /// 2 mm (3,200 steps) and comes back; a buzz ends where it began; a missing axis is a usage error.
 #[test]
+#[cfg(unix)]
 fn device_jog_and_buzz_move_one_axis_over_a_pty() {
     let (mut server, path) = simulator_on_a_pty();
     let device = |words: &[&str]| {
@@ -993,6 +998,7 @@ fn cue_and_check_loads_take_the_platform_of_the_rig() {
 /// running after `device restart`, and shown back as a rig file that describes the same machine to the last bit
 /// (IK through the shown file equals IK through the loaded one); `simulate --geometry` starts with a rig.
 #[test]
+#[cfg(unix)]
 fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let run = |args: &[&str]| std::process::Command::new(&exe).args(args).output().unwrap();
@@ -1097,8 +1103,10 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
 }
 
 /// Kills the simulator when the test ends, passed or failed.
+#[cfg(unix)]
 struct Simulator(std::process::Child);
 
+#[cfg(unix)]
 impl Drop for Simulator {
     fn drop(&mut self) {
         let _ = self.0.kill();
@@ -1107,6 +1115,7 @@ impl Drop for Simulator {
 }
 
 /// A record's device times and states.
+#[cfg(unix)]
 fn record_rows(path: &std::path::Path) -> Vec<(f64, String)> {
     std::fs::read_to_string(path)
         .unwrap()
@@ -1120,6 +1129,7 @@ fn record_rows(path: &std::path::Path) -> Vec<(f64, String)> {
 }
 
 /// Rows a second of device time, and the device time of the first `Running` row.
+#[cfg(unix)]
 fn rate_and_start(rows: &[(f64, String)]) -> (f64, f64) {
     let span = rows[rows.len() - 1].0 - rows[0].0;
     let start = rows.iter().find(|(_, s)| s == "Running").unwrap().0;
@@ -1132,6 +1142,7 @@ fn rate_and_start(rows: &[(f64, String)]) -> (f64, f64) {
 /// period). Over a board's link (the simulator on a pty) a record at 200 Hz, and the device's own rate set back
 /// afterwards.
 #[test]
+#[cfg(unix)]
 fn a_record_at_the_control_rate_reads_the_18_8_hz_experiment() {
     let dir = std::env::temp_dir().join(format!("ringpod-1khz-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

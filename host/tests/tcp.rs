@@ -41,17 +41,11 @@ fn ringpod(args: &[&str]) -> std::process::Output {
 #[test]
 fn a_stream_over_tcp_is_followed_and_a_second_command_finds_the_same_device() {
     let server = serve();
-    let out = ringpod(&[
-        "stream",
-        "--port",
-        &server.1,
-        "--motion",
-        "demo",
-        "--duration",
-        "2",
-        "--quiet",
-        "--report-json",
-    ]);
+    let args = format!(
+        "stream --port {} --motion demo --duration 2 --quiet --report-json",
+        server.1
+    );
+    let out = ringpod(&args.split(' ').collect::<Vec<_>>());
     let report: serde_json::Value =
         serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)));
     assert_eq!(out.status.code(), Some(0), "{report}");

@@ -279,7 +279,8 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
     let mut client = client::Client::new(transport);
     client.cancel = Some(signals.flag());
     if let Some(tracker) = job.motion_compensation {
-        client.tap = Some(crate::vr::tap(tracker, rig.as_ref())?);
+        let rig = rig.as_ref().map(|r| (r.home, r.centre_of_rotation));
+        client.tap = Some(crate::vr::tap(tracker, rig)?);
     }
     // Checked on the platform the device runs, before it powers up.
     if let Some(check) = &job.check_loads {

@@ -77,7 +77,8 @@ impl SixDof {
         out
     }
 
-    /// Reads the bytes back (the reader's side, for tests and checks).
+    /// Reads the bytes back (the reader's side, for tests).
+    #[cfg(test)]
     pub fn from_bytes(bytes: &[u8; SIX_DOF_BYTES]) -> Self {
         let mut v = [0.0; 6];
         for (slot, chunk) in v.iter_mut().zip(bytes.chunks_exact(8)) {
@@ -161,6 +162,7 @@ impl CompensationSpec {
 #[derive(Debug, thiserror::Error)]
 pub enum VrError {
     /// Not on Windows.
+    #[cfg(not(windows))]
     #[error(
         "--motion-compensation writes a Windows named file mapping ({0}), which OpenXR-MotionCompensation reads on \
          Windows only: run ringpod on the game PC"
@@ -225,14 +227,12 @@ impl Compensation {
 }
 
 /// The client's telemetry tap for `stream --motion-compensation`: each sample's followed pose written as it
-/// arrives. The pose is relative to the home of the simulated rig, or of the trainer model for a board (OXRMC takes
-/// its reference where the user calibrates, so a board's other home only shifts what it subtracts).
-pub fn tap(tracker: Tracker, rig: Option<&crate::rig::Rig>) -> Result<crate::link::client::TelemetryTap, VrError> {
-    let home = rig.map_or_else(
-        || Pose::from_array(ringpod_core::kinematics::presets::Preset::TrainerModel.home()),
-        |r| r.home,
-    );
-    let centre = rig.map_or([0.0; 3], |r| r.centre_of_rotation);
+/// arrives. `rig` is the simulated rig's home and centre of rotation; none for a board (the trainer model's home,
+/// the platform origin): OXRMC takes its reference where the user calibrates, so another home only shifts what it
+/// subtracts.
+pub fn tap(tracker: Tracker, rig: Option<(Pose<f64>, [f64; 3])>) -> Result<crate::link::client::TelemetryTap, VrError> {
+    let trainer = || Pose::from_array(ringpod_core::kinematics::presets::Preset::TrainerModel.home());
+    let (home, centre) = rig.unwrap_or_else(|| (trainer(), [0.0; 3]));
     let mut out = Compensation::open(tracker, home, centre)?;
     Ok(Box::new(move |sample| out.write(&sample.pose.cast())))
 }

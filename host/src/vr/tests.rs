@@ -33,13 +33,16 @@ fn reference_values_in_the_files_units_and_signs() {
     // 30 degrees to the left (counter-clockwise from above), 10 mm forward and 5 mm up, about the platform origin.
     let d = six_dof(
         Tracker::Flypt,
-        &pose([0.01, 0.0, 0.305, 0.0, 0.0, 0.5236]),
+        &pose([0.01, 0.0, 0.305, 0.0, 0.0, std::f64::consts::FRAC_PI_6]),
         &home,
         [0.0; 3],
     );
-    assert!((d.yaw - 30.0).abs() < 1e-3, "{d:?}");
+    assert!((d.yaw - 30.0).abs() < 1e-9, "{d:?}");
     // In the rig's own (yawed) axes, 10 mm forward in the base frame is partly to the right.
-    assert!((d.surge - 10.0 * 0.5236f64.cos()).abs() < 1e-6 && (d.sway - 10.0 * 0.5236f64.sin()).abs() < 1e-6);
+    assert!(
+        (d.surge - 10.0 * std::f64::consts::FRAC_PI_6.cos()).abs() < 1e-6
+            && (d.sway - 10.0 * std::f64::consts::FRAC_PI_6.sin()).abs() < 1e-6
+    );
     assert!((d.heave - 5.0).abs() < 1e-9);
     // Nose up is -beta in ringpod, +pitch for FlyPT, -pitch for SimRacingStudio; roll right (alpha > 0) likewise.
     let up = pose([0.0, 0.0, 0.3, 0.1, -0.2, 0.0]);

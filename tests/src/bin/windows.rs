@@ -120,16 +120,7 @@ fn status(mut c: Command, what: &str) -> Result<(), String> {
 fn main_command() -> Result<(), String> {
     let mut c = Command::new("wine");
     c.arg(debug_dir().join("ringpod.exe"))
-        .args([
-            "stream",
-            "--sim",
-            "--motion",
-            "demo",
-            "--duration",
-            "2",
-            "--quiet",
-            "--report-json",
-        ])
+        .args("stream --sim --motion demo --duration 2 --quiet --report-json".split(' '))
         .stderr(Stdio::inherit());
     wine_env(&mut c);
     let out = c.output().map_err(|e| format!("wine ringpod.exe: {e}"))?;
