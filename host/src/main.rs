@@ -12,6 +12,7 @@ mod rig;
 mod signals;
 mod stream;
 mod ui;
+mod vr;
 
 use std::process::ExitCode;
 
@@ -85,8 +86,11 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
         C::Ports => device::ports()?,
         C::Ui(args) => ui::run(args.options()?)?,
         C::Simulate {
-            geometry, mechanism, ..
-        } => device::simulate(cli::platform(geometry, mechanism).as_ref())?,
+            geometry,
+            mechanism,
+            tcp,
+            ..
+        } => device::simulate(cli::platform(geometry, mechanism).as_ref(), *tcp)?,
         C::Monitor { port, sim, frames } => device::monitor(&link::Target::named(port.as_deref(), *sim)?, *frames)?,
         C::Cue(args) => {
             let (text, code) = analysis::cue::run(&args.options())?;

@@ -1024,6 +1024,7 @@ fn a_recorded_run_has_a_row_every_10_ms_and_plots() {
 /// `monitor` on a pseudo-terminal: it takes the terminal (alternate screen), draws the simulated controller's
 /// telemetry (state Off, the supplies, every axis), and gives the terminal back when it ends.
 #[test]
+#[cfg(unix)]
 fn monitor_draws_the_device_on_a_pseudo_terminal() {
     use std::io::Read;
     use std::os::fd::AsFd;

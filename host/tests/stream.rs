@@ -3,7 +3,10 @@
 mod common;
 
 use assert_cmd::Command;
-use common::{spawn_live_stream, spawn_sim_stream};
+use common::spawn_live_stream;
+#[cfg(unix)]
+use common::spawn_sim_stream;
+#[cfg(unix)]
 use nix::sys::signal::Signal;
 use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
 use ringpod_core::motion::{AxisScale, StepConverter};
@@ -44,11 +47,13 @@ fn steps_at(pose: [f64; 6]) -> [i64; 6] {
 }
 
 /// Starts `ringpod simulate --pty` and returns it with the path of its pseudo-terminal.
+#[cfg(unix)]
 fn simulator_on_a_pty() -> (std::process::Child, String) {
     simulator_on_a_pty_with(&[])
 }
 
 /// [`simulator_on_a_pty`] with further arguments to `simulate` (`--mechanism trainer-elbow`).
+#[cfg(unix)]
 fn simulator_on_a_pty_with(args: &[&str]) -> (std::process::Child, String) {
     use std::io::BufRead;
     let mut server = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
@@ -334,6 +339,7 @@ fn garbage_input_gets_a_clear_answer() {
 /// A built-in motion of a very long duration is generated as it is sent, not built in memory first; Ctrl-C ends
 /// it with a stop, a report, and an exit code that is not success.
 #[test]
+#[cfg(unix)]
 fn long_motions_start_at_once_and_stop_on_ctrl_c() {
     let interrupt_after = |args: &[&str], ms: u64| {
         let child = spawn_sim_stream(args);
@@ -364,6 +370,7 @@ fn long_motions_start_at_once_and_stop_on_ctrl_c() {
 /// A second stream to the same device: its counters are this run's, and it agrees with the device's. Garbage
 /// on the line does not break the next request.
 #[test]
+#[cfg(unix)]
 fn a_second_stream_to_the_same_device_agrees() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let (mut server, path) = simulator_on_a_pty();
@@ -429,6 +436,7 @@ fn stream_needs_a_device() {
 /// `ringpod simulate --pty` serves the simulated controller on a pseudo-terminal; `stream --port` reaches it
 /// through the real serial transport, in real time.
 #[test]
+#[cfg(unix)]
 fn stream_through_a_pseudo_terminal() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let (mut server, path) = simulator_on_a_pty();
@@ -508,6 +516,7 @@ fn stream_from_udp_datagrams() {
 /// Ctrl-C (SIGINT) or SIGTERM in the middle of a stream ends it with a stop and a wait for rest, still reports, and
 /// exits with 128 + the signal (130, 143) as a shell or a service manager expects.
 #[test]
+#[cfg(unix)]
 fn a_signal_stops_and_reports() {
     for (signal, code) in [(Signal::SIGINT, 130), (Signal::SIGTERM, 143)] {
         // UDP source: the stream is then certainly running (it announces itself) when the signal comes.
@@ -537,6 +546,7 @@ fn a_signal_stops_and_reports() {
 /// `simulate --pty` started the way a script starts it (`ringpod simulate --pty &`, where the shell sets SIGINT to
 /// ignored): SIGINT and SIGTERM still stop it, and it exits with 128 + the signal, closing its pseudo-terminal.
 #[test]
+#[cfg(unix)]
 fn the_simulator_stops_on_sigint_and_sigterm_even_started_with_sigint_ignored() {
     use std::io::BufRead;
     use std::os::unix::process::CommandExt;
@@ -696,6 +706,7 @@ fn a_live_session_starts_late_pauses_and_resumes() {
 /// The link dies mid-stream (the board unplugged; here the simulator's process killed): the run ends with a
 /// report that says so and exit code 6.
 #[test]
+#[cfg(unix)]
 fn a_lost_link_ends_with_a_report() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let (mut server, path) = simulator_on_a_pty();
@@ -767,6 +778,7 @@ fn telemetry_over_udp_is_cued_live() {
 /// `device jog` of an elbow chain's shoulder takes degrees, as a carriage's: 2 degrees of its 64,000 steps per turn
 /// are 356 steps.
 #[test]
+#[cfg(unix)]
 fn device_jog_turns_a_shoulder_by_degrees() {
     let (mut server, path) = simulator_on_a_pty_with(&["--mechanism", "trainer-elbow"]);
     let device = |words: &[&str]| {
@@ -795,6 +807,7 @@ fn device_jog_turns_a_shoulder_by_degrees() {
 /// Commissioning over the serial transport: `device jog` is refused unpowered; powered, a linear actuator jogs
 /// 2 mm (3,200 steps) and comes back; a buzz ends where it began; a missing axis is a usage error.
 #[test]
+#[cfg(unix)]
 fn device_jog_and_buzz_move_one_axis_over_a_pty() {
     let (mut server, path) = simulator_on_a_pty();
     let device = |words: &[&str]| {
@@ -998,6 +1011,7 @@ fn cue_and_check_loads_take_the_platform_of_the_rig() {
 /// running after `device restart`, and shown back as a rig file that describes the same machine to the last bit
 /// (IK through the shown file equals IK through the loaded one); `simulate --geometry` starts with a rig.
 #[test]
+#[cfg(unix)]
 fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
     let exe = assert_cmd::cargo::cargo_bin("ringpod");
     let run = |args: &[&str]| std::process::Command::new(&exe).args(args).output().unwrap();
@@ -1102,8 +1116,10 @@ fn a_rig_loaded_into_the_device_runs_after_a_restart_and_shows_back() {
 }
 
 /// Kills the simulator when the test ends, passed or failed.
+#[cfg(unix)]
 struct Simulator(std::process::Child);
 
+#[cfg(unix)]
 impl Drop for Simulator {
     fn drop(&mut self) {
         let _ = self.0.kill();
@@ -1112,6 +1128,7 @@ impl Drop for Simulator {
 }
 
 /// A record's device times and states.
+#[cfg(unix)]
 fn record_rows(path: &std::path::Path) -> Vec<(f64, String)> {
     std::fs::read_to_string(path)
         .unwrap()
@@ -1125,6 +1142,7 @@ fn record_rows(path: &std::path::Path) -> Vec<(f64, String)> {
 }
 
 /// Rows a second of device time, and the device time of the first `Running` row.
+#[cfg(unix)]
 fn rate_and_start(rows: &[(f64, String)]) -> (f64, f64) {
     let span = rows[rows.len() - 1].0 - rows[0].0;
     let start = rows.iter().find(|(_, s)| s == "Running").unwrap().0;
@@ -1137,6 +1155,7 @@ fn rate_and_start(rows: &[(f64, String)]) -> (f64, f64) {
 /// period). Over a board's link (the simulator on a pty) a record at 200 Hz, and the device's own rate set back
 /// afterwards.
 #[test]
+#[cfg(unix)]
 fn a_record_at_the_control_rate_reads_the_18_8_hz_experiment() {
     let dir = std::env::temp_dir().join(format!("ringpod-1khz-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -125,9 +125,27 @@ pub fn ensure_browser() -> Result<(), String> {
     )
 }
 
+/// What the Windows runner needs (`--bin windows`): the MinGW-w64 cross compiler (it links the Windows builds and
+/// builds the test-only DLL) and Wine to run them, installed as QEMU is. Debian 12's `wine` with `wine64` runs 64-bit
+/// programs without the i386 architecture; the recommended packages (fonts, GStreamer, 32-bit support) are not
+/// needed by a console program and are left out.
+pub fn ensure_windows() -> Result<(), String> {
+    ensure_packages_with(
+        &["x86_64-w64-mingw32-gcc", "wine"],
+        &["gcc-mingw-w64-x86-64", "wine", "wine64"],
+        "the MinGW-w64 cross compiler and Wine",
+        &["--no-install-recommends"],
+    )
+}
+
 /// Each of `programs` answers `--version`, or `packages` are installed with apt-get when this process may (as
 /// root, or through sudo without a password); otherwise the one line that says what to run.
 fn ensure_packages(programs: &[&str], packages: &[&str], what: &str) -> Result<(), String> {
+    ensure_packages_with(programs, packages, what, &[])
+}
+
+/// [`ensure_packages`] with further `apt-get install` options.
+fn ensure_packages_with(programs: &[&str], packages: &[&str], what: &str, options: &[&str]) -> Result<(), String> {
     let present = || {
         programs.iter().all(|p| {
             Command::new(p)
@@ -153,7 +171,7 @@ fn ensure_packages(programs: &[&str], packages: &[&str], what: &str) -> Result<(
         .stdout(Stdio::null())
         .status()
         .is_ok();
-    let list = packages.join(" ");
+    let list = options.iter().chain(packages).copied().collect::<Vec<_>>().join(" ");
     let command = if root {
         format!("apt-get update && apt-get install -y {list}")
     } else {
@@ -183,6 +201,7 @@ fn ensure_packages(programs: &[&str], packages: &[&str], what: &str) -> Result<(
             .is_ok_and(|s| s.success())
     };
     let mut install = vec!["install", "-y"];
+    install.extend(options);
     install.extend(packages);
     if apt_get(&["update"]) && apt_get(&install) && present() {
         Ok(())

@@ -108,7 +108,8 @@ pub enum Command {
     /// replayed drive, the rig file checked as you type, run records. Prints the URL to open (with its per-run
     /// token); runs until interrupted.
     Ui(UiArgs),
-    /// Lists the serial ports (a board shows up as a USB CDC port, /dev/ttyACM* on Linux).
+    /// Lists the serial ports with their USB VID:PID (a board shows up as a USB CDC port, 1209:0001: /dev/ttyACM* on
+    /// Linux, COMn on Windows).
     Ports,
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
     Loads(LoadsArgs),
@@ -140,12 +141,16 @@ pub enum Command {
     /// (translation high-passed, sustained force by tilt coordination, yaw by heading), every pose limited into the
     /// envelope; writes the pose CSV that `stream --input` reads. Exits 0, or 3 when rows could not be used.
     Cue(CueArgs),
-    /// Serves the simulated controller on a pseudo-terminal and prints its path, so that the serial transport
-    /// (and any other program) can talk to it as to a board. Runs until interrupted.
+    /// Serves the simulated controller on a pseudo-terminal (Unix) or over TCP and prints its path or address, so
+    /// that `--port` (and any other program) can talk to it as to a board. Runs until interrupted.
     Simulate {
-        /// Serve on a pseudo-terminal (the only transport for now).
-        #[arg(long, required = true)]
+        /// Serve on a pseudo-terminal (Unix only).
+        #[arg(long, required_unless_present = "tcp", conflicts_with = "tcp")]
         pty: bool,
+        /// Serve over TCP on this address (`127.0.0.1:5760`; port 0 picks a free one); reach it with
+        /// `--port tcp://ADDRESS`.
+        #[arg(long, value_name = "ADDRESS")]
+        tcp: Option<std::net::SocketAddr>,
         /// Simulate this rig file's platform (with the trainer model's drives and switches) instead of the trainer
         /// model.
         #[arg(long, value_name = "RIG.toml")]

@@ -216,13 +216,14 @@ impl StreamArgs {
             options: crate::stream::Options {
                 home: self.home,
                 host_limits: !self.device_limits_only,
-                telemetry: false,
+                telemetry: self.motion_compensation.is_some(),
                 telemetry_hz: self.record_hz,
                 quiet: self.quiet,
             },
             record: self.record.clone(),
             capture: self.capture.clone(),
             report_json: self.report_json,
+            motion_compensation: self.motion_compensation,
         })
     }
 }

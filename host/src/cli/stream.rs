@@ -86,6 +86,11 @@ pub struct StreamArgs {
     /// Print one JSON report at the end.
     #[arg(long)]
     pub report_json: bool,
+    /// VR motion compensation (Windows): write the pose the seat followed, at the telemetry rate, where
+    /// OpenXR-MotionCompensation's virtual tracker of this type reads it (`flypt`: `Local\motionRigPose`; `srs`:
+    /// `Local\SimRacingStudioMotionRigPose`), about the rig file's `[motion_compensation] centre_of_rotation`.
+    #[arg(long, value_enum, value_name = "TRACKER")]
+    pub motion_compensation: Option<crate::vr::Tracker>,
     /// Record the run: a CSV row per telemetry sample (every 10 ms at the default 100 Hz): host and device time,
     /// the pose commanded, the pose followed (after limiting), the actuator steps, the state and the flags
     /// (limited, refused, held). `ringpod plot FILE` draws it.

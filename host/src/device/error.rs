@@ -30,6 +30,10 @@ pub enum DeviceError {
     /// The status as JSON.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
+    /// What this operating system cannot do, named.
+    #[cfg(not(unix))]
+    #[error("{0}")]
+    Unsupported(&'static str),
     /// The serial ports could not be listed.
     #[error(transparent)]
     Ports(#[from] serialport::Error),

@@ -154,38 +154,72 @@ impl Platform {
     }
 }
 
-/// `ringpod simulate --pty [--geometry RIG.toml | --mechanism PRESET]`: serves until a signal, and exits with
-/// 128 + its number.
-pub fn simulate(platform: Option<&Platform>) -> Result<u8, DeviceError> {
+/// `ringpod simulate --pty | --tcp ADDRESS [--geometry RIG.toml | --mechanism PRESET]`: serves until a signal, and
+/// exits with 128 + its number.
+pub fn simulate(platform: Option<&Platform>, tcp: Option<std::net::SocketAddr>) -> Result<u8, DeviceError> {
     let device = match Platform::rig(platform)? {
         Some(rig) => transport::SimDevice::for_rig(true, &rig)?,
         None => transport::SimDevice::new(true),
     };
     let signals = Signals::install()?;
-    link::pty::serve(device, &|| signals.received())?;
+    match tcp {
+        Some(addr) => link::tcp::serve(device, addr, &|| signals.received()).map_err(link::LinkError::from)?,
+        None => serve_pty(device, &signals)?,
+    }
     eprintln!("ringpod: simulator stopped by {}", signals.name());
     Ok(signals.exit_code())
+}
+
+#[cfg(unix)]
+fn serve_pty(device: transport::SimDevice, signals: &Signals) -> Result<(), DeviceError> {
+    Ok(link::pty::serve(device, &|| signals.received())?)
+}
+
+/// A pseudo-terminal is a Unix device: refused by name, before anything runs.
+#[cfg(not(unix))]
+fn serve_pty(_: transport::SimDevice, _: &Signals) -> Result<(), DeviceError> {
+    Err(DeviceError::Unsupported(
+        "simulate --pty: pseudo-terminals exist only on Unix; serve the simulator over TCP instead (simulate --tcp 127.0.0.1:PORT, then --port tcp://127.0.0.1:PORT)",
+    ))
 }
 
 /// `ringpod ports`: the serial ports this machine has, and what each is.
 pub fn ports() -> Result<u8, DeviceError> {
     let ports = serialport::available_ports()?;
     let mut out = std::io::stdout();
+    let _ = out.write_all(port_list(&ports).as_bytes());
+    Ok(0)
+}
+
+/// The USB vendor and product a ringpod board enumerates with (pid.codes' open-source test pair).
+pub const BOARD_USB_ID: (u16, u16) = (0x1209, 0x0001);
+
+/// One line a port: its name (`/dev/ttyACM0`, `COM5`), its kind with a USB port's VID:PID, and a board marked as
+/// such, so that it is found without the system's device manager.
+fn port_list(ports: &[serialport::SerialPortInfo]) -> String {
     if ports.is_empty() {
-        let _ = writeln!(out, "no serial ports found");
+        return "no serial ports found\n".into();
     }
+    let mut text = String::new();
     for p in ports {
-        let kind = match p.port_type {
+        let kind = match &p.port_type {
             serialport::SerialPortType::UsbPort(u) => {
-                format!("USB {:04x}:{:04x} {}", u.vid, u.pid, u.product.unwrap_or_default())
+                let mut kind = format!("USB {:04x}:{:04x}", u.vid, u.pid);
+                if let Some(product) = u.product.as_deref().filter(|p| !p.is_empty()) {
+                    kind += &format!(" {product}");
+                }
+                if (u.vid, u.pid) == BOARD_USB_ID {
+                    kind += "  <- a ringpod board";
+                }
+                kind
             }
             serialport::SerialPortType::PciPort => "PCI".into(),
             serialport::SerialPortType::BluetoothPort => "Bluetooth".into(),
             serialport::SerialPortType::Unknown => "unknown".into(),
         };
-        let _ = writeln!(out, "{}  {kind}", p.port_name);
+        text += &format!("{}  {kind}\n", p.port_name);
     }
-    Ok(0)
+    text
 }
 
 /// A state as one word (a run record's CSV field, the monitor, the web page): its name, and a fault's reason after
@@ -202,5 +236,43 @@ pub fn state_name(state: State) -> String {
         State::Stopping => "Stopping".into(),
         State::Fault(reason, _) => format!("Fault: {reason}").replace(',', ";"),
         State::ShuttingDown(_) => "ShuttingDown".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use serialport::{SerialPortInfo, SerialPortType, UsbPortInfo};
+
+    fn usb(name: &str, vid: u16, pid: u16, product: Option<&str>) -> SerialPortInfo {
+        SerialPortInfo {
+            port_name: name.into(),
+            port_type: SerialPortType::UsbPort(UsbPortInfo {
+                vid,
+                pid,
+                serial_number: None,
+                manufacturer: None,
+                product: product.map(Into::into),
+            }),
+        }
+    }
+
+    #[test]
+    fn the_board_is_found_by_its_vid_and_pid_under_any_name() {
+        let ports = [
+            usb("COM3", 0x0403, 0x6001, Some("FT232R")),
+            usb("COM5", 0x1209, 0x0001, None),
+            SerialPortInfo {
+                port_name: "COM1".into(),
+                port_type: SerialPortType::PciPort,
+            },
+        ];
+        let text = super::port_list(&ports);
+        assert_eq!(
+            text,
+            "COM3  USB 0403:6001 FT232R\nCOM5  USB 1209:0001  <- a ringpod board\nCOM1  PCI\n"
+        );
+        // Another product of the same vendor is not the board.
+        assert!(!super::port_list(&[usb("/dev/ttyACM0", 0x1209, 0x0002, None)]).contains("board"));
+        assert_eq!(super::port_list(&[]), "no serial ports found\n");
     }
 }

@@ -1,8 +1,11 @@
-//! How the host reaches a controller: a transport (a board's serial port or the simulated controller in this
-//! process), the typed client over it, and the simulated controller served on a pseudo-terminal.
+//! How the host reaches a controller: a transport (a board's serial port, a TCP connection to a served simulator or
+//! a serial-to-network bridge, or the simulated controller in this process), the typed client over it, and the
+//! simulated controller served on a pseudo-terminal (Unix) or over TCP.
 
 pub mod client;
+#[cfg(unix)]
 pub mod pty;
+pub mod tcp;
 pub mod transport;
 
 use ringpod_core::controller::ConfigError;
@@ -21,6 +24,14 @@ pub enum LinkError {
         /// Why.
         reason: serialport::Error,
     },
+    /// The network address of a `tcp://` port could not be reached.
+    #[error("{port}: {reason}")]
+    Connect {
+        /// The port as given (`tcp://HOST:PORT`).
+        port: String,
+        /// Why.
+        reason: std::io::Error,
+    },
     /// A simulated controller cannot drive the rig it was given.
     #[error("{rig}: the controller cannot drive it: {reason}")]
     Undrivable {
@@ -30,6 +41,7 @@ pub enum LinkError {
         reason: ConfigError,
     },
     /// The pseudo-terminal could not be set up.
+    #[cfg(unix)]
     #[error("pseudo-terminal: {0}")]
     Pty(#[from] nix::Error),
     /// Reading or writing the link failed.
@@ -60,6 +72,14 @@ impl Target {
 /// Opens the transport to `target`; a simulated controller runs in real time or as fast as it can.
 pub fn connect(target: &Target, realtime: bool) -> Result<transport::AnyTransport, LinkError> {
     Ok(match target {
+        Target::Port(port) if tcp::address(port).is_some() => {
+            let address = tcp::address(port).unwrap_or_default();
+            let tcp = tcp::Tcp::connect(address).map_err(|reason| LinkError::Connect {
+                port: port.clone(),
+                reason,
+            })?;
+            transport::AnyTransport::Tcp(tcp)
+        }
         Target::Port(port) => {
             let serial = transport::Serial::open(port).map_err(|reason| LinkError::Open {
                 port: port.clone(),

@@ -312,6 +312,8 @@ impl Transport for SimDevice {
 pub enum AnyTransport {
     /// A board.
     Serial(Serial),
+    /// A board behind a serial-to-network bridge, or `simulate --tcp`.
+    Tcp(super::tcp::Tcp),
     /// The simulator.
     Sim(Box<SimDevice>),
 }
@@ -320,18 +322,21 @@ impl Transport for AnyTransport {
     fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
         match self {
             Self::Serial(t) => t.send(bytes),
+            Self::Tcp(t) => t.send(bytes),
             Self::Sim(t) => t.send(bytes),
         }
     }
     fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         match self {
             Self::Serial(t) => t.receive(buf),
+            Self::Tcp(t) => t.receive(buf),
             Self::Sim(t) => t.receive(buf),
         }
     }
     fn elapse(&mut self, dt: Duration) {
         match self {
             Self::Serial(t) => t.elapse(dt),
+            Self::Tcp(t) => t.elapse(dt),
             Self::Sim(t) => t.elapse(dt),
         }
     }

@@ -117,12 +117,19 @@ impl RigFile {
             }
         }
         let record = self.record(ControllerConfig::default_record(&self.name, &geometry, self.home))?;
+        let centre_of_rotation = match &self.motion_compensation {
+            Some(m) => m
+                .checked()
+                .map_err(|why| super::RigError::new("motion_compensation.centre_of_rotation", why))?,
+            None => [0.0; 3],
+        };
         Ok(Rig {
             geometry,
             home,
             ranges,
             drives,
             record,
+            centre_of_rotation,
         })
     }
 

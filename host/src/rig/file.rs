@@ -50,6 +50,9 @@ pub struct RigFile {
     /// stroke).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub homing: Option<HomingSettings>,
+    /// VR motion compensation: the rig's centre of rotation (`stream --motion-compensation`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion_compensation: Option<crate::vr::CompensationSpec>,
 }
 
 /// One chain.
@@ -319,6 +322,7 @@ impl RigFile {
             inputs: None,
             supervisor: None,
             homing: None,
+            motion_compensation: None,
         }
     }
 

@@ -91,6 +91,9 @@ pub struct Rig {
     pub drives: [Option<Drive>; 6],
     /// What a device stores and runs: the geometry, home pose, axes, pose limits and inputs.
     pub record: ringpod_core::protocol::RigRecord,
+    /// The point VR motion compensation reports the pose of (platform coordinates, m; the platform origin unless
+    /// the file's `[motion_compensation]` says otherwise).
+    pub centre_of_rotation: [f64; 3],
 }
 
 /// Reads and checks a rig file to drive it.

@@ -81,6 +81,8 @@ pub struct Job {
     pub capture: Option<PathBuf>,
     /// One JSON report instead of the summary line.
     pub report_json: bool,
+    /// Write the followed pose for VR motion compensation.
+    pub motion_compensation: Option<crate::vr::Tracker>,
 }
 
 /// Why a stream's source could not be opened.
@@ -134,6 +136,9 @@ pub enum JobError {
     /// The report as JSON.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
+    /// `--motion-compensation`.
+    #[error(transparent)]
+    Vr(#[from] crate::vr::VrError),
 }
 
 /// A number of a stream option: finite, above 0 and at most `max`.
@@ -296,6 +301,10 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
     };
     let mut client = client::Client::new(transport);
     client.cancel = Some(signals.flag());
+    if let Some(tracker) = job.motion_compensation {
+        let rig = rig.as_ref().map(|r| (r.home, r.centre_of_rotation));
+        client.tap = Some(crate::vr::tap(tracker, rig)?);
+    }
     // Checked on the platform the device runs, before it powers up.
     if let Some(check) = &job.check_loads {
         if !loads_keep_up(check, &source, &mut client, rig.as_ref())? {

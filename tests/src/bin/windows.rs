@@ -1,0 +1,189 @@
+//! `cargo run -p ringpod-tests --bin windows`: the Windows build of the host, tested on Linux under Wine.
+//!
+//! 1. The MinGW-w64 cross compiler and Wine (installed with apt-get when missing and allowed, as QEMU is), and the
+//!    `x86_64-pc-windows-gnu` standard library (rustup).
+//! 2. A debug cross-build of `ringpod.exe` and of the host's test programs (`cargo test --no-run`).
+//! 3. Beside them, a test-only `bcryptprimitives.dll` built from `tests/windows/bcryptprimitives.c`: Rust's standard
+//!    library imports `ProcessPrng` from it, which Wine 8 lacks.
+//! 4. The host's tests under Wine (`CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUNNER=wine`): unit tests and every
+//!    integration test file, the Unix-only ones left out by `cfg(unix)` in their source, the motion-compensation
+//!    reader among them. Then the README's main command, `ringpod.exe stream --sim --motion demo`, as a check.
+//!
+//! Wine runs in its own prefix under the target folder, so that a developer's `~/.wine` is not touched. Cargo's own
+//! `test result:` lines are passed through; the last line is the sum, `N passed, N failed`, and the exit status is 1
+//! when anything failed.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode, Stdio};
+use std::time::Instant;
+
+use ringpod_tests::setup;
+
+/// The Windows target the host is cross-built for.
+const TARGET: &str = "x86_64-pc-windows-gnu";
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| repo().join("target"), PathBuf::from)
+}
+
+/// The folder of the cross-built debug programs, and of the test programs beside it.
+fn debug_dir() -> PathBuf {
+    target_dir().join(TARGET).join("debug")
+}
+
+fn ensure_target() -> Result<(), String> {
+    let installed = Command::new("rustup")
+        .current_dir(repo())
+        .args(["target", "list", "--installed"])
+        .output()
+        .map_err(|e| format!("rustup: {e} (install the {TARGET} standard library the way the toolchain was)"))?;
+    if String::from_utf8_lossy(&installed.stdout)
+        .lines()
+        .any(|l| l.trim() == TARGET)
+    {
+        return Ok(());
+    }
+    let command = format!("rustup target add {TARGET}");
+    if !setup::may_install() {
+        return Err(format!("the {TARGET} standard library is missing: run `{command}`"));
+    }
+    println!("== the {TARGET} standard library is missing: {command}");
+    let ok = Command::new("rustup")
+        .current_dir(repo())
+        .args(["target", "add", TARGET])
+        .status()
+        .is_ok_and(|s| s.success());
+    ok.then_some(())
+        .ok_or_else(|| format!("`{command}` failed: run it by hand"))
+}
+
+/// Cargo for the Windows target, with Wine as the runner of what it builds.
+fn cargo(args: &[&str]) -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(repo())
+        .args(args)
+        .args(["--target", TARGET])
+        .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUNNER", "wine")
+        .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER", "x86_64-w64-mingw32-gcc");
+    wine_env(&mut c);
+    c
+}
+
+/// Wine in its own prefix, quiet, without the desktop integration a console program does not need.
+fn wine_env(c: &mut Command) {
+    c.env("WINEPREFIX", target_dir().join("wine"))
+        .env("WINEDEBUG", "-all")
+        .env(
+            "WINEDLLOVERRIDES",
+            "mscoree,mshtml,winemenubuilder.exe=;bcryptprimitives=n,b",
+        )
+        .env("WINEARCH", "win64");
+}
+
+/// The test-only DLL, built once and copied beside the programs and the test programs.
+fn shim() -> Result<(), String> {
+    let dll = debug_dir().join("bcryptprimitives.dll");
+    let source = repo().join("tests/windows/bcryptprimitives.c");
+    let status = Command::new("x86_64-w64-mingw32-gcc")
+        .args(["-shared", "-O2", "-o"])
+        .arg(&dll)
+        .arg(&source)
+        .arg("-ladvapi32")
+        .status()
+        .map_err(|e| format!("x86_64-w64-mingw32-gcc: {e}"))?;
+    if !status.success() {
+        return Err(format!("building {} failed ({status})", dll.display()));
+    }
+    std::fs::copy(&dll, debug_dir().join("deps").join("bcryptprimitives.dll"))
+        .map(|_| ())
+        .map_err(|e| format!("copying the DLL beside the test programs: {e}"))
+}
+
+fn step(name: &str, run: impl FnOnce() -> Result<(), String>) -> Result<(), String> {
+    println!("== {name}");
+    let started = Instant::now();
+    let result = run();
+    println!("== {name}: {:.0} s", started.elapsed().as_secs_f64());
+    result
+}
+
+fn status(mut c: Command, what: &str) -> Result<(), String> {
+    let s = c.status().map_err(|e| format!("{what}: {e}"))?;
+    s.success().then_some(()).ok_or_else(|| format!("{what} failed ({s})"))
+}
+
+/// The README's main command under Wine: the demo followed to its end, exit 0.
+fn main_command() -> Result<(), String> {
+    let mut c = Command::new("wine");
+    c.arg(debug_dir().join("ringpod.exe"))
+        .args("stream --sim --motion demo --duration 2 --quiet --report-json".split(' '))
+        .stderr(Stdio::inherit());
+    wine_env(&mut c);
+    let out = c.output().map_err(|e| format!("wine ringpod.exe: {e}"))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let report: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("ringpod.exe printed no report ({e}): {text}"))?;
+    println!(
+        "ringpod.exe stream --sim --motion demo --duration 2: {} ({} of {} applied), exit {:?}",
+        report["outcome"],
+        report["setpoints_applied"],
+        report["setpoints_sent"],
+        out.status.code()
+    );
+    (out.status.success() && report["outcome"] == "followed")
+        .then_some(())
+        .ok_or_else(|| "the demo was not followed under Wine".into())
+}
+
+fn main() -> ExitCode {
+    let mut failed = 0u32;
+    let mut passed = 0u32;
+    let prepared = step("MinGW-w64 and Wine", setup::ensure_windows)
+        .and_then(|()| step("the Windows target", ensure_target))
+        .and_then(|()| {
+            step("cross-build (debug)", || {
+                status(cargo(&["build", "-p", "ringpod"]), "cargo build")?;
+                status(cargo(&["test", "-p", "ringpod", "--no-run"]), "cargo test --no-run")
+            })
+        })
+        .and_then(|()| step("the ProcessPrng DLL", shim));
+    if let Err(e) = prepared {
+        println!("FAIL {e}");
+        println!("0 passed, 1 failed");
+        return ExitCode::FAILURE;
+    }
+    // The test programs print their own `test result:` lines (summed by .ci/run); here each is a check.
+    for (name, result) in [
+        (
+            "the host's tests under Wine",
+            step("the host's tests under Wine", || {
+                status(cargo(&["test", "-p", "ringpod"]), "cargo test under Wine")
+            }),
+        ),
+        (
+            "the main command under Wine",
+            step("the main command under Wine", main_command),
+        ),
+    ] {
+        match result {
+            Ok(()) => {
+                passed += 1;
+                println!("PASS {name}");
+            }
+            Err(e) => {
+                failed += 1;
+                println!("FAIL {name}: {e}");
+            }
+        }
+    }
+    println!("{passed} passed, {failed} failed");
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
