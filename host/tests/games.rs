@@ -67,7 +67,7 @@ impl Game {
             Game::Text => format!("{s} {forward} {left} {G} 0 0 {yaw}").into_bytes(),
             // World axes x right, y forward (heading 0), z up; the car's acceleration without gravity.
             Game::Outsim => packets::outsim::packet(ms, [0.0, 0.0, yaw], [0.0; 3], [-left, forward, 0.0], false),
-            // OutSim Opts ff, the setting the README gives.
+            // OutSim Opts ff, the setting the book's games table gives.
             Game::Outsim2 => packets::outsim2::packet(0xff, ms, [0.0, 0.0, yaw], [0.0; 3], [-left, forward, 0.0]),
             // Car axes x right, y forward, z up; yaw rate positive to the left; no time (the arrival time).
             Game::Beamng => packets::beamng::packet([-left, forward, 0.0], [0.0, 0.0, 1.0], [0.0; 3], [0.0, 0.0, yaw]),

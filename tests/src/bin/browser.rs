@@ -10,7 +10,7 @@
 //!    without the token; the rig editor names a bad key; cueing redraws when a parameter changes; a run record
 //!    opens; a page that goes away stops the stream it started.
 //!
-//! `--screenshots DIR` saves a picture of each panel there (the README's are in `docs/ui/`). The last line is the
+//! `--screenshots DIR` saves a picture of each panel there (the book's are in `docs/book/src/images/ui/`). The last line is the
 //! sum, `N passed, N failed`; the exit status is 1 when anything failed.
 
 use std::io::{BufRead, BufReader, Read, Write};
