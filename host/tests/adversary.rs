@@ -1,6 +1,6 @@
 //! The command line against inputs an adversary would try, one test per class of input: every one ends with a
 //! clear error said once and the documented exit code, or with a correct result; none panics, hangs or succeeds
-//! when its job was not done. The README's Tests section counts these classes.
+//! when its job was not done. The book's Tests chapter counts these classes.
 
 use assert_cmd::Command;
 use std::path::PathBuf;

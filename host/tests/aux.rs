@@ -1,4 +1,4 @@
-//! The auxiliary outputs from the command line (issue 26): `device aux N on|off` against the simulated controller
+//! The auxiliary outputs from the command line: `device aux N on|off` against the simulated controller
 //! served on a pseudo-terminal, and a pose file's `aux1`, `aux2` columns streamed into it.
 
 #![cfg(unix)]

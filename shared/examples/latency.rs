@@ -1,5 +1,5 @@
 //! Pose-to-motion latency of the two follow modes, in control ticks (1 kHz): `cargo run --release -p
-//! ringpod-core --example latency`. The README's latency table comes from here; `tests/pipeline.rs` holds the
+//! ringpod-core --example latency`. The control core chapter's latency table comes from here; `tests/pipeline.rs` holds the
 //! same measurement to its figures.
 
 use ringpod_core::kinematics::{presets, Mechanism, Pose, RingPlatform};

@@ -1,4 +1,4 @@
-//! The auxiliary outputs (issue 26) through the controller: switched by the command and by the setpoints' aux
+//! The auxiliary outputs through the controller: switched by the command and by the setpoints' aux
 //! levels, reported in the status and the telemetry, driven into the simulated plant, dropped by an e-stop; and
 //! the messages that carry them round trip through frames.
 

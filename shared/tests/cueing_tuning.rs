@@ -61,7 +61,7 @@ fn per_axis_corners_give_each_axis_its_own_response() {
 }
 
 #[test]
-fn one_value_for_every_axis_still_reads_as_before() {
+fn one_value_for_every_axis_reads_as_that_value_on_each_axis() {
     let old = r#"{"translation_high_pass": {"omega": 3, "zeta": 0.8}, "tilt_low_pass": {"omega": 4, "zeta": 1},
         "tilt_limit_deg": 12, "tilt_rate_deg": 2.5, "rotation_limit": 0.8, "translation_break": 0.5}"#;
     let old: CueConfig = serde_json::from_str(old).unwrap();

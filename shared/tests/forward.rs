@@ -119,10 +119,10 @@ fn fk_returns_the_platforms_pose_or_an_error_never_another_solution() {
 }
 
 #[test]
-fn the_commands_of_the_issue_get_a_right_answer_or_an_error() {
+fn two_hard_sets_of_actuators_get_a_right_answer_or_an_error() {
     let m = trainer();
     let options = NewtonOptions::default();
-    // From the default guess (home, yaw 0) this converged to z = 0.114, alpha = -27.42 rad with exit 0.
+    // From the default guess (home, yaw 0) Newton reaches z = 0.114, alpha = -27.42 rad: not the platform's pose.
     let q = Actuators([-0.126419, 1.431662, 3.136982, -1.769915, 0.236447, 0.234549]);
     let home = trainer_home();
     if let Ok(fk) = m.forward(&q, &home, &options) {
@@ -135,7 +135,8 @@ fn the_commands_of_the_issue_get_a_right_answer_or_an_error() {
     let back = m.inverse(&fk.pose).expect("the pose has IK");
     assert!(back.0.iter().zip(q.0).all(|(a, b)| (a - b).abs() < 1e-5), "{back:?}");
     assert!(fk.pose.alpha.abs() <= std::f64::consts::PI && fk.pose.beta.abs() <= std::f64::consts::PI);
-    // This returned a pose 7 mm and 0.02 rad from the one the actuators came from: now the right one or an error.
+    // From this guess Newton can reach a pose 7 mm and 0.02 rad from the one the actuators came from: the answer
+    // must be the right one or an error.
     let q = Actuators([-0.227380, 0.848999, 2.658173, -2.129843, 0.222059, 0.253623]);
     let guess = Pose::new(-0.0536, 0.0008, 0.1658, 0.4937, 0.0425, 1.8801);
     match m.forward(&q, &guess, &options) {

@@ -1,4 +1,4 @@
-//! Pose-to-motion latency of both follow modes (the README's table, measured by `examples/latency.rs`).
+//! Pose-to-motion latency of both follow modes (the control core chapter's table, measured by `examples/latency.rs`).
 
 #[allow(dead_code)]
 #[path = "../examples/latency.rs"]

@@ -376,7 +376,7 @@ fn reachable(config: SupervisorConfig) -> HashSet<Supervisor> {
     seen
 }
 
-/// Issue 26: the auxiliary outputs are off in every fault path. Over every reachable state (no depth bound) and
+/// The auxiliary outputs are off in every fault path. Over every reachable state (no depth bound) and
 /// every event, a transition into a fault, a shutdown or `Off` leaves both outputs off; and such transitions do
 /// start from states with outputs on, for every fault an operator can meet while streaming (so the check bites).
 #[test]

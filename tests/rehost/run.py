@@ -289,11 +289,11 @@ def settings_check(m, log, cli, port):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--elf", default=os.path.join(REPO, "target/thumbv7em-none-eabihf/release/ringpod-firmware"))
+    ap.add_argument("--elf", default=os.path.join(REPO, "target/thumbv7em-none-eabihf/firmware/ringpod-firmware"))
     ap.add_argument("--memory-x", default=os.path.join(REPO, "memory.x"))
     ap.add_argument("--seconds", type=float, default=1.0, help="simulated seconds of normal running")
     ap.add_argument("--ringpod", help="the host CLI binary: runs the serial-link checks over a pty")
-    ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the README")
+    ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the book's Emulation chapter")
     args = ap.parse_args()
 
     c = CHECKS

@@ -1,14 +1,19 @@
-//! Issue 24's structure rules, kept true for the core (`shared/src`), the host (`host/src`) and the firmware
-//! (`firmware/src`): no file over 500 lines outside its tests, no function over 100 lines outside tests, and no
-//! import cycle between the top-level modules of a crate (a file or folder directly under `src/`).
+//! The layout rules, kept true for every source tree: the core (`shared/src`), the host (`host/src`), the firmware
+//! (`firmware/src`), the test runners (`tests/src`) and the QEMU programs (`tests/qemu/src`): no file over 500 lines
+//! outside its tests, no function over 100 lines outside tests, and no import cycle between the files of one module
+//! folder: between the top-level modules of a crate (a file or folder directly under `src/`), and between the sibling
+//! files and folders of every folder below (`analysis/branches.rs` and `analysis/kinematics.rs` importing each other
+//! is a cycle of `analysis`). A module that imports its parent or its child makes no cycle: it is not a sibling.
 //!
 //! The sources are parsed with `syn` (line numbers from proc-macro2's `span-locations`), so braces in strings and
 //! comments cannot fool a count. Test code counts nowhere: items under `#[cfg(test)]` (the `mod tests` at the end of
 //! a file), `#[test]` functions, and files named `tests.rs` or under a `tests/` folder.
 //!
 //! An import is any path that starts with `crate::`, `super::` or `self::`, in a `use`, in code or inside a macro's
-//! arguments, resolved to the top-level module it lands in; `crate::X` where the crate root re-exports `X` lands in
-//! the module it is re-exported from. The crate root (`lib.rs`, `main.rs`) declares every module and is no node.
+//! arguments, resolved to the file it lands in; `m::X` where module `m` re-exports `X` (`pub use x::X;`) lands in the
+//! file it is re-exported from. A crate root (`lib.rs`, `main.rs`) declares its modules and is no node of a cycle.
+//! Each binary under `src/bin/` (`bin/x.rs`, or `bin/x/main.rs` with its modules beside it) is a crate of its own, as
+//! cargo builds it: its `crate::` is its own root.
 
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::path::Path;
@@ -20,7 +25,7 @@ use syn::{Attribute, ImplItemFn, Item, ItemFn, ItemMod, ItemUse, Signature, Trai
 
 const MAX_FILE_LINES: usize = 500;
 const MAX_FN_LINES: usize = 100;
-const TREES: [&str; 3] = ["shared/src", "host/src", "firmware/src"];
+const TREES: [&str; 5] = ["shared/src", "host/src", "firmware/src", "tests/src", "tests/qemu/src"];
 
 /// A source file: its path under `src/` (with `/`) and its text.
 struct Source {
@@ -120,94 +125,137 @@ fn module_of(path: &str) -> Vec<String> {
     parts
 }
 
-/// An import edge between two top-level modules, with the first place that makes it.
-type Edges = BTreeMap<(String, String), String>;
+/// A module: the path of names from its crate root (`[]` for the root).
+type Module = Vec<String>;
 
-/// Names the crate root re-exports (`pub use a::X;`), by the top-level module they come from.
-fn root_reexports(file: &syn::File, tops: &BTreeSet<String>, out: &mut BTreeMap<String, String>) {
-    fn walk(tree: &UseTree, top: Option<&str>, tops: &BTreeSet<String>, out: &mut BTreeMap<String, String>) {
+/// Import edges between sibling modules, by the folder (module) they sit in: `(parent, from, to)` with the first
+/// place that makes the edge.
+type Edges = BTreeMap<(Module, String, String), String>;
+
+/// The crate a file belongs to and its path inside that crate: `bin/x.rs` is the root (`main.rs`) of the crate
+/// `bin/x`, a file under `bin/x/` belongs to that crate, and any other file to the library (`lib.rs`, `main.rs`).
+fn crate_of(path: &str) -> (String, String) {
+    let parts: Vec<&str> = path.split('/').collect();
+    match parts.as_slice() {
+        ["bin", file] => (format!("bin/{}", file.trim_end_matches(".rs")), "main.rs".into()),
+        ["bin", name, rest @ ..] => (format!("bin/{name}"), rest.join("/")),
+        _ => (String::new(), path.into()),
+    }
+}
+
+/// The longest prefix of `path` that is a module of the crate (a file); the root at least.
+fn known_prefix<'p>(path: &'p [String], known: &BTreeSet<Module>) -> &'p [String] {
+    (0..=path.len())
+        .rev()
+        .map(|k| &path[..k])
+        .find(|p| known.contains(*p))
+        .unwrap_or_default()
+}
+
+/// Where a `use` path in `module` points, as the full path of names: `None` for another crate.
+fn use_path(module: &[String], segments: &[String], known: &BTreeSet<Module>) -> Option<Module> {
+    let (first, rest) = segments.split_first()?;
+    let mut path: Module = match first.as_str() {
+        "crate" => Vec::new(),
+        "self" => module.to_vec(),
+        "super" => module[..module.len().checked_sub(1)?].to_vec(),
+        name => {
+            // Uniform paths: a child module's name starts a path relative to this module.
+            let child: Module = module.iter().cloned().chain([name.to_string()]).collect();
+            if !known.contains(&child) {
+                return None;
+            }
+            child
+        }
+    };
+    let mut rest = rest;
+    while rest.first().is_some_and(|s| s == "super") {
+        path.pop();
+        rest = &rest[1..];
+    }
+    path.extend(rest.iter().cloned());
+    Some(path)
+}
+
+/// The names a module file brings in with `use` (`pub use x::X;`), by the module they come from.
+fn reexports(file: &syn::File, module: &[String], known: &BTreeSet<Module>, out: &mut Reexports) {
+    fn walk(tree: &UseTree, prefix: &mut Vec<String>, leaves: &mut Vec<(Vec<String>, String)>) {
         match tree {
             UseTree::Path(p) => {
-                let name = p.ident.to_string();
-                let top = match top {
-                    Some(t) => Some(t),
-                    None if name == "crate" || name == "self" => None,
-                    None => tops.get(&name).map(String::as_str),
-                };
-                if top.is_some() || name == "crate" || name == "self" {
-                    walk(&p.tree, top, tops, out);
-                }
+                prefix.push(p.ident.to_string());
+                walk(&p.tree, prefix, leaves);
+                prefix.pop();
             }
             UseTree::Name(n) => {
-                if let Some(top) = top {
-                    out.insert(n.ident.to_string(), top.into());
-                }
+                let mut path = prefix.clone();
+                path.push(n.ident.to_string());
+                leaves.push((path, n.ident.to_string()));
             }
             UseTree::Rename(r) => {
-                if let Some(top) = top {
-                    out.insert(r.rename.to_string(), top.into());
-                }
+                let mut path = prefix.clone();
+                path.push(r.ident.to_string());
+                leaves.push((path, r.rename.to_string()));
             }
-            UseTree::Group(g) => g.items.iter().for_each(|t| walk(t, top, tops, out)),
+            UseTree::Group(g) => g.items.iter().for_each(|t| walk(t, prefix, leaves)),
             UseTree::Glob(_) => {}
         }
     }
     for item in &file.items {
         if let Item::Use(u) = item {
-            walk(&u.tree, None, tops, out);
+            let mut leaves = Vec::new();
+            walk(&u.tree, &mut Vec::new(), &mut leaves);
+            for (segments, name) in leaves {
+                let Some(path) = use_path(module, &segments, known) else {
+                    continue;
+                };
+                let from = known_prefix(&path, known);
+                if from != module {
+                    out.insert((module.to_vec(), name), from.to_vec());
+                }
+            }
         }
     }
 }
 
+/// `(module, name)` to the module the name is re-exported from.
+type Reexports = BTreeMap<(Module, String), Module>;
+
 /// One file's walk: its long functions, and the imports that leave its top-level module.
 struct Scan<'a> {
     path: &'a str,
-    module: Vec<String>,
-    tops: &'a BTreeSet<String>,
-    reexports: &'a BTreeMap<String, String>,
+    /// The module being walked: the file's, and any inline `mod` inside it.
+    module: Module,
+    known: &'a BTreeSet<Module>,
+    reexports: &'a Reexports,
     edges: &'a mut Edges,
     found: &'a mut Vec<String>,
 }
 
 impl Scan<'_> {
-    /// The top-level module a `crate::`/`super::`/`self::` path lands in (`None`: another crate, or the root).
-    fn target(&self, segments: &[String]) -> Option<String> {
-        let mut module = self.module.clone();
-        let mut rest = segments;
-        match rest.first()?.as_str() {
-            "crate" => {
-                module.clear();
-                rest = &rest[1..];
-            }
-            "super" => {
-                while rest.first().is_some_and(|s| s == "super") {
-                    module.pop();
-                    rest = &rest[1..];
-                }
-            }
-            "self" => rest = &rest[1..],
-            _ => return None,
+    /// The module (file) a `crate::`/`super::`/`self::` path lands in (`None`: another crate).
+    fn target(&self, segments: &[String]) -> Option<Module> {
+        if !["crate", "super", "self"].contains(&segments.first()?.as_str()) {
+            return None;
         }
-        match module.first() {
-            Some(top) => Some(top.clone()),
-            None => {
-                let name = rest.first()?;
-                if self.tops.contains(name) {
-                    Some(name.clone())
-                } else {
-                    self.reexports.get(name).cloned()
-                }
-            }
-        }
+        let path = use_path(&self.module, segments, self.known)?;
+        let at = known_prefix(&path, self.known);
+        let through = path
+            .get(at.len())
+            .and_then(|name| self.reexports.get(&(at.to_vec(), name.clone())));
+        Some(through.cloned().unwrap_or_else(|| at.to_vec()))
     }
 
     fn import(&mut self, segments: &[String], span: Span) {
-        let (Some(from), Some(to)) = (self.module.first(), self.target(segments)) else {
+        let Some(to) = self.target(segments) else {
             return;
         };
-        if *from != to {
+        let from = known_prefix(&self.module, self.known);
+        // The edge is between the children of the deepest module both lie in.
+        let common = from.iter().zip(&to).take_while(|(a, b)| a == b).count();
+        if let (Some(a), Some(b)) = (from.get(common), to.get(common)) {
             let at = format!("{}:{} `{}`", self.path, span.start().line, segments.join("::"));
-            self.edges.entry((from.clone(), to)).or_insert(at);
+            let key = (from[..common].to_vec(), a.clone(), b.clone());
+            self.edges.entry(key).or_insert(at);
         }
     }
 
@@ -326,7 +374,7 @@ impl<'ast> Visit<'ast> for Scan<'_> {
 
 /// One shortest cycle through each set of modules that import each other, as `a -> b -> a` with the import that
 /// makes each step.
-fn cycles(tree: &str, edges: &Edges) -> Vec<String> {
+fn cycles(tree: &str, edges: &BTreeMap<(String, String), String>) -> Vec<String> {
     let mut next: BTreeMap<&str, Vec<&str>> = BTreeMap::new();
     for (from, to) in edges.keys() {
         next.entry(from).or_default().push(to);
@@ -379,28 +427,44 @@ fn cycles(tree: &str, edges: &Edges) -> Vec<String> {
     found
 }
 
-/// Every rule broken in one crate's sources (`tree` names it in the messages).
+/// Every rule broken in one tree's sources (`tree` names it in the messages).
 fn check(tree: &str, sources: &[Source]) -> Vec<String> {
     let mut found = Vec::new();
-    let mut parsed = Vec::new();
+    let mut crates: BTreeMap<String, Vec<(&Source, String, syn::File)>> = BTreeMap::new();
     for s in sources.iter().filter(|s| !is_test_file(&s.path)) {
         match syn::parse_file(&s.text) {
-            Ok(file) => parsed.push((s, file)),
+            Ok(file) => {
+                let (krate, inside) = crate_of(&s.path);
+                crates.entry(krate).or_default().push((s, inside, file));
+            }
             Err(e) => found.push(format!("{tree}/{}: does not parse: {e}", s.path)),
         }
     }
-    let tops: BTreeSet<String> = parsed
+    for (krate, files) in &crates {
+        let label = if krate.is_empty() {
+            tree.to_string()
+        } else {
+            format!("{tree}/{krate}")
+        };
+        found.extend(check_crate(tree, &label, files));
+    }
+    found
+}
+
+/// The rules in one crate of a tree: its files with their paths inside the crate.
+fn check_crate(tree: &str, label: &str, files: &[(&Source, String, syn::File)]) -> Vec<String> {
+    let mut found = Vec::new();
+    let known: BTreeSet<Module> = files
         .iter()
-        .filter_map(|(s, _)| module_of(&s.path).first().cloned())
+        .map(|(_, inside, _)| module_of(inside))
+        .chain([Vec::new()])
         .collect();
-    let mut reexports = BTreeMap::new();
-    for (s, file) in &parsed {
-        if module_of(&s.path).is_empty() {
-            root_reexports(file, &tops, &mut reexports);
-        }
+    let mut reexported = Reexports::new();
+    for (_, inside, file) in files {
+        reexports(file, &module_of(inside), &known, &mut reexported);
     }
     let mut edges = Edges::new();
-    for (s, file) in &parsed {
+    for (s, inside, file) in files {
         let n = lines_outside_tests(file, &s.text);
         if n > MAX_FILE_LINES {
             found.push(format!(
@@ -411,20 +475,34 @@ fn check(tree: &str, sources: &[Source]) -> Vec<String> {
         let path = format!("{tree}/{}", s.path);
         let mut scan = Scan {
             path: &path,
-            module: module_of(&s.path),
-            tops: &tops,
-            reexports: &reexports,
+            module: module_of(inside),
+            known: &known,
+            reexports: &reexported,
             edges: &mut edges,
             found: &mut found,
         };
         scan.visit_file(file);
     }
-    found.extend(cycles(tree, &edges));
+    let mut by_folder: BTreeMap<&Module, BTreeMap<(String, String), String>> = BTreeMap::new();
+    for ((folder, from, to), at) in &edges {
+        by_folder
+            .entry(folder)
+            .or_default()
+            .insert((from.clone(), to.clone()), at.clone());
+    }
+    for (folder, edges) in by_folder {
+        let name = [label.to_string()]
+            .into_iter()
+            .chain(folder.iter().cloned())
+            .collect::<Vec<_>>()
+            .join("/");
+        found.extend(cycles(&name, &edges));
+    }
     found
 }
 
 #[test]
-fn the_core_host_and_firmware_keep_the_layout_rules() {
+fn every_source_tree_keeps_the_layout_rules() {
     let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut found = Vec::new();
     for tree in TREES {
@@ -536,4 +614,73 @@ fn imports_within_a_module_or_from_tests_make_no_cycle() {
         Source::new("b/tests.rs", "use crate::a::A;\n"),
     ];
     assert_eq!(check("t", &sources), Vec::<String>::new());
+}
+
+#[test]
+fn a_cycle_between_sibling_files_of_a_folder_is_found() {
+    let sources = [
+        Source::new("lib.rs", "pub mod analysis;\npub mod out;\n"),
+        Source::new(
+            "analysis/mod.rs",
+            "mod branches;\nmod kinematics;\npub use kinematics::Solve;\n",
+        ),
+        Source::new(
+            "analysis/branches.rs",
+            "use super::kinematics::Solve;\npub struct Branch;\n",
+        ),
+        // Through the folder's re-export: `crate::analysis::Solve` is kinematics'.
+        Source::new(
+            "analysis/kinematics.rs",
+            "pub struct Solve;\nfn f(_: super::branches::Branch) {}\n",
+        ),
+        Source::new("out/mod.rs", "mod a;\nmod b;\n"),
+        Source::new(
+            "out/a.rs",
+            "pub struct A;\nfn f() { let _ = crate::analysis::Solve; }\n",
+        ),
+        Source::new("out/b.rs", "pub struct B;\nuse crate::out::a::A;\n"),
+    ];
+    let found = check("t", &sources);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].starts_with("t/analysis: import cycle branches -> kinematics -> branches ("),
+        "{found:?}"
+    );
+    assert!(
+        found[0].contains("t/analysis/kinematics.rs:2 `super::branches::Branch`"),
+        "{found:?}"
+    );
+
+    let sources = [
+        Source::new("lib.rs", "pub mod out;\n"),
+        Source::new("out/mod.rs", "mod a;\nmod b;\npub use a::A;\n"),
+        Source::new("out/a.rs", "pub struct A;\nfn f() { let _ = super::b::B; }\n"),
+        Source::new("out/b.rs", "pub struct B;\nfn g() { let _ = crate::out::A; }\n"),
+    ];
+    let found = check("t", &sources);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(found[0].starts_with("t/out: import cycle a -> b -> a ("), "{found:?}");
+    assert!(found[0].contains("t/out/b.rs:2 `crate::out::A`"), "{found:?}");
+}
+
+#[test]
+fn each_binary_is_a_crate_of_its_own() {
+    // `crate::` in a binary is the binary's root: `bin/x/main.rs` and `bin/x/y.rs` import each other as root and
+    // child, and the library's `a` and `b` are not the binary's.
+    let sources = [
+        Source::new("lib.rs", "pub mod a;\npub mod b;\n"),
+        Source::new("a.rs", "pub struct A;\n"),
+        Source::new("b.rs", "pub struct B;\n"),
+        Source::new("bin/x/main.rs", "mod a;\nmod y;\nuse crate::y::Y;\nfn main() {}\n"),
+        Source::new("bin/x/a.rs", "pub struct A;\nuse crate::y::Y;\n"),
+        Source::new("bin/x/y.rs", "pub struct Y;\nuse crate::a::A;\n"),
+        Source::new(
+            "bin/z.rs",
+            "mod inner { pub struct I; }\nuse crate::inner::I;\nfn main() {}\n",
+        ),
+    ];
+    let found = check("t", &sources);
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(found[0].starts_with("t/bin/x: import cycle a -> y -> a ("), "{found:?}");
+    assert!(found[0].contains("t/bin/x/y.rs:2 `crate::a::A`"), "{found:?}");
 }

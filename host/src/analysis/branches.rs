@@ -8,8 +8,8 @@ use ringpod_core::kinematics::geometry::Branch;
 use ringpod_core::kinematics::{Mechanism, Pose, ToolCarrier};
 use serde::Serialize;
 
-use crate::analysis::kinematics::Units;
 use crate::analysis::mechanism::AnyMechanism;
+use crate::analysis::units::Units;
 use crate::error::CliError;
 
 /// Which assemblies `ik` solves for.

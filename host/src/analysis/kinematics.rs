@@ -4,13 +4,14 @@ use std::fmt::Write;
 
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::kinematics::{
-    start_from_home, AxisKind, Check, KinematicsError, Mechanism, NewtonOptions, Pose, Singularity, WorkspaceReport,
+    start_from_home, AxisKind, KinematicsError, Mechanism, NewtonOptions, Pose, Singularity, WorkspaceReport,
     FROM_HOME_DISTANCE,
 };
 use serde::Serialize;
 
 use crate::analysis::branches::{self, Assembly};
 use crate::analysis::mechanism::{AnyMechanism, Selected};
+use crate::analysis::units::Units;
 use crate::error::CliError;
 use crate::input::numbers;
 pub use crate::out::Outcome;
@@ -58,69 +59,6 @@ pub struct LoadsOptions<'a> {
     pub inertia: Option<&'a str>,
     /// With `input`: a picture of demand against what the drives give.
     pub plot: Option<&'a std::path::Path>,
-}
-
-/// Angle conversion for `--degrees`.
-pub(crate) struct Units {
-    pub(crate) degrees: bool,
-}
-
-impl Units {
-    fn angle_out(&self, rad: f64) -> f64 {
-        if self.degrees {
-            rad.to_degrees()
-        } else {
-            rad
-        }
-    }
-    fn angle_in(&self, v: f64) -> f64 {
-        if self.degrees {
-            v.to_radians()
-        } else {
-            v
-        }
-    }
-    pub(crate) fn angle_unit(&self) -> &'static str {
-        if self.degrees {
-            "deg"
-        } else {
-            "rad"
-        }
-    }
-    /// Pose from the command line: metres, then angles.
-    fn pose_in(&self, v: [f64; 6]) -> Pose<f64> {
-        Pose::from_array(std::array::from_fn(|i| if i < 3 { v[i] } else { self.angle_in(v[i]) }))
-    }
-    pub(crate) fn pose_out(&self, p: &Pose<f64>) -> [f64; 6] {
-        let v = p.to_array();
-        std::array::from_fn(|i| if i < 3 { v[i] } else { self.angle_out(v[i]) })
-    }
-    pub(crate) fn axis_unit(&self, kind: AxisKind) -> &'static str {
-        match kind {
-            AxisKind::Linear => "m",
-            AxisKind::Ring | AxisKind::Angle => self.angle_unit(),
-        }
-    }
-    pub(crate) fn axis_out(&self, kind: AxisKind, v: f64) -> f64 {
-        match kind {
-            AxisKind::Linear => v,
-            AxisKind::Ring | AxisKind::Angle => self.angle_out(v),
-        }
-    }
-    fn margin_unit(&self, check: Check) -> &'static str {
-        if check.unit() == "rad" {
-            self.angle_unit()
-        } else {
-            check.unit()
-        }
-    }
-    fn margin_out(&self, check: Check, v: f64) -> f64 {
-        if check.unit() == "rad" {
-            self.angle_out(v)
-        } else {
-            v
-        }
-    }
 }
 
 #[derive(Serialize)]

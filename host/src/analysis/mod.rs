@@ -16,4 +16,5 @@ pub mod rates;
 pub mod reactions;
 pub mod structure;
 pub mod tipover;
+pub mod units;
 pub mod workspace;

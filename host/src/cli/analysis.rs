@@ -223,7 +223,7 @@ pub struct CueArgs {
     /// Output pose CSV (t,x,y,z,alpha,beta,gamma in s, m, rad).
     #[arg(long)]
     pub out: std::path::PathBuf,
-    /// Washout parameters (TOML; every key optional, see the README).
+    /// Washout parameters (TOML; every key optional, see the book's Motion cueing chapter).
     #[arg(long)]
     pub config: Option<std::path::PathBuf>,
     /// A profile of the --config file (its `[profiles.NAME]` table overrides the base keys).

@@ -45,7 +45,7 @@ pub struct StreamArgs {
     #[arg(long, conflicts_with_all = ["udp", "input", "motion"])]
     pub telemetry_udp: Option<std::net::SocketAddr>,
     /// With --telemetry-udp: `text` (`[t] ax ay az wx wy wz`, the units of `ringpod cue`), a game's own format
-    /// (`outsim`, `outsim2`, `beamng`, `codemasters`, `f1`, `forza`, `xplane`: the README's games table), or `auto`
+    /// (`outsim`, `outsim2`, `beamng`, `codemasters`, `f1`, `forza`, `xplane`: the book's games table), or `auto`
     /// (the first datagram a game's format recognises names it, said on stderr).
     #[arg(long, value_enum, default_value = "text")]
     pub telemetry_format: crate::games::TelemetryFormat,

@@ -12,7 +12,7 @@ pub struct Coverage {
     pub combined: (usize, usize),
 }
 
-/// Measures the spec coverage of a rig (the table of the README's trainer-model section).
+/// Measures the spec coverage of a rig (the table of the book's trainer-model geometry).
 pub fn coverage(m: &RingPlatform<f64>, home: &Pose<f64>, ranges: &[f64; 5]) -> Coverage {
     let inside = |offsets: [f64; 5], yaw: f64| {
         let h = home.to_array();

@@ -129,7 +129,7 @@ fn every_invalid_class_names_its_key() {
     assert!(e.why.contains("rod_lenght") && e.why.contains("line 3"), "{e}");
 }
 
-/// A rig file with elbow chains as a builder writes it (the README's example): the trainer model's rods and
+/// A rig file with elbow chains as a builder writes it (the book's example in Rig files): the trainer model's rods and
 /// two arms of ch. 5.1 fig. 5.2.
 const ELBOW_RIG: &str = r#"
 name = "my-elbow-rig"

@@ -137,7 +137,7 @@ impl ControllerConfig {
         }
         self.pulse_timing().map_err(ConfigError::StepTiming)?;
         self.step_rates()?;
-        super::sections::supervisor_fields(&self.supervisor)?;
+        supervisor_fields(&self.supervisor)?;
         let mechanism = RingPlatform::<f32>::new(geometry);
         let home_pose = Pose::from_array(self.home).cast::<f32>();
         let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;
@@ -290,4 +290,25 @@ fn carriage_search(q: &[f64; 6], a: usize, carriages: usize, min_spacing: f64) -
     let prev = (a + carriages - 1) % carriages;
     let room = gap(a, next).min(gap(prev, a)) - min_spacing;
     (CARRIAGE_HOMING.search as f64).min(0.45 * room).max(0.0) as f32
+}
+
+/// The supervisor's delays, each at most [`SupervisorConfig::LONGEST_MS`], and a supply timeout where a supply is
+/// sensed: the first field that is not.
+pub(super) fn supervisor_fields(s: &SupervisorConfig) -> Result<(), ConfigError> {
+    let delays = [
+        (s.logic_settle_ms, FieldName::LogicSettleMs),
+        (s.power_settle_ms, FieldName::PowerSettleMs),
+        (s.supply_timeout_ms, FieldName::SupplyTimeoutMs),
+        (s.driver_off_ms, FieldName::DriverOffMs),
+        (s.discharge_ms, FieldName::DischargeMs),
+    ];
+    let sensed_without_timeout = s.supply_timeout_ms == 0 && (s.logic_sense || s.power_sense);
+    let bad = match delays.iter().find(|(ms, _)| *ms > SupervisorConfig::LONGEST_MS) {
+        Some((_, name)) => Some(*name),
+        None => sensed_without_timeout.then_some(FieldName::SupplyTimeoutMs),
+    };
+    match bad {
+        Some(name) => Err(ConfigError::Value(Field::of(SettingsKind::Supervisor, name))),
+        None => Ok(()),
+    }
 }

@@ -3,6 +3,7 @@
 //! timing) are [`ControllerConfig::validate`]'s. Homing is kept in the axes' own units and turned into steps here,
 //! so that a motor's steps per unit or direction changes its homing with it.
 
+use super::config::supervisor_fields;
 use super::{ConfigError, ControllerConfig};
 use crate::kinematics::{AxisKind, Mechanism, RingPlatform};
 use crate::motion::{AxisScale, MotionLimits};
@@ -11,7 +12,6 @@ use crate::protocol::{
     StreamSettings, SwitchSettings, Toward,
 };
 use crate::safety::homing::{AxisHoming, HomingConfig};
-use crate::safety::SupervisorConfig;
 
 /// Most steps a count or rate may take (they are `u32` in the step scheduler; 2^31 leaves room to add).
 const MOST_STEPS: f64 = 2_147_483_647.0;
@@ -248,27 +248,6 @@ fn invalid_switch(s: &SwitchSettings) -> Option<FieldName> {
     match positive.iter().find(|(x, _)| !(x.is_finite() && *x > 0.0)) {
         Some((_, name)) => Some(*name),
         None => (!s.switch.is_finite()).then_some(FieldName::Switch),
-    }
-}
-
-/// The supervisor's delays, each at most [`SupervisorConfig::LONGEST_MS`], and a supply timeout where a supply is
-/// sensed: the first field that is not.
-pub(super) fn supervisor_fields(s: &SupervisorConfig) -> Result<(), ConfigError> {
-    let delays = [
-        (s.logic_settle_ms, FieldName::LogicSettleMs),
-        (s.power_settle_ms, FieldName::PowerSettleMs),
-        (s.supply_timeout_ms, FieldName::SupplyTimeoutMs),
-        (s.driver_off_ms, FieldName::DriverOffMs),
-        (s.discharge_ms, FieldName::DischargeMs),
-    ];
-    let sensed_without_timeout = s.supply_timeout_ms == 0 && (s.logic_sense || s.power_sense);
-    let bad = match delays.iter().find(|(ms, _)| *ms > SupervisorConfig::LONGEST_MS) {
-        Some((_, name)) => Some(*name),
-        None => sensed_without_timeout.then_some(FieldName::SupplyTimeoutMs),
-    };
-    match bad {
-        Some(name) => Err(ConfigError::Value(Field::of(SettingsKind::Supervisor, name))),
-        None => Ok(()),
     }
 }
 

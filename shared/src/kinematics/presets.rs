@@ -89,7 +89,7 @@ pub const TRAINER_MODEL_HOME_Z: f64 = 0.227;
 /// pair at `(+-0.181, 0.160)`, nominal heave 0.227 m. Found by `examples/trainer_model_design.rs` (a hill climb on
 /// the worst normalised margin) and rounded to millimetres: every axis of the spec table swept over its whole range
 /// (surge/sway +-50 mm, heave +-40 mm, pitch/roll +-20 deg), at any yaw, passes all six checks with the source's joint
-/// limits. The combined corners of all ranges at once are not all reachable; the README gives the share that is.
+/// limits. The combined corners of all ranges at once are not all reachable; the book's trainer-model geometry gives the share that is.
 /// Linear actuators: 160..310 mm of travel between the end stops, of which 166..310 mm is the working stroke: the
 /// lower end switch sits at 165 mm (homing leaves the actuator 2 mm above it), and limited motion keeps the 2 mm
 /// reach margin above 166 mm, so it never trips the switch (the spec ranges use 174..294 mm).
@@ -115,9 +115,9 @@ pub const TRAINER_MODEL: RingGeometry = unwrap_geometry(RingGeometry::new(
 
 /// The arm of [`TRAINER_ELBOW`]'s elbow chains, in metres.
 ///
-/// Found by a random search (the example `trainer_elbow_design.rs` of commit 9a43fc1, now `ringpod rig design
-/// --arms-only`) over shoulder radius 0.22..0.33 m, height, upper arm, forearm and branch, scoring the arms' worst
-/// margin over the model's spec table swept axis by axis at 24 yaws, and rounded to millimetres: the shoulder 28 mm
+/// Found by a random search (as `ringpod rig design --arms-only` searches any rig with elbow chains) over shoulder
+/// radius 0.22..0.33 m, height, upper arm, forearm and branch, scoring the arms' worst margin over the model's spec
+/// table swept axis by axis at 24 yaws, and rounded to millimetres: the shoulder 28 mm
 /// inside the ring, 17 mm above it; upper arm 105 mm, forearm 189 mm, elbow up. Over that sweep the elbow's interior
 /// angle stays 20 degrees or more inside its 25..155 degree limits, the forearm 10 degrees or more above the platform
 /// cone, the singularity index above 0.05; the shoulder needs 114..175 degrees (the upper arm points outward and up),

@@ -1,6 +1,6 @@
 //! A field of a settings section, as a refused configuration names it on the wire and in words
-//! (`axes[2].steps_per_unit`, `motion.pose_velocity[4]`, `homing.axes[0].search`): the device's checks are the only
-//! ones, and a host prints their verdict instead of repeating them.
+//! (`axes[2].steps_per_unit`, `motion.pose_velocity[4]`, `homing.axes[0].search`), and the cause of a refusal
+//! ([`ConfigRefusal`]): the device's checks are the only ones, and a host prints their verdict instead of repeating them.
 
 use super::SettingsKind;
 
@@ -135,5 +135,37 @@ impl core::fmt::Display for Field {
             (SettingsKind::Homing, _, Some(i)) => write!(f, "homing.axes[{i}].{name}"),
             (_, _, Some(i)) => write!(f, "{section}.{name}[{i}]"),
         }
+    }
+}
+
+/// Why a setting was refused: the cause, named (the controller's `ConfigError`, flattened for the wire).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum ConfigRefusal {
+    /// A field is outside its range ([`Field::must`] says what it must be).
+    OutOfRange(Field),
+    /// With it the home pose would have no solution.
+    HomePose,
+    /// With it the homing plan would be unsafe or inconsistent (searches, spacing proof).
+    Homing,
+    /// With it the step scheduler's timing would be inconsistent.
+    StepTiming,
+    /// With it the step generator's slots could not render the pulses faithfully.
+    PulseSlots,
+    /// The geometry is not a valid ring platform (lengths, chains, joint limits).
+    Geometry,
+}
+
+impl core::fmt::Display for ConfigRefusal {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::OutOfRange(field) => return write!(f, "{field}: must be {}", field.must()),
+            Self::HomePose => "the home pose would have no solution",
+            Self::Homing => "the homing plan would no longer be safe (searches or spacing)",
+            Self::StepTiming => "the step timing would be inconsistent",
+            Self::PulseSlots => "the step generator could not render the pulses faithfully",
+            Self::Geometry => "the geometry is not a valid ring platform",
+        })
     }
 }

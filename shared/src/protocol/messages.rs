@@ -6,7 +6,7 @@ use crate::kinematics::Pose;
 
 use super::rig::{RigRecord, RigSource};
 use super::settings::{Settings, SettingsKind};
-use super::Field;
+use super::ConfigRefusal;
 use crate::motion::{LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
 use crate::safety::{Command, FaultReason, Refusal, State};
 
@@ -192,38 +192,6 @@ impl core::fmt::Display for NackReason {
             Self::OutOfRange => f.write_str("an argument is out of range (OutOfRange)"),
             Self::Malformed => f.write_str("the frame could not be decoded"),
         }
-    }
-}
-
-/// Why a setting was refused: the cause, named (the controller's `ConfigError`, flattened for the wire).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-#[non_exhaustive]
-pub enum ConfigRefusal {
-    /// A field is outside its range ([`Field::must`] says what it must be).
-    OutOfRange(Field),
-    /// With it the home pose would have no solution.
-    HomePose,
-    /// With it the homing plan would be unsafe or inconsistent (searches, spacing proof).
-    Homing,
-    /// With it the step scheduler's timing would be inconsistent.
-    StepTiming,
-    /// With it the step generator's slots could not render the pulses faithfully.
-    PulseSlots,
-    /// The geometry is not a valid ring platform (lengths, chains, joint limits).
-    Geometry,
-}
-
-impl core::fmt::Display for ConfigRefusal {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str(match self {
-            Self::OutOfRange(field) => return write!(f, "{field}: must be {}", field.must()),
-            Self::HomePose => "the home pose would have no solution",
-            Self::Homing => "the homing plan would no longer be safe (searches or spacing)",
-            Self::StepTiming => "the step timing would be inconsistent",
-            Self::PulseSlots => "the step generator could not render the pulses faithfully",
-            Self::Geometry => "the geometry is not a valid ring platform",
-        })
     }
 }
 

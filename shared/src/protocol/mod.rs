@@ -13,11 +13,11 @@ mod messages;
 mod rig;
 mod settings;
 
-pub use field::{Field, FieldName};
+pub use field::{ConfigRefusal, Field, FieldName};
 pub use frame::{decode, encode, parse, unframe, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};
 pub use messages::{
-    setpoint_request, ConfigRefusal, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode,
-    Status, Telemetry, TelemetryFlags, PROTOCOL_VERSION,
+    setpoint_request, DeviceMessage, HostMessage, InputReport, NackReason, Request, Response, StateCode, Status,
+    Telemetry, TelemetryFlags, PROTOCOL_VERSION,
 };
 pub use rig::{RigRecord, RigSource, RIG_NAME_LEN};
 pub use settings::{

@@ -243,7 +243,7 @@ impl HomingSequencer {
             Phase::BackOff => self.back_off(axis, &cfg, pos, active),
             Phase::Slow => {
                 if active {
-                    // The controller now calls this position `home_position`.
+                    // The controller calls this position `home_position`.
                     self.phase = Phase::Clear;
                     self.start = cfg.home_position;
                     return HomingStep::Homed { axis, at: pos };

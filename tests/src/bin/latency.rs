@@ -1,6 +1,6 @@
 //! Latency from a telemetry datagram's arrival to the first step pulse it causes, in `interpolate` and `direct`
 //! follow modes: `cargo run --release -p ringpod-tests --bin latency`. A measurement that prints a table (the
-//! README's Benchmarks section), not a test.
+//! book's Benchmarks chapter), not a test.
 //!
 //! The path of `stream --sim --telemetry-udp` (and of a board), in three parts:
 //! 1. host, wall time on this machine: the datagram over loopback UDP (send to receive), then what the host does

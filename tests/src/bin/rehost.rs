@@ -1,8 +1,8 @@
-//! `cargo run -p ringpod-tests --bin rehost`: the release firmware ELF, exactly as flashed, run on Qiling's
+//! `cargo run -p ringpod-tests --bin rehost`: the firmware ELF, exactly as flashed, run on Qiling's
 //! stm32f411 model with the harness's peripheral models (`tests/rehost`, see its README).
 //!
 //! 1. The `thumbv7em-none-eabihf` standard library (the preflight the QEMU runner uses), then
-//!    `cargo build -p ringpod-firmware --target thumbv7em-none-eabihf --release`.
+//!    `cargo build -p ringpod-firmware --target thumbv7em-none-eabihf --profile firmware`.
 //!    Then the host CLI (`cargo build -p ringpod`), which run.py drives over a pty bridged to the emulated USART1.
 //! 2. A Python venv in `target/rehost-venv` with the pinned emulator (`tests/rehost/requirements.txt`), made again
 //!    whenever that file changes.
@@ -35,16 +35,22 @@ fn run(command: &mut Command, what: &str) -> Result<(), String> {
     }
 }
 
-/// The release ELF, built as for flashing.
+/// The firmware ELF, built as for flashing (the `firmware` profile).
 fn build_firmware() -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     run(
-        Command::new(cargo)
-            .current_dir(repo())
-            .args(["build", "-p", FIRMWARE, "--target", setup::TARGET, "--release"]),
-        "cargo build -p ringpod-firmware --release",
+        Command::new(cargo).current_dir(repo()).args([
+            "build",
+            "-p",
+            FIRMWARE,
+            "--target",
+            setup::TARGET,
+            "--profile",
+            "firmware",
+        ]),
+        "cargo build -p ringpod-firmware --profile firmware",
     )?;
-    Ok(target_dir().join(setup::TARGET).join("release").join(FIRMWARE))
+    Ok(target_dir().join(setup::TARGET).join("firmware").join(FIRMWARE))
 }
 
 /// The host CLI, driven by run.py over a pty on the emulated USART1.

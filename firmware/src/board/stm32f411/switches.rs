@@ -47,7 +47,7 @@ impl InputPins for Switches {
     }
 }
 
-/// The inputs with their pulls (README's pin table): the e-stop chain has an external pull-up, the switches to
+/// The inputs with their pulls (the pin table, README and the book's Hardware chapter): the e-stop chain has an external pull-up, the switches to
 /// ground the internal one, and the supply senses are pulled down.
 pub fn new(r: SwitchPins) -> Switches {
     Switches {

@@ -39,7 +39,7 @@ fn auto_names_the_format_once_and_holds_to_it() {
         matches!(&d, Decoder::Telemetry { reader, .. } if reader.format() == TelemetryFormat::Game(Format::Outsim))
     );
     assert!(pose.is_some_and(|p| p.x < 0.0 && p.beta > 0.0), "{pose:?}");
-    // Named: a text line is now unreadable, not taken as another format.
+    // Named: a text line is unreadable, not taken as another format.
     assert!(d.decode(format!("1.01 0 0 {G} 0 0 0").as_bytes(), now).is_err());
     // A game's format named on the command line reads only that format.
     let mut d = decoder(TelemetryFormat::Game(Format::Forza));

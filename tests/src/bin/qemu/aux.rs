@@ -1,4 +1,4 @@
-//! The auxiliary outputs on the emulated MCU (issue 26): a pose file's `aux1` column and `device aux` switch the
+//! The auxiliary outputs on the emulated MCU: a pose file's `aux1` column and `device aux` switch the
 //! board's pins (the emulated machine prints `AUX n`, the pins' bits, at each change), and an e-stop drops both.
 
 use std::time::Duration;

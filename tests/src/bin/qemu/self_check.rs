@@ -82,7 +82,7 @@ pub(crate) fn core_on_m4f(t: &mut Tally) {
     println!();
 }
 
-/// Instruction budgets of the control path on the M4F (issue "the control tick under 6 % of its period"): a row
+/// Instruction budgets of the control path on the M4F (the control tick under 6 % of its period): a row
 /// whose name contains the key must not cost more. Counts under `-icount` are exact and repeatable for a given
 /// build, so these hold or fail deterministically; they keep the tick from growing back unnoticed.
 pub(crate) const BUDGETS: [(&str, u64); 5] = [

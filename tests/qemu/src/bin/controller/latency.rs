@@ -13,7 +13,7 @@
 //! idle time to the next timer, so the figures are device time, the same on every run and any host.
 
 use core::cell::Cell;
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m_semihosting::{debug, hprintln};
 use critical_section::Mutex as CsMutex;
@@ -57,6 +57,10 @@ static RESULT: Signal<CriticalSectionRawMutex, Measured> = Signal::new();
 static IN_TICK: AtomicBool = AtomicBool::new(false);
 /// Whether the measurement runs (the hooks cost nothing otherwise).
 static ON: AtomicBool = AtomicBool::new(false);
+
+/// Times the step port fell more than four periods behind and started afresh (`machine::Port` counts them, the
+/// `QUEUE` lines print them).
+pub static PORT_RESTARTS: AtomicU32 = AtomicU32::new(0);
 
 /// `Machine::cycles` was read: the start of a tick when none is under way.
 pub fn cycles_read() {
@@ -162,7 +166,7 @@ fn queue(shared: &Shared, when: &str) {
         shared.step_underruns.load(Ordering::Relaxed),
         shared.passes.load(Ordering::Relaxed),
         shared.rephased.load(Ordering::Relaxed),
-        crate::machine::PORT_RESTARTS.load(Ordering::Relaxed)
+        PORT_RESTARTS.load(Ordering::Relaxed)
     );
 }
 

@@ -144,9 +144,6 @@ impl InputPins for Pins {
     }
 }
 
-/// Times the port fell more than four periods behind and started afresh (the latency measurement prints it).
-pub static PORT_RESTARTS: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
-
 /// The step port, as a board's two-period DMA ring: the period written at a boundary plays from the next one,
 /// after the period that has just started (the plant takes each period's words when it starts).
 pub struct Port {
@@ -168,7 +165,7 @@ impl PortOutput for Port {
         Timer::at(self.busy_until).await;
         let now = Instant::now();
         let start = if now > self.busy_until + self.period * 4 {
-            PORT_RESTARTS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
+            crate::latency::PORT_RESTARTS.fetch_add(1, core::sync::atomic::Ordering::Relaxed);
             now
         } else {
             self.busy_until
