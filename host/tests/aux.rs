@@ -1,61 +1,11 @@
 //! The auxiliary outputs from the command line (issue 26): `device aux N on|off` against the simulated controller
 //! served on a pseudo-terminal, and a pose file's `aux1`, `aux2` columns streamed into it.
 
-use std::process::{Child, Command, Stdio};
+#![cfg(unix)]
 
-/// `ringpod simulate --pty`, killed when dropped: also when an assertion fails half-way.
-struct Simulator {
-    child: Child,
-    path: String,
-}
+mod common;
 
-impl Simulator {
-    fn start() -> Self {
-        use std::io::BufRead;
-        let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-            .args(["simulate", "--pty"])
-            .stdout(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let mut path = String::new();
-        let stdout = child.stdout.take();
-        let mut server = Simulator {
-            child,
-            path: String::new(),
-        };
-        std::io::BufReader::new(stdout.unwrap()).read_line(&mut path).unwrap();
-        server.path = path.trim().to_owned();
-        server
-    }
-
-    /// `ringpod WORDS --port PTY`: the exit code and everything it said.
-    fn ringpod(&self, words: &[&str]) -> (Option<i32>, String, String) {
-        let out = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-            .args(words)
-            .args(["--port", &self.path])
-            .output()
-            .unwrap();
-        (
-            out.status.code(),
-            String::from_utf8_lossy(&out.stdout).into_owned(),
-            String::from_utf8_lossy(&out.stderr).into_owned(),
-        )
-    }
-
-    /// `device status`, parsed.
-    fn status(&self) -> serde_json::Value {
-        let (code, out, err) = self.ringpod(&["device", "status"]);
-        assert_eq!(code, Some(0), "{err}");
-        serde_json::from_str(&out).unwrap()
-    }
-}
-
-impl Drop for Simulator {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
+use common::simulator::Simulator;
 
 /// Refused unpowered and before homing with the supervisor's reason; on when Ready, reported in the status; off
 /// again by the command; both off after an e-stop-free disable; a wrong number is a usage error.

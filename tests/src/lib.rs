@@ -1,6 +1,7 @@
 //! End-to-end testing of ringpod without hardware: the controller core with a simulated plant ([`plant`]) and
 //! data-driven scenarios ([`scenario`], files under `tests/scenarios/`).
 
+pub mod busy;
 pub mod emulator;
 pub mod scenario;
 pub mod setup;

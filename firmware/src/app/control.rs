@@ -22,6 +22,10 @@ pub trait Machine {
     fn feed_watchdog(&mut self);
 }
 
+/// Periods a late control loop still ticks to catch up (a tenth of the stream's default timeout at 1 kHz); the
+/// rest of a longer hold-up is passed.
+const CATCH_UP: u32 = 10;
+
 /// Runs the control loop at the controller's rate, forever, each tick held [`TickPhase`]'s lead before the step
 /// generator's next period boundary so that its moves are taken at that boundary.
 pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
@@ -38,11 +42,20 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
         // clocks lose none of them; the phase is only judged on a tick that ran on time, and by when it was due:
         // a tick that starts late behind a link frame is jitter the lead covers, not a phase to correct.
         let scheduled = due;
-        let on_time = Instant::now() < due + period;
+        let now = Instant::now();
+        let on_time = now < due + period;
         due += period;
+        if !on_time {
+            // Catching up: let the link task read what arrived during the hold-up first (a late `Timer::at` is
+            // ready at once and would not yield), so that the stream's timeout is judged on the setpoints sent
+            // meanwhile, not on device time alone.
+            embassy_futures::yield_now().await;
+        }
         // A period still queued (only after a hold-up, or the one period a phase correction gives two ticks) is
-        // passed rather than ticked; see `Controller::pass`. Inputs and faults reach the supervisor either way.
-        let ahead = shared.steps.len() >= super::AHEAD;
+        // passed rather than ticked; see `Controller::pass`. So is a period the loop is more than [`CATCH_UP`]
+        // periods late for: the motors did not move in it, and ticked in a burst such periods would run the stream's
+        // timeout out before the host's next setpoints can arrive. Inputs and faults reach the supervisor either way.
+        let ahead = shared.steps.len() >= super::AHEAD || now >= scheduled + period * CATCH_UP;
         let inputs = Inputs::from_word(shared.inputs.load(Ordering::Relaxed));
         let step_fault = shared.step_fault.swap(false, Ordering::Relaxed);
         let start = machine.cycles();

@@ -27,9 +27,18 @@ impl Serial {
     /// Opens a port at the firmware's USART baud rate (921600, for a USB-serial adapter on the board's USART1;
     /// USB CDC ignores it).
     pub fn open(path: &str) -> Result<Self, serialport::Error> {
-        let port = serialport::new(path, 921_600)
-            .timeout(Duration::from_millis(1))
-            .open()?;
+        let builder = serialport::new(path, 921_600).timeout(Duration::from_millis(1));
+        #[cfg(unix)]
+        let port: Box<dyn serialport::SerialPort> = {
+            let port = builder.open_native()?;
+            // Non-blocking: the bytes `bytes_to_read` counted can be taken by another process that opened the same
+            // port before this one reads them, and a blocking read would then wait for the next byte, for good
+            // and deaf to signals. A read that finds nothing now returns at once.
+            nonblocking(&port)?;
+            Box::new(port)
+        };
+        #[cfg(not(unix))]
+        let port = builder.open()?;
         Ok(Self {
             port,
             epoch: Instant::now(),
@@ -38,9 +47,53 @@ impl Serial {
     }
 }
 
+/// Sets `O_NONBLOCK` on a port's descriptor (serialport opens it blocking).
+#[cfg(unix)]
+fn nonblocking(port: &serialport::TTYPort) -> Result<(), serialport::Error> {
+    use nix::fcntl::{fcntl, FcntlArg, OFlag};
+    use std::os::fd::{AsRawFd, BorrowedFd};
+    // SAFETY: the descriptor belongs to `port`, which outlives this borrow.
+    let fd = unsafe { BorrowedFd::borrow_raw(port.as_raw_fd()) };
+    let flags = fcntl(fd, FcntlArg::F_GETFL).map_err(std::io::Error::from)?;
+    fcntl(
+        fd,
+        FcntlArg::F_SETFL(OFlag::from_bits_truncate(flags) | OFlag::O_NONBLOCK),
+    )
+    .map_err(std::io::Error::from)?;
+    Ok(())
+}
+
+/// Longest a write to a port may wait for room: a board that takes nothing for this long is stalled or gone.
+/// Longer than any hold-up a board recovers from (a flash erase stalls it about 2 s).
+const SEND_PATIENCE: Duration = Duration::from_secs(5);
+
 impl Transport for Serial {
     fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-        self.port.write_all(bytes)
+        // Partial writes and a full output buffer are waited out, up to a deadline: a plain `write_all` would
+        // fail on the first `EAGAIN` of a non-blocking port, or on the port's 1 ms timeout.
+        let deadline = Instant::now() + SEND_PATIENCE;
+        let mut rest = bytes;
+        while !rest.is_empty() {
+            match self.port.write(rest) {
+                Ok(n) => rest = &rest[n..],
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+                    ) =>
+                {
+                    if Instant::now() >= deadline {
+                        return Err(std::io::Error::new(
+                            std::io::ErrorKind::TimedOut,
+                            format!("the port took nothing for {} s", SEND_PATIENCE.as_secs()),
+                        ));
+                    }
+                    std::thread::sleep(Duration::from_micros(200));
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        Ok(())
     }
     fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
         // Never block: a read with nothing to read would wait out the port's timeout (1 ms) on every poll, and a
@@ -52,7 +105,14 @@ impl Transport for Serial {
         let want = ready.min(buf.len());
         match self.port.read(&mut buf[..want]) {
             Ok(n) => Ok(n),
-            Err(e) if matches!(e.kind(), std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted) => Ok(0),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted | std::io::ErrorKind::WouldBlock
+                ) =>
+            {
+                Ok(0)
+            }
             Err(e) => Err(e),
         }
     }
@@ -69,6 +129,10 @@ impl Transport for Serial {
         }
     }
 }
+
+/// How far the real-time simulator may fall behind the wall clock and still tick the periods it owes: a tenth of
+/// the stream's default timeout (100 ms), so that a catch-up burst can never run it out.
+const CATCH_UP: Duration = Duration::from_millis(10);
 
 /// Erase page of the simulator's settings flash.
 const SIM_FLASH_PAGE: usize = 2048;
@@ -89,6 +153,8 @@ pub struct SimDevice {
     realtime: bool,
     started: Instant,
     simulated_us: u64,
+    /// Periods passed after hold-ups (see [`SimDevice::held_up`]), reported in the status as a board's are.
+    passed: u32,
 }
 
 impl SimDevice {
@@ -131,6 +197,7 @@ impl SimDevice {
             realtime,
             started: Instant::now(),
             simulated_us: 0,
+            passed: 0,
         }
     }
 
@@ -168,6 +235,18 @@ impl SimDevice {
         }
     }
 
+    /// Whether the period about to run is one a hold-up of this process cost (in real time only): the simulated
+    /// clock is more than [`CATCH_UP`] behind the wall clock, as after the process was stopped (`kill -STOP`), swapped
+    /// out or starved on a busy machine. Those periods are passed, as a board passes the periods a flash erase cost:
+    /// ticked in a burst, they would run the stream's timeout out in a few milliseconds of wall time, before the
+    /// setpoints the host sent meanwhile could arrive. Lags up to [`CATCH_UP`] are ticked: a busy machine's ordinary
+    /// jitter loses no motion.
+    fn held_up(&self) -> bool {
+        self.realtime
+            && Instant::now().saturating_duration_since(self.started + Duration::from_micros(self.simulated_us))
+                > CATCH_UP
+    }
+
     fn flush_unsolicited(&mut self) {
         let mut out = [0u8; protocol::MAX_FRAME];
         while let Some(msg) = self.rig.controller.unsolicited() {
@@ -203,10 +282,16 @@ impl Transport for SimDevice {
         self.owed_us += dt.as_micros() as u64;
         while self.owed_us >= self.tick_us {
             self.owed_us -= self.tick_us;
-            let started = Instant::now();
-            self.rig.tick();
-            let cost = started.elapsed().as_nanos().min(u128::from(u32::MAX)) as u32;
-            self.rig.controller.set_platform_stats(cost, 0);
+            if self.held_up() {
+                self.rig.pass();
+                self.passed = self.passed.saturating_add(1);
+                self.rig.controller.set_step_counters(0, self.passed);
+            } else {
+                let started = Instant::now();
+                self.rig.tick();
+                let cost = started.elapsed().as_nanos().min(u128::from(u32::MAX)) as u32;
+                self.rig.controller.set_platform_stats(cost, 0);
+            }
             self.simulated_us += self.tick_us;
             if self.rig.ticks.is_multiple_of(100) {
                 self.settings_task();

@@ -4,6 +4,8 @@
 #![allow(dead_code)]
 
 pub mod packets;
+#[cfg(unix)]
+pub mod simulator;
 
 /// Starts `ringpod stream --sim --report-json --quiet ARGS` with its output piped.
 pub fn spawn_sim_stream(args: &[&str]) -> std::process::Child {

@@ -364,6 +364,10 @@ impl Controller {
     /// the outputs, which a timer may have changed.
     pub fn pass(&mut self) -> Outputs {
         self.advance_clock();
+        // A stream's setpoints bound its hold-ups too (`Pipeline::pass`): a loop that stays behind still loses it.
+        if self.supervisor.outputs().motion == Motion::Stream && self.pipeline.pass().is_some() {
+            self.event(Event::StreamLost);
+        }
         self.supervisor.outputs()
     }
 

@@ -228,4 +228,15 @@ impl Rig {
         self.ticks += 1;
         out
     }
+
+    /// A control period that the loop missed (a hold-up of the process that runs it): inputs from the plant and
+    /// [`Controller::pass`], as the firmware does for the periods a hold-up cost; the motors stand still in it.
+    pub fn pass(&mut self) {
+        let o = self.controller.supervisor().outputs();
+        self.controller
+            .set_inputs(self.plant.inputs(o.logic_relay, o.power_relay));
+        let outputs = self.controller.pass();
+        self.plant.aux = outputs.aux;
+        self.ticks += 1;
+    }
 }

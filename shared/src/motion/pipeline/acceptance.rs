@@ -64,6 +64,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         self.segment = Segment::new(self.segment.reference(), limited.pose, ticks);
         self.last = Some((sp.seq, sp.time_us, sp.pose));
         self.since_setpoint_us = 0;
+        self.passed_us = 0;
         self.applied = self.applied.saturating_add(1);
         Ok(accepted)
     }

@@ -48,6 +48,7 @@ use super::steps::StepConverter;
 
 pub use config::{FollowMode, PipelineConfig};
 use segment::Segment;
+pub use tick::HOLD_UP_LIMIT_US;
 
 /// A pose that passed every check, with its actuators.
 type Solved = (Pose<f32>, Actuators<f32>);
@@ -99,7 +100,10 @@ pub struct Pipeline<M: Mechanism<f32>> {
     segment: Segment,
     /// Sequence number, time and pose (as sent, unlimited) of the last accepted setpoint.
     last: Option<(u32, u64, Pose<f32>)>,
+    /// Ticked time since the last accepted setpoint (or the stream's start): the stream timeout's measure.
     since_setpoint_us: u32,
+    /// Passed time since then ([`Pipeline::pass`]): bounded by [`HOLD_UP_LIMIT_US`] alone.
+    passed_us: u32,
     rejected: RejectCounters,
     limited: LimitCounters,
     applied: u32,
@@ -143,6 +147,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             segment: Segment::at(pose),
             last: None,
             since_setpoint_us: 0,
+            passed_us: 0,
             rejected: RejectCounters::default(),
             limited: LimitCounters::default(),
             applied: 0,
@@ -245,6 +250,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         self.segment.rest_at(self.pose);
         self.last = None;
         self.since_setpoint_us = 0;
+        self.passed_us = 0;
     }
 
     /// Brakes to rest at the acceleration limits.

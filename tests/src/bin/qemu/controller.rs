@@ -8,15 +8,31 @@ use crate::emulator::start_or_fail;
 use crate::host_cli::{ringpod, ringpod_json, send_garbage, write_beyond_envelope, write_input};
 use crate::Tally;
 
-/// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
-pub(crate) fn controller_on_m4f(t: &mut Tally) {
-    println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
+/// Builds the host CLI the runs drive.
+fn build_cli() -> Result<(), String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let cli = Command::new(&cargo)
         .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
         .args(["build", "--release", "-p", "ringpod"])
         .status();
-    if !cli.is_ok_and(|s| s.success()) {
+    if cli.is_ok_and(|s| s.success()) {
+        Ok(())
+    } else {
+        Err("the host CLI does not build".into())
+    }
+}
+
+/// Builds everything the suite runs: the host CLI and both Cortex-M4F programs.
+pub(crate) fn build_all() -> Result<(), String> {
+    build_cli()?;
+    crate::emulator::build("ringpod-qemu")?;
+    crate::emulator::build("ringpod-qemu-controller").map(|_| ())
+}
+
+/// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
+pub(crate) fn controller_on_m4f(t: &mut Tally) {
+    println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
+    if build_cli().is_err() {
         t.check(false, "the host CLI builds");
         return;
     }
@@ -183,7 +199,10 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
     std::thread::sleep(Duration::from_secs(4));
     let _ = streaming.kill();
     let _ = streaming.wait();
-    std::thread::sleep(Duration::from_millis(1_500));
+    // The stream timeout, then braking to rest.
+    std::thread::sleep(Duration::from_millis(
+        u64::from(crate::emulator::STREAM_TIMEOUT_MS) + 2_000,
+    ));
     let after = ringpod_json(&["device", "status", "--port", pty]);
     t.check(
         after
@@ -209,6 +228,69 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
         problems.is_empty(),
         "every run above moved the plant by its STEP edges only, within the drivers' timing, drivers enabled",
     );
+    hold_up_mid_stream(t, &emulated);
     crate::aux::aux_on_m4f(t, &emulated);
     drop(emulated);
+}
+
+/// A hold-up of the emulated MCU mid-stream (QEMU stopped for 0.05, 0.5 and 2 s, longer than the stream timeout):
+/// the firmware's control loop lets the link read what arrived first and passes the periods it is far behind, so
+/// the stream goes on: every setpoint applied, no restart, and the periods passed counted in the status.
+fn hold_up_mid_stream(t: &mut Tally, emulated: &crate::emulator::Emulated) {
+    let pty = emulated.pty.as_str();
+    let passed = |s: &serde_json::Value| s["passed_periods"].as_u64().unwrap_or(0);
+    for stall_ms in [50u64, 500, 2_000] {
+        let before = ringpod_json(&["device", "status", "--port", pty])
+            .map(|s| passed(&s))
+            .unwrap_or(0);
+        let streaming = Command::new(ringpod())
+            .args([
+                "stream",
+                "--port",
+                pty,
+                "--motion",
+                "demo",
+                "--duration",
+                "6",
+                "--quiet",
+                "--report-json",
+            ])
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn();
+        let Ok(streaming) = streaming else {
+            t.check(false, "a stream starts");
+            return;
+        };
+        std::thread::sleep(Duration::from_secs(3));
+        let held = emulated.hold_up(Duration::from_millis(stall_ms));
+        let report = streaming
+            .wait_with_output()
+            .ok()
+            .and_then(|o| serde_json::from_slice::<serde_json::Value>(&o.stdout).ok());
+        let after = ringpod_json(&["device", "status", "--port", pty])
+            .map(|s| passed(&s))
+            .unwrap_or(0);
+        if let Some(r) = &report {
+            println!(
+                "a hold-up of {stall_ms} ms: {}, {} of {} applied, {} restarts, {} periods passed",
+                r["outcome"],
+                r["setpoints_applied"],
+                r["setpoints_sent"],
+                r["restarts"],
+                after.saturating_sub(before)
+            );
+        }
+        t.check(
+            held.is_ok()
+                && report.is_some_and(|r| {
+                    r["outcome"] == "followed" && r["restarts"] == 0 && r["setpoints_applied"] == r["setpoints_sent"]
+                })
+                && after.saturating_sub(before) + 20 >= stall_ms,
+            &format!(
+                "a stream goes on through a {stall_ms} ms hold-up of the emulated MCU, the periods it cost passed"
+            ),
+        );
+    }
 }

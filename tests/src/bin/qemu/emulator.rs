@@ -78,6 +78,27 @@ impl Emulated {
     pub(crate) fn printed(&self) -> Vec<String> {
         self.lines.try_iter().collect()
     }
+
+    /// Holds the emulated MCU up for `stall`: QEMU's process stopped (`kill -STOP`) and continued. Its clock follows
+    /// the host's, so the firmware finds `stall` gone at once, as a board does after a flash erase.
+    pub(crate) fn hold_up(&self, stall: Duration) -> Result<(), String> {
+        let signal = |name: &str| {
+            std::process::Command::new("kill")
+                .args([name, &self.child.id().to_string()])
+                .status()
+                .map_err(|e| format!("kill: {e}"))
+                .and_then(|s| {
+                    if s.success() {
+                        Ok(())
+                    } else {
+                        Err(format!("kill {name} failed"))
+                    }
+                })
+        };
+        signal("-STOP")?;
+        std::thread::sleep(stall);
+        signal("-CONT")
+    }
 }
 
 impl Drop for Emulated {
@@ -101,7 +122,13 @@ pub(crate) fn start_or_fail(t: &mut Tally, args: &[&str]) -> Option<Emulated> {
 
 /// Starts the controller program with the semihosting command line `args` and waits for its pty and its `READY`.
 pub(crate) fn start_controller(elf: &Path, args: &[&str]) -> Result<Emulated, String> {
-    let mut child = qemu(elf, None, args)
+    // Device time under `-icount` (8 ns an instruction, 125 MHz): while the emulated CPU runs, its clock advances
+    // with the instructions it executes, so a busy host slows the device down instead of stealing its time; while
+    // it sleeps (`sleep=on`) the clock follows the host's, so the controller keeps pace with the real-time CLI. A
+    // hold-up of the emulator while the CPU sleeps still shows as a jump of device time, which the firmware
+    // catches up as a board does after a hold-up (passing what it is far behind); with icount the catch-up
+    // always ends, where on the host's clock a starved emulator could stay behind.
+    let mut child = qemu(elf, Some("shift=3,sleep=on"), args)
         .args(["-serial", "pty"])
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -144,5 +171,26 @@ pub(crate) fn start_controller(elf: &Path, args: &[&str]) -> Result<Emulated, St
             return Err(line);
         }
     }
+    // The emulator, the host CLI and the suite share this machine's cores, where a board has a CPU of its own: on a
+    // busy machine the CLI can be descheduled for longer than the stream timeout (100 ms) between two setpoints,
+    // which on a board would be a host that is gone. The emulated controller is given a timeout that outlasts
+    // such a hold-up of the test machine (its own hold-ups it passes, as a board does); a killed host is still
+    // braked by it (`controller`'s stream-loss check).
+    let timeout = format!("{}", STREAM_TIMEOUT_MS);
+    let (set, _) = crate::host_cli::ringpod_text(&[
+        "device",
+        "config",
+        "set",
+        "stream.timeout_ms",
+        &timeout,
+        "--port",
+        &emulated.pty,
+    ]);
+    if !set {
+        return Err("the emulated controller took no stream timeout".into());
+    }
     Ok(emulated)
 }
+
+/// The emulated controller's stream timeout (see [`start_controller`]).
+pub(crate) const STREAM_TIMEOUT_MS: u32 = 500;

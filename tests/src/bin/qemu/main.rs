@@ -10,6 +10,9 @@
 //! 3. `watchdog`: a stalled control loop reset by the watchdog. 4. `rig`: a rig of one's own loaded and run, and
 //!    the elbow trainer's and the rotopod's rig files likewise.
 //!
+//! `--busy` builds everything first, then runs the suite beside two spinning threads per core (`ringpod_tests::busy`):
+//! the emulated controller keeps device time under `-icount` and its checks hold on a loaded machine.
+//!
 //! `setup` installs what the suite needs first (the target's standard library, QEMU) or says how;
 //! `cargo run -p ringpod-tests --bin qemu -- --preflight` runs only that. `emulator` starts QEMU and the programs;
 //! `host_cli` drives the `ringpod` CLI against them.
@@ -28,6 +31,7 @@ use crate::controller::controller_on_m4f;
 use crate::rig::{elbow_on_m4f, rig_on_m4f, rotopod_on_m4f};
 use crate::self_check::core_on_m4f;
 use crate::watchdog::watchdog_on_m4f;
+use ringpod_tests::busy::{load_average, Busy};
 use ringpod_tests::setup::{self, preflight};
 
 pub(crate) struct Tally {
@@ -47,11 +51,12 @@ impl Tally {
 }
 
 fn main() -> ExitCode {
-    let only_preflight = match std::env::args().nth(1).as_deref() {
-        None => false,
-        Some("--preflight") => true,
+    let (only_preflight, busy) = match std::env::args().nth(1).as_deref() {
+        None => (false, false),
+        Some("--preflight") => (true, false),
+        Some("--busy") => (false, true),
         Some(other) => {
-            eprintln!("qemu: unknown argument {other:?} (the only one is --preflight)");
+            eprintln!("qemu: unknown argument {other:?} (--preflight, or --busy)");
             return ExitCode::from(2);
         }
     };
@@ -69,12 +74,32 @@ fn main() -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let mut t = Tally { passed: 0, failed: 0 };
+    // `--busy`: everything is built first, then the suite runs beside two spinning threads per core.
+    let load = if busy {
+        if let Err(e) = controller::build_all() {
+            eprintln!("qemu: {e}");
+            println!("0 passed, 1 failed");
+            return ExitCode::FAILURE;
+        }
+        let load = Busy::start(2);
+        println!("== beside {} busy threads (a loaded machine)", load.threads());
+        Some(load)
+    } else {
+        None
+    };
     core_on_m4f(&mut t);
     controller_on_m4f(&mut t);
     watchdog_on_m4f(&mut t);
     rig_on_m4f(&mut t);
     elbow_on_m4f(&mut t);
     rotopod_on_m4f(&mut t);
+    if let Some(load) = load {
+        let average = load_average().map_or("unknown".into(), |l| format!("{l:.1}"));
+        println!(
+            "the suite ran beside {} busy threads; load average {average}",
+            load.threads()
+        );
+    }
     println!("{} passed, {} failed", t.passed, t.failed);
     if t.failed == 0 {
         ExitCode::SUCCESS

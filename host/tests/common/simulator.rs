@@ -1,0 +1,67 @@
+//! `ringpod simulate --pty` for the tests that drive it as a board.
+
+use std::process::{Child, Command, Stdio};
+
+/// `ringpod simulate --pty`, killed when dropped: also when an assertion fails half-way.
+pub struct Simulator {
+    /// The simulator's process.
+    pub child: Child,
+    /// Its pseudo-terminal.
+    pub path: String,
+}
+
+impl Simulator {
+    pub fn start() -> Self {
+        use std::io::BufRead;
+        let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(["simulate", "--pty"])
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut path = String::new();
+        let stdout = child.stdout.take();
+        let mut server = Simulator {
+            child,
+            path: String::new(),
+        };
+        std::io::BufReader::new(stdout.unwrap()).read_line(&mut path).unwrap();
+        server.path = path.trim().to_owned();
+        server
+    }
+
+    /// `ringpod WORDS --port PTY`: the exit code and everything it said.
+    pub fn ringpod(&self, words: &[&str]) -> (Option<i32>, String, String) {
+        let out = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(words)
+            .args(["--port", &self.path])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    }
+
+    /// Whether the simulator's process still runs.
+    pub fn child_running(&self) -> bool {
+        // `try_wait` needs `&mut`; a signal 0 asks the kernel whether the process is there without reaping it.
+        nix::sys::signal::kill(nix::unistd::Pid::from_raw(self.child.id() as i32), None).is_ok()
+            && !std::fs::read_to_string(format!("/proc/{}/stat", self.child.id()))
+                .is_ok_and(|s| s.split_whitespace().nth(2) == Some("Z"))
+    }
+
+    /// `device status`, parsed.
+    pub fn status(&self) -> serde_json::Value {
+        let (code, out, err) = self.ringpod(&["device", "status"]);
+        assert_eq!(code, Some(0), "{err}");
+        serde_json::from_str(&out).unwrap()
+    }
+}
+
+impl Drop for Simulator {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
