@@ -22,6 +22,10 @@ use crate::stream::record::Recorder;
 /// Setpoints sent ahead of their answers: 16 ms of a 1 kHz stream, far more than a USB or pty round trip.
 const IN_FLIGHT: usize = 16;
 
+/// How long the answers to setpoints in flight are waited for: through a device's hold-up (a board's flash erase
+/// stalls it about 2 s, a busy machine stalls the simulator), which the device catches up by itself.
+const HOLD_UP_PATIENCE: Duration = Duration::from_secs(5);
+
 /// Why streaming ended early.
 pub(super) enum Stop {
     /// The device stopped streaming or faulted: the reason.
@@ -201,14 +205,24 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// Counts the answers to setpoints in flight, in order, until at most `keep` are outstanding.
     pub(super) fn collect(&mut self, keep: usize) -> Result<(), StreamError> {
         let step = Duration::from_micros(200);
+        let patience = self.client.timeout.max(HOLD_UP_PATIENCE);
         let mut waited = Duration::ZERO;
         while let Some(&(id, number, pose)) = self.in_flight.front() {
             let Some(answer) = self.client.take_response(id)? else {
                 if self.in_flight.len() <= keep {
                     break;
                 }
-                if waited >= self.client.timeout {
-                    return Err(ClientError::Timeout(self.client.timeout).into());
+                // A stopping signal ends the wait at once: the run's loop stops and the ending counts the rest.
+                if self
+                    .client
+                    .cancel
+                    .as_ref()
+                    .is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst))
+                {
+                    break;
+                }
+                if waited >= patience {
+                    return Err(ClientError::Timeout(patience).into());
                 }
                 self.client.transport().elapse(step);
                 waited += step;
