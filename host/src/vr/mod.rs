@@ -226,11 +226,14 @@ impl Compensation {
     }
 }
 
+/// What the client calls with each telemetry sample (its `TelemetryTap`).
+pub type PoseTap = Box<dyn FnMut(&ringpod_core::protocol::Telemetry) + Send>;
+
 /// The client's telemetry tap for `stream --motion-compensation`: each sample's followed pose written as it
 /// arrives. `rig` is the simulated rig's home and centre of rotation; none for a board (the trainer model's home,
 /// the platform origin): OXRMC takes its reference where the user calibrates, so another home only shifts what it
 /// subtracts.
-pub fn tap(tracker: Tracker, rig: Option<(Pose<f64>, [f64; 3])>) -> Result<crate::link::client::TelemetryTap, VrError> {
+pub fn tap(tracker: Tracker, rig: Option<(Pose<f64>, [f64; 3])>) -> Result<PoseTap, VrError> {
     let trainer = || Pose::from_array(ringpod_core::kinematics::presets::Preset::TrainerModel.home());
     let (home, centre) = rig.unwrap_or_else(|| (trainer(), [0.0; 3]));
     let mut out = Compensation::open(tracker, home, centre)?;
