@@ -57,7 +57,8 @@ fn a_crlf_pose_file_streams_every_row_as_its_lf_copy() {
     let mut csv = String::from("t,x,y,z,alpha,beta,gamma\n");
     for i in 0..200 {
         let t = f64::from(i) * 0.005;
-        csv += &format!("{t},0,0,0,0,0,{}\n", 0.2 * (t * 3.0).sin());
+        // About the trainer model's home height (z = 0.227 m), yawing.
+        csv += &format!("{t},0,0,0.227,0,0,{}\n", 0.2 * (t * 3.0).sin());
     }
     let args = |p: &str| -> Vec<String> {
         ["stream", "--sim", "--fast", "--quiet", "--report-json", "--input", p]

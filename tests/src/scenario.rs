@@ -275,77 +275,9 @@ pub fn run(scenario: &Scenario) -> Result<Report, String> {
     let mut last_steps = rig.controller.steps();
     for now in 0..=end {
         while let Some(step) = steps.next_if(|s| s.at_ms == now) {
-            let at = format!("at {now} ms");
-            if let Some(name) = &step.send {
-                let response = host.send(&mut rig.controller, command(name)?);
-                let text = format!("{:?}", response.body);
-                if let Some(want) = &step.expect_response {
-                    if !text.starts_with(want.as_str()) {
-                        return Err(format!("{at}: `{name}` answered {text}, expected {want}"));
-                    }
-                }
-                let _ = writeln!(report.log, "{at}: {name} -> {text}");
-            }
-            if let Some(i) = &step.input {
-                if let Some(v) = i.estop {
-                    rig.plant.estop_open = v;
-                }
-                if let Some(v) = i.supply_dead {
-                    rig.plant.supply_dead = v;
-                }
-                if let Some(a) = i.limit_axis {
-                    rig.plant.position[a] = rig.plant.switches[a].far_limit.ok_or("not a linear axis")?;
-                }
-            }
-            if let Some(s) = &step.setpoint {
-                host.seq += 1;
-                report.sent += 1;
-                let pose = Pose::from_array(s.pose.map(|v| v as f32));
-                let sp = Setpoint {
-                    seq: host.seq,
-                    time_us: now * 1000,
-                    pose,
-                    aux: [None; 2],
-                };
-                let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
-                let text = format!("{:?}", response.body);
-                if !text.starts_with(s.expect.as_str()) {
-                    return Err(format!(
-                        "{at}: setpoint {:?} answered {text}, expected {}",
-                        s.pose, s.expect
-                    ));
-                }
-                host.accepted(&rig.controller, &response.body, pose);
-            }
-            if let Some(s) = &step.stream {
-                streams.push(ActiveStream {
-                    stream: s.clone(),
-                    start_ms: now,
-                    next_ms: now as f64,
-                });
-            }
-            if let Some(e) = &step.expect {
-                check(&rig, &host, &report, e).map_err(|m| format!("{at}: {m}"))?;
-                let _ = writeln!(report.log, "{at}: expectations met");
-            }
+            apply_step(step, now, &mut rig, &mut host, &mut report, &mut streams)?;
         }
-        for s in &mut streams {
-            while s.next_ms <= now as f64 && now < s.start_ms + s.stream.duration_ms {
-                let t = (s.next_ms - s.start_ms as f64) / 1000.0;
-                let pose = stream_pose(&s.stream, t).cast::<f32>();
-                host.seq += 1;
-                report.sent += 1;
-                let sp = Setpoint {
-                    seq: host.seq,
-                    time_us: (s.next_ms * 1000.0) as u64,
-                    pose,
-                    aux: [None; 2],
-                };
-                let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
-                host.accepted(&rig.controller, &response.body, pose);
-                s.next_ms += 1000.0 / s.stream.rate_hz;
-            }
-        }
+        feed_streams(now, &mut streams, &mut rig, &mut host, &mut report);
         rig.tick();
         let now_steps = rig.controller.steps();
         for a in 0..4 {
@@ -361,6 +293,92 @@ pub fn run(scenario: &Scenario) -> Result<Report, String> {
         ));
     }
     Ok(report)
+}
+
+/// One step of a scenario at `now` (ms): its command, inputs, setpoint, stream and expectations.
+fn apply_step(
+    step: &Step,
+    now: u64,
+    rig: &mut Rig,
+    host: &mut Host,
+    report: &mut Report,
+    streams: &mut Vec<ActiveStream>,
+) -> Result<(), String> {
+    let at = format!("at {now} ms");
+    if let Some(name) = &step.send {
+        let response = host.send(&mut rig.controller, command(name)?);
+        let text = format!("{:?}", response.body);
+        if let Some(want) = &step.expect_response {
+            if !text.starts_with(want.as_str()) {
+                return Err(format!("{at}: `{name}` answered {text}, expected {want}"));
+            }
+        }
+        let _ = writeln!(report.log, "{at}: {name} -> {text}");
+    }
+    if let Some(i) = &step.input {
+        if let Some(v) = i.estop {
+            rig.plant.estop_open = v;
+        }
+        if let Some(v) = i.supply_dead {
+            rig.plant.supply_dead = v;
+        }
+        if let Some(a) = i.limit_axis {
+            rig.plant.position[a] = rig.plant.switches[a].far_limit.ok_or("not a linear axis")?;
+        }
+    }
+    if let Some(s) = &step.setpoint {
+        host.seq += 1;
+        report.sent += 1;
+        let pose = Pose::from_array(s.pose.map(|v| v as f32));
+        let sp = Setpoint {
+            seq: host.seq,
+            time_us: now * 1000,
+            pose,
+            aux: [None; 2],
+        };
+        let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
+        let text = format!("{:?}", response.body);
+        if !text.starts_with(s.expect.as_str()) {
+            return Err(format!(
+                "{at}: setpoint {:?} answered {text}, expected {}",
+                s.pose, s.expect
+            ));
+        }
+        host.accepted(&rig.controller, &response.body, pose);
+    }
+    if let Some(s) = &step.stream {
+        streams.push(ActiveStream {
+            stream: s.clone(),
+            start_ms: now,
+            next_ms: now as f64,
+        });
+    }
+    if let Some(e) = &step.expect {
+        check(rig, host, report, e).map_err(|m| format!("{at}: {m}"))?;
+        let _ = writeln!(report.log, "{at}: expectations met");
+    }
+    Ok(())
+}
+
+/// The setpoints of the running streams due at `now` (ms).
+fn feed_streams(now: u64, streams: &mut [ActiveStream], rig: &mut Rig, host: &mut Host, report: &mut Report) {
+    for s in streams.iter_mut() {
+        while s.next_ms <= now as f64 && now < s.start_ms + s.stream.duration_ms {
+            let t = (s.next_ms - s.start_ms as f64) / 1000.0;
+            let pose = stream_pose(&s.stream, t).cast::<f32>();
+            host.seq += 1;
+            report.sent += 1;
+            let sp = Setpoint {
+                seq: host.seq,
+                time_us: (s.next_ms * 1000.0) as u64,
+                pose,
+                aux: [None; 2],
+            };
+            let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
+            host.accepted(&rig.controller, &response.body, pose);
+            s.next_ms += 1000.0 / s.stream.rate_hz;
+        }
+    }
 }
 
 fn check(rig: &Rig, host: &Host, report: &Report, e: &Expect) -> Result<(), String> {

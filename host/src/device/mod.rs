@@ -12,7 +12,7 @@ use std::path::PathBuf;
 use ringpod_core::protocol::RigSource;
 use ringpod_core::safety::State;
 
-use crate::link::{self, client::Client, transport, Target};
+use crate::link::{self, client::Client, sim, Target};
 use crate::signals::Signals;
 pub use error::DeviceError;
 
@@ -158,8 +158,8 @@ impl Platform {
 /// exits with 128 + its number.
 pub fn simulate(platform: Option<&Platform>, tcp: Option<std::net::SocketAddr>) -> Result<u8, DeviceError> {
     let device = match Platform::rig(platform)? {
-        Some(rig) => transport::SimDevice::for_rig(true, &rig)?,
-        None => transport::SimDevice::new(true),
+        Some(rig) => sim::SimDevice::for_rig(true, &rig)?,
+        None => sim::SimDevice::new(true),
     };
     let signals = Signals::install()?;
     match tcp {
@@ -171,13 +171,13 @@ pub fn simulate(platform: Option<&Platform>, tcp: Option<std::net::SocketAddr>) 
 }
 
 #[cfg(unix)]
-fn serve_pty(device: transport::SimDevice, signals: &Signals) -> Result<(), DeviceError> {
+fn serve_pty(device: sim::SimDevice, signals: &Signals) -> Result<(), DeviceError> {
     Ok(link::pty::serve(device, &|| signals.received())?)
 }
 
 /// A pseudo-terminal is a Unix device: refused by name, before anything runs.
 #[cfg(not(unix))]
-fn serve_pty(_: transport::SimDevice, _: &Signals) -> Result<(), DeviceError> {
+fn serve_pty(_: sim::SimDevice, _: &Signals) -> Result<(), DeviceError> {
     Err(DeviceError::Unsupported(
         "simulate --pty: pseudo-terminals exist only on Unix; serve the simulator over TCP instead (simulate --tcp 127.0.0.1:PORT, then --port tcp://127.0.0.1:PORT)",
     ))

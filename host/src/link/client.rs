@@ -360,7 +360,7 @@ pub fn setpoint_answer(answer: DeviceMessage) -> Result<Result<Accepted, RejectR
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::link::transport::SimDevice;
+    use crate::link::sim::SimDevice;
 
     /// The simulated device behind a link that loses the first `lose` frames the host sends, and counts the time.
     struct Lossy {

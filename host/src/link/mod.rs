@@ -5,6 +5,7 @@
 pub mod client;
 #[cfg(unix)]
 pub mod pty;
+pub mod sim;
 pub mod tcp;
 pub mod transport;
 
@@ -87,6 +88,6 @@ pub fn connect(target: &Target, realtime: bool) -> Result<transport::AnyTranspor
             })?;
             transport::AnyTransport::Serial(serial)
         }
-        Target::Sim => transport::AnyTransport::Sim(Box::new(transport::SimDevice::new(realtime))),
+        Target::Sim => transport::AnyTransport::Sim(Box::new(sim::SimDevice::new(realtime))),
     })
 }

@@ -11,7 +11,7 @@ use nix::pty::openpty;
 use nix::sys::termios::{cfmakeraw, tcgetattr, tcsetattr, SetArg};
 
 use crate::link::client::Transport;
-use crate::link::transport::SimDevice;
+use crate::link::sim::SimDevice;
 use crate::link::LinkError;
 
 /// Opens a pseudo-terminal, prints the path of its device side, and runs the simulated controller behind it in

@@ -10,7 +10,7 @@ use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
 use std::time::{Duration, Instant};
 
 use crate::link::client::Transport;
-use crate::link::transport::SimDevice;
+use crate::link::sim::SimDevice;
 
 /// The scheme that makes `--port` a network address.
 pub const SCHEME: &str = "tcp://";

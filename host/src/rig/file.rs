@@ -2,8 +2,9 @@
 
 use std::path::Path;
 
+use ringpod_core::controller::{ConfigError, ControllerConfig};
 use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, ElbowBranch, RingGeometry, DEG};
-use ringpod_core::protocol::{AxisSettings, HomingSettings};
+use ringpod_core::protocol::{AxisSettings, HomingSettings, RigRecord};
 use serde::{Deserialize, Serialize};
 
 use super::{err, settings, DriveSpec, RigError};
@@ -340,5 +341,51 @@ impl RigFile {
         let mut value = toml::Value::try_from(self)?;
         tidy(&mut value);
         toml::to_string(&value)
+    }
+}
+impl RigFile {
+    /// The record a device stores: geometry and home pose with the file's sections (or the defaults), checked by
+    /// the controller's own code; each error names its key.
+    pub(super) fn record(&self, record: RigRecord) -> Result<RigRecord, RigError> {
+        let mut record = record;
+        record.geometry().or_else(|e| err("rig", e.to_string()))?;
+        if !self.axes.is_empty() && self.axes.len() != 6 {
+            return err(
+                "axes",
+                format!("{} entries: one per actuator (6), or none", self.axes.len()),
+            );
+        }
+        for (slot, axis) in record.machine.axes.iter_mut().zip(&self.axes) {
+            *slot = *axis;
+        }
+        if let Some(m) = &self.motion {
+            record.machine.motion = m.settings(&record.machine.motion);
+        }
+        if let Some(spec) = &self.inputs {
+            record.machine.inputs = spec.config()?;
+        }
+        if let Some(s) = self.supervisor {
+            record.machine.supervisor = s;
+        }
+        if let Some(h) = &self.homing {
+            record.machine.homing = *h;
+        }
+        // The device's checks are the only ones: a field out of range is named by the core, by the file's key.
+        ControllerConfig::from_record(&record).map_err(|e| match e {
+            ConfigError::Value(field) => RigError::new(field.to_string(), format!("must be {}", field.must())),
+            other => RigError::new("rig", format!("the controller cannot drive it: {other}")),
+        })?;
+        Ok(record)
+    }
+
+    /// This file with the sections of `record` written out (what `device rig show` prints).
+    pub fn with_sections(mut self, record: &RigRecord) -> Self {
+        let m = &record.machine;
+        self.axes = m.axes.to_vec();
+        self.motion = Some(settings::MotionSpec::of(&m.motion));
+        self.inputs = Some(settings::InputsSpec::of(&m.inputs));
+        self.supervisor = Some(m.supervisor);
+        self.homing = Some(m.homing);
+        self
     }
 }

@@ -5,12 +5,13 @@
 //! axis's switch and search in the axis's units, and the order). Each is optional and takes the trainer model's
 //! values on this rig when omitted; together with the geometry they make the [`RigRecord`] a device stores.
 
-use ringpod_core::controller::{ConfigError, ControllerConfig};
-use ringpod_core::protocol::{MotionSettings, RigRecord};
+use ringpod_core::protocol::MotionSettings;
+#[cfg(doc)]
+use ringpod_core::protocol::RigRecord;
 use ringpod_core::safety::debounce::{InputBit, InputConfig};
 use serde::{Deserialize, Serialize};
 
-use super::{err, RigError, RigFile};
+use super::{err, RigError};
 
 /// Input wiring.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -51,7 +52,7 @@ pub struct MotionSpec {
 
 impl MotionSpec {
     /// The device's section: this file's limits over `defaults` (the rig's default record's).
-    fn settings(&self, defaults: &MotionSettings) -> MotionSettings {
+    pub(super) fn settings(&self, defaults: &MotionSettings) -> MotionSettings {
         MotionSettings {
             pose_velocity: self.pose_velocity,
             pose_acceleration: self.pose_acceleration,
@@ -61,7 +62,7 @@ impl MotionSpec {
     }
 
     /// The section written out in full.
-    fn of(m: &MotionSettings) -> Self {
+    pub(super) fn of(m: &MotionSettings) -> Self {
         Self {
             pose_velocity: m.pose_velocity,
             pose_acceleration: m.pose_acceleration,
@@ -83,53 +84,6 @@ fn names() -> impl Iterator<Item = (String, InputBit)> {
         ("logic_ok".to_owned(), InputBit::LogicOk),
         ("power_ok".to_owned(), InputBit::PowerOk),
     ])
-}
-
-impl RigFile {
-    /// The record a device stores: geometry and home pose with the file's sections (or the defaults), checked by
-    /// the controller's own code; each error names its key.
-    pub(super) fn record(&self, record: RigRecord) -> Result<RigRecord, RigError> {
-        let mut record = record;
-        record.geometry().or_else(|e| err("rig", e.to_string()))?;
-        if !self.axes.is_empty() && self.axes.len() != 6 {
-            return err(
-                "axes",
-                format!("{} entries: one per actuator (6), or none", self.axes.len()),
-            );
-        }
-        for (slot, axis) in record.machine.axes.iter_mut().zip(&self.axes) {
-            *slot = *axis;
-        }
-        if let Some(m) = &self.motion {
-            record.machine.motion = m.settings(&record.machine.motion);
-        }
-        if let Some(spec) = &self.inputs {
-            record.machine.inputs = spec.config()?;
-        }
-        if let Some(s) = self.supervisor {
-            record.machine.supervisor = s;
-        }
-        if let Some(h) = &self.homing {
-            record.machine.homing = *h;
-        }
-        // The device's checks are the only ones: a field out of range is named by the core, by the file's key.
-        ControllerConfig::from_record(&record).map_err(|e| match e {
-            ConfigError::Value(field) => RigError::new(field.to_string(), format!("must be {}", field.must())),
-            other => RigError::new("rig", format!("the controller cannot drive it: {other}")),
-        })?;
-        Ok(record)
-    }
-
-    /// This file with the sections of `record` written out (what `device rig show` prints).
-    pub fn with_sections(mut self, record: &RigRecord) -> Self {
-        let m = &record.machine;
-        self.axes = m.axes.to_vec();
-        self.motion = Some(MotionSpec::of(&m.motion));
-        self.inputs = Some(InputsSpec::of(&m.inputs));
-        self.supervisor = Some(m.supervisor);
-        self.homing = Some(m.homing);
-        self
-    }
 }
 
 impl InputsSpec {
@@ -171,7 +125,7 @@ mod tests {
     use ringpod_core::store::{restore, store};
 
     use super::super::{parse, RigFile};
-    use super::*;
+    use ringpod_core::controller::ControllerConfig;
 
     /// The trainer model's rig file with every controller section written out and changed from the defaults.
     fn with_sections() -> String {

@@ -295,7 +295,7 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
         Device::Port(_) => (None, false),
     };
     let transport = match (&job.device, &rig) {
-        (_, Some(r)) => link::transport::AnyTransport::Sim(Box::new(link::transport::SimDevice::for_rig(!fast, r)?)),
+        (_, Some(r)) => link::transport::AnyTransport::Sim(Box::new(link::sim::SimDevice::for_rig(!fast, r)?)),
         (Device::Port(port), None) => link::connect(&link::Target::Port(port.clone()), true)?,
         (Device::Sim { .. }, None) => link::connect(&link::Target::Sim, !fast)?,
     };

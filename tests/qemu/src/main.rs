@@ -71,6 +71,16 @@ fn main() -> ! {
         hprintln!("COST {} {}", instructions, name);
     };
 
+    kinematics_costs(&report);
+    controller_costs(&report);
+    render_costs(&report);
+    hprintln!("DONE");
+    debug::exit(debug::EXIT_SUCCESS);
+    halt()
+}
+
+/// IK, IK with its checks, FK and a limited setpoint on the trainer model, over the self-check's 64 poses.
+fn kinematics_costs(report: &dyn Fn(&str, u32, u32)) {
     let trainer = RingPlatform::<f32>::new(&TRAINER_MODEL);
     let poses: [Pose<f32>; 64] = {
         let mut all = [Pose::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0); 64];
@@ -150,7 +160,10 @@ fn main() -> ! {
         64,
     );
     hprintln!("LIMITED {} of 64", limited);
+}
 
+/// A control tick and a setpoint frame at 1 kHz, and the tick at 2 kHz.
+fn controller_costs(report: &dyn Fn(&str, u32, u32)) {
     // A controller brought to Running through power-up and homing, then fed a setpoint frame every tick.
     let (tick, frame, n) = stream_costs(ControllerConfig::trainer_model(), 1_000);
     report(
@@ -172,7 +185,10 @@ fn main() -> ! {
     }
     let (tick, _, n) = stream_costs(fast, 2_000);
     report("control tick at 2 kHz (the same work, half the period)", tick, n);
+}
 
+/// The step generator's CPU work for one period of step buffers.
+fn render_costs(report: &dyn Fn(&str, u32, u32)) {
     // The step generator's CPU work: one period's pulse buffer at 100 k steps/s on all six axes (100 steps each in
     // 1 ms), DIR reversing on every axis.
     let scheduler = SchedulerConfig::default();
@@ -203,9 +219,6 @@ fn main() -> ! {
         render_total,
         20,
     );
-    hprintln!("DONE");
-    debug::exit(debug::EXIT_SUCCESS);
-    halt()
 }
 
 /// SysTick counts of the control ticks and of the setpoint frames of 500 ticks of a stream moving

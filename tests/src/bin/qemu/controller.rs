@@ -42,6 +42,32 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
     };
     let pty = emulated.pty.as_str();
     println!("controller on {pty}");
+    csv_streams(t, pty);
+    garbage_frame(t, pty);
+    telemetry_rows(t, pty);
+    stream_loss(t, pty);
+    // The plant moved only by the STEP edges of the step generator's words: they kept the drivers' timing, and no
+    // step came while the drivers were disabled (the board module prints the first of either).
+    let problems: Vec<String> = emulated
+        .printed()
+        .into_iter()
+        .filter(|l| l.starts_with("TIMING") || l.starts_with("DISABLED") || l.starts_with("ERROR"))
+        .collect();
+    for p in &problems {
+        eprintln!("qemu: {p}");
+    }
+    t.check(
+        problems.is_empty(),
+        "every run above moved the plant by its STEP edges only, within the drivers' timing, drivers enabled",
+    );
+    hold_up_mid_stream(t, &emulated);
+    crate::aux::aux_on_m4f(t, &emulated);
+    drop(emulated);
+}
+
+/// A pose file streamed into the emulated controller and the simulator, and one beyond the envelope and the
+/// limits: the same ends.
+fn csv_streams(t: &mut Tally, pty: &str) {
     let input = std::env::temp_dir().join(format!("ringpod-qemu-{}.csv", std::process::id()));
     if write_input(&input).is_err() {
         t.check(false, "the input file is written");
@@ -119,7 +145,10 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
             );
         }
     }
+}
 
+/// A corrupted frame: answered, counted, never executed.
+fn garbage_frame(t: &mut Tally, pty: &str) {
     // A frame of garbage: answered with a Malformed nack (id 0), counted, never executed.
     let garbage = [0x05, 0x11, 0x22, 0x33, 0x44, 0x55, 0x00];
     let malformed = send_garbage(pty, &garbage).ok().and_then(|bytes| {
@@ -140,7 +169,10 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
             .is_ok_and(|s| s["bad_frames"] == 1 && s["state"] == "Ready"),
         "the device counted the bad frame and moved nothing",
     );
+}
 
+/// A recorded run's telemetry rows, one every 10 ms of device time.
+fn telemetry_rows(t: &mut Tally, pty: &str) {
     // Telemetry from the M4F: a recorded run has a row every 10 ms of device time.
     let record = std::env::temp_dir().join(format!("ringpod-qemu-record-{}.csv", std::process::id()));
     let recorded = ringpod_json(&[
@@ -175,7 +207,10 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
             && device_s.windows(2).all(|w| (w[1] - w[0] - 0.01).abs() < 1e-9),
         "the emulated controller sends telemetry: a recorded run has a row every 10 ms of device time",
     );
+}
 
+/// A host killed mid-stream: the controller brakes to rest by itself.
+fn stream_loss(t: &mut Tally, pty: &str) {
     // Stream loss: the host dies mid-stream; the controller brakes to rest by itself.
     let streaming = Command::new(ringpod())
         .args([
@@ -213,24 +248,6 @@ pub(crate) fn controller_on_m4f(t: &mut Tally) {
     if let Ok(s) = &after {
         println!("after the stream loss: state {}, steps {}", s["state"], s["steps"]);
     }
-
-    // The plant moved only by the STEP edges of the step generator's words: they kept the drivers' timing, and no
-    // step came while the drivers were disabled (the board module prints the first of either).
-    let problems: Vec<String> = emulated
-        .printed()
-        .into_iter()
-        .filter(|l| l.starts_with("TIMING") || l.starts_with("DISABLED") || l.starts_with("ERROR"))
-        .collect();
-    for p in &problems {
-        eprintln!("qemu: {p}");
-    }
-    t.check(
-        problems.is_empty(),
-        "every run above moved the plant by its STEP edges only, within the drivers' timing, drivers enabled",
-    );
-    hold_up_mid_stream(t, &emulated);
-    crate::aux::aux_on_m4f(t, &emulated);
-    drop(emulated);
 }
 
 /// A hold-up of the emulated MCU mid-stream (QEMU stopped for 0.05, 0.5 and 2 s, longer than the stream timeout):
