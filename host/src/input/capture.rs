@@ -23,11 +23,11 @@ use pcap_file::pcapng::{Block, PcapNgParser};
 use pcap_file::{DataLink, PcapError};
 
 mod write;
-pub use write::CaptureWriter;
-#[cfg(test)]
-pub(crate) use write::udp_packet;
 #[cfg(test)]
 use write::checksum;
+#[cfg(test)]
+pub(crate) use write::udp_packet;
+pub use write::CaptureWriter;
 
 /// A UDP datagram of a capture.
 #[derive(Debug, Clone)]

@@ -123,14 +123,15 @@ pub(super) fn report<T: Transport>(
 /// Collects the answers still in flight (a device that stopped streaming has refused them), stops, and waits up
 /// to 10 s for rest; the status at rest, or none when the device did not answer.
 fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
+    // The collection and the wait for rest run to their ends even after a signal (each bounded by its patience):
+    // the platform is brought to rest, then reported.
+    let cancel = s.client.cancel.take();
     while !s.in_flight.is_empty() {
         if let Err(StreamError::Client(_)) = s.collect(0) {
             break;
         }
     }
     let _ = s.client.stop();
-    // The wait for rest runs to its end even after a signal: the platform is brought to rest, then reported.
-    let cancel = s.client.cancel.take();
     let status = s.client.wait_for(Duration::from_secs(10), |st| {
         !matches!(st.state, State::Running | State::Stopping)
     });
