@@ -37,6 +37,11 @@ fn wait_at_most(child: &mut std::process::Child, limit: Duration) -> Option<std:
 /// device's counters.
 fn stream_through_a_stall(stall: Duration) -> (serde_json::Value, serde_json::Value) {
     let sim = Simulator::start();
+    // The simulator, the host and this test share the machine's cores: a host descheduled for longer than the
+    // default timeout (100 ms) is, to the device, a host that is gone. A timeout of 300 ms outlasts that on a busy
+    // machine and is still far shorter than the hold-ups below that the simulator must pass.
+    let (code, _, err) = sim.ringpod(&["device", "config", "set", "stream.timeout_ms", "300"]);
+    assert_eq!(code, Some(0), "{err}");
     let stream = ringpod()
         .args(["stream", "--port", &sim.path, "--motion", "demo", "--duration", "8"])
         .args(["--quiet", "--report-json"])

@@ -161,7 +161,10 @@ fn main() -> ExitCode {
         (
             "the host's tests under Wine",
             step("the host's tests under Wine", || {
-                status(cargo(&["test", "-p", "ringpod"]), "cargo test under Wine")
+                status(
+                    cargo(&["test", "-p", "ringpod", "--no-fail-fast"]),
+                    "cargo test under Wine",
+                )
             }),
         ),
         (
