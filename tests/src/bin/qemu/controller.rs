@@ -250,9 +250,11 @@ fn stream_loss(t: &mut Tally, pty: &str) {
     }
 }
 
-/// A hold-up of the emulated MCU mid-stream (QEMU stopped for 0.05, 0.5 and 2 s, longer than the stream timeout):
-/// the firmware's control loop lets the link read what arrived first and passes the periods it is far behind, so
-/// the stream goes on: every setpoint applied, no restart, and the periods passed counted in the status.
+/// A hold-up of the emulator mid-stream (QEMU's process stopped for 0.05, 0.5 and 2 s, longer than the stream
+/// timeout), as a busy test machine gives one: the stream goes on, every setpoint applied, no restart. Under
+/// `-icount` device time stands still while QEMU is stopped, so the device sees no hold-up of its own (the periods it
+/// passed are printed); the firmware's catch-up after a hold-up of device time is the core's and the simulator's
+/// test (`Controller::pass`, `host/tests/link.rs`).
 fn hold_up_mid_stream(t: &mut Tally, emulated: &crate::emulator::Emulated) {
     let pty = emulated.pty.as_str();
     let passed = |s: &serde_json::Value| s["passed_periods"].as_u64().unwrap_or(0);
@@ -303,11 +305,8 @@ fn hold_up_mid_stream(t: &mut Tally, emulated: &crate::emulator::Emulated) {
             held.is_ok()
                 && report.is_some_and(|r| {
                     r["outcome"] == "followed" && r["restarts"] == 0 && r["setpoints_applied"] == r["setpoints_sent"]
-                })
-                && after.saturating_sub(before) + 20 >= stall_ms,
-            &format!(
-                "a stream goes on through a {stall_ms} ms hold-up of the emulated MCU, the periods it cost passed"
-            ),
+                }),
+            &format!("a stream goes on through a {stall_ms} ms hold-up of the emulator, every setpoint applied"),
         );
     }
 }
