@@ -38,6 +38,14 @@ pub async fn until(c: &Client, expression: &str, within: Duration) -> Result<Val
 }
 
 pub async fn click(c: &Client, css: &str) -> Result<(), String> {
+    // Into the middle of the view first, as a user scrolls to what they click: WebDriver scrolls an element only as
+    // far as the view's edge, where the Control panel's log (sticky at the bottom) covers it.
+    let selector = serde_json::to_string(css).map_err(|e| e.to_string())?;
+    js(
+        c,
+        &format!("(document.querySelector({selector}) || document.body).scrollIntoView({{block: 'center'}}), true"),
+    )
+    .await?;
     c.find(Locator::Css(css))
         .await
         .map_err(|e| format!("{css}: {e}"))?
