@@ -21,6 +21,22 @@ fn signal(pid: u32, signal: nix::sys::signal::Signal) {
     nix::sys::signal::kill(nix::unistd::Pid::from_raw(pid as i32), signal).unwrap();
 }
 
+/// `ringpod stream --port PORT --motion demo --duration SECONDS --quiet`.
+fn demo_stream(port: &str, seconds: &str) -> Command {
+    let mut c = ringpod();
+    c.args([
+        "stream",
+        "--port",
+        port,
+        "--motion",
+        "demo",
+        "--duration",
+        seconds,
+        "--quiet",
+    ]);
+    c
+}
+
 /// Waits for `child` to end, up to `limit`; `None` while it still runs.
 fn wait_at_most(child: &mut std::process::Child, limit: Duration) -> Option<std::process::ExitStatus> {
     let deadline = Instant::now() + limit;
@@ -92,17 +108,7 @@ fn a_live_stream_survives_a_hold_up_of_the_device() {
 fn the_simulator_keeps_serving_when_a_client_stops_reading() {
     let sim = Simulator::start();
     let record = std::env::temp_dir().join(format!("ringpod-link-record-{}.csv", std::process::id()));
-    let mut recorder = ringpod()
-        .args([
-            "stream",
-            "--port",
-            &sim.path,
-            "--motion",
-            "demo",
-            "--duration",
-            "60",
-            "--quiet",
-        ])
+    let mut recorder = demo_stream(&sim.path, "60")
         .arg("--record")
         .arg(&record)
         .arg("--record-hz")
@@ -133,17 +139,7 @@ fn the_simulator_keeps_serving_when_a_client_stops_reading() {
 #[test]
 fn a_port_drained_by_another_reader_never_blocks_the_host() {
     let sim = Simulator::start();
-    let mut stream = ringpod()
-        .args([
-            "stream",
-            "--port",
-            &sim.path,
-            "--motion",
-            "demo",
-            "--duration",
-            "30",
-            "--quiet",
-        ])
+    let mut stream = demo_stream(&sim.path, "30")
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()

@@ -209,21 +209,27 @@ fn telemetry_rows(t: &mut Tally, pty: &str) {
     );
 }
 
+/// `ringpod stream --port PTY --motion demo --duration SECONDS --quiet`, its input closed.
+fn demo_stream(pty: &str, seconds: &str) -> Command {
+    let mut c = Command::new(ringpod());
+    c.args([
+        "stream",
+        "--port",
+        pty,
+        "--motion",
+        "demo",
+        "--duration",
+        seconds,
+        "--quiet",
+    ])
+    .stdin(Stdio::null());
+    c
+}
+
 /// A host killed mid-stream: the controller brakes to rest by itself.
 fn stream_loss(t: &mut Tally, pty: &str) {
     // Stream loss: the host dies mid-stream; the controller brakes to rest by itself.
-    let streaming = Command::new(ringpod())
-        .args([
-            "stream",
-            "--port",
-            pty,
-            "--motion",
-            "demo",
-            "--duration",
-            "30",
-            "--quiet",
-        ])
-        .stdin(Stdio::null())
+    let streaming = demo_stream(pty, "30")
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn();
@@ -262,19 +268,8 @@ fn hold_up_mid_stream(t: &mut Tally, emulated: &crate::emulator::Emulated) {
         let before = ringpod_json(&["device", "status", "--port", pty])
             .map(|s| passed(&s))
             .unwrap_or(0);
-        let streaming = Command::new(ringpod())
-            .args([
-                "stream",
-                "--port",
-                pty,
-                "--motion",
-                "demo",
-                "--duration",
-                "6",
-                "--quiet",
-                "--report-json",
-            ])
-            .stdin(Stdio::null())
+        let streaming = demo_stream(pty, "6")
+            .arg("--report-json")
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn();
