@@ -94,3 +94,26 @@ fn a_reader_sees_the_followed_pose_track_the_device() {
     }
     let _ = std::fs::remove_file(&record);
 }
+
+#[test]
+fn the_workbench_holds_the_mapping_at_the_home_pose() {
+    let name = r"Local\SimRacingStudioMotionRigPose";
+    assert!(read(name).is_none(), "another writer holds the mapping");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ringpod"))
+        .args(["ui", "--sim", "--listen", "127.0.0.1:0", "--motion-compensation", "srs"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    let mut seen = None;
+    while seen.is_none() && started.elapsed() < Duration::from_secs(60) {
+        seen = read(name);
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    // The simulated trainer at rest in its home pose: no offset from home in any of the six values.
+    let pose = seen.expect("the workbench never wrote the mapping");
+    assert!(pose.iter().all(|v| v.abs() < 1e-3), "{pose:?} is not the home pose");
+}

@@ -85,6 +85,7 @@ class Machine:
         self.hw.find = self._find
         self.hw.setup_mmio(0x5000_0000, 0x40000, info="[OTG FS]")
         self.resets = []  # (time, cause)
+        self.cpu_held_until = 0  # a hold-up of the CPU a check asks for (cycles): see `run`
         self.reset_request = None
         self.fault = None
         self.observers = []  # called between chunks, at most once a simulated millisecond
@@ -448,10 +449,12 @@ class Machine:
                 observed = self.now
                 for observe in self.observers:
                     observe()
-            if self.flash.busy_until > self.now:
+            held_until = max(self.flash.busy_until, self.cpu_held_until)
+            if held_until > self.now:
                 # RM0383 3.5: reading flash while a sector is erased stalls the bus; code and vectors are in flash,
-                # so the CPU waits (interrupts stay pending) while the peripherals and the watchdog run on
-                self.now = max(self.now + 1, min(self.next_event(), self.flash.busy_until, until))
+                # so the CPU waits (interrupts stay pending) while the peripherals and the watchdog run on. A check
+                # may hold the CPU so too (`cpu_held_until`): a board's hold-up of its own.
+                self.now = max(self.now + 1, min(self.next_event(), held_until, until))
                 continue
             try:
                 if self.sleeping is not None:

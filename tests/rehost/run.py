@@ -23,6 +23,7 @@ from unicorn import arm_const as A  # noqa: E402
 
 from defmt_log import DefmtLog  # noqa: E402
 from elf import memory_x  # noqa: E402
+from hold_up import hold_up_checks  # noqa: E402
 from machine import SYSCLK, Machine  # noqa: E402
 from models import dma as D  # noqa: E402
 from models import tim as T  # noqa: E402
@@ -176,6 +177,7 @@ def serial_checks(m, p, log, plant, ringpod):
     settings_check(m, log, cli, port)
     homing_check(m, plant, cli, port)
     stream_check(m, plant, cli, port, ringpod)
+    hold_up_checks(CHECKS, m, cli, port)
 
 
 def stream_check(m, plant, cli, port, ringpod):

@@ -48,7 +48,8 @@ class Cli:
     def __init__(self, m, ringpod, bridge):
         self.m, self.ringpod, self.bridge = m, ringpod, bridge
 
-    def run(self, *args, sim_limit_s=20.0):
+    def run(self, *args, sim_limit_s=20.0, during=None):
+        """`during(simulated_s)`, when given, is called between the machine's steps (every 5 simulated ms)."""
         cmd = [self.ringpod, *args]
         with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
             proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
@@ -56,6 +57,8 @@ class Cli:
             step = SYSCLK // 200
             while proc.poll() is None and self.m.now - start < sim_limit_s * SYSCLK and self.m.fault is None:
                 self.m.run(self.m.now + step)
+                if during is not None:
+                    during((self.m.now - start) / SYSCLK)
             if proc.poll() is None:
                 proc.kill()
                 proc.wait()

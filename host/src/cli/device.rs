@@ -75,6 +75,11 @@ pub struct UiArgs {
     /// Let the page stream pose files under DIR by name. Without it the page streams only the files picked in it.
     #[arg(long, value_name = "DIR")]
     pub files: Option<std::path::PathBuf>,
+    /// VR motion compensation (Windows): write the pose the seat followed, whenever the device reports it (every
+    /// run from the page, and at rest), where OpenXR-MotionCompensation's virtual tracker of this type reads it, as
+    /// `stream --motion-compensation` does.
+    #[arg(long, value_enum, value_name = "TRACKER")]
+    pub motion_compensation: Option<crate::vr::Tracker>,
 }
 
 /// Which controller a command drives: a board on a serial port, or the simulated controller in this process (of the

@@ -322,6 +322,7 @@ impl super::UiArgs {
             platform: platform(&self.controller.geometry, &self.controller.mechanism),
             listen: self.listen,
             files: self.files.clone(),
+            motion_compensation: self.motion_compensation,
         })
     }
 }

@@ -92,7 +92,8 @@ pub struct StreamArgs {
     #[arg(long, value_enum, value_name = "TRACKER")]
     pub motion_compensation: Option<crate::vr::Tracker>,
     /// Record the run: a CSV row per telemetry sample (every 10 ms at the default 100 Hz): host and device time,
-    /// the pose commanded, the pose followed (after limiting), the actuator steps, the state and the flags
+    /// the pose commanded, the pose followed (where the device's counted steps put the platform, by forward
+    /// kinematics), the actuator steps, the state and the flags
     /// (limited, refused, held). `ringpod plot FILE` draws it.
     #[arg(long, value_name = "FILE.csv")]
     pub record: Option<std::path::PathBuf>,

@@ -87,6 +87,9 @@ pub struct Client<T: Transport> {
     /// Sees every telemetry sample as it arrives, whoever drives the client (the workbench's live view while a
     /// stream runs); the samples are kept for [`Client::take_telemetry`] all the same.
     pub tap: Option<TelemetryTap>,
+    /// The platform and motors the device runs, when known: each telemetry sample's pose becomes the pose of the
+    /// steps it counted ([`super::followed`]) before the tap and the caller see it.
+    pub followed: Option<super::followed::Followed>,
 }
 
 impl<T: Transport> Client<T> {
@@ -103,6 +106,7 @@ impl<T: Transport> Client<T> {
             timeout: Duration::from_secs(2),
             cancel: None,
             tap: None,
+            followed: None,
         }
     }
 
@@ -124,7 +128,10 @@ impl<T: Transport> Client<T> {
                     if let Ok(response) = protocol::decode::<Response>(frame) {
                         match (response.id, response.body) {
                             (0, DeviceMessage::Fault(reason)) => self.faults.push(reason),
-                            (0, DeviceMessage::Telemetry(sample)) => {
+                            (0, DeviceMessage::Telemetry(mut sample)) => {
+                                if let Some(followed) = &mut self.followed {
+                                    followed.apply(&mut sample);
+                                }
                                 if let Some(tap) = &mut self.tap {
                                     tap(&sample);
                                 }

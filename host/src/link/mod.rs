@@ -3,6 +3,7 @@
 //! simulated controller served on a pseudo-terminal (Unix) or over TCP.
 
 pub mod client;
+pub mod followed;
 #[cfg(unix)]
 pub mod pty;
 pub mod sim;

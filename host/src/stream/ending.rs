@@ -143,6 +143,7 @@ fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
 /// samples dropped, and why it failed, if it did.
 fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordReport {
     let dropped = s.client.telemetry_dropped;
+    let unsolved = s.client.followed.as_ref().map_or(0, |f| f.unsolved);
     let (rows, error) = match (s.recorder.take(), s.record_error.take()) {
         (Some(r), None) => match r.finish() {
             Ok(rows) => (rows, None),
@@ -155,6 +156,7 @@ fn record_report<T: Transport>(s: &mut Streamer<'_, T>, path: String) -> RecordR
         rows,
         telemetry_hz: None,
         dropped,
+        unsolved,
         error,
     }
 }

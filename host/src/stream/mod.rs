@@ -178,6 +178,8 @@ fn device_envelope<T: Transport>(client: &mut Client<T>) -> Result<DeviceEnvelop
     let geometry = rig
         .geometry()
         .map_err(|e| ClientError::Unexpected(format!("the device's rig does not check: {e}")))?;
+    // From here on the run's telemetry (the record, motion compensation) carries the pose of the counted steps.
+    client.followed = crate::link::followed::Followed::of(&rig);
     let (Settings::Stream(stream), _) = client.settings(SettingsKind::Stream)? else {
         return Err(ClientError::Unexpected(
             "the device answered with another section".into(),

@@ -89,7 +89,8 @@ impl Recorder {
         for v in commanded.to_array() {
             row += &format!(",{v}");
         }
-        for v in t.target.to_array() {
+        // The pose followed: where the counted steps put the platform (`link::followed`), not where it was sent.
+        for v in t.pose.to_array() {
             row += &format!(",{v}");
         }
         for s in t.steps {
@@ -140,7 +141,7 @@ pub struct Run {
     pub t: Vec<f64>,
     /// The pose the host commanded last (the record's `cmd_*`).
     pub commanded: Vec<[f64; 6]>,
-    /// The pose followed: the device's setpoint as limited, angles unwrapped.
+    /// The pose followed: where the counted steps put the platform, angles unwrapped.
     pub target: Vec<[f64; 6]>,
     pub steps: Vec<[f64; 6]>,
     pub state: Vec<String>,

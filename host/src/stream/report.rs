@@ -120,6 +120,8 @@ pub struct RecordReport {
     pub telemetry_hz: Option<u16>,
     /// Telemetry samples the client dropped before they were written (none unless the host fell behind).
     pub dropped: u64,
+    /// Rows whose counted steps gave no pose (forward kinematics failed): their followed pose is the device's own.
+    pub unsolved: u64,
     /// Why the file could not be written, if it could not.
     pub error: Option<String>,
 }

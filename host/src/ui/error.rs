@@ -29,6 +29,9 @@ pub enum UiError {
     /// The device thread ended with an error.
     #[error("the device")]
     Device(#[source] worker::WorkerError),
+    /// `--motion-compensation`: the tracker's mapping.
+    #[error(transparent)]
+    Vr(#[from] crate::vr::VrError),
     /// The device thread panicked.
     #[error("the device thread failed")]
     DeviceThread,

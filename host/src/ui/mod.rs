@@ -44,6 +44,8 @@ pub struct Options {
     pub listen: SocketAddr,
     /// The directory whose pose files a page may stream by name (otherwise only the files the user picks).
     pub files: Option<std::path::PathBuf>,
+    /// Write the followed pose for VR motion compensation.
+    pub motion_compensation: Option<crate::vr::Tracker>,
 }
 
 /// The page, its scripts and its style, compiled in.
@@ -90,6 +92,14 @@ pub fn run(options: Options) -> Result<u8, UiError> {
     let signals = Signals::install()?;
     let token = Token::random().map_err(UiError::Random)?;
     let rig = Platform::rig(options.platform.as_ref())?;
+    // The mapping is opened before anything is served: a tracker that cannot be written is said at the start.
+    let compensation = match options.motion_compensation {
+        Some(tracker) => Some(crate::vr::tap(
+            tracker,
+            rig.as_ref().map(|r| (r.home, r.centre_of_rotation)),
+        )?),
+        None => None,
+    };
     // The address first: a port in use is said before anything else starts.
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -114,7 +124,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
     let device = {
         let hub = hub.clone();
         let target = options.target.clone();
-        std::thread::spawn(move || worker::run(target, rig, hub, inbox))
+        std::thread::spawn(move || worker::run(target, rig, hub, inbox, compensation))
     };
     let local = listener.local_addr()?;
     let app = Arc::new(App {

@@ -110,6 +110,7 @@ pub fn run(
     rig: Option<crate::rig::Rig>,
     hub: Arc<Hub>,
     jobs: mpsc::Receiver<Job>,
+    mut compensation: Option<crate::vr::PoseTap>,
 ) -> Result<(), WorkerError> {
     let transport = match (&target, &rig) {
         (_, Some(r)) => AnyTransport::Sim(Box::new(SimDevice::for_rig(true, r)?)),
@@ -129,6 +130,9 @@ pub fn run(
     client.tap = Some(Box::new(move |sample| {
         if let Ok(mut p) = tap.lock() {
             p.see(sample);
+        }
+        if let Some(write) = compensation.as_mut() {
+            write(sample);
         }
     }));
     client.telemetry(true)?;
@@ -165,6 +169,8 @@ fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlat
         eprintln!("warning: {source}");
     }
     let geometry = record.geometry().map_err(WorkerError::DeviceGeometry)?;
+    // The frames and motion compensation show the pose of the counted steps of the rig the device runs now.
+    client.followed = crate::link::followed::Followed::of(&record);
     let mut view = RigView::of(&geometry, record.home, source.to_string());
     // The name the user gave the rig (its file's `name`), not the geometry's generic one.
     if !record.name().trim().is_empty() {

@@ -99,11 +99,7 @@ impl Controller {
             return false;
         };
         let axes = mechanism.axes();
-        let totals = crate::kinematics::Actuators(core::array::from_fn(|a| {
-            let scale = &self.config.scales[a];
-            let per_unit = scale.per_unit(axes[a]) * if scale.invert { -1.0 } else { 1.0 };
-            q_home.0[a] + position[a] as f32 / per_unit
-        }));
+        let totals = crate::motion::actuators_at_steps(&self.config.scales, &axes, &q_home, &position);
         let guess = crate::kinematics::start_from_home(&mechanism, &totals, &self.home_pose);
         let options = crate::kinematics::NewtonOptions {
             max_distance: crate::kinematics::FROM_HOME_DISTANCE as f32,
@@ -131,13 +127,8 @@ impl Controller {
     /// The pose at motor step positions in homed coordinates (step 0 of each axis at the home pose).
     pub(super) fn pose_at_steps(&self, position: &[i64; 6]) -> Result<Pose<f32>, KinematicsError> {
         let mechanism = *self.pipeline.mechanism();
-        let home = MultiTurn::new(mechanism.inverse(&self.home_pose)?);
-        let axes = mechanism.axes();
-        let q = crate::kinematics::Actuators(core::array::from_fn(|a| {
-            let scale = &self.config.scales[a];
-            let per_unit = scale.per_unit(axes[a]) * if scale.invert { -1.0 } else { 1.0 };
-            home.within.0[a] + position[a] as f32 / per_unit
-        }));
+        let home = mechanism.inverse(&self.home_pose)?;
+        let q = crate::motion::actuators_at_steps(&self.config.scales, &mechanism.axes(), &home, position);
         let options = crate::kinematics::NewtonOptions::default();
         Ok(mechanism.forward(&q, &self.home_pose, &options)?.pose)
     }

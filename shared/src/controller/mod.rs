@@ -13,6 +13,7 @@ mod settings;
 /// The inputs the controller reads (they belong to the safety layer, which debounces them).
 pub use crate::safety::Inputs;
 pub use config::{Checked, ConfigError, ControllerConfig};
+pub use sections::axis_scale;
 
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;

@@ -253,7 +253,7 @@ fn invalid_switch(s: &SwitchSettings) -> Option<FieldName> {
 
 /// A motor's scale, checked: 1 to 2^24 steps per unit, whole steps per carriage turn on the ring; a shoulder's
 /// (an angle axis) is given per turn too, not necessarily whole (a gear's ratio need not be).
-fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Option<AxisScale> {
+pub fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Option<AxisScale> {
     let v = axis.steps_per_unit;
     if !(v.is_finite() && (1.0..=16_777_216.0).contains(&v)) {
         return None;

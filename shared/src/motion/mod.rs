@@ -17,4 +17,4 @@ pub use limits::{AxisTracker, MotionLimits};
 pub use pipeline::{FollowMode, Pipeline, PipelineConfig, PipelineEvent};
 pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler, StepTimes};
 pub use setpoint::{Accepted, LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
-pub use steps::{AxisScale, StepConverter};
+pub use steps::{actuators_at_steps, AxisScale, StepConverter};

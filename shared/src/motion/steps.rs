@@ -1,6 +1,6 @@
 //! Conversion between actuator positions and motor steps.
 
-use crate::kinematics::{AxisKind, MultiTurn};
+use crate::kinematics::{Actuators, AxisKind, MultiTurn};
 use crate::Real;
 
 /// How one axis's motor relates to its actuator coordinate.
@@ -66,4 +66,20 @@ impl StepConverter {
             self.offsets[axis] = steps.saturating_sub(at);
         }
     }
+}
+
+/// The actuator positions that motor step positions stand for in homed coordinates, where step 0 of every axis is
+/// its value in `at_zero` (the actuators of the home pose): the inverse of [`StepConverter::to_steps`] after homing,
+/// to within a step's rounding. Ring axes count whole carriage turns, so a value may lie beyond one turn.
+pub fn actuators_at_steps(
+    scales: &[AxisScale; 6],
+    axes: &[AxisKind; 6],
+    at_zero: &Actuators<f32>,
+    position: &[i64; 6],
+) -> Actuators<f32> {
+    Actuators(core::array::from_fn(|a| {
+        let scale = &scales[a];
+        let per_unit = scale.per_unit(axes[a]) * if scale.invert { -1.0 } else { 1.0 };
+        at_zero.0[a] + position[a] as f32 / per_unit
+    }))
 }

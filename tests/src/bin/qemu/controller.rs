@@ -240,11 +240,16 @@ fn stream_loss(t: &mut Tally, pty: &str) {
     std::thread::sleep(Duration::from_secs(4));
     let _ = streaming.kill();
     let _ = streaming.wait();
-    // The stream timeout, then braking to rest.
-    std::thread::sleep(Duration::from_millis(
-        u64::from(crate::emulator::STREAM_TIMEOUT_MS) + 2_000,
-    ));
-    let after = ringpod_json(&["device", "status", "--port", pty]);
+    // The stream timeout, then braking to rest, both in device time: under `-icount` on a busy machine the emulated
+    // clock runs slower than the wall clock, so the check polls the device's state rather than sleeping a fixed
+    // wall-clock time. The deadline only bounds a device that never brakes.
+    let deadline = std::time::Instant::now() + Duration::from_secs(60);
+    std::thread::sleep(Duration::from_millis(u64::from(crate::emulator::STREAM_TIMEOUT_MS)));
+    let mut after = ringpod_json(&["device", "status", "--port", pty]);
+    while std::time::Instant::now() < deadline && !after.as_ref().is_ok_and(|s| s["state"] == "Ready") {
+        std::thread::sleep(Duration::from_millis(250));
+        after = ringpod_json(&["device", "status", "--port", pty]);
+    }
     t.check(
         after
             .as_ref()
