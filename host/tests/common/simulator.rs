@@ -2,6 +2,9 @@
 
 use std::process::{Child, Command, Stdio};
 
+/// The simulator's stream timeout in the tests (see [`Simulator::start`]).
+pub const STREAM_TIMEOUT_MS: u32 = 500;
+
 /// `ringpod simulate --pty`, killed when dropped: also when an assertion fails half-way.
 pub struct Simulator {
     /// The simulator's process.
@@ -26,6 +29,18 @@ impl Simulator {
         };
         std::io::BufReader::new(stdout.unwrap()).read_line(&mut path).unwrap();
         server.path = path.trim().to_owned();
+        // The simulator, the CLI and the other tests share the test machine's cores, where a board has a CPU of its
+        // own: under load the CLI can be descheduled for longer than the default stream timeout (100 ms) between
+        // two setpoints, which to the device is a host that is gone. A timeout that outlasts the machine's own
+        // hold-ups (the QEMU suite gives its emulated board the same); tests of the timeout set their own.
+        let (code, _, err) = server.ringpod(&[
+            "device",
+            "config",
+            "set",
+            "stream.timeout_ms",
+            &STREAM_TIMEOUT_MS.to_string(),
+        ]);
+        assert_eq!(code, Some(0), "{err}");
         server
     }
 
