@@ -40,6 +40,9 @@ fn main() -> ExitCode {
 /// Runs one command: each module's typed error becomes anyhow here, at the top, and nowhere else.
 fn run(command: &cli::Command) -> anyhow::Result<u8> {
     use cli::Command as C;
+    if !command.watches_signals() {
+        signals::end_on_signal()?;
+    }
     Ok(match command {
         C::Presets { json, export } => answer(match export {
             Some(name) => rig::export(name).map_err(error::CliError::from),

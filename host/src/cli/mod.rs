@@ -160,3 +160,14 @@ pub enum Command {
         mechanism: Option<String>,
     },
 }
+
+impl Command {
+    /// Whether the command watches the stopping signals itself (it stops the platform or its server first, then
+    /// reports): the others, which only compute or ask once, are ended by `signals::end_on_signal`.
+    pub fn watches_signals(&self) -> bool {
+        matches!(
+            self,
+            Self::Stream(_) | Self::Device(_) | Self::Ui(_) | Self::Simulate { .. } | Self::Monitor { .. }
+        )
+    }
+}
