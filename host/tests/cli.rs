@@ -1100,6 +1100,41 @@ fn device_inputs_lists_every_input() {
         .stderr(predicate::str::contains("--watch is for `device inputs`"));
 }
 
+/// `device inputs --watch | head -1`: the reader goes away while no input changes and nothing is printed; the
+/// watch notices the closed pipe anyway and ends within a second or two with the closed output's exit (141).
+#[test]
+#[cfg(unix)]
+fn device_inputs_watch_ends_when_its_reader_goes_away_while_nothing_changes() {
+    use std::io::BufRead;
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["device", "inputs", "--watch", "--sim"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = std::io::BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    stdout.read_line(&mut line).unwrap();
+    assert!(!line.is_empty(), "the table's first line");
+    drop(stdout);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the watch still runs 5 s after its reader went away");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut said = String::new();
+    let _ = std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut said);
+    assert_eq!(status.code(), Some(141), "{said}");
+    assert!(said.contains("standard output: Broken pipe"), "{said}");
+}
+
 /// `rates`: the velocity problem against finite differences of IK (actuator rates for pose rates) and of FK (pose
 /// rates for actuator rates), on the trainer model, the rotopod and chapter 5's trainer; the angular velocity of
 /// a pure yaw rate is that rate about z.

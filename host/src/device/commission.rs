@@ -125,18 +125,19 @@ pub fn changes(before: &InputReport, now: &InputReport) -> Vec<String> {
 
 /// Prints the table, then with `watch` every change until `stop` says so.
 pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn() -> bool) -> Result<(), ClientError> {
-    use std::io::Write;
-    let mut out = std::io::stdout();
+    use crate::out::console;
     let mut last = client.inputs()?;
-    // A reader that went away (`| head`) ends the watch, as it ends any filter.
-    if write!(out, "{}", table(&last)).and_then(|()| out.flush()).is_err() {
+    // A reader that went away (`| head`) ends the watch, as it ends any filter: found by a write that fails, or,
+    // while nothing changes and nothing is written, by asking standard output each sweep. Either is kept as the
+    // command's output failure (exit 141).
+    if !console::out(&table(&last)) || !console::flush_stdout() {
         return Ok(());
     }
-    while watch && !stop() {
+    while watch && !stop() && !console::stdout_closed() {
         client.transport().elapse(Duration::from_millis(20));
         let now = client.inputs()?;
         for line in changes(&last, &now) {
-            if writeln!(out, "{line}").and_then(|()| out.flush()).is_err() {
+            if !console::out(&format!("{line}\n")) || !console::flush_stdout() {
                 return Ok(());
             }
         }
