@@ -107,12 +107,7 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
             window,
             from,
             to,
-        } => say(stream::derivatives::plot_command(
-            record,
-            out,
-            *window,
-            (from.unwrap_or(f64::NEG_INFINITY), to.unwrap_or(f64::INFINITY)),
-        ))?,
+        } => say(stream::derivatives::plot_command(record, out, *window, (*from, *to)))?,
         C::Plot { record, out, .. } => say(stream::record::plot_command(record, out))?,
         C::Draw(args) => say(analysis::draw::run(&args.options()))?,
         C::Gram { z, step, out, table } => say(analysis::gram::run(&analysis::gram::Options {

@@ -1135,6 +1135,62 @@ fn device_inputs_watch_ends_when_its_reader_goes_away_while_nothing_changes() {
     assert!(said.contains("standard output: Broken pipe"), "{said}");
 }
 
+/// Numbers a user gave come back in messages at a bounded width: 1e-300 as `1e-300`, never as 300 digits.
+#[test]
+fn messages_show_tiny_and_huge_numbers_at_a_bounded_width() {
+    let picture = std::env::temp_dir().join(format!("ringpod-width-{}.png", std::process::id()));
+    let picture = picture.to_str().unwrap();
+    let cases: [(&[&str], &str); 5] = [
+        (&["gram", "--step", "1e-300", "--out", picture], "--step 1e-300: "),
+        (&["device", "jog", "1", "1e-300", "--sim"], "1e-300 deg is 0 steps"),
+        (&["device", "jog", "1", "1e300", "--sim"], "1e300 deg is out of range"),
+        (&["loads", "--mass", "1e-300"], "holding 1e-300 kg"),
+        (
+            &[
+                "stream",
+                "--sim",
+                "--fast",
+                "--motion",
+                "sine",
+                "--axis",
+                "z",
+                "--frequency",
+                "1e-308",
+                "--amplitude",
+                "0.01",
+                "--duration",
+                "0.05",
+            ],
+            "sine on z at 1e-308 Hz",
+        ),
+    ];
+    for (args, want) in cases {
+        let out = ringpod().args(args).output().unwrap();
+        let said = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        assert!(said.contains(want), "{args:?}: {said}");
+        assert!(said.lines().all(|l| l.len() < 250), "{args:?}: {said}");
+    }
+}
+
+/// A jog of nothing (0, or a distance under one motor step) is refused as such, naming one step's distance, not
+/// called further than a jog goes: a jog checks a motor's direction and scale, and a move of no step checks neither.
+#[test]
+fn a_jog_of_no_step_says_so() {
+    for distance in ["0", "-0", "0.00001"] {
+        let out = ringpod()
+            .args(["device", "jog", "1", distance, "--sim"])
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{said}");
+        assert!(
+            said.contains("deg is 0 steps: a jog moves at least one step ("),
+            "{said}"
+        );
+        assert!(!said.contains("further"), "{said}");
+    }
+}
+
 /// `rates`: the velocity problem against finite differences of IK (actuator rates for pose rates) and of FK (pose
 /// rates for actuator rates), on the trainer model, the rotopod and chapter 5's trainer; the angular velocity of
 /// a pure yaw rate is that rate about z.
@@ -1467,6 +1523,42 @@ fn plot_derivatives_reads_velocity_and_acceleration_from_a_record() {
     for (from, to) in [("2", "1"), ("10", "20"), ("nan", "1")] {
         assert_eq!(stretch(from, to).status.code(), Some(1), "{from} {to}");
     }
+}
+
+/// `plot --derivatives` of a record too short for a derivative says so of the record when no span was asked
+/// (no `--from`/`--to` it was not given), and names only the span's ends that were given when one was.
+#[test]
+fn plot_derivatives_names_only_the_options_given() {
+    let dir = std::env::temp_dir().join(format!("ringpod-short-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let record = dir.join("one.csv");
+    let header = "host_s,device_s,cmd_x,cmd_y,cmd_z,cmd_alpha,cmd_beta,cmd_gamma,x,y,z,alpha,beta,gamma,steps_1,\
+                  steps_2,steps_3,steps_4,steps_5,steps_6,state,limited,refused,held,applied,limited_total,\
+                  refused_total,tick_cost,aux1,aux2";
+    let row = "0.066,0.010,0,0,0.227,0,0,0,0,0,0.227,0,0,0,0,0,0,0,0,0,LogicOn,0,0,0,0,0,0,821,0,0";
+    std::fs::write(&record, format!("{header}\n{row}\n")).unwrap();
+    let plot = |span: &[&str]| {
+        let out = ringpod()
+            .arg("plot")
+            .arg(&record)
+            .args(["--derivatives", "--out"])
+            .arg(dir.join("d.svg"))
+            .args(span)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let said = plot(&[]);
+    assert!(
+        said.contains("one.csv: 1 sample: a derivative needs at least 2"),
+        "{said}"
+    );
+    assert!(!said.contains("--from") && !said.contains("--to"), "{said}");
+    let said = plot(&["--from", "3"]);
+    assert!(said.contains("--from 3: 0 of the record's samples"), "{said}");
+    assert!(!said.contains("--to"), "{said}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `stream --motion sine`: chapter 5.2's 18.8 Hz at 0.008 m/s and 25 Hz at 0.001 m/s run as asked (inside the
