@@ -22,7 +22,7 @@ fn main() -> ExitCode {
     let code = match run(&cli::Cli::parse().command) {
         Ok(code) => code,
         Err(e) => {
-            out::console::err(&format!("ringpod: {e:#}"));
+            out::console::err(&format!("ringpod: {}", error::in_one_line(&e)));
             out::EXIT_ERROR
         }
     };
