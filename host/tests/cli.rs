@@ -1191,6 +1191,94 @@ fn a_jog_of_no_step_says_so() {
     }
 }
 
+/// An option that only one kind of source reads is refused with the others, by clap (exit 2, naming both), rather
+/// than accepted and doing nothing: a file has no --duration, --rate, sine or telemetry options, a built-in motion
+/// no --degrees, --udp-idle or --mass check from a live source; the simulator's options are not the board's.
+#[test]
+fn options_that_would_do_nothing_are_refused_naming_both() {
+    let file = std::env::temp_dir().join(format!("ringpod-unused-{}.csv", std::process::id()));
+    std::fs::write(&file, "t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n").unwrap();
+    let file = file.to_str().unwrap();
+    fn stream<'a>(source: &[&'a str], option: &[&'a str]) -> Vec<&'a str> {
+        let mut args = vec!["stream", "--sim", "--fast", "--quiet"];
+        args.extend(source);
+        args.extend(option);
+        args
+    }
+    let input = ["--input", file];
+    let motion = ["--motion", "heave"];
+    let udp = ["--udp", "127.0.0.1:0"];
+    let telemetry = ["--telemetry-udp", "127.0.0.1:0"];
+    let cases: Vec<(Vec<&str>, [&str; 2])> = vec![
+        (stream(&input, &["--duration", "5"]), ["--input", "--duration"]),
+        (stream(&input, &["--rate", "10"]), ["--input", "--rate"]),
+        (stream(&input, &["--profile", "wet"]), ["--input", "--profile"]),
+        (stream(&input, &["--axis", "z"]), ["--input", "--axis"]),
+        (stream(&input, &["--frequency", "1"]), ["--input", "--frequency"]),
+        (stream(&input, &["--amplitude", "0.01"]), ["--input", "--amplitude"]),
+        (
+            stream(&input, &["--velocity-amplitude", "0.01"]),
+            ["--input", "--velocity-amplitude"],
+        ),
+        (stream(&input, &["--udp-idle", "3"]), ["--input", "--udp-idle"]),
+        (
+            stream(&input, &["--telemetry-format", "beamng"]),
+            ["--input", "--telemetry-format"],
+        ),
+        (stream(&motion, &["--degrees"]), ["--motion", "--degrees"]),
+        (
+            stream(&motion, &["--outsim-opts", "1ff"]),
+            ["--motion", "--outsim-opts"],
+        ),
+        (stream(&motion, &["--udp-idle", "3"]), ["--motion", "--udp-idle"]),
+        (stream(&udp, &["--duration", "5"]), ["--udp", "--duration"]),
+        (
+            stream(&udp, &["--telemetry-format", "beamng"]),
+            ["--udp", "--telemetry-format"],
+        ),
+        (stream(&udp, &["--mass", "5"]), ["--udp", "--mass"]),
+        (stream(&telemetry, &["--degrees"]), ["--telemetry-udp", "--degrees"]),
+        (stream(&telemetry, &["--rate", "10"]), ["--telemetry-udp", "--rate"]),
+        (
+            vec!["stream", "--port", "/dev/null", "--fast", "--motion", "heave"],
+            ["--port", "--fast"],
+        ),
+        (
+            vec![
+                "stream",
+                "--port",
+                "/dev/null",
+                "--mechanism",
+                "trainer-model",
+                "--motion",
+                "heave",
+            ],
+            ["--port", "--mechanism"],
+        ),
+        (
+            vec![
+                "loads",
+                "--mass",
+                "5",
+                "--pose",
+                "0,0,0.227,0,0,0",
+                "--inertia",
+                "1,1,1",
+            ],
+            ["--pose", "--inertia"],
+        ),
+    ];
+    for (args, [a, b]) in cases {
+        let out = ringpod().args(&args).output().unwrap();
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {said}");
+        assert!(
+            said.contains("cannot be used with") && said.contains(&format!("'{a}")) && said.contains(&format!("'{b}")),
+            "{args:?}: {said}"
+        );
+    }
+}
+
 /// `rates`: the velocity problem against finite differences of IK (actuator rates for pose rates) and of FK (pose
 /// rates for actuator rates), on the trainer model, the rotopod and chapter 5's trainer; the angular velocity of
 /// a pure yaw rate is that rate about z.
