@@ -6,19 +6,23 @@ use ringpod_core::cueing::schema::{Param, Values, CHANNELS, PARAMS};
 use serde_json::{json, Value};
 
 /// One control per value, in the order the panel shows them: channel by channel ([`CHANNELS`]), within a channel
-/// in the order of the parameters.
+/// axis by axis (tilt coordination's x, then its y), then in the order of the parameters.
 pub fn fields() -> Value {
-    let mut all: Vec<(usize, Value)> = PARAMS.iter().flat_map(controls).collect();
-    all.sort_by_key(|(channel, _)| *channel);
+    let mut all: Vec<((usize, usize), Value)> = PARAMS.iter().flat_map(controls).collect();
+    all.sort_by_key(|(place, _)| *place);
     Value::Array(all.into_iter().map(|(_, field)| field).collect())
 }
 
-/// A parameter's controls: one per axis of a per-axis key, one for a single value; each with its channel's place.
-fn controls(p: &Param) -> Vec<(usize, Value)> {
+/// A parameter's controls: one per axis of a per-axis key, one for a single value; each with its place (its
+/// channel's, its axis's).
+fn controls(p: &Param) -> Vec<((usize, usize), Value)> {
     let at = |channel: &str| CHANNELS.iter().position(|c| *c == channel).unwrap_or(CHANNELS.len());
     if p.axes.is_empty() {
         let channel = p.channels.first().copied().unwrap_or("");
-        return vec![(at(channel), field(p, path(p.key, None), channel, p.name.to_owned()))];
+        return vec![(
+            (at(channel), 0),
+            field(p, path(p.key, None), channel, p.name.to_owned()),
+        )];
     }
     p.axes
         .iter()
@@ -31,7 +35,7 @@ fn controls(p: &Param) -> Vec<(usize, Value)> {
             } else {
                 format!("{axis}: {}", p.name)
             };
-            (at(channel), field(p, path(p.key, Some(i)), channel, label))
+            ((at(channel), i), field(p, path(p.key, Some(i)), channel, label))
         })
         .collect()
 }
