@@ -238,10 +238,7 @@ mod tests {
             (surge_limit["channel"].as_str(), surge_limit["unit"].as_str()),
             (Some("surge"), Some("m/s²"))
         );
-        assert_eq!(
-            find(json!(["tilt_limit_deg", 1]))["label"],
-            "y force (roll): tilt limit"
-        );
+        assert_eq!(find(json!(["tilt_limit_deg", 1]))["label"], "y (roll): tilt limit");
         assert_eq!(find(json!(["yaw"]))["choices"], json!(["heading", "washout"]));
         assert_eq!(find(json!(["smoothing", "order"]))["only_with"]["initial"], json!(2));
     }

@@ -57,7 +57,7 @@ const TRANSLATION: &[&str] = &TRANSLATION_AXES;
 /// Tilt coordination's two axes: the longitudinal force cued by pitch, the lateral force by roll.
 const TILT: &[&str] = &["tilt coordination", "tilt coordination"];
 /// Its axes as a label says them.
-const TILT_LABELS: &[&str] = &["x force (pitch)", "y force (roll)"];
+const TILT_LABELS: &[&str] = &["x (pitch)", "y (roll)"];
 /// The rotational channels, in the order of the per-axis keys.
 const ROTATION: &[&str] = &ROTATION_AXES;
 

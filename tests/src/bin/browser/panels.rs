@@ -107,7 +107,8 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
     )
     .await?;
     Ok(format!(
-        "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; -5 refused: {refused}"
+        "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; controls by channel with units, selects, the median's \
+         window shown with it: {layout}; -5 refused: {refused}"
     ))
 }
 
