@@ -1140,7 +1140,27 @@ fn device_inputs_watch_ends_when_its_reader_goes_away_while_nothing_changes() {
 fn messages_show_tiny_and_huge_numbers_at_a_bounded_width() {
     let picture = std::env::temp_dir().join(format!("ringpod-width-{}.png", std::process::id()));
     let picture = picture.to_str().unwrap();
-    let cases: [(&[&str], &str); 5] = [
+    let rig = std::env::temp_dir().join(format!("ringpod-width-{}.toml", std::process::id()));
+    let exported = ringpod()
+        .args(["presets", "--export", "trainer-model"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(exported.stdout).unwrap();
+    let tiny = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("ring_radius =") {
+                "ring_radius = 1e-300"
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&rig, tiny).unwrap();
+    let rig = rig.to_str().unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (&["rig", "check", rig], "ring radius 1e-300 m"),
         (&["gram", "--step", "1e-300", "--out", picture], "--step 1e-300: "),
         (&["device", "jog", "1", "1e-300", "--sim"], "1e-300 deg is 0 steps"),
         (&["device", "jog", "1", "1e300", "--sim"], "1e300 deg is out of range"),
