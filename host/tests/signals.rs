@@ -80,3 +80,33 @@ fn the_computing_commands_end_on_sigint_even_started_with_it_ignored() {
     assert!(!dir.join("workspace.svg").exists() && !dir.join("gram.png").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `device home` waits for the homing's end (seconds in real time); started with SIGINT ignored, SIGINT still ends
+/// the wait with exit 130 (the controller goes on homing, as it does when the default action ends the command).
+#[test]
+fn a_device_command_that_waits_ends_on_sigint_even_started_with_it_ignored() {
+    use std::io::BufRead;
+    let mut simulator = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["simulate", "--pty"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut path = String::new();
+    std::io::BufReader::new(simulator.stdout.take().unwrap())
+        .read_line(&mut path)
+        .unwrap();
+    let path = path.trim().to_owned();
+    let enable = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["device", "enable", "--port", &path])
+        .output()
+        .unwrap();
+    assert!(enable.status.success(), "{}", String::from_utf8_lossy(&enable.stderr));
+    // Past the supplies' settling, so that the homing starts and the command waits for its end.
+    std::thread::sleep(Duration::from_millis(800));
+    let (code, said) = interrupted(&["device", "home", "--port", &path], &std::env::temp_dir());
+    let _ = simulator.kill();
+    let _ = simulator.wait();
+    assert_eq!(code, Some(130), "{said}");
+    assert!(said.contains("interrupted by Ctrl-C (SIGINT)"), "{said}");
+}
