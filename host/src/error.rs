@@ -93,8 +93,35 @@ impl From<ringpod_core::kinematics::TipOverError> for CliError {
     }
 }
 
+/// An error and its causes in one line, each said once: a message that already holds its cause's words (`transport:
+/// {0}` over the I/O error it wraps, which is also its `source()`) is not followed by them again, as anyhow's `{:#}`
+/// would ("transport: the peer closed the connection: the peer closed the connection").
+pub fn in_one_line(error: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in error.chain() {
+        let words = cause.to_string();
+        if words.is_empty() || line.contains(&words) {
+            continue;
+        }
+        if !line.is_empty() {
+            line += ": ";
+        }
+        line += &words;
+    }
+    line
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_cause_is_said_once() {
+        let peer = std::io::Error::new(std::io::ErrorKind::UnexpectedEof, "the peer closed the connection");
+        let twice = anyhow::Error::from(crate::link::client::ClientError::Io(peer));
+        assert_eq!(super::in_one_line(&twice), "transport: the peer closed the connection");
+        let chained = anyhow::Error::from(std::io::Error::other("no space")).context("writing x.csv");
+        assert_eq!(super::in_one_line(&chained), "writing x.csv: no space");
+    }
+
     /// The errors that say their cause in their own words give no `source()`: `main` prints an error with its
     /// chain (`{:#}`), and a cause given both ways was printed twice (`/dev/x: No such file: No such file`).
     #[test]

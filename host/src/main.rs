@@ -22,7 +22,7 @@ fn main() -> ExitCode {
     let code = match run(&cli::Cli::parse().command) {
         Ok(code) => code,
         Err(e) => {
-            out::console::err(&format!("ringpod: {e:#}"));
+            out::console::err(&format!("ringpod: {}", error::in_one_line(&e)));
             out::EXIT_ERROR
         }
     };
@@ -40,6 +40,9 @@ fn main() -> ExitCode {
 /// Runs one command: each module's typed error becomes anyhow here, at the top, and nowhere else.
 fn run(command: &cli::Command) -> anyhow::Result<u8> {
     use cli::Command as C;
+    if !command.watches_signals() {
+        signals::end_on_signal()?;
+    }
     Ok(match command {
         C::Presets { json, export } => answer(match export {
             Some(name) => rig::export(name).map_err(error::CliError::from),
@@ -104,12 +107,7 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
             window,
             from,
             to,
-        } => say(stream::derivatives::plot_command(
-            record,
-            out,
-            *window,
-            (from.unwrap_or(f64::NEG_INFINITY), to.unwrap_or(f64::INFINITY)),
-        ))?,
+        } => say(stream::derivatives::plot_command(record, out, *window, (*from, *to)))?,
         C::Plot { record, out, .. } => say(stream::record::plot_command(record, out))?,
         C::Draw(args) => say(analysis::draw::run(&args.options()))?,
         C::Gram { z, step, out, table } => say(analysis::gram::run(&analysis::gram::Options {

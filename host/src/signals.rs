@@ -66,6 +66,23 @@ impl Signals {
     }
 }
 
+/// For the commands that only compute (a workspace scan, a rig design, a drawing): they have no platform to stop
+/// and no loop that polls a flag, so a stopping signal ends the process from a watching thread, after a line that
+/// names it, with 128 + the signal's number. Installed explicitly for the same reason as [`Signals::install`]: a
+/// script's background job inherits SIGINT ignored, and `kill -INT` must still end it. Files these commands write
+/// are renamed into place only when complete, so an end half-way leaves none under the target's name.
+pub fn end_on_signal() -> std::io::Result<()> {
+    let signals = Signals::install()?;
+    std::thread::Builder::new().name("signals".into()).spawn(move || loop {
+        if signals.received() {
+            crate::out::console::err(&format!("ringpod: interrupted by {}", signals.name()));
+            std::process::exit(i32::from(signals.exit_code()));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    })?;
+    Ok(())
+}
+
 #[cfg(unix)]
 mod platform {
     use std::sync::atomic::{AtomicBool, AtomicUsize};

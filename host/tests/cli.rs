@@ -1100,6 +1100,205 @@ fn device_inputs_lists_every_input() {
         .stderr(predicate::str::contains("--watch is for `device inputs`"));
 }
 
+/// `device inputs --watch | head -1`: the reader goes away while no input changes and nothing is printed; the
+/// watch notices the closed pipe anyway and ends within a second or two with the closed output's exit (141).
+#[test]
+#[cfg(unix)]
+fn device_inputs_watch_ends_when_its_reader_goes_away_while_nothing_changes() {
+    use std::io::BufRead;
+    let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["device", "inputs", "--watch", "--sim"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stdout = std::io::BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    stdout.read_line(&mut line).unwrap();
+    assert!(!line.is_empty(), "the table's first line");
+    drop(stdout);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(5);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("the watch still runs 5 s after its reader went away");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut said = String::new();
+    let _ = std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut said);
+    assert_eq!(status.code(), Some(141), "{said}");
+    assert!(said.contains("standard output: Broken pipe"), "{said}");
+}
+
+/// Numbers a user gave come back in messages at a bounded width: 1e-300 as `1e-300`, never as 300 digits.
+#[test]
+fn messages_show_tiny_and_huge_numbers_at_a_bounded_width() {
+    let picture = std::env::temp_dir().join(format!("ringpod-width-{}.png", std::process::id()));
+    let picture = picture.to_str().unwrap();
+    let rig = std::env::temp_dir().join(format!("ringpod-width-{}.toml", std::process::id()));
+    let exported = ringpod()
+        .args(["presets", "--export", "trainer-model"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(exported.stdout).unwrap();
+    let tiny = text
+        .lines()
+        .map(|l| {
+            if l.starts_with("ring_radius =") {
+                "ring_radius = 1e-300"
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(&rig, tiny).unwrap();
+    let rig = rig.to_str().unwrap();
+    let cases: [(&[&str], &str); 6] = [
+        (&["rig", "check", rig], "ring radius 1e-300 m"),
+        (&["gram", "--step", "1e-300", "--out", picture], "--step 1e-300: "),
+        (&["device", "jog", "1", "1e-300", "--sim"], "1e-300 deg is 0 steps"),
+        (&["device", "jog", "1", "1e300", "--sim"], "1e300 deg is out of range"),
+        (&["loads", "--mass", "1e-300"], "holding 1e-300 kg"),
+        (
+            &[
+                "stream",
+                "--sim",
+                "--fast",
+                "--motion",
+                "sine",
+                "--axis",
+                "z",
+                "--frequency",
+                "1e-308",
+                "--amplitude",
+                "0.01",
+                "--duration",
+                "0.05",
+            ],
+            "sine on z at 1e-308 Hz",
+        ),
+    ];
+    for (args, want) in cases {
+        let out = ringpod().args(args).output().unwrap();
+        let said = String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+        assert!(said.contains(want), "{args:?}: {said}");
+        assert!(said.lines().all(|l| l.len() < 250), "{args:?}: {said}");
+    }
+}
+
+/// A jog of nothing (0, or a distance under one motor step) is refused as such, naming one step's distance, not
+/// called further than a jog goes: a jog checks a motor's direction and scale, and a move of no step checks neither.
+#[test]
+fn a_jog_of_no_step_says_so() {
+    for distance in ["0", "-0", "0.00001"] {
+        let out = ringpod()
+            .args(["device", "jog", "1", distance, "--sim"])
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{said}");
+        assert!(
+            said.contains("deg is 0 steps: a jog moves at least one step ("),
+            "{said}"
+        );
+        assert!(!said.contains("further"), "{said}");
+    }
+}
+
+/// An option that only one kind of source reads is refused with the others, by clap (exit 2, naming both), rather
+/// than accepted and doing nothing: a file has no --duration, --rate, sine or telemetry options, a built-in motion
+/// no --degrees, --udp-idle or --mass check from a live source; the simulator's options are not the board's.
+#[test]
+fn options_that_would_do_nothing_are_refused_naming_both() {
+    let file = std::env::temp_dir().join(format!("ringpod-unused-{}.csv", std::process::id()));
+    std::fs::write(&file, "t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n").unwrap();
+    let file = file.to_str().unwrap();
+    fn stream<'a>(source: &[&'a str], option: &[&'a str]) -> Vec<&'a str> {
+        let mut args = vec!["stream", "--sim", "--fast", "--quiet"];
+        args.extend(source);
+        args.extend(option);
+        args
+    }
+    let input = ["--input", file];
+    let motion = ["--motion", "heave"];
+    let udp = ["--udp", "127.0.0.1:0"];
+    let telemetry = ["--telemetry-udp", "127.0.0.1:0"];
+    let cases: Vec<(Vec<&str>, [&str; 2])> = vec![
+        (stream(&input, &["--duration", "5"]), ["--input", "--duration"]),
+        (stream(&input, &["--rate", "10"]), ["--input", "--rate"]),
+        (stream(&input, &["--profile", "wet"]), ["--input", "--profile"]),
+        (stream(&input, &["--axis", "z"]), ["--input", "--axis"]),
+        (stream(&input, &["--frequency", "1"]), ["--input", "--frequency"]),
+        (stream(&input, &["--amplitude", "0.01"]), ["--input", "--amplitude"]),
+        (
+            stream(&input, &["--velocity-amplitude", "0.01"]),
+            ["--input", "--velocity-amplitude"],
+        ),
+        (stream(&input, &["--udp-idle", "3"]), ["--input", "--udp-idle"]),
+        (
+            stream(&input, &["--telemetry-format", "beamng"]),
+            ["--input", "--telemetry-format"],
+        ),
+        (stream(&motion, &["--degrees"]), ["--motion", "--degrees"]),
+        (
+            stream(&motion, &["--outsim-opts", "1ff"]),
+            ["--motion", "--outsim-opts"],
+        ),
+        (stream(&motion, &["--udp-idle", "3"]), ["--motion", "--udp-idle"]),
+        (stream(&udp, &["--duration", "5"]), ["--udp", "--duration"]),
+        (
+            stream(&udp, &["--telemetry-format", "beamng"]),
+            ["--udp", "--telemetry-format"],
+        ),
+        (stream(&udp, &["--mass", "5"]), ["--udp", "--mass"]),
+        (stream(&telemetry, &["--degrees"]), ["--telemetry-udp", "--degrees"]),
+        (stream(&telemetry, &["--rate", "10"]), ["--telemetry-udp", "--rate"]),
+        (
+            vec!["stream", "--port", "/dev/null", "--fast", "--motion", "heave"],
+            ["--port", "--fast"],
+        ),
+        (
+            vec![
+                "stream",
+                "--port",
+                "/dev/null",
+                "--mechanism",
+                "trainer-model",
+                "--motion",
+                "heave",
+            ],
+            ["--port", "--mechanism"],
+        ),
+        (
+            vec![
+                "loads",
+                "--mass",
+                "5",
+                "--pose",
+                "0,0,0.227,0,0,0",
+                "--inertia",
+                "1,1,1",
+            ],
+            ["--pose", "--inertia"],
+        ),
+    ];
+    for (args, [a, b]) in cases {
+        let out = ringpod().args(&args).output().unwrap();
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {said}");
+        assert!(
+            said.contains("cannot be used with") && said.contains(&format!("'{a}")) && said.contains(&format!("'{b}")),
+            "{args:?}: {said}"
+        );
+    }
+}
+
 /// `rates`: the velocity problem against finite differences of IK (actuator rates for pose rates) and of FK (pose
 /// rates for actuator rates), on the trainer model, the rotopod and chapter 5's trainer; the angular velocity of
 /// a pure yaw rate is that rate about z.
@@ -1432,6 +1631,42 @@ fn plot_derivatives_reads_velocity_and_acceleration_from_a_record() {
     for (from, to) in [("2", "1"), ("10", "20"), ("nan", "1")] {
         assert_eq!(stretch(from, to).status.code(), Some(1), "{from} {to}");
     }
+}
+
+/// `plot --derivatives` of a record too short for a derivative says so of the record when no span was asked
+/// (no `--from`/`--to` it was not given), and names only the span's ends that were given when one was.
+#[test]
+fn plot_derivatives_names_only_the_options_given() {
+    let dir = std::env::temp_dir().join(format!("ringpod-short-record-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let record = dir.join("one.csv");
+    let header = "host_s,device_s,cmd_x,cmd_y,cmd_z,cmd_alpha,cmd_beta,cmd_gamma,x,y,z,alpha,beta,gamma,steps_1,\
+                  steps_2,steps_3,steps_4,steps_5,steps_6,state,limited,refused,held,applied,limited_total,\
+                  refused_total,tick_cost,aux1,aux2";
+    let row = "0.066,0.010,0,0,0.227,0,0,0,0,0,0.227,0,0,0,0,0,0,0,0,0,LogicOn,0,0,0,0,0,0,821,0,0";
+    std::fs::write(&record, format!("{header}\n{row}\n")).unwrap();
+    let plot = |span: &[&str]| {
+        let out = ringpod()
+            .arg("plot")
+            .arg(&record)
+            .args(["--derivatives", "--out"])
+            .arg(dir.join("d.svg"))
+            .args(span)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1));
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let said = plot(&[]);
+    assert!(
+        said.contains("one.csv: 1 sample: a derivative needs at least 2"),
+        "{said}"
+    );
+    assert!(!said.contains("--from") && !said.contains("--to"), "{said}");
+    let said = plot(&["--from", "3"]);
+    assert!(said.contains("--from 3: 0 of the record's samples"), "{said}");
+    assert!(!said.contains("--to"), "{said}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `stream --motion sine`: chapter 5.2's 18.8 Hz at 0.008 m/s and 25 Hz at 0.001 m/s run as asked (inside the

@@ -98,6 +98,25 @@ fn nobody_at_the_address_fails_at_once_naming_it() {
     assert!(started.elapsed() < Duration::from_secs(10));
 }
 
+/// A peer that hangs up at once: the error names the cause once ("transport: the peer closed the connection"),
+/// not a second time as the cause of itself.
+#[test]
+fn a_peer_that_hangs_up_is_said_once() {
+    let listener = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let address = format!("tcp://{}", listener.local_addr().unwrap());
+    let hang_up = std::thread::spawn(move || drop(listener.accept().unwrap()));
+    let out = ringpod(&["device", "status", "--port", &address]);
+    hang_up.join().unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    let line = said.lines().next().unwrap_or_default();
+    let mut parts: Vec<&str> = line.split(": ").skip(1).collect();
+    let all = parts.len();
+    parts.sort_unstable();
+    parts.dedup();
+    assert_eq!(parts.len(), all, "a part said twice: {said}");
+}
+
 #[cfg(not(unix))]
 #[test]
 fn a_pseudo_terminal_is_refused_by_name_off_unix() {

@@ -398,7 +398,7 @@ pub fn run(job: &Job, json: bool) -> Result<Outcome, CliError> {
             t,
             "{} moving {} kg (inertia {:?} kg m^2) along {} ({} rows): peak demand per axis",
             job.name,
-            job.mass,
+            crate::input::numbers::readable(job.mass),
             job.inertia,
             job.input.display(),
             p.rows
@@ -469,7 +469,7 @@ fn draw(job: &Job, p: &Profile, units: [&str; 6], out: &Path) -> Result<(), plot
         title: format!(
             "{}: drive demand for {} kg along {}",
             job.name,
-            job.mass,
+            crate::input::numbers::readable(job.mass),
             job.input
                 .file_name()
                 .map_or(String::new(), |f| f.to_string_lossy().into_owned())

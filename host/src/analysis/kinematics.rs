@@ -405,7 +405,11 @@ pub fn loads(args: &LoadsOptions) -> Result<Outcome, CliError> {
         serde_json::to_string_pretty(&out)? + "\n"
     } else {
         let mut t = String::new();
-        let _ = writeln!(t, "{name} holding {} kg at its centre of mass:", args.mass);
+        let _ = writeln!(
+            t,
+            "{name} holding {} kg at its centre of mass:",
+            crate::input::numbers::readable(args.mass)
+        );
         for i in 0..6 {
             let _ = writeln!(t, "  {:<4} {:>12.4} {}", names[i], l.drives[i], units[i]);
         }

@@ -55,10 +55,10 @@ pub struct LoadsArgs {
     #[arg(long, conflicts_with = "pose")]
     pub input: Option<std::path::PathBuf>,
     /// Payload inertia about its centre of mass, platform frame: Ixx,Iyy,Izz (kg m^2). Default: none (a point mass).
-    #[arg(long, allow_hyphen_values = true, requires = "input")]
+    #[arg(long, allow_hyphen_values = true, requires = "input", conflicts_with = "pose")]
     pub inertia: Option<String>,
     /// With --input: draw each axis's demand against what its drive gives at that speed (.svg or .png).
-    #[arg(long, requires = "input", value_name = "FILE")]
+    #[arg(long, requires = "input", conflicts_with = "pose", value_name = "FILE")]
     pub plot: Option<std::path::PathBuf>,
 }
 

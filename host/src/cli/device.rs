@@ -94,10 +94,10 @@ pub struct ControllerArgs {
     pub sim: bool,
     /// With --sim: simulate this rig file's platform (with the trainer model's drives and switches) instead of the
     /// trainer model.
-    #[arg(long, value_name = "RIG.toml", requires = "sim")]
+    #[arg(long, value_name = "RIG.toml", requires = "sim", conflicts_with = "port")]
     pub geometry: Option<std::path::PathBuf>,
     /// With --sim: simulate this preset's ring platform (`ringpod presets`) with the trainer model's drives and
     /// switches, as --geometry does with its exported rig file.
-    #[arg(long, value_name = "PRESET", requires = "sim", conflicts_with = "geometry")]
+    #[arg(long, value_name = "PRESET", requires = "sim", conflicts_with_all = ["geometry", "port"])]
     pub mechanism: Option<String>,
 }

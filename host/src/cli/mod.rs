@@ -160,3 +160,18 @@ pub enum Command {
         mechanism: Option<String>,
     },
 }
+
+impl Command {
+    /// Whether the command watches the stopping signals itself (it stops the platform or its server first, then
+    /// reports): the others, which compute or ask the device and wait for its answer (`device home` waits for the
+    /// homing's end), are ended by `signals::end_on_signal`, as the default action would end them.
+    pub fn watches_signals(&self) -> bool {
+        match self {
+            Self::Device(args) => args.action == DeviceAction::Inputs && args.watch,
+            _ => matches!(
+                self,
+                Self::Stream(_) | Self::Ui(_) | Self::Simulate { .. } | Self::Monitor { .. }
+            ),
+        }
+    }
+}

@@ -4,8 +4,20 @@ use clap::Args;
 
 use super::ControllerArgs;
 
+/// The sources other than a built-in motion (`--duration`, `--rate` and the sine's options are the motion's).
+const NOT_MOTION: [&str; 3] = ["input", "udp", "telemetry_udp"];
+/// The sources other than vehicle telemetry (its format, its Live for Speed options, its cueing file and profile).
+const NOT_TELEMETRY: [&str; 3] = ["input", "motion", "udp"];
+/// The sources that are not live datagrams (`--udp-from`, `--udp-idle`, `--capture` are theirs).
+const NOT_LIVE: [&str; 2] = ["input", "motion"];
+
 /// The source is required: no default motion, so that a script whose arguments came out empty, or a command typed
 /// without one, never moves a platform.
+///
+/// An option that only one kind of source reads names the others it conflicts with, so that clap refuses it with
+/// them (exit 2, naming both) rather than it doing nothing. `requires` alone is not enough there: clap counts a
+/// requirement as met when the required option conflicts with one given (`--profile` requires `--cue-config`,
+/// which conflicts with `--input`, so `--input F --profile P` passed), hence the explicit conflicts beside it.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("source").required(true).args(["input", "motion", "udp", "telemetry_udp"])))]
 pub struct StreamArgs {
@@ -13,25 +25,25 @@ pub struct StreamArgs {
     #[command(flatten)]
     pub controller: ControllerArgs,
     /// With --sim: run as fast as possible instead of in real time.
-    #[arg(long, requires = "sim")]
+    #[arg(long, requires = "sim", conflicts_with = "port")]
     pub fast: bool,
     /// A built-in motion (one source is required: --input, --motion, --udp or --telemetry-udp).
     #[arg(long, value_enum, conflicts_with = "input")]
     pub motion: Option<crate::stream::Motion>,
     /// Length of a built-in motion (s).
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = 20.0, conflicts_with_all = NOT_MOTION)]
     pub duration: f64,
     /// With --motion sine: the pose axis.
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, conflicts_with_all = NOT_MOTION)]
     pub axis: Option<crate::stream::Axis>,
     /// With --motion sine: the frequency (Hz).
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = NOT_MOTION)]
     pub frequency: Option<f64>,
     /// With --motion sine: the velocity amplitude (m/s; rad/s for roll, pitch and yaw).
-    #[arg(long, conflicts_with = "amplitude")]
+    #[arg(long, conflicts_with = "amplitude", conflicts_with_all = NOT_MOTION)]
     pub velocity_amplitude: Option<f64>,
     /// With --motion sine: the position amplitude (m; rad for roll, pitch and yaw).
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = NOT_MOTION)]
     pub amplitude: Option<f64>,
     /// CSV file with header t,x,y,z,alpha,beta,gamma (s, m, rad unless --degrees).
     #[arg(long, conflicts_with = "udp")]
@@ -47,31 +59,31 @@ pub struct StreamArgs {
     /// With --telemetry-udp: `text` (`[t] ax ay az wx wy wz`, the units of `ringpod cue`), a game's own format
     /// (`outsim`, `outsim2`, `beamng`, `codemasters`, `f1`, `forza`, `xplane`: the book's games table), or `auto`
     /// (the first datagram a game's format recognises names it, said on stderr).
-    #[arg(long, value_enum, default_value = "text")]
+    #[arg(long, value_enum, default_value = "text", conflicts_with_all = NOT_TELEMETRY)]
     pub telemetry_format: crate::games::TelemetryFormat,
     /// With --telemetry-udp: Live for Speed's `OutSim Opts` (hexadecimal, as in its cfg.txt), which an `outsim2`
     /// packet's size alone does not always tell.
-    #[arg(long, value_name = "HEX", requires = "telemetry_udp", value_parser = crate::games::outsim2::Opts::parse_hex)]
+    #[arg(long, value_name = "HEX", requires = "telemetry_udp", conflicts_with_all = NOT_TELEMETRY, value_parser = crate::games::outsim2::Opts::parse_hex)]
     pub outsim_opts: Option<crate::games::outsim2::Opts>,
     /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`). The file is watched while
     /// the stream runs: a changed, valid file takes over within a second, blended in; an invalid one is refused.
-    #[arg(long, requires = "telemetry_udp", conflicts_with_all = ["udp", "input", "motion"])]
+    #[arg(long, requires = "telemetry_udp", conflicts_with_all = NOT_TELEMETRY)]
     pub cue_config: Option<std::path::PathBuf>,
     /// With --cue-config: a profile of the cueing file (its `[profiles.NAME]` table overrides the base keys).
-    #[arg(long, requires = "cue_config")]
+    #[arg(long, requires = "cue_config", conflicts_with_all = NOT_TELEMETRY)]
     pub profile: Option<String>,
     /// With --udp or --telemetry-udp: take datagrams from this sender only (others are counted and ignored).
-    #[arg(long, conflicts_with_all = ["input", "motion"])]
+    #[arg(long, conflicts_with_all = NOT_LIVE)]
     pub udp_from: Option<std::net::IpAddr>,
     /// With --udp or --telemetry-udp: end the stream after this many seconds without a readable datagram (a source
     /// that sends only what cannot be read is as good as none).
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, conflicts_with_all = NOT_LIVE)]
     pub udp_idle: f64,
     /// Angles of --input or --udp in degrees.
-    #[arg(long)]
+    #[arg(long, conflicts_with_all = ["motion", "telemetry_udp"])]
     pub degrees: bool,
     /// Setpoints per second for built-in motions.
-    #[arg(long, default_value_t = 1000.0)]
+    #[arg(long, default_value_t = 1000.0, conflicts_with_all = NOT_MOTION)]
     pub rate: f64,
     /// Home even if the device is homed.
     #[arg(long)]
@@ -104,7 +116,7 @@ pub struct StreamArgs {
     /// With --udp or --telemetry-udp: capture every datagram that arrives on the socket (from any sender, readable
     /// or not) to a pcap file, as tcpdump writes one, with its arrival time; `ringpod cue --input FILE.pcap` cues it
     /// again, Wireshark shows it.
-    #[arg(long, value_name = "FILE.pcap", conflicts_with_all = ["input", "motion"])]
+    #[arg(long, value_name = "FILE.pcap", conflicts_with_all = NOT_LIVE)]
     pub capture: Option<std::path::PathBuf>,
     /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics) on the platform
     /// the device runs, against its drives (the --geometry file's `[[drives]]`, or the preset's motor data) for a
@@ -112,9 +124,9 @@ pub struct StreamArgs {
     #[arg(long, requires = "mass", conflicts_with_all = ["udp", "telemetry_udp"])]
     pub check_loads: bool,
     /// With --check-loads: the moving mass (kg) at the platform's centre of mass.
-    #[arg(long, requires = "check_loads")]
+    #[arg(long, requires = "check_loads", conflicts_with_all = ["udp", "telemetry_udp"])]
     pub mass: Option<f64>,
     /// With --check-loads: its inertia Ixx,Iyy,Izz (kg m^2) about the centre of mass.
-    #[arg(long, allow_hyphen_values = true, requires = "check_loads")]
+    #[arg(long, allow_hyphen_values = true, requires = "check_loads", conflicts_with_all = ["udp", "telemetry_udp"])]
     pub inertia: Option<String>,
 }

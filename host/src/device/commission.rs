@@ -13,6 +13,7 @@ use ringpod_core::protocol::endpoints::{Buzz, Jog};
 use ringpod_core::protocol::{NackReason, Settings, SettingsKind};
 use ringpod_core::safety::{FaultReason, State};
 
+use crate::input::numbers::readable;
 use crate::link::client::{Client, ClientError, Transport};
 
 /// Why a commissioning move was not made or did not end well.
@@ -33,17 +34,29 @@ pub enum CommissionError {
     #[error("axis {0} does not exist (1-6)")]
     NoAxis(u16),
     /// The distance is no number of steps.
-    #[error("{distance} {unit} is out of range")]
+    #[error("{} {unit} is out of range", readable(*.distance))]
     Unrepresentable {
         /// The distance asked.
         distance: f64,
         /// Its unit.
         unit: &'static str,
     },
+    /// The distance rounds to no step at all: a jog checks a motor's direction and its steps per unit, and a
+    /// move of nothing checks neither (a "moved 0 steps" success would read as a motor that did not turn).
+    #[error("{} {unit} is 0 steps: a jog moves at least one step ({} {unit} on this axis)", readable(*.distance), readable(*.step))]
+    NoStep {
+        /// The distance asked.
+        distance: f64,
+        /// Its unit.
+        unit: &'static str,
+        /// One motor step in that unit.
+        step: f64,
+    },
     /// The device refused the jog as too far.
     #[error(
-        "{distance} {unit} ({steps} steps) is further than a jog goes: a carriage at most its homing back-off, a \
-         linear actuator or a shoulder its homing search travel"
+        "{} {unit} ({steps} steps) is further than a jog goes: a carriage at most its homing back-off, a \
+         linear actuator or a shoulder its homing search travel",
+        readable(*.distance)
     )]
     TooFar {
         /// The distance asked.
@@ -125,18 +138,19 @@ pub fn changes(before: &InputReport, now: &InputReport) -> Vec<String> {
 
 /// Prints the table, then with `watch` every change until `stop` says so.
 pub fn inputs<T: Transport>(client: &mut Client<T>, watch: bool, stop: &dyn Fn() -> bool) -> Result<(), ClientError> {
-    use std::io::Write;
-    let mut out = std::io::stdout();
+    use crate::out::console;
     let mut last = client.inputs()?;
-    // A reader that went away (`| head`) ends the watch, as it ends any filter.
-    if write!(out, "{}", table(&last)).and_then(|()| out.flush()).is_err() {
+    // A reader that went away (`| head`) ends the watch, as it ends any filter: found by a write that fails, or,
+    // while nothing changes and nothing is written, by asking standard output each sweep. Either is kept as the
+    // command's output failure (exit 141).
+    if !console::out(&table(&last)) || !console::flush_stdout() {
         return Ok(());
     }
-    while watch && !stop() {
+    while watch && !stop() && !console::stdout_closed() {
         client.transport().elapse(Duration::from_millis(20));
         let now = client.inputs()?;
         for line in changes(&last, &now) {
-            if writeln!(out, "{line}").and_then(|()| out.flush()).is_err() {
+            if !console::out(&format!("{line}\n")) || !console::flush_stdout() {
                 return Ok(());
             }
         }
@@ -213,14 +227,22 @@ pub fn begin_move<T: Transport>(
     let motor = axes[usize::from(axis)];
     let per_unit = f64::from(motor.steps_per_unit) * if motor.reverse { -1.0 } else { 1.0 };
     // Steps per carriage or shoulder turn, or per metre.
-    let (steps, unit) = match kind {
-        AxisKind::Ring | AxisKind::Angle => (d / 360.0 * per_unit, "deg"),
-        AxisKind::Linear => (d / 1000.0 * per_unit, "mm"),
+    let (per_turn_or_metre, unit) = match kind {
+        AxisKind::Ring | AxisKind::Angle => (360.0, "deg"),
+        AxisKind::Linear => (1000.0, "mm"),
     };
+    let steps = d / per_turn_or_metre * per_unit;
     if !steps.is_finite() || steps.abs() > f64::from(i32::MAX) {
         return Err(CommissionError::Unrepresentable { distance: d, unit });
     }
     let steps = steps.round() as i32;
+    if steps == 0 {
+        return Err(CommissionError::NoStep {
+            distance: d,
+            unit,
+            step: per_turn_or_metre / per_unit.abs(),
+        });
+    }
     match client.call(Jog { axis, steps }) {
         Err(ClientError::Device(NackReason::OutOfRange)) => {
             return Err(CommissionError::TooFar {
@@ -231,7 +253,7 @@ pub fn begin_move<T: Transport>(
         }
         other => other?,
     }
-    Ok(format!("jogged {d} {unit} ({steps} steps)"))
+    Ok(format!("jogged {} {unit} ({steps} steps)", readable(d)))
 }
 
 #[cfg(test)]

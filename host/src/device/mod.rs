@@ -67,7 +67,8 @@ pub fn run(target: &Target, action: &Action) -> Result<u8, DeviceError> {
         Action::Jog(words) => commission::jog(&mut client, words, false)?,
         Action::Buzz(words) => commission::jog(&mut client, words, true)?,
         Action::Inputs { watch: true } => {
-            // Watched until a signal, which is its normal end: 128 + the signal, as a shell reports it.
+            // Watched until a signal, which is its normal end: 128 + the signal, as a shell reports it. A reader
+            // that went away ends it too, and `main` exits with the output's failure (141) then.
             let signals = Signals::install()?;
             commission::inputs(&mut client, true, &|| signals.received())?;
             return Ok(signals.exit_code());

@@ -54,11 +54,16 @@ impl BadNumber {
         }
     }
 
-    /// `--what given: reason`.
-    pub fn given(what: &'static str, given: impl std::fmt::Display, reason: impl Into<String>) -> Self {
+    /// `--what given: reason`, the number as a person reads it ([`readable`]: 1e-308 as `1e-308`, not 300 digits).
+    pub fn given(what: &'static str, given: f64, reason: impl Into<String>) -> Self {
+        Self::given_text(what, readable(given), reason)
+    }
+
+    /// `--what given: reason`, with words given beside the option (not a number alone).
+    pub fn given_text(what: &'static str, given: impl Into<String>, reason: impl Into<String>) -> Self {
         Self {
             what,
-            given: Some(given.to_string()),
+            given: Some(given.into()),
             reason: reason.into(),
         }
     }
@@ -182,5 +187,20 @@ mod tests {
         for v in [f64::NAN, f64::INFINITY, 31.0, -1e300] {
             assert!(length_in_range("z", v, 0.3).is_err(), "{v}");
         }
+    }
+
+    #[test]
+    fn numbers_in_messages_have_a_bounded_width() {
+        for (v, want) in [
+            (1e-308, "1e-308"),
+            (-1e300, "-1e300"),
+            (0.25, "0.25"),
+            (0.0, "0"),
+            (1.0 / 3.0, "0.333333"),
+        ] {
+            assert_eq!(readable(v), want);
+        }
+        let e = BadNumber::given("frequency", 1e-308, "too low");
+        assert_eq!(e.to_string(), "--frequency 1e-308: too low");
     }
 }

@@ -41,6 +41,30 @@ pub fn out(text: &str) -> bool {
     }
 }
 
+/// Flushes standard output now (a watch's line seen as it happens); false (and the failure kept) when it could not
+/// be written.
+pub fn flush_stdout() -> bool {
+    match std::io::stdout().lock().flush() {
+        Ok(()) => true,
+        Err(e) => {
+            fail("standard output", &e);
+            false
+        }
+    }
+}
+
+/// Whether standard output's reader went away (a pipe whose reader closed: `| head -1`), found without writing,
+/// so that a command that prints only on a change (`device inputs --watch`) notices it while nothing changes. It
+/// is kept as the failure the next write would meet (a broken pipe), and the command exits as any closed output
+/// does. Always false where this cannot be asked (Windows: there the next write finds it).
+pub fn stdout_closed() -> bool {
+    let closed = platform::stdout_hung_up();
+    if closed {
+        fail("standard output", &platform::broken_pipe());
+    }
+    closed
+}
+
 /// Writes `line` and a newline to standard error, unbuffered; false (and the failure kept) when it could not be
 /// written.
 pub fn err(line: &str) -> bool {
@@ -80,4 +104,38 @@ pub fn on_failure(flag: Arc<AtomicBool>) {
         flag.store(true, Ordering::SeqCst);
     }
     *NOTIFY.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(flag);
+}
+
+#[cfg(unix)]
+mod platform {
+    use std::os::fd::AsFd;
+
+    use nix::poll::{poll, PollFd, PollFlags, PollTimeout};
+
+    /// Asks poll() about standard output without waiting: a pipe without a reader reports POLLERR (Linux) or
+    /// POLLHUP (the BSDs, macOS), as does a terminal that hung up; a file or a live reader reports neither.
+    pub(super) fn stdout_hung_up() -> bool {
+        let stdout = std::io::stdout();
+        let mut fds = [PollFd::new(stdout.as_fd(), PollFlags::empty())];
+        matches!(poll(&mut fds, PollTimeout::ZERO), Ok(1..))
+            && fds[0]
+                .revents()
+                .is_some_and(|r| r.intersects(PollFlags::POLLERR | PollFlags::POLLHUP))
+    }
+
+    /// The error a write to a pipe without a reader returns.
+    pub(super) fn broken_pipe() -> std::io::Error {
+        nix::errno::Errno::EPIPE.into()
+    }
+}
+
+#[cfg(not(unix))]
+mod platform {
+    pub(super) fn stdout_hung_up() -> bool {
+        false
+    }
+
+    pub(super) fn broken_pipe() -> std::io::Error {
+        std::io::ErrorKind::BrokenPipe.into()
+    }
 }

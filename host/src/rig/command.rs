@@ -172,8 +172,8 @@ fn check_text(
         t,
         "{name}: analysable: yes ({} chains, ring radius {} m, rod {} m)",
         g.chains().len(),
-        g.ring_radius,
-        g.rod_length
+        crate::input::numbers::readable(g.ring_radius),
+        crate::input::numbers::readable(g.rod_length)
     );
     let _ = match drivable {
         Ok(()) => writeln!(

@@ -146,12 +146,7 @@ fn positive(name: &'static str, v: f64, max: f64) -> Result<f64, SourceError> {
     if v.is_finite() && v > 0.0 && v <= max {
         Ok(v)
     } else {
-        Err(numbers::BadNumber::given(
-            name,
-            numbers::readable(v),
-            format!("must be a number of at most {max:e}, above 0"),
-        )
-        .into())
+        Err(numbers::BadNumber::given(name, v, format!("must be a number of at most {max:e}, above 0")).into())
     }
 }
 

@@ -15,7 +15,7 @@ use std::path::Path;
 
 use plotters::style::colors::{BLUE, GREEN, RED};
 
-use crate::input::numbers::BadNumber;
+use crate::input::numbers::{readable, BadNumber};
 
 use super::record::{self, PlotCommandError};
 use crate::out::plot::{self, Panel, Series, TimePlot};
@@ -66,21 +66,37 @@ struct Measured {
 
 const AXES: [&str; 6] = ["surge x", "sway y", "heave z", "roll alpha", "pitch beta", "yaw gamma"];
 
-/// Draws the derivatives of a record's followed pose over the device times `span` (`[from, to]`, s; the fit takes
-/// the samples around its ends too); returns the summary to print.
-pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> Result<String, PlotCommandError> {
+/// The span of device times asked (`--from`, `--to`, s): either end may be left open.
+pub type Span = (Option<f64>, Option<f64>);
+
+/// A span that cannot be used, said with the options that were given (and only those).
+fn bad_span(span: Span, reason: String) -> BadNumber {
+    match span {
+        (Some(from), Some(to)) => {
+            BadNumber::given_text("from", format!("{} --to {}", readable(from), readable(to)), reason)
+        }
+        (None, Some(to)) => BadNumber::given("to", to, reason),
+        (Some(from), None) => BadNumber::given("from", from, reason),
+        (None, None) => BadNumber::new("from/--to", reason),
+    }
+}
+
+/// Draws the derivatives of a record's followed pose over the device times `span` (the whole record when neither
+/// end is given; the fit takes the samples around its ends too); returns the summary to print.
+pub fn plot_command(input: &Path, out: &Path, window: f64, span: Span) -> Result<String, PlotCommandError> {
     if !(window.is_finite() && window > 0.0 && window <= 10.0) {
         return Err(BadNumber::new(
             "window",
-            format!("{window} s; a window is more than 0 and at most 10 s"),
+            format!("{} s; a window is more than 0 and at most 10 s", readable(window)),
         )
         .into());
     }
-    if span.0.is_nan() || span.1.is_nan() || span.0 >= span.1 {
-        return Err(BadNumber::given("from", format!("{} --to {}", span.0, span.1), "the span is empty").into());
+    let bounds = (span.0.unwrap_or(f64::NEG_INFINITY), span.1.unwrap_or(f64::INFINITY));
+    if bounds.0.is_nan() || bounds.1.is_nan() || bounds.0 >= bounds.1 {
+        return Err(bad_span(span, "the span is empty".into()).into());
     }
     let whole = record::read(input)?;
-    let measured = measure(&whole, window, span)?;
+    let measured = measure(input, &whole, window, (span, bounds))?;
     let name = input
         .file_name()
         .map_or(String::new(), |f| f.to_string_lossy().into_owned());
@@ -88,8 +104,14 @@ pub fn plot_command(input: &Path, out: &Path, window: f64, span: (f64, f64)) -> 
     Ok(summary(&whole.t, &measured, window, out))
 }
 
-/// Fits the whole record (so that the span's ends have their neighbours) and keeps the samples inside the span.
-fn measure(whole: &record::Run, window: f64, span: (f64, f64)) -> Result<Measured, BadNumber> {
+/// Fits the whole record (so that the span's ends have their neighbours) and keeps the samples inside the span
+/// (as asked, and its bounds with the open ends infinite).
+fn measure(
+    input: &Path,
+    whole: &record::Run,
+    window: f64,
+    (span, bounds): (Span, (f64, f64)),
+) -> Result<Measured, PlotCommandError> {
     let all: Vec<Vec<(f64, f64)>> = (0..6)
         .map(|k| {
             let y: Vec<f64> = whole.target.iter().map(|p| p[k]).collect();
@@ -98,18 +120,23 @@ fn measure(whole: &record::Run, window: f64, span: (f64, f64)) -> Result<Measure
         .collect();
     // The samples inside the span: drawn and measured.
     let inside: Vec<usize> = (0..whole.t.len())
-        .filter(|&i| whole.t[i] >= span.0 && whole.t[i] <= span.1)
+        .filter(|&i| whole.t[i] >= bounds.0 && whole.t[i] <= bounds.1)
         .collect();
     if inside.len() < 2 {
-        return Err(BadNumber::new(
-            "from/--to",
-            format!(
-                "{} of the record's samples (device time {:.3} to {:.3} s) are in the span",
-                inside.len(),
-                whole.t[0],
-                whole.t[whole.t.len() - 1]
-            ),
-        ));
+        return Err(match (span, whole.t.first(), whole.t.last()) {
+            ((None, None), _, _) | (_, None, _) | (_, _, None) => PlotCommandError::TooShort {
+                path: input.to_path_buf(),
+                samples: whole.t.len(),
+            },
+            (_, Some(first), Some(last)) => bad_span(
+                span,
+                format!(
+                    "{} of the record's samples (device time {first:.3} to {last:.3} s) are in the span",
+                    inside.len()
+                ),
+            )
+            .into(),
+        });
     }
     Ok(Measured {
         t: inside.iter().map(|&i| whole.t[i]).collect(),

@@ -201,6 +201,18 @@ pub enum PlotCommandError {
     /// The picture was not written.
     #[error(transparent)]
     Plot(#[from] plot::PlotError),
+    /// A record too short to take a derivative of.
+    #[error(
+        "{}: {samples} sample{}: a derivative needs at least 2",
+        path.display(),
+        if *samples == 1 { "" } else { "s" }
+    )]
+    TooShort {
+        /// The record.
+        path: std::path::PathBuf,
+        /// How many samples it holds.
+        samples: usize,
+    },
 }
 
 /// Reads a run record (`stream --record`).

@@ -124,7 +124,7 @@ impl Sine {
         let mut line = format!(
             "sine on {} at {} Hz: amplitude {:.4e} {len}, velocity {:.6} {vel}, acceleration {:.6} {acc}",
             ["x", "y", "z", "roll", "pitch", "yaw"][k],
-            self.frequency,
+            crate::input::numbers::readable(self.frequency),
             p.position,
             p.velocity,
             p.acceleration

@@ -18,9 +18,10 @@ pub const EXAMPLE_DRIVE: &str = include_str!("../../../docs/drive-telemetry.csv"
 /// Cells per side of the Rig panel's workspace section.
 const SECTION_CELLS: usize = 48;
 
-/// The cueing parameters as the panel starts them: the defaults, and the example drive's name.
+/// The cueing parameters as the panel starts them: the defaults, the example drive's name, and the controls the
+/// panel builds for them (channel, unit, range or choices of each value, from the core's list).
 pub fn cue_defaults() -> Value {
-    json!({ "config": CueConfig::default(), "drive": "example" })
+    json!({ "config": CueConfig::default(), "drive": "example", "fields": super::cue_fields::fields() })
 }
 
 /// What the Cueing panel sends: the parameters, and the drive (a telemetry CSV's text; the example without).

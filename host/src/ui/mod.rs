@@ -3,6 +3,7 @@
 //! typed, and run records. The page and its one WebSocket (`/ws`) carry the per-run token; see [`guard`].
 
 mod api;
+mod cue_fields;
 mod error;
 mod files;
 mod frame;

@@ -24,6 +24,7 @@ pub mod axes;
 mod config;
 pub mod filter;
 mod live;
+pub mod schema;
 pub mod smoothing;
 
 pub use config::{ConfigError, Corner, CueConfig, Forward, YawMode, ROTATION_AXES, TILT_AXES, TRANSLATION_AXES};

@@ -207,7 +207,7 @@ $("park").addEventListener("click", () => send({ do: "park" }));
 $("start-help").textContent = "Start lets the device follow setpoints: it waits for a stream (Run motion, Stream file, Start session), which starts by itself.";
 
 // ---- Cueing ----
-const cue = { config: null, drive: null, charts: [], timer: null };
+const cue = { config: null, fields: [], drive: null, charts: [], timer: null };
 
 async function post(path, body) {
   const r = await fetch(api(path), { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
@@ -220,62 +220,89 @@ async function loadCueDefaults() {
   const r = await fetch(api("/api/cue/defaults"));
   const j = await r.json();
   cue.config = j.config;
-  buildControls($("cue-controls"), cue.config, []);
+  cue.fields = j.fields;
+  buildCueControls();
   const charts = $("cue-charts");
   charts.innerHTML = "";
   cue.charts = ["surge (x)", "sway (y)", "heave (z)"].map((n) => new Chart(charts, n, " m/s²"));
   recue();
 }
 
-// The axes of a per-axis list, by the key's first word (the core's TRANSLATION_AXES, TILT_AXES, ROTATION_AXES).
-const AXIS_NAMES = { translation: ["surge", "sway", "heave"], tilt: ["x force", "y force"], rotation: ["roll", "pitch"] };
-
-// A number input per number of the configuration (nested tables as fieldsets, lists per axis).
-function buildControls(parent, obj, path) {
+// The controls, from the server's list of them (the core's parameter list, each per-axis key spread over its
+// axes): a fieldset per channel in the list's order, each value labelled with its unit and range, a select where
+// it takes one of a few values. A value read only with a choice of another (a median's window) shows with it.
+function buildCueControls() {
+  const parent = $("cue-controls");
   parent.innerHTML = "";
-  const axes = Array.isArray(obj) ? AXIS_NAMES[String(path[path.length - 1]).split("_")[0]] : null;
-  for (const [key, value] of Object.entries(obj)) {
-    const here = path.concat(key);
-    const name = axes && axes[+key] ? axes[+key] : key;
-    if (value !== null && typeof value === "object") {
+  const groups = new Map();
+  for (const f of cue.fields) {
+    if (f.only_with && getPath(cue.config, f.only_with.path) !== f.only_with.value) continue;
+    if (!groups.has(f.channel)) {
       const fs = document.createElement("fieldset");
       const lg = document.createElement("legend");
-      lg.textContent = name;
+      lg.textContent = f.channel;
       fs.appendChild(lg);
-      const inner = document.createElement("div");
-      fs.appendChild(inner);
       parent.appendChild(fs);
-      buildControls(inner, value, here);
-    } else if (typeof value === "string") {
-      // A choice (`forward`, `yaw`, a smoothing kind): its words are checked by the server as a cueing file's.
-      const label = document.createElement("label");
-      label.textContent = name;
-      const input = document.createElement("input");
-      input.type = "text"; input.size = 9; input.value = value;
-      input.dataset.path = here.join(".");
-      input.addEventListener("input", () => {
-        setPath(cue.config, here, input.value);
-        clearTimeout(cue.timer);
-        cue.timer = setTimeout(recue, 300);
-      });
-      label.appendChild(input);
-      parent.appendChild(label);
-    } else if (typeof value === "number" || typeof value === "boolean") {
-      const label = document.createElement("label");
-      label.textContent = name;
-      const input = document.createElement("input");
-      input.dataset.path = here.join(".");
-      if (typeof value === "boolean") { input.type = "checkbox"; input.checked = value; }
-      else { input.type = "number"; input.step = "any"; input.value = value; }
-      input.addEventListener("input", () => {
-        setPath(cue.config, here, input.type === "checkbox" ? input.checked : parseFloat(input.value));
-        clearTimeout(cue.timer);
-        cue.timer = setTimeout(recue, 200);
-      });
-      label.appendChild(input);
-      parent.appendChild(label);
+      groups.set(f.channel, fs);
     }
+    groups.get(f.channel).appendChild(cueControl(f));
   }
+}
+
+function cueControl(f) {
+  const label = document.createElement("label");
+  const name = document.createElement("span");
+  name.textContent = f.label;
+  label.appendChild(name);
+  const value = getPath(cue.config, f.path);
+  let input;
+  if (f.choices) {
+    input = document.createElement("select");
+    f.choices.forEach((c, i) => {
+      const o = document.createElement("option");
+      o.value = String(i); o.textContent = String(c); o.selected = c === value;
+      input.appendChild(o);
+    });
+    input.addEventListener("change", () => cueChoose(f, f.choices[+input.value]));
+  } else {
+    input = document.createElement("input");
+    input.type = "number"; input.step = "any"; input.min = f.min; input.max = f.max; input.value = value;
+    input.title = `${f.min} to ${f.max}${f.unit ? " " + f.unit : ""}`;
+    input.addEventListener("input", () => {
+      setPath(cue.config, f.path, parseFloat(input.value));
+      clearTimeout(cue.timer);
+      cue.timer = setTimeout(recue, 200);
+    });
+  }
+  input.dataset.path = f.path.join(".");
+  const unit = document.createElement("span");
+  unit.className = "unit";
+  unit.textContent = f.unit;
+  const box = document.createElement("span");
+  box.appendChild(input); box.appendChild(unit);
+  label.appendChild(box);
+  return label;
+}
+
+// A choice: the values read only with another choice of it go, the ones read with this one come with their
+// starting value, and the controls follow.
+function cueChoose(f, v) {
+  setPath(cue.config, f.path, v);
+  const key = f.path.join(".");
+  for (const g of cue.fields) {
+    if (!g.only_with || g.only_with.path.join(".") !== key) continue;
+    const table = getPath(cue.config, g.path.slice(0, -1));
+    const leaf = g.path[g.path.length - 1];
+    if (g.only_with.value === v) { if (!(leaf in table)) table[leaf] = g.only_with.initial; }
+    else delete table[leaf];
+  }
+  buildCueControls();
+  clearTimeout(cue.timer);
+  cue.timer = setTimeout(recue, 300);
+}
+
+function getPath(obj, path) {
+  return path.reduce((o, k) => (o === undefined || o === null ? undefined : o[k]), obj);
 }
 
 function setPath(obj, path, v) {
@@ -298,7 +325,7 @@ async function recue() {
       { x: j.t, y: j.asked.map((f) => f[i]), colour: pale(COLOURS[i]), width: 4 },
       { x: j.t, y: j.delivered.map((f) => f[i]), colour: COLOURS[i] },
     ]));
-    document.querySelectorAll("#cue-controls input").forEach((i) => i.classList.remove("bad"));
+    document.querySelectorAll("#cue-controls input, #cue-controls select").forEach((i) => i.classList.remove("bad"));
   } catch (e) {
     status.className = "small msg bad"; status.textContent = e.message;
     // The plots were of other parameters: not shown as if they were of these.

@@ -61,6 +61,39 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
     if p2 <= p1 * 1.02 {
         return Err(format!("the delivered surge did not grow with its scale: {p1} -> {p2}"));
     }
+    // The parameters by channel with their units; a key of a few values is a select, and choosing the median
+    // smoothing brings its window (at its starting value, which the replay takes).
+    let layout = js(
+        c,
+        "(() => { const q = (p) => document.querySelector(`[data-path=\"${p}\"]`); \
+         return [q('translation_scale.0').closest('fieldset').querySelector('legend').textContent, \
+         q('tilt_limit_deg.1').closest('fieldset').querySelector('legend').textContent, \
+         q('translation_limit.0').parentElement.querySelector('.unit').textContent, q('yaw').tagName, \
+         !!q('smoothing.window')]; })()",
+    )
+    .await?;
+    if layout != json!(["surge", "tilt coordination", "m/s²", "SELECT", false]) {
+        return Err(format!(
+            "the controls are not grouped by channel with units and selects: {layout}"
+        ));
+    }
+    let runs = second[0].as_u64().unwrap_or(0);
+    js(
+        c,
+        "(() => { const s = document.querySelector('[data-path=\"smoothing.kind\"]'); \
+         s.value = [...s.options].find((o) => o.textContent === 'median').value; \
+         s.dispatchEvent(new Event('change')); return true; })()",
+    )
+    .await?;
+    until(
+        c,
+        &format!(
+            "window.ringpod.cueRuns > {runs} && !!document.querySelector('[data-path=\"smoothing.window\"]') \
+             && !document.getElementById('cue-status').className.includes('bad')"
+        ),
+        Duration::from_secs(20),
+    )
+    .await?;
     js(
         c,
         "(() => { const i = document.querySelector('[data-path=\"translation_scale.0\"]'); \
@@ -74,7 +107,8 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
     )
     .await?;
     Ok(format!(
-        "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; -5 refused: {refused}"
+        "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; controls by channel with units, selects, the median's \
+         window shown with it: {layout}; -5 refused: {refused}"
     ))
 }
 
