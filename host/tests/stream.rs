@@ -678,7 +678,9 @@ fn a_live_session_starts_late_pauses_and_resumes() {
                 text += &" ".repeat(2000);
             }
             socket.send_to(text.as_bytes(), &addr).unwrap();
-            if k == 10 {
+            // Under Wine a datagram sent from a socket bound to 127.0.0.2 arrives from 127.0.0.1: the other sender
+            // is a Linux check.
+            if k == 10 && cfg!(unix) {
                 stranger.send_to(b"0 0 0.3 0 0 0", &addr).unwrap();
             }
             std::thread::sleep(std::time::Duration::from_millis(10));
@@ -695,7 +697,7 @@ fn a_live_session_starts_late_pauses_and_resumes() {
     assert_eq!(report["setpoints_applied"], 60, "{report}");
     assert_eq!(report["rejected"], serde_json::json!({}));
     assert_eq!(report["datagrams"]["received"], 60);
-    assert_eq!(report["datagrams"]["other_senders"], 1);
+    assert_eq!(report["datagrams"]["other_senders"], u64::from(cfg!(unix)));
     // The pause and the idle end: both held, the stream never stopped; led in once.
     assert_eq!(report["held_gaps"], 2, "{report}");
     assert_eq!(report["restarts"], 0);

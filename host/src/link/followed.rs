@@ -8,8 +8,11 @@
 //! homing solves it, from the sample's commanded pose (a few milliseconds from the counted one, so Newton's method
 //! converges in an iteration or two).
 //!
-//! Step counts are homed coordinates only once the device has homed: the pose is replaced in the states that imply
-//! it (Ready, Running, Stopping); in the others the sample keeps the device's own pose.
+//! Step counts are homed coordinates only once the device has homed: the pose is solved in the states that imply it
+//! (Ready, Running, Stopping). In the others (powering up, homing, jogging) where the seat is is not known from
+//! the steps, and the sample's pose becomes its target, where the device is taking it: during homing the commanded
+//! pose is a placeholder that jumps when homing finds the axes, and a record's derivatives or a VR view must not
+//! see that jump as motion.
 
 use ringpod_core::controller::axis_scale;
 use ringpod_core::kinematics::{Actuators, AxisKind, Mechanism, NewtonOptions, Pose, RingPlatform};
@@ -62,9 +65,10 @@ impl Followed {
         solved.ok().map(|s| s.pose)
     }
 
-    /// Replaces the sample's pose by the counted one where there is one.
+    /// Replaces the sample's pose by the counted one where there is one (its target before homing).
     pub fn apply(&mut self, sample: &mut Telemetry) {
         if !matches!(sample.state, State::Ready | State::Running | State::Stopping) {
+            sample.pose = sample.target;
             return;
         }
         match self.pose(sample) {

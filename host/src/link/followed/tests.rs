@@ -79,9 +79,10 @@ fn a_lagging_yaw_is_shown_where_the_steps_are() {
 }
 
 #[test]
-fn before_homing_the_device_pose_stands() {
+fn before_homing_the_pose_is_where_the_device_takes_it() {
     let (config, mut followed) = trainer();
-    let commanded = near_home(&config, [0.0; 3], [0.0; 3]);
+    let placeholder = near_home(&config, [0.0; 3], [20.0, 0.0, 0.0]);
+    let target = near_home(&config, [0.0; 3], [0.0; 3]);
     for state in [
         State::Off,
         State::LogicOn,
@@ -89,9 +90,10 @@ fn before_homing_the_device_pose_stands() {
         State::Homing,
         State::Jogging,
     ] {
-        let mut s = sample(state, commanded, [1_000, -2_000, 3_000, 0, 0, 0]);
+        let mut s = sample(state, placeholder, [1_000, -2_000, 3_000, 0, 0, 0]);
+        s.target = target;
         followed.apply(&mut s);
-        assert_eq!(s.pose, commanded, "{state:?}");
+        assert_eq!(s.pose, target, "{state:?}");
     }
     assert_eq!(followed.unsolved, 0);
 }
