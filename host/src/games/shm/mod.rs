@@ -56,6 +56,7 @@ pub enum Game {
 
 impl Game {
     /// Every game.
+    #[cfg(test)]
     pub const ALL: [Game; 7] = [
         Game::Ac,
         Game::Acc,
@@ -311,3 +312,6 @@ impl Bytes<'_> {
         [self.f64(at), self.f64(at + 8), self.f64(at + 16)]
     }
 }
+
+#[cfg(test)]
+mod tests;

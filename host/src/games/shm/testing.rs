@@ -13,7 +13,6 @@ pub enum C {
     I32,
     F32,
     F64,
-    U64,
 }
 
 impl C {
@@ -22,7 +21,7 @@ impl C {
             C::I8 => 1,
             C::I16 => 2,
             C::I32 | C::F32 => 4,
-            C::F64 | C::U64 => 8,
+            C::F64 => 8,
         }
     }
 }
@@ -99,7 +98,7 @@ impl Page {
 }
 
 /// What a test's game does at a read of its memory: (the read's number from 0, the pages).
-pub type Writer = Box<dyn FnMut(usize, &mut [Option<Vec<u8>>])>;
+pub type Writer = Box<dyn FnMut(usize, &mut [Option<Vec<u8>>]) + Send>;
 
 /// A game's mappings held in vectors (`None`: not there), and what the game writes between reads.
 pub struct Fake {
