@@ -104,7 +104,11 @@ pub struct Mappings {
 impl Mappings {
     /// `game`'s mappings, none open yet.
     pub fn new(game: Game) -> Self {
-        let names = game.mappings();
+        Self::named(game.mappings())
+    }
+
+    /// The mappings of these names (a game's, in its order), none open yet.
+    pub fn named(names: &'static [&'static str]) -> Self {
         Self {
             names,
             views: names.iter().map(|_| None).collect(),
@@ -130,3 +134,6 @@ impl Memory for Mappings {
         }
     }
 }
+
+#[cfg(test)]
+mod tests;
