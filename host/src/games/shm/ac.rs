@@ -1,10 +1,12 @@
 //! Assetto Corsa and Assetto Corsa Competizione: the physics page of their shared memory.
 //!
-//! Sources: Kunos Simulazioni's "Assetto Corsa Shared Memory" reference (`SharedFileOut.h`, the structures
-//! `SPageFilePhysics`, `SPageFileGraphic`, `SPageFileStatic`, `#pragma pack(4)`, as the community copies of the AC
-//! 1.x documentation mirror it) and "ACC Shared Memory Documentation" v1.8.12 (Kunos, 2021: ACC's
-//! `SPageFilePhysics`, which keeps AC's fields and appends `localVelocity`, `P2PActivations` .. `waterTemp`). Both
-//! games write the page to the named mapping `Local\acpmf_physics`, little-endian, 4-byte packed:
+//! Sources: Kunos Simulazioni's shared-memory header for Assetto Corsa (`SharedFileOut.h`: `SPageFilePhysics`,
+//! `SPageFileGraphic`, `SPageFileStatic`, `#pragma pack(4)`), read in a copy kept in public code (Kunos publish it
+//! in a forum post, not read here), and Kunos' "ACC Shared Memory Documentation" v1.8.12 as a public C++ header
+//! transcribes it (ACC's `SPageFilePhysics`, which keeps AC's fields and appends `localVelocity`,
+//! `P2PActivations` .. `waterTemp`; the transcription checks `abs` at 252, `slipRatio` at 640 and `absInAction`
+//! at 676 with `static_assert`s). Both games write the page to the named mapping `Local\acpmf_physics`,
+//! little-endian, 4-byte packed:
 //!
 //! | bytes | field | |
 //! |---|---|---|

@@ -1,8 +1,9 @@
 //! Automobilista 2 and Project CARS 2: their shared memory (`Shared Memory: Project CARS 2` in the game's options).
 //!
-//! Source: Slightly Mad Studios' / Reiza's `SharedMemory.h` ("Storage structure for storing and updating shared
-//! memory", `SHARED_MEMORY_VERSION` 13 in the AMS2 copy read, 14 in AMS2's later releases, which append fields
-//! at the end), in the mapping `$pcars2$`. Every member is at most 4 bytes, so the natural alignment is 4-byte
+//! Source: `SharedMemory.h` of Project CARS 2 as Reiza ships it with AMS2 ("Storage structure for storing and
+//! updating shared memory", `SHARED_MEMORY_VERSION` 13 in the copy read, kept in public code; AMS2's later
+//! releases, version 14, append fields at the end, as the "AMS2 Additions (v10...)" before them did), in the
+//! mapping `$pcars2$`. Every member is at most 4 bytes, so the natural alignment is 4-byte
 //! packing; little-endian:
 //!
 //! | bytes | field | |

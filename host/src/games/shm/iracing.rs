@@ -1,9 +1,10 @@
 //! iRacing: the telemetry of its SDK's memory-mapped file, read through its variable headers.
 //!
-//! Source: iRacing.com Motorsport Simulations' iRacing SDK, `irsdk_defines.h` (`IRSDK_VER 2`; the copy of the
-//! SDK's header in friss/iracing-sdk-js, `src/cpp/irsdk/irsdk_defines.h`), with the variable names, units and
-//! descriptions as the sim publishes them in its variable headers. The mapping `Local\IRSDKMemMapFileName` is
-//! self-describing, little-endian:
+//! Source: iRacing.com Motorsport Simulations' iRacing SDK, `irsdk_defines.h` (© 2013; the copy read is the SDK's
+//! header as ECU-IR/irsdk keeps it, commit 69fdf8d, whose `irsdk_header` and `irsdk_varHeader` later SDK releases
+//! keep, the variable header's padding int becoming `bool countAsTime` and padding), with the variable names,
+//! units and descriptions as the sim publishes them in its variable headers. The mapping
+//! `Local\IRSDKMemMapFileName` is self-describing, little-endian:
 //!
 //! | bytes | field | |
 //! |---|---|---|
@@ -17,7 +18,9 @@
 //! `offset` (i32 at 4, into a buffer), `count` (i32 at 8), `countAsTime` (bool at 12), `name` (32 bytes at 16,
 //! NUL-terminated), `desc` (64 at 48), `unit` (32 at 112). The sim writes its buffers in turn, each stamped with
 //! the tick it holds; a reader takes the buffer with the highest `tickCount`, copies it, and reads that
-//! `tickCount` again: unchanged, the copy is whole (the SDK's `irsdk_getNewData` does the same).
+//! `tickCount` again: unchanged, the copy is whole (the SDK's `irsdk_getNewData` does the same). The header's
+//! comment: "Variables ... are output at a rate of 60 times a second ... The sim writes a new line of variables
+//! every 16 ms ... we triple buffer it".
 //!
 //! No offset is hard-coded: each variable is found by its name in the headers, and its type checked.
 //!

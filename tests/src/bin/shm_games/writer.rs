@@ -23,7 +23,14 @@ impl Mapping {
         let wide: Vec<u16> = name.encode_utf16().chain(std::iter::once(0)).collect();
         // SAFETY: a paging-file-backed section with a NUL-terminated name; the handle is checked.
         let handle = unsafe {
-            CreateFileMappingW(INVALID_HANDLE_VALUE, std::ptr::null(), PAGE_READWRITE, 0, len as u32, wide.as_ptr())
+            CreateFileMappingW(
+                INVALID_HANDLE_VALUE,
+                std::ptr::null(),
+                PAGE_READWRITE,
+                0,
+                len as u32,
+                wide.as_ptr(),
+            )
         };
         if handle.is_null() {
             return Err(format!("{name}: {}", std::io::Error::last_os_error()));
@@ -85,7 +92,11 @@ impl Moment {
     fn specific_force(&self) -> [f64; 3] {
         let (sp, cp) = self.pitch.sin_cos();
         let (sr, cr) = self.roll.sin_cos();
-        [self.accel[0] + G * sp, self.accel[1] + G * cp * sr, self.accel[2] + G * cp * cr]
+        [
+            self.accel[0] + G * sp,
+            self.accel[1] + G * cp * sr,
+            self.accel[2] + G * cp * cr,
+        ]
     }
 }
 
@@ -94,9 +105,19 @@ fn drive(t: f64) -> Option<Moment> {
     let m = Moment::default();
     Some(match (t % 7.5) as u32 {
         0 => m,
-        1 => Moment { accel: [3.0, 0.0, 0.0], ..m },
-        2 => Moment { accel: [-8.0, 0.0, 0.0], ..m },
-        3 => Moment { accel: [0.0, 6.0, 0.0], rate: [0.0, 0.0, 0.4], ..m },
+        1 => Moment {
+            accel: [3.0, 0.0, 0.0],
+            ..m
+        },
+        2 => Moment {
+            accel: [-8.0, 0.0, 0.0],
+            ..m
+        },
+        3 => Moment {
+            accel: [0.0, 6.0, 0.0],
+            rate: [0.0, 0.0, 0.4],
+            ..m
+        },
         4 => Moment { pitch: 0.15, ..m },
         5 => Moment { roll: 0.12, ..m },
         _ => return None,
