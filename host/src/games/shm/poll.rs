@@ -37,6 +37,9 @@ pub struct Counts {
     pub stalls: u64,
     /// Seconds spent in those pauses.
     pub stalled_s: f64,
+    /// Samples whose game time went back (a new session, a restart): each passed on without its time, so that the
+    /// stream times it by its arrival and takes the new clock from the next sample on.
+    pub clock_restarts: u64,
 }
 
 /// What one poll gave.
@@ -55,6 +58,8 @@ pub enum Outcome {
 pub struct Poller {
     game: Game,
     last: Option<u64>,
+    /// The game time of the last new sample that had one.
+    last_time: Option<f64>,
     /// When the last new sample came (or the poller started), and whether the pause since is counted as a stall.
     since: Instant,
     stalled: bool,
@@ -69,6 +74,7 @@ impl Poller {
         Self {
             game,
             last: None,
+            last_time: None,
             since: start,
             stalled: false,
             counts: Counts::default(),
@@ -99,9 +105,10 @@ impl Poller {
 
     /// Polls once at `now`.
     pub fn poll(&mut self, mem: &mut dyn Memory, now: Instant) -> Outcome {
-        let outcome = self.take(mem);
+        let mut outcome = self.take(mem);
         let paused = now.saturating_duration_since(self.since);
-        if let Outcome::New(_) = outcome {
+        if let Outcome::New(read) = &mut outcome {
+            self.clock(read);
             if self.stalled {
                 self.counts.stalled_s += paused.as_secs_f64();
                 self.news = Some(format!(
@@ -122,6 +129,23 @@ impl Poller {
             ));
         }
         outcome
+    }
+
+    /// A game time before the last one (the game's clock started again): the sample goes on without it, once.
+    fn clock(&mut self, read: &mut Read) {
+        let Some(t) = read.sample.time else {
+            return;
+        };
+        if self.last_time.is_some_and(|last| t < last) {
+            self.counts.clock_restarts += 1;
+            self.news = Some(format!(
+                "{}: the game's clock went back from {:.3} s to {t:.3} s (a new session): timed by arrival once",
+                self.game.title(),
+                self.last_time.unwrap_or_default()
+            ));
+            read.sample.time = None;
+        }
+        self.last_time = Some(t);
     }
 
     /// The end of the run: a stall still going on counts its seconds.

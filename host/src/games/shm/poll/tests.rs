@@ -105,3 +105,33 @@ fn the_polling_interval_follows_the_games_rate() {
     assert_eq!(Poller::new(Game::Rf2, t0).interval(), ms(5));
     assert!(Poller::new(Game::Iracing, t0).interval() > ms(4));
 }
+
+#[test]
+fn a_clock_that_goes_back_is_passed_on_without_its_time_once() {
+    use super::super::ets2;
+    let t0 = Instant::now();
+    let page = |time_us: u64| {
+        let mut p = Page::zeros(ets2::SIZE);
+        p.put(ets2::at::SDK_ACTIVE, &[1])
+            .u32(ets2::at::REVISION, 10)
+            .u64(ets2::at::TIME, time_us);
+        p.0
+    };
+    let mut mem = Fake::new(vec![page(90_000_000)]);
+    let mut p = Poller::new(Game::Ets2, t0);
+    let time = |o: Outcome| match o {
+        Outcome::New(r) => r.sample.time,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(time(p.poll(&mut mem, t0)), Some(90.0));
+    mem.pages[0] = Some(page(1_000_000));
+    assert_eq!(
+        time(p.poll(&mut mem, t0)),
+        None,
+        "the new clock's first sample: timed by arrival"
+    );
+    assert!(p.news().is_some_and(|n| n.contains("went back")));
+    mem.pages[0] = Some(page(1_016_000));
+    assert_eq!(time(p.poll(&mut mem, t0)), Some(1.016), "then the new clock");
+    assert_eq!(p.counts.clock_restarts, 1);
+}
