@@ -142,3 +142,6 @@ fn refuse_shm(_: &str) -> Result<crate::games::shm::Game, String> {
         std::env::consts::OS
     ))
 }
+
+#[cfg(test)]
+mod tests;
