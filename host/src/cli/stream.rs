@@ -62,7 +62,10 @@ pub struct StreamArgs {
     pub telemetry_format: crate::games::TelemetryFormat,
     /// With --telemetry-udp: Live for Speed's `OutSim Opts` (hexadecimal, as in its cfg.txt), which an `outsim2`
     /// packet's size alone does not always tell.
+    // `requires` alone lets it through with a source that conflicts with --telemetry-udp (clap does not require an
+    // argument that conflicts with one given), so those sources are named as conflicts too.
     #[arg(long, value_name = "HEX", requires = "telemetry_udp", value_parser = crate::games::outsim2::Opts::parse_hex)]
+    #[arg(conflicts_with_all = ["udp", "input", "motion", "telemetry_shm"])]
     pub outsim_opts: Option<crate::games::outsim2::Opts>,
     /// With --telemetry-udp or --telemetry-shm: washout parameters (TOML, as for `ringpod cue --config`). The file is
     /// watched while the stream runs: a changed, valid file takes over within a second, blended in; an invalid one

@@ -56,9 +56,20 @@ fn telemetry_shm_is_refused_by_name_off_windows() {
     assert!(text.contains("--telemetry-shm") && text.contains("Windows"), "{text}");
 }
 
-/// The cueing file goes with either telemetry source, and with no other.
+/// The cueing file goes with either telemetry source, and with no other; LFS's `OutSim Opts` only with UDP telemetry.
 #[test]
 fn a_cueing_file_needs_a_telemetry_source() {
+    for source in [
+        &["--motion", "demo"][..],
+        &["--udp", "127.0.0.1:0"],
+        &["--input", "x.csv"],
+    ] {
+        assert!(
+            parse(&[source, &["--outsim-opts", "ff"]].concat()).is_err(),
+            "{source:?}"
+        );
+    }
+    assert!(parse(&["--telemetry-udp", "127.0.0.1:0", "--outsim-opts", "ff"]).is_ok());
     assert!(parse(&["--telemetry-udp", "127.0.0.1:0", "--cue-config", "c.toml"]).is_ok());
     assert!(parse(&["--udp", "127.0.0.1:0", "--cue-config", "c.toml"]).is_err());
     let args = parse(&["--telemetry-udp", "127.0.0.1:0"]).unwrap();
