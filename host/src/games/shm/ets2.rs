@@ -18,7 +18,8 @@
 //!
 //! The plugin writes `time` at the start of each of the game's frames and the channels as the game hands them
 //! over in that frame; it has no version or sequence, so a copy is checked only by `time` being the same before and
-//! after it (a copy taken between the frame's start and its channels can mix two frames: a limit of the layout).
+//! after it; a new `time` is left to stand for one poll before it is copied ([`super::poll`]), so that the frame's
+//! channels are written by then.
 //! The game calls its plugins every rendered frame: ringpod assumes 60 Hz.
 //!
 //! ## Conversion

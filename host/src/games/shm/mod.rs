@@ -104,6 +104,13 @@ impl Game {
         }
     }
 
+    /// Whether the layout guards its writes (rF2's version block, AMS2's sequence, iRacing's rotating buffers): a
+    /// layout without (AC, ACC, ETS2) has its counter read again after the copy only, and a new counter is left to
+    /// stand for a poll before it is copied.
+    pub fn guarded(self) -> bool {
+        !matches!(self, Game::Ac | Game::Acc | Game::Ets2)
+    }
+
     /// How often the game writes a new sample (Hz), as published or assumed (each module's table says which):
     /// the pause after which a game is counted as stalled is a number of these periods.
     pub fn rate_hz(self) -> f64 {

@@ -22,6 +22,9 @@ pub struct Counts {
     pub samples: u64,
     /// Polls that found the counter where it was (no new sample yet).
     pub repeats: u64,
+    /// Polls that found a new counter of a game without a write guard (AC, ACC, ETS2) and left it to stand for a
+    /// poll before copying, so that the values it counts are written.
+    pub settling: u64,
     /// Copies found torn (the game wrote while they were taken), each taken again.
     pub torn: u64,
     /// Polls that gave up after [`TRIES`] torn copies (the next poll tries again).
@@ -58,6 +61,8 @@ pub enum Outcome {
 pub struct Poller {
     game: Game,
     last: Option<u64>,
+    /// An unguarded game's counter as the last poll found it.
+    seen: Option<u64>,
     /// The game time of the last new sample that had one.
     last_time: Option<f64>,
     /// When the last new sample came (or the poller started), and whether the pause since is counted as a stall.
@@ -74,6 +79,7 @@ impl Poller {
         Self {
             game,
             last: None,
+            seen: None,
             last_time: None,
             since: start,
             stalled: false,
@@ -174,6 +180,13 @@ impl Poller {
                 }
                 Ok(Now::Tick(t)) if Some(t) == self.last => {
                     c.repeats += 1;
+                    return Outcome::Nothing;
+                }
+                // A layout without a write guard: its counter may move before the values it counts (the SCS
+                // plugin stamps the frame first), so a new counter is taken only once it has stood for a poll.
+                Ok(Now::Tick(t)) if !self.game.guarded() && self.seen != Some(t) => {
+                    self.seen = Some(t);
+                    c.settling += 1;
                     return Outcome::Nothing;
                 }
                 Ok(Now::Tick(t)) => t,
