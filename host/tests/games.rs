@@ -220,3 +220,32 @@ fn every_format_drives_the_stream_end_to_end() {
         }
     });
 }
+
+/// `--telemetry-shm` off Windows: refused by name as a usage error (exit 2), before anything is opened; with the
+/// other sources or options it does not go with, refused as well.
+#[test]
+fn shared_memory_is_refused_by_name_off_windows_and_with_other_sources() {
+    use assert_cmd::Command;
+    let ringpod = || Command::cargo_bin("ringpod").unwrap();
+    if !cfg!(windows) {
+        let out = ringpod()
+            .args(["stream", "--sim", "--telemetry-shm", "iracing"])
+            .assert()
+            .code(2);
+        let err = String::from_utf8_lossy(&out.get_output().stderr).to_string();
+        assert!(err.contains("--telemetry-shm") && err.contains("Windows"), "{err}");
+    }
+    for other in [
+        &["--telemetry-udp", "127.0.0.1:0"][..],
+        &["--udp", "127.0.0.1:0"],
+        &["--motion", "demo"],
+        &["--udp-from", "127.0.0.1"],
+        &["--outsim-opts", "ff"],
+    ] {
+        ringpod()
+            .args(["stream", "--sim", "--telemetry-shm", "ac"])
+            .args(other)
+            .assert()
+            .code(2);
+    }
+}

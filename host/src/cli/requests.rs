@@ -134,11 +134,13 @@ impl CueArgs {
 /// Arguments that do not go together (the combinations clap cannot express).
 #[derive(Debug, thiserror::Error)]
 pub enum RequestError {
-    /// `--capture` without a UDP source.
-    #[error("--capture records a UDP source: it needs --udp or --telemetry-udp")]
+    /// `--capture` without a live source.
+    #[error("--capture records a live source: it needs --udp, --telemetry-udp or --telemetry-shm")]
     CaptureWithoutUdp,
     /// `stream` without a source (clap requires one; this is the same rule for a request built otherwise).
-    #[error("stream needs a source: --input FILE.csv, --motion NAME, --udp ADDR or --telemetry-udp ADDR")]
+    #[error(
+        "stream needs a source: --input FILE.csv, --motion NAME, --udp ADDR, --telemetry-udp ADDR or --telemetry-shm GAME"
+    )]
     NoSource,
     /// `--motion sine` without all of its parameters.
     #[error("--motion sine needs --axis, --frequency and --velocity-amplitude or --amplitude")]
@@ -166,38 +168,8 @@ pub enum RequestError {
 impl StreamArgs {
     /// The stream these arguments ask for (clap has already refused the combinations that make no sense).
     pub fn job(&self) -> Result<crate::stream::command::Job, RequestError> {
-        use crate::stream::command::{Datagrams, Device, Input, Job, LoadsCheck};
-        let udp = |addr, holds| Input::Udp {
-            addr,
-            holds,
-            from: self.udp_from,
-            idle: self.udp_idle,
-        };
-        if self.capture.is_some() && self.udp.is_none() && self.telemetry_udp.is_none() {
-            return Err(RequestError::CaptureWithoutUdp);
-        }
-        let input = match (self.udp, self.telemetry_udp, &self.input) {
-            (Some(addr), _, _) => udp(addr, Datagrams::Poses { degrees: self.degrees }),
-            (None, Some(addr), _) => udp(
-                addr,
-                Datagrams::Telemetry {
-                    format: self.telemetry_format,
-                    cue_config: self.cue_config.clone(),
-                    profile: self.profile.clone(),
-                    outsim_opts: self.outsim_opts,
-                },
-            ),
-            (None, None, Some(path)) => Input::File {
-                path: path.clone(),
-                degrees: self.degrees,
-            },
-            (None, None, None) => Input::Motion {
-                motion: self.motion.ok_or(RequestError::NoSource)?,
-                sine: self.sine()?,
-                seconds: self.duration,
-                rate_hz: self.rate,
-            },
-        };
+        use crate::stream::command::{Device, Job, LoadsCheck};
+        let input = self.input()?;
         let c = &self.controller;
         let device = match crate::link::Target::named(c.port.as_deref(), c.sim)? {
             crate::link::Target::Port(port) => Device::Port(port),
@@ -229,6 +201,49 @@ impl StreamArgs {
 }
 
 impl StreamArgs {
+    /// Where the stream's poses come from.
+    fn input(&self) -> Result<crate::stream::command::Input, RequestError> {
+        use crate::stream::command::{Datagrams, Input};
+        let udp = |addr, holds| Input::Udp {
+            addr,
+            holds,
+            from: self.udp_from,
+            idle: self.udp_idle,
+        };
+        let live = self.udp.is_some() || self.telemetry_udp.is_some() || self.telemetry_shm.is_some();
+        if self.capture.is_some() && !live {
+            return Err(RequestError::CaptureWithoutUdp);
+        }
+        Ok(match (self.udp, self.telemetry_udp, self.telemetry_shm, &self.input) {
+            (Some(addr), ..) => udp(addr, Datagrams::Poses { degrees: self.degrees }),
+            (None, Some(addr), ..) => udp(
+                addr,
+                Datagrams::Telemetry {
+                    format: self.telemetry_format,
+                    cue_config: self.cue_config.clone(),
+                    profile: self.profile.clone(),
+                    outsim_opts: self.outsim_opts,
+                },
+            ),
+            (None, None, Some(game), _) => Input::Shm {
+                game,
+                cue_config: self.cue_config.clone(),
+                profile: self.profile.clone(),
+                idle: self.udp_idle,
+            },
+            (None, None, None, Some(path)) => Input::File {
+                path: path.clone(),
+                degrees: self.degrees,
+            },
+            (None, None, None, None) => Input::Motion {
+                motion: self.motion.ok_or(RequestError::NoSource)?,
+                sine: self.sine()?,
+                seconds: self.duration,
+                rate_hz: self.rate,
+            },
+        })
+    }
+
     /// `--motion sine`'s parameters: all of them for a sine, none for anything else.
     fn sine(&self) -> Result<Option<crate::stream::Sine>, RequestError> {
         use crate::stream::{Amplitude, Motion, Sine};

@@ -5,7 +5,7 @@ use clap::Args;
 use super::ControllerArgs;
 
 /// The sources other than a built-in motion (`--duration`, `--rate` and the sine's options are the motion's).
-const NOT_MOTION: [&str; 3] = ["input", "udp", "telemetry_udp"];
+const NOT_MOTION: [&str; 4] = ["input", "udp", "telemetry_udp", "telemetry_shm"];
 /// The sources other than vehicle telemetry (its format, its Live for Speed options, its cueing file and profile).
 const NOT_TELEMETRY: [&str; 3] = ["input", "motion", "udp"];
 /// The sources that are not live datagrams (`--udp-from`, `--udp-idle`, `--capture` are theirs).
@@ -19,7 +19,8 @@ const NOT_LIVE: [&str; 2] = ["input", "motion"];
 /// requirement as met when the required option conflicts with one given (`--profile` requires `--cue-config`,
 /// which conflicts with `--input`, so `--input F --profile P` passed), hence the explicit conflicts beside it.
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("source").required(true).args(["input", "motion", "udp", "telemetry_udp"])))]
+#[command(group(clap::ArgGroup::new("source").required(true).args(["input", "motion", "udp", "telemetry_udp", "telemetry_shm"])))]
+#[command(group(clap::ArgGroup::new("telemetry").args(["telemetry_udp", "telemetry_shm"])))]
 pub struct StreamArgs {
     /// The controller.
     #[command(flatten)]
@@ -27,7 +28,7 @@ pub struct StreamArgs {
     /// With --sim: run as fast as possible instead of in real time.
     #[arg(long, requires = "sim", conflicts_with = "port")]
     pub fast: bool,
-    /// A built-in motion (one source is required: --input, --motion, --udp or --telemetry-udp).
+    /// A built-in motion (one source is required: --input, --motion, --udp, --telemetry-udp or --telemetry-shm).
     #[arg(long, value_enum, conflicts_with = "input")]
     pub motion: Option<crate::stream::Motion>,
     /// Length of a built-in motion (s).
@@ -56,31 +57,44 @@ pub struct StreamArgs {
     /// does with a file): one datagram per sample, in --telemetry-format.
     #[arg(long, conflicts_with_all = ["udp", "input", "motion"])]
     pub telemetry_udp: Option<std::net::SocketAddr>,
+    /// Read vehicle telemetry from a game's shared memory (Windows) and cue it with the classical washout: `ac`
+    /// (Assetto Corsa), `acc` (Assetto Corsa Competizione), `iracing`, `rf2` (rFactor 2) or `lmu` (Le Mans
+    /// Ultimate; both through the rF2SharedMemoryMapPlugin), `ams2` (Automobilista 2 and Project CARS 2) or `ets2`
+    /// (Euro Truck Simulator 2 and American Truck Simulator, through the scs-sdk-plugin). A sample is taken each
+    /// time the game's own counter moves; the book's games table gives each game's fields, signs and rate. The
+    /// game may start after the stream: it is waited for as a paused UDP source is (--udp-idle).
+    #[cfg_attr(windows, arg(long, value_enum, value_name = "GAME"))]
+    #[cfg_attr(not(windows), arg(long, value_name = "GAME", value_parser = refuse_shm))]
+    #[arg(conflicts_with_all = ["udp", "input", "motion", "telemetry_udp"])]
+    pub telemetry_shm: Option<crate::games::shm::Game>,
     /// With --telemetry-udp: `text` (`[t] ax ay az wx wy wz`, the units of `ringpod cue`), a game's own format
     /// (`outsim`, `outsim2`, `beamng`, `codemasters`, `f1`, `forza`, `xplane`: the book's games table), or `auto`
     /// (the first datagram a game's format recognises names it, said on stderr).
-    #[arg(long, value_enum, default_value = "text", conflicts_with_all = NOT_TELEMETRY)]
+    #[arg(long, value_enum, default_value = "text", conflicts_with_all = NOT_TELEMETRY, conflicts_with = "telemetry_shm")]
     pub telemetry_format: crate::games::TelemetryFormat,
     /// With --telemetry-udp: Live for Speed's `OutSim Opts` (hexadecimal, as in its cfg.txt), which an `outsim2`
     /// packet's size alone does not always tell.
-    #[arg(long, value_name = "HEX", requires = "telemetry_udp", conflicts_with_all = NOT_TELEMETRY, value_parser = crate::games::outsim2::Opts::parse_hex)]
+    #[arg(long, value_name = "HEX", requires = "telemetry_udp", value_parser = crate::games::outsim2::Opts::parse_hex)]
+    #[arg(conflicts_with_all = NOT_TELEMETRY, conflicts_with = "telemetry_shm")]
     pub outsim_opts: Option<crate::games::outsim2::Opts>,
-    /// With --telemetry-udp: washout parameters (TOML, as for `ringpod cue --config`). The file is watched while
-    /// the stream runs: a changed, valid file takes over within a second, blended in; an invalid one is refused.
-    #[arg(long, requires = "telemetry_udp", conflicts_with_all = NOT_TELEMETRY)]
+    /// With --telemetry-udp or --telemetry-shm: washout parameters (TOML, as for `ringpod cue --config`). The file is
+    /// watched while the stream runs: a changed, valid file takes over within a second, blended in; an invalid one
+    /// is refused.
+    #[arg(long, requires = "telemetry", conflicts_with_all = NOT_TELEMETRY)]
     pub cue_config: Option<std::path::PathBuf>,
     /// With --cue-config: a profile of the cueing file (its `[profiles.NAME]` table overrides the base keys).
     #[arg(long, requires = "cue_config", conflicts_with_all = NOT_TELEMETRY)]
     pub profile: Option<String>,
     /// With --udp or --telemetry-udp: take datagrams from this sender only (others are counted and ignored).
-    #[arg(long, conflicts_with_all = NOT_LIVE)]
+    #[arg(long, conflicts_with_all = NOT_LIVE, conflicts_with = "telemetry_shm")]
     pub udp_from: Option<std::net::IpAddr>,
-    /// With --udp or --telemetry-udp: end the stream after this many seconds without a readable datagram (a source
-    /// that sends only what cannot be read is as good as none).
+    /// With --udp, --telemetry-udp or --telemetry-shm: end the stream after this many seconds without a readable
+    /// datagram or new sample (a source that sends only what cannot be read is as good as none; a game paused or
+    /// closed for longer ends the stream: raise it to wait through pauses).
     #[arg(long, default_value_t = 2.0, conflicts_with_all = NOT_LIVE)]
     pub udp_idle: f64,
     /// Angles of --input or --udp in degrees.
-    #[arg(long, conflicts_with_all = ["motion", "telemetry_udp"])]
+    #[arg(long, conflicts_with_all = ["motion", "telemetry_udp", "telemetry_shm"])]
     pub degrees: bool,
     /// Setpoints per second for built-in motions.
     #[arg(long, default_value_t = 1000.0, conflicts_with_all = NOT_MOTION)]
@@ -115,18 +129,33 @@ pub struct StreamArgs {
     pub record_hz: Option<u16>,
     /// With --udp or --telemetry-udp: capture every datagram that arrives on the socket (from any sender, readable
     /// or not) to a pcap file, as tcpdump writes one, with its arrival time; `ringpod cue --input FILE.pcap` cues it
-    /// again, Wireshark shows it.
+    /// again, Wireshark shows it. With --telemetry-shm: each new sample as a UDP datagram (from and to 127.0.0.1,
+    /// port 0) holding its `text` telemetry line `[t] ax ay az wx wy wz`, which `ringpod cue --input FILE.pcap
+    /// --telemetry-format text` cues again.
     #[arg(long, value_name = "FILE.pcap", conflicts_with_all = NOT_LIVE)]
     pub capture: Option<std::path::PathBuf>,
     /// Before moving, predict the drive demand of the file's or motion's poses (inverse dynamics) on the platform
     /// the device runs, against its drives (the --geometry file's `[[drives]]`, or the preset's motor data) for a
     /// payload of --mass kg; where it exceeds the motors, say where and do not stream (exit 1).
-    #[arg(long, requires = "mass", conflicts_with_all = ["udp", "telemetry_udp"])]
+    #[arg(long, requires = "mass", conflicts_with_all = ["udp", "telemetry_udp", "telemetry_shm"])]
     pub check_loads: bool,
     /// With --check-loads: the moving mass (kg) at the platform's centre of mass.
-    #[arg(long, requires = "check_loads", conflicts_with_all = ["udp", "telemetry_udp"])]
+    #[arg(long, requires = "check_loads", conflicts_with_all = ["udp", "telemetry_udp", "telemetry_shm"])]
     pub mass: Option<f64>,
     /// With --check-loads: its inertia Ixx,Iyy,Izz (kg m^2) about the centre of mass.
-    #[arg(long, allow_hyphen_values = true, requires = "check_loads", conflicts_with_all = ["udp", "telemetry_udp"])]
+    #[arg(long, allow_hyphen_values = true, requires = "check_loads", conflicts_with_all = ["udp", "telemetry_udp", "telemetry_shm"])]
     pub inertia: Option<String>,
 }
+
+/// `--telemetry-shm` on a system without Windows' named file mappings: refused by name, a usage error (exit 2).
+#[cfg(not(windows))]
+fn refuse_shm(_: &str) -> Result<crate::games::shm::Game, String> {
+    Err(format!(
+        "--telemetry-shm reads a game's shared memory, which is Windows' (named file mappings): not available on {}; \
+         use the game's UDP telemetry (--telemetry-udp) where it has one",
+        std::env::consts::OS
+    ))
+}
+
+#[cfg(test)]
+mod tests;

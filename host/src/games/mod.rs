@@ -48,6 +48,7 @@ pub mod forza;
 pub mod outsim;
 pub mod outsim2;
 pub mod reader;
+pub mod shm;
 mod telemetry;
 pub mod xplane;
 
@@ -209,26 +210,24 @@ pub fn decode_with(format: Format, bytes: &[u8], outsim_opts: Option<outsim2::Op
 
 /// Refuses a sample with a value that is not finite, or a time that is not a time.
 fn checked(format: Format, sample: Sample) -> Result<Sample, Unreadable> {
+    checked_values(&sample).map_err(|what| Unreadable::NotFinite { format, what })?;
+    Ok(sample)
+}
+
+/// Which of a sample's values is not finite (a force, an angular rate, or its time, which must also be a time), if
+/// one is: the rule of every game's decoder, UDP or shared memory.
+fn checked_values(sample: &Sample) -> Result<(), &'static str> {
     let t = &sample.telemetry;
     if t.force.iter().any(|v| !v.is_finite()) {
-        return Err(Unreadable::NotFinite {
-            format,
-            what: "a force",
-        });
+        return Err("a force");
     }
     if t.rate.iter().any(|v| !v.is_finite()) {
-        return Err(Unreadable::NotFinite {
-            format,
-            what: "an angular rate",
-        });
+        return Err("an angular rate");
     }
     if sample.time.is_some_and(|t| !t.is_finite() || t.abs() > MAX_TIME_S) {
-        return Err(Unreadable::NotFinite {
-            format,
-            what: "its time",
-        });
+        return Err("its time");
     }
-    Ok(sample)
+    Ok(())
 }
 
 /// Which format a datagram is, by its size and first bytes (the rules and their order are in the module's

@@ -5,7 +5,8 @@
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
-use super::{datagram, exit, Motion, Options, Report, Source, UdpSource};
+use super::live::{LiveSource, Receiver};
+use super::{datagram, exit, Motion, Options, Report, Source};
 use crate::error::CliError;
 use crate::input::{files, numbers};
 use crate::link::{self, client};
@@ -33,6 +34,16 @@ pub enum Input {
         /// Only datagrams from this sender count.
         from: Option<IpAddr>,
         /// Seconds without a readable datagram after which the stream ends.
+        idle: f64,
+    },
+    /// A game's shared memory (Windows), its telemetry cued by the washout.
+    Shm {
+        /// The game.
+        game: crate::games::shm::Game,
+        /// The cueing file, and a profile of it.
+        cue_config: Option<PathBuf>,
+        profile: Option<String>,
+        /// Seconds without a new sample after which the stream ends.
         idle: f64,
     },
 }
@@ -77,7 +88,7 @@ pub struct Job {
     pub options: Options,
     /// The run record to write.
     pub record: Option<PathBuf>,
-    /// A UDP source: the pcap file its datagrams are captured to.
+    /// A live source: the pcap file its datagrams (or shared-memory samples) are captured to.
     pub capture: Option<PathBuf>,
     /// One JSON report instead of the summary line.
     pub report_json: bool,
@@ -105,6 +116,10 @@ pub enum SourceError {
         /// Why.
         reason: std::io::Error,
     },
+    /// `--telemetry-shm` on a system without Windows' named file mappings (the command line refuses it first).
+    #[cfg(not(windows))]
+    #[error("--telemetry-shm reads a game's shared memory, a Windows named file mapping: not on this system")]
+    NoSharedMemory,
     /// The pose file could not be read, or is not a pose file.
     #[error("{}: {reason}", path.display())]
     File {
@@ -166,32 +181,35 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
                     cue_config,
                     profile,
                     outsim_opts,
-                } => {
-                    let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
-                    let washout = ringpod_core::cueing::Live::new(config).map_err(SourceError::Washout)?;
-                    datagram::Decoder::Telemetry {
-                        reader: Box::new(crate::games::Reader::new(*format, *outsim_opts)),
-                        washout: Box::new(washout),
-                        // The device's home pose, once the stream has asked for its rig.
-                        neutral: None,
-                        last: None,
-                        gaps: 0,
-                        watch: cue_config
-                            .as_ref()
-                            .map(|path| Box::new(datagram::Watch::new(path.clone(), profile.clone()))),
-                    }
-                }
+                } => telemetry_decoder(*format, *outsim_opts, cue_config, profile)?,
             };
             let idle = positive("udp-idle", *idle, 1e6)?;
             let socket = std::net::UdpSocket::bind(addr).map_err(|reason| SourceError::Bind { addr: *addr, reason })?;
-            let source = UdpSource {
-                socket,
+            let source = LiveSource {
+                receiver: Receiver::Udp(socket),
                 decoder,
                 idle: std::time::Duration::from_secs_f64(idle),
                 from: *from,
                 capture: None,
             };
-            (Source::Udp(source), Vec::new())
+            (Source::Live(source), Vec::new())
+        }
+        Input::Shm {
+            game,
+            cue_config,
+            profile,
+            idle,
+        } => {
+            let decoder = telemetry_decoder(crate::games::TelemetryFormat::Text, None, cue_config, profile)?;
+            let idle = positive("udp-idle", *idle, 1e6)?;
+            let source = LiveSource {
+                receiver: shared_memory(*game)?,
+                decoder,
+                idle: std::time::Duration::from_secs_f64(idle),
+                from: None,
+                capture: None,
+            };
+            (Source::Live(source), Vec::new())
         }
         Input::File { path, degrees } => {
             let in_file = |reason| SourceError::File {
@@ -237,6 +255,45 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
     })
 }
 
+/// A decoder of vehicle telemetry through the washout of the cueing file (or the defaults), watched for changes.
+pub(crate) fn telemetry_decoder(
+    format: crate::games::TelemetryFormat,
+    outsim_opts: Option<crate::games::outsim2::Opts>,
+    cue_config: &Option<PathBuf>,
+    profile: &Option<String>,
+) -> Result<datagram::Decoder, SourceError> {
+    let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
+    let washout = ringpod_core::cueing::Live::new(config).map_err(SourceError::Washout)?;
+    Ok(datagram::Decoder::Telemetry {
+        reader: Box::new(crate::games::Reader::new(format, outsim_opts)),
+        washout: Box::new(washout),
+        // The device's home pose, once the stream has asked for its rig.
+        neutral: None,
+        last: None,
+        gaps: 0,
+        watch: cue_config
+            .as_ref()
+            .map(|path| Box::new(datagram::Watch::new(path.clone(), profile.clone()))),
+    })
+}
+
+/// `game`'s shared memory: its named mappings, opened read-only as they appear (Windows only).
+fn shared_memory(game: crate::games::shm::Game) -> Result<Receiver, SourceError> {
+    #[cfg(windows)]
+    {
+        let memory = crate::games::shm::windows::Mappings::new(game);
+        Ok(Receiver::Shm(Box::new(super::live::ShmSource::new(
+            game,
+            Box::new(memory),
+        ))))
+    }
+    #[cfg(not(windows))]
+    {
+        let _ = game;
+        Err(SourceError::NoSharedMemory)
+    }
+}
+
 /// Whether the motion's drive demand on the platform the device runs is within its drives (printed either way).
 fn loads_keep_up<T: client::Transport>(
     check: &LoadsCheck,
@@ -265,6 +322,9 @@ fn inputs(input: &Input) -> Vec<&std::path::Path> {
                 cue_config: Some(path), ..
             },
             ..
+        }
+        | Input::Shm {
+            cue_config: Some(path), ..
         } => vec![path.as_path()],
         _ => Vec::new(),
     }
@@ -280,8 +340,8 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
         crate::out::file::not_an_input(out, &read).map_err(|e| CliError::file(out, e))?;
     }
     let (mut source, input_errors) = open(&job.input)?;
-    if let (Some(path), Source::Udp(udp)) = (&job.capture, &mut source) {
-        let local = udp.socket.local_addr()?;
+    if let (Some(path), Source::Live(udp)) = (&job.capture, &mut source) {
+        let local = udp.receiver.local_addr()?;
         let writer = crate::input::capture::CaptureWriter::create(path, local).map_err(|e| CliError::file(path, e))?;
         udp.capture = Some((Box::new(writer), path.display().to_string()));
     }

@@ -152,48 +152,57 @@ impl Decoder {
     pub fn decode(&mut self, bytes: &[u8], now: Instant) -> Result<Pose<f64>, String> {
         match self {
             Decoder::Poses { degrees } => parse_pose(bytes, *degrees),
-            Decoder::Telemetry {
-                reader,
-                washout,
-                neutral,
-                last,
-                gaps,
-                ..
-            } => {
-                let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
+            Decoder::Telemetry { reader, .. } => {
                 let read = reader.read(bytes);
                 // `auto`'s lock, or its lock dropped: said once.
                 if let Some(news) = reader.news() {
                     console::err(&format!("telemetry: {news}"));
                 }
-                let games::Sample {
-                    time: t,
-                    telemetry: sample,
-                } = read?;
-                let dt = match *last {
-                    None => None,
-                    Some((Some(t0), _)) if t.is_some() => t.map(|t| t - t0),
-                    Some((_, arrived)) => Some(now.duration_since(arrived).as_secs_f64()),
-                };
-                let offset = match dt.map(|dt| washout.step(&sample, dt)) {
-                    // The first sample: the washout's first input, at neutral.
-                    None => washout.begin(&sample).map_err(|_| "a value is not finite".to_string()),
-                    Some(Ok(offset)) => Ok(offset),
-                    Some(Err(SampleError::NonFinite)) => Err("a value is not finite".to_string()),
-                    Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| dt > 0.0) => {
-                        // A pause of more than a second: wash out to neutral and start again from here, this
-                        // sample the first input.
-                        *gaps += 1;
-                        washout.reset();
-                        washout.begin(&sample).map_err(|_| "a value is not finite".to_string())
-                    }
-                    Some(Err(SampleError::Interval)) => Err("its time is not after the last one's".to_string()),
-                };
-                let offset = offset?;
-                *last = Some((t, now));
-                Ok(cueing::pose(&neutral, &offset))
+                self.cue(read, now)
             }
         }
+    }
+
+    /// The pose a telemetry sample (read from a datagram, or a game's shared memory) asks for, arriving at `now`,
+    /// through the washout; a sample that could not be read stays refused with its reason.
+    pub fn cue(&mut self, read: Result<games::Sample, String>, now: Instant) -> Result<Pose<f64>, String> {
+        let Decoder::Telemetry {
+            washout,
+            neutral,
+            last,
+            gaps,
+            ..
+        } = self
+        else {
+            return Err("a pose source reads no telemetry".into());
+        };
+        let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
+        let games::Sample {
+            time: t,
+            telemetry: sample,
+        } = read?;
+        let dt = match *last {
+            None => None,
+            Some((Some(t0), _)) if t.is_some() => t.map(|t| t - t0),
+            Some((_, arrived)) => Some(now.duration_since(arrived).as_secs_f64()),
+        };
+        let offset = match dt.map(|dt| washout.step(&sample, dt)) {
+            // The first sample: the washout's first input, at neutral.
+            None => washout.begin(&sample).map_err(|_| "a value is not finite".to_string()),
+            Some(Ok(offset)) => Ok(offset),
+            Some(Err(SampleError::NonFinite)) => Err("a value is not finite".to_string()),
+            Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| dt > 0.0) => {
+                // A pause of more than a second: wash out to neutral and start again from here, this sample the
+                // first input.
+                *gaps += 1;
+                washout.reset();
+                washout.begin(&sample).map_err(|_| "a value is not finite".to_string())
+            }
+            Some(Err(SampleError::Interval)) => Err("its time is not after the last one's".to_string()),
+        };
+        let offset = offset?;
+        *last = Some((t, now));
+        Ok(cueing::pose(&neutral, &offset))
     }
 
     /// A telemetry source paused for `dt` more seconds (until `now`): the pose of the vehicle at rest through the

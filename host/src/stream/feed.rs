@@ -1,5 +1,5 @@
-//! Feeding a run its poses: those known beforehand (a file, a motion) each at its own time, or a UDP source's as
-//! they arrive, with the washout while it pauses.
+//! Feeding a run its poses: those known beforehand (a file, a motion) each at its own time, or a live source's (UDP
+//! datagrams, a game's shared memory) as they arrive, with the washout while it pauses.
 
 use std::time::{Duration, Instant};
 
@@ -9,9 +9,10 @@ use ringpod_core::safety::AuxLevels;
 
 use ringpod_core::protocol::MotionSettings;
 
+use super::live::{Arrival, LiveSource};
 use super::report::{CaptureReport, DatagramReport};
 use super::session::{Kind, Stop, StreamError, Streamer, KEEP_ALIVE, NO_AUX};
-use super::{motion_pose, InputError, Source, UdpSource};
+use super::{motion_pose, InputError, Source};
 use crate::link::client::{ClientError, Transport};
 use crate::out::console;
 
@@ -85,22 +86,18 @@ impl<T: Transport> Streamer<'_, T> {
         self.collect(0)
     }
 
-    /// Streams datagrams as they arrive: the platform waits where it is for the first one, leads in and starts;
-    /// while the source pauses, the stream stays alive (telemetry washes out to neutral, a pose source's last pose
-    /// is held, counted in `held_s` and `held_gaps`); `idle` without a datagram ends the session.
+    /// Streams a live source's samples as they arrive: the platform waits where it is for the first one, leads in
+    /// and starts; while the source pauses, the stream stays alive (telemetry washes out to neutral, a pose source's
+    /// last pose is held, counted in `held_s` and `held_gaps`); `idle` without a readable sample ends the session.
     pub(super) fn live(
         &mut self,
-        source: &mut UdpSource,
+        source: &mut LiveSource,
         report: &mut DatagramReport,
         errors: &mut Vec<InputError>,
     ) -> Result<(), StreamError> {
-        source
-            .socket
-            .set_read_timeout(Some(Duration::from_millis(1)))
-            .map_err(ClientError::Io)?;
-        let addr = source.socket.local_addr().map_or("?".into(), |a| a.to_string());
-        self.bar
-            .suspend(|| console::err(&format!("streaming: send datagrams to {addr}")));
+        source.receiver.start().map_err(ClientError::Io)?;
+        let listening = source.receiver.describe();
+        self.bar.suspend(|| console::err(&format!("streaming: {listening}")));
         // The largest UDP payload: no datagram is ever cut.
         let mut buf = vec![0u8; 65_536];
         let mut wall = Instant::now();
@@ -112,31 +109,19 @@ impl<T: Transport> Streamer<'_, T> {
             if (self.interrupted)() {
                 return Err(StreamError::Stop(Stop::Interrupted));
             }
-            let got = source.socket.recv_from(&mut buf);
+            let got = source.receiver.receive(&mut buf).map_err(ClientError::Io)?;
             let now = Instant::now();
-            if let (Ok((n, from)), Some((capture, _))) = (&got, source.capture.as_mut()) {
-                capture.write(&buf[..*n], *from, std::time::SystemTime::now());
+            if let Some(news) = source.receiver.news() {
+                self.bar.suspend(|| console::err(&format!("telemetry: {news}")));
             }
+            capture(source, &buf, got.as_ref());
             // A changed cueing file takes over here, between two samples.
             source.decoder.poll_config(now);
             self.elapse(now - wall)?;
             wall = now;
-            let datagram = match got {
-                Ok(got) => Some(got),
-                // A signal (Ctrl-C) interrupts the wait: nothing arrived, and the loop then sees the flag.
-                Err(e)
-                    if matches!(
-                        e.kind(),
-                        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
-                    ) =>
-                {
-                    None
-                }
-                Err(e) => return Err(ClientError::Io(e).into()),
-            };
-            // Only a readable datagram of the source counts as the source being there: a stranger's datagrams and
+            // Only a readable sample of the source counts as the source being there: a stranger's datagrams and
             // unreadable ones (a flood of them included) leave the pause logic below running.
-            let readable = datagram.and_then(|(n, from)| read(source, &buf[..n], from, now, report, errors, &self.bar));
+            let readable = got.and_then(|got| read(source, &buf, got, now, report, errors, &self.bar));
             let admitted =
                 readable.and_then(|(n, pose)| self.admit(n, pose, streaming, report, errors).map(|p| (n, p)));
             let Some((number, pose)) = admitted else {
@@ -173,6 +158,22 @@ impl<T: Transport> Streamer<'_, T> {
     }
 }
 
+/// `--capture`: a datagram as it came (from any sender, readable or not), a shared-memory sample as a line of the
+/// `text` telemetry format (its refusals are not samples: not captured).
+fn capture(source: &mut LiveSource, buf: &[u8], got: Option<&Arrival>) {
+    let Some((writer, _)) = source.capture.as_mut() else {
+        return;
+    };
+    match got {
+        Some(Arrival::Datagram { len, from }) => writer.write(&buf[..*len], *from, std::time::SystemTime::now()),
+        Some(Arrival::Sample(Ok(sample))) => {
+            let line = crate::games::shm::text_line(sample);
+            writer.write(line.as_bytes(), super::live::SHM_CAPTURE, std::time::SystemTime::now());
+        }
+        Some(Arrival::Sample(Err(_))) | None => {}
+    }
+}
+
 impl<T: Transport> Streamer<'_, T> {
     /// A readable datagram's pose if it may be sent: garbage, or a pose to lead in to that is too far outside, is
     /// refused with its number and counted as unreadable.
@@ -201,7 +202,7 @@ impl<T: Transport> Streamer<'_, T> {
 
     /// One setpoint `dt` into a pause of a live source, keeping the stream alive: the vehicle at rest through the
     /// washout (the platform glides back to neutral), or a pose source's last pose held.
-    fn bridge(&mut self, source: &mut UdpSource, dt: Duration, now: Instant) -> Result<(), StreamError> {
+    fn bridge(&mut self, source: &mut LiveSource, dt: Duration, now: Instant) -> Result<(), StreamError> {
         self.held_s += dt.as_secs_f64();
         match source.decoder.idle(dt.as_secs_f64(), now) {
             Some(pose) => {
@@ -219,24 +220,30 @@ impl<T: Transport> Streamer<'_, T> {
     }
 }
 
-/// One datagram of the UDP source: counted, and decoded into its number and pose, or reported as unreadable (or
-/// ignored as a stranger's) with `None`.
+/// One arrival of the live source (a datagram, a shared-memory sample): counted, and decoded into its number and
+/// pose, or reported as unreadable (or ignored as a stranger's) with `None`.
 fn read(
-    source: &mut UdpSource,
-    bytes: &[u8],
-    from: std::net::SocketAddr,
+    source: &mut LiveSource,
+    buf: &[u8],
+    got: Arrival,
     now: Instant,
     report: &mut DatagramReport,
     errors: &mut Vec<InputError>,
     bar: &ProgressBar,
 ) -> Option<(usize, ringpod_core::kinematics::Pose<f64>)> {
-    if source.from.is_some_and(|ip| ip != from.ip()) {
-        report.other_senders += 1;
-        return None;
+    if let Arrival::Datagram { from, .. } = got {
+        if source.from.is_some_and(|ip| ip != from.ip()) {
+            report.other_senders += 1;
+            return None;
+        }
     }
     report.received += 1;
     let number = report.received as usize;
-    match source.decoder.decode(bytes, now) {
+    let decoded = match got {
+        Arrival::Datagram { len, .. } => source.decoder.decode(&buf[..len], now),
+        Arrival::Sample(sample) => source.decoder.cue(sample, now),
+    };
+    match decoded {
         Ok(pose) => Some((number, pose)),
         Err(reason) => {
             report.unreadable += 1;
@@ -282,9 +289,10 @@ pub(super) fn feed<T: Transport>(
             let mut poses = p.iter().map(|(line, t, pose, aux)| (Some(*line), *t, *pose, *aux));
             (s.timed(&mut poses, fast, input_errors), None, None)
         }
-        Source::Udp(udp) => {
+        Source::Live(udp) => {
             let mut d = DatagramReport::default();
             let r = s.live(udp, &mut d, input_errors);
+            d.shared_memory = udp.receiver.shm_report();
             d.telemetry_gaps = udp.decoder.gaps();
             d.telemetry_format_locks = udp.decoder.locks();
             // Some were counted and not printed: the counts, once.

@@ -121,7 +121,7 @@ pub fn check_loads(
                 })
                 .collect()
         }
-        Source::Udp(_) => return Err(LoadsError::Live),
+        Source::Live(_) => return Err(LoadsError::Live),
     };
     crate::analysis::demand::preflight(&platform.ring, &platform.drives, &rows, payload).map_err(LoadsError::Demand)
 }

@@ -12,6 +12,7 @@ pub mod datagram;
 pub mod derivatives;
 mod ending;
 mod feed;
+pub mod live;
 mod loads;
 mod prepare;
 pub mod record;
@@ -31,7 +32,7 @@ pub use loads::{check_loads, platform as loads_platform};
 use prepare::{greet, prepare};
 pub use report::{LimitedReport, Report};
 use session::Streamer;
-pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source, UdpSource};
+pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source};
 
 pub use crate::input::table::InputError;
 use crate::link::client::{Client, ClientError, Transport};
@@ -253,8 +254,8 @@ pub fn run<T: Transport>(
         options.telemetry_hz,
     )?;
     let home = envelope.platform.home;
-    if let Source::Udp(udp) = &mut source {
-        udp.decoder.centre_on(Pose::from_array(home));
+    if let Source::Live(live) = &mut source {
+        live.decoder.centre_on(Pose::from_array(home));
     }
     let bar = progress_bar(&source, options.quiet);
     let limits = envelope.limits;
@@ -293,7 +294,7 @@ fn progress_bar(source: &Source, quiet: bool) -> ProgressBar {
     let total = match source {
         Source::Motion { seconds, rate_hz, .. } => (seconds * rate_hz).round() as u64 + 1,
         Source::Poses(p) => p.len() as u64,
-        Source::Udp(_) => 0,
+        Source::Live(_) => 0,
     };
     let bar = if quiet {
         ProgressBar::hidden()

@@ -22,10 +22,10 @@ pub struct LimitedReport {
     pub largest_deg: f64,
 }
 
-/// What came over UDP.
+/// What came from a live source: UDP datagrams, or a game's shared memory (each new sample counted as a datagram).
 #[derive(Debug, Default, Serialize)]
 pub struct DatagramReport {
-    /// Datagrams received from the source.
+    /// Datagrams received from the source (shared memory: new samples, and new counters whose snapshot was refused).
     pub received: u32,
     /// Datagrams that did not parse (the first few of each kind also in `input_errors`).
     pub unreadable: u32,
@@ -45,6 +45,9 @@ pub struct DatagramReport {
     /// Telemetry: changes of the `--cue-config` file refused (a key out of range; the running configuration
     /// stayed).
     pub cue_refused: u32,
+    /// `--telemetry-shm`: the game, its mappings, and its samples, repeats, torn reads and stalls.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shared_memory: Option<super::live::ShmReport>,
     /// Telemetry: reads of the changed `--cue-config` file ignored as not yet whole (empty, cut short: not TOML,
     /// as an editor's truncate-then-write leaves it for a moment); read again at its next change.
     pub cue_ignored: u32,

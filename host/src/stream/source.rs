@@ -1,6 +1,5 @@
-//! Where a stream's poses come from: a built-in motion, a pose file, or UDP datagrams from simulator software.
-
-use std::time::Duration;
+//! Where a stream's poses come from: a built-in motion, a pose file, or a live source (UDP datagrams from simulator
+//! software, a game's shared memory: [`super::live`]).
 
 use ringpod_core::kinematics::presets::TRAINER_MODEL_RANGES;
 use ringpod_core::kinematics::Pose;
@@ -184,23 +183,8 @@ pub enum Source {
     },
     /// Timed poses from a CSV file.
     Poses(Vec<TimedPose>),
-    /// Poses from UDP datagrams, sent as they arrive.
-    Udp(UdpSource),
-}
-
-/// A live source of poses: simulator software sending one datagram per pose or per telemetry sample.
-pub struct UdpSource {
-    /// The bound socket.
-    pub socket: std::net::UdpSocket,
-    /// What a datagram means.
-    pub decoder: crate::stream::datagram::Decoder,
-    /// End after this long without a datagram.
-    pub idle: Duration,
-    /// Take datagrams from this address only.
-    pub from: Option<std::net::IpAddr>,
-    /// `--capture`: every datagram that arrives (from any sender, readable or not) written to a pcap file, and the
-    /// file's name.
-    pub capture: Option<(Box<crate::input::capture::CaptureWriter>, String)>,
+    /// Poses from a live source (UDP datagrams, a game's shared memory), sent as they arrive.
+    Live(super::live::LiveSource),
 }
 
 /// The columns of a pose file.

@@ -1,0 +1,107 @@
+//! Automobilista 2 and Project CARS 2: their shared memory (`Shared Memory: Project CARS 2` in the game's options).
+//!
+//! Source: `SharedMemory.h` of Project CARS 2 as Reiza ships it with AMS2 ("Storage structure for storing and
+//! updating shared memory", `SHARED_MEMORY_VERSION` 13 in the copy read, kept in public code; AMS2's later
+//! releases, version 14, append fields at the end, as the "AMS2 Additions (v10...)" before them did), in the
+//! mapping `$pcars2$`. Every member is at most 4 bytes, so the natural alignment is 4-byte
+//! packing; little-endian:
+//!
+//! | bytes | field | |
+//! |---|---|---|
+//! | 0 | `mVersion` | u32, `SHARED_MEMORY_VERSION`: 8 or above has `mSequenceNumber` |
+//! | 8 | `mGameState` | u32: not used (AMS2 is reported to write 3, paused, while driving) |
+//! | 28-6427 | `mParticipantInfo[64]` | 100 bytes each: not read |
+//! | 6908-6919 | `mOrientation[3]` | f32, "Euler Angles" |
+//! | 6944-6955 | `mAngularVelocity[3]` | f32, "Radians per-second" |
+//! | 6956-6967 | `mLocalAcceleration[3]` | f32, "Metres per-second" (per second squared: an acceleration) |
+//! | 7320 | `mSequenceNumber` | u32, "incremented at start and end of writing, so odd when Shared Memory is being filled, even when the memory is not being touched" |
+//!
+//! The offsets follow from the header's members in order (`mOrientation` after `mBoostAmount` at 6904;
+//! `mSequenceNumber` after `mCloudBrightness` at 7316). The header says the memory "will be updated once per
+//! graphics frame": ringpod assumes 60 Hz for its stall count. A sample is new when `mSequenceNumber` is even and
+//! has moved; an odd one, or one that moved during the copy, is a torn read.
+//!
+//! ## Conversion
+//!
+//! `SharedMemory.h` gives units, not axes, nor the order of the Euler angles, nor whether the angular velocity is
+//! in the car's axes: **all assumed** here. The car's axes x to its right, y up, z back (right-handed), the
+//! acceleration without gravity, the angular velocity in the car's axes and right-handed, and `mOrientation` as
+//! (pitch, heading, roll) with pitch positive nose up and roll positive right side down:
+//!
+//! | ringpod | from | |
+//! |---|---|---|
+//! | force x | `-mLocalAcceleration[2] + g sin(pitch)` | assumed |
+//! | force y | `-mLocalAcceleration[0] + g cos(pitch) sin(roll)` | assumed |
+//! | force z | `mLocalAcceleration[1] + g cos(pitch) cos(roll)` | assumed |
+//! | rate roll | `-mAngularVelocity[2]` | assumed |
+//! | rate pitch | `-mAngularVelocity[0]` | assumed |
+//! | rate yaw | `mAngularVelocity[1]` | assumed |
+//! | time | none: the arrival time is used | the structure has no simulation clock |
+//!
+//! A drive captured in the game is the check: accelerating must give force x > 0, a left turn force y > 0 and a
+//! positive yaw rate.
+
+use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
+use crate::games::{add, gravity_from_attitude, Telemetry};
+
+/// The mapping.
+pub const MAPPING: &str = "$pcars2$";
+/// Assumed: a graphics frame at 60 Hz.
+pub const RATE_HZ: f64 = 60.0;
+/// The first version with `mSequenceNumber`.
+pub const MIN_VERSION: u32 = 8;
+/// The bytes read: through `mSequenceNumber`.
+pub const SIZE: usize = at::SEQUENCE_NUMBER + 4;
+
+/// Byte offsets of the fields read.
+pub mod at {
+    /// `mVersion`.
+    pub const VERSION: usize = 0;
+    /// `mOrientation[3]`.
+    pub const ORIENTATION: usize = 6908;
+    /// `mAngularVelocity[3]`.
+    pub const ANGULAR_VELOCITY: usize = 6944;
+    /// `mLocalAcceleration[3]`.
+    pub const LOCAL_ACCELERATION: usize = 6956;
+    /// `mSequenceNumber`.
+    pub const SEQUENCE_NUMBER: usize = 7320;
+}
+
+/// Reads one snapshot of `$pcars2$` (at least its first [`SIZE`] bytes).
+pub fn decode(page: &[u8]) -> Result<Read, Unreadable> {
+    let b = Bytes(page);
+    let (Some(version), Some(sequence)) = (b.u32(at::VERSION), b.u32(at::SEQUENCE_NUMBER)) else {
+        return Err(Unreadable::size(
+            Game::Ams2,
+            MAPPING,
+            page.len(),
+            format!("{SIZE} bytes"),
+        ));
+    };
+    if version < MIN_VERSION {
+        return Err(Unreadable::Header {
+            game: Game::Ams2,
+            why: format!("mVersion is {version}: before {MIN_VERSION} the memory has no mSequenceNumber"),
+        });
+    }
+    if sequence % 2 == 1 {
+        return Err(Unreadable::Torn { game: Game::Ams2 });
+    }
+    let [pitch, _, roll] = b.vec3(at::ORIENTATION);
+    let [wx, wy, wz] = b.vec3(at::ANGULAR_VELOCITY);
+    let [ax, ay, az] = b.vec3(at::LOCAL_ACCELERATION);
+    Ok(Read {
+        tick: u64::from(sequence),
+        guard: Guard::of(page, 0, at::SEQUENCE_NUMBER, 4),
+        sample: Sample {
+            time: None,
+            telemetry: Telemetry {
+                force: add([-az, -ax, ay], gravity_from_attitude(pitch, roll)),
+                rate: [-wz, -wx, wy],
+            },
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,86 @@
+//! A game's shared memory through the whole stream, on the simulated device: the memory is held in vectors and
+//! written by a thread-free "game" at each read, as the poller reads it.
+
+use std::time::{Duration, Instant};
+
+use super::*;
+use crate::games::shm::testing::{Fake, Page};
+use crate::games::shm::{ams2, Game};
+use crate::link::client::Client;
+use crate::link::sim::SimDevice;
+use crate::link::transport::AnyTransport;
+use crate::stream::{Options, Source};
+
+/// AMS2's memory: a new sample every 5 ms for `drive` (accelerating forward at 2 m/s^2), then nothing (the game
+/// paused); every 50th read finds the game mid-write (an odd sequence).
+fn game(drive: Duration) -> Fake {
+    let start = Instant::now();
+    let page = |sequence: u32| {
+        let mut p = Page::zeros(ams2::SIZE);
+        // The module's axes: z back, so forward is -z.
+        p.u32(ams2::at::VERSION, 14)
+            .f32s(ams2::at::LOCAL_ACCELERATION + 8, &[-2.0])
+            .u32(ams2::at::SEQUENCE_NUMBER, sequence);
+        p.0
+    };
+    let mut fake = Fake::new(vec![page(2)]);
+    fake.game = Some(Box::new(move |read, pages| {
+        let t = start.elapsed().min(drive);
+        let sequence = 2 + 2 * (t.as_millis() / 5) as u32;
+        let odd = u32::from(read % 50 == 49 && t < drive);
+        pages[0] = Some(page(sequence + odd));
+    }));
+    fake
+}
+
+#[test]
+fn a_games_shared_memory_is_streamed_captured_and_counted() {
+    let dir = std::env::temp_dir().join(format!("ringpod-shm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let capture_path = dir.join("drive.pcap");
+    let writer = crate::input::capture::CaptureWriter::create(&capture_path, SHM_CAPTURE).unwrap();
+    let decoder =
+        crate::stream::command::telemetry_decoder(crate::games::TelemetryFormat::Text, None, &None, &None).unwrap();
+    let source = Source::Live(LiveSource {
+        receiver: Receiver::Shm(Box::new(ShmSource::new(
+            Game::Ams2,
+            Box::new(game(Duration::from_millis(800))),
+        ))),
+        decoder,
+        idle: Duration::from_millis(600),
+        from: None,
+        capture: Some((Box::new(writer), capture_path.display().to_string())),
+    });
+    let mut client = Client::new(AnyTransport::Sim(Box::new(SimDevice::new(false))));
+    let options = Options {
+        home: false,
+        host_limits: true,
+        quiet: true,
+        telemetry: false,
+        telemetry_hz: None,
+    };
+    let report = crate::stream::run(&mut client, source, Vec::new(), &options, true, &|| false, None).unwrap();
+    let d = report.datagrams.as_ref().unwrap();
+    let shm = d.shared_memory.as_ref().unwrap();
+    assert_eq!(report.outcome, "followed", "{report:?}");
+    assert_eq!(shm.game, Game::Ams2);
+    assert!(shm.counts.samples > 50, "{shm:?}");
+    assert_eq!(u64::from(d.received), shm.counts.samples + shm.counts.refused);
+    assert!(shm.counts.repeats > 0 && shm.counts.torn > 0, "{shm:?}");
+    assert_eq!(shm.counts.stalls, 1, "the game's pause at the end: {shm:?}");
+    assert!(report.setpoints_sent as u64 >= shm.counts.samples, "{report:?}");
+    // The capture holds each sample as a text line, which `cue --input` reads back.
+    let c = report.capture.as_ref().unwrap();
+    assert_eq!((c.packets, c.error.as_deref()), (shm.counts.samples, None));
+    let bytes = std::fs::read(&capture_path).unwrap();
+    let (rows, errors, _) =
+        crate::analysis::cue_capture::rows(&bytes, crate::games::TelemetryFormat::Text, None, None).unwrap();
+    assert!(errors.is_empty(), "{errors:?}");
+    assert_eq!(rows.len() as u64, shm.counts.samples);
+    let row = &rows[rows.len() / 2].1;
+    assert!(
+        (row[1] - 2.0).abs() < 1e-6 && (row[3] - ringpod_core::cueing::G).abs() < 1e-6,
+        "{row:?}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
