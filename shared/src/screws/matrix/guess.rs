@@ -10,19 +10,20 @@ use super::pairs::{inverse, Joint};
 use super::LoopError;
 
 /// The frame `A_0k = [[1, 0], [r_o, e_x e_y e_z]]` through the origin `o` with `x` on its +X axis and `z` on its +Z
-/// axis: `e_x`, `e_z` normalised, `e_y = e_z x e_x`. The two directions must be perpendicular (as the sketch draws
-/// them); a zero or non-finite direction is refused.
+/// axis: `e_x`, `e_z` normalised, `e_y = e_z x e_x`. A sketch's directions are seldom exactly perpendicular, so
+/// `e_x` is first made perpendicular to `e_z` (the paper assumes they are); a zero, parallel or non-finite
+/// direction is refused.
 pub fn frame(o: &Vector3<f64>, x: &Vector3<f64>, z: &Vector3<f64>) -> Result<Matrix4<f64>, LoopError> {
     let unit = |v: Vector3<f64>| {
         let n = libm::sqrt(v.dot(&v));
-        if n > 0.0 && n.is_finite() {
+        if n > 1e-12 && n.is_finite() {
             Ok(v / n)
         } else {
             Err(LoopError::NonFinite)
         }
     };
-    let ex = unit(x - o)?;
     let ez = unit(z - o)?;
+    let ex = unit((x - o) - ez * (x - o).dot(&ez))?;
     let ey = ez.cross(&ex);
     let mut a = Matrix4::identity();
     a.fixed_view_mut::<3, 1>(1, 0).copy_from(o);
@@ -54,7 +55,11 @@ pub fn values(joint: Joint, a: &Matrix4<f64>) -> [f64; 3] {
         // cos phi) and a33 = cos theta; theta is taken in [0, pi].
         Joint::Spherical => {
             let s = libm::sqrt(e(1, 3) * e(1, 3) + e(2, 3) * e(2, 3));
-            [libm::atan2(e(1, 3), -e(2, 3)), libm::atan2(s, e(3, 3)), libm::atan2(e(3, 1), e(3, 2))]
+            [
+                libm::atan2(e(1, 3), -e(2, 3)),
+                libm::atan2(s, e(3, 3)),
+                libm::atan2(e(3, 1), e(3, 2)),
+            ]
         }
     }
 }
