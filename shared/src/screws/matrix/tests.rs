@@ -25,7 +25,7 @@ fn is_rigid(a: &Matrix4<f64>) -> bool {
 }
 
 #[test]
-fn every_pair_is_a_rigid_motion_whose_generators_are_its_derivatives() {
+fn every_pair_is_a_rigid_motion_whose_generators_are_its_derivatives() -> Result<(), LoopError> {
     let h = 1e-6;
     for joint in PAIRS {
         let n = joint.variables();
@@ -44,6 +44,7 @@ fn every_pair_is_a_rigid_motion_whose_generators_are_its_derivatives() {
         }
         assert_eq!(joint.generator(n, &Q[..n]), Matrix4::zeros(), "{joint:?}");
     }
+    Ok(())
 }
 
 #[test]
@@ -73,7 +74,7 @@ fn screw_and_cylindrical_share_the_revolute_axes() {
 }
 
 #[test]
-fn each_pairs_variables_are_read_back_from_its_transform() {
+fn each_pairs_variables_are_read_back_from_its_transform() -> Result<(), LoopError> {
     for joint in PAIRS {
         let n = joint.variables();
         let got = values(joint, &joint.transform(&Q[..n]));
@@ -81,15 +82,16 @@ fn each_pairs_variables_are_read_back_from_its_transform() {
             assert!((got[k] - Q[k]).abs() < 1e-12, "{joint:?} {k}: {got:?}");
         }
     }
+    Ok(())
 }
 
 #[test]
-fn a_frame_from_three_points_and_the_revolute_angle_between_two() {
+fn a_frame_from_three_points_and_the_revolute_angle_between_two() -> Result<(), LoopError> {
     let o = Vector3::new(0.1, 0.2, 0.3);
-    let base = frame(&o, &(o + Vector3::x()), &(o + Vector3::z())).unwrap();
+    let base = frame(&o, &(o + Vector3::x()), &(o + Vector3::z()))?;
     // Ten degrees round z, with the +X point 5 % off the perpendicular (a sketch's error).
     let (s, c) = (10f64.to_radians().sin(), 10f64.to_radians().cos());
-    let other = frame(&o, &(o + Vector3::new(c, s, 0.05)), &(o + Vector3::z() * 2.0)).unwrap();
+    let other = frame(&o, &(o + Vector3::new(c, s, 0.05)), &(o + Vector3::z() * 2.0))?;
     assert!(is_rigid(&other));
     let g = values(Joint::Revolute, &relative(&base, &other))[0];
     assert!((g - 10f64.to_radians()).abs() < 1e-15);
@@ -97,6 +99,7 @@ fn a_frame_from_three_points_and_the_revolute_angle_between_two() {
         frame(&o, &(o + Vector3::z()), &(o + Vector3::z())),
         Err(LoopError::NonFinite)
     );
+    Ok(())
 }
 
 mod spatial_loop;

@@ -16,7 +16,7 @@ fn link(a: f64, alpha: f64, d: f64, theta: f64) -> Matrix4<f64> {
 }
 
 /// Three skew links; the fourth closes the loop at [`AT`].
-fn rcsr() -> Loop<4> {
+fn rcsr() -> Result<Loop<4>, LoopError> {
     let mut l = Loop {
         joints: JOINTS,
         links: [
@@ -26,37 +26,38 @@ fn rcsr() -> Loop<4> {
             Matrix4::identity(),
         ],
     };
-    let open = l.closure(&AT).unwrap();
+    let open = l.closure(&AT)?;
     l.links[3] = inverse(&open);
-    l
+    Ok(l)
 }
 
-fn close_at(l: &Loop<4>, guess: &[f64; 7]) -> [f64; 7] {
-    let (q, _) = l.close(0, guess, 1e-13, 30).unwrap();
-    assert!((l.closure(&q).unwrap() - Matrix4::identity()).amax() < 1e-10);
-    q
+fn close_at(l: &Loop<4>, guess: &[f64; 7]) -> Result<[f64; 7], LoopError> {
+    let (q, _) = l.close(0, guess, 1e-13, 30)?;
+    assert!((l.closure(&q)? - Matrix4::identity()).amax() < 1e-10);
+    Ok(q)
 }
 
 #[test]
-fn closes_from_a_perturbed_guess() {
-    let l = rcsr();
+fn closes_from_a_perturbed_guess() -> Result<(), LoopError> {
+    let l = rcsr()?;
     assert_eq!(l.variables(), 7);
     let mut guess = AT;
     for (k, v) in guess.iter_mut().enumerate().skip(1) {
         *v += if k % 2 == 0 { 0.06 } else { -0.05 };
     }
-    let (q, iterations) = l.close(0, &guess, 1e-12, 30).unwrap();
-    assert!((l.closure(&q).unwrap() - Matrix4::identity()).amax() < 1e-10);
+    let (q, iterations) = l.close(0, &guess, 1e-12, 30)?;
+    assert!((l.closure(&q)? - Matrix4::identity()).amax() < 1e-10);
     assert!(
         q.iter().zip(&AT).all(|(a, b)| (a - b).abs() < 1e-9),
         "{q:?} after {iterations}"
     );
     assert!(iterations <= 8, "{iterations} iterations");
+    Ok(())
 }
 
 #[test]
-fn closes_from_a_sketch_of_three_points_per_frame() {
-    let l = rcsr();
+fn closes_from_a_sketch_of_three_points_per_frame() -> Result<(), LoopError> {
+    let l = rcsr()?;
     // Sketch each pair's two frames (before and after its motion) by three points, each point a millimetre or so
     // off, as drawn; read the pair's variables from A_ij = A_0i^-1 A_0j.
     let mut before = Matrix4::identity();
@@ -71,31 +72,32 @@ fn closes_from_a_sketch_of_three_points_per_frame() {
                     .fixed_rows::<3>(1)
                     .into_owned()
             };
-            frame(&p(0.0, 0.0), &p(0.1, 0.0), &p(0.0, 0.1)).unwrap()
+            frame(&p(0.0, 0.0), &p(0.1, 0.0), &p(0.0, 0.1))
         };
         wobble += 0.0007;
-        let got = values(*joint, &relative(&sketch(&before, wobble), &sketch(&after, -wobble)));
+        let got = values(*joint, &relative(&sketch(&before, wobble)?, &sketch(&after, -wobble)?));
         guess[v..v + n].copy_from_slice(&got[..n]);
         before = after * l.links[i];
         v += n;
     }
     guess[0] = AT[0];
-    let q = close_at(&l, &guess);
+    let q = close_at(&l, &guess)?;
     assert!(
         q.iter().zip(&AT).all(|(a, b)| (a - b).abs() < 1e-9),
         "{q:?} from {guess:?}"
     );
+    Ok(())
 }
 
 #[test]
-fn follows_a_path_with_warm_starts_and_its_rates_match_finite_differences() {
-    let l = rcsr();
+fn follows_a_path_with_warm_starts_and_its_rates_match_finite_differences() -> Result<(), LoopError> {
+    let l = rcsr()?;
     let (h, step) = (1e-5, 0.02);
     let mut q = AT;
     for _ in 0..40 {
         let mut next = q;
         next[0] += step;
-        let (closed, iterations) = l.close(0, &next, 1e-13, 30).unwrap();
+        let (closed, iterations) = l.close(0, &next, 1e-13, 30)?;
         assert!(iterations <= 5, "{iterations} iterations at {}", next[0]);
         q = closed;
         let shifted = |d: f64| {
@@ -103,10 +105,10 @@ fn follows_a_path_with_warm_starts_and_its_rates_match_finite_differences() {
             g[0] += d;
             close_at(&l, &g)
         };
-        let (up, down) = (shifted(h), shifted(-h));
-        let rates = l.rates(0, &q, 1.0).unwrap();
-        let accels = l.accelerations(0, &q, &rates, 0.0).unwrap();
-        let (rates_up, rates_down) = (l.rates(0, &up, 1.0).unwrap(), l.rates(0, &down, 1.0).unwrap());
+        let (up, down) = (shifted(h)?, shifted(-h)?);
+        let rates = l.rates(0, &q, 1.0)?;
+        let accels = l.accelerations(0, &q, &rates, 0.0)?;
+        let (rates_up, rates_down) = (l.rates(0, &up, 1.0)?, l.rates(0, &down, 1.0)?);
         for k in 0..7 {
             let fd = (up[k] - down[k]) / (2.0 * h);
             assert!(
@@ -122,12 +124,14 @@ fn follows_a_path_with_warm_starts_and_its_rates_match_finite_differences() {
             );
         }
     }
+    Ok(())
 }
 
 #[test]
-fn a_wrong_number_of_variables_is_refused() {
-    let l = rcsr();
+fn a_wrong_number_of_variables_is_refused() -> Result<(), LoopError> {
+    let l = rcsr()?;
     assert_eq!(l.closure(&[0.0; 4]), Err(LoopError::Shape));
     assert_eq!(l.close(0, &[0.0; 6], 1e-12, 5), Err(LoopError::Shape));
     assert_eq!(l.rates(7, &AT, 1.0), Err(LoopError::Shape));
+    Ok(())
 }
