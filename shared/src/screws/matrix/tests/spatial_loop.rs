@@ -153,3 +153,45 @@ fn a_wrong_number_of_variables_is_refused() -> Result<(), LoopError> {
     }
     Ok(())
 }
+
+/// The frame after each pair, at `q`.
+fn frames(l: &Loop<4>, q: &[f64; 7]) -> [Matrix4<f64>; 4] {
+    let (mut acc, mut v) = (Matrix4::identity(), 0);
+    core::array::from_fn(|i| {
+        let n = l.joints[i].variables();
+        let here = acc * l.joints[i].transform(&q[v..v + n]);
+        acc = here * l.links[i];
+        v += n;
+        here
+    })
+}
+
+#[test]
+fn the_mass_matches_finite_differences_of_the_link_frames() -> Result<(), LoopError> {
+    let h = 1e-6;
+    let inertia = [
+        Some(rod_along_x(1.0, 0.12)),
+        Some(rod_along_x(2.0, 0.35)),
+        Some(rod_along_x(1.5, 0.20)),
+        None,
+    ];
+    for joints in LOOPS {
+        let l = built(joints)?;
+        let shifted = |d: f64| {
+            let mut g = AT;
+            g[0] += d;
+            close_at(&l, &g)
+        };
+        let (up, down) = (frames(&l, &shifted(h)?), frames(&l, &shifted(-h)?));
+        let mut want = 0.0;
+        for i in 0..4 {
+            if let Some(j) = &inertia[i] {
+                let c = (up[i] - down[i]) / (2.0 * h);
+                want += (c * j * c.transpose()).trace();
+            }
+        }
+        let got = l.mass(0, &AT, &inertia)?;
+        assert!((got - want).abs() < 1e-6 * want, "{joints:?}: {got} vs {want}");
+    }
+    Ok(())
+}
