@@ -174,9 +174,9 @@ impl<const N: usize> Loop<N> {
     }
 
     /// Accelerations of the variables for the input's rate and acceleration, at a closed `q` with rates `qd`:
-    /// `sum B_v q''_v = -sum_(u<v) q'_u q'_v (B_u B_v - B_v B_u)`. The pairs of several variables here commute
-    /// (cylindrical) or are products whose generators follow the same ordered rule, so the formula holds for them
-    /// with the variables in loop order.
+    /// `sum B_v q''_v = -sum_(u<v) q'_u q'_v (B_u B_v - B_v B_u)`. It holds for pairs of several variables too:
+    /// each variable moves by a constant generator conjugated by all that precedes it in the loop (the cylindrical
+    /// pair's two motions commute, so their order does not matter), which is what the formula assumes.
     pub fn accelerations<const V: usize>(
         &self,
         input: usize,
