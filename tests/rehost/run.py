@@ -127,7 +127,7 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
-def serial_checks(m, p, log, plant, ringpod, board_hold_up=False):
+def serial_checks(m, p, log, plant, ringpod):
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -177,7 +177,7 @@ def serial_checks(m, p, log, plant, ringpod, board_hold_up=False):
     settings_check(m, log, cli, port)
     homing_check(m, plant, cli, port)
     stream_check(m, plant, cli, port, ringpod)
-    hold_up_checks(CHECKS, m, cli, port, board=board_hold_up)
+    hold_up_checks(CHECKS, m, cli, port)
 
 
 def stream_check(m, plant, cli, port, ringpod):
@@ -295,8 +295,6 @@ def main():
     ap.add_argument("--memory-x", default=os.path.join(REPO, "memory.x"))
     ap.add_argument("--seconds", type=float, default=1.0, help="simulated seconds of normal running")
     ap.add_argument("--ringpod", help="the host CLI binary: runs the serial-link checks over a pty")
-    ap.add_argument("--board-hold-up", action="store_true",
-                    help="also hold the board's CPU up mid-stream (a known failure: see hold_up.py)")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the book's Emulation chapter")
     args = ap.parse_args()
 
@@ -460,7 +458,7 @@ def main():
     # -- the host link on USART1: the real CLI over a pty --
     m.nvic.held.discard(TIM5_IRQ)
     if args.ringpod:
-        serial_checks(m, p, log, plant, args.ringpod, args.board_hold_up)
+        serial_checks(m, p, log, plant, args.ringpod)
 
     wall = time.time() - wall0
     sim = m.now / SYSCLK
