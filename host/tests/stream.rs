@@ -1227,8 +1227,14 @@ fn a_record_at_the_control_rate_reads_the_18_8_hz_experiment() {
         span(&mut window.iter().map(|w| w.0)),
         span(&mut window.iter().map(|w| w.1)),
     );
-    assert!((seat - asked).abs() < 40e-6, "the seat spans {seat} m, the sine {asked} m");
-    assert!((asked / (2.0 * 0.008 / (std::f64::consts::TAU * 18.8)) - 1.0).abs() < 0.01, "{asked}");
+    assert!(
+        (seat - asked).abs() < 40e-6,
+        "the seat spans {seat} m, the sine {asked} m"
+    );
+    assert!(
+        (asked / (2.0 * 0.008 / (std::f64::consts::TAU * 18.8)) - 1.0).abs() < 0.01,
+        "{asked}"
+    );
 
     // On a board's link: the rate is the device's setting, set for the run and back after it.
     let (server, path) = simulator_on_a_pty();
