@@ -22,6 +22,9 @@ from machine import SYSCLK
 
 STALLS_S = (0.05, 0.5, 2.0)
 BOARD_STALL_S = 0.03
+# The hold-ups come once the stream's setpoints flow (about 40 frames sent), not during the requests before it,
+# whose answers the host waits 2 s for.
+STREAMING_BYTES = 2_000
 
 
 def _status(cli, port):
@@ -52,12 +55,18 @@ def hold_up_checks(checks, m, cli, port):
     _board_hold_up(checks, m, cli, port)
 
 
+def _streaming(cli, since):
+    """Whether the host's setpoints flow: it has sent more than a request's worth since `since` (bytes)."""
+    return cli.bridge.to_board - since > STREAMING_BYTES
+
+
 def _machine_hold_ups(checks, cli, port):
     for stall in STALLS_S:
         held = []
+        since = cli.bridge.to_board
 
-        def during(sim_s, stall=stall, held=held):
-            if not held and sim_s >= 0.05:
+        def during(sim_s, stall=stall, held=held, since=since):
+            if not held and _streaming(cli, since):
                 held.append(sim_s)
                 time.sleep(stall)  # the machine does not run: device time stands still, the pty fills
 
@@ -76,9 +85,10 @@ def _machine_hold_ups(checks, cli, port):
 def _board_hold_up(checks, m, cli, port):
     overruns0 = m.usart1.overruns
     held = []
+    since = cli.bridge.to_board
 
     def during(sim_s):
-        if not held and sim_s >= 0.1:
+        if not held and _streaming(cli, since):
             held.append(sim_s)
             m.cpu_held_until = m.now + int(BOARD_STALL_S * SYSCLK)
 
