@@ -9,6 +9,10 @@ use std::path::PathBuf;
 /// part is the error number in Rust's text of the error.
 const MISSING: &str = if cfg!(windows) { "(os error" } else { "No such file" };
 
+/// How the system says a path is a directory where a file was asked for: Linux's words; Windows refuses to open it
+/// ("Access denied", error 5).
+const DIRECTORY: &str = if cfg!(windows) { "(os error 5)" } else { "directory" };
+
 fn ringpod() -> Command {
     Command::cargo_bin("ringpod").unwrap()
 }
@@ -80,7 +84,7 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
         ),
         (write("binary.toml", &[0xff, 0xfe, 0x00, 0x80, 0x13, 0x37]), "UTF-8"),
         (dir.join("missing.toml").display().to_string(), MISSING),
-        (dir.display().to_string(), "directory"),
+        (dir.display().to_string(), DIRECTORY),
     ];
     let picture = dir.join("ws.svg").display().to_string();
     for (path, cause) in &cases {
@@ -233,7 +237,7 @@ fn a_file_that_is_not_a_text_file_is_refused_at_once() {
     let binary = binary.display().to_string();
     let mut cases = vec![
         (binary.as_str(), "not UTF-8"),
-        (folder.as_str(), "directory"),
+        (folder.as_str(), DIRECTORY),
         ("/nonexistent/poses.csv", MISSING),
     ];
     // An endless file: Unix has one to hand.
