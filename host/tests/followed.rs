@@ -2,24 +2,9 @@
 //! carriages keep up with) recorded at every control tick, each row's followed pose checked against the steps the
 //! same row counts.
 
-use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
-use ringpod_core::motion::{AxisScale, StepConverter};
+mod common;
 
-/// The trainer model's steps converter after homing (step 0 of every axis at the home pose), and that position.
-fn homed() -> (RingPlatform<f32>, StepConverter, MultiTurn<f32>) {
-    let m = RingPlatform::<f32>::new(&presets::TRAINER_MODEL);
-    let c = AxisScale::MODEL_CARRIAGE;
-    let l = AxisScale::MODEL_LINEAR;
-    let mut conv = StepConverter::new([c, c, c, c, l, l], m.axes());
-    let home = MultiTurn::new(
-        m.inverse(&Pose::from_array(presets::Preset::TrainerModel.home()).cast())
-            .unwrap(),
-    );
-    for a in 0..6 {
-        conv.set_home(a, &home, 0);
-    }
-    (m, conv, home)
-}
+use ringpod_core::kinematics::Pose;
 
 #[test]
 fn the_followed_pose_of_every_row_is_its_counted_steps() {
@@ -51,7 +36,7 @@ fn the_followed_pose_of_every_row_is_its_counted_steps() {
     let pose_cols = ["x", "y", "z", "alpha", "beta", "gamma"].map(col);
     let step_cols = ["steps_1", "steps_2", "steps_3", "steps_4", "steps_5", "steps_6"].map(col);
     let (state, cmd_gamma) = (col("state"), col("cmd_gamma"));
-    let (m, conv, mut q) = homed();
+    let (m, conv, mut q) = common::trainer_homed();
     let (mut running, mut worst, mut lag) = (0, 0i64, 0.0f64);
     for line in lines {
         let f: Vec<&str> = line.split(',').collect();

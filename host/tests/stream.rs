@@ -8,8 +8,7 @@ use common::spawn_live_stream;
 use common::spawn_sim_stream;
 #[cfg(unix)]
 use nix::sys::signal::Signal;
-use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
-use ringpod_core::motion::{AxisScale, StepConverter};
+use ringpod_core::kinematics::Pose;
 
 fn stream(args: &[&str], csv: Option<&str>) -> (serde_json::Value, std::process::Output) {
     let dir = std::env::temp_dir().join(format!("ringpod-stream-{}", std::process::id()));
@@ -30,17 +29,7 @@ fn stream(args: &[&str], csv: Option<&str>) -> (serde_json::Value, std::process:
 
 /// The steps of the model's axes at a pose, after homing (home pose = step 0 on every axis).
 fn steps_at(pose: [f64; 6]) -> [i64; 6] {
-    let m = RingPlatform::<f32>::new(&presets::TRAINER_MODEL);
-    let c = AxisScale::MODEL_CARRIAGE;
-    let l = AxisScale::MODEL_LINEAR;
-    let mut conv = StepConverter::new([c, c, c, c, l, l], m.axes());
-    let home = MultiTurn::new(
-        m.inverse(&Pose::from_array(presets::Preset::TrainerModel.home()).cast())
-            .unwrap(),
-    );
-    for a in 0..6 {
-        conv.set_home(a, &home, 0);
-    }
+    let (m, conv, home) = common::trainer_homed();
     let mut q = home;
     q.inverse_near(&m, &Pose::from_array(pose).cast()).unwrap();
     conv.to_steps(&q)

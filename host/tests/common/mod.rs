@@ -7,6 +7,26 @@ pub mod packets;
 #[cfg(unix)]
 pub mod simulator;
 
+use ringpod_core::kinematics::{presets, Mechanism, MultiTurn, Pose, RingPlatform};
+use ringpod_core::motion::{AxisScale, StepConverter};
+
+/// The trainer model's mechanism, its steps converter after homing (step 0 of every axis at the home pose), and
+/// that position.
+pub fn trainer_homed() -> (RingPlatform<f32>, StepConverter, MultiTurn<f32>) {
+    let m = RingPlatform::<f32>::new(&presets::TRAINER_MODEL);
+    let c = AxisScale::MODEL_CARRIAGE;
+    let l = AxisScale::MODEL_LINEAR;
+    let mut conv = StepConverter::new([c, c, c, c, l, l], m.axes());
+    let home = MultiTurn::new(
+        m.inverse(&Pose::from_array(presets::Preset::TrainerModel.home()).cast())
+            .unwrap(),
+    );
+    for a in 0..6 {
+        conv.set_home(a, &home, 0);
+    }
+    (m, conv, home)
+}
+
 /// Starts `ringpod stream --sim --report-json --quiet ARGS` with its output piped.
 pub fn spawn_sim_stream(args: &[&str]) -> std::process::Child {
     std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
