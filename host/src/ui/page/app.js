@@ -201,6 +201,7 @@ $("stream-file").addEventListener("click", async () => {
 $("run-udp").addEventListener("click", () => {
   const request = { do: "udp", port: +$("udp-port").value, holds: $("udp-holds").value, format: $("udp-format").value, idle: +$("udp-idle").value };
   if ($("udp-from").value.trim()) request.from = $("udp-from").value.trim();
+  if ($("udp-outsim-opts").value.trim()) request.outsim_opts = $("udp-outsim-opts").value.trim();
   send(request);
 });
 $("park").addEventListener("click", () => send({ do: "park" }));
