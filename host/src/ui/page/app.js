@@ -183,8 +183,10 @@ function showGates(gates) {
     b.disabled = !!why;
     b.title = why || "";
   });
-  $("gates").innerHTML = Object.entries(gates).filter(([, why]) => why)
-    .map(([k, why]) => `<div><b>${k}</b>: ${why}</div>`).join("");
+  // One line per reason, naming the actions it holds back: six buttons refused for the same reason read as one.
+  const byWhy = new Map();
+  for (const [k, why] of Object.entries(gates)) if (why) byWhy.set(why, [...(byWhy.get(why) || []), k]);
+  $("gates").innerHTML = [...byWhy].map(([why, ks]) => `<div><b>${ks.join(", ")}</b>: ${escapeHtml(why)}</div>`).join("");
 }
 document.querySelectorAll("[data-do]").forEach((b) => b.addEventListener("click", () => send({ do: b.dataset.do })));
 $("jog").addEventListener("click", () => send({ do: "jog", axis: +$("jog-axis").value, distance: +$("jog-distance").value }));
@@ -271,6 +273,7 @@ function cueControl(f) {
     input.title = `${f.min} to ${f.max}${f.unit ? " " + f.unit : ""}`;
     input.addEventListener("input", () => {
       setPath(cue.config, f.path, parseFloat(input.value));
+      cue.edited = input;
       clearTimeout(cue.timer);
       cue.timer = setTimeout(recue, 200);
     });
@@ -329,6 +332,8 @@ async function recue() {
     document.querySelectorAll("#cue-controls input, #cue-controls select").forEach((i) => i.classList.remove("bad"));
   } catch (e) {
     status.className = "small msg bad"; status.textContent = e.message;
+    // The value just typed is the one refused (the others were taken before it): marked where the eye is.
+    if (cue.edited) cue.edited.classList.add("bad");
     // The plots were of other parameters: not shown as if they were of these.
     cue.charts.forEach((c) => c.set([]));
   }

@@ -10,8 +10,8 @@
 //!    without the token; the rig editor names a bad key; cueing redraws when a parameter changes; a run record
 //!    opens; a page that goes away stops the stream it started, and with no page left the platform powers down.
 //!
-//! `--screenshots DIR` saves a picture of each panel there (the README's are in `docs/ui/`), and of every panel at
-//! 1366x768 and 1920x1080 at the end. The last line is the
+//! `--screenshots DIR` saves a picture of each panel there (the book's are in `docs/book/src/images/ui/`), and of
+//! every panel at 1366x768 and 1920x1080 at the end, in `DIR/sizes/`. The last line is the
 //! sum, `N passed, N failed`; the exit status is 1 when anything failed.
 
 mod control;
@@ -95,6 +95,10 @@ async fn checks(driver: &str, url: &str, record: &Path, shots: Option<&Path>) ->
     k.report("the rig editor names a bad key", rig_editor(&c, url, shots).await);
     k.report("cueing redraws when a parameter changes", cueing(&c, shots).await);
     k.report("a run record opens in the Runs panel", runs(&c, record, shots).await);
+    k.report(
+        "at 1366x768 the Control panel's buttons are on screen above its log",
+        page::control_fits(&c).await,
+    );
     if let Some(dir) = shots {
         k.report("every panel at 1366x768 and 1920x1080", page::sizes(&c, dir).await);
     }

@@ -67,8 +67,9 @@ pub async fn screenshot(c: &Client, dir: Option<&Path>, name: &str) -> Result<()
 
 pub const STATE: &str = "window.ringpod.frame && window.ringpod.frame.state";
 
-/// Every panel at the two screen sizes a newcomer has, as `PANEL-WxH.png`.
+/// Every panel at the two screen sizes a newcomer has, as `sizes/PANEL-WxH.png` (the book's layout).
 pub async fn sizes(c: &Client, dir: &Path) -> Result<String, String> {
+    let dir = &dir.join("sizes");
     let mut saved = 0;
     for (w, h) in [(1366, 768), (1920, 1080)] {
         c.set_window_size(w, h)
@@ -82,4 +83,36 @@ pub async fn sizes(c: &Client, dir: &Path) -> Result<String, String> {
         }
     }
     Ok(format!("{saved} pictures in {}", dir.display()))
+}
+
+/// At 1366x768 (the smallest screen the workbench is laid out for) the Control panel's every button that starts
+/// something is on screen, above the log that stays at the bottom, without scrolling; then the window is put back.
+pub async fn control_fits(c: &Client) -> Result<String, String> {
+    let (w, h) = c.get_window_size().await.map_err(|e| format!("window size: {e}"))?;
+    c.set_window_size(1366, 768)
+        .await
+        .map_err(|e| format!("window 1366x768: {e}"))?;
+    tab(c, "control").await?;
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let placed = js(
+        c,
+        "(() => { window.scrollTo(0, 0); const log = document.querySelector('#panel-control .log-card') \
+         .getBoundingClientRect().top; \
+         return ['enable', 'run-motion', 'stream-file', 'run-udp', 'jog'].map((id) => { \
+         const b = id === 'enable' ? document.querySelector('[data-do=enable]') : document.getElementById(id); \
+         const r = b.getBoundingClientRect(); return [id, r.top >= 0 && r.bottom <= log, Math.round(r.bottom), \
+         Math.round(log)]; }); })()",
+    )
+    .await?;
+    c.set_window_size(w as u32, h as u32)
+        .await
+        .map_err(|e| format!("window back to {w}x{h}: {e}"))?;
+    let rows = placed.as_array().cloned().unwrap_or_default();
+    if rows.len() == 5 && rows.iter().all(|r| r[1] == true) {
+        Ok(format!("every source's button above the log: {placed}"))
+    } else {
+        Err(format!(
+            "below the fold or under the log ([id, on screen, bottom, log's top]): {placed}"
+        ))
+    }
 }

@@ -35,7 +35,23 @@ pub async fn rig_editor(c: &Client, url: &str, shots: Option<&Path>) -> Result<S
     if !message.as_str().is_some_and(|m| m.contains("ring_raduis")) {
         return Err(format!("the message does not name the key: {message}"));
     }
-    Ok(format!("valid rig drawn; the typo says: {message}"))
+    // Mended, the rig is drawn again (and the panel is left as a user would find it).
+    js(
+        c,
+        "(() => { const t = document.getElementById('rig-text'); \
+         t.value = t.value.replace('ring_raduis', 'ring_radius'); \
+         t.dispatchEvent(new Event('input')); return true; })()",
+    )
+    .await?;
+    until(
+        c,
+        "!document.querySelector('.rig-error') && document.getElementById('rig-messages').textContent.includes('drivable: yes')",
+        Duration::from_secs(20),
+    )
+    .await?;
+    Ok(format!(
+        "valid rig drawn; the typo says: {message}; mended, drawn again"
+    ))
 }
 
 pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> {
@@ -106,9 +122,33 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
         Duration::from_secs(10),
     )
     .await?;
+    // The refusal is said beside the plots, and the value refused is marked, not somewhere below the list.
+    let seen = js(
+        c,
+        "(() => { const r = document.getElementById('cue-status').getBoundingClientRect(); \
+         return [r.top >= 0 && r.bottom <= window.innerHeight, \
+         document.querySelector('[data-path=\"translation_scale.0\"]').classList.contains('bad')]; })()",
+    )
+    .await?;
+    if seen != json!([true, true]) {
+        return Err(format!("the refusal is out of view or the value not marked: {seen}"));
+    }
+    let runs = js(c, "window.ringpod.cueRuns").await?.as_u64().unwrap_or(0);
+    js(
+        c,
+        "(() => { const i = document.querySelector('[data-path=\"translation_scale.0\"]'); \
+         i.value = '0.3'; i.dispatchEvent(new Event('input')); return true; })()",
+    )
+    .await?;
+    until(
+        c,
+        &format!("window.ringpod.cueRuns > {runs} && !document.querySelector('#cue-controls .bad')"),
+        Duration::from_secs(20),
+    )
+    .await?;
     Ok(format!(
         "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; controls by channel with units, selects, the median's \
-         window shown with it: {layout}; -5 refused: {refused}"
+         window shown with it: {layout}; -5 refused in view and marked: {refused}"
     ))
 }
 
