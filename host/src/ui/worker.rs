@@ -347,9 +347,16 @@ impl Device {
                 profile: None,
                 outsim_opts: None,
             },
+            // A front end's pose strings, at the default ranges (the command line's --pose-range).
+            "strings" => {
+                use crate::stream::datagram::template::{Template, DEFAULT_RANGES};
+                let template = Template::parse(format.unwrap_or_default(), DEFAULT_RANGES)
+                    .map_err(|e| WorkerError::NoSuch(e.to_string()))?;
+                Datagrams::Strings(Box::new(template))
+            }
             other => {
                 return Err(WorkerError::NoSuch(format!(
-                    "a UDP session holds `poses` or `telemetry`, not {other:?}"
+                    "a UDP session holds `poses`, `telemetry` or `strings`, not {other:?}"
                 )))
             }
         };
