@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::spawn_live_stream;
+use common::{numbers, spawn_live_stream};
 
 /// The trainer model's home pose (the neutral the strings' offsets are taken from).
 const HOME: [f64; 6] = [0.0, 0.0, 0.227, 0.0, 0.0, 0.0];
@@ -54,12 +54,7 @@ fn each_preset_streams_its_front_ends_strings() {
             1,
             "{preset}: {report}"
         );
-        let last: Vec<f64> = report["last_applied_pose"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect();
+        let last = numbers(&report["last_applied_pose"]);
         let want = [0.0, 0.0, HOME[2] + 0.020, -10f64.to_radians(), 0.0, 0.0];
         // Within a 16-bit step of each axis's range (50, 50, 40 mm; 20 degrees) either way: 32768 is a step
         // above the middle of 0..65535.
