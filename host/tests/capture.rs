@@ -155,35 +155,45 @@ fn block(kind: u32, body: &[u8]) -> Vec<u8> {
     b
 }
 
+/// The capture's first packet time, ns since the epoch.
+const T0_NS: u64 = 1_700_000_000_000_000_000;
+
+/// A pcapng section header and one Ethernet interface with nanosecond times, as Wireshark writes them.
+fn pcapng_header() -> Vec<u8> {
+    let mut shb = 0x1a2b_3c4du32.to_le_bytes().to_vec();
+    shb.extend([1, 0, 0, 0]);
+    shb.extend(u64::MAX.to_le_bytes());
+    let mut file = block(0x0a0d_0d0a, &shb);
+    // Interface: Ethernet, snap length 262144, option if_tsresol = 9, end of options.
+    let mut idb = vec![1, 0, 0, 0];
+    idb.extend(262_144u32.to_le_bytes());
+    idb.extend([9, 0, 1, 0, 9, 0, 0, 0, 0, 0, 0, 0]);
+    file.extend(block(1, &idb));
+    file
+}
+
+/// An enhanced packet block of interface 0: `frame` at `ns`.
+fn epb(ns: u64, frame: &[u8]) -> Vec<u8> {
+    let mut b = 0u32.to_le_bytes().to_vec();
+    b.extend(((ns >> 32) as u32).to_le_bytes());
+    b.extend((ns as u32).to_le_bytes());
+    b.extend((frame.len() as u32).to_le_bytes());
+    b.extend((frame.len() as u32).to_le_bytes());
+    b.extend(frame);
+    while !b.len().is_multiple_of(4) {
+        b.push(0);
+    }
+    block(6, &b)
+}
+
 /// A pcapng file as Wireshark saves one (section header, an Ethernet interface with nanosecond times, enhanced
 /// packet blocks): text telemetry without a time at 100 Hz, and among it an ARP frame, a TCP segment and an IPv4
 /// fragment, skipped and counted.
 #[test]
 fn a_wireshark_pcapng_capture_is_cued() {
     let d = dir("pcapng");
-    let mut file = Vec::new();
-    let mut shb = 0x1a2b_3c4du32.to_le_bytes().to_vec();
-    shb.extend([1, 0, 0, 0]);
-    shb.extend(u64::MAX.to_le_bytes());
-    file.extend(block(0x0a0d_0d0a, &shb));
-    // Interface: Ethernet, snap length 262144, option if_tsresol = 9, end of options.
-    let mut idb = vec![1, 0, 0, 0];
-    idb.extend(262_144u32.to_le_bytes());
-    idb.extend([9, 0, 1, 0, 9, 0, 0, 0, 0, 0, 0, 0]);
-    file.extend(block(1, &idb));
-    let t0: u64 = 1_700_000_000_000_000_000;
-    let epb = |ns: u64, frame: &[u8]| {
-        let mut b = 0u32.to_le_bytes().to_vec();
-        b.extend(((ns >> 32) as u32).to_le_bytes());
-        b.extend((ns as u32).to_le_bytes());
-        b.extend((frame.len() as u32).to_le_bytes());
-        b.extend((frame.len() as u32).to_le_bytes());
-        b.extend(frame);
-        while !b.len().is_multiple_of(4) {
-            b.push(0);
-        }
-        block(6, &b)
-    };
+    let mut file = pcapng_header();
+    let t0 = T0_NS;
     let g = 9.80665;
     for k in 0..50u64 {
         let text = format!("-4 0 {g} 0 0 0");
@@ -298,4 +308,68 @@ fn capture_needs_a_udp_source_and_a_writable_file() {
     let o = run(&["--telemetry-udp", "127.0.0.1:0", "--capture", "/nonexistent/dir/x.pcap"]);
     assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(String::from_utf8_lossy(&o.stderr).contains("/nonexistent/dir/x.pcap"));
+}
+
+/// Live for Speed with `OutSim Opts 19` (header, main section, inputs: 84 bytes, the size of `2f` too, which
+/// places ID and Time before the main section): the size alone cannot tell, so the capture is read only with the
+/// option set, from the command line or from the cueing file (its base or a game's profile); an option set for a
+/// format that never reads OutSimPack2 is refused.
+#[test]
+fn outsim2_options_come_from_the_command_line_or_the_cueing_file() {
+    let d = dir("outsim-opts");
+    let mut file = pcapng_header();
+    for k in 0..50u32 {
+        // Heading 0 faces world +y: braking at 3 m/s^2.
+        let packet = common::packets::outsim2::packet(0x19, k * 10, [0.0; 3], [0.0; 3], [0.0, -3.0, 0.0]);
+        assert_eq!(packet.len(), 84);
+        file.extend(epb(T0_NS + u64::from(k) * 10_000_000, &ethernet_ipv4(17, 0, &packet)));
+    }
+    let path = d.join("lfs.pcapng");
+    std::fs::write(&path, &file).unwrap();
+    let poses = d.join("poses.csv");
+    let base = d.join("base.toml");
+    std::fs::write(&base, "outsim_opts = \"19\"\n").unwrap();
+    let profiled = d.join("profiled.toml");
+    std::fs::write(&profiled, "[profiles.lfs]\noutsim_opts = \"0x19\"\n").unwrap();
+    let (code, summary, said) = cue(&path, &poses, &["--telemetry-format", "outsim2"]);
+    assert_ne!(
+        summary["rows"], 50,
+        "read without the option set: {code:?} {summary} {said}"
+    );
+    assert!(summary.to_string().contains("--outsim-opts"), "{summary} {said}");
+    for args in [
+        &["--outsim-opts", "19"][..],
+        &["--config", base.to_str().unwrap()],
+        &["--config", profiled.to_str().unwrap(), "--profile", "lfs"],
+        // The command line's set wins over the file's.
+        &[
+            "--config",
+            base.to_str().unwrap(),
+            "--outsim-opts",
+            "19",
+            "--telemetry-format",
+            "auto",
+        ],
+    ] {
+        let (code, summary, said) = cue(&path, &poses, args);
+        assert_eq!(
+            (code, &summary["rows"]),
+            (Some(0), &serde_json::json!(50)),
+            "{args:?}: {said}"
+        );
+        assert!(last_pose(&poses)[0] < 0.0, "braking moves the platform back");
+    }
+    let (code, _, said) = cue(&path, &poses, &["--config", profiled.to_str().unwrap()]);
+    assert_ne!(code, Some(0), "the base has no option set: {said}");
+    std::fs::write(&base, "outsim_opts = 409\n").unwrap();
+    let (code, _, said) = cue(&path, &poses, &["--config", base.to_str().unwrap()]);
+    assert!(code != Some(0) && said.contains("outsim_opts"), "{said}");
+    std::fs::write(&base, "outsim_opts = \"7\"\n").unwrap();
+    let (code, _, said) = cue(&path, &poses, &["--config", base.to_str().unwrap()]);
+    assert!(
+        code != Some(0) && said.contains("outsim_opts") && said.contains("main section"),
+        "{said}"
+    );
+    let (code, _, said) = cue(&path, &poses, &["--telemetry-format", "f1", "--outsim-opts", "19"]);
+    assert!(code != Some(0) && said.contains("outsim2 or auto"), "{said}");
 }

@@ -251,9 +251,18 @@ fn read_input(
     };
     let bytes = crate::input::files::read_bytes(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
     if crate::input::capture::is_capture(&bytes) {
+        if args.outsim_opts.is_some() && args.telemetry_format.is_some_and(|f| !f.reads_outsim2()) {
+            return Err(bad(
+                "--outsim-opts describes Live for Speed's OutSimPack2 packets: it needs \
+                 --telemetry-format outsim2 or auto"
+                    .into(),
+            ));
+        }
         let format = args.telemetry_format.unwrap_or(crate::games::TelemetryFormat::Auto);
-        let (rows, errors, summary) = super::cue_capture::rows(&bytes, format, args.udp_port, args.outsim_opts)
-            .map_err(|e| bad(e.to_string()))?;
+        let opts = crate::games::outsim2::Opts::chosen(format, args.outsim_opts, args.config, args.profile)
+            .map_err(CliError::from)?;
+        let (rows, errors, summary) =
+            super::cue_capture::rows(&bytes, format, args.udp_port, opts).map_err(|e| bad(e.to_string()))?;
         return Ok((rows, errors, Some(summary)));
     }
     if args.telemetry_format.is_some() || args.udp_port.is_some() || args.outsim_opts.is_some() {

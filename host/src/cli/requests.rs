@@ -137,6 +137,11 @@ pub enum RequestError {
     /// `--capture` without a live source.
     #[error("--capture records a live source: it needs --udp, --telemetry-udp or --telemetry-shm")]
     CaptureWithoutUdp,
+    /// `--outsim-opts` with a telemetry format that never reads `OutSimPack2`.
+    #[error(
+        "--outsim-opts describes Live for Speed's OutSimPack2 packets: it needs --telemetry-format outsim2 or auto"
+    )]
+    OutsimOptsFormat,
     /// `stream` without a source (clap requires one; this is the same rule for a request built otherwise).
     #[error(
         "stream needs a source: --input FILE.csv, --motion NAME, --udp ADDR, --telemetry-udp ADDR or --telemetry-shm GAME"
@@ -213,6 +218,9 @@ impl StreamArgs {
         let live = self.udp.is_some() || self.telemetry_udp.is_some() || self.telemetry_shm.is_some();
         if self.capture.is_some() && !live {
             return Err(RequestError::CaptureWithoutUdp);
+        }
+        if self.outsim_opts.is_some() && !self.telemetry_format.reads_outsim2() {
+            return Err(RequestError::OutsimOptsFormat);
         }
         Ok(match (self.udp, self.telemetry_udp, self.telemetry_shm, &self.input) {
             (Some(addr), ..) => udp(

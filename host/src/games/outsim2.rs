@@ -176,6 +176,29 @@ impl Opts {
         }
         Ok(Opts(value))
     }
+
+    /// The option set a reader of `format` takes: `given` (the command line's), else the cueing file's
+    /// `outsim_opts` (its profile's), checked; none for a format that does not read `OutSimPack2`, so that one
+    /// cueing file serves every game.
+    pub fn chosen(
+        format: super::TelemetryFormat,
+        given: Option<Opts>,
+        cue_config: Option<&std::path::Path>,
+        profile: Option<&str>,
+    ) -> Result<Option<Opts>, crate::input::cueing::CueingFileError> {
+        if !format.reads_outsim2() || given.is_some() {
+            return Ok(given.filter(|_| format.reads_outsim2()));
+        }
+        let Some(hex) = crate::input::cueing::load_outsim_opts(cue_config, profile)? else {
+            return Ok(None);
+        };
+        Opts::parse_hex(&hex)
+            .map(Some)
+            .map_err(|e| crate::input::cueing::CueingFileError::File {
+                path: cue_config.map(std::path::Path::to_path_buf).unwrap_or_default(),
+                reason: format!("outsim_opts: {e}"),
+            })
+    }
 }
 
 /// The largest packet (`1ff`).

@@ -31,6 +31,11 @@ impl TelemetryFormat {
         TelemetryFormat::Game(Format::Xplane),
         TelemetryFormat::Auto,
     ];
+
+    /// Whether a reader of this format may read `OutSimPack2` packets, and so takes `OutSim Opts`.
+    pub fn reads_outsim2(self) -> bool {
+        matches!(self, TelemetryFormat::Game(Format::Outsim2) | TelemetryFormat::Auto)
+    }
 }
 
 impl clap::ValueEnum for TelemetryFormat {

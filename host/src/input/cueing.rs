@@ -53,8 +53,53 @@ pub fn whole(text: &str) -> Result<(), String> {
 /// A cueing file's text: the base keys, and `[profiles.NAME]` tables, each a partial override of the base. With
 /// `profile`, that profile's keys replace the base's, each key as a whole (a `[profiles.NAME.smoothing]` table
 /// replaces `[smoothing]`, a per-axis list replaces the list); an unknown profile is refused naming the known
-/// ones. The result is checked: an error names the key (and the axis).
+/// ones. The result is checked: an error names the key (and the axis). The file's `outsim_opts` belongs to the
+/// telemetry reader, not the washout ([`outsim_opts`]).
 pub fn parse_config(text: &str, profile: Option<&str>) -> Result<CueConfig, String> {
+    let (mut table, where_) = merged(text, profile)?;
+    opts_of(&mut table, &where_)?;
+    let config: CueConfig = toml::Value::Table(table)
+        .try_into()
+        .map_err(|e: toml::de::Error| format!("{where_}{}", e.to_string().trim_end()))?;
+    config.validate().map_err(|e| format!("{where_}{e}"))?;
+    Ok(config)
+}
+
+/// The `outsim_opts` of a cueing file's text, with `profile`'s override: Live for Speed's `OutSim Opts` as its
+/// cfg.txt writes it (`outsim_opts = "1ff"`), what a game's profile says of its packets. The telemetry reader
+/// parses it (`games::outsim2::Opts::parse_hex`); here it is only taken out of the washout's keys.
+pub fn outsim_opts(text: &str, profile: Option<&str>) -> Result<Option<String>, String> {
+    let (mut table, where_) = merged(text, profile)?;
+    opts_of(&mut table, &where_)
+}
+
+/// [`outsim_opts`] of a cueing file (none without a file); errors name the file and the key.
+pub fn load_outsim_opts(path: Option<&Path>, profile: Option<&str>) -> Result<Option<String>, CueingFileError> {
+    let Some(path) = path else {
+        return Ok(None);
+    };
+    let in_file = |reason| CueingFileError::File {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let text = super::files::read_text(path, super::files::CONFIG_LIMIT).map_err(in_file)?;
+    outsim_opts(&text, profile).map_err(in_file)
+}
+
+/// Takes `outsim_opts` out of a merged table: a string, or none.
+fn opts_of(table: &mut toml::Table, where_: &str) -> Result<Option<String>, String> {
+    match table.remove("outsim_opts") {
+        None => Ok(None),
+        Some(toml::Value::String(hex)) => Ok(Some(hex)),
+        Some(_) => Err(format!(
+            "{where_}outsim_opts must be a string of hexadecimal digits, as in LFS's cfg.txt: outsim_opts = \"1ff\""
+        )),
+    }
+}
+
+/// The base table with `profile`'s keys in place (each key replaced whole), and the words that say where an
+/// error is (the profile's name, or nothing for the base).
+fn merged(text: &str, profile: Option<&str>) -> Result<(toml::Table, String), String> {
     let mut table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
     let profiles = match table.remove("profiles") {
         None => toml::Table::new(),
@@ -81,9 +126,5 @@ pub fn parse_config(text: &str, profile: Option<&str>) -> Result<CueConfig, Stri
         }
         where_ = format!("profile `{name}`: ");
     }
-    let config: CueConfig = toml::Value::Table(table)
-        .try_into()
-        .map_err(|e: toml::de::Error| format!("{where_}{}", e.to_string().trim_end()))?;
-    config.validate().map_err(|e| format!("{where_}{e}"))?;
-    Ok(config)
+    Ok((table, where_))
 }

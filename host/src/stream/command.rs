@@ -270,6 +270,8 @@ pub(crate) fn telemetry_decoder(
 ) -> Result<datagram::Decoder, SourceError> {
     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
     let washout = ringpod_core::cueing::Live::new(config).map_err(SourceError::Washout)?;
+    let outsim_opts =
+        crate::games::outsim2::Opts::chosen(format, outsim_opts, cue_config.as_deref(), profile.as_deref())?;
     Ok(datagram::Decoder::Telemetry {
         reader: Box::new(crate::games::Reader::new(format, outsim_opts)),
         washout: Box::new(washout),

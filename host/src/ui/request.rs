@@ -57,6 +57,10 @@ pub enum Request {
         /// Only datagrams from this sender's address count (as the CLI's `--from`).
         #[serde(default)]
         from: Option<std::net::IpAddr>,
+        /// Live for Speed's `OutSim Opts` (hexadecimal), for `outsim2` or `auto` telemetry (as the CLI's
+        /// `--outsim-opts`).
+        #[serde(default)]
+        outsim_opts: Option<String>,
     },
     /// A rig file's text, stored on the device (it must be `Off`), then the device restarted to run it.
     LoadRig {
@@ -141,6 +145,7 @@ mod tests {
                 degrees: false,
                 idle: 30.0,
                 from: None,
+                outsim_opts: None,
             }
         );
     }

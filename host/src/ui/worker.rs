@@ -254,7 +254,17 @@ impl Device {
                 degrees,
                 idle,
                 from,
-            } => self.udp(job.page, *port, holds, format.as_deref(), *degrees, *idle, *from),
+                outsim_opts,
+            } => self.udp(
+                job.page,
+                *port,
+                holds,
+                format.as_deref(),
+                outsim_opts.as_deref(),
+                *degrees,
+                *idle,
+                *from,
+            ),
             Request::LoadRig { text } => self.load_rig(text),
         };
         match result {
@@ -334,26 +344,41 @@ impl Device {
         port: u16,
         holds: &str,
         format: Option<&str>,
+        outsim_opts: Option<&str>,
         degrees: bool,
         idle: f64,
         from: Option<std::net::IpAddr>,
     ) -> Result<String, WorkerError> {
         let holds = match holds {
-            "poses" => Datagrams::Poses { degrees },
-            "telemetry" => Datagrams::Telemetry {
-                format: clap::ValueEnum::from_str(format.unwrap_or("auto"), true)
-                    .map_err(|e| WorkerError::NoSuch(format!("telemetry format: {e}")))?,
-                cue_config: Some(self.hub.cue_file.clone()),
-                profile: None,
-                outsim_opts: None,
-            },
-            // A front end's pose strings, at the default ranges (the command line's --pose-range).
-            "strings" => {
+            "poses" if outsim_opts.is_none() => Datagrams::Poses { degrees },
+            "telemetry" => {
+                let format: crate::games::TelemetryFormat =
+                    clap::ValueEnum::from_str(format.unwrap_or("auto"), true)
+                        .map_err(|e| WorkerError::NoSuch(format!("telemetry format: {e}")))?;
+                let outsim_opts = match outsim_opts {
+                    Some(_) if !format.reads_outsim2() => {
+                        return Err(WorkerError::NoSuch(
+                            "OutSim Opts describe outsim2 packets: choose the format outsim2 or auto".into(),
+                        ))
+                    }
+                    Some(hex) => Some(crate::games::outsim2::Opts::parse_hex(hex).map_err(WorkerError::NoSuch)?),
+                    None => None,
+                };
+                Datagrams::Telemetry {
+                    format,
+                    cue_config: Some(self.hub.cue_file.clone()),
+                    profile: None,
+                    outsim_opts,
+                }
+            }
+            "strings" if outsim_opts.is_none() => {
+                // A front end's pose strings, at the default ranges (the command line's --pose-range).
                 use crate::stream::datagram::template::{Template, DEFAULT_RANGES};
                 let template = Template::parse(format.unwrap_or_default(), DEFAULT_RANGES)
                     .map_err(|e| WorkerError::NoSuch(e.to_string()))?;
                 Datagrams::Strings(Box::new(template))
             }
+            "poses" | "strings" => return Err(WorkerError::NoSuch("OutSim Opts are for telemetry, not poses".into())),
             other => {
                 return Err(WorkerError::NoSuch(format!(
                     "a UDP session holds `poses`, `telemetry` or `strings`, not {other:?}"

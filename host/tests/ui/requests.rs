@@ -203,6 +203,38 @@ fn the_host_is_checked_on_every_request_and_unknown_fields_are_refused() {
     }
 }
 
+/// OutSim Opts from the page: refused before any session when they cannot apply (poses, a format that never
+/// reads OutSimPack2) or are not an option set; nothing moves (the device stays Off).
+#[test]
+fn outsim_options_from_the_page_are_checked_before_a_session() {
+    let bench = Workbench::start(&[]);
+    let mut a = bench.page();
+    for (request, says) in [
+        (
+            json!({ "do": "udp", "port": 1, "holds": "poses", "outsim_opts": "1ff" }),
+            "telemetry",
+        ),
+        (
+            json!({ "do": "udp", "port": 1, "holds": "telemetry", "format": "f1", "outsim_opts": "1ff" }),
+            "outsim2 or auto",
+        ),
+        (
+            json!({ "do": "udp", "port": 1, "holds": "telemetry", "format": "outsim2", "outsim_opts": "zz" }),
+            "hexadecimal",
+        ),
+        (
+            json!({ "do": "udp", "port": 1, "holds": "telemetry", "format": "auto", "outsim_opts": "7" }),
+            "main section",
+        ),
+    ] {
+        let r = reply(&mut a, request.clone(), Duration::from_secs(10));
+        assert_eq!(r["ok"], false, "{request}: {r}");
+        assert!(r["text"].as_str().unwrap().contains(says), "{request}: {r}");
+    }
+    let frame = a.until(Duration::from_secs(10), |m| m["type"] == "frame").unwrap();
+    assert_eq!(state(&frame), Some("Off"), "{frame}");
+}
+
 #[test]
 fn replies_are_never_dropped_for_a_page_that_lags() {
     let bench = Workbench::start(&[]);

@@ -75,3 +75,33 @@ fn a_cueing_file_needs_a_telemetry_source() {
     let args = parse(&["--telemetry-udp", "127.0.0.1:0"]).unwrap();
     assert!(matches!(args.job().unwrap().input, Input::Udp { .. }));
 }
+
+#[test]
+fn outsim_options_need_a_format_that_reads_outsim2() {
+    use crate::cli::requests::RequestError;
+    for format in ["text", "outsim", "f1", "forza", "beamng"] {
+        let args = parse(&[
+            "--telemetry-udp",
+            "127.0.0.1:0",
+            "--telemetry-format",
+            format,
+            "--outsim-opts",
+            "ff",
+        ]);
+        assert!(
+            matches!(args.unwrap().job(), Err(RequestError::OutsimOptsFormat)),
+            "{format}"
+        );
+    }
+    for format in ["outsim2", "auto"] {
+        let args = parse(&[
+            "--telemetry-udp",
+            "127.0.0.1:0",
+            "--telemetry-format",
+            format,
+            "--outsim-opts",
+            "ff",
+        ]);
+        assert!(args.unwrap().job().is_ok(), "{format}");
+    }
+}

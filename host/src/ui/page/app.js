@@ -203,6 +203,7 @@ $("run-udp").addEventListener("click", () => {
   const format = holds === "strings" ? $("udp-template").value : $("udp-format").value;
   const request = { do: "udp", port: +$("udp-port").value, holds, format, idle: +$("udp-idle").value };
   if ($("udp-from").value.trim()) request.from = $("udp-from").value.trim();
+  if ($("udp-outsim-opts").value.trim()) request.outsim_opts = $("udp-outsim-opts").value.trim();
   send(request);
 });
 $("park").addEventListener("click", () => send({ do: "park" }));
