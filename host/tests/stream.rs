@@ -3,9 +3,9 @@
 mod common;
 
 use assert_cmd::Command;
-use common::spawn_live_stream;
 #[cfg(unix)]
 use common::spawn_sim_stream;
+use common::{numbers, spawn_live_stream};
 #[cfg(unix)]
 use nix::sys::signal::Signal;
 use ringpod_core::kinematics::Pose;
@@ -69,10 +69,6 @@ fn assert_at_the_last_pose(report: &serde_json::Value) {
             "final steps {got:?}, IK of the last pose {want:?}"
         );
     }
-}
-
-fn numbers(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
 #[test]

@@ -223,7 +223,13 @@ impl StreamArgs {
             return Err(RequestError::OutsimOptsFormat);
         }
         Ok(match (self.udp, self.telemetry_udp, self.telemetry_shm, &self.input) {
-            (Some(addr), ..) => udp(addr, Datagrams::Poses { degrees: self.degrees }),
+            (Some(addr), ..) => udp(
+                addr,
+                match &self.pose_format {
+                    Some(template) => Datagrams::Strings(Box::new(template.clone().with_ranges(self.pose_range))),
+                    None => Datagrams::Poses { degrees: self.degrees },
+                },
+            ),
             (None, Some(addr), ..) => udp(
                 addr,
                 Datagrams::Telemetry {

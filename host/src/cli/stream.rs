@@ -3,6 +3,7 @@
 use clap::Args;
 
 use super::ControllerArgs;
+use crate::stream::datagram::template::{self, Template};
 
 /// The sources other than a built-in motion (`--duration`, `--rate` and the sine's options are the motion's).
 const NOT_MOTION: [&str; 4] = ["input", "udp", "telemetry_udp", "telemetry_shm"];
@@ -50,9 +51,24 @@ pub struct StreamArgs {
     #[arg(long, conflicts_with = "udp")]
     pub input: Option<std::path::PathBuf>,
     /// Receive poses from motion-simulator software: one datagram = one text line of six numbers
-    /// `x y z alpha beta gamma` (spaces, commas or semicolons; m and rad unless --degrees), sent as they arrive.
+    /// `x y z alpha beta gamma` (spaces, commas or semicolons; m and rad unless --degrees), or with --pose-format a
+    /// motion front end's output string; sent as they arrive.
     #[arg(long, conflicts_with = "motion")]
     pub udp: Option<std::net::SocketAddr>,
+    /// With --udp: read each datagram as a motion front end's pose string (FlyPT Mover, SimTools, SimHub): a
+    /// preset (`flypt`, `simtools`, `simhub`) or `ENCODING:STRING`, ENCODING `decBITS`, `hexBITS`, `binBITS`
+    /// (fixed-point, 0..2^BITS-1 with neutral half-way) or `fracPLACES` (-1..1), STRING the front end's output
+    /// string: `<Axis1a>`..`<Axis6a>` (or `<Axis1>`, `<surge>`..`<yaw>`) the axes surge, sway, heave, roll, pitch,
+    /// yaw, `<N>` the byte N, other characters as they are. Each axis is an offset from the platform's neutral,
+    /// its full scale --pose-range. The book's streaming chapter gives each front end's settings.
+    #[arg(long, value_name = "TEMPLATE", requires = "udp", conflicts_with = "degrees")]
+    #[arg(value_parser = pose_format)]
+    pub pose_format: Option<Template>,
+    /// With --pose-format: the offset each axis reaches at the end of its range, either way from neutral:
+    /// `surge,sway,heave,roll,pitch,yaw` in mm and degrees.
+    #[arg(long, value_name = "MM,MM,MM,DEG,DEG,DEG", requires = "pose_format")]
+    #[arg(value_parser = template::parse_ranges, default_value = "50,50,40,20,20,20")]
+    pub pose_range: [f64; 6],
     /// Receive vehicle telemetry from simulator software and cue it with the classical washout (as `ringpod cue`
     /// does with a file): one datagram per sample, in --telemetry-format.
     #[arg(long, conflicts_with_all = ["udp", "input", "motion"])]
@@ -145,6 +161,12 @@ pub struct StreamArgs {
     /// With --check-loads: its inertia Ixx,Iyy,Izz (kg m^2) about the centre of mass.
     #[arg(long, allow_hyphen_values = true, requires = "check_loads", conflicts_with_all = ["udp", "telemetry_udp", "telemetry_shm"])]
     pub inertia: Option<String>,
+}
+
+/// `--pose-format`: checked whole before anything starts (a usage error naming the character), at the default
+/// ranges until `--pose-range` is applied.
+fn pose_format(text: &str) -> Result<Template, template::TemplateError> {
+    Template::parse(text, template::DEFAULT_RANGES)
 }
 
 /// `--telemetry-shm` on a system without Windows' named file mappings: refused by name, a usage error (exit 2).

@@ -52,6 +52,8 @@ pub enum Input {
 pub enum Datagrams {
     /// Six numbers, a pose.
     Poses { degrees: bool },
+    /// A motion front end's pose strings.
+    Strings(Box<datagram::template::Template>),
     /// Vehicle telemetry in a format, cued by the washout of a cueing file (or the defaults).
     Telemetry {
         format: crate::games::TelemetryFormat,
@@ -176,6 +178,10 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
         } => {
             let decoder = match holds {
                 Datagrams::Poses { degrees } => datagram::Decoder::Poses { degrees: *degrees },
+                Datagrams::Strings(template) => datagram::Decoder::Template {
+                    template: template.clone(),
+                    neutral: None,
+                },
                 Datagrams::Telemetry {
                     format,
                     cue_config,

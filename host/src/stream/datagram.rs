@@ -1,5 +1,6 @@
-//! What a UDP datagram from simulator software means: a pose, or vehicle telemetry that the core's washout turns
-//! into a pose (a text line, or a game's own packet: [`crate::games`]).
+//! What a UDP datagram from simulator software means: a pose, a motion front end's pose string ([`template`]), or
+//! vehicle telemetry that the core's washout turns into a pose (a text line, or a game's own packet:
+//! [`crate::games`]).
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
@@ -10,12 +11,21 @@ use ringpod_core::kinematics::Pose;
 use crate::games::{self, numbers};
 use crate::out::console;
 
+pub mod template;
+
 /// Turns datagrams into poses.
 pub enum Decoder {
     /// Six numbers `x y z alpha beta gamma` (m; rad, or degrees).
     Poses {
         /// Angles in degrees.
         degrees: bool,
+    },
+    /// A motion front end's pose strings (FlyPT Mover, SimTools, SimHub): offsets from the platform's neutral.
+    Template {
+        /// The strings' template.
+        template: Box<template::Template>,
+        /// The platform's neutral pose: the home pose of the rig the device runs ([`Decoder::centre_on`]).
+        neutral: Option<Pose<f64>>,
     },
     /// Vehicle telemetry through the washout.
     Telemetry {
@@ -152,6 +162,10 @@ impl Decoder {
     pub fn decode(&mut self, bytes: &[u8], now: Instant) -> Result<Pose<f64>, String> {
         match self {
             Decoder::Poses { degrees } => parse_pose(bytes, *degrees),
+            Decoder::Template { template, neutral } => {
+                let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
+                Ok(cueing::pose(&neutral, &template.read(bytes)?))
+            }
             Decoder::Telemetry { reader, .. } => {
                 let read = reader.read(bytes);
                 // `auto`'s lock, or its lock dropped: said once.
@@ -209,7 +223,7 @@ impl Decoder {
     /// washout (washing out to neutral), or `None` for a pose source (the platform holds).
     pub fn idle(&mut self, dt: f64, now: Instant) -> Option<Pose<f64>> {
         match self {
-            Decoder::Poses { .. } => None,
+            Decoder::Poses { .. } | Decoder::Template { .. } => None,
             Decoder::Telemetry {
                 washout, neutral, last, ..
             } => {
@@ -227,7 +241,7 @@ impl Decoder {
 
     /// Cues around `home` (the home pose of the rig the device runs); a pose source has no neutral.
     pub fn centre_on(&mut self, home: Pose<f64>) {
-        if let Decoder::Telemetry { neutral, .. } = self {
+        if let Decoder::Telemetry { neutral, .. } | Decoder::Template { neutral, .. } = self {
             *neutral = Some(home);
         }
     }
@@ -256,7 +270,7 @@ impl Decoder {
     /// `auto`'s changes of format (telemetry only).
     pub fn locks(&self) -> Vec<games::Lock> {
         match self {
-            Decoder::Poses { .. } => Vec::new(),
+            Decoder::Poses { .. } | Decoder::Template { .. } => Vec::new(),
             Decoder::Telemetry { reader, .. } => reader.locks().to_vec(),
         }
     }
@@ -264,7 +278,7 @@ impl Decoder {
     /// Gaps after which the washout started again (telemetry only).
     pub fn gaps(&self) -> u32 {
         match self {
-            Decoder::Poses { .. } => 0,
+            Decoder::Poses { .. } | Decoder::Template { .. } => 0,
             Decoder::Telemetry { gaps, .. } => *gaps,
         }
     }

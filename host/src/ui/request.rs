@@ -41,8 +41,9 @@ pub enum Request {
         #[serde(default)]
         degrees: bool,
     },
-    /// Poses (`holds = "poses"`) or a game's telemetry (`holds = "telemetry"`, cued by the workbench's live
-    /// cueing file) on a UDP port of the address the workbench listens on.
+    /// Poses (`holds = "poses"`), a game's telemetry (`holds = "telemetry"`, cued by the workbench's live
+    /// cueing file) or a motion front end's pose strings (`holds = "strings"`, `format` the `--pose-format`
+    /// template) on a UDP port of the address the workbench listens on.
     Udp {
         port: u16,
         holds: String,

@@ -371,10 +371,17 @@ impl Device {
                     outsim_opts,
                 }
             }
-            "poses" => return Err(WorkerError::NoSuch("OutSim Opts are for telemetry, not poses".into())),
+            "strings" if outsim_opts.is_none() => {
+                // A front end's pose strings, at the default ranges (the command line's --pose-range).
+                use crate::stream::datagram::template::{Template, DEFAULT_RANGES};
+                let template = Template::parse(format.unwrap_or_default(), DEFAULT_RANGES)
+                    .map_err(|e| WorkerError::NoSuch(e.to_string()))?;
+                Datagrams::Strings(Box::new(template))
+            }
+            "poses" | "strings" => return Err(WorkerError::NoSuch("OutSim Opts are for telemetry, not poses".into())),
             other => {
                 return Err(WorkerError::NoSuch(format!(
-                    "a UDP session holds `poses` or `telemetry`, not {other:?}"
+                    "a UDP session holds `poses`, `telemetry` or `strings`, not {other:?}"
                 )))
             }
         };

@@ -27,6 +27,11 @@ pub fn trainer_homed() -> (RingPlatform<f32>, StepConverter, MultiTurn<f32>) {
     (m, conv, home)
 }
 
+/// The numbers of a JSON array (a report's pose or steps).
+pub fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+}
+
 /// Starts `ringpod stream --sim --report-json --quiet ARGS` with its output piped.
 pub fn spawn_sim_stream(args: &[&str]) -> std::process::Child {
     std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))

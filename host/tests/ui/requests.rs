@@ -90,6 +90,42 @@ fn a_udp_session_binds_the_workbench_address_and_takes_only_its_sender() {
         .unwrap();
 }
 
+/// A session of a motion front end's pose strings: a template that cannot be read is refused naming its
+/// character, before anything binds; a preset's strings are followed as offsets from neutral.
+#[test]
+fn a_udp_session_reads_a_front_ends_strings() {
+    let bench = Workbench::start(&[]);
+    let mut a = bench.page();
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let bad = json!({ "do": "udp", "port": port, "holds": "strings", "format": "dec8:<Axis7a>" });
+    let r = reply(&mut a, bad, Duration::from_secs(10));
+    assert_eq!(r["ok"], false, "{r}");
+    assert!(r["text"].as_str().unwrap().contains("character 6"), "{r}");
+    a.send(json!({ "do": "udp", "port": port, "holds": "strings", "format": "simtools", "idle": 60 }));
+    a.until(Duration::from_secs(60), |m| {
+        m["type"] == "frame" && m["streaming"] == true && state(m) == Some("Ready")
+    })
+    .unwrap();
+    let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    // SimTools' 16-bit decimal: heave 49151 is +20 mm of its 40 mm range, from the home pose's 0.227 m.
+    for _ in 0..60 {
+        s.send_to(b"32768~32768~49151~32768~32768~32768~", ("127.0.0.1", port))
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    a.until(Duration::from_secs(10), |m| {
+        m["type"] == "frame" && (m["pose"][2].as_f64().unwrap() - 0.247).abs() < 0.0005
+    })
+    .unwrap();
+    let stop = a.send(json!({ "do": "halt" }));
+    a.until(Duration::from_secs(20), |m| m["type"] == "halted" && m["id"] == stop)
+        .unwrap();
+}
+
 #[cfg(unix)]
 #[test]
 fn the_live_cueing_file_is_private_and_replaced_whole() {

@@ -201,7 +201,9 @@ $("stream-file").addEventListener("click", async () => {
   else send({ do: "file", name: $("file-name").value, degrees });
 });
 $("run-udp").addEventListener("click", () => {
-  const request = { do: "udp", port: +$("udp-port").value, holds: $("udp-holds").value, format: $("udp-format").value, idle: +$("udp-idle").value };
+  const holds = $("udp-holds").value;
+  const format = holds === "strings" ? $("udp-template").value : $("udp-format").value;
+  const request = { do: "udp", port: +$("udp-port").value, holds, format, idle: +$("udp-idle").value };
   if ($("udp-from").value.trim()) request.from = $("udp-from").value.trim();
   if ($("udp-outsim-opts").value.trim()) request.outsim_opts = $("udp-outsim-opts").value.trim();
   send(request);
