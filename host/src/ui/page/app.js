@@ -200,6 +200,13 @@ $("stream-file").addEventListener("click", async () => {
   if (picked) send({ do: "file", name: picked.name, text: await picked.text(), degrees });
   else send({ do: "file", name: $("file-name").value, degrees });
 });
+// A session's card shows the settings of what it holds only (a pose format for front-end strings, a format and
+// OutSim Opts for telemetry): the card stays short enough for a 1366x768 screen.
+function showHolds() {
+  document.querySelectorAll("[data-holds]").forEach((l) => { l.hidden = l.dataset.holds !== $("udp-holds").value; });
+}
+$("udp-holds").addEventListener("change", showHolds);
+showHolds();
 $("run-udp").addEventListener("click", () => {
   const holds = $("udp-holds").value;
   const format = holds === "strings" ? $("udp-template").value : $("udp-format").value;
