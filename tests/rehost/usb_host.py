@@ -70,11 +70,13 @@ class UsbHost:
         self.dev.suspend()
         self.task = None
         self.reset_state()
+        self.out.clear()
         self.next_at = NEVER
         self.log.append((self.clock(), "unplugged"))
 
     def feed(self, data):
-        self.out += data
+        if self.plugged:  # bytes written to a port whose cable is out are lost with it
+            self.out += data
 
     # -- the scheduler's interface --
     def advance(self, now):
