@@ -129,7 +129,7 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
-def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_cable=False):
+def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False):
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -177,13 +177,12 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_cable
     cli.run("device", "disable", *port)
     m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
     settings_check(m, log, cli, port)
-    if usb is None:
-        homing_check(m, plant, cli, port)
-    else:  # homing over USB: the same check, once (7.5 simulated s)
-        usb_link_checks(CHECKS, m, usb, plant, homing_check, port)
+    if usb is not None:
+        usb_link_checks(CHECKS, m, usb, port)
+    homing_check(m, plant, cli, port)
     stream_check(m, plant, cli, port, ringpod)
     if usb is not None:
-        usb_stream_checks(CHECKS, m, usb, plant, stream_check, usb_cable)
+        usb_stream_checks(CHECKS, m, usb, plant, stream_check, homing_check if usb_full else None)
     if hold_ups:
         hold_up_checks(CHECKS, m, cli, port)
 
@@ -307,7 +306,8 @@ def main():
     ap.add_argument("--hold-ups", action="store_true",
                     help="also the hold-up checks mid-stream (hold_up.py; not yet reliable at the emulator's speed)")
     ap.add_argument("--no-usb", action="store_true", help="no USB host: every link check over USART1")
-    ap.add_argument("--usb-cable", action="store_true", help="also the cable pulled mid-stream and plugged again")
+    ap.add_argument("--usb-full", action="store_true",
+                    help="also homing over USB, and the cable pulled mid-stream and plugged again (usb_checks.py)")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the book's Emulation chapter")
     args = ap.parse_args()
 
@@ -472,7 +472,7 @@ def main():
     # -- the host link on USART1: the real CLI over a pty --
     m.nvic.held.discard(TIM5_IRQ)
     if args.ringpod:
-        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_cable)
+        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full)
 
     wall = time.time() - wall0
     sim = m.now / SYSCLK
