@@ -256,7 +256,7 @@ def homing_check(m, plant, cli, port, name="serial-home"):
                  f"(fast approach, back-off, slow approach, clear), {m.exti.edges - exti0} EXTI edges; plant at "
                  f"{plant.position}, device counts {dev}: latched at {latched} (on the switch: {on_switch}), "
                  f"{past_ms} ms past the switch edge at the slow approach's speed (more than 0, at most 22 ms: the debounce, "
-                 f"at most one 10 ms sweep)")
+                 f"at most one 10 ms sweep)" + ("" if home.code == 0 else f"; {home}"))
 
 
 def settings_check(m, log, cli, port):
