@@ -93,7 +93,8 @@ def descriptor_check(checks, m, link):
                  f"{h.enumerations} enumerations (first configured at {enumerated[0] * 1000 / SYSCLK if enumerated else 0:.1f} "
                  f"ms); device descriptor {dev.hex()}, VID:PID {vid_pid[0]:04x}:{vid_pid[1]:04x}, {len(iads)} IAD, "
                  f"interfaces {[(tuple(i['desc'][5:8]), i['endpoints']) for i in ifaces]}, strings {strings}; "
-                 f"SET_LINE_CODING 921600 8N1 and SET_CONTROL_LINE_STATE DTR|RTS accepted; OTG_FS IRQ {IRQ} priority "
+                 f"{'SET_LINE_CODING 921600 8N1 and SET_CONTROL_LINE_STATE DTR|RTS accepted' if h.configured else 'not configured'}"
+                 f"; bus log {[(round(t * 1000 / SYSCLK, 1), what) for t, what in h.log[-4:]]}; OTG_FS IRQ {IRQ} priority "
                  f"{m.nvic.priority(16 + IRQ) >> 4}" + (f"; wrong: {', '.join(bad)}" if bad else "")
                  + (f"; stalls {h.stalls}" if h.stalls else ""))
 
