@@ -27,8 +27,8 @@ Modelled (section numbers of RM0383):
 
 Not modelled: host mode and the OTG protocols (SRP/HNP, ID pin, A-device), DATA0/DATA1 toggles and CRC or bit
 errors (every packet arrives whole), isochronous endpoints and incomplete-isochronous interrupts, the OTG power
-savings (PCGCCTL stored, no clock gating), remote wakeup signalling, the global IN/OUT NAK sequence (SGINAK/SGONAK
-take effect at once), endpoint-disable handshakes beyond EPDISD at once, DMA (the F411's OTG FS has none), the
+savings (PCGCCTL stored, no clock gating), remote wakeup signalling, the global IN/OUT NAK (SGINAK/SGONAK are stored
+without effect), endpoint-disable handshakes beyond EPDISD at once, DMA (the F411's OTG FS has none), the
 transceiver's electrical behaviour and SOF output, and the FIFO RAM layout (each FIFO is checked against its own
 size, not against overlaps with the others).
 """
