@@ -1,8 +1,8 @@
 """The release ELF on Qiling's stm32f411 profile, with the harness's models and its own CPU scheduler.
 
 Qiling provides the memory map, the ELF loader, Unicorn, and its models of RCC, PWR, SCB, GPIO, EXTI, SYSCFG and
-DBGMCU. The harness replaces NVIC, TIMx, DMAx and the FLASH interface, adds IWDG, DWT and an OTG FS stub
-(`models/`), and runs the CPU itself instead of `ql.run()`:
+DBGMCU. The harness replaces NVIC, TIMx, DMAx and the FLASH interface, adds IWDG, DWT and the OTG FS
+device core (`models/`), and runs the CPU itself instead of `ql.run()`:
 
 - Time is counted in CPU cycles, one per instruction, at the 96 MHz the firmware configures. The CPU runs in
   chunks that end before the next peripheral event (`next_event`), so a chunk never hides an interrupt; the
@@ -150,7 +150,9 @@ class Machine:
                 tim.update_dma.append(_Request(self.dma[dma], stream, channel))
             self.tim[label] = tim
         self.iwdg = self.install("iwdg", 0x4000_3000, Iwdg(self.clock, self._watchdog_timeout, SYSCLK))
-        self.otg = self.install("otg_fs", 0x5000_0000, OtgFs())
+        # RM0383 6.3.10 RCC_AHB2ENR.OTGFSEN (bit 7) clocks the OTG FS core
+        self.otg = self.install("otg_fs", 0x5000_0000,
+                                OtgFs(self.pend, clocked=lambda: self.rcc.instance.AHB2ENR >> 7 & 1))
         self.dwt = self.install("dwt", 0xE000_1000, Dwt(self.clock))
         self.exti = self.install("exti", 0x4001_3C00, Exti(self.pend, self._exticr))
         self.usart1 = self.install("usart1", 0x4001_1000, Usart("usart1", self.clock, self.pend, USART1_IRQ))
@@ -419,7 +421,7 @@ class Machine:
         history = (self.flash.erases, self.flash.programs, self.flash.rejected)
         self.flash.__init__(self, self.clock, SYSCLK)  # an erase in progress is cut short
         self.flash.erases, self.flash.programs, self.flash.rejected = history  # kept for the checks
-        self.otg.__init__()
+        self.otg.reset()
         self.dwt.__init__(self.clock)
         self._cache.clear()
         self._cpu_reset()

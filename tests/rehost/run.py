@@ -32,6 +32,7 @@ from models.rcc import IWDGRSTF  # noqa: E402
 from plant import FLAG_WIDTH, HOME_POSITION, SLOW_RATE, TOWARD, Plant  # noqa: E402
 from seqstore import used_up_page  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
+from usb_checks import UsbLink, usb_link_checks, usb_stream_checks  # noqa: E402
 
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411/settings.rs, SETTINGS)
 GPIOB_BSRR = 0x4002_0418
@@ -107,6 +108,7 @@ class Probes:
 
 class Snapshot:
     def __init__(self, m):
+        m.advance()  # the models up to now: the last chunk may have ended past their last update
         st = m.dma["dma2"].streams[5]
         self.t = m.now
         self.updates = m.tim["tim1"].updates
@@ -127,7 +129,7 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
-def serial_checks(m, p, log, plant, ringpod, hold_ups=False):
+def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False):
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -175,13 +177,17 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False):
     cli.run("device", "disable", *port)
     m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
     settings_check(m, log, cli, port)
+    if usb is not None:
+        usb_link_checks(CHECKS, m, usb, port)
     homing_check(m, plant, cli, port)
     stream_check(m, plant, cli, port, ringpod)
+    if usb is not None:
+        usb_stream_checks(CHECKS, m, usb, plant, stream_check, homing_check if usb_full else None)
     if hold_ups:
         hold_up_checks(CHECKS, m, cli, port)
 
 
-def stream_check(m, plant, cli, port, ringpod):
+def stream_check(m, plant, cli, port, ringpod, name="serial-stream", backwards=False):
     """`ringpod stream` of a one-second CSV (heave 4 mm and yaw 3 degrees, at rest at both ends) over the link:
     the device's step counts, the STEP edges on GPIOB (signed by DIR) and the simulated controller
     (`stream --sim --fast`, the same core on the host) end at the same steps. The host paces the rows by its own
@@ -192,6 +198,7 @@ def stream_check(m, plant, cli, port, ringpod):
         for i in range(51):
             t = i / 50
             s = t * t * (3 - 2 * t)  # smoothstep: at rest at both ends
+            s = 1 - s if backwards else s
             f.write(f"{t:.2f},0,0,{0.227 + 0.004 * s:.6f},0,0,{3.0 * s:.4f}\n")  # from the home pose (z 227 mm)
     args = ["--input", f.name, "--degrees", "--report-json", "--quiet"]
     sim = subprocess.run([ringpod, "stream", "--sim", "--fast", *args], capture_output=True, text=True, timeout=120)
@@ -206,7 +213,7 @@ def stream_check(m, plant, cli, port, ringpod):
     except (ValueError, KeyError):
         report, want = {}, None
     moved = [b - a for a, b in zip(before, after)] if before and after else None
-    CHECKS.check("serial-stream", r.code == 0 and report.get("outcome") == "followed"
+    CHECKS.check(name, r.code == 0 and report.get("outcome") == "followed"
                  and report.get("setpoints_applied") == report.get("setpoints_sent")
                  and moved == plant.net and after == report.get("final_steps") == want,
                  f"`ringpod stream` exit {r.code} after {r.sim_s:.2f} simulated s: {report.get('outcome')}, "
@@ -217,7 +224,7 @@ def stream_check(m, plant, cli, port, ringpod):
                  + ("" if r.code == 0 else f"; {r}"))
 
 
-def homing_check(m, plant, cli, port):
+def homing_check(m, plant, cli, port, name="serial-home"):
     """`device home` through the plant's switches: each axis approaches its switch, backs off, approaches slowly
     and is given its home position where the debounced switch trips, then the platform moves to the home pose.
     Where the device's count and the STEP edges put each axis then gives the plant position the device latched:
@@ -241,7 +248,7 @@ def homing_check(m, plant, cli, port):
     past_ms = [round(1000 * (x - 0) * t / r, 1) for x, t, r in zip(latched, TOWARD, SLOW_RATE)]
     on_switch = all(0 <= x < FLAG_WIDTH if a < 4 else x <= 0 for a, x in enumerate(latched))
     edges = [b - a for a, b in zip(edges0, plant.switch_edges)]
-    CHECKS.check("serial-home", home.code == 0 and status.get("state") == "Ready" and status.get("homed")
+    CHECKS.check(name, home.code == 0 and status.get("state") == "Ready" and status.get("homed")
                  and on_switch and all(0 < t <= 22 for t in past_ms) and all(e >= 4 for e in edges)
                  and m.exti.edges - exti0 >= sum(edges),
                  f"{en}; `device home` exit {home.code} after {home.sim_s:.2f} simulated s: state "
@@ -249,7 +256,7 @@ def homing_check(m, plant, cli, port):
                  f"(fast approach, back-off, slow approach, clear), {m.exti.edges - exti0} EXTI edges; plant at "
                  f"{plant.position}, device counts {dev}: latched at {latched} (on the switch: {on_switch}), "
                  f"{past_ms} ms past the switch edge at the slow approach's speed (more than 0, at most 22 ms: the debounce, "
-                 f"at most one 10 ms sweep)")
+                 f"at most one 10 ms sweep)" + ("" if home.code == 0 else f"; {home}"))
 
 
 def settings_check(m, log, cli, port):
@@ -298,6 +305,9 @@ def main():
     ap.add_argument("--ringpod", help="the host CLI binary: runs the serial-link checks over a pty")
     ap.add_argument("--hold-ups", action="store_true",
                     help="also the hold-up checks mid-stream (hold_up.py; not yet reliable at the emulator's speed)")
+    ap.add_argument("--no-usb", action="store_true", help="no USB host: every link check over USART1")
+    ap.add_argument("--usb-full", action="store_true",
+                    help="also homing over USB, and the cable pulled mid-stream and plugged again (usb_checks.py)")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the book's Emulation chapter")
     args = ap.parse_args()
 
@@ -309,6 +319,7 @@ def main():
     log = DefmtLog(m)
     m.observers.append(log.poll)
     plant = Plant(m)
+    usb = None if args.ringpod is None or args.no_usb else UsbLink(m, args.ringpod)  # plugged in from power-on
     if args.count_instructions:
         m.count_instructions()
 
@@ -461,7 +472,7 @@ def main():
     # -- the host link on USART1: the real CLI over a pty --
     m.nvic.held.discard(TIM5_IRQ)
     if args.ringpod:
-        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups)
+        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full)
 
     wall = time.time() - wall0
     sim = m.now / SYSCLK

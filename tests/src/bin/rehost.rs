@@ -3,7 +3,8 @@
 //!
 //! 1. The `thumbv7em-none-eabihf` standard library (the preflight the QEMU runner uses), then
 //!    `cargo build -p ringpod-firmware --target thumbv7em-none-eabihf --profile firmware`.
-//!    Then the host CLI (`cargo build -p ringpod`), which run.py drives over a pty bridged to the emulated USART1.
+//!    Then the host CLI (`cargo build -p ringpod`), which run.py drives over ptys bridged to the emulated USART1
+//!    and to the USB host on the emulated OTG FS core.
 //! 2. A Python venv in `target/rehost-venv` with the pinned emulator (`tests/rehost/requirements.txt`), made again
 //!    whenever that file changes.
 //! 3. The models' unit tests (`python -m unittest`), counted as one check, then `tests/rehost/run.py`, whose checks

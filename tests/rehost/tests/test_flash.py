@@ -1,7 +1,6 @@
 import unittest
 
 from models.flash import BSY, FLASH_BASE, LOCK, PG, SER, STRT, FlashInterface, sector_of
-from models.otg import OtgFs
 from tests.helpers import Clock, Memory
 
 
@@ -60,20 +59,6 @@ class FlashTest(unittest.TestCase):
         self.assertEqual(sector_of(0x0804_0000), 6)
         self.assertEqual(sector_of(0x0807_FFFF), 7)
         self.assertIsNone(sector_of(0x0808_0000))
-
-
-class OtgTest(unittest.TestCase):
-    def test_core_reset_completes_and_ahb_is_idle(self):
-        o = OtgFs()
-        o.write(OtgFs.GRSTCTL, 4, 1)
-        self.assertEqual(o.read(OtgFs.GRSTCTL, 4), 1 << 31)
-
-    def test_gintsts_is_rc_w1_in_device_mode(self):
-        o = OtgFs()
-        o.regs[OtgFs.GINTSTS] = (1 << 12) | 1
-        self.assertEqual(o.read(OtgFs.GINTSTS, 4), 1 << 12)
-        o.write(OtgFs.GINTSTS, 4, 1 << 12)
-        self.assertEqual(o.read(OtgFs.GINTSTS, 4), 0)
 
 
 if __name__ == "__main__":
