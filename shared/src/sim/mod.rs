@@ -124,7 +124,6 @@ impl Plant {
     /// shoulders with index flags, linear actuators with a home end switch and a far end switch 2 mm past their
     /// stroke.
     pub fn for_config(config: &crate::controller::ControllerConfig) -> Self {
-        use crate::kinematics::Mechanism;
         let axes = config.geometry.axes();
         let start = parked(&axes);
         let stroke = config.geometry.limits.stroke;
