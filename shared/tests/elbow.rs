@@ -560,3 +560,12 @@ fn shoulders_come_after_every_radial_length() {
         "{p:?}"
     );
 }
+
+#[test]
+fn a_geometry_names_its_axes_as_its_platform_drives_them() {
+    // A carriage per chain, then a length per radial chain, then a shoulder per elbow chain.
+    use AxisKind::{Angle, Linear, Ring};
+    assert_eq!(presets::TRAINER_MODEL.axes(), [Ring, Ring, Ring, Ring, Linear, Linear]);
+    assert_eq!(TRAINER_ELBOW.axes(), [Ring, Ring, Ring, Ring, Angle, Angle]);
+    assert_eq!(presets::ROTOPOD_CH4.axes(), [Ring; 6]);
+}

@@ -200,9 +200,11 @@ impl ControllerConfig {
     /// its home-pose check).
     pub fn default_record(name: &str, geometry: &RingGeometry, home: [f64; 6]) -> RigRecord {
         let model = Self::trainer_model();
-        let m = RingPlatform::<f64>::new(geometry);
-        let axes = m.axes();
-        let solved = m.inverse(&Pose::from_array(home)).map(|q| q.0).ok();
+        let axes = geometry.axes();
+        let solved = RingPlatform::<f64>::new(geometry)
+            .inverse(&Pose::from_array(home))
+            .map(|q| q.0)
+            .ok();
         let q = solved.unwrap_or([0.0; 6]);
         let mut machine = model.machine();
         let carriages = axes.iter().filter(|k| **k == AxisKind::Ring).count();

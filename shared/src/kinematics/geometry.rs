@@ -303,6 +303,23 @@ impl RingGeometry {
         self.chains.get(..self.chain_count).unwrap_or(&[])
     }
 
+    /// What each actuator drives, in actuator order: a carriage per chain, then a length per radial chain, then a
+    /// shoulder angle per elbow chain, six in all in a valid geometry (what [`super::Mechanism::axes`] of its platform returns, without building
+    /// the platform).
+    pub fn axes(&self) -> [super::AxisKind; 6] {
+        let chains = self.chains();
+        let radial = chains.iter().filter(|c| c.kind == ChainKind::Radial).count();
+        let mut axes = [super::AxisKind::Ring; 6];
+        for (a, axis) in axes.iter_mut().enumerate().skip(chains.len()) {
+            *axis = if a < chains.len() + radial {
+                super::AxisKind::Linear
+            } else {
+                super::AxisKind::Angle
+            };
+        }
+        axes
+    }
+
     /// The arm of the elbow chain whose shoulder angle is actuator `axis` (0-based), if it is one.
     pub fn arm_of_axis(&self, axis: usize) -> Option<Elbow> {
         let chains = self.chains();

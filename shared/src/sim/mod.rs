@@ -124,8 +124,7 @@ impl Plant {
     /// shoulders with index flags, linear actuators with a home end switch and a far end switch 2 mm past their
     /// stroke.
     pub fn for_config(config: &crate::controller::ControllerConfig) -> Self {
-        use crate::kinematics::Mechanism;
-        let axes = crate::kinematics::RingPlatform::<f64>::new(&config.geometry).axes();
+        let axes = config.geometry.axes();
         let start = parked(&axes);
         let stroke = config.geometry.limits.stroke;
         let per_m = axes

@@ -4,7 +4,7 @@
 //! written with); the actuator limits a version-2 rig gets are its axes' kinds' on the trainer model's drives,
 //! which is what a version-2 device drove them with.
 
-use crate::kinematics::{Chain, Mechanism, RingLimits, RingPlatform};
+use crate::kinematics::{Chain, RingLimits};
 use crate::model;
 use crate::protocol::{
     AxisSettings, ControlSettings, HomingSettings, MachineSettings, MotionSettings, RigRecord, StreamSettings,
@@ -80,7 +80,7 @@ impl Record {
         };
         if let Ok(geometry) = record.geometry() {
             let motion = &mut record.machine.motion;
-            for (a, kind) in RingPlatform::<f64>::new(&geometry).axes().iter().enumerate() {
+            for (a, kind) in geometry.axes().iter().enumerate() {
                 (motion.actuator_velocity[a], motion.actuator_acceleration[a]) = model::actuator_limits(*kind);
             }
         }

@@ -46,20 +46,26 @@ pub(super) struct Shoulder<T> {
 impl<T: Real> Arm<T> {
     /// The arm of a validated chain, its shoulder angle at actuator `axis`.
     pub fn new(e: &Elbow, axis: usize) -> Self {
-        let (l1, l2) = (e.upper_arm, e.forearm);
-        // Law of cosines at the elbow; clamped at zero against rounding of a folded equal-armed elbow.
-        let span = |angle: f64| libm::sqrt((l1 * l1 + l2 * l2 - 2.0 * l1 * l2 * libm::cos(angle)).max(0.0));
+        let (l1, l2) = (T::of(e.upper_arm), T::of(e.forearm));
+        // Law of cosines at the elbow in its half-angle form, `d^2 = (l1 - l2)^2 + 4 l1 l2 sin^2(angle / 2)`: a sum
+        // of squares (never negative, no cancellation near a folded elbow), in `T`, so that an `f32` platform
+        // computes it with the core's single-precision sine rather than software `f64`.
+        let span = |angle: f64| {
+            let half = (T::of(angle) * T::of(0.5)).sin_();
+            let diff = l1 - l2;
+            (diff * diff + T::of(4.0) * l1 * l2 * half * half).sqrt_()
+        };
         Self {
             axis,
             rs: T::of(e.shoulder_radius),
             hs: T::of(e.shoulder_height),
-            l1: T::of(l1),
-            l2: T::of(l2),
+            l1,
+            l2,
             sign: match e.branch {
                 ElbowBranch::Up => T::one(),
                 ElbowBranch::Down => -T::one(),
             },
-            span: e.elbow_angle.map(|a| T::of(span(a))),
+            span: e.elbow_angle.map(span),
             travel: e.shoulder_angle.map(T::of),
             middle: T::of(0.5 * (e.shoulder_angle[0] + e.shoulder_angle[1])),
         }
@@ -116,6 +122,50 @@ impl<T: Real> Arm<T> {
                 .min_(self.l1 * (s.angle - self.travel[0]))
                 .min_(self.l1 * (self.travel[1] - s.angle)),
             None => span,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// The spans as the law of cosines gives them in `f64`, `sqrt(l1^2 + l2^2 - 2 l1 l2 cos(angle))`.
+    fn law_of_cosines(l1: f64, l2: f64, angle: f64) -> f64 {
+        libm::sqrt((l1 * l1 + l2 * l2 - 2.0 * l1 * l2 * libm::cos(angle)).max(0.0))
+    }
+
+    proptest! {
+        /// The half-angle form in `f32` and `f64` against the law of cosines in `f64`, over arms of 1 cm to 1 m and
+        /// every elbow angle from folded to straight.
+        #[test]
+        fn spans_match_the_law_of_cosines(
+            l1 in 0.01f64..1.0,
+            l2 in 0.01f64..1.0,
+            a0 in 0.0f64..core::f64::consts::PI,
+            a1 in 0.0f64..core::f64::consts::PI,
+        ) {
+            let e = Elbow {
+                shoulder_radius: 0.2,
+                shoulder_height: 0.0,
+                upper_arm: l1,
+                forearm: l2,
+                branch: ElbowBranch::Up,
+                shoulder_angle: [-1.0, 1.0],
+                elbow_angle: [a0, a1],
+            };
+            let single = Arm::<f32>::new(&e, 4);
+            let double = Arm::<f64>::new(&e, 4);
+            for (k, angle) in [a0, a1].into_iter().enumerate() {
+                let want = law_of_cosines(l1, l2, angle);
+                // Compared as squares (the law of cosines' rounding, 1e-16 of (l1 + l2)^2, is a large share of a
+                // folded elbow's small span): f64 to its rounding, f32 to a few of its ulps.
+                let (s, d, want2, scale) = (f64::from(single.span[k]), double.span[k], want * want, (l1 + l2) * (l1 + l2));
+                prop_assert!((d * d - want2).abs() <= 1e-15 * scale, "{d} {want}");
+                prop_assert!((s * s - want2).abs() <= 1e-6 * scale, "{s} {want}");
+            }
         }
     }
 }

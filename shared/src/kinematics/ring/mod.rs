@@ -81,7 +81,6 @@ impl<T: Real> RingPlatform<T> {
         let mut kinds = [Shape::Radial; 6];
         let mut length_axis = [None; 6];
         let mut arms = [None; 6];
-        let mut axes = [AxisKind::Ring; 6];
         let mut next_length = n;
         // The validated geometry has at most six chains and exactly six actuators, so every index is in range.
         for (i, c) in chains.iter().enumerate() {
@@ -89,7 +88,6 @@ impl<T: Real> RingPlatform<T> {
             kinds[i] = Shape::of(&c.kind);
             if c.kind == ChainKind::Radial {
                 length_axis[i] = Some(next_length);
-                axes[next_length] = AxisKind::Linear;
                 next_length += 1;
             }
         }
@@ -97,9 +95,6 @@ impl<T: Real> RingPlatform<T> {
         for (i, c) in chains.iter().enumerate() {
             if let ChainKind::Elbow(e) = &c.kind {
                 arms[i] = Some(Arm::new(e, next_length));
-                if let Some(axis) = axes.get_mut(next_length) {
-                    *axis = AxisKind::Angle;
-                }
                 next_length += 1;
             }
         }
@@ -113,7 +108,7 @@ impl<T: Real> RingPlatform<T> {
             kinds,
             length_axis,
             arms,
-            axes,
+            axes: geometry.axes(),
             stroke: l.stroke.map(T::of),
             spacing: l.carriage_spacing.map(T::of),
             cones: [T::of(l.base_cone), T::of(l.platform_cone)],
