@@ -262,8 +262,8 @@ mod paper_003_slice {
 
     use super::DEG;
 
-    /// SCREWS.md 4, T5: the layout and the mixed assembly give the paper's worked pose, its actuator angles and
-    /// joints.
+    /// SCREWS.md 4, T5: the layout and the mixed assembly give the specification's test pose (the paper prints
+    /// none), its actuator angles and joints.
     #[test]
     fn t5_the_worked_pose_from_the_layout() {
         let f = Vector3::new(-0.25, -0.12, -0.18);

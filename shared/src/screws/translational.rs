@@ -5,7 +5,8 @@
 //! `e_i` at `A = -OA e_i`, `B` and `C` turn about `u_i(theta_i)` (perpendicular to `e_i`, at the actuator's angle
 //! `theta_i`), `D` and `E` about `e_i`, and `E`'s axis passes through the platform point `F`. The paper gives the
 //! joints' axes and lengths (`AB = BC = CD = DE = 0.2`, `EF = 0.3`, `OA = 0.5` m) but its link layout only in a
-//! figure; this is the layout SCREWS.md 3 assumes and its worked pose (T5) confirms, with `v_i = e_i x u_i`:
+//! figure; this is the layout SCREWS.md 3 assumes and its test pose (SCREWS.md 4, T5; the paper prints
+//! no pose) confirms, with `v_i = e_i x u_i`:
 //! `B = A + AB v`, `C = B + BC (cos(alpha) e_i + sin(alpha) v)`, `D = C + CD v`, `E = F - EF e_i`. In the plane
 //! across `e_i` (right-handed: `(y, z)`, `(z, x)`, `(x, y)`), `u_i` lies at the angle `theta_i` and `v_i` a quarter
 //! turn on. Each chain then has two elbows (the sign of `sin(alpha)`) and two sides (which way `v_i` turns from `F`).
@@ -40,7 +41,7 @@ pub struct ChainBranch {
     pub side: Branch,
 }
 
-/// The assembly of the paper's worked pose (SCREWS.md 4, T5): every elbow `Minus`, the sides mixed.
+/// The assembly of the specification's test pose (SCREWS.md 4, T5): every elbow `Minus`, the sides mixed.
 pub const MIXED: [ChainBranch; 3] = [
     ChainBranch {
         elbow: Branch::Minus,
