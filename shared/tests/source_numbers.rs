@@ -244,3 +244,64 @@ fn tool5_pivots_x_changes_no_drive() {
     assert_eq!(q, base);
     assert!((base.0[0] - 0.128_365).abs() < 1e-6, "q1 = x + L1 sin(beta), printed 0");
 }
+
+/// Chapter 4's direct problem: a step of 0.1 rad on every carriage (the lengths held) turns the platform 0.1 rad
+/// about Z and moves nothing else, for the rotopod (as computed and as stated) and for chapter 4.2's mechanism.
+#[test]
+fn ch4_carriage_steps_of_0_1_give_a_pure_yaw_of_0_1() {
+    let rotopods = [rotopod(1.024, 0.98), presets::ROTOPOD_CH4];
+    for g in &rotopods {
+        let m = RingPlatform::<f64>::new(g);
+        let pose = Pose::new(0.0, 0.0, 0.7, 0.0, 0.0, 0.0);
+        let q = m.inverse(&pose).unwrap();
+        check_pure_yaw(&m, &pose, &q, [0.1; 6]);
+    }
+    let g = RingGeometry::new(
+        "ch4-2",
+        3.0,
+        1.0,
+        presets::TRAINER_CH5.chains(),
+        presets::TRAINER_CH5.limits,
+    )
+    .unwrap();
+    let m = RingPlatform::<f64>::new(&g);
+    let pose = Pose::new(0.0, 0.0, 0.172, 0.0, 0.0, 0.0);
+    let q = m.inverse(&pose).unwrap();
+    check_pure_yaw(&m, &pose, &q, [0.1, 0.1, 0.1, 0.1, 0.0, 0.0]);
+}
+
+/// `dp = -A^-1 B dq` is `(0, 0, 0, 0, 0, 0.1)`.
+fn check_pure_yaw(m: &RingPlatform<f64>, pose: &Pose<f64>, q: &Actuators<f64>, dq: [f64; 6]) {
+    let j = m.jacobians(pose, q);
+    let rhs = -(j.b * nalgebra::Vector6::from(dq));
+    let dp = j.a.lu().solve(&rhs).unwrap();
+    let want = nalgebra::Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.1);
+    assert!((dp - want).norm() < 1e-12, "{dp:?}");
+}
+
+/// Chapter 5.1's model at `(0, 0, 1, 0, 0, 0)`: rods `l1 = l2 = 1.298`, radial lengths printed 1.259 (1.25841: the
+/// source rounds up), carriages `q1 = 4.371` (4.3726: a slip of 0.0016 in its `arctg 2.828 + pi`), `q2 = -1.231`,
+/// `q3 = 1.107`, `q4 = 2.033` (2.0344, the same slip).
+#[test]
+fn ch5_printed_lengths_and_carriage_angles() {
+    let g = &presets::TRAINER_CH5;
+    assert!((g.rod_length - 1.298).abs() < 6e-4);
+    let q = RingPlatform::<f64>::new(g)
+        .inverse(&Pose::new(0.0, 0.0, 1.0, 0.0, 0.0, 0.0))
+        .unwrap();
+    assert!((q.0[4] - 1.258_41).abs() < 1e-5 && (q.0[4] - 1.259).abs() > 5e-4);
+    assert_eq!(q.0[4], q.0[5]);
+    for (got, want, slip) in [
+        (q.0[0], 4.371, true),
+        (q.0[1], -1.231, false),
+        (q.0[2], 1.107, false),
+        (q.0[3], 2.033, true),
+    ] {
+        let err = angle_diff(got, want).abs();
+        if slip {
+            assert!(err > 1e-3 && err < 2e-3, "{got} vs {want}");
+        } else {
+            assert!(err < 5e-4, "{got} vs {want}");
+        }
+    }
+}
