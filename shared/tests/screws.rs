@@ -265,7 +265,7 @@ mod paper_003_slice {
     /// SCREWS.md 4, T5: the layout and the mixed assembly give the specification's test pose (the paper prints
     /// none), its actuator angles and joints.
     #[test]
-    fn t5_the_worked_pose_from_the_layout() {
+    fn t5_the_test_pose_from_the_layout() {
         let f = Vector3::new(-0.25, -0.12, -0.18);
         let theta = [-157.2695, -175.4759, -290.4576];
         let joints = [
