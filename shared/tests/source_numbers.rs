@@ -4,8 +4,10 @@
 // Index loops over the printed matrices' rows and columns read more plainly than zips here.
 #![allow(clippy::needless_range_loop)]
 
+use ringpod_core::kinematics::presets::{self, Preset};
 use ringpod_core::kinematics::{
-    presets, Actuators, Branch, Chain, ChainKind, Mechanism, Pose, RingGeometry, RingPlatform, ToolCarrier,
+    Actuators, Branch, Chain, ChainKind, Check, KinematicsError, Mechanism, Pose, RingGeometry, RingPlatform,
+    ToolCarrier,
 };
 
 /// Difference of two angles modulo a turn, in (-pi, pi].
@@ -304,4 +306,44 @@ fn ch5_printed_lengths_and_carriage_angles() {
             assert!(err < 5e-4, "{got} vs {want}");
         }
     }
+}
+
+/// Chapter 3.2's mechanism (`trainer-ch3`): every check passes at heave 0.948 to 0.997 at the centre, bounded below
+/// by the actuators' shortest length (0.95 = `sqrt((R - r)^2 + z^2)`) and above by the rods' reach (`L = 1`).
+#[test]
+fn ch3_2_preset_heave_range() {
+    let m = RingPlatform::<f64>::new(&presets::TRAINER_CH3);
+    let at = |z: f64| m.inverse_checked(&Pose::new(0.0, 0.0, z, 0.0, 0.0, 0.0));
+    let (q, report) = at(0.947).unwrap();
+    assert_eq!(report.first_failure(), Some(Check::Reach));
+    assert!(q.0[4] < 0.95);
+    for z in [0.948, presets::TRAINER_CH3_HOME_Z, 0.997] {
+        assert!(at(z).unwrap().1.all_pass(), "{z}");
+    }
+    assert!(matches!(at(0.998), Err(KinematicsError::Unreachable { chain: 2, .. })));
+    // The radial carriages on their joints' radii, the rods' as the chapter's phi13 -+ phi33.
+    let q = at(presets::TRAINER_CH3_HOME_Z).unwrap().0;
+    assert!((q.0[0] - 0.75 * std::f64::consts::PI).abs() < 1e-12);
+    assert!((angle_diff(q.0[1], -0.75 * std::f64::consts::PI)).abs() < 1e-12);
+    assert!(q.0[2] < -std::f64::consts::FRAC_PI_4 + 0.5 && q.0[2] > -std::f64::consts::FRAC_PI_4);
+}
+
+/// Chapter 4.2's mechanism (`trainer-ch4`): its radial lengths at the chapter's pose are the printed 0.783; that
+/// pose fails the joint cones and the singularity index; the home passes everything.
+#[test]
+fn ch4_2_preset_at_the_chapters_pose_and_at_home() {
+    let m = RingPlatform::<f64>::new(&presets::TRAINER_CH4);
+    let (q, report) = m.inverse_checked(&Pose::new(0.0, 0.0, 0.172, 0.0, 0.0, 0.0)).unwrap();
+    assert!((q.0[4] - 0.783).abs() < 5e-4 && q.0[4] == q.0[5]);
+    assert!(!report.passes(Check::JointCones) && !report.passes(Check::Singularity));
+    let h = Preset::TrainerCh4.home();
+    let home = Pose::new(h[0], h[1], h[2], h[3], h[4], h[5]);
+    assert!(m.inverse_checked(&home).unwrap().1.all_pass());
+    let h = Preset::TrainerCh3.home();
+    let home = Pose::new(h[0], h[1], h[2], h[3], h[4], h[5]);
+    assert!(RingPlatform::<f64>::new(&presets::TRAINER_CH3)
+        .inverse_checked(&home)
+        .unwrap()
+        .1
+        .all_pass());
 }
