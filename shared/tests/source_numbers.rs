@@ -148,14 +148,7 @@ const CH42_B: [f64; 6] = [-1.566, -1.566, 1.663, -1.66, 5.588, -5.598];
 /// first row's beta, -0.688, is a slip for -0.344 (`-2 z a_x`, as the mirror row's 0.344).
 #[test]
 fn ch4_2_printed_matrices_are_the_jacobians_at_chapter_5s_angles() {
-    let g = RingGeometry::new(
-        "ch4-2",
-        3.0,
-        1.0,
-        presets::TRAINER_CH5.chains(),
-        presets::TRAINER_CH5.limits,
-    )
-    .unwrap();
+    let g = presets::TRAINER_CH4;
     let ch5 = RingPlatform::<f64>::new(&presets::TRAINER_CH5)
         .inverse(&Pose::new(0.0, 0.0, 1.0, 0.0, 0.0, 0.0))
         .unwrap();
@@ -258,14 +251,7 @@ fn ch4_carriage_steps_of_0_1_give_a_pure_yaw_of_0_1() {
         let q = m.inverse(&pose).unwrap();
         check_pure_yaw(&m, &pose, &q, [0.1; 6]);
     }
-    let g = RingGeometry::new(
-        "ch4-2",
-        3.0,
-        1.0,
-        presets::TRAINER_CH5.chains(),
-        presets::TRAINER_CH5.limits,
-    )
-    .unwrap();
+    let g = presets::TRAINER_CH4;
     let m = RingPlatform::<f64>::new(&g);
     let pose = Pose::new(0.0, 0.0, 0.172, 0.0, 0.0, 0.0);
     let q = m.inverse(&pose).unwrap();

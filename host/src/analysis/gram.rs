@@ -20,6 +20,8 @@ use crate::input::numbers::BadNumber;
 
 use crate::out::plot::{self, Picture};
 
+mod reactions;
+
 /// What `gram` is asked to do.
 pub struct Options<'a> {
     /// The slice's height (m).
@@ -30,6 +32,8 @@ pub struct Options<'a> {
     pub out: &'a Path,
     /// The markdown table, if asked.
     pub table: Option<&'a Path>,
+    /// Figs. 3 and 5 (the largest constraint reaction, unprojected and projected), if asked.
+    pub reactions: Option<&'a Path>,
 }
 
 /// Below this a determinant counts as near zero.
@@ -37,7 +41,7 @@ const NEAR_ZERO: f64 = 1e-4;
 /// A cell this near (m) to a sign change of `det M_C` is on the constraint singularity.
 const BOUNDARY: f64 = 0.006;
 /// The scanned square, `x` and `y` (m).
-const SPAN: (f64, f64) = (-0.4, 0.0);
+pub(super) const SPAN: (f64, f64) = (-0.4, 0.0);
 
 /// The slice: cells row by row (`y` up), `None` where a chain cannot reach.
 struct Slice {
@@ -149,6 +153,9 @@ pub fn run(args: &Options) -> Result<String, CliError> {
         );
     }
     let _ = writeln!(text, "picture: {}", args.out.display());
+    if let Some(path) = args.reactions {
+        text += &reactions::draw(args.z, args.step, path)?;
+    }
     if let Some(path) = args.table {
         crate::out::file::write(path, table(&slice, &all_stats).as_bytes()).map_err(|e| CliError::file(path, e))?;
         let _ = writeln!(text, "table: {}", path.display());
@@ -243,20 +250,12 @@ impl Picture for SlicePicture<'_> {
     where
         DB::ErrorType: 'static,
     {
-        let fail = plot::failed(out);
-        root.fill(&WHITE).map_err(|e| fail(&e))?;
-        let (title, body) = root.split_vertically(40);
-        title
-            .draw(&Text::new(
-                format!(
-                    "paper 003: Gram determinants over the slice z = {} m ({} mm grid; dark: near 0, log scale 1e-6..1)",
-                    self.slice.z,
-                    self.slice.step * 1e3
-                ),
-                (20, 12),
-                (plot::FONT, 18),
-            ))
-            .map_err(|e| fail(&e))?;
+        let title = format!(
+            "paper 003: Gram determinants over the slice z = {} m ({} mm grid; dark: near 0, log scale 1e-6..1)",
+            self.slice.z,
+            self.slice.step * 1e3
+        );
+        let body = plot::titled(root, &title, 18, out)?;
         let panels = body.split_evenly((2, 2));
         let sign = |g: &GramDeterminants| {
             if g.det_mc < 0.0 {
