@@ -192,6 +192,18 @@ fn dm(d: f64, m: f64) -> f64 {
     d + m / 60.0
 }
 
+/// The tool carrier's third example: `(0, 0, 400 mm)`, alpha 15 deg 13', beta 25 deg 20'.
+fn third_example() -> Pose<f64> {
+    Pose::new(
+        0.0,
+        0.0,
+        0.4,
+        dm(15.0, 13.0).to_radians(),
+        dm(25.0, 20.0).to_radians(),
+        0.0,
+    )
+}
+
 /// The third example's printed dyad angles: `q2`, `q2'`, `q4` within a minute of the formulas' at the printed pose
 /// (the source rounds 134 deg 07.9' and 34 deg 21.6' up and cuts 65 deg 01.6' down), and `q4'` 169 deg 20.4' where
 /// the source prints 169 deg 22': a slip of 1.6' in the source (with `q4 + q4' = 2 eta`, `eta` = 101 deg 51', its
@@ -202,14 +214,7 @@ fn tool5_third_example_q4_prime_is_169_deg_20_4() {
     let minus = base.with_branches([Branch::Minus, Branch::Minus]);
     let plus = base.with_branches([Branch::Plus, Branch::Plus]);
     let printed = [dm(65.0, 1.0), dm(134.0, 8.0), dm(34.0, 22.0), dm(169.0, 22.0)];
-    let pose = Pose::new(
-        0.0,
-        0.0,
-        0.4,
-        dm(15.0, 13.0).to_radians(),
-        dm(25.0, 20.0).to_radians(),
-        0.0,
-    );
+    let pose = third_example();
     let (m, p) = (minus.inverse(&pose).unwrap(), plus.inverse(&pose).unwrap());
     let at = [m.0[1], p.0[1], m.0[3], p.0[3]].map(f64::to_degrees);
     for k in 0..3 {
@@ -223,14 +228,7 @@ fn tool5_third_example_q4_prime_is_169_deg_20_4() {
 /// plane along X, which changes no angle. ringpod keeps it in the preset and draws with it.
 #[test]
 fn tool5_pivots_x_changes_no_drive() {
-    let pose = Pose::new(
-        0.0,
-        0.0,
-        0.4,
-        dm(15.0, 13.0).to_radians(),
-        dm(25.0, 20.0).to_radians(),
-        0.0,
-    );
+    let pose = third_example();
     let base = ToolCarrier::<f64>::new(&presets::TOOL5_EX).inverse(&pose).unwrap();
     let mut moved = presets::TOOL5_EX;
     moved.pivot_b[0] = 0.0;

@@ -230,6 +230,18 @@ fn table(slice: &Slice, all_stats: &[Stats]) -> String {
     t
 }
 
+/// A map of the slice's cells, `x` and `y` over [`SPAN`], with its caption.
+fn slice_map(caption: &str) -> plot::CellMap<'_> {
+    plot::CellMap {
+        caption: (caption, 15),
+        margin: 12,
+        label_areas: (36, 56),
+        axes: ("x (m)", "y (m)", 11),
+        u: SPAN,
+        v: SPAN,
+    }
+}
+
 /// Dark where a determinant is small (the wrenches dependent), light where it is near 1; `log10` from -6 to 0.
 fn shade(d: f64) -> RGBColor {
     let t = ((d.max(1e-12).log10() + 6.0) / 6.0).clamp(0.0, 1.0);
@@ -297,14 +309,7 @@ impl SlicePicture<'_> {
     {
         let s = self.slice;
         let half = s.step / 2.0;
-        let map = plot::CellMap {
-            caption: (caption, 15),
-            margin: 12,
-            label_areas: (36, 56),
-            axes: ("x (m)", "y (m)", 11),
-            u: SPAN,
-            v: SPAN,
-        };
+        let map = slice_map(caption);
         map.draw(
             area,
             out,

@@ -12,7 +12,7 @@ use plotters::prelude::*;
 use rayon::prelude::*;
 use ringpod_core::screws::translational::{gram, max_reactions, MaxReactions, FIG_LOAD, MIXED};
 
-use super::SPAN;
+use super::{slice_map, SPAN};
 use crate::error::CliError;
 use crate::out::plot::{self, Picture};
 
@@ -117,14 +117,7 @@ impl Picture for ReactionsPicture<'_> {
             let m = self.map;
             let half = m.step / 2.0;
             let centre = |i: usize| SPAN.0 + (i as f64 + 0.5) * m.step;
-            let map = plot::CellMap {
-                caption: (caption, 15),
-                margin: 12,
-                label_areas: (36, 56),
-                axes: ("x (m)", "y (m)", 11),
-                u: SPAN,
-                v: SPAN,
-            };
+            let map = slice_map(caption);
             map.draw(
                 area,
                 out,
