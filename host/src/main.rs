@@ -110,11 +110,18 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
         } => say(stream::derivatives::plot_command(record, out, *window, (*from, *to)))?,
         C::Plot { record, out, .. } => say(stream::record::plot_command(record, out))?,
         C::Draw(args) => say(analysis::draw::run(&args.options()))?,
-        C::Gram { z, step, out, table } => say(analysis::gram::run(&analysis::gram::Options {
+        C::Gram {
+            z,
+            step,
+            out,
+            table,
+            reactions,
+        } => say(analysis::gram::run(&analysis::gram::Options {
             z: *z,
             step: *step,
             out,
             table: table.as_deref(),
+            reactions: reactions.as_deref(),
         }))?,
         C::Workspace(args) => say(analysis::workspace::run(&args.options()))?,
     })

@@ -175,7 +175,9 @@ fn presets_lists_every_geometry() {
             "trainer-elbow",
             "trainer-ch5",
             "rotopod-ch4",
-            "tool5-ex"
+            "tool5-ex",
+            "trainer-ch3",
+            "trainer-ch4"
         ]
     );
 }

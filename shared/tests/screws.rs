@@ -257,15 +257,48 @@ mod paper_003_slice {
     //! determinants of paper 003's figs. 3-5.
 
     use nalgebra::Vector3;
+    use nalgebra::Vector6;
     use proptest::prelude::*;
-    use ringpod_core::screws::translational::{chain, gram, TranslationalError, MIXED, SLICE_Z};
+    use ringpod_core::screws::translational::{
+        chain, gram, max_reactions, TranslationalError, FIG_LOAD, MIXED, SLICE_Z,
+    };
 
     use super::DEG;
 
-    /// SCREWS.md 4, T5: the layout and the mixed assembly give the paper's worked pose, its actuator angles and
-    /// joints.
+    /// Figs. 3 and 5's `r_max` at T5 is the largest constraint reaction of T6 (unit actuation wrenches change only
+    /// the actuators' reactions): unprojected 2.96711 and projected 0 for a pure force, 0.22839 and 0.31592 for T6's
+    /// general load (within 2e-3: T6 takes the joints as printed to four decimals, these the layout's exact ones).
     #[test]
-    fn t5_the_worked_pose_from_the_layout() {
+    fn figs_3_and_5_r_max_at_t5() {
+        let f = Vector3::new(-0.25, -0.12, -0.18);
+        let r = max_reactions(&f, MIXED, &Vector6::new(0.0, 0.0, 10.0, 0.0, 0.0, 0.0)).unwrap();
+        assert!(
+            (r.unprojected - 2.96711).abs() < 2e-3 && r.projected.abs() < 1e-9,
+            "{r:?}"
+        );
+        let r = max_reactions(&f, MIXED, &Vector6::new(1.0, 2.0, 3.0, 0.1, -0.2, 0.3)).unwrap();
+        assert!(
+            (r.unprojected - 0.22839).abs() < 2e-3 && (r.projected - 0.31592).abs() < 2e-3,
+            "{r:?}"
+        );
+        // The figures' load: its couple alone sets the projected reactions.
+        let load = Vector6::from(FIG_LOAD);
+        let couple = Vector6::new(0.0, 0.0, 0.0, 0.1, 0.1, 0.1);
+        let (a, b) = (
+            max_reactions(&f, MIXED, &load).unwrap(),
+            max_reactions(&f, MIXED, &couple).unwrap(),
+        );
+        assert!((a.projected - b.projected).abs() < 1e-12 && (a.unprojected - b.unprojected).abs() > 1e-3);
+        assert_eq!(
+            max_reactions(&Vector3::new(0.05, -0.1, SLICE_Z), MIXED, &load),
+            Err(TranslationalError::Unreachable(0))
+        );
+    }
+
+    /// SCREWS.md 4, T5: the layout and the mixed assembly give the specification's test pose (the paper prints
+    /// none), its actuator angles and joints.
+    #[test]
+    fn t5_the_test_pose_from_the_layout() {
         let f = Vector3::new(-0.25, -0.12, -0.18);
         let theta = [-157.2695, -175.4759, -290.4576];
         let joints = [

@@ -76,7 +76,8 @@ pub struct ReactionsArgs {
 
 #[derive(Debug, Args)]
 pub struct Common {
-    /// Geometry: trainer-model, trainer-elbow, trainer-ch5, rotopod-ch4, tool5-ex (see `ringpod presets`).
+    /// Geometry: trainer-model, trainer-elbow, trainer-ch5, rotopod-ch4, tool5-ex, trainer-ch3, trainer-ch4 (see
+    /// `ringpod presets`).
     #[arg(long, short, default_value = "trainer-model")]
     pub mechanism: String,
     /// Your own ring platform: a rig file (TOML; see `ringpod rig check`), instead of --mechanism.

@@ -118,7 +118,7 @@ pub enum Command {
     Reactions(ReactionsArgs),
     /// Paper 003's figs. 3-5: the Gram determinants of its three-DOF translational mechanism's wrenches (constraint,
     /// actuation, all) over a slice of its workspace, drawn as four maps (with the sign of det M_C) and written as
-    /// a markdown table.
+    /// a markdown table; with --reactions, figs. 3 and 5's largest constraint reaction, unprojected and projected.
     Gram {
         /// The slice's height (m).
         #[arg(long, default_value_t = ringpod_core::screws::translational::SLICE_Z, allow_hyphen_values = true)]
@@ -132,6 +132,10 @@ pub enum Command {
         /// Also write the statistics and a table of values every 50 mm (markdown).
         #[arg(long, value_name = "FILE.md")]
         table: Option<std::path::PathBuf>,
+        /// Also draw figs. 3 and 5, the largest constraint reaction without and with projection (.png or .svg),
+        /// for a load of 1 N down and 0.1 N m about each axis (the paper does not say which it used).
+        #[arg(long, value_name = "FILE")]
+        reactions: Option<std::path::PathBuf>,
     },
     /// Scans the workspace of a ring platform or the tool carrier with all its checks (in parallel), draws a section
     /// (positions, or the two tilts) coloured by the limiting check, and prints the cells inside, the reachable

@@ -55,6 +55,24 @@ pub trait Picture {
         DB::ErrorType: 'static;
 }
 
+/// Fills the picture white and writes `title` (of `size` points) in a 40-pixel band at the top; the area below.
+pub fn titled<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    size: u32,
+    out: &Path,
+) -> Result<DrawingArea<DB, Shift>, PlotError>
+where
+    DB::ErrorType: 'static,
+{
+    let fail = failed(out);
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let (band, body) = root.split_vertically(40);
+    band.draw(&Text::new(title.to_owned(), (20, 12), (FONT, size)))
+        .map_err(|e| fail(&e))?;
+    Ok(body)
+}
+
 /// Writes `picture` to `out`: SVG when the name ends in `.svg`, PNG when it ends in `.png`. It is drawn in memory
 /// and written whole ([`super::file::write`]): a full disk leaves no partial picture behind, and is an error.
 pub fn save(out: &Path, size: (u32, u32), picture: &impl Picture) -> Result<(), PlotError> {

@@ -80,6 +80,53 @@ pub const TOOL5_EX: ToolGeometry = unwrap_geometry(ToolGeometry::new(
     0.02,
 ));
 
+/// Four-chain mechanism of dissertation ch. 3.2 (normalised units): linear actuators 0.95..1.05 in chains 1, 2 (side
+/// by side, as a car's rear suspension), rods of 1 in chains 3, 4 (`phi3 = phi13 + phi33`, `phi4 = phi13 - phi33`),
+/// platform joints on the square of half-side 0.672 (on the rotopod's circle, `r = 0.95`), ring radius 1.0198.
+pub const TRAINER_CH3: RingGeometry = unwrap_geometry(RingGeometry::new(
+    "trainer-ch3",
+    1.0198,
+    1.0,
+    &[
+        radial(-0.672, 0.672),
+        radial(-0.672, -0.672),
+        rod(Branch::Plus, 0.672, -0.672),
+        rod(Branch::Minus, 0.672, 0.672),
+    ],
+    RingLimits {
+        stroke: [0.95, 1.05],
+        ..TRAINER_CH5.limits
+    },
+));
+
+/// Four-chain mechanism of dissertation ch. 4.2 (normalised units): chapter 5's ring and platform with rods of 1 and
+/// linear actuators of 0.2..1.2. The rods' carriages sit inside their pair (chapter 5's branches put them 141 deg
+/// from the radial carriages at every height, past the 120 deg limit); the chapter's own pose, heave 0.172, tilts the
+/// rods past the joint cones and lies near a type 2 singularity, so the home is the middle of the heave that passes
+/// every check (0.39..0.55).
+pub const TRAINER_CH4: RingGeometry = unwrap_geometry(RingGeometry::new(
+    "trainer-ch4",
+    3.0,
+    1.0,
+    &[
+        rod(Branch::Minus, -1.0, -2.0),
+        rod(Branch::Plus, 1.0, -2.0),
+        radial(1.0, 2.0),
+        radial(-1.0, 2.0),
+    ],
+    RingLimits {
+        stroke: [0.2, 1.2],
+        ..TRAINER_CH5.limits
+    },
+));
+
+/// Home heave of [`TRAINER_CH3`]: every check passes from 0.948 (the actuators' shortest, 0.95) to 0.997 (the rods'
+/// reach).
+pub const TRAINER_CH3_HOME_Z: f64 = 0.97;
+
+/// Home heave of [`TRAINER_CH4`].
+pub const TRAINER_CH4_HOME_Z: f64 = 0.47;
+
 /// Nominal heave of the trainer model: the centre of its heave range (m).
 pub const TRAINER_MODEL_HOME_Z: f64 = 0.227;
 
@@ -179,6 +226,10 @@ pub enum Preset {
     TrainerElbow,
     /// [`TOOL5_EX`].
     Tool5Ex,
+    /// [`TRAINER_CH3`].
+    TrainerCh3,
+    /// [`TRAINER_CH4`].
+    TrainerCh4,
 }
 
 /// The geometry of a preset: a ring platform or a tool carrier.
@@ -192,12 +243,14 @@ pub enum PresetGeometry {
 
 impl Preset {
     /// Every preset.
-    pub const ALL: [Preset; 5] = [
+    pub const ALL: [Preset; 7] = [
         Preset::TrainerModel,
         Preset::TrainerElbow,
         Preset::TrainerCh5,
         Preset::RotopodCh4,
         Preset::Tool5Ex,
+        Preset::TrainerCh3,
+        Preset::TrainerCh4,
     ];
 
     /// The preset's name, as in the reference files.
@@ -208,6 +261,8 @@ impl Preset {
             Preset::TrainerModel => "trainer-model",
             Preset::TrainerElbow => "trainer-elbow",
             Preset::Tool5Ex => "tool5-ex",
+            Preset::TrainerCh3 => "trainer-ch3",
+            Preset::TrainerCh4 => "trainer-ch4",
         }
     }
 
@@ -226,6 +281,8 @@ impl Preset {
                 "the 1:20 trainer model with elbow arms (ch. 5.1 fig. 5.2) for its linear actuators"
             }
             Preset::Tool5Ex => "five-DOF tool carrier of the worked position problem, metres",
+            Preset::TrainerCh3 => "four chains of dissertation ch. 3.2, normalised units (ring radius 1.0198)",
+            Preset::TrainerCh4 => "four chains of dissertation ch. 4.2, normalised units (ring radius 3, rods 1)",
         }
     }
 
@@ -237,6 +294,8 @@ impl Preset {
             Preset::TrainerModel => PresetGeometry::Ring(&TRAINER_MODEL),
             Preset::TrainerElbow => PresetGeometry::Ring(&TRAINER_ELBOW),
             Preset::Tool5Ex => PresetGeometry::Tool(&TOOL5_EX),
+            Preset::TrainerCh3 => PresetGeometry::Ring(&TRAINER_CH3),
+            Preset::TrainerCh4 => PresetGeometry::Ring(&TRAINER_CH4),
         }
     }
 
@@ -256,6 +315,8 @@ impl Preset {
             Preset::RotopodCh4 => [0.0, 0.0, 0.7, 0.0, 0.0, 0.0],
             Preset::TrainerModel | Preset::TrainerElbow => [0.0, 0.0, TRAINER_MODEL_HOME_Z, 0.0, 0.0, 0.0],
             Preset::Tool5Ex => [0.0, 0.0, 0.4, 0.0, 0.0, 0.0],
+            Preset::TrainerCh3 => [0.0, 0.0, TRAINER_CH3_HOME_Z, 0.0, 0.0, 0.0],
+            Preset::TrainerCh4 => [0.0, 0.0, TRAINER_CH4_HOME_Z, 0.0, 0.0, 0.0],
         }
     }
 }

@@ -5,7 +5,8 @@
 //! `e_i` at `A = -OA e_i`, `B` and `C` turn about `u_i(theta_i)` (perpendicular to `e_i`, at the actuator's angle
 //! `theta_i`), `D` and `E` about `e_i`, and `E`'s axis passes through the platform point `F`. The paper gives the
 //! joints' axes and lengths (`AB = BC = CD = DE = 0.2`, `EF = 0.3`, `OA = 0.5` m) but its link layout only in a
-//! figure; this is the layout SCREWS.md 3 assumes and its worked pose (T5) confirms, with `v_i = e_i x u_i`:
+//! figure; this is the layout SCREWS.md 3 assumes and its test pose (SCREWS.md 4, T5; the paper prints
+//! no pose) confirms, with `v_i = e_i x u_i`:
 //! `B = A + AB v`, `C = B + BC (cos(alpha) e_i + sin(alpha) v)`, `D = C + CD v`, `E = F - EF e_i`. In the plane
 //! across `e_i` (right-handed: `(y, z)`, `(z, x)`, `(x, y)`), `u_i` lies at the angle `theta_i` and `v_i` a quarter
 //! turn on. Each chain then has two elbows (the sign of `sin(alpha)`) and two sides (which way `v_i` turns from `F`).
@@ -19,7 +20,7 @@
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
 use super::line;
-use super::reactions::actuation_wrench;
+use super::reactions::{actuation_wrench, reactions};
 use crate::kinematics::geometry::Branch;
 
 /// Distance from the origin to each actuated joint `OA` (m).
@@ -40,7 +41,7 @@ pub struct ChainBranch {
     pub side: Branch,
 }
 
-/// The assembly of the paper's worked pose (SCREWS.md 4, T5): every elbow `Minus`, the sides mixed.
+/// The assembly of the specification's test pose (SCREWS.md 4, T5): every elbow `Minus`, the sides mixed.
 pub const MIXED: [ChainBranch; 3] = [
     ChainBranch {
         elbow: Branch::Minus,
@@ -65,6 +66,8 @@ pub enum TranslationalError {
     Unreachable(usize),
     /// Chain `i`'s actuation wrench is not defined (its passive joints and constraint leave no single direction).
     Degenerate(usize),
+    /// The six wrenches are dependent (a singularity): no reactions balance a load.
+    Singular,
 }
 
 impl core::fmt::Display for TranslationalError {
@@ -73,6 +76,7 @@ impl core::fmt::Display for TranslationalError {
             Self::NonFinite => f.write_str("the point is not finite"),
             Self::Unreachable(i) => write!(f, "chain {} cannot reach the point", i + 1),
             Self::Degenerate(i) => write!(f, "chain {}'s actuation wrench is not defined there", i + 1),
+            Self::Singular => f.write_str("the wrenches are dependent there (a singularity)"),
         }
     }
 }
@@ -217,4 +221,40 @@ pub fn gram(f: &Vector3<f64>, branches: [ChainBranch; 3]) -> Result<GramDetermin
         actuation: g3(&w.actuation),
         all: g,
     })
+}
+
+/// The load of paper 003's figs. 3 and 5 as ringpod draws them, `[force; couple]` about `F`: the paper does not say
+/// which it used. A pure force is all taken by the actuators once projected (the projected constraint reactions are
+/// `W_C^+ P`, the couple's share), so the load is 1 N down with a couple of 0.1 N m about each axis.
+pub const FIG_LOAD: [f64; 6] = [0.0, 0.0, -1.0, 0.1, 0.1, 0.1];
+
+/// The largest constraint reaction at a point, `r_max = max |r_Ci|` (the paper's fig. 3 unprojected, fig. 5 with
+/// the actuation wrenches projected onto the complement of the constraints' span), for a load `p` on the platform.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaxReactions {
+    /// Fig. 3: it grows near actuation singularities as well as near the constraint singularity.
+    pub unprojected: f64,
+    /// Fig. 5: it grows only near the constraint singularity.
+    pub projected: f64,
+}
+
+/// [`MaxReactions`] at platform point `f` for the load `p` (N, N m), the actuation wrenches of unit length as in
+/// [`wrenches`] (their reactions' scale is theirs, the constraint reactions are in N m).
+pub fn max_reactions(
+    f: &Vector3<f64>,
+    branches: [ChainBranch; 3],
+    p: &Vector6<f64>,
+) -> Result<MaxReactions, TranslationalError> {
+    let w = wrenches(f, branches)?;
+    let r = reactions(&w.actuation, &w.constraints, p).ok_or(TranslationalError::Singular)?;
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let out = MaxReactions {
+        unprojected: largest(&r.constraints[..3]),
+        projected: largest(&r.constraints_projected[..3]),
+    };
+    if out.unprojected.is_finite() && out.projected.is_finite() {
+        Ok(out)
+    } else {
+        Err(TranslationalError::Singular)
+    }
 }
