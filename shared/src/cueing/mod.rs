@@ -24,6 +24,7 @@ pub mod axes;
 mod config;
 pub mod filter;
 mod live;
+pub mod perception;
 pub mod schema;
 pub mod smoothing;
 
