@@ -263,7 +263,7 @@ pub(crate) fn telemetry_decoder(
     profile: &Option<String>,
 ) -> Result<datagram::Decoder, SourceError> {
     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
-    let washout = ringpod_core::cueing::Live::new(config).map_err(SourceError::Washout)?;
+    let washout = super::cueing::LiveCueing::new(config).map_err(SourceError::Washout)?;
     Ok(datagram::Decoder::Telemetry {
         reader: Box::new(crate::games::Reader::new(format, outsim_opts)),
         washout: Box::new(washout),
