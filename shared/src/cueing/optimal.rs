@@ -26,26 +26,36 @@ pub struct OptimalConfig {
     /// Length of one step (s; default 0.15): the horizon looks `horizon * step_s` ahead.
     pub step_s: f64,
     /// Weight of the perceived specific-force error, per axis (per (m/s^2)^2; default 1).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub force_weight: [f64; 3],
     /// Weight of the perceived roll and pitch rate error (per (rad/s)^2; default 10).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub rotation_weight: [f64; 2],
     /// Return to neutral: weight of the position offset, per axis (per m^2; default 10).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub position_weight: [f64; 3],
     /// Weight of the velocity, per axis (per (m/s)^2; default 1).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub velocity_weight: [f64; 3],
     /// Return to neutral: weight of the tilt, x (pitch) and y (roll) (per rad^2; default 0.1).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub tilt_weight: [f64; 2],
     /// Effort: weight of the platform's acceleration, per axis (per (m/s^2)^2; default 0.001).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub acceleration_weight: [f64; 3],
     /// Effort: weight of the angular rate, x (pitch) and y (roll) (per (rad/s)^2; default 0.01).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub rate_weight: [f64; 2],
     /// The rig's velocity limit, per axis (m/s; default 0.5).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub max_velocity: [f64; 3],
     /// The rig's acceleration limit, per axis (m/s^2; default 5).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub max_acceleration: [f64; 3],
     /// The rig's angular rate limit, x (pitch) and y (roll) (deg/s; default 60).
+    #[serde(deserialize_with = "super::axes::one_or_each")]
     pub max_rate_deg: [f64; 2],
-    /// The share of each axis's range about home (from the workspace scan) the optimiser may use (default 0.7):
+    /// The share of each axis's range about home (from the workspace scan) the optimiser may use (default 0.5):
     /// the ranges are found one axis at a time, and a pose that uses several axes at once needs a margin.
     pub envelope_share: f64,
     /// A solve that takes longer than this falls back to the classical washout for its sample (ms; default 2).
@@ -67,7 +77,7 @@ impl Default for OptimalConfig {
             max_velocity: [0.5; 3],
             max_acceleration: [5.0; 3],
             max_rate_deg: [60.0; 2],
-            envelope_share: 0.7,
+            envelope_share: 0.5,
             budget_ms: 2.0,
         }
     }

@@ -21,7 +21,8 @@ pub enum Values {
 pub struct Param {
     /// The key as the cueing file writes it, a table's key after a dot: `yaw_scale`, `tilt_low_pass.omega`,
     /// `smoothing.window`. A per-axis key is a list of one value per axis (`translation_scale` is
-    /// `[surge, sway, heave]`); its axis index goes after the key's first part.
+    /// `[surge, sway, heave]`); its axis index goes after the key's first part (in the `optimal` table, after
+    /// its second: `optimal.force_weight` is the list).
     pub key: &'static str,
     /// What it is, in a few words, for a label.
     pub name: &'static str,

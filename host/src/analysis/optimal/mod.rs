@@ -370,5 +370,11 @@ mod tests {
             (o.counts().late, o.counts().solve_s.iter().cloned().fold(0.0, f64::max))
         );
         assert!(last[4] > 0.01, "{last:?}");
+        // Within the envelope it plans in (a share of the ranges), which the slacks' price keeps.
+        let share = o.config.optimal.envelope_share;
+        assert!(
+            last[0].abs() <= 0.05 * share + 1e-3 && last[4] <= 0.3 * share + 1e-3,
+            "{last:?}"
+        );
     }
 }
