@@ -5,7 +5,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use ringpod_core::cueing::{Algorithm, CueConfig, Telemetry, G};
 
 // The optimal cueing's module as the binary builds it (the host is a binary crate: no library to link).
-#[allow(dead_code)]
+#[allow(dead_code, unused_imports)]
 #[path = "../src/analysis/optimal/mod.rs"]
 mod optimal;
 
