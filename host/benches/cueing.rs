@@ -22,7 +22,13 @@ fn one_sample(c: &mut Criterion) {
         ..CueConfig::default()
     };
     // The trainer model's ranges about home as the workspace scan finds them (m, rad).
-    let ranges = [(-0.129, 0.129), (-0.055, 0.095), (-0.067, 0.059), (-0.454, 0.384), (-0.358, 0.358)];
+    let ranges = [
+        (-0.129, 0.129),
+        (-0.055, 0.095),
+        (-0.067, 0.059),
+        (-0.454, 0.384),
+        (-0.358, 0.358),
+    ];
     let mut o = optimal::Optimal::new(config, &ranges).expect("the defaults are valid");
     o.begin(&sample(0.0)).expect("finite");
     let mut t = 0.0;

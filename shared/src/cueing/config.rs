@@ -259,6 +259,6 @@ impl CueConfig {
             return err("yaw_high_pass", CORNER);
         }
         self.smoothing.check().or_else(|(key, must)| err(key, must))?;
-        self.optimal.validate()
+        self.optimal.validate().or_else(|(key, must)| err(key, must))
     }
 }

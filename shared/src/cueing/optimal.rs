@@ -2,8 +2,6 @@
 //! motion limits, as a cueing file's `[optimal]` table. The solver runs on the host (`ringpod cue`, `stream`);
 //! the core holds what a file says and checks it, as it does the washout's.
 
-use super::config::ConfigError;
-
 /// Which cueing algorithm a file asks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -84,10 +82,11 @@ impl Default for OptimalConfig {
 }
 
 impl OptimalConfig {
-    /// Checks every parameter; the error names the first key out of range, as `optimal.KEY`.
-    pub fn validate(&self) -> Result<(), ConfigError> {
+    /// Checks every parameter; the error is the first key out of range, as `optimal.KEY`, and what it must be
+    /// (the configuration's check turns it into its error).
+    pub fn validate(&self) -> Result<(), (&'static str, &'static str)> {
         let ok = |v: f64, lo: f64, hi: f64| v.is_finite() && v >= lo && v <= hi;
-        let err = |key, must| Err(ConfigError { key, axis: None, must });
+        let err = |key, must| Err((key, must));
         if !(2..=60).contains(&self.horizon) {
             return err("optimal.horizon", "2 to 60 steps");
         }
