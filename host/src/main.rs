@@ -96,7 +96,10 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
         } => device::simulate(cli::platform(geometry, mechanism).as_ref(), *tcp)?,
         C::Monitor { port, sim, frames } => device::monitor(&link::Target::named(port.as_deref(), *sim)?, *frames)?,
         C::Cue(args) => {
-            let (text, code) = analysis::cue::run(&args.options())?;
+            let (text, code) = match args.bench() {
+                Some(bench) => analysis::cue_bench::run(&bench)?,
+                None => analysis::cue::run(&args.options()?)?,
+            };
             print(&text);
             code
         }

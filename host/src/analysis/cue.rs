@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::Path;
 
 use plotters::style::colors::{BLACK, BLUE, CYAN, GREEN, MAGENTA, RED};
-use ringpod_core::cueing::{self, SampleError, Telemetry, Washout};
+use ringpod_core::cueing::{self, SampleError, Telemetry};
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
@@ -38,6 +38,9 @@ pub struct Summary {
     /// A packet capture's input: what it held (its input errors are numbered by packet).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub capture: Option<super::cue_capture::CaptureSummary>,
+    /// The optimal cueing's samples planned and fallbacks to the classical washout.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub optimal: Option<super::optimal::Counts>,
 }
 
 /// One cued sample, for the output and the plot.
@@ -58,6 +61,8 @@ pub struct Replay {
     pub limited: usize,
     /// Rows that could not be used, by line.
     pub errors: Vec<InputError>,
+    /// The optimal cueing's counts (solves, fallbacks, solve times); none for the classical washout.
+    pub counts: Option<super::optimal::Counts>,
 }
 
 /// What `cue` is asked to do.
@@ -80,6 +85,8 @@ pub struct Options<'a> {
     pub plot: Option<&'a Path>,
     /// The summary as JSON.
     pub json: bool,
+    /// The optimal cueing sees the drive's next samples (a recorded drive's preview).
+    pub preview: bool,
     /// The platform: a preset by name...
     pub mechanism: &'a str,
     /// ...or a rig file.
@@ -104,7 +111,8 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         cued,
         limited,
         errors: mut cue_errors,
-    } = replay(&rows, config, &mechanism, &neutral)?;
+        counts,
+    } = replay(&rows, config, &mechanism, &neutral, args.preview)?;
     errors.append(&mut cue_errors);
     errors.sort_by_key(|e| e.line);
     write_poses(args.out, &cued)?;
@@ -117,6 +125,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         limited,
         input_errors: errors,
         capture,
+        optimal: counts,
     };
     let code = if summary.input_errors.is_empty() && summary.rows > 0 {
         0
@@ -133,6 +142,12 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
             args.out.display(),
             summary.limited
         );
+        if let Some(o) = &summary.optimal {
+            s += &format!(
+                "optimal cueing: {} samples planned, {} fell back to the classical washout ({} late)\n",
+                o.samples, o.fallbacks, o.late
+            );
+        }
         if let Some(c) = &summary.capture {
             s += &format!(
                 "{}: {} packets, {} UDP datagrams read as {}; skipped: {:?}\n",
@@ -176,15 +191,20 @@ pub enum CueError {
 }
 
 /// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`,
-/// every pose limited into the envelope.
+/// every pose limited into the envelope; with `preview`, the optimal cueing sees the drive's next samples (the
+/// reference over its horizon) rather than the last sample held.
 pub fn replay(
     rows: &[(usize, Vec<f64>)],
     config: cueing::CueConfig,
     mechanism: &RingPlatform<f64>,
     neutral: &Pose<f64>,
+    preview: bool,
 ) -> Result<Replay, CueError> {
     let margins = EnvelopeMargins::default();
-    let mut washout = Washout::<f64>::new(config).map_err(CueError::Washout)?;
+    let ranges = super::cue_engine::ranges(mechanism, neutral);
+    let mut washout = super::cue_engine::Engine::new(config, &ranges).map_err(CueError::Washout)?;
+    // A recorded drive's next samples, for the optimal cueing's preview.
+    let preview = washout.horizon().filter(|_| preview);
     let mut errors = Vec::new();
     let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
     let mut limited = 0;
@@ -199,7 +219,10 @@ pub fn replay(
         let offset = match last_t {
             // The first row (and the first after a gap) starts the washout at neutral and is its first input.
             None => washout.begin(&sample),
-            Some(l) => washout.step(&sample, t - l),
+            Some(l) => {
+                let ahead = preview.map_or_else(Vec::new, |(n, h)| super::cue_engine::ahead(rows, t, n, h));
+                washout.step(&sample, t - l, &ahead)
+            }
         };
         last_t = Some(t);
         let pose = match offset {
@@ -230,7 +253,39 @@ pub fn replay(
         held = pose;
         cued.push(Cued { t, input: sample, pose });
     }
-    Ok(Replay { cued, limited, errors })
+    Ok(Replay {
+        cued,
+        limited,
+        errors,
+        counts: washout.counts().cloned(),
+    })
+}
+
+/// A drive's telemetry rows (CSV, or a packet capture in its own format), for the bench; a row that cannot be
+/// read refuses the drive (a bench scores whole drives).
+pub fn read_drive(path: &Path) -> Result<Vec<(usize, Vec<f64>)>, CueError> {
+    let args = Options {
+        input: path,
+        telemetry_format: None,
+        udp_port: None,
+        outsim_opts: None,
+        out: path,
+        config: None,
+        profile: None,
+        plot: None,
+        json: false,
+        preview: false,
+        mechanism: "",
+        geometry: None,
+    };
+    let (rows, errors, _) = read_input(&args)?;
+    match errors.first() {
+        None => Ok(rows),
+        Some(e) => Err(CueError::Input {
+            path: path.to_path_buf(),
+            reason: format!("line {}: {}", e.line, e.reason),
+        }),
+    }
 }
 
 /// The telemetry rows of the input: a CSV, or a packet capture ([`super::cue_capture`]).
@@ -482,6 +537,7 @@ mod tests {
             profile: None,
             plot: None,
             json: false,
+            preview: false,
             mechanism: "trainer-model",
             geometry: None,
         };

@@ -5,12 +5,15 @@
 
 pub mod branches;
 pub mod cue;
+pub mod cue_bench;
 pub mod cue_capture;
+pub mod cue_engine;
 pub mod demand;
 pub mod draw;
 pub mod gram;
 pub mod kinematics;
 pub mod mechanism;
+pub mod optimal;
 pub mod placement;
 pub mod rates;
 pub mod reactions;

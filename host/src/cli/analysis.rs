@@ -218,12 +218,26 @@ pub struct WorkspaceArgs {
 pub struct CueArgs {
     /// Telemetry CSV with the header t,ax,ay,az,wx,wy,wz (s; specific force in m/s^2 in the vehicle frame, x
     /// forward, y left, z up, +9.81 on z at rest; angular rates in rad/s), or a packet capture (pcap, pcapng) of a
-    /// game's telemetry datagrams (see --telemetry-format).
-    #[arg(long)]
-    pub input: std::path::PathBuf,
-    /// Output pose CSV (t,x,y,z,alpha,beta,gamma in s, m, rad).
+    /// game's telemetry datagrams (see --telemetry-format). With --compare, one or more drives.
+    #[arg(long, num_args = 1.., required = true)]
+    pub input: Vec<std::path::PathBuf>,
+    /// Output pose CSV (t,x,y,z,alpha,beta,gamma in s, m, rad); with --compare, the report (JSON).
     #[arg(long)]
     pub out: std::path::PathBuf,
+    /// The bench: cue the drives by both cueing files and compare what the rider perceives (perceived specific
+    /// force and rotation errors, false cues, envelope used, limiter interventions, solve times); --plot draws
+    /// the perceived forces of both.
+    #[arg(long, num_args = 2, value_names = ["A.toml", "B.toml"],
+          conflicts_with_all = ["config", "profile", "telemetry_format", "udp_port", "outsim_opts"])]
+    pub compare: Option<Vec<std::path::PathBuf>>,
+    /// With --compare: first tune the first file's classical washout for the best score on the same drives and
+    /// envelope (a small coordinate search, see the book's Motion cueing chapter).
+    #[arg(long, requires = "compare")]
+    pub tune: bool,
+    /// With `algorithm = "optimal"`: the reference over the horizon is the drive's own next samples (a recorded
+    /// drive's preview) rather than the last sample held, as a live game gives it.
+    #[arg(long)]
+    pub preview: bool,
     /// Washout parameters (TOML; every key optional, see the book's Motion cueing chapter).
     #[arg(long)]
     pub config: Option<std::path::PathBuf>,

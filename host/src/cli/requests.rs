@@ -113,27 +113,51 @@ impl WorkspaceArgs {
 }
 
 impl CueArgs {
-    /// The options `cue` takes.
-    pub fn options(&self) -> crate::analysis::cue::Options<'_> {
-        crate::analysis::cue::Options {
-            input: &self.input,
+    /// The bench's options, with --compare.
+    pub fn bench(&self) -> Option<crate::analysis::cue_bench::Options<'_>> {
+        let c = self.compare.as_deref()?;
+        let [a, b] = c else { return None };
+        Some(crate::analysis::cue_bench::Options {
+            configs: [a, b],
+            inputs: &self.input,
+            out: &self.out,
+            plot: self.plot.as_deref(),
+            tune: self.tune,
+            json: self.json,
+            preview: self.preview,
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+        })
+    }
+
+    /// The options `cue` takes (one input: several are for --compare).
+    pub fn options(&self) -> Result<crate::analysis::cue::Options<'_>, RequestError> {
+        let [input] = self.input.as_slice() else {
+            return Err(RequestError::CueOneInput);
+        };
+        Ok(crate::analysis::cue::Options {
+            input,
             out: &self.out,
             config: self.config.as_deref(),
             profile: self.profile.as_deref(),
             plot: self.plot.as_deref(),
             json: self.json,
+            preview: self.preview,
             telemetry_format: self.telemetry_format,
             udp_port: self.udp_port,
             outsim_opts: self.outsim_opts,
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
-        }
+        })
     }
 }
 
 /// Arguments that do not go together (the combinations clap cannot express).
 #[derive(Debug, thiserror::Error)]
 pub enum RequestError {
+    /// `cue` with several inputs but no --compare.
+    #[error("cue takes one --input (several are for --compare)")]
+    CueOneInput,
     /// `--capture` without a live source.
     #[error("--capture records a live source: it needs --udp, --telemetry-udp or --telemetry-shm")]
     CaptureWithoutUdp,

@@ -5,9 +5,11 @@
 use std::path::PathBuf;
 use std::time::{Duration, Instant, SystemTime};
 
-use ringpod_core::cueing::{self, Live, SampleError, Telemetry, G};
+use ringpod_core::cueing::{self, SampleError, Telemetry, G};
 use ringpod_core::kinematics::Pose;
 
+use super::cueing::LiveCueing;
+use crate::analysis::optimal::Ranges;
 use crate::games::{self, numbers};
 use crate::out::console;
 
@@ -32,7 +34,7 @@ pub enum Decoder {
         /// The datagrams' format, and `auto`'s lock.
         reader: Box<games::Reader>,
         /// The washout, retuned live when its file changes.
-        washout: Box<Live<f64>>,
+        washout: Box<LiveCueing>,
         /// The platform's neutral pose: the home pose of the rig the device runs, set by the stream once it knows it
         /// ([`Decoder::centre_on`]), before the first datagram is read.
         neutral: Option<Pose<f64>>,
@@ -51,7 +53,7 @@ pub const WATCH_EVERY: Duration = Duration::from_millis(500);
 /// A cueing file watched while streaming: its modification time and length are polled every [`WATCH_EVERY`] from
 /// the stream's loop (a `stat`, no thread; a file system watcher would add a thread and a dependency to save a
 /// call that costs microseconds twice a second, and would not see files on network shares any better). A change
-/// is read, checked and handed to the washout ([`Live::retune`]: blended in over a second); an invalid file is
+/// is read, checked and handed to the cueing ([`LiveCueing::retune`]: blended in over a second); an invalid file is
 /// refused with its key on stderr and the running configuration stays.
 pub struct Watch {
     path: PathBuf,
@@ -89,7 +91,7 @@ impl Watch {
     }
 
     /// Looks at the file if [`WATCH_EVERY`] has passed, and retunes `washout` if it changed and is valid.
-    pub fn poll(&mut self, now: Instant, washout: &mut Live<f64>) {
+    pub fn poll(&mut self, now: Instant, washout: &mut LiveCueing) {
         if self.polled.is_some_and(|p| now.duration_since(p) < WATCH_EVERY) {
             return;
         }
@@ -239,11 +241,25 @@ impl Decoder {
         }
     }
 
-    /// Cues around `home` (the home pose of the rig the device runs); a pose source has no neutral.
-    pub fn centre_on(&mut self, home: Pose<f64>) {
-        if let Decoder::Telemetry { neutral, .. } | Decoder::Template { neutral, .. } = self {
-            *neutral = Some(home);
+    /// Cues around `home` (the home pose of the rig the device runs), within `ranges` about it (the optimal
+    /// cueing plans in them: given when [`Decoder::cues`]); front-end strings are offsets from it; a pose source
+    /// has no neutral.
+    pub fn centre_on(&mut self, home: Pose<f64>, ranges: Option<Ranges>) {
+        match self {
+            Decoder::Telemetry { neutral, washout, .. } => {
+                *neutral = Some(home);
+                if let Some(ranges) = ranges {
+                    washout.place(ranges);
+                }
+            }
+            Decoder::Template { neutral, .. } => *neutral = Some(home),
+            Decoder::Poses { .. } => {}
         }
+    }
+
+    /// Whether this decoder cues telemetry (and so wants the envelope [`Decoder::centre_on`] takes).
+    pub fn cues(&self) -> bool {
+        matches!(self, Decoder::Telemetry { .. })
     }
 
     /// Looks at the cueing file (every [`WATCH_EVERY`]) and retunes the washout if it changed: call it from the

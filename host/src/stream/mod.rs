@@ -8,6 +8,7 @@
 
 mod admit;
 pub mod command;
+pub mod cueing;
 pub mod datagram;
 pub mod derivatives;
 mod ending;
@@ -255,7 +256,13 @@ pub fn run<T: Transport>(
     )?;
     let home = envelope.platform.home;
     if let Source::Live(live) = &mut source {
-        live.decoder.centre_on(Pose::from_array(home));
+        let home = Pose::from_array(home);
+        // The envelope's scan only for a decoder that cues (the optimal cueing plans in it).
+        let ranges = live.decoder.cues().then(|| {
+            let mechanism = ringpod_core::kinematics::RingPlatform::new(&envelope.platform.geometry);
+            crate::analysis::cue_engine::ranges(&mechanism, &home)
+        });
+        live.decoder.centre_on(home, ranges);
     }
     let bar = progress_bar(&source, options.quiet);
     let limits = envelope.limits;

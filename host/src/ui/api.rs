@@ -47,7 +47,7 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
     let text = request.drive.as_deref().unwrap_or(EXAMPLE_DRIVE);
     let (rows, mut errors) = crate::input::table::read(text, &TELEMETRY_COLUMNS)?;
     let m = RingPlatform::<f64>::new(geometry);
-    let run = replay(&rows, config, &m, &Pose::from_array(home)).map_err(|e| format!("{e:#}"))?;
+    let run = replay(&rows, config, &m, &Pose::from_array(home), false).map_err(|e| format!("{e:#}"))?;
     errors.extend(run.errors);
     let delivered = delivered_forces(&run.cued);
     let toml = toml::to_string(&config).map_err(|e| e.to_string())?;

@@ -40,12 +40,15 @@ fn controls(p: &Param) -> Vec<((usize, usize), Value)> {
         .collect()
 }
 
-/// The path of a value in the parameters' JSON: `tilt_low_pass.omega` of axis 1 is `["tilt_low_pass", 1, "omega"]`.
+/// The path of a value in the parameters' JSON: `tilt_low_pass.omega` of axis 1 is `["tilt_low_pass", 1, "omega"]`;
+/// in the `optimal` table the list is the second part: `optimal.force_weight` of axis 1 is
+/// `["optimal", "force_weight", 1]`.
 fn path(key: &str, axis: Option<usize>) -> Vec<Value> {
-    let mut parts = key.split('.');
-    let mut path = vec![json!(parts.next().unwrap_or(key))];
-    path.extend(axis.map(|i| json!(i)));
-    path.extend(parts.map(|p| json!(p)));
+    let list = if key.starts_with("optimal.") { 2 } else { 1 };
+    let mut path: Vec<Value> = key.split('.').map(|p| json!(p)).collect();
+    if let Some(i) = axis {
+        path.insert(list.min(path.len()), json!(i));
+    }
     path
 }
 

@@ -2,6 +2,7 @@
 //! checked as a whole ([`CueConfig::validate`]) with errors that name the key and the axis.
 
 use super::axes;
+use super::optimal::{Algorithm, OptimalConfig};
 use super::smoothing::Smoothing;
 
 /// Which platform direction faces the vehicle's forward.
@@ -99,6 +100,10 @@ pub struct CueConfig {
     pub forward: Forward,
     /// Smoothing of the telemetry before the washout (default off).
     pub smoothing: Smoothing,
+    /// Which cueing runs: the classical washout (default) or the optimal cueing (on the host).
+    pub algorithm: Algorithm,
+    /// The optimal cueing's parameters (`[optimal]`), read whichever algorithm runs.
+    pub optimal: OptimalConfig,
 }
 
 impl Default for CueConfig {
@@ -121,6 +126,8 @@ impl Default for CueConfig {
             yaw_high_pass: Corner { omega: 0.5, zeta: 1.0 },
             forward: Forward::PlusX,
             smoothing: Smoothing::Off,
+            algorithm: Algorithm::Classical,
+            optimal: OptimalConfig::default(),
         }
     }
 }
@@ -251,6 +258,7 @@ impl CueConfig {
         if !corner_ok(&self.yaw_high_pass) {
             return err("yaw_high_pass", CORNER);
         }
-        self.smoothing.check().or_else(|(key, must)| err(key, must))
+        self.smoothing.check().or_else(|(key, must)| err(key, must))?;
+        self.optimal.validate().or_else(|(key, must)| err(key, must))
     }
 }

@@ -24,12 +24,15 @@ pub mod axes;
 mod config;
 pub mod filter;
 mod live;
+pub mod optimal;
+pub mod perception;
 pub mod schema;
 pub mod smoothing;
 
 pub use config::{ConfigError, Corner, CueConfig, Forward, YawMode, ROTATION_AXES, TILT_AXES, TRANSLATION_AXES};
 use filter::{Biquad, Section};
 pub use live::{Live, HANDOVER_S};
+pub use optimal::{Algorithm, OptimalConfig};
 pub use smoothing::{Smoother, Smoothing};
 
 use crate::kinematics::Pose;
@@ -326,16 +329,8 @@ impl<T: Real> Washout<T> {
     /// The current offset from neutral in platform axes: `[x, y, z, alpha, beta, gamma]`.
     pub fn offset(&self) -> [T; 6] {
         let c = &self.channels;
-        let (x, y) = (c.translation[0], c.translation[1]);
         let (roll, pitch) = (c.tilt[0] + c.rotation[0], c.tilt[1] + c.rotation[1]);
-        // Vehicle axes to platform axes: a quarter turn about z moves x to y (and roll to pitch) and y to -x.
-        let (px, py, pa, pb) = match self.config.forward {
-            Forward::PlusX => (x, y, roll, pitch),
-            Forward::PlusY => (-y, x, -pitch, roll),
-            Forward::MinusX => (-x, -y, -roll, -pitch),
-            Forward::MinusY => (y, -x, pitch, -roll),
-        };
-        [px, py, c.translation[2], pa, pb, c.yaw]
+        to_platform(self.config.forward, c.translation, roll, pitch, c.yaw)
     }
 
     /// Back to neutral (filters at rest, smoothing empty, yaw kept): the next sample is a first one.
@@ -367,6 +362,20 @@ pub fn delivered<T: Real>(accel: [T; 3], alpha: T, beta: T) -> [T; 3] {
         accel[1] + g * alpha.sin_() * beta.cos_(),
         accel[2] + g * alpha.cos_() * beta.cos_(),
     ]
+}
+
+/// An offset in vehicle axes (translation, roll, pitch, yaw) as the platform's `[x, y, z, alpha, beta, gamma]`,
+/// for the platform direction that faces the vehicle's forward.
+pub fn to_platform<T: Real>(forward: Forward, translation: [T; 3], roll: T, pitch: T, yaw: T) -> [T; 6] {
+    let [x, y, z] = translation;
+    // Vehicle axes to platform axes: a quarter turn about z moves x to y (and roll to pitch) and y to -x.
+    let (px, py, pa, pb) = match forward {
+        Forward::PlusX => (x, y, roll, pitch),
+        Forward::PlusY => (-y, x, -pitch, roll),
+        Forward::MinusX => (-x, -y, -roll, -pitch),
+        Forward::MinusY => (y, -x, pitch, -roll),
+    };
+    [px, py, z, pa, pb, yaw]
 }
 
 /// A pose: the neutral pose plus an offset (yaw added).

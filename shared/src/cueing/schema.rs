@@ -21,7 +21,8 @@ pub enum Values {
 pub struct Param {
     /// The key as the cueing file writes it, a table's key after a dot: `yaw_scale`, `tilt_low_pass.omega`,
     /// `smoothing.window`. A per-axis key is a list of one value per axis (`translation_scale` is
-    /// `[surge, sway, heave]`); its axis index goes after the key's first part.
+    /// `[surge, sway, heave]`); its axis index goes after the key's first part (in the `optimal` table, after
+    /// its second: `optimal.force_weight` is the list).
     pub key: &'static str,
     /// What it is, in a few words, for a label.
     pub name: &'static str,
@@ -38,9 +39,10 @@ pub struct Param {
     pub only_with: Option<(&'static str, &'static str, f64)>,
 }
 
-/// The channels in the order a person reads them: the three translations, the tilt that cues a sustained force,
+/// The channels in the order a person reads them: the algorithm and its parameters, the three translations, the tilt that cues a sustained force,
 /// the three rotations, then what applies to all.
-pub const CHANNELS: [&str; 9] = [
+pub const CHANNELS: [&str; 10] = [
+    "algorithm",
     "surge",
     "sway",
     "heave",
@@ -249,7 +251,117 @@ pub const PARAMS: &[Param] = &[
             Values::Numbers(&[1, 2]),
         )
     },
+    param(
+        "algorithm",
+        "cueing",
+        one(&["algorithm"]),
+        "",
+        Values::Words(&["classical", "optimal"]),
+    ),
+    param(
+        "optimal.horizon",
+        "optimal: horizon",
+        one(&["algorithm"]),
+        "steps",
+        Values::Numbers(&[4, 6, 8, 10, 12, 16, 20, 30, 40, 60]),
+    ),
+    param(
+        "optimal.step_s",
+        "optimal: step",
+        one(&["algorithm"]),
+        "s",
+        Values::Range(0.005, 0.5),
+    ),
+    param(
+        "optimal.force_weight",
+        "optimal: perceived force weight",
+        (TRANSLATION, TRANSLATION),
+        "",
+        WEIGHT,
+    ),
+    param(
+        "optimal.rotation_weight",
+        "optimal: perceived rate weight",
+        (ROTATION, ROTATION),
+        "",
+        WEIGHT,
+    ),
+    param(
+        "optimal.position_weight",
+        "optimal: return to neutral",
+        (TRANSLATION, TRANSLATION),
+        "",
+        WEIGHT,
+    ),
+    param(
+        "optimal.velocity_weight",
+        "optimal: velocity weight",
+        (TRANSLATION, TRANSLATION),
+        "",
+        WEIGHT,
+    ),
+    param(
+        "optimal.tilt_weight",
+        "optimal: tilt return to neutral",
+        (TILT_LABELS, TILT),
+        "",
+        WEIGHT,
+    ),
+    param(
+        "optimal.acceleration_weight",
+        "optimal: acceleration effort",
+        (TRANSLATION, TRANSLATION),
+        "",
+        EFFORT,
+    ),
+    param(
+        "optimal.rate_weight",
+        "optimal: rate effort",
+        (TILT_LABELS, TILT),
+        "",
+        EFFORT,
+    ),
+    param(
+        "optimal.max_velocity",
+        "optimal: velocity limit",
+        (TRANSLATION, TRANSLATION),
+        "m/s",
+        Values::Range(1e-6, 10.0),
+    ),
+    param(
+        "optimal.max_acceleration",
+        "optimal: acceleration limit",
+        (TRANSLATION, TRANSLATION),
+        "m/s²",
+        Values::Range(1e-6, 100.0),
+    ),
+    param(
+        "optimal.max_rate_deg",
+        "optimal: rate limit",
+        (TILT_LABELS, TILT),
+        "deg/s",
+        Values::Range(1e-6, 720.0),
+    ),
+    param(
+        "optimal.envelope_share",
+        "optimal: share of the envelope",
+        one(&["platform"]),
+        "",
+        Values::Range(0.05, 1.0),
+    ),
+    param(
+        "optimal.budget_ms",
+        "optimal: solve budget",
+        one(&["algorithm"]),
+        "ms",
+        Values::Range(0.01, 1000.0),
+    ),
 ];
+
+/// A weight of the optimal cueing's cost, as [`super::OptimalConfig::validate`] bounds it.
+const WEIGHT: Values = Values::Range(0.0, 1e6);
+/// An effort weight: above zero (it keeps the programme strictly convex).
+const EFFORT: Values = Values::Range(1e-9, 1e6);
 
 // Each per-axis key has a channel per axis: the lists agree with the core's axis names.
 const _: () = assert!(TRANSLATION.len() == TRANSLATION_AXES.len() && TILT.len() == TILT_AXES.len());

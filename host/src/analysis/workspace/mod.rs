@@ -359,6 +359,20 @@ fn contiguous(m: &AnyMechanism, home: [f64; 6], axis: usize, step: f64, limit: f
     (home[axis] + lo, home[axis] + hi)
 }
 
+/// Each axis's contiguous range about home, as offsets from it: x, y, z (m), roll and pitch (rad), found one axis
+/// at a time as the summary reports them. The optimal cueing plans in these (a share of them).
+pub fn ranges_about_home(m: &AnyMechanism, home: [f64; 6]) -> [(f64, f64); 5] {
+    let length = m.characteristic_length();
+    core::array::from_fn(|i| {
+        let (lo, hi) = if i < 3 {
+            line_range(m, home, i, length)
+        } else {
+            angle_range(m, home, i)
+        };
+        (lo - home[i], hi - home[i])
+    })
+}
+
 /// The contiguous range of one angle around `home` that passes every check (rad), in 0.5 degree steps.
 fn angle_range(m: &AnyMechanism, home: [f64; 6], axis: usize) -> (f64, f64) {
     contiguous(m, home, axis, 0.5 * DEG, 90.0 * DEG)

@@ -15,7 +15,7 @@ fn outsim(time_ms: u32, accel: [f32; 3]) -> Vec<u8> {
 fn decoder(format: TelemetryFormat) -> Decoder {
     Decoder::Telemetry {
         reader: Box::new(games::Reader::new(format, None)),
-        washout: Box::new(Live::new(ringpod_core::cueing::CueConfig::default()).unwrap()),
+        washout: Box::new(LiveCueing::new(ringpod_core::cueing::CueConfig::default()).unwrap()),
         neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
         last: None,
         gaps: 0,
@@ -88,7 +88,7 @@ fn text_telemetry_with_and_without_time() {
 
 #[test]
 fn a_telemetry_stream_is_cued_and_a_pause_washes_out() {
-    let washout = Live::new(ringpod_core::cueing::CueConfig::default()).unwrap();
+    let washout = LiveCueing::new(ringpod_core::cueing::CueConfig::default()).unwrap();
     let neutral = Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0);
     let mut d = Decoder::Telemetry {
         reader: Box::new(games::Reader::new(TelemetryFormat::Text, None)),
@@ -125,7 +125,7 @@ fn reload_run(name: &str, initial: &str, change: Option<&str>) -> ([f64; 6], Dec
     let config = crate::input::cueing::load_config(Some(&path), None).unwrap();
     let mut d = Decoder::Telemetry {
         reader: Box::new(games::Reader::new(TelemetryFormat::Text, None)),
-        washout: Box::new(Live::new(config).unwrap()),
+        washout: Box::new(LiveCueing::new(config).unwrap()),
         neutral: Some(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0)),
         last: None,
         gaps: 0,
@@ -225,7 +225,7 @@ fn a_cueing_file_caught_half_way_through_a_save_is_ignored_until_whole() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("cue.toml");
     std::fs::write(&path, old).unwrap();
-    let mut washout = Live::new(crate::input::cueing::load_config(Some(&path), None).unwrap()).unwrap();
+    let mut washout = LiveCueing::new(crate::input::cueing::load_config(Some(&path), None).unwrap()).unwrap();
     let mut watch = Watch::new(path.clone(), None);
     let start = Instant::now();
     for (k, text) in ["", "tilt_limit_deg = 8\n"].iter().enumerate() {

@@ -1,0 +1,44 @@
+//! One sample of the optimal cueing (its three axes' solves) on the trainer model's envelope, at the default
+//! horizon: the time the 2 ms budget of a 100 Hz sample is measured against.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use ringpod_core::cueing::{Algorithm, CueConfig, Telemetry, G};
+
+// The optimal cueing's module as the binary builds it (the host is a binary crate: no library to link).
+#[allow(dead_code, unused_imports)]
+#[path = "../src/analysis/optimal/mod.rs"]
+mod optimal;
+
+fn sample(t: f64) -> Telemetry<f64> {
+    Telemetry {
+        force: [-6.0 * (t * 0.7).sin(), 8.0 * (t * 0.3).sin(), G + (t * 9.0).sin()],
+        rate: [0.1 * (t * 2.0).sin(), 0.05 * (t * 1.3).cos(), 0.3],
+    }
+}
+
+fn one_sample(c: &mut Criterion) {
+    let config = CueConfig {
+        algorithm: Algorithm::Optimal,
+        ..CueConfig::default()
+    };
+    // The trainer model's ranges about home as the workspace scan finds them (m, rad).
+    let ranges = [
+        (-0.129, 0.129),
+        (-0.055, 0.095),
+        (-0.067, 0.059),
+        (-0.454, 0.384),
+        (-0.358, 0.358),
+    ];
+    let mut o = optimal::Optimal::new(config, &ranges).expect("the defaults are valid");
+    o.begin(&sample(0.0)).expect("finite");
+    let mut t = 0.0;
+    c.bench_function("optimal cueing: one sample (three axes)", |b| {
+        b.iter(|| {
+            t += 0.01;
+            o.step(&sample(t), 0.01, &[]).expect("finite")
+        })
+    });
+}
+
+criterion_group!(benches, one_sample);
+criterion_main!(benches);

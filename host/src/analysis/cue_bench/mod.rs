@@ -1,0 +1,290 @@
+//! `ringpod cue --compare A.toml B.toml --input DRIVE...`: two cueing files on the same drives and the same
+//! platform, scored by what the rider perceives ([`score`]), printed as a table and written as JSON, with a
+//! picture of the perceived forces. `--tune` first searches the first file's classical washout for the best score
+//! on the same drives and envelope ([`tune`]), so that a comparison is against the best classical tuning.
+
+mod picture;
+pub mod score;
+pub mod tune;
+
+use std::path::{Path, PathBuf};
+
+use ringpod_core::cueing::{Algorithm, CueConfig};
+use ringpod_core::kinematics::{Pose, RingPlatform};
+use serde::Serialize;
+
+use super::cue::{read_drive, replay, CueError};
+use super::mechanism::{AnyMechanism, Selected};
+use super::optimal::Ranges;
+use crate::error::CliError;
+use crate::input::cueing::load_config;
+use score::{score, Score, Trace};
+
+/// What the bench is asked to do.
+pub struct Options<'a> {
+    /// The two cueing files compared.
+    pub configs: [&'a Path; 2],
+    /// The drives (telemetry CSV or packet captures).
+    pub inputs: &'a [PathBuf],
+    /// The report (JSON).
+    pub out: &'a Path,
+    /// The picture of the perceived forces (SVG or PNG).
+    pub plot: Option<&'a Path>,
+    /// Tune the first file's classical washout first.
+    pub tune: bool,
+    /// Print the report as JSON rather than a table.
+    pub json: bool,
+    /// The optimal cueing sees each drive's next samples.
+    pub preview: bool,
+    /// The platform: a preset by name...
+    pub mechanism: &'a str,
+    /// ...or a rig file.
+    pub geometry: Option<&'a Path>,
+}
+
+/// One algorithm on every drive.
+#[derive(Debug, Clone, Serialize)]
+pub struct Entry {
+    /// The cueing file (and `tuned` for the tuned classical washout).
+    pub name: String,
+    /// Its algorithm.
+    pub algorithm: Algorithm,
+    /// Each drive's score, in the order of the drives.
+    pub drives: Vec<Score>,
+    /// All drives together: RMS over every sample, peaks and envelope shares the largest, false cues summed.
+    pub total: Score,
+    /// Poses the envelope limiter changed.
+    pub limited: usize,
+    /// Samples where the optimal cueing fell back to the classical washout (none for the washout).
+    pub fallbacks: Option<usize>,
+    /// The optimal cueing's solve time per sample, all axes: p50, p99, max (ms).
+    pub solve_ms: Option<[f64; 3]>,
+}
+
+/// The bench's report.
+#[derive(Debug, Serialize)]
+pub struct Report {
+    /// The drives, as given.
+    pub drives: Vec<String>,
+    /// The platform.
+    pub mechanism: String,
+    /// The envelope about home the optimal cueing planned in: x, y, z (m), roll, pitch (rad).
+    pub ranges: Ranges,
+    /// The tuned classical washout's file, when `--tune` ran.
+    pub tuned: Option<String>,
+    /// The algorithms compared.
+    pub entries: Vec<Entry>,
+}
+
+/// A drive's rows.
+pub type Rows = Vec<(usize, Vec<f64>)>;
+
+/// The platform a bench runs on.
+pub struct Rig {
+    /// The mechanism.
+    pub mechanism: RingPlatform<f64>,
+    /// Its home (the neutral pose).
+    pub neutral: Pose<f64>,
+    /// Its envelope about home.
+    pub ranges: Ranges,
+}
+
+/// Cues every drive by `config` and scores it; with each drive's perceived forces.
+pub fn evaluate(
+    name: &str,
+    config: CueConfig,
+    drives: &[Rows],
+    rig: &Rig,
+    preview: bool,
+) -> Result<(Entry, Vec<Vec<Trace>>), CueError> {
+    let mut scores = Vec::new();
+    let mut traces = Vec::new();
+    let (mut limited, mut fallbacks, mut times) = (0, 0, Vec::new());
+    for rows in drives {
+        let r = replay(rows, config, &rig.mechanism, &rig.neutral, preview)?;
+        let (s, t) = score(&r.cued, &rig.neutral, &rig.ranges, config.forward);
+        limited += r.limited;
+        if let Some(c) = &r.counts {
+            fallbacks += c.fallbacks;
+            times.extend_from_slice(&c.solve_s);
+        }
+        scores.push(s);
+        traces.push(t);
+    }
+    let optimal = config.algorithm == Algorithm::Optimal;
+    Ok((
+        Entry {
+            name: name.to_owned(),
+            algorithm: config.algorithm,
+            total: combined(&scores),
+            drives: scores,
+            limited,
+            fallbacks: optimal.then_some(fallbacks),
+            solve_ms: optimal.then(|| percentiles(&mut times)),
+        },
+        traces,
+    ))
+}
+
+/// p50, p99 and max of times in seconds, as milliseconds.
+fn percentiles(times: &mut [f64]) -> [f64; 3] {
+    if times.is_empty() {
+        return [0.0; 3];
+    }
+    times.sort_by(f64::total_cmp);
+    let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize] * 1000.0;
+    [at(0.5), at(0.99), at(1.0)]
+}
+
+/// The scores of several drives as one: RMS weighted by samples, the largest peaks and shares, the sums.
+fn combined(scores: &[Score]) -> Score {
+    let mut t = Score::default();
+    let n: usize = scores.iter().map(|s| s.samples).sum();
+    let rms = |f: &dyn Fn(&Score) -> f64| {
+        (scores.iter().map(|s| f(s).powi(2) * s.samples as f64).sum::<f64>() / n.max(1) as f64).sqrt()
+    };
+    t.samples = n;
+    for i in 0..3 {
+        t.force_rms[i] = rms(&|s| s.force_rms[i]);
+        t.rotation_rms[i] = rms(&|s| s.rotation_rms[i]);
+        t.force_peak[i] = scores.iter().map(|s| s.force_peak[i]).fold(0.0, f64::max);
+        for s in scores {
+            t.false_force[i].count += s.false_force[i].count;
+            t.false_force[i].seconds += s.false_force[i].seconds;
+        }
+    }
+    for s in scores {
+        for i in 0..2 {
+            t.false_rotation[i].count += s.false_rotation[i].count;
+            t.false_rotation[i].seconds += s.false_rotation[i].seconds;
+        }
+        for i in 0..5 {
+            t.envelope_share[i] = t.envelope_share[i].max(s.envelope_share[i]);
+        }
+    }
+    t
+}
+
+/// Runs the bench; returns the report as text (a table, or JSON) and the exit code.
+pub fn run(args: &Options) -> Result<(String, u8), CueError> {
+    let mut inputs: Vec<&Path> = args.inputs.iter().map(PathBuf::as_path).collect();
+    inputs.extend(args.configs);
+    for out in [Some(args.out), args.plot].into_iter().flatten() {
+        crate::out::file::not_an_input(out, &inputs).map_err(|e| CliError::file(out, e))?;
+    }
+    let configs = [0, 1].map(|i| load_config(Some(args.configs[i]), None));
+    let [a, b] = configs;
+    let (a, b) = (a.map_err(CliError::from)?, b.map_err(CliError::from)?);
+    let selected = Selected::of(args.mechanism, args.geometry)?;
+    let AnyMechanism::Ring(mechanism) = selected.mechanism else {
+        return Err(CliError::NotARing(selected.name).into());
+    };
+    let neutral = Pose::from_array(selected.home);
+    let rig = Rig {
+        ranges: super::cue_engine::ranges(&mechanism, &neutral),
+        mechanism: *mechanism,
+        neutral,
+    };
+    let drives: Vec<Rows> = args.inputs.iter().map(|p| read_drive(p)).collect::<Result<_, _>>()?;
+    let name = |p: &Path| {
+        p.file_name()
+            .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into())
+    };
+    let mut entries = Vec::new();
+    let mut traces = Vec::new();
+    let mut tuned = None;
+    let first = if args.tune && a.algorithm == Algorithm::Classical {
+        let best = tune::tune(a, &drives, &rig)?;
+        tuned = Some(toml::to_string(&best).map_err(|e| CueError::Input {
+            path: args.configs[0].to_path_buf(),
+            reason: e.to_string(),
+        })?);
+        (format!("{} (tuned)", name(args.configs[0])), best)
+    } else {
+        (name(args.configs[0]), a)
+    };
+    for (n, c) in [first, (name(args.configs[1]), b)] {
+        let (e, t) = evaluate(&n, c, &drives, &rig, args.preview)?;
+        entries.push(e);
+        traces.push(t);
+    }
+    let report = Report {
+        drives: args.inputs.iter().map(|p| p.display().to_string()).collect(),
+        mechanism: selected.name,
+        ranges: rig.ranges,
+        tuned,
+        entries,
+    };
+    let json = serde_json::to_string_pretty(&report).map_err(CliError::from)? + "\n";
+    crate::out::file::write(args.out, json.as_bytes()).map_err(|reason| CueError::Output {
+        path: args.out.to_path_buf(),
+        reason,
+    })?;
+    if let Some(plot) = args.plot {
+        picture::draw(plot, &report, &traces).map_err(CliError::from)?;
+    }
+    let text = if args.json { json } else { table(&report) };
+    Ok((text, 0))
+}
+
+/// The report as a table: one column per algorithm.
+fn table(r: &Report) -> String {
+    let mut s = format!(
+        "{} drive(s) on {}: {}\n",
+        r.drives.len(),
+        r.mechanism,
+        r.drives.join(", ")
+    );
+    let row = |label: &str, f: &dyn Fn(&Entry) -> String| {
+        let mut line = format!("{label:<44}");
+        for e in &r.entries {
+            line += &format!("{:>26}", f(e));
+        }
+        line + "\n"
+    };
+    s += &row("", &|e| e.name.clone());
+    s += &row("algorithm", &|e| format!("{:?}", e.algorithm).to_lowercase());
+    let v3 = |v: [f64; 3]| format!("{:.3} {:.3} {:.3}", v[0], v[1], v[2]);
+    s += &row("perceived force error RMS x y z (m/s^2)", &|e| v3(e.total.force_rms));
+    s += &row("  all axes (m/s^2)", &|e| format!("{:.3}", e.total.force_total()));
+    s += &row("perceived force error peak x y z (m/s^2)", &|e| v3(e.total.force_peak));
+    s += &row("perceived rotation error RMS r p y (rad/s)", &|e| {
+        v3(e.total.rotation_rms)
+    });
+    s += &row("false cues x y z roll pitch (count)", &|e| {
+        let f = &e.total;
+        format!(
+            "{} {} {} {} {}",
+            f.false_force[0].count,
+            f.false_force[1].count,
+            f.false_force[2].count,
+            f.false_rotation[0].count,
+            f.false_rotation[1].count
+        )
+    });
+    s += &row("false cues, time (s)", &|e| {
+        let f = &e.total;
+        let t: f64 = f.false_force.iter().chain(&f.false_rotation).map(|c| c.seconds).sum();
+        format!("{t:.2}")
+    });
+    s += &row("envelope used x y z r p (share)", &|e| {
+        let v = e.total.envelope_share;
+        format!("{:.2} {:.2} {:.2} {:.2} {:.2}", v[0], v[1], v[2], v[3], v[4])
+    });
+    s += &row("envelope limiter interventions", &|e| e.limited.to_string());
+    s += &row("fallbacks to the classical washout", &|e| {
+        e.fallbacks.map_or("-".into(), |f| f.to_string())
+    });
+    s += &row("solve time p50 p99 max (ms)", &|e| {
+        e.solve_ms
+            .map_or("-".into(), |t| format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2]))
+    });
+    if let [a, b] = r.entries.as_slice() {
+        let ratio = b.total.force_total() / a.total.force_total().max(1e-12);
+        s += &format!(
+            "{} / {} perceived force error (RMS, all axes): {ratio:.3}\n",
+            b.name, a.name
+        );
+    }
+    s
+}

@@ -1,0 +1,104 @@
+//! The cueing a configuration asks for (`algorithm`): the core's classical washout or the host's optimal cueing,
+//! behind one interface for `cue`, the bench and the workbench.
+
+use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout};
+use ringpod_core::kinematics::{Pose, RingPlatform};
+
+use super::mechanism::AnyMechanism;
+use super::optimal::{Counts, Optimal, Ranges};
+
+/// A running cueing.
+pub enum Engine {
+    /// The classical washout.
+    Classical(Box<Washout<f64>>),
+    /// The optimal cueing.
+    Optimal(Box<Optimal>),
+}
+
+/// The envelope about `neutral` the optimal cueing plans in: each axis's range from the workspace scan.
+pub fn ranges(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Ranges {
+    super::workspace::ranges_about_home(&AnyMechanism::Ring(Box::new(*mechanism)), neutral.to_array())
+}
+
+impl Engine {
+    /// The engine of `config` for a platform whose envelope about home is `ranges`.
+    pub fn new(config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
+        Ok(match config.algorithm {
+            Algorithm::Classical => Self::Classical(Box::new(Washout::new(config)?)),
+            Algorithm::Optimal => Self::Optimal(Box::new(Optimal::new(config, ranges)?)),
+        })
+    }
+
+    /// The first sample of a stream.
+    pub fn begin(&mut self, sample: &Telemetry<f64>) -> Result<[f64; 6], SampleError> {
+        match self {
+            Self::Classical(w) => w.begin(sample),
+            Self::Optimal(o) => o.begin(sample),
+        }
+    }
+
+    /// One sample after `dt` seconds; `ahead`: the drive's next samples at the optimal cueing's steps (preview),
+    /// or none.
+    pub fn step(
+        &mut self,
+        sample: &Telemetry<f64>,
+        dt: f64,
+        ahead: &[Telemetry<f64>],
+    ) -> Result<[f64; 6], SampleError> {
+        match self {
+            Self::Classical(w) => w.step(sample, dt),
+            Self::Optimal(o) => o.step(sample, dt, ahead),
+        }
+    }
+
+    /// The current offset from neutral.
+    pub fn offset(&self) -> [f64; 6] {
+        match self {
+            Self::Classical(w) => w.offset(),
+            Self::Optimal(o) => o.offset(),
+        }
+    }
+
+    /// Back to neutral: the next sample is a first one.
+    pub fn reset(&mut self) {
+        match self {
+            Self::Classical(w) => w.reset(),
+            Self::Optimal(o) => o.reset(),
+        }
+    }
+
+    /// The optimal cueing's counts (none for the classical washout).
+    pub fn counts(&self) -> Option<&Counts> {
+        match self {
+            Self::Classical(_) => None,
+            Self::Optimal(o) => Some(o.counts()),
+        }
+    }
+
+    /// The samples ahead the optimal cueing looks at, with a preview: how many and at which step (s).
+    pub fn horizon(&self) -> Option<(usize, f64)> {
+        match self {
+            Self::Optimal(o) => Some((o.config().optimal.horizon as usize, o.config().optimal.step_s)),
+            Self::Classical(_) => None,
+        }
+    }
+}
+
+/// The samples at `t + k h` for `k = 1..=steps` of rows sorted by time (`t, ax, ay, az, wx, wy, wz`): each the
+/// last row at or before its time (the drive's end held).
+pub fn ahead(rows: &[(usize, Vec<f64>)], t: f64, steps: usize, h: f64) -> Vec<Telemetry<f64>> {
+    if rows.is_empty() {
+        return Vec::new();
+    }
+    (1..=steps)
+        .map(|k| {
+            let at = t + k as f64 * h;
+            let i = rows.partition_point(|(_, v)| v[0] <= at).saturating_sub(1);
+            let v = &rows[i].1;
+            Telemetry {
+                force: [v[1], v[2], v[3]],
+                rate: [v[4], v[5], v[6]],
+            }
+        })
+        .collect()
+}

@@ -1,0 +1,380 @@
+//! The optimal (model-predictive) cueing: at each telemetry sample, one quadratic programme per platform axis
+//! over a horizon ([`qp`]) plans the platform's motion so that what the rider perceives ([`model`], the core's
+//! perception model) follows what the vehicle's occupant perceives, within the rig's envelope about home and its
+//! velocity, acceleration and tilt-rate limits; the first step of the plan is applied, and the next sample plans
+//! again from where it led.
+//!
+//! The reference is the last sample held over the horizon (a game gives no preview), or, for a recorded drive,
+//! the drive's own next samples (`preview`). Yaw follows the classical washout's heading channel (a ring
+//! platform turns without limit: nothing to optimise). A classical washout runs alongside on the same samples:
+//! a solve that fails or runs past its budget takes that axis's classical channels for the sample (counted),
+//! and the plan continues from there.
+
+pub mod model;
+pub mod qp;
+
+use std::time::Instant;
+
+use nalgebra::DVector;
+use ringpod_core::cueing::{self, ConfigError, CueConfig, SampleError, Telemetry, Washout, G};
+
+use model::{Discrete, Linear};
+use qp::{AxisQp, Bound, Spec};
+
+/// The envelope an optimiser plans in: per axis of the platform's offset `[x, y, z, alpha, beta]` the range
+/// about home (m, rad) in which the pose passes every check, found one axis at a time.
+pub type Ranges = [(f64, f64); 5];
+
+/// What the optimal cueing did, sample by sample.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct Counts {
+    /// Samples planned.
+    pub samples: usize,
+    /// Samples where an axis fell back to the classical washout (its solve failed or ran late).
+    pub fallbacks: usize,
+    /// Of those, solves that ran past the budget.
+    pub late: usize,
+    /// Each sample's solve time, the three axes together (s).
+    #[serde(skip)]
+    pub solve_s: Vec<f64>,
+}
+
+/// One axis: its programme, the platform's state (with the rider's perception of it) and the vehicle's
+/// perception, which gives the reference.
+struct Axis {
+    model: Linear,
+    qp: AxisQp,
+    perception: Linear,
+    /// The perception at the horizon's step.
+    perception_h: Discrete,
+    x: DVector<f64>,
+    vehicle: DVector<f64>,
+    /// Both models at the last sample interval (most sources keep one).
+    at_dt: Option<(f64, Discrete, Discrete)>,
+}
+
+/// Which way an axis's angle turns the platform: x's angle is minus the pitch (a pitch-up, `beta < 0`, gives a
+/// forward force), y's is the roll.
+const X: usize = 0;
+const Y: usize = 1;
+const Z: usize = 2;
+
+/// The optimal cueing, one instance per stream.
+pub struct Optimal {
+    config: CueConfig,
+    classical: Washout<f64>,
+    axes: [Axis; 3],
+    counts: Counts,
+}
+
+impl Optimal {
+    /// Sets the programmes up for `config` in `ranges` (the envelope about home).
+    pub fn new(config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
+        let classical = Washout::new(config)?;
+        Ok(Self {
+            config,
+            classical,
+            axes: [X, Y, Z].map(|i| Axis::new(i, &config, ranges)),
+            counts: Counts::default(),
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &CueConfig {
+        &self.config
+    }
+
+    /// What it did so far.
+    pub fn counts(&self) -> &Counts {
+        &self.counts
+    }
+
+    /// The first sample of a stream: the vehicle's perception settled on it (a drive that starts in a corner is
+    /// perceived as in it), the platform at neutral.
+    pub fn begin(&mut self, sample: &Telemetry<f64>) -> Result<[f64; 6], SampleError> {
+        self.classical.begin(sample)?;
+        for (i, axis) in self.axes.iter_mut().enumerate() {
+            let r = stimulus(i, sample);
+            // Steady state: A z + B r = 0.
+            let rhs = -(&axis.perception.b * &r);
+            axis.vehicle = axis.perception.a.clone().lu().solve(&rhs).unwrap_or_else(|| rhs * 0.0);
+            axis.x.fill(0.0);
+        }
+        Ok(self.offset())
+    }
+
+    /// One sample after `dt` seconds; `ahead` holds the drive's next samples at the horizon's steps (preview),
+    /// or nothing (the sample held). Returns the offset from neutral in platform axes.
+    pub fn step(
+        &mut self,
+        sample: &Telemetry<f64>,
+        dt: f64,
+        ahead: &[Telemetry<f64>],
+    ) -> Result<[f64; 6], SampleError> {
+        self.classical.step(sample, dt)?;
+        let started = Instant::now();
+        let budget = self.config.optimal.budget_ms / 1000.0;
+        let mut fell_back = false;
+        let mut late = false;
+        for i in 0..3 {
+            let fallback = self.fallback(i);
+            let axis = &mut self.axes[i];
+            let (d_model, d_perception) = axis.at(dt);
+            let r = stimulus(i, sample);
+            axis.vehicle = &d_perception.a * &axis.vehicle + &d_perception.b * &r;
+            let reference = axis.reference(&r, ahead, i);
+            let t0 = Instant::now();
+            let solved = axis.qp.solve(&axis.x, &reference);
+            let was_late = t0.elapsed().as_secs_f64() > budget;
+            match solved {
+                Ok((u, _)) if !was_late => axis.x = &d_model.a * &axis.x + &d_model.b * &u,
+                _ => {
+                    late |= was_late;
+                    fell_back = true;
+                    axis.take(fallback, dt);
+                }
+            }
+        }
+        self.counts.samples += 1;
+        self.counts.fallbacks += usize::from(fell_back);
+        self.counts.late += usize::from(late);
+        self.counts.solve_s.push(started.elapsed().as_secs_f64());
+        Ok(self.offset())
+    }
+
+    /// The classical washout's channels of axis `i` for this sample: position and the angle's two parts.
+    fn fallback(&self, i: usize) -> [f64; 3] {
+        let c = self.classical.channels();
+        match i {
+            X => [c.translation[0], -c.tilt[1], -c.rotation[1]],
+            Y => [c.translation[1], c.tilt[0], c.rotation[0]],
+            _ => [c.translation[2], 0.0, 0.0],
+        }
+    }
+
+    /// The offset from neutral in platform axes.
+    pub fn offset(&self) -> [f64; 6] {
+        let [x, y, z] = &self.axes;
+        let angle = |a: &Axis| a.x[2] + a.x[3];
+        let roll = angle(y);
+        let pitch = -angle(x);
+        let yaw = self.classical.channels().yaw;
+        cueing::to_platform(self.config.forward, [x.x[0], y.x[0], z.x[0]], roll, pitch, yaw)
+    }
+
+    /// Back to neutral (yaw kept): the next sample is a first one.
+    pub fn reset(&mut self) {
+        self.classical.reset();
+        for a in &mut self.axes {
+            a.x.fill(0.0);
+            a.vehicle.fill(0.0);
+        }
+    }
+
+    /// The same cueing under another configuration from here on: the platform's and the perception's states
+    /// carried (the models are the same whatever the configuration), the programmes set up anew.
+    pub fn retuned(&self, config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
+        let mut new = Self::new(config, ranges)?;
+        new.classical = self.classical.retuned(config)?;
+        for (n, o) in new.axes.iter_mut().zip(&self.axes) {
+            n.x.copy_from(&o.x);
+            n.vehicle.copy_from(&o.vehicle);
+        }
+        new.counts = self.counts.clone();
+        Ok(new)
+    }
+}
+
+/// The vehicle's stimulus of axis `i`: `[specific force, rate]` (x: the pitch rate's negative, as x's angle is
+/// minus the pitch), `[specific force less g]` on z.
+fn stimulus(i: usize, s: &Telemetry<f64>) -> DVector<f64> {
+    match i {
+        X => DVector::from_vec(vec![s.force[0], -s.rate[1]]),
+        Y => DVector::from_vec(vec![s.force[1], s.rate[0]]),
+        _ => DVector::from_vec(vec![s.force[2] - G]),
+    }
+}
+
+/// Axis `i`'s weights (per output), effort weights (per input) and bounds.
+fn cost_and_bounds(i: usize, config: &CueConfig, ranges: &Ranges) -> (Vec<f64>, Vec<f64>, Vec<Bound>) {
+    let o = &config.optimal;
+    let share = o.envelope_share;
+    let (lo, hi) = (ranges[i].0 * share, ranges[i].1 * share);
+    let (v, a) = (o.max_velocity[i], o.max_acceleration[i]);
+    let speed = |output| Bound::State { output, lo: -v, hi: v };
+    if i == Z {
+        return (
+            vec![o.force_weight[i], o.position_weight[i], o.velocity_weight[i]],
+            vec![o.acceleration_weight[i]],
+            vec![
+                Bound::State { output: 1, lo, hi },
+                speed(2),
+                Bound::Input { mask: 1, limit: a },
+            ],
+        );
+    }
+    // x's angle is minus the pitch (index 4 of the ranges), y's the roll (index 3); the tilt keys are per force
+    // axis (x 0, y 1), the rotation keys per rotation (roll 0, pitch 1).
+    let (alo, ahi) = if i == X {
+        (-ranges[4].1 * share, -ranges[4].0 * share)
+    } else {
+        (ranges[3].0 * share, ranges[3].1 * share)
+    };
+    let limit = config.tilt_limit_deg[i].to_radians();
+    let rot = 1 - i;
+    (
+        vec![
+            o.force_weight[i],
+            o.rotation_weight[rot],
+            o.position_weight[i],
+            o.velocity_weight[i],
+            o.tilt_weight[i],
+        ],
+        vec![o.acceleration_weight[i], o.rate_weight[i], o.rate_weight[i]],
+        vec![
+            Bound::State { output: 2, lo, hi },
+            speed(3),
+            Bound::State {
+                output: 4,
+                lo: alo.max(-limit),
+                hi: ahi.min(limit),
+            },
+            Bound::Input { mask: 1, limit: a },
+            Bound::Input {
+                mask: 2,
+                limit: config.tilt_rate_deg[i].to_radians(),
+            },
+            Bound::Input {
+                mask: 6,
+                limit: o.max_rate_deg[i].to_radians(),
+            },
+        ],
+    )
+}
+
+impl Axis {
+    /// Axis `i` at neutral, its programme set up.
+    fn new(i: usize, config: &CueConfig, ranges: &Ranges) -> Self {
+        let o = &config.optimal;
+        let (model, perception) = if i == Z {
+            (model::vertical(), model::perception(false))
+        } else {
+            (model::horizontal(), model::perception(true))
+        };
+        let (weights, effort, bounds) = cost_and_bounds(i, config, ranges);
+        let spec = Spec {
+            model: &model,
+            steps: o.horizon as usize,
+            h: o.step_s,
+            output_weight: &weights,
+            input_weight: &effort,
+            bounds: &bounds,
+        };
+        let qp = AxisQp::new(&spec, o.budget_ms / 1000.0);
+        let (nx, np) = (model.dims().0, perception.dims().0);
+        Self {
+            perception_h: perception.discretise(o.step_s),
+            x: DVector::zeros(nx),
+            vehicle: DVector::zeros(np),
+            model,
+            qp,
+            perception,
+            at_dt: None,
+        }
+    }
+
+    /// The models discretised at `dt`, kept for the next sample of the same interval.
+    fn at(&mut self, dt: f64) -> (Discrete, Discrete) {
+        match &self.at_dt {
+            Some((d, m, p)) if *d == dt => (m.clone(), p.clone()),
+            _ => {
+                let (m, p) = (self.model.discretise(dt), self.perception.discretise(dt));
+                self.at_dt = Some((dt, m.clone(), p.clone()));
+                (m, p)
+            }
+        }
+    }
+
+    /// The reference over the horizon: the vehicle's perception run on from its state, each step's stimulus the
+    /// sample held or the previewed one; the other outputs (position, velocity, angle) towards zero.
+    fn reference(&self, r: &DVector<f64>, ahead: &[Telemetry<f64>], i: usize) -> DVector<f64> {
+        let n = self.qp.steps();
+        let ny = self.qp.outputs();
+        let mut out = DVector::zeros(n * ny);
+        let mut z = self.vehicle.clone();
+        let d = &self.perception_h;
+        for k in 0..n {
+            let rk = ahead.get(k).map_or_else(|| r.clone(), |s| stimulus(i, s));
+            z = &d.a * &z + &d.b * &rk;
+            let y = self.perception.output(&z, &rk);
+            for (j, v) in y.iter().enumerate() {
+                out[k * ny + j] = *v;
+            }
+        }
+        out
+    }
+
+    /// Takes the classical channels `[position, tilt, rotation]` for this sample: the velocity from the change.
+    fn take(&mut self, [p, tilt, rotation]: [f64; 3], dt: f64) {
+        let v = (p - self.x[0]) / dt;
+        self.x[0] = p;
+        self.x[1] = v;
+        if self.x.len() > 4 {
+            self.x[2] = tilt;
+            self.x[3] = rotation;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ranges() -> Ranges {
+        [(-0.05, 0.05), (-0.05, 0.05), (-0.03, 0.03), (-0.3, 0.3), (-0.3, 0.3)]
+    }
+
+    fn sample(ax: f64) -> Telemetry<f64> {
+        Telemetry {
+            force: [ax, 0.0, G],
+            rate: [0.0; 3],
+        }
+    }
+
+    /// A configuration whose solves are never late (the tests run unoptimised, on a loaded machine).
+    fn patient() -> CueConfig {
+        let mut c = CueConfig {
+            algorithm: cueing::Algorithm::Optimal,
+            ..CueConfig::default()
+        };
+        c.optimal.budget_ms = 1000.0;
+        c
+    }
+
+    #[test]
+    fn braking_is_cued_by_moving_back_and_pitching_nose_down() {
+        let mut o = Optimal::new(patient(), &ranges()).unwrap();
+        o.begin(&sample(0.0)).unwrap();
+        let r = &mut o.axes[X];
+        let reference = r.reference(&stimulus(X, &sample(-6.0)), &[], X);
+        let solved = r.qp.solve(&r.x, &reference);
+        assert!(solved.is_ok(), "{solved:?}");
+        let mut last = [0.0; 6];
+        for _ in 0..100 {
+            last = o.step(&sample(-6.0), 0.01, &[]).unwrap();
+        }
+        assert_eq!(
+            o.counts().fallbacks,
+            0,
+            "{:?}",
+            (o.counts().late, o.counts().solve_s.iter().cloned().fold(0.0, f64::max))
+        );
+        assert!(last[4] > 0.01, "{last:?}");
+        // Within the envelope it plans in (a share of the ranges), which the slacks' price keeps.
+        let share = o.config.optimal.envelope_share;
+        assert!(
+            last[0].abs() <= 0.05 * share + 1e-3 && last[4] <= 0.3 * share + 1e-3,
+            "{last:?}"
+        );
+    }
+}

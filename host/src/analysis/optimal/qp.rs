@@ -1,0 +1,256 @@
+//! One axis's quadratic programme over the horizon, condensed (the inputs are the variables, the states their
+//! linear function): its matrices are fixed by the configuration, so the solver is set up once and each sample
+//! only changes the linear cost (the state and the reference) and the constraints' bounds (the state).
+//!
+//! Clarabel is an interior-point solver: it takes no warm start (an interior point cannot start from the last
+//! solution, which lies on the constraints). What carries over from one sample to the next is its setup: the
+//! equilibration, the KKT system's structure and its symbolic factorisation, updated in place.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+use nalgebra::{DMatrix, DVector};
+
+use super::model::Linear;
+
+/// The quadratic price of a state bound's slack (per unit squared) and its linear price (per unit): a bound
+/// is given up only where nothing else is possible.
+const SLACK_WEIGHT: f64 = 1e6;
+const SLACK_PRICE: f64 = 1e3;
+
+/// A bound on one linear function of the states at every step of the horizon, or on one input.
+#[derive(Debug, Clone, Copy)]
+pub enum Bound {
+    /// `lo <= C x_k <= hi` for the state row `c` (its coefficients over the states).
+    State {
+        /// Which output row of the model (its `C` row) is bounded; its `D` part must be zero.
+        output: usize,
+        /// Lower bound.
+        lo: f64,
+        /// Upper bound.
+        hi: f64,
+    },
+    /// `|sum of inputs in mask| <= limit` at every step.
+    Input {
+        /// The inputs summed (a bit per input).
+        mask: u8,
+        /// The limit.
+        limit: f64,
+    },
+}
+
+/// What one axis's programme is made of.
+pub struct Spec<'a> {
+    /// The model.
+    pub model: &'a Linear,
+    /// Steps of the horizon.
+    pub steps: usize,
+    /// One step (s).
+    pub h: f64,
+    /// Weight of each output.
+    pub output_weight: &'a [f64],
+    /// Weight of each input (effort).
+    pub input_weight: &'a [f64],
+    /// The bounds.
+    pub bounds: &'a [Bound],
+}
+
+/// Why a solve gave no plan.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolveError {
+    /// The solver ended without a solution (infeasible, out of iterations or time, numerical trouble).
+    Status(SolverStatus),
+    /// The solver refused the sample's data.
+    Update,
+}
+
+/// One axis's programme, ready to solve from any state and reference.
+pub struct AxisQp {
+    solver: DefaultSolver<f64>,
+    /// Outputs over the horizon from the initial state: `Y = psi x0 + gy U`.
+    psi: DMatrix<f64>,
+    /// `q = 2 gy' W (psi x0 - Yref)`: this matrix times the error.
+    q_of_error: DMatrix<f64>,
+    /// Constraint bounds `b = b0 - bx x0`.
+    b0: DVector<f64>,
+    bx: DMatrix<f64>,
+    inputs: usize,
+    outputs: usize,
+    steps: usize,
+    slacks: usize,
+}
+
+impl AxisQp {
+    /// Sets the programme up; `budget_s` bounds each solve's time.
+    pub fn new(spec: &Spec, budget_s: f64) -> Self {
+        let (nx, nu, ny) = spec.model.dims();
+        let (n, m) = (spec.steps, spec.model);
+        let d = m.discretise(spec.h);
+        // States over the horizon: X = phi x0 + gamma U (x_1 .. x_N).
+        let mut phi = DMatrix::zeros(n * nx, nx);
+        let mut gamma = DMatrix::zeros(n * nx, n * nu);
+        let mut power = DMatrix::identity(nx, nx);
+        let mut markov = Vec::with_capacity(n);
+        for k in 0..n {
+            markov.push(&power * &d.b);
+            power = &d.a * &power;
+            phi.view_mut((k * nx, 0), (nx, nx)).copy_from(&power);
+        }
+        for k in 0..n {
+            for j in 0..=k {
+                gamma.view_mut((k * nx, j * nu), (nx, nu)).copy_from(&markov[k - j]);
+            }
+        }
+        let mut cb = DMatrix::zeros(n * ny, n * nx);
+        let mut db = DMatrix::zeros(n * ny, n * nu);
+        for k in 0..n {
+            cb.view_mut((k * ny, k * nx), (ny, nx)).copy_from(&m.c);
+            db.view_mut((k * ny, k * nu), (ny, nu)).copy_from(&m.d);
+        }
+        let psi = &cb * &phi;
+        let gy = &cb * &gamma + &db;
+        let w = DVector::from_fn(n * ny, |i, _| spec.output_weight[i % ny]);
+        let gyw = gy.transpose() * DMatrix::from_diagonal(&w);
+        let mut p = &gyw * &gy * 2.0;
+        for i in 0..n * nu {
+            p[(i, i)] += 2.0 * spec.input_weight[i % nu];
+        }
+        let q_of_error = gyw * 2.0;
+        let (a, b0, bx) = constraints(spec, &psi, &gy, nx, nu, ny);
+        // One slack per state bound, shared by the horizon's steps, priced far above any cue: the programme is
+        // feasible from any state (a state a fallback left outside a bound, or one the model's linearisation
+        // did not foresee), and a plan that can keep within every bound does.
+        let slacks = a.ncols() - n * nu;
+        let p = {
+            let mut full = DMatrix::zeros(n * nu + slacks, n * nu + slacks);
+            full.view_mut((0, 0), (n * nu, n * nu)).copy_from(&p);
+            for j in 0..slacks {
+                full[(n * nu + j, n * nu + j)] = 2.0 * SLACK_WEIGHT;
+            }
+            full
+        };
+        let settings = DefaultSettings {
+            verbose: false,
+            presolve_enable: false,
+            input_sparse_dropzeros: false,
+            time_limit: budget_s,
+            max_iter: 60,
+            tol_gap_abs: 1e-6,
+            tol_gap_rel: 1e-6,
+            tol_feas: 1e-7,
+            ..DefaultSettings::default()
+        };
+        let q = vec![0.0; n * nu + slacks];
+        let cones = [SupportedConeT::NonnegativeConeT(a.nrows())];
+        let solver = DefaultSolver::new(&csc(&p, true), &q, &csc(&a, false), b0.as_slice(), &cones, settings)
+            .expect("the programme's dimensions agree by construction");
+        Self {
+            solver,
+            psi,
+            q_of_error,
+            b0,
+            bx,
+            inputs: nu,
+            outputs: ny,
+            steps: n,
+            slacks,
+        }
+    }
+
+    /// Steps of the horizon.
+    pub fn steps(&self) -> usize {
+        self.steps
+    }
+
+    /// Outputs per step.
+    pub fn outputs(&self) -> usize {
+        self.outputs
+    }
+
+    /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`); returns the first
+    /// step's inputs and the solver's iterations.
+    pub fn solve(&mut self, x0: &DVector<f64>, reference: &DVector<f64>) -> Result<(DVector<f64>, u32), SolveError> {
+        let error = &self.psi * x0 - reference;
+        let mut q: Vec<f64> = (&self.q_of_error * error).iter().copied().collect();
+        q.resize(self.steps * self.inputs + self.slacks, SLACK_PRICE);
+        let b: Vec<f64> = (&self.b0 - &self.bx * x0).iter().copied().collect();
+        self.solver.update_q(&q).map_err(|_| SolveError::Update)?;
+        self.solver.update_b(&b).map_err(|_| SolveError::Update)?;
+        self.solver.solve();
+        let s = &self.solver.solution;
+        match s.status {
+            SolverStatus::Solved | SolverStatus::AlmostSolved => {
+                Ok((DVector::from_column_slice(&s.x[..self.inputs]), s.iterations))
+            }
+            status => Err(SolveError::Status(status)),
+        }
+    }
+}
+
+/// The constraints `A U <= b0 - bx x0`.
+fn constraints(
+    spec: &Spec,
+    psi: &DMatrix<f64>,
+    gy: &DMatrix<f64>,
+    nx: usize,
+    nu: usize,
+    ny: usize,
+) -> (DMatrix<f64>, DVector<f64>, DMatrix<f64>) {
+    let n = spec.steps;
+    let slacks = spec.bounds.iter().filter(|b| matches!(b, Bound::State { .. })).count();
+    // Each bound two rows a step; each slack its own row (at least zero).
+    let rows = 2 * n * spec.bounds.len() + slacks;
+    let mut a = DMatrix::zeros(rows, n * nu + slacks);
+    let mut b0 = DVector::zeros(rows);
+    let mut bx = DMatrix::zeros(rows, nx);
+    let mut r = 0;
+    let mut slack = n * nu;
+    for bound in spec.bounds {
+        for k in 0..n {
+            match *bound {
+                Bound::State { output, lo, hi } => {
+                    let row = k * ny + output;
+                    for (sign, limit) in [(1.0, hi), (-1.0, -lo)] {
+                        a.view_mut((r, 0), (1, n * nu)).copy_from(&(gy.row(row) * sign));
+                        a[(r, slack)] = -1.0;
+                        bx.row_mut(r).copy_from(&(psi.row(row) * sign));
+                        b0[r] = limit;
+                        r += 1;
+                    }
+                }
+                Bound::Input { mask, limit } => {
+                    for sign in [1.0, -1.0] {
+                        for i in (0..nu).filter(|i| mask & (1 << i) != 0) {
+                            a[(r, k * nu + i)] = sign;
+                        }
+                        b0[r] = limit;
+                        r += 1;
+                    }
+                }
+            }
+        }
+        if matches!(bound, Bound::State { .. }) {
+            slack += 1;
+        }
+    }
+    // -s <= 0.
+    for j in n * nu..n * nu + slacks {
+        a[(r, j)] = -1.0;
+        r += 1;
+    }
+    (a, b0, bx)
+}
+
+/// A dense matrix as compressed columns (the upper triangle only, for the cost's matrix), zeros left out.
+fn csc(m: &DMatrix<f64>, upper: bool) -> CscMatrix<f64> {
+    let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..m.ncols() {
+        for i in 0..m.nrows() {
+            if (!upper || i <= j) && m[(i, j)] != 0.0 {
+                rows.push(i);
+                cols.push(j);
+                vals.push(m[(i, j)]);
+            }
+        }
+    }
+    CscMatrix::new_from_triplets(m.nrows(), m.ncols(), rows, cols, vals)
+}

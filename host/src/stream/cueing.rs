@@ -1,0 +1,233 @@
+//! The cueing a telemetry stream runs, retuned live when its file changes: the classical washout or the optimal
+//! cueing (`algorithm`), a new tuning blended in over [`HANDOVER_S`] from the running one, as the core's
+//! [`ringpod_core::cueing::Live`] does for the washout alone. The same algorithm carries its state into the new
+//! tuning (the washout's filters retuned without a bump, the optimal cueing's platform and perception states
+//! kept); a change of algorithm starts the new one at neutral on the next sample and blends it in.
+
+use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout, HANDOVER_S};
+
+use crate::analysis::cue_engine::Engine;
+use crate::analysis::optimal::Ranges;
+
+/// A stream's cueing.
+pub struct LiveCueing {
+    config: CueConfig,
+    /// The platform's envelope about home, once the stream knows the rig.
+    ranges: Option<Ranges>,
+    /// The running engine; none while the optimal cueing waits for the envelope.
+    engine: Option<Engine>,
+    /// The engine has taken no sample yet (its next is a first one).
+    fresh: bool,
+    /// The engine before the last change and the time since (s), blended out.
+    fading: Option<(Engine, f64)>,
+    /// A change that came during a handover: taken when it ends.
+    pending: Option<CueConfig>,
+}
+
+/// The handover's weight of the new engine after `elapsed` seconds: smooth from 0 to 1 over [`HANDOVER_S`].
+fn weight(elapsed: f64) -> f64 {
+    let s = (elapsed / HANDOVER_S).clamp(0.0, 1.0);
+    s * s * (3.0 - 2.0 * s)
+}
+
+impl LiveCueing {
+    /// The cueing of `config`; the optimal cueing is set up when the envelope is known ([`LiveCueing::place`]).
+    pub fn new(config: CueConfig) -> Result<Self, ConfigError> {
+        config.validate()?;
+        let engine = match config.algorithm {
+            Algorithm::Classical => Some(Engine::Classical(Box::new(Washout::new(config)?))),
+            Algorithm::Optimal => None,
+        };
+        Ok(Self {
+            config,
+            ranges: None,
+            engine,
+            fresh: true,
+            fading: None,
+            pending: None,
+        })
+    }
+
+    /// The platform's envelope about home: the optimal cueing plans in it.
+    pub fn place(&mut self, ranges: Ranges) {
+        self.ranges = Some(ranges);
+        if self.engine.is_none() {
+            // The configuration was checked when it was taken: the engine accepts it.
+            self.engine = Engine::new(self.config, &ranges).ok();
+            self.fresh = true;
+        }
+    }
+
+    /// The running configuration.
+    #[cfg(test)]
+    pub fn config(&self) -> &CueConfig {
+        &self.config
+    }
+
+    /// Whether a handover is under way.
+    #[cfg(test)]
+    pub fn handing_over(&self) -> bool {
+        self.fading.is_some()
+    }
+
+    /// Takes a new configuration; returns whether it changes anything. A refused one changes nothing.
+    pub fn retune(&mut self, config: CueConfig) -> Result<bool, ConfigError> {
+        config.validate()?;
+        if self.fading.is_some() {
+            let changes = self.pending.map_or(config != self.config, |p| p != config);
+            self.pending = Some(config);
+            return Ok(changes);
+        }
+        if config == self.config {
+            return Ok(false);
+        }
+        let new = match (&self.engine, self.ranges, config.algorithm) {
+            (Some(Engine::Classical(w)), _, Algorithm::Classical) => {
+                Some(Engine::Classical(Box::new(w.retuned(config)?)))
+            }
+            (Some(Engine::Optimal(o)), Some(r), Algorithm::Optimal) => {
+                Some(Engine::Optimal(Box::new(o.retuned(config, &r)?)))
+            }
+            (_, _, Algorithm::Classical) => {
+                self.fresh = true;
+                Some(Engine::Classical(Box::new(Washout::new(config)?)))
+            }
+            (_, Some(r), Algorithm::Optimal) => {
+                self.fresh = true;
+                Some(Engine::new(config, &r)?)
+            }
+            (_, None, Algorithm::Optimal) => None,
+        };
+        self.config = config;
+        let old = core::mem::replace(&mut self.engine, new);
+        self.fading = old.filter(|_| self.engine.is_some()).map(|e| (e, 0.0));
+        Ok(true)
+    }
+
+    /// The first sample of a stream.
+    pub fn begin(&mut self, sample: &Telemetry<f64>) -> Result<[f64; 6], SampleError> {
+        if let Some((old, _)) = &mut self.fading {
+            old.begin(sample)?;
+        }
+        if let Some(e) = &mut self.engine {
+            e.begin(sample)?;
+            self.fresh = false;
+        }
+        Ok(self.offset())
+    }
+
+    /// One sample after `dt` seconds.
+    pub fn step(&mut self, sample: &Telemetry<f64>, dt: f64) -> Result<[f64; 6], SampleError> {
+        if let Some(e) = &mut self.engine {
+            if self.fresh {
+                e.begin(sample)?;
+                self.fresh = false;
+            } else {
+                e.step(sample, dt, &[])?;
+            }
+        }
+        if let Some((old, elapsed)) = &mut self.fading {
+            old.step(sample, dt, &[])?;
+            *elapsed += dt;
+        }
+        let offset = self.offset();
+        if self.fading.as_ref().is_some_and(|(_, e)| *e >= HANDOVER_S) {
+            self.fading = None;
+            if let Some(config) = self.pending.take() {
+                let _ = self.retune(config);
+            }
+        }
+        Ok(offset)
+    }
+
+    /// The offset from neutral: the running engine's, blended from the old one during a handover; neutral while
+    /// the optimal cueing waits for the envelope (no sample is cued before the stream knows its rig).
+    pub fn offset(&self) -> [f64; 6] {
+        let new = self.engine.as_ref().map_or([0.0; 6], Engine::offset);
+        match &self.fading {
+            None => new,
+            Some((old, elapsed)) => {
+                let w = weight(*elapsed);
+                let old = old.offset();
+                core::array::from_fn(|i| old[i] + w * (new[i] - old[i]))
+            }
+        }
+    }
+
+    /// Back to neutral (a gap): the handover ends, a pending change is taken.
+    pub fn reset(&mut self) {
+        self.fading = None;
+        if let Some(config) = self.pending.take() {
+            let _ = self.retune(config);
+            self.fading = None;
+        }
+        if let Some(e) = &mut self.engine {
+            e.reset();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ringpod_core::cueing::G;
+
+    fn ranges() -> Ranges {
+        [(-0.05, 0.05), (-0.05, 0.05), (-0.03, 0.03), (-0.3, 0.3), (-0.3, 0.3)]
+    }
+
+    fn braking() -> Telemetry<f64> {
+        Telemetry {
+            force: [-6.0, 0.0, G],
+            rate: [0.0; 3],
+        }
+    }
+
+    /// From the classical washout to the optimal cueing mid-stream: no jump, the new one blended in over the
+    /// handover, and then alone.
+    #[test]
+    fn a_change_of_algorithm_blends_in_without_a_jump() {
+        let mut c = LiveCueing::new(CueConfig::default()).unwrap();
+        c.place(ranges());
+        c.begin(&braking()).unwrap();
+        let mut last = [0.0; 6];
+        for _ in 0..50 {
+            last = c.step(&braking(), 0.01).unwrap();
+        }
+        let optimal = CueConfig {
+            algorithm: Algorithm::Optimal,
+            ..CueConfig::default()
+        };
+        assert!(c.retune(optimal).unwrap());
+        assert!(c.handing_over());
+        let next = c.step(&braking(), 0.01).unwrap();
+        for i in 0..6 {
+            assert!((next[i] - last[i]).abs() < 2e-3, "axis {i}: {} -> {}", last[i], next[i]);
+        }
+        for _ in 0..100 {
+            c.step(&braking(), 0.01).unwrap();
+        }
+        assert!(!c.handing_over());
+        assert!(matches!(c.engine, Some(Engine::Optimal(_))));
+        assert!(
+            !c.retune(optimal).unwrap(),
+            "the same configuration again changes nothing"
+        );
+    }
+
+    #[test]
+    fn the_optimal_cueing_waits_for_the_envelope() {
+        let optimal = CueConfig {
+            algorithm: Algorithm::Optimal,
+            ..CueConfig::default()
+        };
+        let mut c = LiveCueing::new(optimal).unwrap();
+        assert!(c.engine.is_none());
+        assert_eq!(c.begin(&braking()).unwrap(), [0.0; 6]);
+        c.place(ranges());
+        c.begin(&braking()).unwrap();
+        let o = (0..30).map(|_| c.step(&braking(), 0.01).unwrap()).last().unwrap();
+        // Braking: nose down, gravity's share backwards (the optimiser may move either way meanwhile).
+        assert!(o[4] > 0.005, "braking: nose down: {o:?}");
+    }
+}
