@@ -186,8 +186,11 @@ impl Opts {
         cue_config: Option<&std::path::Path>,
         profile: Option<&str>,
     ) -> Result<Option<Opts>, crate::input::cueing::CueingFileError> {
-        if !format.reads_outsim2() || given.is_some() {
-            return Ok(given.filter(|_| format.reads_outsim2()));
+        if !format.reads_outsim2() {
+            return Ok(None);
+        }
+        if given.is_some() {
+            return Ok(given);
         }
         let Some(hex) = crate::input::cueing::load_outsim_opts(cue_config, profile)? else {
             return Ok(None);

@@ -7,6 +7,15 @@ use serde_json::{json, Value};
 use super::workbench::{http, Workbench};
 use super::{is_reply, state};
 
+/// A loopback UDP port free when asked (the socket that found it is closed again).
+fn free_udp_port() -> u16 {
+    std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
 fn reply(page: &mut super::workbench::Page, request: Value, within: Duration) -> Value {
     let id = page.send(request);
     page.until(within, |m| is_reply(m, id)).unwrap()
@@ -52,11 +61,7 @@ fn a_file_is_read_only_when_picked_or_under_the_named_directory_and_never_quoted
 fn a_udp_session_binds_the_workbench_address_and_takes_only_its_sender() {
     let bench = Workbench::start(&[]);
     let mut a = bench.page();
-    let port = std::net::UdpSocket::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
+    let port = free_udp_port();
     a.send(json!({ "do": "udp", "port": port, "holds": "poses", "from": "127.0.0.2", "idle": 60 }));
     a.until(Duration::from_secs(60), |m| {
         m["type"] == "frame" && m["streaming"] == true && state(m) == Some("Ready")
@@ -96,11 +101,7 @@ fn a_udp_session_binds_the_workbench_address_and_takes_only_its_sender() {
 fn a_udp_session_reads_a_front_ends_strings() {
     let bench = Workbench::start(&[]);
     let mut a = bench.page();
-    let port = std::net::UdpSocket::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
+    let port = free_udp_port();
     let bad = json!({ "do": "udp", "port": port, "holds": "strings", "format": "dec8:<Axis7a>" });
     let r = reply(&mut a, bad, Duration::from_secs(10));
     assert_eq!(r["ok"], false, "{r}");
