@@ -55,8 +55,9 @@ pub struct Entry {
     pub total: Score,
     /// Poses the envelope limiter changed.
     pub limited: usize,
-    /// Samples where the optimal cueing fell back to the classical washout (none for the washout).
-    pub fallbacks: Option<usize>,
+    /// The optimal cueing's fallbacks (none for the washout): samples where an axis fell back, axes that
+    /// followed their last plan, axes that took the classical washout's change.
+    pub fallbacks: Option<[usize; 3]>,
     /// The optimal cueing's solve time per sample, all axes: p50, p99, max (ms).
     pub solve_ms: Option<[f64; 3]>,
 }
@@ -99,13 +100,15 @@ pub fn evaluate(
 ) -> Result<(Entry, Vec<Vec<Trace>>), CueError> {
     let mut scores = Vec::new();
     let mut traces = Vec::new();
-    let (mut limited, mut fallbacks, mut times) = (0, 0, Vec::new());
+    let (mut limited, mut fallbacks, mut times) = (0, [0; 3], Vec::new());
     for rows in drives {
         let r = replay(rows, config, &rig.mechanism, &rig.neutral, preview)?;
         let (s, t) = score(&r.cued, &rig.neutral, &rig.ranges, config.forward);
         limited += r.limited;
         if let Some(c) = &r.counts {
-            fallbacks += c.fallbacks;
+            fallbacks[0] += c.fallbacks;
+            fallbacks[1] += c.followed_plan;
+            fallbacks[2] += c.took_classical;
             times.extend_from_slice(&c.solve_s);
         }
         scores.push(s);
@@ -272,8 +275,9 @@ fn table(r: &Report) -> String {
         format!("{:.2} {:.2} {:.2} {:.2} {:.2}", v[0], v[1], v[2], v[3], v[4])
     });
     s += &row("envelope limiter interventions", &|e| e.limited.to_string());
-    s += &row("fallbacks to the classical washout", &|e| {
-        e.fallbacks.map_or("-".into(), |f| f.to_string())
+    s += &row("fallbacks (axes: last plan, washout)", &|e| {
+        e.fallbacks
+            .map_or("-".into(), |[n, plan, washout]| format!("{n} ({plan}, {washout})"))
     });
     s += &row("solve time p50 p99 max (ms)", &|e| {
         e.solve_ms

@@ -166,8 +166,13 @@ impl AxisQp {
         self.outputs
     }
 
-    /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`); returns the first
-    /// step's inputs and the solver's iterations.
+    /// Inputs per step.
+    pub fn inputs(&self) -> usize {
+        self.inputs
+    }
+
+    /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`); returns the plan
+    /// (every step's inputs, `N * inputs`) and the solver's iterations.
     pub fn solve(&mut self, x0: &DVector<f64>, reference: &DVector<f64>) -> Result<(DVector<f64>, u32), SolveError> {
         let error = &self.psi * x0 - reference;
         let mut q: Vec<f64> = (&self.q_of_error * error).iter().copied().collect();
@@ -178,9 +183,10 @@ impl AxisQp {
         self.solver.solve();
         let s = &self.solver.solution;
         match s.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Ok((DVector::from_column_slice(&s.x[..self.inputs]), s.iterations))
-            }
+            SolverStatus::Solved | SolverStatus::AlmostSolved => Ok((
+                DVector::from_column_slice(&s.x[..self.steps * self.inputs]),
+                s.iterations,
+            )),
             status => Err(SolveError::Status(status)),
         }
     }
