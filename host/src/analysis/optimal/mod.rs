@@ -45,6 +45,48 @@ pub struct Counts {
     pub solve_s: Vec<f64>,
 }
 
+impl Counts {
+    /// Adds another run's counts (an engine retired while streaming, another drive of a bench).
+    pub fn add(&mut self, other: &Counts) {
+        self.samples += other.samples;
+        self.fallbacks += other.fallbacks;
+        self.late += other.late;
+        self.followed_plan += other.followed_plan;
+        self.took_classical += other.took_classical;
+        self.solve_s.extend_from_slice(&other.solve_s);
+    }
+
+    /// The solve time per sample: p50, p99 and max (ms); zeros before any.
+    pub fn solve_ms(&self) -> [f64; 3] {
+        let mut times = self.solve_s.clone();
+        if times.is_empty() {
+            return [0.0; 3];
+        }
+        times.sort_by(f64::total_cmp);
+        let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize] * 1000.0;
+        [at(0.5), at(0.99), at(1.0)]
+    }
+}
+
+/// What a stream's optimal cueing did (`--report-json`'s `datagrams.optimal`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CountsReport {
+    /// The counts.
+    #[serde(flatten)]
+    pub counts: Counts,
+    /// The solve time per sample, p50, p99, max (ms).
+    pub solve_ms: [f64; 3],
+}
+
+impl From<Counts> for CountsReport {
+    fn from(counts: Counts) -> Self {
+        Self {
+            solve_ms: counts.solve_ms(),
+            counts,
+        }
+    }
+}
+
 /// One axis: its programme, the platform's state (with the rider's perception of it) and the vehicle's
 /// perception, which gives the reference.
 struct Axis {
@@ -200,7 +242,8 @@ impl Optimal {
     }
 
     /// The same cueing under another configuration from here on: the platform's and the perception's states
-    /// carried (the models are the same whatever the configuration), the programmes set up anew.
+    /// carried (the models are the same whatever the configuration), the programmes set up anew; the counts
+    /// start again (the old cueing keeps its own while it fades out).
     pub fn retuned(&self, config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
         let mut new = Self::new(config, ranges)?;
         new.classical = self.classical.retuned(config)?;
@@ -213,7 +256,6 @@ impl Optimal {
             n.plan.clone_from(&o.plan);
             n.plan_age = o.plan_age;
         }
-        new.counts = self.counts.clone();
         Ok(new)
     }
 }
@@ -463,7 +505,7 @@ mod tests {
         let mut o = o.retuned(hurried, &ranges()).unwrap();
         let fell_back = largest_steps(&mut o, 300, |k| if k < 150 { -6.0 } else { 2.0 });
         let c = o.counts();
-        assert_eq!((c.samples, c.fallbacks), (400, 300));
+        assert_eq!((c.samples, c.fallbacks), (300, 300));
         // Each axis follows its plan over the first half of its horizon (4 steps of 0.15 s: 60 samples), then the
         // washout.
         let half = 60;

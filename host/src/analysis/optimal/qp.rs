@@ -166,11 +166,6 @@ impl AxisQp {
         self.outputs
     }
 
-    /// Inputs per step.
-    pub fn inputs(&self) -> usize {
-        self.inputs
-    }
-
     /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`); returns the plan
     /// (every step's inputs, `N * inputs`) and the solver's iterations.
     pub fn solve(&mut self, x0: &DVector<f64>, reference: &DVector<f64>) -> Result<(DVector<f64>, u32), SolveError> {
