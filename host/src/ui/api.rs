@@ -190,6 +190,7 @@ mod tests {
     fn the_example_drive_is_cued_and_a_bad_parameter_is_named() {
         let (g, home) = trainer();
         let request = CueRequest {
+            compare: false,
             config: cue_defaults()["config"].clone(),
             drive: None,
         };
@@ -208,6 +209,7 @@ mod tests {
         bad["translation_scale"][0] = json!(-5.0);
         let e = cue(
             &CueRequest {
+                compare: false,
                 config: bad,
                 drive: None,
             },
@@ -220,6 +222,7 @@ mod tests {
         wrong["forward"] = json!("sideways");
         let e = cue(
             &CueRequest {
+                compare: false,
                 config: wrong,
                 drive: None,
             },
@@ -232,6 +235,7 @@ mod tests {
         let drive = "t,ax,ay,az,wx,wy,wz\n0,0,0,9.8,0,0,0\n0.01,x,0,9.8,0,0,0\n0.02,0,0,9.8,0,0,0\n";
         let out = cue(
             &CueRequest {
+                compare: false,
                 config: cue_defaults()["config"].clone(),
                 drive: Some(drive.into()),
             },
