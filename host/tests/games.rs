@@ -143,6 +143,12 @@ fn session(
     (out.status.code(), report, said)
 }
 
+/// A JSON array of numbers.
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    let all = v.as_array().unwrap_or_else(|| panic!("not an array: {v}"));
+    all.iter().map(|n| n.as_f64().unwrap()).collect()
+}
+
 /// What every session of the drive must show: homed and at rest at the end, every readable datagram one setpoint
 /// applied (received = applied + unreadable), the device's counts agreeing, and the last pose where the washout
 /// takes the drive: forward and to the left (surge and sway), nose up (the acceleration's tilt), right side down
@@ -170,12 +176,7 @@ fn assert_cued(what: &str, game: Game, report: &serde_json::Value, unreadable: u
         report["datagrams"].get("optimal").is_none(),
         "{what}: the washout: {report}"
     );
-    let last: Vec<f64> = report["last_applied_pose"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let last = numbers(&report["last_applied_pose"]);
     // Measured on the text drive (`ringpod cue`): x 3.2 mm, y 9.9 mm, alpha 0.021, beta -0.052 rad.
     assert!(last[0] > 0.001, "{what}: surges forward: {last:?}");
     assert!(last[1] > 0.004, "{what}: sways left: {last:?}");
@@ -256,19 +257,9 @@ fn the_optimal_cueing_runs_live() {
     );
     let axes = n("followed_plan") + n("took_classical");
     assert!((n("fallbacks")..=3 * n("fallbacks")).contains(&axes), "{report}");
-    let ms: Vec<f64> = o["solve_ms"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let ms = numbers(&o["solve_ms"]);
     assert!(ms[0] > 0.0 && ms[0] <= ms[1] && ms[1] <= ms[2], "{report}");
-    let last: Vec<f64> = report["last_applied_pose"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let last = numbers(&report["last_applied_pose"]);
     // The corner's force to the left: right side down; its turn to the left through the heading channel.
     assert!(last[3] > 0.005, "right side down: {last:?}");
     assert!((last[5] - 0.16).abs() < 0.03, "turned left: {last:?}");
