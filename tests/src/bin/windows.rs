@@ -195,15 +195,8 @@ fn cue_game(game: &str) -> Result<(), String> {
         .arg(debug_dir().join("ringpod.exe"))
         // `--fast`: the simulated controller homes at once rather than in the seconds a rig takes, during which
         // the drive would go on unread.
-        .args([
-            "stream",
-            "--sim",
-            "--fast",
-            "--quiet",
-            "--report-json",
-            "--telemetry-shm",
-            game,
-        ])
+        .args("stream --sim --fast --quiet --report-json --telemetry-shm".split(' '))
+        .arg(game)
         .args(["--udp-idle", IDLE_S])
         .stderr(Stdio::null());
     wine_env(&mut reader);
