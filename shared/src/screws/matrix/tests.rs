@@ -103,3 +103,4 @@ fn a_frame_from_three_points_and_the_revolute_angle_between_two() -> Result<(), 
 }
 
 mod spatial_loop;
+mod ring_dynamics;
