@@ -97,7 +97,9 @@ impl Model {
             return Err(LoopError::Shape);
         }
         let finite = bodies.iter().all(|b| b.inertia.iter().all(|v| v.is_finite()))
-            && elements.iter().all(|e| [e.stiffness, e.rest, e.damping, e.force].iter().all(|v| v.is_finite()))
+            && elements
+                .iter()
+                .all(|e| [e.stiffness, e.rest, e.damping, e.force].iter().all(|v| v.is_finite()))
             && gravity.iter().all(|v| v.is_finite());
         if !finite {
             return Err(LoopError::NonFinite);

@@ -11,7 +11,7 @@
 //! `a`'s path only, 0 on both; at closure the velocity condition is `sum s_v B_v q'_v = 0` and the acceleration
 //! condition `sum s_v (B_v q''_v + B'_v q'_v) = 0` with `B'_v = [W_v, B_v]`, `W_v` the twist of all before `v`.
 
-use nalgebra::{Matrix4, SMatrix, SVector};
+use nalgebra::{Matrix4, SMatrix, SVector, Vector3, Vector4};
 
 use super::pairs::{inverse, Joint};
 use super::LoopError;
@@ -241,8 +241,13 @@ impl Mechanism {
         let mut normal = Square::zeros();
         let mut right = Column::zeros();
         for c in &self.closures[..self.closure_count] {
-            let cols: [[f64; 12]; MAX_VARIABLES] =
-                core::array::from_fn(|v| if v < n && !self.driven(v) { column(c, v) } else { [0.0; 12] });
+            let cols: [[f64; 12]; MAX_VARIABLES] = core::array::from_fn(|v| {
+                if v < n && !self.driven(v) {
+                    column(c, v)
+                } else {
+                    [0.0; 12]
+                }
+            });
             let r = rhs(c);
             let dot = |a: &[f64; 12], b: &[f64; 12]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
             for i in 0..n {
@@ -380,6 +385,24 @@ impl Mechanism {
         (0..self.variable_count)
             .filter(|v| self.moves(*v, i))
             .fold(Matrix4::zeros(), |w, v| w + f.twists[v] * qdd[v] + drift[v] * qd[v])
+    }
+
+    /// A point `r` of link `i` (in the link's frame): its position `R = A_0i r` (eq. 5), velocity `W_i A_0i r`
+    /// (eq. 6) and acceleration `(W'_i + W_i W_i) A_0i r` in the base, for rates `qd` and accelerations `qdd`.
+    pub fn point(
+        &self,
+        f: &Frames,
+        qd: &[f64; MAX_VARIABLES],
+        qdd: &[f64; MAX_VARIABLES],
+        i: usize,
+        r: &Vector3<f64>,
+    ) -> [Vector3<f64>; 3] {
+        let frame = f.links.get(i).copied().unwrap_or_else(Matrix4::identity);
+        let at = frame * Vector4::new(1.0, r.x, r.y, r.z);
+        let w = self.link_twist(f, qd, i);
+        let wd = self.link_twist_rate(f, qd, qdd, i);
+        let tail = |v: Vector4<f64>| Vector3::new(v[1], v[2], v[3]);
+        [tail(at), tail(w * at), tail((wd + w * w) * at)]
     }
 
     /// The drives' values spread over the variables (zero elsewhere); `Shape` for a wrong count.

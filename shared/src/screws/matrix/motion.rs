@@ -76,13 +76,23 @@ impl Model {
     ) -> Result<([f64; MAX_DRIVES], State), LoopError> {
         let d = self.drive_count();
         if tau.len() != d || !tau.iter().all(|v| v.is_finite()) {
-            return Err(if tau.len() != d { LoopError::Shape } else { LoopError::NonFinite });
+            return Err(if tau.len() != d {
+                LoopError::Shape
+            } else {
+                LoopError::NonFinite
+            });
         }
         let zero = [0.0; MAX_DRIVES];
         let at_rest = self.solve_point(guess, u, ud, &zero[..d])?;
         let m = self.mass(&at_rest.frames)?;
         // Unused drives get identity rows, so one 6 x 6 decomposition serves any count.
-        let matrix = Matrix6::from_fn(|a, b| if a < d && b < d { m[a][b] } else { f64::from(u8::from(a == b)) });
+        let matrix = Matrix6::from_fn(|a, b| {
+            if a < d && b < d {
+                m[a][b]
+            } else {
+                f64::from(u8::from(a == b))
+            }
+        });
         let rhs = Vector6::from_fn(|a, _| if a < d { tau[a] - at_rest.forces[a] } else { 0.0 });
         let x = matrix.lu().solve(&rhs).ok_or(LoopError::Singular)?;
         Ok((core::array::from_fn(|a| if a < d { x[a] } else { 0.0 }), at_rest.state))
@@ -112,7 +122,11 @@ impl Model {
         let (k2x, k2v) = slope(&add(u, &k1x, dt / 2.0), &add(ud, &k1v, dt / 2.0), dt / 2.0)?;
         let (k3x, k3v) = slope(&add(u, &k2x, dt / 2.0), &add(ud, &k2v, dt / 2.0), dt / 2.0)?;
         let (k4x, k4v) = slope(&add(u, &k3x, dt), &add(ud, &k3v, dt), dt)?;
-        let combine = |x: &[f64; MAX_DRIVES], a: &[f64; MAX_DRIVES], b: &[f64; MAX_DRIVES], c: &[f64; MAX_DRIVES], e: &[f64; MAX_DRIVES]| {
+        let combine = |x: &[f64; MAX_DRIVES],
+                       a: &[f64; MAX_DRIVES],
+                       b: &[f64; MAX_DRIVES],
+                       c: &[f64; MAX_DRIVES],
+                       e: &[f64; MAX_DRIVES]| {
             core::array::from_fn(|k| x[k] + dt / 6.0 * (a[k] + 2.0 * b[k] + 2.0 * c[k] + e[k]))
         };
         let u1 = combine(u, &k1x, &k2x, &k3x, &k4x);

@@ -115,11 +115,21 @@ pub fn ring_model(
         let last = match chain.kind {
             ChainKind::Rod(_) => {
                 let across = rod.cross(&z).cross(&rod);
-                s.add(Joint::Hooke, carriage, frame_of(&ball, &axes(&rod, &across)?), &[0.0, 0.0])?
+                s.add(
+                    Joint::Hooke,
+                    carriage,
+                    frame_of(&ball, &axes(&rod, &across)?),
+                    &[0.0, 0.0],
+                )?
             }
             ChainKind::Radial => {
                 let tangent = z.cross(&radial);
-                let tilt = s.add(Joint::Revolute, carriage, frame_of(&ball, &axes(&radial, &tangent)?), &[0.0])?;
+                let tilt = s.add(
+                    Joint::Revolute,
+                    carriage,
+                    frame_of(&ball, &axes(&radial, &tangent)?),
+                    &[0.0],
+                )?;
                 lengths[length_count] = s.variables;
                 length_count += 1;
                 let slide = frame_of(&ball, &axes(&tangent, &rod)?);
