@@ -10,13 +10,14 @@
 //! one loop welded to it. The Hooke's joint is sketched at `(0, 0)` and the spherical pair at `(0, pi/2, 0)`, away
 //! from the Euler angles' gimbal lock at `theta = 0`. The chains are massless; the platform carries the payload.
 
-use nalgebra::{Matrix3, Matrix4, Vector3};
+use nalgebra::{Matrix3, Matrix4, Matrix6, Vector3, Vector6};
 
 use super::lagrange::{pseudo_inertia, Body, Model};
-use super::mechanism::{Closure, Mechanism, Pair, GROUND, MAX_PAIRS, MAX_VARIABLES};
+use super::mechanism::{Closure, Frames, Mechanism, Pair, GROUND, MAX_PAIRS, MAX_VARIABLES};
 use super::pairs::{inverse, Joint};
 use super::LoopError;
-use crate::kinematics::{geometry::ChainKind, Mechanism as _, Pose, RingGeometry, RingPlatform};
+use crate::kinematics::{geometry::ChainKind, Mechanism as _, MotionState, Pose, RingGeometry, RingPlatform};
+use crate::screws::twist_of;
 
 /// Standard gravity (m/s^2), as the ring platform's statics use.
 pub const GRAVITY: f64 = 9.80665;
@@ -164,4 +165,35 @@ pub fn ring_model(
         platform: ends[0],
         platform_offset: offsets[0],
     })
+}
+
+impl RingModel {
+    /// The drives' rates and accelerations that give the platform a motion's twist and its rate, at closed frames
+    /// `f`: `K u' = xi`, `K u'' = xi' - (the platform twist's rate at u'' = 0)`, `K` the platform's twist per unit
+    /// drive rate and `xi = [w; p' - w x p]` the twist about the base origin (the velocity of the platform point at
+    /// the origin). `Singular` where the drives do not determine the platform.
+    pub fn drive_motion(
+        &self,
+        f: &Frames,
+        ring: &RingPlatform<f64>,
+        s: &MotionState<f64>,
+    ) -> Result<([f64; 6], [f64; 6]), LoopError> {
+        let m = &self.model.mechanism;
+        let sens = self.model.sensitivities(f)?;
+        let k = Matrix6::from_fn(|r, c| twist_of(&m.link_twist(f, &sens[c], self.platform))[r]);
+        let body = ring.body_motion(s);
+        let p = s.pose.position();
+        let pd = Vector3::new(s.rates[0], s.rates[1], s.rates[2]);
+        let pdd = Vector3::new(s.accelerations[0], s.accelerations[1], s.accelerations[2]);
+        let join = |a: Vector3<f64>, b: Vector3<f64>| Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z);
+        let xi = join(body.omega, pd - body.omega.cross(&p));
+        let xi_rate = join(body.omega_dot, pdd - body.omega_dot.cross(&p) - body.omega.cross(&pd));
+        let lu = k.lu();
+        let ud = lu.solve(&xi).ok_or(LoopError::Singular)?;
+        let qd = m.rates(f, ud.as_slice())?;
+        let qdd = m.accelerations(f, &qd, &[0.0; 6])?;
+        let bias = twist_of(&m.link_twist_rate(f, &qd, &qdd, self.platform));
+        let udd = lu.solve(&(xi_rate - bias)).ok_or(LoopError::Singular)?;
+        Ok((core::array::from_fn(|i| ud[i]), core::array::from_fn(|i| udd[i])))
+    }
 }

@@ -2,14 +2,12 @@
 //! of the payload, the drives from the wrench matrix's statics): along the same smooth motion, the platform's frame,
 //! and the drive torques and forces within 1e-6 of the largest.
 
-use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
+use nalgebra::Matrix3;
 
 use super::super::mechanism::MAX_VARIABLES;
-use super::super::ring::{ring_model, RingModel};
-use super::super::*;
+use super::super::ring::ring_model;
 use crate::kinematics::presets::{ROTOPOD_CH4, TRAINER_CH5};
 use crate::kinematics::{Mechanism as _, MotionState, Payload, Pose, RingGeometry, RingPlatform};
-use crate::screws::twist_of;
 
 const MASS: f64 = 3.5;
 
@@ -28,31 +26,6 @@ fn motion(home: &[f64; 6], scale: f64, t: f64) -> MotionState<f64> {
         rates: core::array::from_fn(|k| a[k] * w[k] * (w[k] * t + p[k]).cos()),
         accelerations: core::array::from_fn(|k| -a[k] * w[k] * w[k] * (w[k] * t + p[k]).sin()),
     }
-}
-
-/// The drives' rates and accelerations that give the platform the motion's twist and its rate: `K u' = xi`,
-/// `K u'' = xi' - (the platform twist's rate at u'' = 0)`, `K` the platform twist per unit drive rate.
-fn drive_motion(rm: &RingModel, f: &Frames, ring: &RingPlatform<f64>, s: &MotionState<f64>) -> ([f64; 6], [f64; 6]) {
-    let m = &rm.model.mechanism;
-    let sens = rm.model.sensitivities(f).unwrap();
-    let k = Matrix6::from_fn(|r, c| twist_of(&m.link_twist(f, &sens[c], rm.platform))[r]);
-    let body = ring.body_motion(s);
-    let (p, pd, pdd) = (
-        s.pose.position(),
-        Vector3::new(s.rates[0], s.rates[1], s.rates[2]),
-        Vector3::new(s.accelerations[0], s.accelerations[1], s.accelerations[2]),
-    );
-    let join = |a: Vector3<f64>, b: Vector3<f64>| Vector6::new(a.x, a.y, a.z, b.x, b.y, b.z);
-    // The twist about the base origin: the velocity of the platform point at the origin is p' - w x p.
-    let xi = join(body.omega, pd - body.omega.cross(&p));
-    let xi_rate = join(body.omega_dot, pdd - body.omega_dot.cross(&p) - body.omega.cross(&pd));
-    let lu = k.lu();
-    let ud = lu.solve(&xi).unwrap();
-    let qd = m.rates(f, ud.as_slice()).unwrap();
-    let qdd = m.accelerations(f, &qd, &[0.0; 6]).unwrap();
-    let bias = twist_of(&m.link_twist_rate(f, &qd, &qdd, rm.platform));
-    let udd = lu.solve(&(xi_rate - bias)).unwrap();
-    (core::array::from_fn(|i| ud[i]), core::array::from_fn(|i| udd[i]))
 }
 
 /// Runs the motion on `geometry`; returns the worst drive error relative to the largest drive seen, and that.
@@ -76,7 +49,7 @@ fn compare(geometry: &RingGeometry, home: [f64; 6], scale: f64) -> (f64, f64) {
         let platform = f.links[rm.platform] * rm.platform_offset;
         let pose = ring_frame(&s.pose);
         assert!((platform - pose).amax() < 1e-10, "step {step}");
-        let (ud, udd) = drive_motion(&rm, &f, &ring, &s);
+        let (ud, udd) = rm.drive_motion(&f, &ring, &s).unwrap();
         let solved = rm.model.solve_point(&closed, &q.0, &ud, &udd).unwrap();
         for (got, want) in solved.forces.iter().zip(&expected) {
             worst = worst.max((got - want).abs());

@@ -1,0 +1,112 @@
+//! `ringpod dynamics` run as a user runs it: the matrix method's drive forces agree with the ring platform's own
+//! inverse dynamics (exit 0), the table holds what its header says and keeps the energy balance, the plot is drawn,
+//! and every bad argument is refused with exit 1 and nothing written.
+
+use assert_cmd::Command;
+
+fn ringpod() -> Command {
+    Command::cargo_bin("ringpod").unwrap()
+}
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("ringpod-dynamics-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn the_trainer_and_the_rotopod_agree_with_the_ring_platforms_inverse_dynamics() {
+    for (preset, amplitude) in [("rotopod-ch4", "0.05"), ("trainer-ch5", "0.0125")] {
+        let csv = scratch(&format!("{preset}.csv"));
+        let png = scratch(&format!("{preset}.png"));
+        let out = ringpod()
+            .args([
+                "dynamics",
+                "-m",
+                preset,
+                "--amplitude",
+                amplitude,
+                "--duration",
+                "0.5",
+                "--step",
+                "0.01",
+            ])
+            .arg("--table")
+            .arg(&csv)
+            .arg("--plot")
+            .arg(&png)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(text.contains("51 samples over 0.5 s, 6 drives"), "{text}");
+        let table = std::fs::read_to_string(&csv).unwrap();
+        let mut lines = table.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert_eq!(head.len(), 1 + 4 * 6 + 3);
+        let rows: Vec<Vec<f64>> = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(rows.len(), 51);
+        let column = |name: &str| head.iter().position(|h| *h == name).unwrap();
+        // The drives' power is the total energy's rate: central differences of kinetic + potential.
+        let (kinetic, potential, power) = (column("kinetic"), column("potential"), column("drive_power"));
+        for k in 1..rows.len() - 1 {
+            let energy = |r: &Vec<f64>| r[kinetic] + r[potential];
+            let rate = (energy(&rows[k + 1]) - energy(&rows[k - 1])) / 0.02;
+            let scale = rows[k][power].abs().max(1.0);
+            assert!(
+                (rate - rows[k][power]).abs() < 2e-3 * scale,
+                "{preset} row {k}: {rate} vs {}",
+                rows[k][power]
+            );
+        }
+        // The positions' rates are the rates' integral's derivative, likewise.
+        let (u1, ud1) = (column("u1"), column("ud1"));
+        let rate = (rows[26][u1] - rows[24][u1]) / 0.02;
+        assert!(
+            (rate - rows[25][ud1]).abs() < 1e-3 * rows[25][ud1].abs().max(1e-3),
+            "{preset}"
+        );
+        assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+    }
+}
+
+#[test]
+fn bad_arguments_are_refused_and_write_nothing() {
+    let csv = scratch("refused.csv");
+    for args in [
+        &["--step", "0"][..],
+        &["--step=-0.1"],
+        &["--duration", "NaN"],
+        &["--duration", "1e9", "--step", "1e-6"],
+        &["--amplitude=-1"],
+        &["--mass=-2"],
+        &["--inertia", "1,2"],
+        &["-m", "tool5-ex"],
+        &["-m", "trainer-elbow"],
+        &["-m", "no-such-preset"],
+        &["--amplitude", "0.5"],
+    ] {
+        let out = ringpod()
+            .arg("dynamics")
+            .args(args)
+            .arg("--table")
+            .arg(&csv)
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        assert!(!String::from_utf8_lossy(&out.stderr).is_empty(), "{args:?}");
+        assert!(!csv.exists(), "{args:?} wrote the table");
+    }
+}
