@@ -358,9 +358,11 @@ impl Mechanism {
             }
             let (p, k) = self.owner[v];
             let mut w = self.link_twist(f, qd, self.pairs[p].parent);
-            for j in self.first[p]..self.first[p] + k {
-                w += f.twists[j] * qd[j];
-            }
+            let earlier = self.first[p]..self.first[p] + k;
+            w += f.twists[earlier.clone()]
+                .iter()
+                .zip(&qd[earlier])
+                .fold(Matrix4::zeros(), |m, (b, r)| m + b * *r);
             bracket(&w, &f.twists[v])
         })
     }

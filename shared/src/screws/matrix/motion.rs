@@ -13,6 +13,9 @@ pub const TOLERANCE: f64 = 1e-13;
 /// Gauss-Newton iterations allowed at each point of a motion.
 pub const ITERATIONS: u32 = 40;
 
+/// The drives' values and rates after a step, and every variable closed there.
+pub type Stepped = ([f64; MAX_DRIVES], [f64; MAX_DRIVES], [f64; MAX_VARIABLES]);
+
 /// One point of a motion, solved.
 #[derive(Debug, Clone, Copy)]
 pub struct Solved {
@@ -107,7 +110,7 @@ impl Model {
         ud: &[f64; MAX_DRIVES],
         dt: f64,
         tau: impl Fn(f64) -> [f64; MAX_DRIVES],
-    ) -> Result<([f64; MAX_DRIVES], [f64; MAX_DRIVES], [f64; MAX_VARIABLES]), LoopError> {
+    ) -> Result<Stepped, LoopError> {
         let d = self.drive_count();
         let add = |x: &[f64; MAX_DRIVES], k: &[f64; MAX_DRIVES], h: f64| -> [f64; MAX_DRIVES] {
             core::array::from_fn(|a| x[a] + k[a] * h)

@@ -12,7 +12,7 @@ fn tx(a: f64) -> Matrix4<f64> {
     translation(Vector3::new(a, 0.0, 0.0))
 }
 
-fn four_bar() -> Mechanism {
+fn four_bar() -> Result<Mechanism, LoopError> {
     let pair = |parent: usize, place: Matrix4<f64>| Pair {
         joint: Joint::Revolute,
         parent,
@@ -29,12 +29,12 @@ fn four_bar() -> Mechanism {
         b: GROUND,
         offset: tx(-0.30),
     };
-    Mechanism::new(&pairs, &[closure], &[0]).unwrap()
+    Mechanism::new(&pairs, &[closure], &[0])
 }
 
 /// T3's rods (1, 2 and 1.5 kg from each joint along its link), gravity along -y, a spring and a damper on the
 /// coupler's pair and a force on the rocker's.
-fn model(damping: f64, force: f64) -> Model {
+fn model(damping: f64, force: f64) -> Result<Model, LoopError> {
     let bodies = [
         Body {
             link: 1,
@@ -63,7 +63,7 @@ fn model(damping: f64, force: f64) -> Model {
             ..Element::default()
         },
     ];
-    Model::new(four_bar(), &bodies, &elements, Vector3::new(0.0, -9.81, 0.0)).unwrap()
+    Model::new(four_bar()?, &bodies, &elements, Vector3::new(0.0, -9.81, 0.0))
 }
 
 const DEG: f64 = core::f64::consts::PI / 180.0;
@@ -76,7 +76,7 @@ fn guess() -> [f64; MAX_VARIABLES] {
 
 #[test]
 fn t1_positions_rates_and_accelerations() -> Result<(), LoopError> {
-    let m = four_bar();
+    let m = four_bar()?;
     let (q, iterations) = m.close(&guess(), 1e-13, 30)?;
     let expected = [60.0, -44.535497, -131.354371, 115.889868];
     for (got, want) in q.iter().zip(&expected) {
@@ -98,7 +98,7 @@ fn t1_positions_rates_and_accelerations() -> Result<(), LoopError> {
 
 #[test]
 fn t3_mass_and_the_single_loops_agree() -> Result<(), LoopError> {
-    let model = model(0.0, 0.0);
+    let model = model(0.0, 0.0)?;
     let q = model.closed(&guess(), &[60.0 * DEG])?;
     let m = model.mass(&model.mechanism.frames(&q)?)?;
     assert!((m[0][0] - 0.0263978).abs() < 1e-7, "{}", m[0][0]);
@@ -107,7 +107,7 @@ fn t3_mass_and_the_single_loops_agree() -> Result<(), LoopError> {
 
 #[test]
 fn a_link_points_velocity_and_acceleration_are_the_derivatives_of_its_path() -> Result<(), LoopError> {
-    let model = model(0.0, 0.0);
+    let model = model(0.0, 0.0)?;
     let m = &model.mechanism;
     let u = |t: f64| 1.0 + 0.3 * libm::sin(3.0 * t);
     let r = Vector3::new(0.2, 0.05, 0.01);
@@ -158,7 +158,7 @@ fn total_energy(model: &Model, u: f64, ud: f64, q: &[f64; MAX_VARIABLES]) -> Res
 
 #[test]
 fn without_friction_the_energy_is_kept() -> Result<(), LoopError> {
-    let model = model(0.0, 0.0);
+    let model = model(0.0, 0.0)?;
     let path = integrate(&model, 60.0 * DEG, 0.0, 800, 5e-4, |_| 0.0)?;
     let start = total_energy(&model, path[0].0, path[0].1, &path[0].2)?;
     let mut swing = 0.0f64;
@@ -174,7 +174,7 @@ fn without_friction_the_energy_is_kept() -> Result<(), LoopError> {
 
 #[test]
 fn the_drives_and_elements_power_is_the_energys_rate() -> Result<(), LoopError> {
-    let model = model(0.4, 1.5);
+    let model = model(0.4, 1.5)?;
     let (u, ud, udd) = (
         |t: f64| 1.0 + 0.3 * libm::sin(3.0 * t),
         |t: f64| 0.9 * libm::cos(3.0 * t),
@@ -197,7 +197,7 @@ fn the_drives_and_elements_power_is_the_energys_rate() -> Result<(), LoopError> 
 
 #[test]
 fn forward_dynamics_of_the_inverse_dynamics_forces_reproduces_the_motion() -> Result<(), LoopError> {
-    let model = model(0.4, 1.5);
+    let model = model(0.4, 1.5)?;
     let u = |t: f64| 1.0 + 0.3 * libm::sin(3.0 * t);
     let ud = |t: f64| 0.9 * libm::cos(3.0 * t);
     let udd = |t: f64| -2.7 * libm::sin(3.0 * t);
@@ -222,11 +222,12 @@ proptest! {
     fn the_forces_are_the_mass_times_the_acceleration_plus_the_rest(
         u in 0.6f64..1.4, ud in -3.0f64..3.0, udd in -20.0f64..20.0,
     ) {
-        let model = model(0.4, 1.5);
-        let q = model.closed(&guess(), &[u]).unwrap();
-        let moving = model.solve_point(&q, &[u], &[ud], &[udd]).unwrap();
-        let coasting = model.solve_point(&q, &[u], &[ud], &[0.0]).unwrap();
-        let m = model.mass(&moving.frames).unwrap()[0][0];
+        let fail = |e: LoopError| TestCaseError::fail(format!("{e:?}"));
+        let model = model(0.4, 1.5).map_err(fail)?;
+        let q = model.closed(&guess(), &[u]).map_err(fail)?;
+        let moving = model.solve_point(&q, &[u], &[ud], &[udd]).map_err(fail)?;
+        let coasting = model.solve_point(&q, &[u], &[ud], &[0.0]).map_err(fail)?;
+        let m = model.mass(&moving.frames).map_err(fail)?[0][0];
         prop_assert!(m > 0.0);
         let inertial = moving.forces[0] - coasting.forces[0];
         prop_assert!((inertial - m * udd).abs() <= 1e-10 * (1.0 + (m * udd).abs()), "{} vs {}", inertial, m * udd);
@@ -234,7 +235,7 @@ proptest! {
 }
 
 #[test]
-fn every_bad_mechanism_and_model_is_refused() {
+fn every_bad_mechanism_and_model_is_refused() -> Result<(), LoopError> {
     let r = |parent| Pair {
         joint: Joint::Revolute,
         parent,
@@ -274,7 +275,7 @@ fn every_bad_mechanism_and_model_is_refused() {
     off.offset[(2, 0)] = f64::INFINITY;
     assert_eq!(Mechanism::new(&[r(0), r(1)], &[off], &[0]), Err(LoopError::NonFinite));
     // A model's body on a missing link, an element on a missing variable, a non-finite number.
-    let m = four_bar();
+    let m = four_bar()?;
     let g = Vector3::new(0.0, 0.0, -9.81);
     let body = |link| Body {
         link,
@@ -291,7 +292,7 @@ fn every_bad_mechanism_and_model_is_refused() {
         Err(LoopError::NonFinite)
     );
     // Points of a motion: a wrong drive count, non-finite drives and positions.
-    let model = model(0.0, 0.0);
+    let model = model(0.0, 0.0)?;
     let q = guess();
     assert_eq!(
         model.solve_point(&q, &[1.0, 2.0], &[0.0], &[0.0]).err(),
@@ -306,4 +307,5 @@ fn every_bad_mechanism_and_model_is_refused() {
         model.drive_accelerations(&q, &[1.0], &[0.0], &[f64::NAN]).err(),
         Some(LoopError::NonFinite)
     );
+    Ok(())
 }
