@@ -240,10 +240,28 @@ fn draw(o: &Options, rows: &[Row], drives: usize, path: &Path) -> Result<(), plo
     plot::save(path, (1000, 900), &plot)
 }
 
+/// `dynamics` as asked on the command line.
+pub struct Request<'a> {
+    /// A preset's name (used when no rig file is given).
+    pub mechanism: &'a str,
+    /// A rig file, instead of the preset.
+    pub geometry: Option<&'a Path>,
+    /// Payload mass (kg) and principal inertia `Ixx,Iyy,Izz` (kg m^2) as typed.
+    pub mass: f64,
+    pub inertia: &'a str,
+    /// The motion's amplitude, duration and step.
+    pub amplitude: f64,
+    pub duration: f64,
+    pub step: f64,
+    /// Where to write the table and the plot.
+    pub table: Option<&'a Path>,
+    pub plot: Option<&'a Path>,
+}
+
 /// `dynamics` from its arguments: the mechanism selected, the numbers checked (a positive duration and step, a
 /// finite amplitude, a mass and inertia as `loads` takes them).
-pub fn command(args: &crate::cli::DynamicsArgs) -> Result<Outcome, CliError> {
-    let selected = crate::analysis::mechanism::Selected::of(&args.mechanism, args.geometry.as_deref())?;
+pub fn command(args: &Request) -> Result<Outcome, CliError> {
+    let selected = crate::analysis::mechanism::Selected::of(args.mechanism, args.geometry)?;
     let crate::analysis::mechanism::AnyMechanism::Ring(ring) = &selected.mechanism else {
         return Err(CliError::bad(
             "mechanism",
@@ -276,11 +294,11 @@ pub fn command(args: &crate::cli::DynamicsArgs) -> Result<Outcome, CliError> {
         geometry: ring.geometry(),
         home: selected.home,
         mass: crate::input::numbers::mass(args.mass)?,
-        inertia: crate::input::numbers::inertia(Some(&args.inertia))?,
+        inertia: crate::input::numbers::inertia(Some(args.inertia))?,
         amplitude: args.amplitude,
         duration,
         step,
-        table: args.table.as_deref(),
-        plot: args.plot.as_deref(),
+        table: args.table,
+        plot: args.plot,
     })
 }
