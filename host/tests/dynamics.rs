@@ -55,7 +55,7 @@ fn the_trainer_and_the_rotopod_agree_with_the_ring_platforms_inverse_dynamics() 
         assert_eq!(rows.len(), 51);
         let column = |name: &str| head.iter().position(|h| *h == name).unwrap();
         // The drives' power is the total energy's rate: central differences of kinetic + potential.
-        let (kinetic, potential, power) = (column("kinetic"), column("potential"), column("drive_power"));
+        let (kinetic, potential, power) = (column("kinetic"), column("potential"), column("power"));
         for k in 1..rows.len() - 1 {
             let energy = |r: &Vec<f64>| r[kinetic] + r[potential];
             let rate = (energy(&rows[k + 1]) - energy(&rows[k - 1])) / 0.02;
@@ -109,4 +109,50 @@ fn bad_arguments_are_refused_and_write_nothing() {
         assert!(!String::from_utf8_lossy(&out.stderr).is_empty(), "{args:?}");
         assert!(!csv.exists(), "{args:?} wrote the table");
     }
+}
+
+#[test]
+fn a_mechanism_file_gives_its_drive_forces_and_keeps_the_energy_balance() {
+    let csv = scratch("four-bar.csv");
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/dynamics/four-bar.toml");
+    let out = ringpod()
+        .args(["dynamics", "--file", file, "--table"])
+        .arg(&csv)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("four-bar: 201 samples over 2 s, 1 drives"), "{text}");
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<f64>> = table
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // Columns t, u1, ud1, udd1, force1, kinetic, potential, power: the power (the drive's, the damper's) is the
+    // energy's rate, and the damper takes some.
+    for k in 1..rows.len() - 1 {
+        let energy = |r: &Vec<f64>| r[5] + r[6];
+        let rate = (energy(&rows[k + 1]) - energy(&rows[k - 1])) / 0.02;
+        assert!(
+            (rate - rows[k][7]).abs() < 2e-3 * rows[k][7].abs().max(0.1),
+            "row {k}: {rate} vs {}",
+            rows[k][7]
+        );
+    }
+    let drive_only: Vec<f64> = rows.iter().map(|r| r[4] * r[2]).collect();
+    assert!(rows.iter().zip(&drive_only).any(|(r, d)| (r[7] - d).abs() > 1e-4));
+    ringpod()
+        .args(["dynamics", "--file", file, "--mass", "2"])
+        .assert()
+        .code(2);
+    ringpod()
+        .args(["dynamics", "--file", "/no/such/file.toml"])
+        .assert()
+        .code(1);
 }

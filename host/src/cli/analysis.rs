@@ -92,6 +92,10 @@ pub struct DynamicsArgs {
     /// Draw the drive forces and the energy balance (.png or .svg).
     #[arg(long, value_name = "FILE")]
     pub plot: Option<std::path::PathBuf>,
+    /// A mechanism file in paper 002's terms (pairs, loops, bodies, springs, the drives' motion; see the book's
+    /// "Paper 002" chapter), instead of a ring platform.
+    #[arg(long, value_name = "MECHANISM.toml", conflicts_with_all = ["geometry", "mass", "inertia", "amplitude", "duration", "step"])]
+    pub file: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Args)]

@@ -110,6 +110,7 @@ impl super::DynamicsArgs {
             step: self.step,
             table: self.table.as_deref(),
             plot: self.plot.as_deref(),
+            file: self.file.as_deref(),
         }
     }
 }
