@@ -85,3 +85,33 @@ fn trainer_drive_torques_and_forces_equal_the_ring_platforms_inverse_dynamics() 
     assert!(relative < 1e-6, "{relative:e}");
     Ok(())
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(48))]
+    /// At any pose near the rotopod's home, with any rates and accelerations, the matrix method's drive torques are
+    /// the ring platform's.
+    #[test]
+    fn any_instant_near_home_gives_the_ring_platforms_drive_torques(
+        offset in proptest::array::uniform6(-0.05f64..0.05),
+        rates in proptest::array::uniform6(-0.5f64..0.5),
+        accelerations in proptest::array::uniform6(-3.0f64..3.0),
+    ) {
+        let fail = |e: String| proptest::test_runner::TestCaseError::fail(e);
+        let home = [0.0, 0.0, 0.7, 0.0, 0.0, 0.0];
+        let ring = RingPlatform::<f64>::new(&ROTOPOD_CH4);
+        let at = |p: [f64; 6]| Pose::new(p[0], p[1], p[2], p[3], p[4], p[5]);
+        let rm = ring_model(&ROTOPOD_CH4, &at(home), MASS, &inertia()).map_err(|e| fail(format!("{e:?}")))?;
+        let s = MotionState { pose: at(core::array::from_fn(|k| home[k] + offset[k])), rates, accelerations };
+        let payload = Payload { mass: MASS, inertia: inertia() };
+        let q = ring.inverse(&s.pose).map_err(|e| fail(format!("{e:?}")))?;
+        let expected = ring.drive_demand(&s, &q, &payload).map_err(|e| fail(format!("{e:?}")))?.drives;
+        let closed = rm.model.closed(&rm.q, &q.0).map_err(|e| fail(format!("{e:?}")))?;
+        let f = rm.model.mechanism.frames(&closed).map_err(|e| fail(format!("{e:?}")))?;
+        let (ud, udd) = rm.drive_motion(&f, &ring, &s).map_err(|e| fail(format!("{e:?}")))?;
+        let solved = rm.model.solve_point(&closed, &q.0, &ud, &udd).map_err(|e| fail(format!("{e:?}")))?;
+        let largest = expected.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for (got, want) in solved.forces.iter().zip(&expected) {
+            proptest::prop_assert!((got - want).abs() <= 1e-9 * largest, "{:?} vs {:?}", solved.forces, expected);
+        }
+    }
+}
