@@ -14,44 +14,50 @@ fn scratch(name: &str) -> std::path::PathBuf {
     dir.join(name)
 }
 
+/// Runs `dynamics` with `args` and the table to `csv`; asserts exit 0 and that the text says `says`; returns the
+/// table's header and rows.
+fn table_of(args: &[&std::ffi::OsStr], csv: &std::path::Path, says: &str) -> (Vec<String>, Vec<Vec<f64>>) {
+    let out = ringpod()
+        .arg("dynamics")
+        .args(args)
+        .arg("--table")
+        .arg(csv)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains(says), "{text}");
+    let table = std::fs::read_to_string(csv).unwrap();
+    let mut lines = table.lines();
+    let head = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (head, rows)
+}
+
 #[test]
 fn the_trainer_and_the_rotopod_agree_with_the_ring_platforms_inverse_dynamics() {
     for (preset, amplitude) in [("rotopod-ch4", "0.05"), ("trainer-ch5", "0.0125")] {
         let csv = scratch(&format!("{preset}.csv"));
         let png = scratch(&format!("{preset}.png"));
-        let out = ringpod()
-            .args([
-                "dynamics",
-                "-m",
-                preset,
-                "--amplitude",
-                amplitude,
-                "--duration",
-                "0.5",
-                "--step",
-                "0.01",
+        let args: Vec<std::ffi::OsString> = ["-m", preset, "--amplitude", amplitude, "--duration", "0.5"]
+            .iter()
+            .map(|a| a.into())
+            .chain([
+                "--step".into(),
+                "0.01".into(),
+                "--plot".into(),
+                png.clone().into_os_string(),
             ])
-            .arg("--table")
-            .arg(&csv)
-            .arg("--plot")
-            .arg(&png)
-            .output()
-            .unwrap();
-        let text = String::from_utf8_lossy(&out.stdout);
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{text}{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        assert!(text.contains("51 samples over 0.5 s, 6 drives"), "{text}");
-        let table = std::fs::read_to_string(&csv).unwrap();
-        let mut lines = table.lines();
-        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
-        assert_eq!(head.len(), 1 + 4 * 6 + 3);
-        let rows: Vec<Vec<f64>> = lines
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
             .collect();
+        let args: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let (head, rows) = table_of(&args, &csv, "51 samples over 0.5 s, 6 drives");
         assert_eq!(rows.len(), 51);
         let column = |name: &str| head.iter().position(|h| *h == name).unwrap();
         // The drives' power is the total energy's rate: central differences of kinetic + potential.
@@ -115,25 +121,11 @@ fn bad_arguments_are_refused_and_write_nothing() {
 fn a_mechanism_file_gives_its_drive_forces_and_keeps_the_energy_balance() {
     let csv = scratch("four-bar.csv");
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/dynamics/four-bar.toml");
-    let out = ringpod()
-        .args(["dynamics", "--file", file, "--table"])
-        .arg(&csv)
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{text}{}",
-        String::from_utf8_lossy(&out.stderr)
+    let (_, rows) = table_of(
+        &["--file".as_ref(), file.as_ref()],
+        &csv,
+        "four-bar: 201 samples over 2 s, 1 drives",
     );
-    assert!(text.contains("four-bar: 201 samples over 2 s, 1 drives"), "{text}");
-    let table = std::fs::read_to_string(&csv).unwrap();
-    let rows: Vec<Vec<f64>> = table
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
     // Columns t, u1, ud1, udd1, force1, kinetic, potential, power: the power (the drive's, the damper's) is the
     // energy's rate, and the damper takes some.
     for k in 1..rows.len() - 1 {
