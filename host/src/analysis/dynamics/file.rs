@@ -105,6 +105,14 @@ fn bad(what: String) -> CliError {
     CliError::Dynamics(what)
 }
 
+/// Why a file's mechanism or model is refused, in words.
+fn refused(e: LoopError) -> &'static str {
+    match e {
+        LoopError::NonFinite => "a value is not finite",
+        _ => "past the limits, or too few loops to determine the variables that are not driven (six conditions a loop)",
+    }
+}
+
 fn joint(name: &str, pitch: f64) -> Result<Joint, CliError> {
     Ok(match name {
         "revolute" => Joint::Revolute,
@@ -266,7 +274,7 @@ fn build(f: &File) -> Result<Built, CliError> {
         ));
     }
     let mechanism =
-        Mechanism::new(&pairs, &closures, &drives).map_err(|e| bad(format!("the mechanism: {}", describe(e))))?;
+        Mechanism::new(&pairs, &closures, &drives).map_err(|e| bad(format!("the mechanism: {}", refused(e))))?;
     let bodies = f
         .body
         .iter()
@@ -283,7 +291,7 @@ fn build(f: &File) -> Result<Built, CliError> {
         .collect::<Result<Vec<_>, CliError>>()?;
     let elements = elements(f, &first, &q)?;
     let model = Model::new(mechanism, &bodies, &elements, v3(&f.gravity))
-        .map_err(|e| bad(format!("the model: {}", describe(e))))?;
+        .map_err(|e| bad(format!("the model: {}", refused(e))))?;
     let swing = drives
         .iter()
         .zip(m.amplitude.iter().zip(&m.frequency))
