@@ -31,6 +31,9 @@ pub enum CliError {
     /// A mechanism's chains could not be analysed.
     #[error("structure: {0}")]
     Structure(String),
+    /// The matrix-method dynamics have no answer at a point of the motion.
+    #[error("dynamics: {0}")]
+    Dynamics(String),
     /// A tip-over analysis has no answer.
     #[error("tip-over: {0}")]
     TipOver(ringpod_core::kinematics::TipOverError),

@@ -76,6 +76,7 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
         C::Rates(args) => answer(analysis::rates::run(&args.options()))?,
         C::Structure(args) => answer(analysis::structure::run(&args.options()))?,
         C::Loads(args) => answer(analysis::kinematics::loads(&args.options()))?,
+        C::Dynamics(args) => answer(analysis::dynamics::command(&args.request()))?,
         C::Reactions(args) => answer(analysis::reactions::run(
             &args.common.on(),
             args.pose.as_deref(),

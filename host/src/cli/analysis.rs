@@ -1,5 +1,5 @@
 //! Arguments of the commands that compute on a platform: `rig`, `ik`, `fk`, `check`, `loads`, `reactions`,
-//! `rates`, `structure`, `draw`, `workspace`, `cue`.
+//! `rates`, `structure`, `draw`, `workspace`, `cue`, `dynamics`.
 
 use clap::{Args, Subcommand};
 
@@ -60,6 +60,42 @@ pub struct LoadsArgs {
     /// With --input: draw each axis's demand against what its drive gives at that speed (.svg or .png).
     #[arg(long, requires = "input", conflicts_with = "pose", value_name = "FILE")]
     pub plot: Option<std::path::PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct DynamicsArgs {
+    /// Geometry: trainer-ch5, rotopod-ch4 or another preset of rod and radial chains (see `ringpod presets`).
+    #[arg(long, short, default_value = "rotopod-ch4")]
+    pub mechanism: String,
+    /// Your own ring platform: a rig file (TOML; see `ringpod rig check`), instead of --mechanism.
+    #[arg(long, value_name = "RIG.toml")]
+    pub geometry: Option<std::path::PathBuf>,
+    /// Payload mass (kg), at the geometry's centre of mass.
+    #[arg(long, default_value_t = 3.5)]
+    pub mass: f64,
+    /// Payload principal inertia about its centre of mass, platform frame: Ixx,Iyy,Izz (kg m^2).
+    #[arg(long, default_value = "0.3,0.42,0.55", allow_hyphen_values = true)]
+    pub inertia: String,
+    /// The built-in motion's amplitude (length units on x, y, z; radians on the angles), each coordinate at its own
+    /// frequency about the home pose.
+    #[arg(long, default_value_t = 0.05)]
+    pub amplitude: f64,
+    /// Duration (s).
+    #[arg(long, default_value_t = 2.0)]
+    pub duration: f64,
+    /// Sample step (s).
+    #[arg(long, default_value_t = 0.01)]
+    pub step: f64,
+    /// Write the table (positions, rates, accelerations, forces, energies, power) as CSV.
+    #[arg(long, value_name = "FILE.csv")]
+    pub table: Option<std::path::PathBuf>,
+    /// Draw the drive forces and the energy balance (.png or .svg).
+    #[arg(long, value_name = "FILE")]
+    pub plot: Option<std::path::PathBuf>,
+    /// A mechanism file in paper 002's terms (pairs, loops, bodies, springs, the drives' motion; see the book's
+    /// "Paper 002" chapter), instead of a ring platform.
+    #[arg(long, value_name = "MECHANISM.toml", conflicts_with_all = ["geometry", "mass", "inertia", "amplitude", "duration", "step"])]
+    pub file: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Args)]

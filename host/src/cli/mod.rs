@@ -6,8 +6,8 @@ pub mod requests;
 mod stream;
 
 pub use analysis::{
-    CheckArgs, Common, CueArgs, DrawArgs, FkArgs, LoadsArgs, PoseArgs, RatesArgs, ReactionsArgs, RigAction,
-    StructureArgs, WorkspaceArgs,
+    CheckArgs, Common, CueArgs, DrawArgs, DynamicsArgs, FkArgs, LoadsArgs, PoseArgs, RatesArgs, ReactionsArgs,
+    RigAction, StructureArgs, WorkspaceArgs,
 };
 pub use device::{ControllerArgs, DeviceAction, DeviceArgs, UiArgs};
 pub use requests::platform;
@@ -113,6 +113,11 @@ pub enum Command {
     Ports,
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
     Loads(LoadsArgs),
+    /// Paper 002's matrix method on a ring platform (trainer-ch5, rotopod-ch4, or a rig file of rod and radial
+    /// chains): pairs, link matrices and loops closed by Gauss-Newton, moved along a built-in motion about home; the
+    /// Lagrange equation gives the drive torques and forces, the energies and the drives' power, each force checked
+    /// against the ring platform's own inverse dynamics. Exits 0, or 3 when they differ by more than 1e-6.
+    Dynamics(DynamicsArgs),
     /// Loads of a tool wrench on the five-DOF tool carrier (paper 003's projection method): drive forces and
     /// torques, the X guide's bearing load, the frame pivots' forces and the constraint couple.
     Reactions(ReactionsArgs),

@@ -97,6 +97,24 @@ impl LoadsArgs {
     }
 }
 
+impl super::DynamicsArgs {
+    /// What `dynamics` is asked.
+    pub fn request(&self) -> crate::analysis::dynamics::Request<'_> {
+        crate::analysis::dynamics::Request {
+            mechanism: &self.mechanism,
+            geometry: self.geometry.as_deref(),
+            mass: self.mass,
+            inertia: &self.inertia,
+            amplitude: self.amplitude,
+            duration: self.duration,
+            step: self.step,
+            table: self.table.as_deref(),
+            plot: self.plot.as_deref(),
+            file: self.file.as_deref(),
+        }
+    }
+}
+
 impl WorkspaceArgs {
     /// The options `workspace` takes.
     pub fn options(&self) -> crate::analysis::workspace::Options<'_> {

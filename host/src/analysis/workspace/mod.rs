@@ -419,6 +419,23 @@ mod tests {
         );
     }
 
+    /// Chapter 5.1 says fig. 3.10's scheme (chapter 3.2's four chains) gives "the largest volume"; with chapter 3.2's
+    /// own parameters it does not: its actuators' 0.95..1.05 hold the heave to 0.948..0.997, and the rotopod's volume
+    /// at zero orientation is about twenty times the four chains' (the numbers of the book's comparison table).
+    #[test]
+    fn chapter_3_2s_four_chains_do_not_give_the_largest_volume_with_their_own_parameters() {
+        let volume_of = |name: &str| {
+            let m = AnyMechanism::by_name(name).unwrap().1;
+            let AnyMechanism::Ring(r) = &m else {
+                unreachable!("{name} is a ring platform")
+            };
+            volume(&m, ring_bounds(r))
+        };
+        let (rotopod, four) = (volume_of("rotopod-ch4"), volume_of("trainer-ch3"));
+        assert_eq!(format!("{rotopod:.3} {four:.4}"), "0.139 0.0071");
+        assert!(rotopod > 15.0 * four, "{rotopod} {four}");
+    }
+
     /// Along x at home the carriage's stroke is the limit: [-0.5, 0.5] m to the step.
     #[test]
     fn the_tool_carriers_x_range_is_its_stroke() {

@@ -5,13 +5,23 @@
 //! (`r` the child origin in the parent, `L` the rotation). A loop is `J1(q1) L1 J2(q2) L2 ... Jn(qn) Ln = E`, each
 //! `J` a pair of the paper's table 1 ([`Joint`], one to three variables) and each `L` a constant link transform.
 //! A loop's variables are those of its pairs in loop order; `input` always names a variable.
+//!
+//! Mechanisms of several loops and drives are trees of pairs closed by loop conditions ([`mechanism`]); their
+//! equation of motion is in [`lagrange`], motions and forward dynamics in [`motion`], the ring platforms in
+//! paper 002's terms in [`ring`].
 
 mod guess;
+pub mod lagrange;
+pub mod mechanism;
+pub mod motion;
 mod pairs;
+pub mod ring;
 #[cfg(test)]
 mod tests;
 
 pub use guess::{frame, relative, values};
+pub use lagrange::{pseudo_inertia, Body, Element, Energy, Model, State};
+pub use mechanism::{Closure, Frames, Mechanism, Pair, GROUND};
 pub use pairs::{inverse, rot_x, rot_z, translation, Joint};
 
 use nalgebra::Matrix4;

@@ -102,4 +102,6 @@ fn a_frame_from_three_points_and_the_revolute_angle_between_two() -> Result<(), 
     Ok(())
 }
 
+mod four_bar;
+mod ring_dynamics;
 mod spatial_loop;
