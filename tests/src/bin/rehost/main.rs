@@ -19,9 +19,9 @@ mod prepare;
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Command, ExitCode, Stdio};
+use std::process::{Command, ExitCode};
 
-use prepare::{build_cli, build_firmware, repo, venv};
+use prepare::{build_cli, build_firmware, repo, run_py, venv};
 use ringpod_tests::setup;
 
 /// The models' unit tests: Ok(number of tests) when all passed.
@@ -55,16 +55,7 @@ fn tally(line: &str) -> Option<(u32, u32)> {
 
 /// run.py, its lines passed through as they come, except its count, which is returned.
 fn checks(python: &Path, elf: &Path, cli: &Path) -> Result<(u32, u32, bool), String> {
-    let mut child = Command::new(python)
-        .env("PYTHONDONTWRITEBYTECODE", "1")
-        .arg(repo().join("tests/rehost/run.py"))
-        .arg("--elf")
-        .arg(elf)
-        .arg("--ringpod")
-        .arg(cli)
-        .stdout(Stdio::piped())
-        .spawn()
-        .map_err(|e| format!("run.py: {e}"))?;
+    let mut child = run_py(python, elf, cli, &[])?;
     let mut count = None;
     if let Some(out) = child.stdout.take() {
         for line in BufReader::new(out).lines().map_while(Result::ok) {

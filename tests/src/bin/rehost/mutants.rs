@@ -5,12 +5,12 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode, Stdio};
+use std::process::ExitCode;
 use std::time::Instant;
 
 use serde::Deserialize;
 
-use crate::prepare::{build_firmware_at, repo, target_dir};
+use crate::prepare::{build_firmware_at, repo, run_py, target_dir};
 
 /// The mutation list.
 #[derive(Deserialize)]
@@ -77,26 +77,25 @@ fn apply(mutant: &Mutant, root: &Path) -> Result<(), String> {
         let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", edit.file))?;
         let found = text.matches(&edit.find).count();
         if found != 1 {
-            return Err(format!("{}: the text to replace occurs {found} times, not once: {:?}", edit.file, edit.find));
+            return Err(format!(
+                "{}: the text to replace occurs {found} times, not once: {:?}",
+                edit.file, edit.find
+            ));
         }
-        std::fs::write(&path, text.replacen(&edit.find, &edit.replace, 1)).map_err(|e| format!("{}: {e}", edit.file))?;
+        std::fs::write(&path, text.replacen(&edit.find, &edit.replace, 1))
+            .map_err(|e| format!("{}: {e}", edit.file))?;
     }
     Ok(())
 }
 
 /// run.py on `elf` up to `check`: the checks that failed.
 fn failed_checks(python: &Path, elf: &Path, cli: &Path, check: &str) -> Result<Vec<String>, String> {
-    let mut child = Command::new(python)
-        .env("PYTHONDONTWRITEBYTECODE", "1")
-        .arg(repo().join("tests/rehost/run.py"))
-        .arg("--elf")
-        .arg(elf)
-        .arg("--ringpod")
-        .arg(cli)
-        .args(["--until", check, "--max-sim-s", "30", "--max-wall-s", "900"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .map_err(|e| format!("run.py: {e}"))?;
+    let mut child = run_py(
+        python,
+        elf,
+        cli,
+        &["--until", check, "--max-sim-s", "30", "--max-wall-s", "900"],
+    )?;
     let mut failed = Vec::new();
     if let Some(out) = child.stdout.take() {
         for line in BufReader::new(out).lines().map_while(Result::ok) {
@@ -130,7 +129,10 @@ fn outcome(mutant: &Mutant, python: &Path, cli: &Path) -> Outcome {
 /// Runs the mutants named in `only` (all when empty), one at a time; success when each was caught.
 pub fn run(python: &Path, cli: &Path, only: &[String]) -> ExitCode {
     let path: PathBuf = repo().join("tests/rehost/mutants.toml");
-    let list: List = match std::fs::read_to_string(&path).map_err(|e| e.to_string()).and_then(|t| toml::from_str(&t).map_err(|e| e.to_string())) {
+    let list: List = match std::fs::read_to_string(&path)
+        .map_err(|e| e.to_string())
+        .and_then(|t| toml::from_str(&t).map_err(|e| e.to_string()))
+    {
         Ok(l) => l,
         Err(e) => {
             eprintln!("rehost: {}: {e}", path.display());
@@ -160,7 +162,11 @@ pub fn run(python: &Path, cli: &Path, only: &[String]) -> ExitCode {
         .iter()
         .filter(|(_, r, _)| matches!(r, Outcome::NotCaught | Outcome::Broken(_)))
         .count();
-    println!("{} mutants, {} caught or refused, {missed} not", rows.len(), rows.len() - missed);
+    println!(
+        "{} mutants, {} caught or refused, {missed} not",
+        rows.len(),
+        rows.len() - missed
+    );
     if missed == 0 {
         ExitCode::SUCCESS
     } else {

@@ -1,7 +1,7 @@
 //! What a rehost run needs: the firmware ELF, the host CLI and the emulator's venv.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Child, Command, Stdio};
 
 use ringpod_tests::setup;
 
@@ -33,15 +33,18 @@ pub fn build_firmware() -> Result<PathBuf, String> {
 pub fn build_firmware_at(root: &Path, target: &Path) -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     run(
-        Command::new(cargo).current_dir(root).env("CARGO_TARGET_DIR", target).args([
-            "build",
-            "-p",
-            FIRMWARE,
-            "--target",
-            setup::TARGET,
-            "--profile",
-            "firmware",
-        ]),
+        Command::new(cargo)
+            .current_dir(root)
+            .env("CARGO_TARGET_DIR", target)
+            .args([
+                "build",
+                "-p",
+                FIRMWARE,
+                "--target",
+                setup::TARGET,
+                "--profile",
+                "firmware",
+            ]),
         "cargo build -p ringpod-firmware --profile firmware",
     )?;
     Ok(target.join(setup::TARGET).join("firmware").join(FIRMWARE))
@@ -93,3 +96,17 @@ pub fn venv() -> Result<PathBuf, String> {
     Ok(python)
 }
 
+/// run.py on `elf`, driving the CLI at `cli`, with `extra` arguments; its output piped.
+pub fn run_py(python: &Path, elf: &Path, cli: &Path, extra: &[&str]) -> Result<Child, String> {
+    Command::new(python)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .arg(repo().join("tests/rehost/run.py"))
+        .arg("--elf")
+        .arg(elf)
+        .arg("--ringpod")
+        .arg(cli)
+        .args(extra)
+        .stdout(Stdio::piped())
+        .spawn()
+        .map_err(|e| format!("run.py: {e}"))
+}
