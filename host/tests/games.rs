@@ -105,11 +105,16 @@ const SAMPLES: u32 = 100;
 const FOREIGN_AFTER: u32 = 30;
 
 /// One session: the real binary, the drive sent in real time (each packet at its own time after the first, so
-/// that a late one does not delay the rest), and `foreign` sent after sample 30. Returns the exit code, the report
-/// and stderr.
-fn session(format: &str, game: Game, foreign: Option<Vec<u8>>) -> (Option<i32>, serde_json::Value, String) {
+/// that a late one does not delay the rest), and `foreign` sent after sample 30; `more` arguments. Returns the exit
+/// code, the report and stderr.
+fn session(
+    format: &str,
+    game: Game,
+    foreign: Option<Vec<u8>>,
+    more: &[&str],
+) -> (Option<i32>, serde_json::Value, String) {
     use std::io::Read;
-    let (child, mut stderr, addr) = common::spawn_live_stream(&[
+    let mut args = vec![
         "--fast",
         "--telemetry-udp",
         "127.0.0.1:0",
@@ -117,7 +122,9 @@ fn session(format: &str, game: Game, foreign: Option<Vec<u8>>) -> (Option<i32>, 
         format,
         "--udp-idle",
         "0.4",
-    ]);
+    ];
+    args.extend_from_slice(more);
+    let (child, mut stderr, addr) = common::spawn_live_stream(&args);
     let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
     let start = Instant::now();
     for k in 0..SAMPLES {
@@ -134,6 +141,12 @@ fn session(format: &str, game: Game, foreign: Option<Vec<u8>>) -> (Option<i32>, 
     stderr.read_to_string(&mut said).unwrap();
     let report = serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{format} {game:?}: {e}: {said}"));
     (out.status.code(), report, said)
+}
+
+/// A JSON array of numbers.
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    let all = v.as_array().unwrap_or_else(|| panic!("not an array: {v}"));
+    all.iter().map(|n| n.as_f64().unwrap()).collect()
 }
 
 /// What every session of the drive must show: homed and at rest at the end, every readable datagram one setpoint
@@ -159,12 +172,11 @@ fn assert_cued(what: &str, game: Game, report: &serde_json::Value, unreadable: u
     );
     assert_eq!(report["rejected"], serde_json::json!({}), "{what}: {report}");
     assert_eq!(report["counts_agree"], true, "{what}: {report}");
-    let last: Vec<f64> = report["last_applied_pose"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    assert!(
+        report["datagrams"].get("optimal").is_none(),
+        "{what}: the washout: {report}"
+    );
+    let last = numbers(&report["last_applied_pose"]);
     // Measured on the text drive (`ringpod cue`): x 3.2 mm, y 9.9 mm, alpha 0.021, beta -0.052 rad.
     assert!(last[0] > 0.001, "{what}: surges forward: {last:?}");
     assert!(last[1] > 0.004, "{what}: sways left: {last:?}");
@@ -190,7 +202,7 @@ fn every_format_drives_the_stream_end_to_end() {
             let foreign = next.packet(300, 4.0, 0.0, 0.0);
             runs.push(scope.spawn(move || {
                 let what = format!("{game:?} as {}", game.format());
-                let (code, report, said) = session(game.format(), game, Some(foreign));
+                let (code, report, said) = session(game.format(), game, Some(foreign), &[]);
                 assert_eq!(code, Some(3), "{what}: one unreadable datagram: {report} {said}");
                 assert_eq!(report["outcome"], "input_errors", "{what}: {report}");
                 assert_eq!(
@@ -205,7 +217,7 @@ fn every_format_drives_the_stream_end_to_end() {
             }
             runs.push(scope.spawn(move || {
                 let what = format!("{game:?} as auto");
-                let (code, report, said) = session("auto", game, None);
+                let (code, report, said) = session("auto", game, None, &[]);
                 assert_eq!(code, Some(0), "{what}: {report} {said}");
                 assert_eq!(report["outcome"], "followed", "{what}: {report}");
                 let named = format!("telemetry: the datagrams are {} (", game.format());
@@ -219,6 +231,38 @@ fn every_format_drives_the_stream_end_to_end() {
             }
         }
     });
+}
+
+/// The optimal cueing live: the drive through `docs/drives/optimal.toml` (its 2 ms budget on whatever this
+/// machine gives a test), every datagram one setpoint applied (none rejected: what leaves the coupled envelope
+/// is limited on the host), the corner cued as the washout cues it, and its counts in the report adding up: one
+/// sample planned per datagram after the first and per setpoint of the washout to neutral while the source
+/// paused; a fallback is a sample, and each one took one to three axes off their own solve.
+#[test]
+fn the_optimal_cueing_runs_live() {
+    let config = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/drives/optimal.toml");
+    let (code, report, said) = session("outsim", Game::Outsim, None, &["--cue-config", config]);
+    assert_eq!(code, Some(0), "{report} {said}");
+    assert_eq!(report["outcome"], "followed", "{report}");
+    assert_eq!(report["state"], "Ready", "{report}");
+    assert_eq!(report["setpoints_sent"], report["setpoints_applied"], "{report}");
+    assert_eq!(report["rejected"], serde_json::json!({}), "{report}");
+    let o = &report["datagrams"]["optimal"];
+    let n = |k: &str| o[k].as_u64().unwrap_or_else(|| panic!("{k} in {report}"));
+    let paused = report["washout_sent"].as_u64().unwrap();
+    assert_eq!(n("samples"), u64::from(SAMPLES) - 1 + paused, "{report}");
+    assert!(
+        n("late") <= n("fallbacks") && n("fallbacks") <= n("samples"),
+        "{report}"
+    );
+    let axes = n("followed_plan") + n("took_classical");
+    assert!((n("fallbacks")..=3 * n("fallbacks")).contains(&axes), "{report}");
+    let ms = numbers(&o["solve_ms"]);
+    assert!(ms[0] > 0.0 && ms[0] <= ms[1] && ms[1] <= ms[2], "{report}");
+    let last = numbers(&report["last_applied_pose"]);
+    // The corner's force to the left: right side down; its turn to the left through the heading channel.
+    assert!(last[3] > 0.005, "right side down: {last:?}");
+    assert!((last[5] - 0.16).abs() < 0.03, "turned left: {last:?}");
 }
 
 /// `--telemetry-shm` off Windows: refused by name as a usage error (exit 2), before anything is opened; with the

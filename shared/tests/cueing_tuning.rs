@@ -1,7 +1,9 @@
 //! Per-axis parameters, input smoothing, the first sample, and live retuning without a jump.
 
 use proptest::prelude::*;
-use ringpod_core::cueing::{Corner, CueConfig, Live, Smoother, Smoothing, Telemetry, Washout, G, HANDOVER_S};
+use ringpod_core::cueing::{
+    Corner, CueConfig, Live, OptimalConfig, Smoother, Smoothing, Telemetry, Washout, G, HANDOVER_S,
+};
 
 fn sample(force: [f64; 3], rate: [f64; 3]) -> Telemetry<f64> {
     Telemetry { force, rate }
@@ -406,4 +408,65 @@ proptest! {
             }
         }
     }
+}
+
+/// Every key of `[optimal]` refused out of its range, as not a number and as infinite, with the key named; a
+/// value at each end of its range taken.
+#[test]
+fn every_optimal_key_is_refused_out_of_range_by_name() {
+    type Set = fn(&mut OptimalConfig, f64);
+    let keys: [(&str, Set, f64, f64); 14] = [
+        ("optimal.horizon", |o, v| o.horizon = v as u32, 2.0, 60.0),
+        ("optimal.step_s", |o, v| o.step_s = v, 0.005, 0.5),
+        ("optimal.force_weight", |o, v| o.force_weight[2] = v, 0.0, 1e6),
+        ("optimal.rotation_weight", |o, v| o.rotation_weight[1] = v, 0.0, 1e6),
+        ("optimal.position_weight", |o, v| o.position_weight[0] = v, 0.0, 1e6),
+        ("optimal.velocity_weight", |o, v| o.velocity_weight[1] = v, 0.0, 1e6),
+        ("optimal.tilt_weight", |o, v| o.tilt_weight[0] = v, 0.0, 1e6),
+        (
+            "optimal.acceleration_weight",
+            |o, v| o.acceleration_weight[1] = v,
+            1e-9,
+            1e6,
+        ),
+        ("optimal.rate_weight", |o, v| o.rate_weight[1] = v, 1e-9, 1e6),
+        ("optimal.max_velocity", |o, v| o.max_velocity[2] = v, 1e-6, 10.0),
+        (
+            "optimal.max_acceleration",
+            |o, v| o.max_acceleration[0] = v,
+            1e-6,
+            100.0,
+        ),
+        ("optimal.max_rate_deg", |o, v| o.max_rate_deg[1] = v, 1e-6, 720.0),
+        ("optimal.envelope_share", |o, v| o.envelope_share = v, 0.05, 1.0),
+        ("optimal.budget_ms", |o, v| o.budget_ms = v, 0.01, 1000.0),
+    ];
+    let with = |set: Set, v: f64| {
+        let mut c = CueConfig::default();
+        set(&mut c.optimal, v);
+        c.validate()
+    };
+    for (key, set, lo, hi) in keys {
+        assert!(with(set, lo).is_ok() && with(set, hi).is_ok(), "{key} at {lo} or {hi}");
+        let integer = key == "optimal.horizon";
+        let mut bad = vec![if integer { lo - 1.0 } else { lo * 0.5 - 1e-3 }, hi * 2.0 + 1.0];
+        if !integer {
+            bad.extend([f64::NAN, f64::INFINITY, -f64::INFINITY]);
+        }
+        if lo > 0.0 && !integer {
+            // Zero, where the range starts above it.
+            bad.push(0.0);
+        }
+        for v in bad {
+            let e = with(set, v).expect_err(key);
+            assert_eq!(e.key, key, "{key} = {v}");
+            assert!(e.to_string().starts_with(key), "{e}");
+        }
+    }
+    // Unknown keys and lists of the wrong length are refused by the parser.
+    assert!(serde_json::from_str::<CueConfig>(r#"{"optimal": {"horizont": 8}}"#).is_err());
+    assert!(serde_json::from_str::<CueConfig>(r#"{"optimal": {"force_weight": [1, 2]}}"#).is_err());
+    assert!(serde_json::from_str::<CueConfig>(r#"{"optimal": {"horizon": -1}}"#).is_err());
+    let one: CueConfig = serde_json::from_str(r#"{"optimal": {"force_weight": 3}}"#).unwrap();
+    assert_eq!(one.optimal.force_weight, [3.0; 3]);
 }

@@ -10,18 +10,36 @@ pub fn qemu_dir() -> PathBuf {
 }
 
 /// Builds a program of the `tests/qemu` workspace for the M4F (its own `.cargo/config.toml` selects the target,
-/// so cargo runs in that folder) and returns its ELF.
+/// so cargo runs in that folder) and returns its ELF, where cargo says it wrote it (a `CARGO_TARGET_DIR` or a
+/// configured target directory moves it out of `tests/qemu/target`, and a path guessed there would run a stale
+/// build or none).
 pub fn build(bin: &str) -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
+    let out = Command::new(cargo)
         .current_dir(qemu_dir())
-        .args(["build", "--release", "--bin", bin])
-        .status()
+        .args([
+            "build",
+            "--release",
+            "--bin",
+            bin,
+            "--message-format=json-render-diagnostics",
+        ])
+        .stderr(std::process::Stdio::inherit())
+        .output()
         .map_err(|e| format!("cargo: {e}"))?;
-    if !status.success() {
+    if !out.status.success() {
         return Err(format!("building {bin} failed"));
     }
-    Ok(qemu_dir().join("target/thumbv7em-none-eabihf/release").join(bin))
+    executable(&out.stdout, bin).ok_or_else(|| format!("cargo built {bin} but named no executable for it"))
+}
+
+/// The executable of binary `bin` in cargo's JSON messages.
+fn executable(messages: &[u8], bin: &str) -> Option<PathBuf> {
+    messages
+        .split(|b| *b == b'\n')
+        .filter_map(|line| serde_json::from_slice::<serde_json::Value>(line).ok())
+        .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == bin)
+        .find_map(|m| m["executable"].as_str().map(PathBuf::from))
 }
 
 /// QEMU's command line for an ELF on mps2-an386 with semihosting; `args` are the program's semihosting command
@@ -49,4 +67,25 @@ pub fn qemu(elf: &Path, icount: Option<&str>, args: &[&str]) -> Command {
     }
     c.arg("-kernel").arg(elf);
     c
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_executable_is_where_cargo_says() {
+        let messages = concat!(
+            "{\"reason\":\"compiler-artifact\",\"target\":{\"name\":\"ringpod-core\"},\"executable\":null}\n",
+            "not json\n",
+            "{\"reason\":\"compiler-artifact\",\"target\":{\"name\":\"suite\"},",
+            "\"executable\":\"/t/thumbv7em-none-eabihf/release/suite\"}\n",
+            "{\"reason\":\"build-finished\",\"success\":true}\n"
+        );
+        assert_eq!(
+            executable(messages.as_bytes(), "suite"),
+            Some(PathBuf::from("/t/thumbv7em-none-eabihf/release/suite"))
+        );
+        assert_eq!(executable(messages.as_bytes(), "other"), None);
+    }
 }

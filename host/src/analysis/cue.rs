@@ -38,7 +38,7 @@ pub struct Summary {
     /// A packet capture's input: what it held (its input errors are numbered by packet).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub capture: Option<super::cue_capture::CaptureSummary>,
-    /// The optimal cueing's samples planned and fallbacks to the classical washout.
+    /// The optimal cueing's samples planned and its fallbacks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal: Option<super::optimal::Counts>,
 }
@@ -144,8 +144,9 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         );
         if let Some(o) = &summary.optimal {
             s += &format!(
-                "optimal cueing: {} samples planned, {} fell back to the classical washout ({} late)\n",
-                o.samples, o.fallbacks, o.late
+                "optimal cueing: {} samples planned, {} fell back ({} late; axes that followed their last plan {}, \
+                 that took the classical washout's change {})\n",
+                o.samples, o.fallbacks, o.late, o.followed_plan, o.took_classical
             );
         }
         if let Some(c) = &summary.capture {

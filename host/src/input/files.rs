@@ -12,14 +12,18 @@ pub const CONFIG_LIMIT: u64 = 1 << 20;
 /// The text of the file at `path`, at most `limit` bytes, or why not, without the path: the callers name the file
 /// in their own way (a rig error's key, a command's option).
 pub fn read_text(path: &Path, limit: u64) -> Result<String, String> {
-    let bytes = read_bytes(path, limit)?;
+    as_text(read_bytes(path, limit)?)
+}
+
+/// Bytes read as UTF-8 text, or where they are not.
+pub fn as_text(bytes: Vec<u8>) -> Result<String, String> {
     String::from_utf8(bytes).map_err(|e| format!("not UTF-8 text (byte {} is not)", e.utf8_error().valid_up_to() + 1))
 }
 
 /// Opens `path` to read, without waiting: on Unix non-blocking, so that a FIFO with no writer does not hold the
 /// caller in `open` (where no signal reaches a command's loop), and a FIFO or socket is then refused: a file
 /// named where a file is read must be one that ends. A device reads as a file does (`/dev/zero` up to the limit).
-fn open(path: &Path) -> Result<std::fs::File, String> {
+pub fn open(path: &Path) -> Result<std::fs::File, String> {
     let mut options = std::fs::OpenOptions::new();
     options.read(true);
     #[cfg(unix)]
@@ -44,7 +48,11 @@ fn open(path: &Path) -> Result<std::fs::File, String> {
 
 /// The bytes of the file at `path` (a packet capture), at most `limit`, or why not, without the path.
 pub fn read_bytes(path: &Path, limit: u64) -> Result<Vec<u8>, String> {
-    let file = open(path)?;
+    read_open(open(path)?, limit)
+}
+
+/// The bytes of an open file, at most `limit`, or why not.
+pub fn read_open(file: std::fs::File, limit: u64) -> Result<Vec<u8>, String> {
     let mut bytes = Vec::new();
     // One byte more than allowed tells "too large" from "exactly the limit".
     file.take(limit + 1)

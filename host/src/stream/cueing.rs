@@ -7,7 +7,7 @@
 use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout, HANDOVER_S};
 
 use crate::analysis::cue_engine::Engine;
-use crate::analysis::optimal::Ranges;
+use crate::analysis::optimal::{Counts, Ranges};
 
 /// A stream's cueing.
 pub struct LiveCueing {
@@ -22,6 +22,10 @@ pub struct LiveCueing {
     fading: Option<(Engine, f64)>,
     /// A change that came during a handover: taken when it ends.
     pending: Option<CueConfig>,
+    /// The optimal cueing's counts of the engines that faded out.
+    retired: Counts,
+    /// Whether an optimal cueing has run.
+    optimal_ran: bool,
 }
 
 /// The handover's weight of the new engine after `elapsed` seconds: smooth from 0 to 1 over [`HANDOVER_S`].
@@ -45,6 +49,8 @@ impl LiveCueing {
             fresh: true,
             fading: None,
             pending: None,
+            retired: Counts::default(),
+            optimal_ran: false,
         })
     }
 
@@ -100,8 +106,41 @@ impl LiveCueing {
         };
         self.config = config;
         let old = core::mem::replace(&mut self.engine, new);
-        self.fading = old.filter(|_| self.engine.is_some()).map(|e| (e, 0.0));
+        self.fade_out();
+        match old {
+            Some(e) if self.engine.is_some() => self.fading = Some((e, 0.0)),
+            Some(e) => self.retire(e.counts().cloned()),
+            None => {}
+        }
         Ok(true)
+    }
+
+    /// The optimal cueing's counts over the whole stream (every engine it ran, faded out or running); none if
+    /// it never ran.
+    pub fn optimal_counts(&self) -> Option<Counts> {
+        let running = [self.engine.as_ref(), self.fading.as_ref().map(|f| &f.0)];
+        let any = self.optimal_ran || running.iter().flatten().any(|e| e.counts().is_some());
+        any.then(|| {
+            let mut all = self.retired.clone();
+            for c in running.into_iter().flatten().filter_map(Engine::counts) {
+                all.add(c);
+            }
+            all
+        })
+    }
+
+    /// Ends the handover: the old engine's counts kept.
+    fn fade_out(&mut self) {
+        if let Some((old, _)) = self.fading.take() {
+            self.retire(old.counts().cloned());
+        }
+    }
+
+    fn retire(&mut self, counts: Option<Counts>) {
+        if let Some(c) = counts {
+            self.retired.add(&c);
+            self.optimal_ran = true;
+        }
     }
 
     /// The first sample of a stream.
@@ -132,7 +171,7 @@ impl LiveCueing {
         }
         let offset = self.offset();
         if self.fading.as_ref().is_some_and(|(_, e)| *e >= HANDOVER_S) {
-            self.fading = None;
+            self.fade_out();
             if let Some(config) = self.pending.take() {
                 let _ = self.retune(config);
             }
@@ -156,10 +195,10 @@ impl LiveCueing {
 
     /// Back to neutral (a gap): the handover ends, a pending change is taken.
     pub fn reset(&mut self) {
-        self.fading = None;
+        self.fade_out();
         if let Some(config) = self.pending.take() {
             let _ = self.retune(config);
-            self.fading = None;
+            self.fade_out();
         }
         if let Some(e) = &mut self.engine {
             e.reset();
@@ -229,5 +268,38 @@ mod tests {
         let o = (0..30).map(|_| c.step(&braking(), 0.01).unwrap()).last().unwrap();
         // Braking: nose down, gravity's share backwards (the optimiser may move either way meanwhile).
         assert!(o[4] > 0.005, "braking: nose down: {o:?}");
+    }
+
+    /// Every optimal engine's samples counted, running, fading out or gone: a retune of the optimal cueing
+    /// and a change to the washout lose none; the washout alone reports none.
+    #[test]
+    fn the_optimal_counts_add_up_across_retunes() {
+        let optimal = CueConfig {
+            algorithm: Algorithm::Optimal,
+            ..CueConfig::default()
+        };
+        let mut c = LiveCueing::new(optimal).unwrap();
+        c.place(ranges());
+        c.begin(&braking()).unwrap();
+        let steps = |c: &mut LiveCueing, n: usize| {
+            for _ in 0..n {
+                c.step(&braking(), 0.01).unwrap();
+            }
+        };
+        steps(&mut c, 30);
+        let mut heavier = optimal;
+        heavier.optimal.force_weight = [2.0; 3];
+        assert!(c.retune(heavier).unwrap());
+        steps(&mut c, 150);
+        assert!(c.retune(CueConfig::default()).unwrap());
+        steps(&mut c, 150);
+        // The handover lasts 100 samples, in which the old engine plans too: 30 + 100, then 150 + 100.
+        let counts = c.optimal_counts().unwrap();
+        assert_eq!(counts.samples, 380, "{counts:?}");
+        assert_eq!(counts.solve_s.len(), 380);
+        assert!(LiveCueing::new(CueConfig::default())
+            .unwrap()
+            .optimal_counts()
+            .is_none());
     }
 }

@@ -298,6 +298,14 @@ impl Decoder {
             Decoder::Telemetry { gaps, .. } => *gaps,
         }
     }
+
+    /// What the optimal cueing did (telemetry cued by it only).
+    pub fn optimal_counts(&self) -> Option<crate::analysis::optimal::Counts> {
+        match self {
+            Decoder::Telemetry { washout, .. } => washout.optimal_counts(),
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -294,6 +294,7 @@ pub(super) fn feed<T: Transport>(
             let r = s.live(udp, &mut d, input_errors);
             d.shared_memory = udp.receiver.shm_report();
             d.telemetry_gaps = udp.decoder.gaps();
+            d.optimal = udp.decoder.optimal_counts().map(Into::into);
             d.telemetry_format_locks = udp.decoder.locks();
             // Some were counted and not printed: the counts, once.
             if d.unreadable_by_kind

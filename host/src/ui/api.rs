@@ -2,13 +2,14 @@
 //! file as it is typed, reading a run record. Each takes the page's JSON and gives JSON, through the same code as
 //! `ringpod cue`, `ringpod rig check` and `ringpod plot`.
 
-use ringpod_core::cueing::CueConfig;
+use ringpod_core::cueing::{Algorithm, CueConfig};
 use ringpod_core::kinematics::{Check, Pose, RingGeometry, RingPlatform};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
 use super::frame::RigView;
-use crate::analysis::cue::{delivered_forces, replay, TELEMETRY_COLUMNS};
+use crate::analysis::cue::{delivered_forces, replay, Replay, TELEMETRY_COLUMNS};
+use crate::analysis::cue_bench::score::score;
 use crate::analysis::placement::place;
 use crate::analysis::workspace::{classify, Cell};
 
@@ -24,13 +25,16 @@ pub fn cue_defaults() -> Value {
     json!({ "config": CueConfig::default(), "drive": "example", "fields": super::cue_fields::fields() })
 }
 
-/// What the Cueing panel sends: the parameters, and the drive (a telemetry CSV's text; the example without).
+/// What the Cueing panel sends: the parameters, the drive (a telemetry CSV's text; the example without), and
+/// whether to cue it by the other algorithm too (the same parameters otherwise), to see both on one drive.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CueRequest {
     pub config: Value,
     #[serde(default)]
     pub drive: Option<String>,
+    #[serde(default)]
+    pub compare: bool,
 }
 
 /// The panel's parameters, checked as a cueing file's are: each error names its key.
@@ -41,13 +45,39 @@ pub fn cue_config(config: &Value) -> Result<CueConfig, String> {
 }
 
 /// Cues the drive on the platform and gives, per sample, the specific force asked (as the vehicle felt it) and
-/// delivered (by the limited poses), the poses, and the parameters as a cueing file (TOML).
+/// delivered (by the limited poses), the poses, the bench's score of the cueing (what the rider perceives, as
+/// `cue --compare` scores it), and the parameters as a cueing file (TOML); with `compare`, the delivered force
+/// and the score of the other algorithm on the same drive.
 pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Result<Value, String> {
     let config = cue_config(&request.config)?;
     let text = request.drive.as_deref().unwrap_or(EXAMPLE_DRIVE);
     let (rows, mut errors) = crate::input::table::read(text, &TELEMETRY_COLUMNS)?;
     let m = RingPlatform::<f64>::new(geometry);
-    let run = replay(&rows, config, &m, &Pose::from_array(home), false).map_err(|e| format!("{e:#}"))?;
+    let neutral = Pose::from_array(home);
+    let ranges = crate::analysis::cue_engine::ranges(&m, &neutral);
+    let scored = |config: CueConfig| -> Result<(Replay, Value), String> {
+        let run = replay(&rows, config, &m, &neutral, false).map_err(|e| format!("{e:#}"))?;
+        let (s, _) = score(&run.cued, &neutral, &ranges, config.forward);
+        let summary = json!({
+            "algorithm": config.algorithm,
+            "force_rms": s.force_total(),
+            "false_cues": s.false_total(),
+            "limited": run.limited,
+            "fallbacks": run.counts.as_ref().map(|c| c.fallbacks),
+        });
+        Ok((run, summary))
+    };
+    let (run, summary) = scored(config)?;
+    let other = if request.compare {
+        let algorithm = match config.algorithm {
+            Algorithm::Classical => Algorithm::Optimal,
+            Algorithm::Optimal => Algorithm::Classical,
+        };
+        let (r, s) = scored(CueConfig { algorithm, ..config })?;
+        Some(json!({ "delivered": delivered_forces(&r.cued), "score": s }))
+    } else {
+        None
+    };
     errors.extend(run.errors);
     let delivered = delivered_forces(&run.cued);
     let toml = toml::to_string(&config).map_err(|e| e.to_string())?;
@@ -66,6 +96,8 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
         "limited": run.limited,
         "errors": errors,
         "toml": toml,
+        "score": summary,
+        "other": other,
     }))
 }
 
@@ -158,6 +190,7 @@ mod tests {
     fn the_example_drive_is_cued_and_a_bad_parameter_is_named() {
         let (g, home) = trainer();
         let request = CueRequest {
+            compare: false,
             config: cue_defaults()["config"].clone(),
             drive: None,
         };
@@ -176,6 +209,7 @@ mod tests {
         bad["translation_scale"][0] = json!(-5.0);
         let e = cue(
             &CueRequest {
+                compare: false,
                 config: bad,
                 drive: None,
             },
@@ -188,6 +222,7 @@ mod tests {
         wrong["forward"] = json!("sideways");
         let e = cue(
             &CueRequest {
+                compare: false,
                 config: wrong,
                 drive: None,
             },
@@ -200,6 +235,7 @@ mod tests {
         let drive = "t,ax,ay,az,wx,wy,wz\n0,0,0,9.8,0,0,0\n0.01,x,0,9.8,0,0,0\n0.02,0,0,9.8,0,0,0\n";
         let out = cue(
             &CueRequest {
+                compare: false,
                 config: cue_defaults()["config"].clone(),
                 drive: Some(drive.into()),
             },

@@ -32,6 +32,32 @@ pub fn under(dir: Option<&Path>, name: &str) -> Result<PathBuf, String> {
     }
 }
 
+/// The text of the file `name` under `dir` (at most `limit` bytes), or why the page may not read it, as
+/// [`under`] says. The name is checked, the file opened, and the name checked again against the file that was
+/// opened: someone who can write in the directory and swaps a component for a link between the check and the
+/// open gets the open file refused, whatever it is (the same file by a hard link is the same file).
+pub fn read_under(dir: Option<&Path>, name: &str, limit: u64) -> Result<String, String> {
+    let path = under(dir, name)?;
+    let file = crate::input::files::open(&path)?;
+    still_under(&file, dir, name)?;
+    crate::input::files::as_text(crate::input::files::read_open(file, limit)?)
+}
+
+/// Whether the open `file` is the one `name` under `dir` resolves to now.
+fn still_under(file: &std::fs::File, dir: Option<&Path>, name: &str) -> Result<(), String> {
+    let now = under(dir, name)?;
+    let same = file
+        .try_clone()
+        .and_then(same_file::Handle::from_file)
+        .and_then(|opened| Ok(opened == same_file::Handle::from_path(&now)?))
+        .unwrap_or(false);
+    if same {
+        Ok(())
+    } else {
+        Err(format!("{name}: changed while it was opened: not read"))
+    }
+}
+
 /// Why a pose file was refused, without what it holds: the table reader quotes a header it does not understand,
 /// which for a file the page named could be any file's first line.
 pub fn reason_without_content(reason: &str) -> &str {
@@ -78,6 +104,30 @@ mod tests {
             assert!(e.contains("not a file under"), "{name}: {e}");
         }
         assert!(under(None, "poses.csv").unwrap_err().contains("--files"));
+    }
+
+    /// A link swapped in after the name was checked and swapped back after the open: the open file is not the
+    /// one the name leads to, and it is refused.
+    #[cfg(unix)]
+    #[test]
+    fn a_file_swapped_between_the_check_and_the_open_is_refused() {
+        let root = private_dir().unwrap();
+        let dir = root.path().join("files");
+        std::fs::create_dir(&dir).unwrap();
+        std::fs::write(root.path().join("secret.txt"), "hunter2\n").unwrap();
+        let name = dir.join("poses.csv");
+        std::os::unix::fs::symlink(root.path().join("secret.txt"), &name).unwrap();
+        let opened = std::fs::File::open(&name).unwrap();
+        std::fs::remove_file(&name).unwrap();
+        std::fs::write(&name, "t,x,y,z,alpha,beta,gamma\n").unwrap();
+        let e = still_under(&opened, Some(&dir), "poses.csv").unwrap_err();
+        assert!(e.contains("changed while it was opened"), "{e}");
+        // Left alone, the file is read.
+        let text = read_under(Some(&dir), "poses.csv", 1 << 20).unwrap();
+        assert!(text.starts_with("t,x"), "{text}");
+        assert!(read_under(Some(&dir), "../secret.txt", 1 << 20)
+            .unwrap_err()
+            .contains("not a file under"));
     }
 
     #[test]

@@ -327,8 +327,8 @@ impl Device {
         let text = match text {
             Some(t) => t.to_owned(),
             None => {
-                let path = files::under(self.hub.files.as_deref(), name).map_err(WorkerError::File)?;
-                crate::input::files::read_text(&path, crate::input::files::DATA_LIMIT).map_err(refused)?
+                let limit = crate::input::files::DATA_LIMIT;
+                files::read_under(self.hub.files.as_deref(), name, limit).map_err(refused)?
             }
         };
         let (poses, errors) = stream::read_csv(&text, degrees).map_err(refused)?;

@@ -275,3 +275,49 @@ fn a_message_over_the_limit_is_closed_with_1009() {
     };
     assert!(closed.starts_with("closed 1009"), "{closed}");
 }
+
+/// The Cueing panel's replay scores what the rider perceives, and with `compare` cues the same drive by the
+/// other algorithm too: both scored, the other's delivered force sample for sample; without it, none.
+#[test]
+fn the_cueing_panel_scores_both_algorithms_on_one_drive() {
+    let bench = Workbench::start(&[]);
+    let host = bench.addr.clone();
+    let path = |p: &str| format!("{p}?token={}", bench.token);
+    let (_, defaults) = http(&bench.addr, "GET", &path("/api/cue/defaults"), &host, None);
+    let config = serde_json::from_str::<Value>(&defaults).unwrap()["config"].clone();
+    let cue = |compare: bool| {
+        let body = json!({ "config": config, "compare": compare });
+        // The device's rig comes with its first status: asked again until it has.
+        let deadline = std::time::Instant::now() + Duration::from_secs(20);
+        loop {
+            let (status, text) = http(&bench.addr, "POST", &path("/api/cue"), &host, Some(&body));
+            if status == 200 || std::time::Instant::now() > deadline {
+                assert_eq!(status, 200, "{text}");
+                return serde_json::from_str::<Value>(&text).unwrap();
+            }
+            std::thread::sleep(Duration::from_millis(200));
+        }
+    };
+    let both = cue(true);
+    let (mine, other) = (&both["score"], &both["other"]["score"]);
+    assert_eq!(
+        (&mine["algorithm"], &other["algorithm"]),
+        (&json!("classical"), &json!("optimal")),
+        "{both}"
+    );
+    assert_eq!(mine["fallbacks"], Value::Null, "{both}");
+    assert!(other["fallbacks"].is_u64(), "{both}");
+    for s in [mine, other] {
+        assert!(
+            s["force_rms"].as_f64().unwrap() > 0.0 && s["false_cues"].is_u64(),
+            "{both}"
+        );
+    }
+    let samples = both["t"].as_array().unwrap().len();
+    assert!(samples > 1000, "{both}");
+    assert_eq!(both["other"]["delivered"].as_array().unwrap().len(), samples);
+    assert_ne!(both["other"]["delivered"], both["delivered"]);
+    let one = cue(false);
+    assert_eq!(one["other"], Value::Null);
+    assert_eq!(one["score"], *mine, "the same replay scored the same");
+}

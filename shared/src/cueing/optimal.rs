@@ -108,17 +108,14 @@ impl OptimalConfig {
             }
         }
         // Effort weights keep the programme strictly convex: zero would leave an input free where nothing else
-        // weighs it.
-        if !self
-            .acceleration_weight
-            .iter()
-            .chain(&self.rate_weight)
-            .all(|&w| w >= 1e-9)
-        {
-            return err(
-                "optimal.acceleration_weight",
-                "above 0 (with rate_weight): it keeps the solve unique",
-            );
+        // weighs it. Each key named on its own, so that the message points at the value that is wrong.
+        for (key, w) in [
+            ("optimal.acceleration_weight", &self.acceleration_weight[..]),
+            ("optimal.rate_weight", &self.rate_weight[..]),
+        ] {
+            if !w.iter().all(|&w| w >= 1e-9) {
+                return err(key, "above 0: it keeps the solve unique");
+            }
         }
         let limits: [(&'static str, &[f64], f64, &'static str); 3] = [
             (

@@ -15,7 +15,7 @@ use serde::Serialize;
 
 use super::cue::{read_drive, replay, CueError};
 use super::mechanism::{AnyMechanism, Selected};
-use super::optimal::Ranges;
+use super::optimal::{Counts, Ranges};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
 use score::{score, Score, Trace};
@@ -55,8 +55,9 @@ pub struct Entry {
     pub total: Score,
     /// Poses the envelope limiter changed.
     pub limited: usize,
-    /// Samples where the optimal cueing fell back to the classical washout (none for the washout).
-    pub fallbacks: Option<usize>,
+    /// The optimal cueing's fallbacks (none for the washout): samples where an axis fell back, axes that
+    /// followed their last plan, axes that took the classical washout's change.
+    pub fallbacks: Option<[usize; 3]>,
     /// The optimal cueing's solve time per sample, all axes: p50, p99, max (ms).
     pub solve_ms: Option<[f64; 3]>,
 }
@@ -99,14 +100,13 @@ pub fn evaluate(
 ) -> Result<(Entry, Vec<Vec<Trace>>), CueError> {
     let mut scores = Vec::new();
     let mut traces = Vec::new();
-    let (mut limited, mut fallbacks, mut times) = (0, 0, Vec::new());
+    let (mut limited, mut counts) = (0, Counts::default());
     for rows in drives {
         let r = replay(rows, config, &rig.mechanism, &rig.neutral, preview)?;
         let (s, t) = score(&r.cued, &rig.neutral, &rig.ranges, config.forward);
         limited += r.limited;
         if let Some(c) = &r.counts {
-            fallbacks += c.fallbacks;
-            times.extend_from_slice(&c.solve_s);
+            counts.add(c);
         }
         scores.push(s);
         traces.push(t);
@@ -119,21 +119,11 @@ pub fn evaluate(
             total: combined(&scores),
             drives: scores,
             limited,
-            fallbacks: optimal.then_some(fallbacks),
-            solve_ms: optimal.then(|| percentiles(&mut times)),
+            fallbacks: optimal.then_some([counts.fallbacks, counts.followed_plan, counts.took_classical]),
+            solve_ms: optimal.then(|| counts.solve_ms()),
         },
         traces,
     ))
-}
-
-/// p50, p99 and max of times in seconds, as milliseconds.
-fn percentiles(times: &mut [f64]) -> [f64; 3] {
-    if times.is_empty() {
-        return [0.0; 3];
-    }
-    times.sort_by(f64::total_cmp);
-    let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize] * 1000.0;
-    [at(0.5), at(0.99), at(1.0)]
 }
 
 /// The scores of several drives as one: RMS weighted by samples, the largest peaks and shares, the sums.
@@ -272,8 +262,9 @@ fn table(r: &Report) -> String {
         format!("{:.2} {:.2} {:.2} {:.2} {:.2}", v[0], v[1], v[2], v[3], v[4])
     });
     s += &row("envelope limiter interventions", &|e| e.limited.to_string());
-    s += &row("fallbacks to the classical washout", &|e| {
-        e.fallbacks.map_or("-".into(), |f| f.to_string())
+    s += &row("fallbacks (axes: last plan, washout)", &|e| {
+        e.fallbacks
+            .map_or("-".into(), |[n, plan, washout]| format!("{n} ({plan}, {washout})"))
     });
     s += &row("solve time p50 p99 max (ms)", &|e| {
         e.solve_ms

@@ -6,9 +6,11 @@
 //!
 //! The reference is the last sample held over the horizon (a game gives no preview), or, for a recorded drive,
 //! the drive's own next samples (`preview`). Yaw follows the classical washout's heading channel (a ring
-//! platform turns without limit: nothing to optimise). A classical washout runs alongside on the same samples:
-//! a solve that fails or runs past its budget takes that axis's classical channels for the sample (counted),
-//! and the plan continues from there.
+//! platform turns without limit: nothing to optimise). A solve that fails or runs past its budget falls back
+//! (counted) without a jump: the axis follows the last plan that was solved, step by step, over the first half
+//! of that plan's horizon (what the optimiser meant to do from there); past it, the classical washout that runs
+//! alongside on the same samples gives its *change* over the sample, carried on from where the platform is.
+//! Taking the washout's position instead would jump between two different trajectories: felt as a false cue.
 
 pub mod model;
 pub mod qp;
@@ -30,13 +32,59 @@ pub type Ranges = [(f64, f64); 5];
 pub struct Counts {
     /// Samples planned.
     pub samples: usize,
-    /// Samples where an axis fell back to the classical washout (its solve failed or ran late).
+    /// Samples where an axis fell back (its solve failed or ran late).
     pub fallbacks: usize,
+    /// Of the axes that fell back, sample by sample: those that followed their last plan...
+    pub followed_plan: usize,
+    /// ...and those past their last plan's horizon, which took the classical washout's change.
+    pub took_classical: usize,
     /// Of those, solves that ran past the budget.
     pub late: usize,
     /// Each sample's solve time, the three axes together (s).
     #[serde(skip)]
     pub solve_s: Vec<f64>,
+}
+
+impl Counts {
+    /// Adds another run's counts (an engine retired while streaming, another drive of a bench).
+    pub fn add(&mut self, other: &Counts) {
+        self.samples += other.samples;
+        self.fallbacks += other.fallbacks;
+        self.late += other.late;
+        self.followed_plan += other.followed_plan;
+        self.took_classical += other.took_classical;
+        self.solve_s.extend_from_slice(&other.solve_s);
+    }
+
+    /// The solve time per sample: p50, p99 and max (ms); zeros before any.
+    pub fn solve_ms(&self) -> [f64; 3] {
+        let mut times = self.solve_s.clone();
+        if times.is_empty() {
+            return [0.0; 3];
+        }
+        times.sort_by(f64::total_cmp);
+        let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize] * 1000.0;
+        [at(0.5), at(0.99), at(1.0)]
+    }
+}
+
+/// What a stream's optimal cueing did (`--report-json`'s `datagrams.optimal`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CountsReport {
+    /// The counts.
+    #[serde(flatten)]
+    pub counts: Counts,
+    /// The solve time per sample, p50, p99, max (ms).
+    pub solve_ms: [f64; 3],
+}
+
+impl From<Counts> for CountsReport {
+    fn from(counts: Counts) -> Self {
+        Self {
+            solve_ms: counts.solve_ms(),
+            counts,
+        }
+    }
 }
 
 /// One axis: its programme, the platform's state (with the rider's perception of it) and the vehicle's
@@ -51,6 +99,11 @@ struct Axis {
     vehicle: DVector<f64>,
     /// Both models at the last sample interval (most sources keep one).
     at_dt: Option<(f64, Discrete, Discrete)>,
+    /// The last plan solved (every step's inputs; empty before the first) and how long it has run (s).
+    plan: DVector<f64>,
+    plan_age: f64,
+    /// The classical washout's channels of this axis at the last sample (`[position, tilt, rotation]`).
+    classical: [f64; 3],
 }
 
 /// Which way an axis's angle turns the platform: x's angle is minus the pitch (a pitch-up, `beta < 0`, gives a
@@ -99,6 +152,10 @@ impl Optimal {
             let rhs = -(&axis.perception.b * &r);
             axis.vehicle = axis.perception.a.clone().lu().solve(&rhs).unwrap_or_else(|| rhs * 0.0);
             axis.x.fill(0.0);
+            axis.plan = DVector::zeros(0);
+        }
+        for i in 0..3 {
+            self.axes[i].classical = self.classical_channels(i);
         }
         Ok(self.offset())
     }
@@ -116,8 +173,9 @@ impl Optimal {
         let budget = self.config.optimal.budget_ms / 1000.0;
         let mut fell_back = false;
         let mut late = false;
+        let h = self.config.optimal.step_s;
         for i in 0..3 {
-            let fallback = self.fallback(i);
+            let classical = self.classical_channels(i);
             let axis = &mut self.axes[i];
             let (d_model, d_perception) = axis.at(dt);
             let r = stimulus(i, sample);
@@ -127,13 +185,24 @@ impl Optimal {
             let solved = axis.qp.solve(&axis.x, &reference);
             let was_late = t0.elapsed().as_secs_f64() > budget;
             match solved {
-                Ok((u, _)) if !was_late => axis.x = &d_model.a * &axis.x + &d_model.b * &u,
+                Ok((plan, _)) if !was_late => {
+                    axis.plan = plan;
+                    axis.plan_age = 0.0;
+                    axis.follow_plan(&d_model, dt, h);
+                }
                 _ => {
                     late |= was_late;
                     fell_back = true;
-                    axis.take(fallback, dt);
+                    if axis.follow_plan(&d_model, dt, h) {
+                        self.counts.followed_plan += 1;
+                    } else {
+                        let change = [0, 1, 2].map(|j| classical[j] - axis.classical[j]);
+                        axis.carry(&d_model, change, dt);
+                        self.counts.took_classical += 1;
+                    }
                 }
             }
+            axis.classical = classical;
         }
         self.counts.samples += 1;
         self.counts.fallbacks += usize::from(fell_back);
@@ -142,8 +211,8 @@ impl Optimal {
         Ok(self.offset())
     }
 
-    /// The classical washout's channels of axis `i` for this sample: position and the angle's two parts.
-    fn fallback(&self, i: usize) -> [f64; 3] {
+    /// The classical washout's channels of axis `i` at its last sample: position and the angle's two parts.
+    fn classical_channels(&self, i: usize) -> [f64; 3] {
         let c = self.classical.channels();
         match i {
             X => [c.translation[0], -c.tilt[1], -c.rotation[1]],
@@ -168,19 +237,25 @@ impl Optimal {
         for a in &mut self.axes {
             a.x.fill(0.0);
             a.vehicle.fill(0.0);
+            a.plan = DVector::zeros(0);
         }
     }
 
     /// The same cueing under another configuration from here on: the platform's and the perception's states
-    /// carried (the models are the same whatever the configuration), the programmes set up anew.
+    /// carried (the models are the same whatever the configuration), the programmes set up anew; the counts
+    /// start again (the old cueing keeps its own while it fades out).
     pub fn retuned(&self, config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
         let mut new = Self::new(config, ranges)?;
         new.classical = self.classical.retuned(config)?;
         for (n, o) in new.axes.iter_mut().zip(&self.axes) {
             n.x.copy_from(&o.x);
             n.vehicle.copy_from(&o.vehicle);
+            n.classical = o.classical;
+            // The models are the configuration's too: the plan solved under the old one is still a motion of
+            // this platform, and a late solve under the new one follows it.
+            n.plan.clone_from(&o.plan);
+            n.plan_age = o.plan_age;
         }
-        new.counts = self.counts.clone();
         Ok(new)
     }
 }
@@ -280,6 +355,9 @@ impl Axis {
             qp,
             perception,
             at_dt: None,
+            plan: DVector::zeros(0),
+            plan_age: 0.0,
+            classical: [0.0; 3],
         }
     }
 
@@ -314,15 +392,38 @@ impl Axis {
         out
     }
 
-    /// Takes the classical channels `[position, tilt, rotation]` for this sample: the velocity from the change.
-    fn take(&mut self, [p, tilt, rotation]: [f64; 3], dt: f64) {
-        let v = (p - self.x[0]) / dt;
+    /// One sample of `dt` along the last plan (`d` the model at `dt`, `h` the plan's step): the input of the
+    /// plan's step it has reached. False, and nothing moved, past the first half of the plan's horizon or before
+    /// any plan: a plan's later steps are shaped by where its horizon ends (nothing is priced beyond it, so it
+    /// spends the envelope there: a swing from one bound to the other), not by the drive.
+    fn follow_plan(&mut self, d: &Discrete, dt: f64, h: f64) -> bool {
+        let nu = d.b.ncols();
+        // The age is a whole number of samples: a hair under a step boundary is still that step.
+        let k = ((self.plan_age + 1e-9) / h) as usize;
+        let steps = self.plan.len() / nu;
+        if k >= steps.div_ceil(2) {
+            return false;
+        }
+        let u = self.plan.rows(k * nu, nu).into_owned();
+        self.x = &d.a * &self.x + &d.b * &u;
+        self.plan_age += dt;
+        true
+    }
+
+    /// One sample of `dt` carrying the classical washout's change `[position, tilt, rotation]` over it on from
+    /// where the platform is: the position and the angles move by exactly that, the velocity is the change's,
+    /// and the rider's perception of the platform runs on the inputs that make it (`d` the model at `dt`).
+    fn carry(&mut self, d: &Discrete, [dp, dtilt, drotation]: [f64; 3], dt: f64) {
+        let (p, v) = (self.x[0] + dp, dp / dt);
+        let mut u = DVector::zeros(d.b.ncols());
+        u[0] = (v - self.x[1]) / dt;
+        if u.len() == 3 {
+            u[1] = dtilt / dt;
+            u[2] = drotation / dt;
+        }
+        self.x = &d.a * &self.x + &d.b * &u;
         self.x[0] = p;
         self.x[1] = v;
-        if self.x.len() > 4 {
-            self.x[2] = tilt;
-            self.x[3] = rotation;
-        }
     }
 }
 
@@ -375,6 +476,60 @@ mod tests {
         assert!(
             last[0].abs() <= 0.05 * share + 1e-3 && last[4] <= 0.3 * share + 1e-3,
             "{last:?}"
+        );
+    }
+
+    /// The largest change of each offset component from one sample to the next over `samples` samples.
+    fn largest_steps(o: &mut Optimal, samples: usize, force: impl Fn(usize) -> f64) -> [f64; 6] {
+        let mut last = o.offset();
+        let mut largest = [0.0f64; 6];
+        for k in 0..samples {
+            let now = o.step(&sample(force(k)), 0.01, &[]).unwrap();
+            for j in 0..6 {
+                largest[j] = largest[j].max((now[j] - last[j]).abs());
+            }
+            last = now;
+        }
+        largest
+    }
+
+    #[test]
+    fn a_late_solve_follows_the_last_plan_then_the_washouts_change_without_a_jump() {
+        let mut o = Optimal::new(patient(), &ranges()).unwrap();
+        o.begin(&sample(0.0)).unwrap();
+        let solved = largest_steps(&mut o, 100, |_| -6.0);
+        assert_eq!(o.counts().fallbacks, 0);
+        // From here every solve is late: 0.01 ms is less than any solve takes.
+        let mut hurried = patient();
+        hurried.optimal.budget_ms = 0.01;
+        let mut o = o.retuned(hurried, &ranges()).unwrap();
+        let fell_back = largest_steps(&mut o, 300, |k| if k < 150 { -6.0 } else { 2.0 });
+        let c = o.counts();
+        assert_eq!((c.samples, c.fallbacks), (300, 300));
+        // Each axis follows its plan over the first half of its horizon (4 steps of 0.15 s: 60 samples), then the
+        // washout.
+        let half = 60;
+        assert!((3 * (half - 1)..=3 * (half + 1)).contains(&c.followed_plan), "{c:?}");
+        assert_eq!(c.followed_plan + c.took_classical, 3 * 300, "{c:?}");
+        // No jump: no sample moves the platform further than a solved one did, or than the washout's own steps.
+        let mut washout = Washout::new(patient()).unwrap();
+        washout.begin(&sample(0.0)).unwrap();
+        let mut last = *washout.channels();
+        let mut washout_step = 0.0f64;
+        for k in 0..400 {
+            washout.step(&sample(if k < 250 { -6.0 } else { 2.0 }), 0.01).unwrap();
+            let now = *washout.channels();
+            let moved = (0..3).map(|j| (now.translation[j] - last.translation[j]).abs());
+            washout_step = moved.fold(washout_step, f64::max);
+            last = now;
+        }
+        let bound = solved[0].max(washout_step) * 1.5 + 1e-6;
+        assert!(fell_back[0] <= bound, "surge step {} > {bound}", fell_back[0]);
+        let angle_bound = solved[4].max(patient().tilt_rate_deg[0].to_radians() * 0.01) * 1.5 + 1e-6;
+        assert!(
+            fell_back[4] <= angle_bound,
+            "pitch step {} > {angle_bound}",
+            fell_back[4]
         );
     }
 }

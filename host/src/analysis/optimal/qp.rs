@@ -166,8 +166,8 @@ impl AxisQp {
         self.outputs
     }
 
-    /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`); returns the first
-    /// step's inputs and the solver's iterations.
+    /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`); returns the plan
+    /// (every step's inputs, `N * inputs`) and the solver's iterations.
     pub fn solve(&mut self, x0: &DVector<f64>, reference: &DVector<f64>) -> Result<(DVector<f64>, u32), SolveError> {
         let error = &self.psi * x0 - reference;
         let mut q: Vec<f64> = (&self.q_of_error * error).iter().copied().collect();
@@ -175,12 +175,18 @@ impl AxisQp {
         let b: Vec<f64> = (&self.b0 - &self.bx * x0).iter().copied().collect();
         self.solver.update_q(&q).map_err(|_| SolveError::Update)?;
         self.solver.update_b(&b).map_err(|_| SolveError::Update)?;
+        // Clarabel's time limit is on its total time, which keeps the setup's (the equilibration and the KKT
+        // system's factorisation, once, in `new`) and resets only the solve's: the setup would eat into every
+        // sample's budget, and on a loaded machine leave none (every solve ending at once as MaxTime). Fresh
+        // timers: the limit is this solve's.
+        self.solver.timers = Some(clarabel::timers::Timers::default());
         self.solver.solve();
         let s = &self.solver.solution;
         match s.status {
-            SolverStatus::Solved | SolverStatus::AlmostSolved => {
-                Ok((DVector::from_column_slice(&s.x[..self.inputs]), s.iterations))
-            }
+            SolverStatus::Solved | SolverStatus::AlmostSolved => Ok((
+                DVector::from_column_slice(&s.x[..self.steps * self.inputs]),
+                s.iterations,
+            )),
             status => Err(SolveError::Status(status)),
         }
     }
@@ -253,4 +259,44 @@ fn csc(m: &DMatrix<f64>, upper: bool) -> CscMatrix<f64> {
         }
     }
     CscMatrix::new_from_triplets(m.nrows(), m.ncols(), rows, cols, vals)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The budget is each solve's own: the time Clarabel reports (and holds to the limit) is no more than the
+    /// solve took from outside, not the setup's time added (which would leave a loaded machine no budget).
+    #[test]
+    fn the_time_limit_holds_each_solve_alone() {
+        let model = super::super::model::vertical();
+        let spec = Spec {
+            model: &model,
+            steps: 8,
+            h: 0.15,
+            output_weight: &[1.0, 10.0, 1.0],
+            input_weight: &[0.001],
+            bounds: &[
+                Bound::State {
+                    output: 1,
+                    lo: -0.03,
+                    hi: 0.03,
+                },
+                Bound::Input { mask: 1, limit: 5.0 },
+            ],
+        };
+        let mut qp = AxisQp::new(&spec, 1.0);
+        let x0 = DVector::zeros(model.dims().0);
+        for k in 0..5 {
+            let reference = DVector::from_element(8 * 3, k as f64);
+            let started = std::time::Instant::now();
+            qp.solve(&x0, &reference).unwrap();
+            let outside = started.elapsed().as_secs_f64();
+            let reported = qp.solver.solution.solve_time;
+            assert!(
+                reported <= outside,
+                "solve {k}: Clarabel counts {reported} s, the solve took {outside} s"
+            );
+        }
+    }
 }

@@ -327,15 +327,19 @@ function setPath(obj, path, v) {
 async function recue() {
   const status = $("cue-status");
   try {
-    const j = await post("/api/cue", { config: cue.config, drive: cue.drive });
-    status.className = "small"; status.textContent = `${j.t.length} samples cued, ${j.limited} limited into the envelope` + (j.errors.length ? `; ${j.errors.length} rows unusable` : "");
+    const j = await post("/api/cue", { config: cue.config, drive: cue.drive, compare: $("cue-compare").checked });
+    // What the rider perceives, scored as the bench scores it, for this cueing and (compared) the other one.
+    const scored = (s) => `${s.algorithm}: perceived force error ${s.force_rms.toFixed(2)} m/s² RMS, ${s.false_cues} false cues, ${s.limited} limited` + (s.fallbacks == null ? "" : `, ${s.fallbacks} fallbacks`);
+    status.className = "small"; status.textContent = `${j.t.length} samples cued. ${scored(j.score)}` + (j.other ? `. ${scored(j.other.score)} (grey)` : "") + (j.errors.length ? `; ${j.errors.length} rows unusable` : "");
     $("cue-summary").textContent = cue.drive ? "(your drive)" : "(the example drive)";
     cue.toml = j.toml;
     // For tests and the curious: how many replays, and the largest surge delivered in the last.
     state.cueRuns = (state.cueRuns || 0) + 1;
     state.cuePeak = Math.max(...j.delivered.map((f) => Math.abs(f[0])));
+    state.cueScores = [j.score, j.other && j.other.score];
     cue.charts.forEach((c, i) => c.set([
       { x: j.t, y: j.asked.map((f) => f[i]), colour: pale(COLOURS[i]), width: 4 },
+      ...(j.other ? [{ x: j.t, y: j.other.delivered.map((f) => f[i]), colour: "#888888", width: 1 }] : []),
       { x: j.t, y: j.delivered.map((f) => f[i]), colour: COLOURS[i] },
     ]));
     document.querySelectorAll("#cue-controls input, #cue-controls select").forEach((i) => i.classList.remove("bad"));
@@ -361,6 +365,7 @@ $("cue-apply").addEventListener("click", async () => {
     $("cue-status").textContent = `applied: ${j.applied} (a running telemetry session blends them in)`;
   } catch (e) { $("cue-status").textContent = e.message; }
 });
+$("cue-compare").addEventListener("change", () => recue());
 $("cue-drive").addEventListener("change", async (e) => {
   const file = e.target.files[0];
   if (file) { cue.drive = await file.text(); recue(); }

@@ -146,9 +146,31 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
         Duration::from_secs(20),
     )
     .await?;
+    // Both algorithms on the same drive: the optimal cueing beside the classical one, each scored.
+    let runs = js(c, "window.ringpod.cueRuns").await?.as_u64().unwrap_or(0);
+    js(
+        c,
+        "(() => { const b = document.getElementById('cue-compare'); b.checked = true; \
+         b.dispatchEvent(new Event('change')); return true; })()",
+    )
+    .await?;
+    let both = until(
+        c,
+        &format!(
+            "window.ringpod.cueRuns > {runs} && window.ringpod.cueScores[1] && \
+             [window.ringpod.cueScores.map((s) => s.algorithm), document.getElementById('cue-status').textContent]"
+        ),
+        Duration::from_secs(60),
+    )
+    .await?;
+    if both[0] != json!(["classical", "optimal"]) || !both[1].as_str().unwrap_or("").contains("optimal: perceived") {
+        return Err(format!("both algorithms not scored side by side: {both}"));
+    }
+    screenshot(c, shots, "cueing-both").await?;
     Ok(format!(
         "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; controls by channel with units, selects, the median's \
-         window shown with it: {layout}; -5 refused in view and marked: {refused}"
+         window shown with it: {layout}; -5 refused in view and marked: {refused}; both: {}",
+        both[1]
     ))
 }
 
