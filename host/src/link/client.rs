@@ -29,6 +29,10 @@ pub trait Transport {
     fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize>;
     /// Lets `dt` pass: a real device runs on its own clock (sleep); the simulator ticks through it.
     fn elapse(&mut self, dt: Duration);
+    /// From here the time that passes is the wall clock's (a live source's samples): a simulator that runs as fast
+    /// as the machine computes ties its clock to the wall clock, as one in real time does. A board runs on its own
+    /// clock: nothing to do.
+    fn keep_pace(&mut self) {}
 }
 
 /// What a device says of itself in the handshake.

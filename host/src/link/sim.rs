@@ -35,7 +35,10 @@ pub struct SimDevice {
     tick_us: u64,
     owed_us: u64,
     realtime: bool,
-    started: Instant,
+    /// Where the simulated clock is tied to the wall clock (the wall's instant and the simulated time then), if it
+    /// is: from the start in real time; as fast as the machine computes, only once the source is live
+    /// ([`Transport::keep_pace`]).
+    paced: Option<(Instant, u64)>,
     simulated_us: u64,
     /// Periods passed after hold-ups (see [`SimDevice::held_up`]), reported in the status as a board's are.
     passed: u32,
@@ -79,7 +82,7 @@ impl SimDevice {
             tick_us,
             owed_us: 0,
             realtime,
-            started: Instant::now(),
+            paced: realtime.then(|| (Instant::now(), 0)),
             simulated_us: 0,
             passed: 0,
         }
@@ -119,16 +122,21 @@ impl SimDevice {
         }
     }
 
-    /// Whether the period about to run is one a hold-up of this process cost (in real time only): the simulated
-    /// clock is more than [`CATCH_UP`] behind the wall clock, as after the process was stopped (`kill -STOP`), swapped
-    /// out or starved on a busy machine. Those periods are passed, as a board passes the periods a flash erase cost:
-    /// ticked in a burst, they would run the stream's timeout out in a few milliseconds of wall time, before the
-    /// setpoints the host sent meanwhile could arrive. Lags up to [`CATCH_UP`] are ticked: a busy machine's ordinary
-    /// jitter loses no motion.
+    /// Whether the period about to run is one a hold-up of this process cost (when paced by the wall clock): the
+    /// simulated clock is more than [`CATCH_UP`] behind the wall clock, as after the process was stopped (`kill
+    /// -STOP`), swapped out or starved on a busy machine. Those periods are passed, as a board passes the periods a
+    /// flash erase cost: ticked in a burst, they would run the stream's timeout out in a few milliseconds of wall
+    /// time, before the setpoints the host sent meanwhile could arrive. Lags up to [`CATCH_UP`] are ticked: a busy
+    /// machine's ordinary jitter loses no motion.
     fn held_up(&self) -> bool {
-        self.realtime
-            && Instant::now().saturating_duration_since(self.started + Duration::from_micros(self.simulated_us))
-                > CATCH_UP
+        self.due()
+            .is_some_and(|due| Instant::now().saturating_duration_since(due) > CATCH_UP)
+    }
+
+    /// When the wall clock reaches the simulated time, if the two are tied.
+    fn due(&self) -> Option<Instant> {
+        self.paced
+            .map(|(wall, us)| wall + Duration::from_micros(self.simulated_us.saturating_sub(us)))
     }
 
     fn flush_unsolicited(&mut self) {
@@ -183,11 +191,21 @@ impl Transport for SimDevice {
             // After every tick, as the firmware's control task does: no sample is coalesced with the next.
             self.flush_unsolicited();
         }
-        if self.realtime {
-            let due = self.started + Duration::from_micros(self.simulated_us);
-            if let Some(wait) = due.checked_duration_since(Instant::now()) {
-                std::thread::sleep(wait);
-            }
+        if let Some(wait) = self
+            .due()
+            .filter(|_| self.realtime)
+            .and_then(|due| due.checked_duration_since(Instant::now()))
+        {
+            std::thread::sleep(wait);
+        }
+    }
+
+    fn keep_pace(&mut self) {
+        // In real time the clocks are tied from the start. As fast as the machine computes, the simulated clock ran
+        // ahead (homing, the lead-in) and is tied from now on: a live source's gaps are wall time, so a hold-up of
+        // this process is one to pass as in real time, not a burst of ticks that loses the stream.
+        if !self.realtime {
+            self.paced = Some((Instant::now(), self.simulated_us));
         }
     }
 }

@@ -154,4 +154,9 @@ impl Transport for AnyTransport {
             Self::Sim(t) => t.elapse(dt),
         }
     }
+    fn keep_pace(&mut self) {
+        if let Self::Sim(t) = self {
+            t.keep_pace();
+        }
+    }
 }

@@ -148,7 +148,10 @@ impl<T: Transport> Streamer<'_, T> {
                 self.limit(pose)
             } else {
                 streaming = true;
-                self.start_and_lead_in(pose)?
+                let pose = self.start_and_lead_in(pose)?;
+                // The lead-in ran on the device's clock; the samples come on the wall clock.
+                self.client.transport().keep_pace();
+                pose
             };
             self.send(pose, Kind::Input(Some(number)), NO_AUX)?;
             self.bar.inc(1);

@@ -19,7 +19,7 @@
 //! sample's followed pose: what the seat did, not what was asked of it.
 
 #[cfg(windows)]
-mod mapping;
+pub(crate) mod mapping;
 
 use nalgebra::{Matrix3, Vector3};
 use ringpod_core::kinematics::Pose;
@@ -179,6 +179,11 @@ pub enum VrError {
     },
 }
 
+/// The mapping's size: one page. The pose takes 48 bytes; readers that map a larger fixed view (up to a page) find
+/// it too, and a section is page-sized whatever is asked.
+#[cfg(windows)]
+const MAPPING_SIZE: usize = 4096;
+
 /// The writer: one named mapping, kept open (readers find it only while it is) until dropped.
 pub struct Compensation {
     tracker: Tracker,
@@ -196,7 +201,8 @@ impl Compensation {
         #[cfg(windows)]
         {
             let name = tracker.mapping_name();
-            let mapping = mapping::Mapping::create(name).map_err(|reason| VrError::Mapping { name, reason })?;
+            let mapping =
+                mapping::Mapping::create(name, MAPPING_SIZE).map_err(|reason| VrError::Mapping { name, reason })?;
             let mut out = Self {
                 tracker,
                 home,
@@ -219,7 +225,8 @@ impl Compensation {
     pub fn write(&mut self, followed: &Pose<f64>) {
         let values = six_dof(self.tracker, followed, &self.home, self.centre);
         #[cfg(windows)]
-        self.mapping.write(&values.to_bytes());
+        // 48 bytes at the start of a page: always inside.
+        self.mapping.write(0, &values.to_bytes());
         #[cfg(not(windows))]
         let _ = values;
         self.written += 1;

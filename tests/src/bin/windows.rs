@@ -2,13 +2,15 @@
 //!
 //! 1. The MinGW-w64 cross compiler and Wine (installed with apt-get when missing and allowed, as QEMU is), and the
 //!    `x86_64-pc-windows-gnu` standard library (rustup).
-//! 2. A debug cross-build of `ringpod.exe` and of its test programs (`cargo test --no-run`).
+//! 2. A debug cross-build of `ringpod.exe` and of its test programs and examples (`cargo test --no-run`).
 //! 3. Beside them, a test-only `bcryptprimitives.dll` built from `tests/windows/bcryptprimitives.c`: Rust's standard
 //!    library imports `ProcessPrng` from it, which Wine 8 lacks.
 //! 4. The host's tests under Wine, unit and integration (`cargo test` with Wine as the target's runner): the
 //!    integration tests start `ringpod.exe` as a user does; the ones that need a Unix facility (a pseudo-terminal,
 //!    signals, FIFOs, inode numbers) are left out by `cfg(unix)` in their source. Then the README's main command,
 //!    `ringpod.exe stream --sim --motion demo`, as a check.
+//! 5. Each game of `--telemetry-shm` cued end to end: the example `shm_games.exe GAME` writes a drive into the
+//!    game's named mappings in its publisher's layout while `ringpod.exe stream --sim --telemetry-shm GAME` reads it.
 //!
 //! Wine runs in its own prefix under the target folder, so that a developer's `~/.wine` is not touched. Cargo's own
 //! `test result:` lines are passed through; the last line is the sum, `N passed, N failed`, and the exit status is 1
@@ -102,9 +104,11 @@ fn shim() -> Result<(), String> {
     if !status.success() {
         return Err(format!("building {} failed ({status})", dll.display()));
     }
-    std::fs::copy(&dll, debug_dir().join("deps").join("bcryptprimitives.dll"))
-        .map(|_| ())
-        .map_err(|e| format!("copying the DLL beside the test programs: {e}"))
+    for dir in ["deps", "examples"] {
+        std::fs::copy(&dll, debug_dir().join(dir).join("bcryptprimitives.dll"))
+            .map_err(|e| format!("copying the DLL beside the programs in {dir}: {e}"))?;
+    }
+    Ok(())
 }
 
 fn step(name: &str, run: impl FnOnce() -> Result<(), String>) -> Result<(), String> {
@@ -145,67 +149,21 @@ fn main_command() -> Result<(), String> {
 
 /// The games whose shared memory `--telemetry-shm` reads (`ringpod stream --help`).
 const SHM_GAMES: [&str; 7] = ["ac", "acc", "iracing", "rf2", "lmu", "ams2", "ets2"];
+/// Seconds of each stand-in's drive: one cycle of it (6 s of motion, then its pause of 1.5 s), and a half second.
+const DRIVE_S: &str = "8";
+/// The reader ends this long after its last sample (once the drive is over): longer than the drive's pause.
+const IDLE_S: &str = "3";
 
 /// Each shared-memory game cued end to end under Wine: `shm_games.exe GAME` creates the game's named mappings in its
 /// publisher's layout and writes a drive at the game's rate (with a pause), while `ringpod.exe stream --sim
 /// --telemetry-shm GAME` reads them, cues them and streams to the simulated controller. Both run in one Wine prefix
 /// (one wineserver holds the named objects). Each game: followed, every setpoint applied, more than a hundred new
-/// samples taken (the drive runs 8 s at 50 Hz or more), none refused.
+/// samples taken (the drive runs at 50 Hz or more), none refused.
 fn shared_memory_games() -> Result<(), String> {
-    let mut failed = Vec::new();
-    for game in SHM_GAMES {
-        let mut writer = Command::new("wine");
-        writer
-            .arg(debug_dir().join("shm_games.exe"))
-            .args([game, "10"])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null());
-        wine_env(&mut writer);
-        let mut writer = writer.spawn().map_err(|e| format!("wine shm_games.exe: {e}"))?;
-        // Wine takes a second or two to start a program: the game is running before ringpod looks for it.
-        std::thread::sleep(std::time::Duration::from_secs(3));
-        let mut reader = Command::new("wine");
-        reader
-            .arg(debug_dir().join("ringpod.exe"))
-            .args([
-                "stream",
-                "--sim",
-                "--fast",
-                "--quiet",
-                "--report-json",
-                "--telemetry-shm",
-                game,
-                "--udp-idle",
-                "4",
-            ])
-            .stderr(Stdio::null());
-        wine_env(&mut reader);
-        let out = reader.output().map_err(|e| format!("wine ringpod.exe: {e}"))?;
-        let _ = writer.kill();
-        let _ = writer.wait();
-        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
-        let counts = &report["datagrams"]["shared_memory"];
-        println!(
-            "{game}: exit {:?}, {}, {} of {} applied; {} samples, {} repeats, {} torn, {} stalls, {} refused",
-            out.status.code(),
-            report["outcome"],
-            report["setpoints_applied"],
-            report["setpoints_sent"],
-            counts["samples"],
-            counts["repeats"],
-            counts["torn"],
-            counts["stalls"],
-            counts["refused"]
-        );
-        let ok = out.status.success()
-            && report["outcome"] == "followed"
-            && report["setpoints_applied"] == report["setpoints_sent"]
-            && counts["samples"].as_u64().unwrap_or(0) > 100
-            && counts["refused"] == 0;
-        if !ok {
-            failed.push(game);
-        }
-    }
+    let failed: Vec<&str> = SHM_GAMES
+        .into_iter()
+        .filter(|game| cue_game(game).map_err(|e| println!("{game}: {e}")).is_err())
+        .collect();
     if failed.is_empty() {
         Ok(())
     } else {
@@ -213,17 +171,68 @@ fn shared_memory_games() -> Result<(), String> {
     }
 }
 
+/// One game: its stand-in started and ready (its mappings created), then ringpod reading it until the drive is over.
+fn cue_game(game: &str) -> Result<(), String> {
+    let mut writer = Command::new("wine");
+    writer
+        .arg(debug_dir().join("examples").join("shm_games.exe"))
+        .args([game, DRIVE_S])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit());
+    wine_env(&mut writer);
+    let mut writer = writer.spawn().map_err(|e| format!("wine shm_games.exe: {e}"))?;
+    // Wine takes a second or more to start a program: ringpod starts once the game's mappings are there.
+    let mut lines = std::io::BufRead::lines(std::io::BufReader::new(writer.stdout.take().expect("piped")));
+    if !lines.any(|l| l.is_ok_and(|l| l.ends_with("ready"))) {
+        let _ = writer.kill();
+        return Err(format!(
+            "shm_games.exe ended without its mappings ({:?})",
+            writer.wait()
+        ));
+    }
+    let mut reader = Command::new("wine");
+    reader
+        .arg(debug_dir().join("ringpod.exe"))
+        // `--fast`: the simulated controller homes at once rather than in the seconds a rig takes, during which
+        // the drive would go on unread.
+        .args("stream --sim --fast --quiet --report-json --telemetry-shm".split(' '))
+        .arg(game)
+        .args(["--udp-idle", IDLE_S])
+        .stderr(Stdio::null());
+    wine_env(&mut reader);
+    let out = reader.output().map_err(|e| format!("wine ringpod.exe: {e}"))?;
+    let wrote = lines.find_map(Result::ok).unwrap_or_default();
+    let writer = writer.wait().map_err(|e| format!("shm_games.exe: {e}"))?;
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap_or_default();
+    let counts = &report["datagrams"]["shared_memory"];
+    println!(
+        "{game}: exit {:?}, {}, {} of {} applied; {} samples, {} repeats, {} settling, {} torn, {} stalls, {} refused \
+         ({wrote})",
+        out.status.code(),
+        report["outcome"],
+        report["setpoints_applied"],
+        report["setpoints_sent"],
+        counts["samples"],
+        counts["repeats"],
+        counts["settling"],
+        counts["torn"],
+        counts["stalls"],
+        counts["refused"]
+    );
+    let ok = out.status.success()
+        && writer.success()
+        && report["outcome"] == "followed"
+        && report["setpoints_applied"] == report["setpoints_sent"]
+        && counts["samples"].as_u64().unwrap_or(0) > 100
+        && counts["refused"] == 0;
+    ok.then_some(()).ok_or_else(|| "not cued end to end".into())
+}
+
 fn main() -> ExitCode {
-    // `--shm-games`: also cue every shared-memory game end to end (about two minutes more; not in the README's test
-    // command until it has run clean on more machines than one).
-    let shm_games = match std::env::args().nth(1).as_deref() {
-        None => false,
-        Some("--shm-games") => true,
-        Some(other) => {
-            eprintln!("windows: unknown argument {other:?} (--shm-games)");
-            return ExitCode::from(2);
-        }
-    };
+    if let Some(other) = std::env::args().nth(1) {
+        eprintln!("windows: unknown argument {other:?} (it takes none)");
+        return ExitCode::from(2);
+    }
     let mut failed = 0u32;
     let mut passed = 0u32;
     let prepared = step("MinGW-w64 and Wine", setup::ensure_windows)
@@ -231,12 +240,7 @@ fn main() -> ExitCode {
         .and_then(|()| {
             step("cross-build (debug)", || {
                 status(cargo(&["build", "-p", "ringpod"]), "cargo build")?;
-                if shm_games {
-                    status(
-                        cargo(&["build", "-p", "ringpod-tests", "--bin", "shm_games"]),
-                        "cargo build shm_games",
-                    )?;
-                }
+                // The test programs, and the examples with them: `shm_games.exe`, the games' stand-in.
                 status(cargo(&["test", "-p", "ringpod", "--no-run"]), "cargo test --no-run")
             })
         })
@@ -261,14 +265,12 @@ fn main() -> ExitCode {
             "the main command under Wine",
             step("the main command under Wine", main_command),
         ),
-    ];
-    let games = shm_games.then(|| {
         (
             "the shared-memory games under Wine",
             step("the shared-memory games under Wine", shared_memory_games),
-        )
-    });
-    for (name, result) in checks.into_iter().chain(games) {
+        ),
+    ];
+    for (name, result) in checks {
         match result {
             Ok(()) => {
                 passed += 1;

@@ -32,7 +32,9 @@
 //! `InternalsPlugin.hpp` publishes the axes: "+x points out the left side of the car, +y points out the roof, +z
 //! points out the back of the car", and the rotations: "+x pitches up, +y yaws to the right, +z rolls to the right".
 //! Whether `mLocalAccel` includes gravity is not stated: ringpod assumes it does not (a kinematic acceleration) and
-//! adds gravity's reaction from the orientation's up row.
+//! adds gravity's reaction from the orientation's up row. That row is read as ISI's example internals plugin
+//! (`Example.cpp`, kept in the public plugins built on it: "Orientation matrix is left-handed") reads it: pitch from
+//! the forward vector's world-up share, `-mOri[1].z`, and roll from the left vector's, `mOri[1].x`.
 //!
 //! | ringpod | from | sign |
 //! |---|---|---|

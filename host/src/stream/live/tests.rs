@@ -33,23 +33,17 @@ fn game(drive: Duration) -> Fake {
     fake
 }
 
-#[test]
-fn a_games_shared_memory_is_streamed_captured_and_counted() {
-    let dir = std::env::temp_dir().join(format!("ringpod-shm-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let capture_path = dir.join("drive.pcap");
-    let writer = crate::input::capture::CaptureWriter::create(&capture_path, SHM_CAPTURE).unwrap();
+/// `fake` streamed whole to a simulator running as fast as the machine computes (`--fast`), the stream ending 600 ms
+/// after the last sample.
+fn stream(fake: Fake, capture: Option<(Box<crate::input::capture::CaptureWriter>, String)>) -> crate::stream::Report {
     let decoder =
         crate::stream::command::telemetry_decoder(crate::games::TelemetryFormat::Text, None, &None, &None).unwrap();
     let source = Source::Live(LiveSource {
-        receiver: Receiver::Shm(Box::new(ShmSource::new(
-            Game::Ams2,
-            Box::new(game(Duration::from_millis(800))),
-        ))),
+        receiver: Receiver::Shm(Box::new(ShmSource::new(Game::Ams2, Box::new(fake)))),
         decoder,
         idle: Duration::from_millis(600),
         from: None,
-        capture: Some((Box::new(writer), capture_path.display().to_string())),
+        capture,
     });
     let mut client = Client::new(AnyTransport::Sim(Box::new(SimDevice::new(false))));
     let options = Options {
@@ -59,7 +53,17 @@ fn a_games_shared_memory_is_streamed_captured_and_counted() {
         telemetry: false,
         telemetry_hz: None,
     };
-    let report = crate::stream::run(&mut client, source, Vec::new(), &options, true, &|| false, None).unwrap();
+    crate::stream::run(&mut client, source, Vec::new(), &options, true, &|| false, None).unwrap()
+}
+
+#[test]
+fn a_games_shared_memory_is_streamed_captured_and_counted() {
+    let dir = std::env::temp_dir().join(format!("ringpod-shm-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let capture_path = dir.join("drive.pcap");
+    let writer = crate::input::capture::CaptureWriter::create(&capture_path, SHM_CAPTURE).unwrap();
+    let capture = Some((Box::new(writer), capture_path.display().to_string()));
+    let report = stream(game(Duration::from_millis(800)), capture);
     let d = report.datagrams.as_ref().unwrap();
     let shm = d.shared_memory.as_ref().unwrap();
     assert_eq!(report.outcome, "followed", "{report:?}");
@@ -83,4 +87,25 @@ fn a_games_shared_memory_is_streamed_captured_and_counted() {
         "{row:?}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The process held up mid-stream (starved on a busy machine, or Wine's scheduling) for longer than the device's
+/// stream timeout (100 ms): a simulator running as fast as it computes passes the periods the hold-up cost once the
+/// source is live, as one in real time does, rather than ticking them in a burst that loses the stream before the
+/// next sample can arrive.
+#[test]
+fn a_hold_up_of_the_process_does_not_lose_a_fast_simulators_stream() {
+    let mut fake = game(Duration::from_millis(800));
+    let mut write = fake.game.take().unwrap();
+    fake.game = Some(Box::new(move |read, pages| {
+        if read == 100 {
+            std::thread::sleep(Duration::from_millis(300));
+        }
+        write(read, pages);
+    }));
+    let report = stream(fake, None);
+    assert_eq!(report.outcome, "followed", "{report:?}");
+    assert_eq!(report.setpoints_applied, report.setpoints_sent, "{report:?}");
+    let shm = report.datagrams.as_ref().unwrap().shared_memory.as_ref().unwrap();
+    assert!(shm.counts.samples > 50, "{shm:?}");
 }

@@ -146,7 +146,15 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
         Duration::from_secs(20),
     )
     .await?;
-    // Both algorithms on the same drive: the optimal cueing beside the classical one, each scored.
+    let both = both_algorithms(c, shots).await?;
+    Ok(format!(
+        "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; controls by channel with units, selects, the median's \
+         window shown with it: {layout}; -5 refused in view and marked: {refused}; both: {both}"
+    ))
+}
+
+/// Both algorithms on the same drive: the optimal cueing beside the classical one, each scored.
+async fn both_algorithms(c: &Client, shots: Option<&Path>) -> Result<String, String> {
     let runs = js(c, "window.ringpod.cueRuns").await?.as_u64().unwrap_or(0);
     js(
         c,
@@ -167,11 +175,7 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
         return Err(format!("both algorithms not scored side by side: {both}"));
     }
     screenshot(c, shots, "cueing-both").await?;
-    Ok(format!(
-        "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; controls by channel with units, selects, the median's \
-         window shown with it: {layout}; -5 refused in view and marked: {refused}; both: {}",
-        both[1]
-    ))
+    Ok(both[1].as_str().unwrap_or("").to_owned())
 }
 
 pub async fn runs(c: &Client, record: &Path, shots: Option<&Path>) -> Result<String, String> {

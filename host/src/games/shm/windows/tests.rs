@@ -3,44 +3,11 @@
 
 use std::time::Instant;
 
-use windows_sys::Win32::Foundation::{CloseHandle, INVALID_HANDLE_VALUE};
-use windows_sys::Win32::System::Memory::{
-    CreateFileMappingW, MapViewOfFile, UnmapViewOfFile, FILE_MAP_ALL_ACCESS, PAGE_READWRITE,
-};
-
 use super::super::poll::{Outcome, Poller};
 use super::super::testing::Page;
 use super::super::{ams2, Game};
 use super::*;
-
-/// Creates the mapping `name` of `len` bytes holding `bytes`, as a game does, and keeps it until `f` returns.
-fn with_mapping(name: &str, len: usize, bytes: &[u8], f: impl FnOnce(*mut u8)) {
-    let wide = wide(name);
-    // SAFETY: a paging-file-backed section with a NUL-terminated name; the handle is checked.
-    let handle = unsafe {
-        CreateFileMappingW(
-            INVALID_HANDLE_VALUE,
-            std::ptr::null(),
-            PAGE_READWRITE,
-            0,
-            len as u32,
-            wide.as_ptr(),
-        )
-    };
-    assert!(!handle.is_null(), "{}", std::io::Error::last_os_error());
-    // SAFETY: the section is `len` bytes, mapped whole and writable; released below.
-    let view = unsafe { MapViewOfFile(handle, FILE_MAP_ALL_ACCESS, 0, 0, 0) };
-    assert!(!view.Value.is_null(), "{}", std::io::Error::last_os_error());
-    let base = view.Value.cast::<u8>();
-    // SAFETY: `bytes` fits in the view.
-    unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), base, bytes.len().min(len)) };
-    f(base);
-    // SAFETY: both are ours and released once.
-    unsafe {
-        UnmapViewOfFile(view);
-        CloseHandle(handle);
-    }
-}
+use crate::vr::mapping::Mapping;
 
 fn ams2_page(sequence: u32, forward: f64) -> Vec<u8> {
     let mut p = Page::zeros(ams2::SIZE);
@@ -59,24 +26,22 @@ fn a_games_mapping_is_opened_read_only_and_polled() {
     let mut poller = Poller::new(Game::Ams2, Instant::now());
     assert_eq!(poller.poll(&mut mem, Instant::now()), Outcome::Nothing);
     assert_eq!(poller.counts.absent, 1);
-    with_mapping(name, 16 * 1024, &ams2_page(2, 1.5), |base| {
-        let mut mem = Mappings::named(names);
-        let Outcome::New(read) = poller.poll(&mut mem, Instant::now()) else {
-            panic!("{:?}", poller.counts)
-        };
-        assert!((read.sample.telemetry.force[0] - 1.5).abs() < 1e-6, "{read:?}");
-        assert_eq!(poller.poll(&mut mem, Instant::now()), Outcome::Nothing, "a repeat");
-        // The game writes the next sample.
-        let next = ams2_page(4, -3.0);
-        // SAFETY: the view is the section's, 16 KiB.
-        unsafe { std::ptr::copy_nonoverlapping(next.as_ptr(), base, next.len()) };
-        let Outcome::New(read) = poller.poll(&mut mem, Instant::now()) else {
-            panic!("{:?}", poller.counts)
-        };
-        assert_eq!(read.tick, 4);
-        assert!((read.sample.telemetry.force[0] + 3.0).abs() < 1e-6, "{read:?}");
-        // A read past the section's pages is absent, not a fault.
-        let mut far = [0u8; 8];
-        assert_eq!(mem.read(0, 1 << 20, &mut far), Err(Absent));
-    });
+    let mut game = Mapping::create(name, 16 * 1024).expect("a named mapping");
+    assert!(game.write(0, &ams2_page(2, 1.5)));
+    let mut mem = Mappings::named(names);
+    let Outcome::New(read) = poller.poll(&mut mem, Instant::now()) else {
+        panic!("{:?}", poller.counts)
+    };
+    assert!((read.sample.telemetry.force[0] - 1.5).abs() < 1e-6, "{read:?}");
+    assert_eq!(poller.poll(&mut mem, Instant::now()), Outcome::Nothing, "a repeat");
+    // The game writes the next sample.
+    assert!(game.write(0, &ams2_page(4, -3.0)));
+    let Outcome::New(read) = poller.poll(&mut mem, Instant::now()) else {
+        panic!("{:?}", poller.counts)
+    };
+    assert_eq!(read.tick, 4);
+    assert!((read.sample.telemetry.force[0] + 3.0).abs() < 1e-6, "{read:?}");
+    // A read past the section's pages is absent, not a fault.
+    let mut far = [0u8; 8];
+    assert_eq!(mem.read(0, 1 << 20, &mut far), Err(Absent));
 }

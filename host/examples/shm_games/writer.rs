@@ -4,76 +4,42 @@ use std::f64::consts::TAU;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use windows_sys::Win32::Foundation::{CloseHandle, HANDLE, INVALID_HANDLE_VALUE};
-use windows_sys::Win32::System::Memory::{
-    CreateFileMappingW, MapViewOfFile, UnmapViewOfFile, FILE_MAP_ALL_ACCESS, MEMORY_MAPPED_VIEW_ADDRESS, PAGE_READWRITE,
-};
+#[path = "../../src/vr/mapping.rs"]
+mod mapping;
 
 const G: f64 = 9.80665;
 
-/// A named mapping this program created, and its view.
-struct Mapping {
-    handle: HANDLE,
-    view: MEMORY_MAPPED_VIEW_ADDRESS,
-    len: usize,
-}
+/// A named mapping this program created, written in little-endian fields at the publisher's offsets.
+struct Mapping(mapping::Mapping);
 
 impl Mapping {
     fn create(name: &str, len: usize) -> Result<Self, String> {
-        let wide: Vec<u16> = name.encode_utf16().chain(std::iter::once(0)).collect();
-        // SAFETY: a paging-file-backed section with a NUL-terminated name; the handle is checked.
-        let handle = unsafe {
-            CreateFileMappingW(
-                INVALID_HANDLE_VALUE,
-                std::ptr::null(),
-                PAGE_READWRITE,
-                0,
-                len as u32,
-                wide.as_ptr(),
-            )
-        };
-        if handle.is_null() {
-            return Err(format!("{name}: {}", std::io::Error::last_os_error()));
-        }
-        // SAFETY: the section is `len` bytes, mapped whole and writable.
-        let view = unsafe { MapViewOfFile(handle, FILE_MAP_ALL_ACCESS, 0, 0, 0) };
-        if view.Value.is_null() {
-            // SAFETY: the handle is ours.
-            unsafe { CloseHandle(handle) };
-            return Err(format!("{name}: {}", std::io::Error::last_os_error()));
-        }
-        Ok(Self { handle, view, len })
+        mapping::Mapping::create(name, len)
+            .map(Self)
+            .map_err(|e| format!("{name}: {e}"))
     }
 
-    /// Writes `bytes` at `at` (inside the mapping).
-    fn put(&self, at: usize, bytes: &[u8]) {
-        assert!(at + bytes.len() <= self.len);
-        // SAFETY: inside the view, which lives as long as `self`.
-        unsafe { std::ptr::copy_nonoverlapping(bytes.as_ptr(), self.view.Value.cast::<u8>().add(at), bytes.len()) };
+    /// This program's own offsets: one outside the mapping is its bug.
+    fn put(&mut self, at: usize, bytes: &[u8]) {
+        assert!(
+            self.0.write(at, bytes),
+            "{} bytes at {at}: outside the mapping",
+            bytes.len()
+        );
     }
 
-    fn f32s(&self, at: usize, v: &[f64]) {
+    fn f32s(&mut self, at: usize, v: &[f64]) {
         let b: Vec<u8> = v.iter().flat_map(|x| (*x as f32).to_le_bytes()).collect();
         self.put(at, &b);
     }
 
-    fn f64s(&self, at: usize, v: &[f64]) {
+    fn f64s(&mut self, at: usize, v: &[f64]) {
         let b: Vec<u8> = v.iter().flat_map(|x| x.to_le_bytes()).collect();
         self.put(at, &b);
     }
 
-    fn i32(&self, at: usize, v: i32) {
+    fn i32(&mut self, at: usize, v: i32) {
         self.put(at, &v.to_le_bytes());
-    }
-}
-
-impl Drop for Mapping {
-    fn drop(&mut self) {
-        // SAFETY: both are ours, released once.
-        unsafe {
-            UnmapViewOfFile(self.view);
-            CloseHandle(self.handle);
-        }
     }
 }
 
@@ -139,7 +105,7 @@ impl Game for Ac {
         Duration::from_millis(3)
     }
     fn write(&mut self, n: u32, _: f64, m: &Moment) {
-        let p = &self.0;
+        let p = &mut self.0;
         // SPageFilePhysics: accG at 44 (x left, y up, z forward, g), pitch 212, roll 216, localAngularVel 296.
         p.f32s(44, &[m.accel[1] / G, m.accel[2] / G, m.accel[0] / G]);
         p.f32s(212, &[m.pitch, m.roll]);
@@ -162,7 +128,7 @@ const IR_VARS: [(&str, i32, usize); 7] = [
 ];
 
 impl Iracing {
-    fn new(m: Mapping) -> Self {
+    fn new(mut m: Mapping) -> Self {
         for (at, v) in [(0, 2), (4, 1), (8, 60), (24, 7), (28, 112), (32, 3), (36, 64)] {
             m.i32(at, v);
         }
@@ -185,7 +151,7 @@ impl Game for Iracing {
         Duration::from_micros(16_667)
     }
     fn write(&mut self, n: u32, t: f64, m: &Moment) {
-        let (p, b) = (&self.0, n as usize % 3);
+        let (p, b) = (&mut self.0, n as usize % 3);
         let buf = 2048 + 64 * b;
         let f = m.specific_force();
         p.f64s(buf, &[t]);
@@ -202,7 +168,7 @@ impl Game for Rf2 {
         Duration::from_millis(20)
     }
     fn write(&mut self, n: u32, t: f64, m: &Moment) {
-        let (tel, sc) = (&self.0, &self.1);
+        let (tel, sc) = (&mut self.0, &mut self.1);
         sc.put(0, &[1, 0, 0, 0, 1, 0, 0, 0]);
         sc.i32(116, 1);
         sc.i32(560, 1);
@@ -230,7 +196,7 @@ impl Game for Ams2 {
         Duration::from_micros(16_667)
     }
     fn write(&mut self, n: u32, _: f64, m: &Moment) {
-        let p = &self.0;
+        let p = &mut self.0;
         p.i32(0, 14);
         p.i32(7320, 2 * n as i32 - 1);
         p.f32s(6908, &[m.pitch, 0.0, m.roll]);
@@ -248,7 +214,7 @@ impl Game for Ets2 {
         Duration::from_micros(16_667)
     }
     fn write(&mut self, _: u32, t: f64, m: &Moment) {
-        let p = &self.0;
+        let p = &mut self.0;
         p.put(0, &[1]);
         p.i32(40, 10);
         p.f32s(1880, &[-m.rate[1] / TAU, m.rate[2] / TAU, -m.rate[0] / TAU]);
@@ -286,8 +252,14 @@ pub fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // The mappings exist: a runner waiting for this line starts the reader now.
+    println!("shm_games: ready");
+    let _ = std::io::Write::flush(&mut std::io::stdout());
     let start = Instant::now();
     let (mut n, mut written) = (0u32, 0u64);
+    // Each sample at its own deadline, not a period after the last write: a sleep overshoots (by a millisecond or
+    // more under Wine), and sleeping a whole period after each would write below the game's rate.
+    let mut next = start;
     while start.elapsed().as_secs_f64() < seconds {
         let t = start.elapsed().as_secs_f64();
         if let Some(m) = drive(t) {
@@ -295,7 +267,8 @@ pub fn main() -> ExitCode {
             game.write(n, t, &m);
             written += 1;
         }
-        std::thread::sleep(game.period());
+        next += game.period();
+        std::thread::sleep(next.saturating_duration_since(Instant::now()));
     }
     println!("shm_games: {written} samples written in {seconds} s");
     ExitCode::SUCCESS
