@@ -16,6 +16,7 @@ device core (`models/`), and runs the CPU itself instead of `ql.run()`:
 """
 
 import struct
+import time
 
 from qiling import Qiling
 from qiling.const import QL_ARCH, QL_OS, QL_VERBOSE
@@ -89,6 +90,8 @@ class Machine:
         self.reset_request = None
         self.fault = None
         self.observers = []  # called between chunks, at most once a simulated millisecond
+        self.sim_limit, self.wall_limit = None, None  # `limit`
+        self.over_limit = None  # why the run stopped at its limit
         self._build()
         # Erased flash reads 0xFF (RM0383 3.3); then the ELF exactly as a programmer writes it.
         self.uc.mem_write(FLASH_BASE, b"\xff" * FLASH_SIZE)
@@ -427,6 +430,19 @@ class Machine:
         self._cpu_reset()
         self.rcc.set_reset_flags(flags)
 
+    def limit(self, cycles, wall_deadline):
+        """Stops the run (as a fault: every later step returns at once) past `cycles` simulated or at the wall
+        clock's `wall_deadline` (time.time()): a firmware that hangs the harness fails instead of running on."""
+        self.sim_limit, self.wall_limit = cycles, wall_deadline
+
+    def _check_limit(self):
+        if self.sim_limit is not None and self.now > self.sim_limit:
+            self.over_limit = f"past {self.sim_limit / SYSCLK:.0f} simulated s"
+        elif self.wall_limit is not None and time.time() > self.wall_limit:
+            self.over_limit = f"past the wall-clock limit at {self.now / SYSCLK:.1f} simulated s"
+        if self.over_limit:
+            self.fault = f"run limit: {self.over_limit}"
+
     # -- the scheduler --
     def advance(self):
         for model in self.timed:
@@ -449,6 +465,7 @@ class Machine:
                 continue
             if self.now - observed >= SYSCLK // 1000:
                 observed = self.now
+                self._check_limit()
                 for observe in self.observers:
                     observe()
             held_until = max(self.flash.busy_until, self.cpu_held_until)

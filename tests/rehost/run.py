@@ -13,6 +13,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import Counter
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
@@ -23,6 +24,7 @@ from unicorn import arm_const as A  # noqa: E402
 
 from defmt_log import DefmtLog  # noqa: E402
 from elf import memory_x  # noqa: E402
+from board_checks import estop_check, inputs_check, pins_check, priority_check, timing  # noqa: E402
 from hold_up import hold_up_checks  # noqa: E402
 from machine import SYSCLK, Machine  # noqa: E402
 from models import dma as D  # noqa: E402
@@ -32,12 +34,16 @@ from models.rcc import IWDGRSTF  # noqa: E402
 from plant import FLAG_WIDTH, HOME_POSITION, SLOW_RATE, TOWARD, Plant  # noqa: E402
 from seqstore import used_up_page  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
-from usb_checks import UsbLink, usb_link_checks, usb_stream_checks  # noqa: E402
+from usb_checks import UsbLink, usb_full_checks, usb_link_checks, usb_stream_checks  # noqa: E402
 
+CLI_BAUD = 921_600  # host/src/link: the serial ports' rate (USART_BAUD in firmware/src/board/stm32f411/uart.rs)
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411/settings.rs, SETTINGS)
 GPIOB_BSRR = 0x4002_0418
-TIM5_IRQ = 50
 STEP_PINS, ENABLE_N, LOGIC_RELAY, POWER_RELAY = range(6), 13, 14, 15  # board::resources::PORT_MAP, pin table
+
+
+class Enough(Exception):
+    """The check `--until` names has run."""
 
 
 class Checks:
@@ -45,6 +51,7 @@ class Checks:
 
     def __init__(self):
         self.passed = self.failed = 0
+        self.until = None
 
     def check(self, name, ok, detail):
         print(f"{'PASS' if ok else 'FAIL'} {name}: {detail}", flush=True)
@@ -52,6 +59,8 @@ class Checks:
             self.passed += 1
         else:
             self.failed += 1
+        if name == self.until:
+            raise Enough
 
 
 CHECKS = Checks()
@@ -80,6 +89,12 @@ class Probes:
         for pattern in (r"^HardFault_?$", r"^DefaultHandler_?$", r"rust_begin_unwind", r"^_defmt_panic$"):
             for name, addr, _size in elf.find(pattern):
                 m.add_breakpoint(addr, lambda mm, name=name: self.faults.append((name, mm.now)))
+        # `Controller::advance_clock`: one call per control period, ticked or passed (device time advances by one
+        # period); a standalone function in the release ELF
+        self.periods = []  # simulated times of each call
+        for _name, addr, _size in elf.find(r"Controller::advance_clock$"):
+            m.add_breakpoint(addr, lambda mm: self.periods.append(mm.now))
+        self.stalled = None  # (task, resets then): its polls return at once until the next reset
         self.settings_reads = 0
         self.settings_not_erased = 0
         m.uc.hook_add(UC_HOOK_MEM_READ, self._settings_read, None, SETTINGS[0], SETTINGS[1] - 1)
@@ -99,6 +114,15 @@ class Probes:
         for task, (addr, size) in self.pools.items():
             if addr <= r0 < addr + size:
                 self.polled.setdefault(task, set()).add(m.reg(A.UC_ARM_REG_IPSR) & 0x1FF)
+                if self.stalled == (task, len(m.resets)):
+                    m.uc.reg_write(A.UC_ARM_REG_PC, m.reg(A.UC_ARM_REG_LR) | 1)  # the poll returns at once
+
+    def stall(self, task):
+        """Stops polling `task` (the others run on) until the chip resets."""
+        self.stalled = (task, len(self.m.resets))
+
+    def periods_between(self, t0, t1):
+        return sum(1 for t in self.periods if t0 <= t < t1)
 
     def _settings_read(self, uc, access, addr, size, value, ud):
         self.settings_reads += 1
@@ -142,9 +166,15 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
         status = json.loads(r.stdout)
     except ValueError:
         status = {}
+    # RM0383 19.3.4: with OVER8 0, baud = f_PCLK / (16 x USARTDIV), USARTDIV in 1/16ths (BRR): rounding it is at
+    # most half a sixteenth off, 1 / (32 USARTDIV) of the rate (0.48 % at 921,600 from 96 MHz); the receiver
+    # takes up to 3.41 % (19.3.5, a fractional divider)
     baud = SYSCLK / max(1, u.brr)
-    c.check("serial-status", r.code == 0 and "state" in status and u.overruns == 0,
-            f"{r} | USART1 BRR {u.brr} ({baud:.0f} baud), CR1 {u.cr1:#06x}; {bridge.to_board} bytes in, "
+    error = baud / CLI_BAUD - 1
+    rounding = 16 / (32 * u.brr) if u.brr else 0
+    c.check("serial-status", r.code == 0 and "state" in status and u.overruns == 0 and abs(error) <= rounding,
+            f"{r} | USART1 BRR {u.brr} ({baud:.0f} baud, {100 * error:+.2f} % from the CLI's {CLI_BAUD}; BRR "
+            f"rounding allows {100 * rounding:.2f} %), CR1 {u.cr1:#06x}; {bridge.to_board} bytes in, "
             f"{bridge.to_host} out, {u.overruns} overruns; {r.sim_s:.2f} simulated s")
 
     def steps():
@@ -159,32 +189,37 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
     clear = cli.run("device", "clear", *port)
     before = steps()
     plant.reset_counts()
-    for w in plant.widths + plant.setups:
-        w.clear()
+    plant.clear_timing()
     en = cli.run("device", "enable", *port)
     m.run(m.now + int(0.6 * SYSCLK))  # logic, then power, each with its settling time
     jog = cli.run("device", "jog", "1", "0.5", *port)
     after = steps()
     dev = [b - a for a, b in zip(before, after)] if before and after else None
-    slot_us = source_constant("STEP_SLOT_NS") / 1000
-    widths = sorted(set().union(*plant.widths))
-    setups = sorted(set().union(*plant.setups))
+    timed, timing_said = timing(plant, SLOT_US, both_ways=False)
     c.check("serial-jog", en.code == 0 and jog.code == 0 and dev is not None and dev[0] != 0
-            and dev == plant.net and widths and min(widths) * slot_us >= 2.5
-            and (not setups or min(setups) * slot_us >= 5.0),
-            f"{clear}; {en}; {jog}; device steps moved {dev}, STEP edges on PB0-PB5 (signed by DIR) {plant.net}; STEP high "
-            f"{[w * slot_us for w in widths]} us (>= 2.5), DIR set-up {[t * slot_us for t in setups[:3]]} us (>= 5)")
+            and dev == plant.net and timed,
+            f"{clear}; {en}; {jog}; device steps moved {dev}, STEP edges on PB0-PB5 (signed by DIR) {plant.net}; "
+            f"{timing_said}")
     cli.run("device", "disable", *port)
     m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
-    settings_check(m, log, cli, port)
+    settings_check(m, p, log, cli, port)
     if usb is not None:
         usb_link_checks(CHECKS, m, usb, port)
     homing_check(m, plant, cli, port)
     stream_check(m, plant, cli, port, ringpod)
     if usb is not None:
-        usb_stream_checks(CHECKS, m, usb, plant, stream_check, homing_check if usb_full else None)
+        usb_stream_checks(CHECKS, m, usb, plant, stream_check)
+    pins_check(CHECKS, plant, Counter(plant.ignored), plant.dir_undriven)
+    estop_check(CHECKS, m, cli, port, plant)
+    if usb is not None and usb_full:
+        usb_full_checks(CHECKS, m, usb, plant, homing_check)
     if hold_ups:
+        if not usb_full:
+            homing_check(m, plant, cli, port, name="serial-home-again")
         hold_up_checks(CHECKS, m, cli, port)
+
+
+SLOT_US = source_constant("STEP_SLOT_NS") / 1000
 
 
 def stream_check(m, plant, cli, port, ringpod, name="serial-stream", backwards=False):
@@ -204,6 +239,7 @@ def stream_check(m, plant, cli, port, ringpod, name="serial-stream", backwards=F
     sim = subprocess.run([ringpod, "stream", "--sim", "--fast", *args], capture_output=True, text=True, timeout=120)
     before = json.loads(cli.run("device", "status", *port).stdout or "{}").get("steps")
     plant.reset_counts()
+    plant.clear_timing()
     r = cli.run("stream", *port, *args, sim_limit_s=30)
     m.run(m.now + SYSCLK // 20)  # the steps still in the ring
     after = json.loads(cli.run("device", "status", *port).stdout or "{}").get("steps")
@@ -213,14 +249,15 @@ def stream_check(m, plant, cli, port, ringpod, name="serial-stream", backwards=F
     except (ValueError, KeyError):
         report, want = {}, None
     moved = [b - a for a, b in zip(before, after)] if before and after else None
+    timed, timing_said = timing(plant, SLOT_US, both_ways=True)
     CHECKS.check(name, r.code == 0 and report.get("outcome") == "followed"
                  and report.get("setpoints_applied") == report.get("setpoints_sent")
-                 and moved == plant.net and after == report.get("final_steps") == want,
+                 and moved == plant.net and after == report.get("final_steps") == want and timed,
                  f"`ringpod stream` exit {r.code} after {r.sim_s:.2f} simulated s: {report.get('outcome')}, "
                  f"{report.get('setpoints_sent')} setpoints sent, {report.get('setpoints_applied')} applied, limited "
                  f"{report.get('limited', {}).get('device')} by the device; device "
                  f"steps {before} -> {after} (moved {moved}), STEP edges on PB0-PB5 (signed by DIR) {plant.net}, the "
-                 f"report's final steps {report.get('final_steps')}, `stream --sim --fast` {want}"
+                 f"report's final steps {report.get('final_steps')}, `stream --sim --fast` {want}; {timing_said}"
                  + ("" if r.code == 0 else f"; {r}"))
 
 
@@ -234,6 +271,7 @@ def homing_check(m, plant, cli, port, name="serial-home"):
     two of the inputs task's
     waits and its 10 ms sweep finds it (firmware/src/app/inputs.rs)."""
     edges0, exti0 = list(plant.switch_edges), m.exti.edges
+    plant.clear_timing()
     en = cli.run("device", "enable", *port)
     m.run(m.now + int(0.6 * SYSCLK))
     home = cli.run("device", "home", *port)
@@ -248,7 +286,8 @@ def homing_check(m, plant, cli, port, name="serial-home"):
     past_ms = [round(1000 * (x - 0) * t / r, 1) for x, t, r in zip(latched, TOWARD, SLOW_RATE)]
     on_switch = all(0 <= x < FLAG_WIDTH if a < 4 else x <= 0 for a, x in enumerate(latched))
     edges = [b - a for a, b in zip(edges0, plant.switch_edges)]
-    CHECKS.check(name, home.code == 0 and status.get("state") == "Ready" and status.get("homed")
+    timed, timing_said = timing(plant, SLOT_US, both_ways=True)
+    CHECKS.check(name, home.code == 0 and status.get("state") == "Ready" and status.get("homed") and timed
                  and on_switch and all(0 < t <= 22 for t in past_ms) and all(e >= 4 for e in edges)
                  and m.exti.edges - exti0 >= sum(edges),
                  f"{en}; `device home` exit {home.code} after {home.sim_s:.2f} simulated s: state "
@@ -256,10 +295,10 @@ def homing_check(m, plant, cli, port, name="serial-home"):
                  f"(fast approach, back-off, slow approach, clear), {m.exti.edges - exti0} EXTI edges; plant at "
                  f"{plant.position}, device counts {dev}: latched at {latched} (on the switch: {on_switch}), "
                  f"{past_ms} ms past the switch edge at the slow approach's speed (more than 0, at most 22 ms: the debounce, "
-                 f"at most one 10 ms sweep)" + ("" if home.code == 0 else f"; {home}"))
+                 f"at most one 10 ms sweep); {timing_said}" + ("" if home.code == 0 else f"; {home}"))
 
 
-def settings_check(m, log, cli, port):
+def settings_check(m, p, log, cli, port):
     """A setting stored over the link into sectors 6-7 and restored after `device restart`. Sector 6 is first
     filled as ~200 saves leave it (written through the debug port, as a probe would), so this save closes it,
     writes into sector 7 and erases sector 6: 2 s with the CPU stalled, under the widened watchdog."""
@@ -274,6 +313,9 @@ def settings_check(m, log, cli, port):
         m.run(m.now + SYSCLK // 100)
         widened.append(iw.rlr_act)
         log.poll()
+    m.run(m.now + SYSCLK // 2)  # the periods the erase cost, caught up
+    # device time (one control period per `Controller::advance_clock`) against simulated time across the save
+    periods, sim_ms = p.periods_between(start, m.now), ms(m.now - start)
     stored = [t for _, _, t in log.lines[lines:] if "the configuration" in t]
     feeds = [t for t in iw.reloads if t >= start]
     gap = max((b - a for a, b in zip(feeds, feeds[1:])), default=0)
@@ -290,11 +332,29 @@ def settings_check(m, log, cli, port):
     timeout = max(widened, default=0) * iw.tick(iw.pr_act)
     CHECKS.check("serial-settings", st.code == 0 and stored and "stored" in stored[0] and value == 250
                  and fl.erases[erases:] == [6] and new and not outside and not fl.rejected
-                 and restarted == ["SYSRESETREQ"] and gap < timeout,
+                 and restarted == ["SYSRESETREQ"] and gap < timeout and abs(periods - sim_ms) <= 2,
                  f"{st}; the settings task: {stored[0] if stored else 'nothing stored'!r}, {len(new)} words programmed, "
                  f"sector erases {fl.erases[erases:]} (BSY and the CPU stalled for {ms(busy):.0f} ms), outside sectors 6-7: {outside or 'none'}, {len(fl.rejected)} rejected stores; "
                  f"the watchdog widened to RLR {max(widened, default=0)} ({ms(timeout):.0f} ms), longest gap between "
-                 f"feeds {ms(gap):.0f} ms; {rs}: resets {restarted}; {got}")
+                 f"feeds {ms(gap):.0f} ms; device time {periods} ms in {sim_ms:.1f} simulated ms across the save (within 2 "
+                 f"ms); {rs}: resets {restarted}; {got}")
+
+
+# Lines above info the run causes on purpose: the watchdog-reset check's reset.
+EXPECTED_LOG = [r"the last reset was the watchdog's"]
+
+
+def log_check(m, log):
+    """Every defmt line of the run: the boot's, and nothing above info but the lines its checks cause."""
+    log.poll()
+    up = [text for _, level, text in log.lines if "firmware up" in text]
+    noisy = [f"{ms(t):.0f} ms {level}: {text}" for t, level, text in log.lines
+             if level not in ("info", "debug", "trace") and not any(re.search(e, text) for e in EXPECTED_LOG)]
+    expected = sorted({text for _, level, text in log.lines if level not in ("info", "debug", "trace")} - set(noisy))
+    CHECKS.check("log", up and any("settings:" in text for _, _, text in log.lines) and not noisy,
+                 f"{len(log.lines)} defmt lines read over RTT in the whole run; {len(up)} starts "
+                 f"({up[0] if up else 'never up'}); above info only the expected {expected}"
+                 + (f"; unexpected: {noisy[:4]}" if noisy else ""))
 
 
 def main():
@@ -308,13 +368,18 @@ def main():
     ap.add_argument("--no-usb", action="store_true", help="no USB host: every link check over USART1")
     ap.add_argument("--usb-full", action="store_true",
                     help="also homing over USB, and the cable pulled mid-stream and plugged again (usb_checks.py)")
+    ap.add_argument("--until", help="stop after this check (the mutants' runs)")
+    ap.add_argument("--max-sim-s", type=float, default=60.0, help="stop the run past this many simulated seconds")
+    ap.add_argument("--max-wall-s", type=float, default=1200.0, help="stop the run past this many wall seconds")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the book's Emulation chapter")
     args = ap.parse_args()
 
     c = CHECKS
+    c.until = args.until
     ram = memory_x(args.memory_x)["RAM"]
     wall0 = time.time()
     m = Machine(args.elf, ram)
+    m.limit(int(args.max_sim_s * SYSCLK), wall0 + args.max_wall_s)
     p = Probes(m)
     log = DefmtLog(m)
     m.observers.append(log.poll)
@@ -414,22 +479,22 @@ def main():
             f"no host command: {step_edges} STEP edges on PB0-PB5; ENABLE (PB13, active low) {odr >> ENABLE_N & 1}, "
             f"relays PB14/PB15 {odr >> LOGIC_RELAY & 1}/{odr >> POWER_RELAY & 1}; GPIOB.ODR {odr:#06x}")
 
-    log.poll()
-    boot_log = list(log.lines)
-    up = [text for _, level, text in boot_log if "firmware up" in text]
-    noisy = [f"{level}: {text}" for _, level, text in boot_log if level not in ("info", "debug", "trace")]
-    c.check("log", up and any("settings:" in text for _, _, text in boot_log) and not noisy,
-            f"{len(boot_log)} defmt lines read over RTT, none above info"
-            f"{'; ' + up[0] if up else ''}" + (f"; {noisy[:3]}" if noisy else ""))
-
     # -- the watchdog --
     iw = m.iwdg
-    feeds = [t for t in iw.reloads if t >= before.t]
+    feeds = [t for t in iw.reloads if before.t <= t < after.t]
+    config_feeds = [t for t in iw.config_reloads if before.t <= t < after.t]
+    periods = p.periods_between(before.t, after.t)
     gaps = [b - a for a, b in zip(feeds, feeds[1:])]
     timeout = iw.rlr_act * iw.tick(iw.pr_act)
-    c.check("watchdog-fed", iw.started and gaps and max(gaps) < timeout and not m.resets,
+    # each control period (ticked or passed: `Controller::advance_clock`) ends with one feed; the window's edges
+    # may split one period from its feed
+    c.check("watchdog-fed", iw.started and gaps and max(gaps) < timeout and not m.resets and periods > 0
+            and abs(len(feeds) - periods) <= 1 and not config_feeds,
             f"IWDG PR {iw.pr_act} (/{4 << iw.pr_act}) RLR {iw.rlr_act}: timeout {ms(timeout):.0f} ms at LSI 32 kHz; "
-            f"fed {len(feeds)} times in {ms(dt):.0f} ms, longest gap {ms(max(gaps or [0])):.2f} ms")
+            f"fed {len(feeds)} times in {ms(dt):.0f} ms ({len(config_feeds)} by a change of its configuration), "
+            f"{periods} control periods ticked or passed; longest gap {ms(max(gaps or [0])):.2f} ms")
+    priority_check(c, m)
+    inputs_check(c, m, plant)
 
     # -- settings flash --
     erased = all(b == 0xFF for b in m.uc.mem_read(SETTINGS[0], SETTINGS[1] - SETTINGS[0]))
@@ -445,11 +510,12 @@ def main():
             + (f"; rejected at {[(hex(a), sector_of(a), why) for a, _, why in m.flash.rejected[:3]]}"
                if m.flash.rejected else ""))
 
-    # -- the watchdog resets a stalled control loop --
+    # -- the watchdog resets a stalled control loop: the control task alone stops, every timer runs on --
     held_at = m.now
-    last_feed = iw.reloads[-1] if iw.reloads else 0
-    m.nvic.held.add(TIM5_IRQ)  # the time driver's interrupt never arrives: every timer stalls
+    feeds_before = iw.reloads  # the reset starts a new list
+    p.stall("control_task")
     m.run(held_at + int(0.2 * SYSCLK))
+    last_feed = feeds_before[-1] if feeds_before else 0
     reset = m.resets[0] if m.resets else None
     after_reset = m.now
     m.run(after_reset + int(0.3 * SYSCLK))
@@ -459,20 +525,31 @@ def main():
     refeeds = [t for t in m.iwdg.reloads if reset and t > reset[0]]
     since_reset = m.now - reset[0] if reset else 0
     c.check("watchdog-reset", reset is not None and reset[1] == "IWDG" and csr_after
+            and reset[0] - held_at <= timeout + SYSCLK // 1000
             and csr_after[0] & IWDGRSTF and m.rcc.instance.CSR & IWDGRSTF == 0 and len(refeeds) > ms(since_reset) * 0.9
             and any("the last reset was the watchdog's" in text for text in said)
             and m.fault is None,
-            (f"TIM5's interrupt held from {ms(held_at):.1f} ms: IWDG reset at {ms(reset[0]):.1f} ms "
-             f"({ms(reset[0] - last_feed):.1f} ms after the last feed); after the reset the firmware read "
+            (f"the control task stalled from {ms(held_at):.1f} ms (TIM5 and the other tasks running): IWDG reset at "
+             f"{ms(reset[0]):.1f} ms ({ms(reset[0] - last_feed):.1f} ms after the last feed, "
+             f"{ms(reset[0] - held_at):.1f} after the stall; at most {ms(timeout):.0f} + 1); after the reset the firmware read "
              f"RCC_CSR {csr_after[0] if csr_after else 0:#010x} (IWDGRSTF {bool(csr_after and csr_after[0] & IWDGRSTF)}) "
              f"and cleared it (RMVF), logged {said[0].split(' ms ', 1)[-1] if said else 'no error'!r}, fed the watchdog {len(refeeds)} times in the "
              f"{ms(since_reset):.0f} ms after the reset"
-             if reset else f"no reset within 200 ms of holding TIM5's interrupt (fault: {m.fault})"))
+             if reset else f"no reset within 200 ms of stalling the control task (fault: {m.fault})"))
 
     # -- the host link on USART1: the real CLI over a pty --
-    m.nvic.held.discard(TIM5_IRQ)
     if args.ringpod:
         serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full)
+    if not args.ringpod:
+        pins_check(c, plant, plant.ignored, plant.dir_undriven)
+    log_check(m, log)
+    if args.ringpod:
+        c.check("cli-exits", not Cli.unexpected,
+                "every `ringpod` run ended with the exit status its check expects"
+                + "".join(f"; {r}" for r in Cli.unexpected[:4]))
+    c.check("run-limits", not m.over_limit,
+            f"{m.now / SYSCLK:.1f} simulated s (at most {args.max_sim_s}), {time.time() - wall0:.0f} wall s (at "
+            f"most {args.max_wall_s})" + (f"; stopped: {m.over_limit}" if m.over_limit else ""))
 
     wall = time.time() - wall0
     sim = m.now / SYSCLK
@@ -488,6 +565,9 @@ def main():
 if __name__ == "__main__":
     try:
         sys.exit(main())
+    except Enough:
+        print(f"{CHECKS.passed} passed, {CHECKS.failed} failed")
+        sys.exit(0 if CHECKS.failed == 0 else 1)
     except Exception as e:  # a harness error is a failed check, said as one, not a traceback alone
         import traceback
 

@@ -42,17 +42,30 @@ class PtyBridge:
             del self.out[:n]
 
 
+# The CLI's waits for the board lengthened (host/src/link: RINGPOD_PATIENCE): the emulated board runs 13-55 times
+# slower than real time, so an answer due within the CLI's 2 s comes after up to 110 wall s.
+PATIENCE = "60"
+
+
+def cli_env():
+    return {**os.environ, "RINGPOD_PATIENCE": PATIENCE}
+
+
 class Cli:
-    """One `ringpod` command run to its end while the machine runs; its output and the simulated time it took."""
+    """One `ringpod` command run to its end while the machine runs; its output and the simulated time it took.
+    Every run whose exit status is not one its caller expects is kept in `Cli.unexpected` (the `cli-exits` check)."""
+
+    unexpected = []
 
     def __init__(self, m, ringpod, bridge):
         self.m, self.ringpod, self.bridge = m, ringpod, bridge
 
-    def run(self, *args, sim_limit_s=20.0, during=None):
-        """`during(simulated_s)`, when given, is called between the machine's steps (every 5 simulated ms)."""
+    def run(self, *args, sim_limit_s=20.0, during=None, expect=(0,)):
+        """`during(simulated_s)`, when given, is called between the machine's steps (every 5 simulated ms);
+        `expect`: the exit statuses this run may end with (None: any)."""
         cmd = [self.ringpod, *args]
         with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-            proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL)
+            proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL, env=cli_env())
             start = self.m.now
             step = SYSCLK // 200
             while proc.poll() is None and self.m.now - start < sim_limit_s * SYSCLK and self.m.fault is None:
@@ -65,8 +78,11 @@ class Cli:
             self.bridge.poll()
             out.seek(0)
             err.seek(0)
-            return Result(cmd, proc.returncode, out.read().decode(errors="replace"),
-                          err.read().decode(errors="replace"), (self.m.now - start) / SYSCLK)
+            r = Result(cmd, proc.returncode, out.read().decode(errors="replace"),
+                       err.read().decode(errors="replace"), (self.m.now - start) / SYSCLK)
+            if expect is not None and r.code not in expect:
+                Cli.unexpected.append(r)
+            return r
 
 
 class Result:

@@ -23,7 +23,7 @@ import tempfile
 
 from machine import SYSCLK
 from models.otg import IRQ
-from serial_link import Cli, PtyBridge
+from serial_link import Cli, PtyBridge, cli_env
 from usb_host import UsbHost
 
 VID_PID = (0x1209, 0x0001)
@@ -123,22 +123,25 @@ def usb_link_checks(checks, m, link, serial_port):
     both_links_check(checks, m, link, port, serial_port)
 
 
-def usb_stream_checks(checks, m, link, plant, stream_check, homing_check=None):
-    """Homed (over USART1): a stream over USB; then, given `homing_check` (`--usb-full`), homing over USB and the
-    cable pulled and plugged again."""
+def usb_stream_checks(checks, m, link, plant, stream_check):
+    """Homed (over USART1): a stream over USB."""
     port = ["--port", link.bridge.path]
     # from where the serial stream ended back to the home pose: the same rows, backwards
     stream_check(m, plant, link.cli, port, link.ringpod, name="usb-stream", backwards=True)
-    if homing_check is not None:
-        homing_check(m, plant, link.cli, port, name="usb-home")
-        cable_check(checks, m, link, plant)
+
+
+def usb_full_checks(checks, m, link, plant, homing_check):
+    """`--usb-full`: homing over USB, then the cable pulled and plugged again."""
+    port = ["--port", link.bridge.path]
+    homing_check(m, plant, link.cli, port, name="usb-home")
+    cable_check(checks, m, link, plant)
 
 
 def both_links_check(checks, m, link, port, serial_port):
     """`device status` over USART1 and over USB at the same time: each link gets its own answer."""
     with tempfile.TemporaryFile() as out:
         proc = subprocess.Popen([link.ringpod, "device", "status", *serial_port], stdout=out,
-                                stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL)
+                                stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=cli_env())
         r = link.cli.run("device", "status", *port)
         start = m.now
         while proc.poll() is None and m.now - start < 20 * SYSCLK:
@@ -189,7 +192,7 @@ def cable_check(checks, m, link, plant):
             link.host.unplug()
 
     r = link.cli.run("stream", *port, "--motion", "demo", "--duration", "4", "--rate", "50", "--quiet",
-                     "--report-json", sim_limit_s=30, during=during)
+                     "--report-json", sim_limit_s=30, during=during, expect=(6,))
     if pulled:
         m.run(max(m.now, pulled[0] + SYSCLK // 2))
     m.observers.remove(watch)

@@ -37,6 +37,12 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
     let mut worst = 0u32;
     let mut n = 0u32;
     loop {
+        // Device time a stall cost the time driver: those periods are due already, and are caught up below.
+        let lost = shared.clock_lost_us.swap(0, Ordering::Relaxed);
+        due = Instant::from_ticks(
+            due.as_ticks()
+                .saturating_sub(Duration::from_micros(u64::from(lost)).as_ticks()),
+        );
         Timer::at(due).await;
         // After a hold-up the periods it cost are caught up at once (mostly as passes), so that the controller's
         // clocks lose none of them; the phase is only judged on a tick that ran on time, and by when it was due:

@@ -58,6 +58,9 @@ pub struct Shared {
     pub boundary_us: AtomicU32,
     /// Control ticks moved to their phase (`motion::phase`): once at start, and after a hold-up.
     pub rephased: AtomicU32,
+    /// Device time a stall of the CPU cost the time driver (a flash erase: `settings::run` measures it), in
+    /// microseconds, for the control loop to catch up.
+    pub clock_lost_us: AtomicU32,
     /// The step generator found its buffer overrun (the DMA lapped it): a fault for the control tick to latch.
     pub step_fault: core::sync::atomic::AtomicBool,
 }
@@ -77,6 +80,7 @@ impl Shared {
             passes: AtomicU32::new(0),
             boundary_us: AtomicU32::new(0),
             rephased: AtomicU32::new(0),
+            clock_lost_us: AtomicU32::new(0),
             step_fault: core::sync::atomic::AtomicBool::new(false),
         }
     }

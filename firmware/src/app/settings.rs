@@ -7,7 +7,9 @@
 
 use core::ops::Range;
 
-use embassy_time::{Duration, Timer};
+use core::sync::atomic::Ordering;
+
+use embassy_time::{Duration, Instant, Timer};
 use embedded_storage_async::nor_flash::NorFlash;
 use ringpod_core::controller::ControllerConfig;
 pub use ringpod_core::store::Restored;
@@ -21,6 +23,11 @@ pub trait Board {
     fn widen_watchdog(&mut self, wide: bool);
     /// Resets the MCU (the next start restores what was stored).
     fn restart(&mut self) -> !;
+    /// A free-running cycle counter that counts on while an erase stalls the CPU (DWT CYCCNT on a board), and its
+    /// cycles per microsecond; `None` where an erase does not stall device time.
+    fn stall_clock(&self) -> Option<(u32, u32)> {
+        None
+    }
 }
 
 /// The compiled-in defaults, or the stored rig, with every stored setting replayed over them.
@@ -35,9 +42,20 @@ pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared,
         Timer::after(Duration::from_millis(100)).await;
         // The controller hands it out only while the supplies are off.
         if let Some(config) = shared.with(|c| c.take_unsaved()) {
+            let (since, cycles) = (Instant::now(), board.stall_clock());
             board.widen_watchdog(true);
             let result = store(flash, range.clone(), &config).await;
             board.widen_watchdog(false);
+            if let (Some((c0, per_us)), Some((c1, _))) = (cycles, board.stall_clock()) {
+                // An erase stalls the CPU, so the time driver's interrupt that counts its timer's wraps cannot run:
+                // device time loses most of the erase. The cycle counter does not; the control loop catches the
+                // difference up as passed periods, so that the supervisor's and the stream's timers lose nothing.
+                let real_us = c1.wrapping_sub(c0) / per_us.max(1);
+                let seen_us = u32::try_from(since.elapsed().as_micros()).unwrap_or(u32::MAX);
+                shared
+                    .clock_lost_us
+                    .fetch_add(real_us.saturating_sub(seen_us), Ordering::Relaxed);
+            }
             let rig = config.rig();
             match result {
                 Ok(()) => defmt::info!("stored the configuration (rig {})", rig.name()),

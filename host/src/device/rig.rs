@@ -28,8 +28,8 @@ pub enum DeviceRigError {
     #[error("the device's rig as TOML: {0}")]
     Toml(#[from] toml::ser::Error),
     /// The device did not come back.
-    #[error("the device did not restart within 10 s")]
-    NoRestart,
+    #[error("the device did not restart within {0:?}")]
+    NoRestart(Duration),
 }
 
 /// `device rig load FILE`: checks the file here (every error names its key), then the device checks and stores
@@ -82,13 +82,14 @@ pub fn as_file(record: &ringpod_core::protocol::RigRecord) -> Result<String, Dev
 /// request before `hello` is refused as not connected) and shows the rig it came up with.
 pub fn restart<T: Transport>(client: &mut Client<T>) -> Result<String, DeviceRigError> {
     client.restart()?;
-    let deadline = Instant::now() + Duration::from_secs(10);
+    let limit = crate::link::patience(Duration::from_secs(10));
+    let deadline = Instant::now() + limit;
     loop {
         match client.call(GetStatus) {
             Err(ClientError::Device(NackReason::NotConnected)) => break,
             // A board on USB leaves: its port closes, and it comes back under the same name in a moment.
             Err(ClientError::Io(_)) => return Ok("restarting: the port closed; the board enumerates again".into()),
-            _ if Instant::now() > deadline => return Err(DeviceRigError::NoRestart),
+            _ if Instant::now() > deadline => return Err(DeviceRigError::NoRestart(limit)),
             _ => client.transport().elapse(Duration::from_millis(50)),
         }
     }

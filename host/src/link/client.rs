@@ -107,7 +107,7 @@ impl<T: Transport> Client<T> {
             faults: Vec::new(),
             telemetry: VecDeque::new(),
             telemetry_dropped: 0,
-            timeout: Duration::from_secs(2),
+            timeout: super::patience(Duration::from_secs(2)),
             cancel: None,
             tap: None,
             followed: None,
@@ -228,7 +228,7 @@ impl<T: Transport> Client<T> {
     /// so it is sent again every half second until the whole timeout (at least 5 s) has passed; the answers to
     /// earlier tries are dropped.
     pub fn hello(&mut self) -> Result<Device, ClientError> {
-        let patience = self.timeout.max(Duration::from_secs(5));
+        let patience = self.timeout.max(super::patience(Duration::from_secs(5)));
         let per_try = Duration::from_millis(500);
         let timeout = self.timeout;
         self.timeout = per_try;
@@ -331,8 +331,9 @@ impl<T: Transport> Client<T> {
         self.call(GetInputs)
     }
 
-    /// Polls the status every 10 ms until `done` says so, or `limit` passes.
+    /// Polls the status every 10 ms until `done` says so, or `limit` (lengthened by [`super::patience`]) passes.
     pub fn wait_for(&mut self, limit: Duration, done: impl Fn(&Status) -> bool) -> Result<Status, ClientError> {
+        let limit = super::patience(limit);
         let step = Duration::from_millis(10);
         let mut waited = Duration::ZERO;
         loop {

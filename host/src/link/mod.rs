@@ -10,7 +10,38 @@ pub mod sim;
 pub mod tcp;
 pub mod transport;
 
+use std::sync::OnceLock;
+use std::time::Duration;
+
 use ringpod_core::controller::ConfigError;
+
+/// The environment variable whose factor (1 to 1000, default 1) lengthens every wait of the host for a board: a
+/// board run in an emulator many times slower than real time (the rehost harness) answers in the same device time
+/// as a real one but later in wall time.
+pub const PATIENCE_VAR: &str = "RINGPOD_PATIENCE";
+
+/// `wait` lengthened by [`PATIENCE_VAR`]'s factor.
+pub fn patience(wait: Duration) -> Duration {
+    static FACTOR: OnceLock<f64> = OnceLock::new();
+    let factor = FACTOR.get_or_init(|| {
+        let value = std::env::var(PATIENCE_VAR).ok();
+        patience_factor(value.as_deref()).unwrap_or_else(|given| {
+            eprintln!("ringpod: {PATIENCE_VAR}={given:?} ignored: a factor from 1 to 1000");
+            1.0
+        })
+    });
+    wait.mul_f64(*factor)
+}
+
+/// The factor a [`PATIENCE_VAR`] value gives: 1 when it is not set; the value itself when it is not a number
+/// from 1 to 1000.
+pub fn patience_factor(value: Option<&str>) -> Result<f64, String> {
+    let Some(value) = value else { return Ok(1.0) };
+    match value.trim().parse::<f64>() {
+        Ok(f) if (1.0..=1000.0).contains(&f) => Ok(f),
+        _ => Err(value.to_owned()),
+    }
+}
 
 /// Why a link to a controller could not be made or kept.
 #[derive(Debug, thiserror::Error)]
@@ -91,4 +122,21 @@ pub fn connect(target: &Target, realtime: bool) -> Result<transport::AnyTranspor
         }
         Target::Sim => transport::AnyTransport::Sim(Box::new(sim::SimDevice::new(realtime))),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::patience_factor;
+
+    #[test]
+    fn patience_factor_takes_1_to_1000_and_refuses_the_rest() {
+        assert_eq!(patience_factor(None), Ok(1.0));
+        assert_eq!(patience_factor(Some("40")), Ok(40.0));
+        assert_eq!(patience_factor(Some(" 2.5 ")), Ok(2.5));
+        assert_eq!(patience_factor(Some("1")), Ok(1.0));
+        assert_eq!(patience_factor(Some("1000")), Ok(1000.0));
+        for garbage in ["", "0.5", "0", "-3", "1001", "NaN", "inf", "forty"] {
+            assert_eq!(patience_factor(Some(garbage)), Err(garbage.to_owned()), "{garbage:?}");
+        }
+    }
 }

@@ -63,7 +63,7 @@ impl Transport for Serial {
     fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
         // Partial writes and a full output buffer are waited out, up to a deadline: a plain `write_all` would
         // fail on the first `EAGAIN` of a non-blocking port, or on the port's 1 ms timeout.
-        let deadline = Instant::now() + SEND_PATIENCE;
+        let deadline = Instant::now() + super::patience(SEND_PATIENCE);
         let mut rest = bytes;
         while !rest.is_empty() {
             match self.port.write(rest) {

@@ -205,7 +205,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// Counts the answers to setpoints in flight, in order, until at most `keep` are outstanding.
     pub(super) fn collect(&mut self, keep: usize) -> Result<(), StreamError> {
         let step = Duration::from_micros(200);
-        let patience = self.client.timeout.max(HOLD_UP_PATIENCE);
+        let patience = self.client.timeout.max(crate::link::patience(HOLD_UP_PATIENCE));
         let mut waited = Duration::ZERO;
         while let Some(&(id, number, pose)) = self.in_flight.front() {
             let Some(answer) = self.client.take_response(id)? else {

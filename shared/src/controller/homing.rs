@@ -36,7 +36,9 @@ impl Homing {
 
 impl Controller {
     /// One tick of a jog: the axis a step further, the others where they are; done at the end of the last leg or
-    /// when the axis's home switch closes.
+    /// when the axis's home switch closes, one tick later: the last leg's steps play in the period after the tick
+    /// that planned them, and the next tick comes before that period ends (`motion::phase`), so ending the jog there
+    /// would disable the drivers under its last steps.
     pub(super) fn jog_tick(&mut self, position: [i64; 6], tick_us: u32) -> [i64; 6] {
         let Some((jog, home_at_start)) = self.jog.as_mut() else {
             self.event(Event::JogDone);
@@ -57,7 +59,6 @@ impl Controller {
             }
             None => {
                 self.jog = None;
-                self.event(Event::JogDone);
                 position
             }
         }

@@ -3,19 +3,27 @@
 Qiling's model applies BSRR's reset bits after its set bits (the opposite priority), reads every input as 0
 whatever its pull resistor, and handles a BSRR word bit by bit with a log call: too slow for 400,000 DMA words
 a simulated second. `bsrr_words` takes the DMA's words in bulk and counts the pin edges they make.
+
+The pins seen from outside the chip: `driven(pin)` is the level an output drives (ODR through a push-pull output;
+an open-drain output drives only its low), `None` for a pin that drives nothing (an input, analog, an alternate
+function whose level is the peripheral's); an input reads what drives it from outside (`drive`), else its pull,
+else it floats: a read of a floating `wired` pin is counted in `floating_reads` (on silicon it reads noise).
 """
 
 from collections import Counter
 
 from qiling.hw.gpio.stm32f4xx_gpio import STM32F4xxGpio
 
-MODER, PUPDR, IDR, ODR, BSRR = 0x00, 0x0C, 0x10, 0x14, 0x18
+MODER, OTYPER, PUPDR, IDR, ODR, BSRR = 0x00, 0x04, 0x0C, 0x10, 0x14, 0x18
+INPUT, OUTPUT, ALTERNATE, ANALOG = range(4)  # RM0383 8.4.1 GPIOx_MODER
 
 
 class Gpio(STM32F4xxGpio):
     def __init__(self, ql, label, **kwargs):
         super().__init__(ql, label, **kwargs)
-        self.external = {}  # pin -> level driven from outside the chip
+        self.external = {}  # pin -> level driven from outside the chip (absent or None: nothing drives it)
+        self.wired = set()  # pins something outside is connected to: their floating reads are counted
+        self.floating_reads = Counter()  # pin -> reads of IDR while that wired input floated
         self.bsrr_writes = 0
         self.dma_words = 0  # of bsrr_writes, those the DMA made (counted by the bus)
         self.rises = Counter()  # mask of pins that rose together -> count
@@ -23,22 +31,47 @@ class Gpio(STM32F4xxGpio):
         self.on_change = None  # called with (old ODR, new ODR, DMA word index) on every change of the pins
 
     def drive(self, pin, level):
-        """Drive an input pin from outside (a switch, a relay contact)."""
-        self.external[pin] = 1 if level else 0
+        """Drive a pin from outside: 0 (a contact to ground), 1 (a supply, an external pull-up) or None (released)."""
+        self.external[pin] = None if level is None else (1 if level else 0)
 
-    def _input_level(self, pin):
-        # RM0383 8.3.1 / 8.4.4: an input with no external driver reads its pull-up (1) or pull-down (0)
-        if pin in self.external:
-            return self.external[pin]
-        pull = (self.instance.PUPDR >> (2 * pin)) & 3
-        return 1 if pull == 1 else 0
+    def mode(self, pin):
+        return (self.instance.MODER >> (2 * pin)) & 3
+
+    def driven(self, pin, odr=None):
+        """The level the chip drives on `pin` (RM0383 8.3.10: ODR through the output driver when MODER is output;
+        open drain (OTYPER) drives only the low), None when it drives nothing. `odr`: ODR as it is about to be."""
+        if self.mode(pin) != OUTPUT:
+            return None
+        bit = ((self.instance.ODR if odr is None else odr) >> pin) & 1
+        if (self.instance.OTYPER >> pin) & 1:
+            return 0 if bit == 0 else None
+        return bit
+
+    def pull(self, pin):
+        """1 for a pull-up, 0 for a pull-down, None for none (RM0383 8.4.4 GPIOx_PUPDR; 11 is reserved)."""
+        return {1: 1, 2: 0}.get((self.instance.PUPDR >> (2 * pin)) & 3)
+
+    def level(self, pin):
+        """The pin's electrical level: the chip's output, else what drives it from outside, else its pull; None
+        when it floats."""
+        out = self.driven(pin)
+        if out is not None:
+            return out
+        ext = self.external.get(pin)
+        return ext if ext is not None else self.pull(pin)
 
     def idr(self):
-        # RM0383 8.3 (I/O port control): IDR samples every pin, so an output reads back its level
-        odr, moder, value = self.instance.ODR, self.instance.MODER, 0
+        # RM0383 8.3 (I/O port control): IDR samples every pin, so an output reads back its level; an analog pin
+        # reads 0 (8.3.12: the Schmitt trigger is off)
+        value = 0
         for pin in range(16):
-            mode = (moder >> (2 * pin)) & 3
-            level = (odr >> pin) & 1 if mode == 1 else self._input_level(pin)
+            if self.mode(pin) == ANALOG:
+                continue
+            level = self.level(pin)
+            if level is None:
+                if pin in self.wired:
+                    self.floating_reads[pin] += 1
+                continue  # floating: read as 0 here, counted as a fault
             value |= level << pin
         return value
 

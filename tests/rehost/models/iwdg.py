@@ -26,6 +26,8 @@ class Iwdg(Block):
         self.pvu_until = self.rvu_until = 0
         self.t_a, self.c_a = 0, 0xFFF  # counter value c_a at time t_a
         self.reloads = []  # times of every KR = 0xAAAA while running
+        self.config_reloads = []  # of those, the ones that end a configuration (after a KR = 0x5555)
+        self.configuring = False
         self.expired_at = None
 
     def tick(self, pr):
@@ -77,6 +79,7 @@ class Iwdg(Block):
         self.advance(now)
         if off == self.KR:
             key = value & 0xFFFF
+            self.configuring |= key == KEY_ACCESS
             self.access = key == KEY_ACCESS  # RM0383 15.3 (register access protection): any other key protects PR and RLR again
             if key == KEY_START and not self.started:
                 self.started = True  # RM0383 15.3: start counting from the reset value 0xFFF
@@ -84,6 +87,9 @@ class Iwdg(Block):
             elif key == KEY_RELOAD:
                 if self.started:
                     self.reloads.append(now)
+                    if self.configuring:
+                        self.config_reloads.append(now)
+                self.configuring = False
                 self.c_a, self.t_a = self.rlr_act, now  # RM0383 15.3: reload the counter with RLR
         elif off == self.PR and self.access:
             self.pr, self.pvu_until = value & 7, now + self.update_time()

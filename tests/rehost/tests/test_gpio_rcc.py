@@ -32,6 +32,29 @@ class GpioTest(unittest.TestCase):
         self.assertEqual(g.read(IDR, 4) & 0b110, 0b100)
 
 
+    def test_an_output_drives_its_level_and_nothing_else_does(self):
+        g = Gpio(FakeQl(), "gpiob")
+        g.write(ODR, 4, 0b111)
+        self.assertEqual([g.driven(p) for p in range(3)], [None] * 3)  # inputs after reset
+        g.write(0x00, 4, 0b01 | 0b01 << 2 | 0b11 << 4)  # PB0, PB1 outputs, PB2 analog
+        g.write(0x04, 4, 0b10)  # PB1 open drain
+        self.assertEqual([g.driven(p) for p in range(3)], [1, None, None])
+        g.write(ODR, 4, 0)
+        self.assertEqual([g.driven(p) for p in range(3)], [0, 0, None])
+
+    def test_a_floating_wired_input_is_counted_and_reads_low(self):
+        g = Gpio(FakeQl(), "gpioa")
+        g.wired.add(3)
+        self.assertEqual(g.read(IDR, 4) >> 3 & 1, 0)
+        self.assertEqual(g.floating_reads[3], 1)
+        g.drive(3, 1)  # an external pull-up
+        self.assertEqual(g.read(IDR, 4) >> 3 & 1, 1)
+        g.drive(3, None)  # released
+        g.write(0x0C, 4, 0b01 << 6)  # pull-up
+        self.assertEqual(g.read(IDR, 4) >> 3 & 1, 1)
+        self.assertEqual(g.floating_reads[3], 1)
+        self.assertEqual(sum(g.floating_reads.values()), 1)  # unwired pins float uncounted
+
 class RccTest(unittest.TestCase):
     def test_hse_ready_follows_hseon(self):
         r = Rcc(FakeQl(), "rcc")

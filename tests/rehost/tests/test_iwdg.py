@@ -39,6 +39,14 @@ class IwdgTest(unittest.TestCase):
         self.w.advance(self.clock.now)
         self.assertEqual(self.timeouts, [last + 48 * MS])
 
+    def test_a_reload_that_ends_a_configuration_is_told_apart(self):
+        self.w.write(Iwdg.KR, 4, 0xCCCC)
+        self.configure(6, 6)
+        self.w.write(Iwdg.KR, 4, 0xAAAA)
+        self.w.write(Iwdg.KR, 4, 0xAAAA)
+        self.assertEqual(len(self.w.reloads), 3)
+        self.assertEqual(len(self.w.config_reloads), 1)
+
     def test_registers_are_protected_without_the_access_key(self):
         self.w.write(Iwdg.PR, 4, 6)
         self.assertEqual(self.w.read(Iwdg.PR, 4), 0)

@@ -3,6 +3,9 @@
 use embassy_stm32::time::Hertz;
 use embassy_stm32::{rcc, Config};
 
+/// The core clock the tree below gives (the cycle counter's rate).
+pub const SYSCLK_HZ: u32 = 96_000_000;
+
 /// Clock tree from the 25 MHz HSE crystal. USB needs exactly 48 MHz from the same PLL as the core, and no VCO
 /// frequency gives both 100 MHz (PLLP) and 48 MHz (PLLQ), so the core runs at 96 MHz:
 /// VCO  = 25 MHz / 25 (PLLM) * 384 (PLLN) = 384 MHz

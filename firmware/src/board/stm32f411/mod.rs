@@ -80,6 +80,7 @@ pub async fn start(spawner: Spawner) {
     let (device, usb_link) = usb::new(r.usb);
     let uart_link = uart::new(r.uart);
 
+    resources::set_priorities();
     watchdog::start(watchdog::NORMAL_US);
     spawner.spawn(defmt::unwrap!(outputs::control_task(machine, shared)));
     spawner.spawn(defmt::unwrap!(switches::inputs_task(switches, shared)));

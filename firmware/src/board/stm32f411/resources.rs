@@ -2,6 +2,7 @@
 //! `assign_resources!`), the interrupts the drivers bind, and the STEP/DIR bits of port B.
 
 use assign_resources::assign_resources;
+use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::{bind_interrupts, dma, exti, interrupt, peripherals, usart, usb, Peri};
 use ringpod_core::motion::pulse::PortMap;
 
@@ -17,6 +18,40 @@ bind_interrupts!(pub struct Irqs {
     EXTI9_5 => exti::InterruptHandler<interrupt::typelevel::EXTI9_5>;
     EXTI15_10 => exti::InterruptHandler<interrupt::typelevel::EXTI15_10>;
 });
+
+/// The step generator's feeder (the interrupt executor on USART6) renders the next period while the DMA plays the
+/// current one: it has a whole period for that, so only short handlers may pre-empt it: the DMA interrupt that wakes
+/// it (`dma_interrupt_priority`, P0 by default) and USART1's, which must take each received byte within two byte
+/// times (21.7 us at 921,600 baud: the data register and the shift register) or lose the next to an overrun, while a
+/// period's rendering takes longer than that. Lower numbers pre-empt higher ones; the F411 implements 4 priority
+/// bits (PM0214 4.3.7).
+pub const STEP_EXECUTOR_PRIORITY: Priority = Priority::P1;
+/// USART1: above the step executor, for its receive register (see above); its handler moves a byte and wakes.
+const UART_PRIORITY: Priority = Priority::P0;
+/// Embassy's time driver (TIM5): below the step executor, above USB and the switches, so that a long USB handler
+/// does not delay the clock's half-period interrupt.
+const TIME_PRIORITY: Priority = Priority::P2;
+/// USB (its core buffers whole packets and NAKs the host while it is busy) and the switches' edges (debounced over
+/// milliseconds): their handlers only move packets and wake tasks in thread mode.
+const IO_PRIORITY: Priority = Priority::P3;
+
+/// Gives every enabled interrupt but the step generator's its priority (embassy's drivers enable theirs at P0).
+pub fn set_priorities() {
+    interrupt::USART1.set_priority(UART_PRIORITY);
+    interrupt::TIM5.set_priority(TIME_PRIORITY);
+    for irq in [
+        interrupt::OTG_FS,
+        interrupt::EXTI0,
+        interrupt::EXTI1,
+        interrupt::EXTI2,
+        interrupt::EXTI3,
+        interrupt::EXTI4,
+        interrupt::EXTI9_5,
+        interrupt::EXTI15_10,
+    ] {
+        irq.set_priority(IO_PRIORITY);
+    }
+}
 
 /// STEP on PB0-PB5, DIR on PB6-PB10 and PB12 (PB11 is not bonded out on the F411CE's package).
 pub const PORT_MAP: PortMap = PortMap {

@@ -79,6 +79,14 @@ impl app::settings::Board for SettingsBoard {
     fn restart(&mut self) -> ! {
         cortex_m::peripheral::SCB::sys_reset()
     }
+
+    /// CYCCNT counts core clock cycles, stalled ones included (ARMv7-M ARM C1.8.8), at SYSCLK (`clocks`).
+    fn stall_clock(&self) -> Option<(u32, u32)> {
+        Some((
+            cortex_m::peripheral::DWT::cycle_count(),
+            super::clocks::SYSCLK_HZ / 1_000_000,
+        ))
+    }
 }
 
 #[embassy_executor::task]

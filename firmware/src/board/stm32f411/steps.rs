@@ -1,13 +1,13 @@
 //! The step generator: TIM1 updating every slot (2.5 us) paces DMA2 stream 5 (channel 6, TIM1_UP), which copies one
 //! word per update from a ring of two rendered periods into `GPIOB.BSRR`; its feeder task runs in an interrupt
-//! executor above everything else.
+//! executor above everything but the DMA interrupt that wakes it and USART1's.
 
 use core::future::poll_fn;
 use core::task::Poll;
 
 use embassy_executor::InterruptExecutor;
 use embassy_stm32::dma::{self, TransferOptions, WritableRingBuffer};
-use embassy_stm32::interrupt::{self, InterruptExt, Priority};
+use embassy_stm32::interrupt::{self, InterruptExt};
 use embassy_stm32::pac;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::low_level::{RoundTo, Timer};
@@ -18,7 +18,7 @@ use ringpod_firmware::app::steps::{Overrun, PortOutput};
 use ringpod_firmware::app::{self, Shared};
 use static_cell::StaticCell;
 
-use super::resources::{Irqs, StepGeneratorParts};
+use super::resources::{Irqs, StepGeneratorParts, STEP_EXECUTOR_PRIORITY};
 
 /// The step generator's DMA ring: room for two periods of the longest buffer. It runs over two periods of the
 /// configured one, so that its half-transfer and transfer-complete interrupts fall on the period boundaries: the
@@ -62,7 +62,8 @@ impl PortOutput for DmaPort {
 
 static STEP_EXECUTOR: InterruptExecutor = InterruptExecutor::new();
 
-/// The step generator's executor runs in the USART6 interrupt (unused on this board), above everything else.
+/// The step generator's executor runs in the USART6 interrupt (unused on this board), above everything but the
+/// DMA interrupt that wakes it and USART1's receive interrupt (`resources::set_priorities`).
 #[embassy_stm32::interrupt]
 #[allow(non_snake_case)]
 unsafe fn USART6() {
@@ -79,7 +80,7 @@ async fn steps_task(mut port: DmaPort, renderer: PulseRenderer, shared: &'static
 pub fn start(r: StepGeneratorParts, renderer: PulseRenderer, shared: &'static Shared) {
     let ring = step_generator(r, 2 * renderer.timing().slots);
 
-    interrupt::USART6.set_priority(Priority::P1);
+    interrupt::USART6.set_priority(STEP_EXECUTOR_PRIORITY);
     let high = STEP_EXECUTOR.start(interrupt::USART6);
     high.spawn(defmt::unwrap!(steps_task(DmaPort { ring }, renderer, shared)));
 }

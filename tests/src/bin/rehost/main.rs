@@ -10,95 +10,19 @@
 //! 3. The models' unit tests (`python -m unittest`), counted as one check, then `tests/rehost/run.py`, whose checks
 //!    print `PASS`/`FAIL` lines. The last line is the sum, `N passed, N failed`; the exit status is 1 when anything
 //!    failed.
+//!
+//! `-- --mutants [NAME...]`: instead, the firmware faults of `tests/rehost/mutants.toml`, each built from a copy of
+//! the sources and run up to the check meant to catch it (`mutants`).
+
+mod mutants;
+mod prepare;
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode, Stdio};
+use std::path::Path;
+use std::process::{Command, ExitCode};
 
+use prepare::{build_cli, build_firmware, repo, run_py, venv};
 use ringpod_tests::setup;
-
-const FIRMWARE: &str = "ringpod-firmware";
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn target_dir() -> PathBuf {
-    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| repo().join("target"), PathBuf::from)
-}
-
-fn run(command: &mut Command, what: &str) -> Result<(), String> {
-    let status = command.status().map_err(|e| format!("{what}: cannot start: {e}"))?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(format!("{what} failed ({status})"))
-    }
-}
-
-/// The firmware ELF, built as for flashing (the `firmware` profile).
-fn build_firmware() -> Result<PathBuf, String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    run(
-        Command::new(cargo).current_dir(repo()).args([
-            "build",
-            "-p",
-            FIRMWARE,
-            "--target",
-            setup::TARGET,
-            "--profile",
-            "firmware",
-        ]),
-        "cargo build -p ringpod-firmware --profile firmware",
-    )?;
-    Ok(target_dir().join(setup::TARGET).join("firmware").join(FIRMWARE))
-}
-
-/// The host CLI, driven by run.py over a pty on the emulated USART1.
-fn build_cli() -> Result<PathBuf, String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    run(
-        Command::new(cargo).current_dir(repo()).args(["build", "-p", "ringpod"]),
-        "cargo build -p ringpod",
-    )?;
-    Ok(target_dir().join("debug").join("ringpod"))
-}
-
-/// The venv's Python, with `requirements.txt` installed exactly.
-fn venv() -> Result<PathBuf, String> {
-    let dir = target_dir().join("rehost-venv");
-    let python = dir.join("bin/python");
-    let requirements = repo().join("tests/rehost/requirements.txt");
-    let wanted = std::fs::read_to_string(&requirements).map_err(|e| format!("{}: {e}", requirements.display()))?;
-    let stamp = dir.join("ringpod-requirements.txt");
-    if python.exists() && std::fs::read_to_string(&stamp).is_ok_and(|s| s == wanted) {
-        return Ok(python);
-    }
-    let create = format!("python3 -m venv --clear {}", dir.display());
-    if !setup::may_install() {
-        return Err(format!(
-            "the emulator's venv is missing or stale: run `{create} && {} -m pip install -r {}`",
-            python.display(),
-            requirements.display()
-        ));
-    }
-    println!("== {create}; pip install -r tests/rehost/requirements.txt");
-    run(
-        Command::new("python3").args(["-m", "venv", "--clear"]).arg(&dir),
-        &create,
-    )
-    .map_err(|e| {
-        format!("{e}: the rehost runner needs Python 3.8+ with venv (on Debian: apt-get install python3-venv)")
-    })?;
-    run(
-        Command::new(&python)
-            .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check", "-r"])
-            .arg(&requirements),
-        "pip install -r tests/rehost/requirements.txt",
-    )?;
-    std::fs::write(&stamp, wanted).map_err(|e| format!("{}: {e}", stamp.display()))?;
-    Ok(python)
-}
 
 /// The models' unit tests: Ok(number of tests) when all passed.
 fn unit_tests(python: &Path) -> Result<u32, String> {
@@ -131,16 +55,7 @@ fn tally(line: &str) -> Option<(u32, u32)> {
 
 /// run.py, its lines passed through as they come, except its count, which is returned.
 fn checks(python: &Path, elf: &Path, cli: &Path) -> Result<(u32, u32, bool), String> {
-    let mut child = Command::new(python)
-        .env("PYTHONDONTWRITEBYTECODE", "1")
-        .arg(repo().join("tests/rehost/run.py"))
-        .arg("--elf")
-        .arg(elf)
-        .arg("--ringpod")
-        .arg(cli)
-        .stdout(Stdio::piped())
-        .spawn()
-        .map_err(|e| format!("run.py: {e}"))?;
+    let mut child = run_py(python, elf, cli, &[])?;
     let mut count = None;
     if let Some(out) = child.stdout.take() {
         for line in BufReader::new(out).lines().map_while(Result::ok) {
@@ -167,6 +82,10 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().is_some_and(|a| a == "--mutants") {
+        return mutants::run(&python, &cli, &args[1..]);
+    }
     let (mut passed, mut failed) = (0, 0);
     match unit_tests(&python) {
         Ok(n) => {
