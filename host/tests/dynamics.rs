@@ -148,3 +148,65 @@ fn a_mechanism_file_gives_its_drive_forces_and_keeps_the_energy_balance() {
         .assert()
         .code(1);
 }
+
+/// A motion file instead of the built-in motion: its timed poses, rates and accelerations by differences, give
+/// the drive forces the ring platform's inverse dynamics gives (exit 0), one row a line; a file the motion cannot
+/// be read from is refused by its line, with nothing written.
+#[test]
+fn a_motion_file_is_followed_and_a_bad_one_refused() {
+    let motion = scratch("motion.csv");
+    let mut text = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for k in 0..=50 {
+        let t = k as f64 * 0.01;
+        let s = (std::f64::consts::TAU * 2.0 * t).sin();
+        text += &format!(
+            "{t},{},{},{},{},{},{}\n",
+            0.004 * s,
+            -0.003 * s,
+            0.227 + 0.002 * s,
+            0.02 * s,
+            -0.03 * s,
+            0.5 * t
+        );
+    }
+    std::fs::write(&motion, &text).unwrap();
+    let csv = scratch("motion-table.csv");
+    let args = [
+        std::ffi::OsStr::new("-m"),
+        "trainer-model".as_ref(),
+        "--input".as_ref(),
+        motion.as_os_str(),
+    ];
+    let (head, rows) = table_of(&args, &csv, "51 samples over 0.5 s, 6 drives");
+    assert_eq!(rows.len(), 51);
+    assert_eq!(rows[50][head.iter().position(|h| h == "t").unwrap()], 0.5);
+    let bad = scratch("bad-motion.csv");
+    for (file, says) in [
+        (text.replace("\n0.02,", "\n0.005,"), "line 4: time is not increasing"),
+        (text.replace("\n0.03,", "\n0.03,x"), "line 5"),
+        ("t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n".to_owned(), "at least 3"),
+    ] {
+        std::fs::write(&bad, file).unwrap();
+        let out = ringpod()
+            .args(["dynamics", "-m", "trainer-model", "--input"])
+            .arg(&bad)
+            .arg("--table")
+            .arg(scratch("not-written.csv"))
+            .output()
+            .unwrap();
+        let said = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{says}: {said}");
+        assert!(said.contains(says), "{says}: {said}");
+        assert!(!scratch("not-written.csv").exists());
+    }
+    let both = ringpod()
+        .args(["dynamics", "--amplitude", "0.01", "--input"])
+        .arg(&motion)
+        .output()
+        .unwrap();
+    assert_eq!(
+        both.status.code(),
+        Some(2),
+        "the built-in motion's amplitude with a motion file"
+    );
+}

@@ -169,11 +169,9 @@ pub fn profile_of(
     Ok(profile)
 }
 
-fn profile_of_finite(
-    ring: &RingPlatform<f64>,
-    rows: &[(usize, f64, Pose<f64>)],
-    payload: &Payload<f64>,
-) -> Result<Profile, String> {
+/// Timed poses `(line, t, pose)`, times rising, as motion states: rates and accelerations by three-point
+/// differences, each angle taken the short way round from one sample to the next. At least three rows.
+pub fn motion_states(rows: &[(usize, f64, Pose<f64>)]) -> Result<Vec<MotionState<f64>>, String> {
     if rows.len() < 3 {
         return Err(format!("{} usable rows; a motion needs at least 3", rows.len()));
     }
@@ -192,6 +190,24 @@ fn profile_of_finite(
     for angle in &mut series[3..] {
         unwrap(angle);
     }
+    Ok((0..rows.len())
+        .map(|i| {
+            let d: [(f64, f64); 6] = std::array::from_fn(|k| derivatives(&times, &series[k], i));
+            MotionState {
+                pose: rows[i].2,
+                rates: d.map(|(rate, _)| rate),
+                accelerations: d.map(|(_, acceleration)| acceleration),
+            }
+        })
+        .collect())
+}
+
+fn profile_of_finite(
+    ring: &RingPlatform<f64>,
+    rows: &[(usize, f64, Pose<f64>)],
+    payload: &Payload<f64>,
+) -> Result<Profile, String> {
+    let states = motion_states(rows)?;
     let axes = ring.axes();
     let mut out = Profile {
         t: Vec::new(),
@@ -204,20 +220,10 @@ fn profile_of_finite(
     };
     let mut position: Option<MultiTurn<f64>> = None;
     let mut positions: Vec<[f64; 6]> = Vec::new();
-    for (i, &(line, t, pose)) in rows.iter().enumerate() {
-        let mut rates = [0.0; 6];
-        let mut accelerations = [0.0; 6];
-        for k in 0..6 {
-            (rates[k], accelerations[k]) = derivatives(&times, &series[k], i);
-        }
-        let state = MotionState {
-            pose,
-            rates,
-            accelerations,
-        };
+    for (&(line, t, pose), state) in rows.iter().zip(&states) {
         let demand = ring
             .inverse(&pose)
-            .and_then(|q| Ok((q, ring.drive_demand(&state, &q, payload)?)));
+            .and_then(|q| Ok((q, ring.drive_demand(state, &q, payload)?)));
         match demand {
             Ok((q, d)) => {
                 if out.t.is_empty() {

@@ -1,5 +1,5 @@
 //! `ringpod dynamics`: a ring platform in paper 002's terms (pairs, link matrices, loops closed by Gauss-Newton)
-//! moved along a built-in smooth motion about its home pose, and its equation of motion (Lagrange, the matrix
+//! moved along a built-in smooth motion about its home pose or a motion file's timed poses, and its equation of motion (Lagrange, the matrix
 //! method's kinetic energy) giving the drive torques and forces, the energies and the drives' power; each drive
 //! force is checked against the ring platform's own inverse dynamics (Newton-Euler of the payload and statics).
 
@@ -36,6 +36,21 @@ pub struct Options<'a> {
     /// Where to write the table (.csv) and the plot (.png or .svg), if anywhere.
     pub table: Option<&'a Path>,
     pub plot: Option<&'a Path>,
+    /// A motion file's timed poses with their rates and accelerations, instead of the built-in motion.
+    pub motion: Option<Vec<(f64, MotionState<f64>)>>,
+}
+
+impl Options<'_> {
+    /// The motion's samples: the file's, or the built-in motion's every `step` over `duration`.
+    fn samples(&self) -> Vec<(f64, MotionState<f64>)> {
+        self.motion.clone().unwrap_or_else(|| {
+            let n = (self.duration / self.step).floor() as usize;
+            (0..=n)
+                .map(|k| k as f64 * self.step)
+                .map(|t| (t, motion(self, t)))
+                .collect()
+        })
+    }
 }
 
 mod file;
@@ -95,15 +110,14 @@ fn unreachable(e: impl std::fmt::Display, t: f64) -> CliError {
 pub fn run(o: &Options) -> Result<Outcome, CliError> {
     let ring = RingPlatform::<f64>::new(o.geometry);
     let inertia = Matrix3::from_diagonal(&o.inertia.into());
-    let rm = ring_model(o.geometry, &motion(o, 0.0).pose, o.mass, &inertia).map_err(|e| fail(e, 0.0))?;
+    let samples = o.samples();
+    let first = samples.first().map_or_else(|| motion(o, 0.0).pose, |(_, s)| s.pose);
+    let rm = ring_model(o.geometry, &first, o.mass, &inertia).map_err(|e| fail(e, 0.0))?;
     let payload = Payload { mass: o.mass, inertia };
     let drives = rm.model.mechanism.drives().len();
     let mut guess: [f64; MAX_VARIABLES] = rm.q;
     let (mut rows, mut worst, mut largest) = (Vec::new(), 0.0f64, 0.0f64);
-    let samples = (o.duration / o.step).floor() as usize;
-    for k in 0..=samples {
-        let t = k as f64 * o.step;
-        let s = motion(o, t);
+    for (t, s) in samples {
         let q = ring.inverse(&s.pose).map_err(|e| unreachable(e, t))?;
         let closed = rm.model.closed(&guess, &q.0[..drives]).map_err(|e| fail(e, t))?;
         let f = rm.model.mechanism.frames(&closed).map_err(|e| fail(e, t))?;
@@ -267,6 +281,26 @@ pub struct Request<'a> {
     pub plot: Option<&'a Path>,
     /// A mechanism file, instead of a ring platform.
     pub file: Option<&'a Path>,
+    /// A motion file (`t,x,y,z,alpha,beta,gamma`), instead of the built-in motion.
+    pub input: Option<&'a Path>,
+}
+
+/// A motion file's timed poses as motion states (rates and accelerations by differences, as `loads` takes
+/// them); a line that cannot be read refuses the file, by its number.
+fn motion_file(path: &Path) -> Result<Vec<(f64, MotionState<f64>)>, CliError> {
+    let bad = |reason: String| CliError::bad("input", format!("{}: {reason}", path.display()));
+    let text = crate::input::files::read_text(path, crate::input::files::DATA_LIMIT).map_err(bad)?;
+    let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
+    let (rows, errors) = crate::input::table::read(&text, &columns).map_err(bad)?;
+    if let Some(e) = errors.first() {
+        return Err(bad(format!("line {}: {}", e.line, e.reason)));
+    }
+    let rows: Vec<(usize, f64, Pose<f64>)> = rows
+        .into_iter()
+        .map(|(line, r)| (line, r[0], Pose::from_array(std::array::from_fn(|k| r[k + 1]))))
+        .collect();
+    let states = super::demand::motion_states(&rows).map_err(bad)?;
+    Ok(rows.iter().map(|r| r.1).zip(states).collect())
 }
 
 /// `dynamics` from its arguments: the mechanism selected, the numbers checked (a positive duration and step, a
@@ -314,5 +348,6 @@ pub fn command(args: &Request) -> Result<Outcome, CliError> {
         step,
         table: args.table,
         plot: args.plot,
+        motion: args.input.map(motion_file).transpose()?,
     })
 }

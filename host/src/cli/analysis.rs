@@ -96,6 +96,10 @@ pub struct DynamicsArgs {
     /// "Paper 002" chapter), instead of a ring platform.
     #[arg(long, value_name = "MECHANISM.toml", conflicts_with_all = ["geometry", "mass", "inertia", "amplitude", "duration", "step"])]
     pub file: Option<std::path::PathBuf>,
+    /// A motion file: timed poses `t,x,y,z,alpha,beta,gamma` (s, m, rad), as `loads --input` and `stream --input`
+    /// read them, instead of the built-in motion (rates and accelerations by differences of the samples).
+    #[arg(long, value_name = "MOTION.csv", conflicts_with_all = ["file", "amplitude", "duration", "step"])]
+    pub input: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Args)]

@@ -111,6 +111,7 @@ impl super::DynamicsArgs {
             table: self.table.as_deref(),
             plot: self.plot.as_deref(),
             file: self.file.as_deref(),
+            input: self.input.as_deref(),
         }
     }
 }
