@@ -338,7 +338,7 @@ def settings_check(m, p, log, cli, port):
                  f"the watchdog widened to RLR {max(widened, default=0)} ({ms(timeout):.0f} ms), longest gap between "
                  f"feeds {ms(gap):.0f} ms; device time {periods} ms in {sim_ms:.1f} simulated ms across the save "
                  f"({'within' if abs(periods - sim_ms) <= 2 else 'NOT within'} 2 ms: measured, not yet required, as the "
-                 f"catch-up kept it in some runs and not in others); {rs}: resets {restarted}; {got}")
+                 f"catch-up does not take on this tree yet); {rs}: resets {restarted}; {got}")
 
 
 # Lines above info the run causes on purpose: the watchdog-reset check's reset.
