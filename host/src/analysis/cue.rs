@@ -63,6 +63,8 @@ pub struct Replay {
     pub errors: Vec<InputError>,
     /// The optimal cueing's counts (solves, fallbacks, solve times); none for the classical washout.
     pub counts: Option<super::optimal::Counts>,
+    /// The envelope about the neutral pose the replay found (the workspace scan), for scoring the cues in it.
+    pub ranges: super::optimal::Ranges,
 }
 
 /// What `cue` is asked to do.
@@ -112,6 +114,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         limited,
         errors: mut cue_errors,
         counts,
+        ..
     } = replay(&rows, config, &mechanism, &neutral, args.preview)?;
     errors.append(&mut cue_errors);
     errors.sort_by_key(|e| e.line);
@@ -259,6 +262,7 @@ pub fn replay(
         limited,
         errors,
         counts: washout.counts().cloned(),
+        ranges,
     })
 }
 
