@@ -183,8 +183,9 @@ fn assert_cued(what: &str, game: Game, report: &serde_json::Value, unreadable: u
     assert!(last[3] > 0.01, "{what}: right side down: {last:?}");
     assert!(last[4] < -0.03, "{what}: nose up: {last:?}");
     if game.has_rates() {
-        // 40 samples at 0.4 rad/s; a late packet (a busy machine) costs the washout's rest that long.
-        assert!((last[5] - 0.16).abs() < 0.03, "{what}: turned left: {last:?}");
+        // 40 samples at 0.4 rad/s: 0.16 rad. A late packet (a busy machine: seventeen sessions side by side, under
+        // Wine on the Windows runner) costs the washout's rest that long, so the bound below is wide on that side.
+        assert!(last[5] > 0.10 && last[5] < 0.19, "{what}: turned left: {last:?}");
     } else {
         assert_eq!(last[5], 0.0, "{what}: no rates, no turn: {last:?}");
     }

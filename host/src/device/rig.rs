@@ -2,10 +2,9 @@
 //! by the same core code that restores it at the next start, stored in its flash, shown back as a rig file.
 
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use ringpod_core::protocol::endpoints::GetStatus;
-use ringpod_core::protocol::{NackReason, RigSource};
+use ringpod_core::protocol::RigSource;
 
 use ringpod_core::kinematics::GeometryError;
 
@@ -82,16 +81,12 @@ pub fn as_file(record: &ringpod_core::protocol::RigRecord) -> Result<String, Dev
 /// request before `hello` is refused as not connected) and shows the rig it came up with.
 pub fn restart<T: Transport>(client: &mut Client<T>) -> Result<String, DeviceRigError> {
     client.restart()?;
-    let limit = crate::link::patience(Duration::from_secs(10));
-    let deadline = Instant::now() + limit;
-    loop {
-        match client.call(GetStatus) {
-            Err(ClientError::Device(NackReason::NotConnected)) => break,
-            // A board on USB leaves: its port closes, and it comes back under the same name in a moment.
-            Err(ClientError::Io(_)) => return Ok("restarting: the port closed; the board enumerates again".into()),
-            _ if Instant::now() > deadline => return Err(DeviceRigError::NoRestart(limit)),
-            _ => client.transport().elapse(Duration::from_millis(50)),
-        }
+    let limit = Duration::from_secs(10);
+    match client.await_new_start(limit) {
+        Ok(true) => {}
+        Ok(false) => return Ok("restarting: the port closed; the board enumerates again".into()),
+        Err(ClientError::Timeout(waited)) => return Err(DeviceRigError::NoRestart(waited)),
+        Err(e) => return Err(e.into()),
     }
     client.hello()?;
     let (record, source, _) = client.rig()?;

@@ -321,6 +321,44 @@ impl<T: Transport> Client<T> {
         self.call(Restart)
     }
 
+    /// After [`Client::restart`]: polls the status until the device answers as a new start (a request before
+    /// `hello` is refused as not connected), or `limit` (lengthened by [`super::patience`]) passes. A poll sent
+    /// while the board resets is lost with it, so each waits a quarter second (lengthened alike), not a request's
+    /// whole timeout, before the next; answers to earlier polls are dropped. `Ok(false)`: the port closed (a board on
+    /// USB leaves, and comes back under the same name in a moment).
+    pub fn await_new_start(&mut self, limit: Duration) -> Result<bool, ClientError> {
+        let limit = super::patience(limit);
+        let per_try = super::patience(Duration::from_millis(250));
+        let pause = Duration::from_millis(50);
+        let timeout = std::mem::replace(&mut self.timeout, per_try);
+        let mut tries = Vec::new();
+        let mut waited = Duration::ZERO;
+        let outcome = loop {
+            let answer = self.send(GetStatus.request()).and_then(|id| {
+                tries.push(id);
+                self.wait_response(id)
+            });
+            match answer {
+                Ok(DeviceMessage::Nack(NackReason::NotConnected)) => break Ok(true),
+                Err(ClientError::Io(_)) => break Ok(false),
+                Err(ClientError::Timeout(_)) => waited += per_try,
+                // Answered by the controller before it went (still storing), or garbled by the reset.
+                _ => {}
+            }
+            if waited >= limit {
+                break Err(ClientError::Timeout(limit));
+            }
+            self.transport.elapse(pause);
+            waited += pause;
+        };
+        self.timeout = timeout;
+        if matches!(outcome, Ok(true)) {
+            self.pump()?;
+        }
+        self.inbox.retain(|r| !tries.contains(&r.id));
+        outcome
+    }
+
     /// The device's status.
     pub fn status(&mut self) -> Result<Status, ClientError> {
         self.call(GetStatus)
@@ -374,16 +412,20 @@ mod tests {
     use super::*;
     use crate::link::sim::SimDevice;
 
-    /// The simulated device behind a link that loses the first `lose` frames the host sends, and counts the time.
+    /// The simulated device behind a link that passes the first `pass` frames the host sends, loses the next
+    /// `lose`, and counts the time.
     struct Lossy {
         device: SimDevice,
+        pass: usize,
         lose: usize,
         elapsed: Duration,
     }
 
     impl Transport for Lossy {
         fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-            if self.lose > 0 {
+            if self.pass > 0 {
+                self.pass -= 1;
+            } else if self.lose > 0 {
                 self.lose -= 1;
                 return Ok(());
             }
@@ -401,6 +443,7 @@ mod tests {
     fn lossy(lose: usize) -> Client<Lossy> {
         Client::new(Lossy {
             device: SimDevice::new(false),
+            pass: 0,
             lose,
             elapsed: Duration::ZERO,
         })
@@ -434,5 +477,41 @@ mod tests {
             Duration::from_secs(2),
             "the request timeout is restored"
         );
+    }
+
+    #[test]
+    fn a_restart_outlives_the_polls_its_reset_loses() {
+        // hello and restart pass; the first two status polls are lost in the reset.
+        let mut client = lossy(2);
+        client.transport().pass = 2;
+        client.hello().unwrap();
+        let said = crate::device::rig::restart(&mut client).unwrap();
+        assert_eq!(said, "restarted: running trainer-model (compiled in)");
+        // Two polls lost at a quarter second each and their pauses, not two whole request timeouts.
+        let elapsed = client.transport().elapsed;
+        assert!(
+            elapsed >= Duration::from_millis(500) && elapsed < Duration::from_millis(1_000),
+            "{elapsed:?}"
+        );
+        assert_eq!(
+            client.timeout,
+            Duration::from_secs(2),
+            "the request timeout is restored"
+        );
+        assert!(client.inbox.is_empty());
+        assert!(client.status().is_ok());
+    }
+
+    #[test]
+    fn a_restart_that_never_comes_back_is_said_in_its_time() {
+        let mut client = lossy(usize::MAX);
+        client.transport().pass = 2;
+        client.hello().unwrap();
+        match crate::device::rig::restart(&mut client) {
+            Err(crate::device::rig::DeviceRigError::NoRestart(t)) => assert_eq!(t, Duration::from_secs(10)),
+            other => panic!("{other:?}"),
+        }
+        let elapsed = client.transport().elapsed;
+        assert!(elapsed <= Duration::from_millis(10_400), "{elapsed:?}");
     }
 }
