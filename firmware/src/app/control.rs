@@ -36,21 +36,27 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
     let mut due = Instant::now() + period;
     let mut worst = 0u32;
     let mut n = 0u32;
+    let mut owed_us = 0u64;
     loop {
-        // Device time a stall cost the time driver: those periods are due already, and are caught up below.
-        let lost = shared.clock_lost_us.swap(0, Ordering::Relaxed);
-        due = Instant::from_ticks(
-            due.as_ticks()
-                .saturating_sub(Duration::from_micros(u64::from(lost)).as_ticks()),
-        );
-        Timer::at(due).await;
+        // Device time a stall cost the time driver (an erase, `settings`): periods gone already, each passed before
+        // the timer's next. Kept apart from `due`, which a stall longer than the time since the start (a save soon
+        // after a reset) would take below zero, where the excess would be lost.
+        owed_us += u64::from(shared.clock_lost_us.swap(0, Ordering::Relaxed));
+        let owed = owed_us >= u64::from(tick_us);
+        if owed {
+            owed_us -= u64::from(tick_us);
+        } else {
+            Timer::at(due).await;
+        }
         // After a hold-up the periods it cost are caught up at once (mostly as passes), so that the controller's
         // clocks lose none of them; the phase is only judged on a tick that ran on time, and by when it was due:
         // a tick that starts late behind a link frame is jitter the lead covers, not a phase to correct.
         let scheduled = due;
         let now = Instant::now();
-        let on_time = now < due + period;
-        due += period;
+        let on_time = !owed && now < due + period;
+        if !owed {
+            due += period;
+        }
         if !on_time {
             // Catching up: let the link task read what arrived during the hold-up first (a late `Timer::at` is
             // ready at once and would not yield), so that the stream's timeout is judged on the setpoints sent
@@ -61,7 +67,7 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
         // passed rather than ticked; see `Controller::pass`. So is a period the loop is more than [`CATCH_UP`]
         // periods late for: the motors did not move in it, and ticked in a burst such periods would run the stream's
         // timeout out before the host's next setpoints can arrive. Inputs and faults reach the supervisor either way.
-        let ahead = shared.steps.len() >= super::AHEAD || now >= scheduled + period * CATCH_UP;
+        let ahead = owed || shared.steps.len() >= super::AHEAD || now >= scheduled + period * CATCH_UP;
         let inputs = Inputs::from_word(shared.inputs.load(Ordering::Relaxed));
         let step_fault = shared.step_fault.swap(false, Ordering::Relaxed);
         let start = machine.cycles();

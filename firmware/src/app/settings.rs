@@ -52,9 +52,13 @@ pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared,
                 // difference up as passed periods, so that the supervisor's and the stream's timers lose nothing.
                 let real_us = c1.wrapping_sub(c0) / per_us.max(1);
                 let seen_us = u32::try_from(since.elapsed().as_micros()).unwrap_or(u32::MAX);
-                shared
-                    .clock_lost_us
-                    .fetch_add(real_us.saturating_sub(seen_us), Ordering::Relaxed);
+                let lost = real_us.saturating_sub(seen_us);
+                shared.clock_lost_us.fetch_add(lost, Ordering::Relaxed);
+                defmt::info!(
+                    "the store took {} us, {} us of them lost to device time: caught up",
+                    real_us,
+                    lost
+                );
             }
             let rig = config.rig();
             match result {
