@@ -415,7 +415,7 @@ proptest! {
 #[test]
 fn every_optimal_key_is_refused_out_of_range_by_name() {
     type Set = fn(&mut OptimalConfig, f64);
-    let keys: [(&str, Set, f64, f64); 14] = [
+    let keys: [(&str, Set, f64, f64); 15] = [
         ("optimal.horizon", |o, v| o.horizon = v as u32, 2.0, 60.0),
         ("optimal.step_s", |o, v| o.step_s = v, 0.005, 0.5),
         ("optimal.force_weight", |o, v| o.force_weight[2] = v, 0.0, 1e6),
@@ -439,6 +439,7 @@ fn every_optimal_key_is_refused_out_of_range_by_name() {
         ),
         ("optimal.max_rate_deg", |o, v| o.max_rate_deg[1] = v, 1e-6, 720.0),
         ("optimal.envelope_share", |o, v| o.envelope_share = v, 0.05, 1.0),
+        ("optimal.tilt_share", |o, v| o.tilt_share = v, 0.05, 1.0),
         ("optimal.budget_ms", |o, v| o.budget_ms = v, 0.01, 1000.0),
     ];
     let with = |set: Set, v: f64| {

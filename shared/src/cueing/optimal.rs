@@ -53,9 +53,13 @@ pub struct OptimalConfig {
     /// The rig's angular rate limit, x (pitch) and y (roll) (deg/s; default 60).
     #[serde(deserialize_with = "super::axes::one_or_each")]
     pub max_rate_deg: [f64; 2],
-    /// The share of each axis's range about home (from the workspace scan) the optimiser may use (default 0.5):
-    /// the ranges are found one axis at a time, and a pose that uses several axes at once needs a margin.
+    /// The share of each translation's range about home (from the workspace scan) the optimiser may use (default
+    /// 0.5): the ranges are found one axis at a time, and a pose that uses several axes at once needs a margin.
     pub envelope_share: f64,
+    /// The share of the roll and pitch ranges about home the optimiser may tilt in (default 0.5). Apart from the
+    /// translations' share: on a small rig sustained force is mostly tilt, and the best cueing uses nearly all of
+    /// the tilt range and little translation, a mix whose poses stay inside the coupled envelope.
+    pub tilt_share: f64,
     /// A solve that takes longer than this falls back to the classical washout for its sample (ms; default 2).
     pub budget_ms: f64,
 }
@@ -76,6 +80,7 @@ impl Default for OptimalConfig {
             max_acceleration: [5.0; 3],
             max_rate_deg: [60.0; 2],
             envelope_share: 0.5,
+            tilt_share: 0.5,
             budget_ms: 2.0,
         }
     }
@@ -144,6 +149,9 @@ impl OptimalConfig {
         }
         if !ok(self.envelope_share, 0.05, 1.0) {
             return err("optimal.envelope_share", "0.05 to 1");
+        }
+        if !ok(self.tilt_share, 0.05, 1.0) {
+            return err("optimal.tilt_share", "0.05 to 1");
         }
         if !ok(self.budget_ms, 0.01, 1000.0) {
             return err("optimal.budget_ms", "0.01 to 1000 ms");

@@ -350,6 +350,13 @@ pub const PARAMS: &[Param] = &[
         Values::Range(0.05, 1.0),
     ),
     param(
+        "optimal.tilt_share",
+        "optimal: share of the tilt range",
+        one(&["platform"]),
+        "",
+        Values::Range(0.05, 1.0),
+    ),
+    param(
         "optimal.budget_ms",
         "optimal: solve budget",
         one(&["algorithm"]),

@@ -290,10 +290,11 @@ fn cost_and_bounds(i: usize, config: &CueConfig, ranges: &Ranges) -> (Vec<f64>, 
     }
     // x's angle is minus the pitch (index 4 of the ranges), y's the roll (index 3); the tilt keys are per force
     // axis (x 0, y 1), the rotation keys per rotation (roll 0, pitch 1).
+    let tilt = o.tilt_share;
     let (alo, ahi) = if i == X {
-        (-ranges[4].1 * share, -ranges[4].0 * share)
+        (-ranges[4].1 * tilt, -ranges[4].0 * tilt)
     } else {
-        (ranges[3].0 * share, ranges[3].1 * share)
+        (ranges[3].0 * tilt, ranges[3].1 * tilt)
     };
     let limit = config.tilt_limit_deg[i].to_radians();
     let rot = 1 - i;
@@ -472,9 +473,9 @@ mod tests {
         );
         assert!(last[4] > 0.01, "{last:?}");
         // Within the envelope it plans in (a share of the ranges), which the slacks' price keeps.
-        let share = o.config.optimal.envelope_share;
+        let (share, tilt) = (o.config.optimal.envelope_share, o.config.optimal.tilt_share);
         assert!(
-            last[0].abs() <= 0.05 * share + 1e-3 && last[4] <= 0.3 * share + 1e-3,
+            last[0].abs() <= 0.05 * share + 1e-3 && last[4] <= 0.3 * tilt + 1e-3,
             "{last:?}"
         );
     }
