@@ -263,7 +263,8 @@ fn the_optimal_cueing_runs_live() {
     let last = numbers(&report["last_applied_pose"]);
     // The corner's force to the left: right side down; its turn to the left through the heading channel.
     assert!(last[3] > 0.005, "right side down: {last:?}");
-    assert!((last[5] - 0.16).abs() < 0.03, "turned left: {last:?}");
+    // As in `assert_cued`: 0.16 rad, less where a busy machine delays a packet.
+    assert!(last[5] > 0.10 && last[5] < 0.19, "turned left: {last:?}");
 }
 
 /// `--telemetry-shm` off Windows: refused by name as a usage error (exit 2), before anything is opened; with the

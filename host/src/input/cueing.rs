@@ -128,3 +128,43 @@ fn merged(text: &str, profile: Option<&str>) -> Result<(toml::Table, String), St
     }
     Ok((table, where_))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ringpod_core::cueing::Algorithm;
+
+    /// The bench's cueing files, as shipped: each loads, and says what the book's table says of it.
+    #[test]
+    fn the_bench_files_load_as_the_book_describes_them() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/drives");
+        let load = |name: &str| load_config(Some(&dir.join(name)), None).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .filter(|n| n.ends_with(".toml"))
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "classical.toml",
+                "optimal-tilt.toml",
+                "optimal-unbounded.toml",
+                "optimal.toml",
+                "tilt-bound.toml"
+            ]
+        );
+        assert_eq!(load("classical.toml"), CueConfig::default());
+        let tilt = load("optimal-tilt.toml");
+        assert_eq!(tilt.algorithm, Algorithm::Optimal);
+        assert_eq!((tilt.optimal.envelope_share, tilt.optimal.tilt_share), (0.2, 0.95));
+        assert_eq!((tilt.tilt_limit_deg, tilt.tilt_rate_deg), ([20.0; 2], [18.75; 2]));
+        // The yardstick: tilt alone, to the trainer model's roll and pitch ranges, at once.
+        let bound = load("tilt-bound.toml");
+        assert_eq!(bound.algorithm, Algorithm::Classical);
+        assert_eq!((bound.translation_scale, bound.rotation_scale), ([0.0; 3], [0.0; 2]));
+        assert_eq!((bound.tilt_scale, bound.tilt_limit_deg), ([1.0; 2], [22.0, 20.5]));
+        assert_eq!(load("optimal-unbounded.toml").optimal.budget_ms, 1000.0);
+    }
+}
