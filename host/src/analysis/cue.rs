@@ -63,8 +63,6 @@ pub struct Replay {
     pub errors: Vec<InputError>,
     /// The optimal cueing's counts (solves, fallbacks, solve times); none for the classical washout.
     pub counts: Option<super::optimal::Counts>,
-    /// The envelope about the neutral pose the replay found (the workspace scan), for scoring the cues in it.
-    pub ranges: super::optimal::Ranges,
 }
 
 /// What `cue` is asked to do.
@@ -115,7 +113,14 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         errors: mut cue_errors,
         counts,
         ..
-    } = replay(&rows, config, &mechanism, &neutral, args.preview)?;
+    } = replay(
+        &rows,
+        config,
+        &mechanism,
+        &neutral,
+        &super::cue_engine::ranges(&mechanism, &neutral),
+        args.preview,
+    )?;
     errors.append(&mut cue_errors);
     errors.sort_by_key(|e| e.line);
     write_poses(args.out, &cued)?;
@@ -194,19 +199,20 @@ pub enum CueError {
     Cli(#[from] CliError),
 }
 
-/// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`,
-/// every pose limited into the envelope; with `preview`, the optimal cueing sees the drive's next samples (the
+/// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`
+/// (whose envelope about home is `ranges`, [`super::cue_engine::ranges`]: scanned once by the caller, however
+/// many configurations it replays), every pose limited into the envelope; with `preview`, the optimal cueing sees the drive's next samples (the
 /// reference over its horizon) rather than the last sample held.
 pub fn replay(
     rows: &[(usize, Vec<f64>)],
     config: cueing::CueConfig,
     mechanism: &RingPlatform<f64>,
     neutral: &Pose<f64>,
+    ranges: &super::optimal::Ranges,
     preview: bool,
 ) -> Result<Replay, CueError> {
     let margins = EnvelopeMargins::default();
-    let ranges = super::cue_engine::ranges(mechanism, neutral);
-    let mut washout = super::cue_engine::Engine::new(config, &ranges).map_err(CueError::Washout)?;
+    let mut washout = super::cue_engine::Engine::new(config, ranges).map_err(CueError::Washout)?;
     // A recorded drive's next samples, for the optimal cueing's preview.
     let preview = washout.horizon().filter(|_| preview);
     let mut errors = Vec::new();
@@ -262,7 +268,6 @@ pub fn replay(
         limited,
         errors,
         counts: washout.counts().cloned(),
-        ranges,
     })
 }
 

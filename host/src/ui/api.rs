@@ -54,9 +54,11 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
     let (rows, mut errors) = crate::input::table::read(text, &TELEMETRY_COLUMNS)?;
     let m = RingPlatform::<f64>::new(geometry);
     let neutral = Pose::from_array(home);
+    // One scan of the envelope for both algorithms' replays and scores.
+    let ranges = crate::analysis::cue_engine::ranges(&m, &neutral);
     let scored = |config: CueConfig| -> Result<(Replay, Value), String> {
-        let run = replay(&rows, config, &m, &neutral, false).map_err(|e| format!("{e:#}"))?;
-        let (s, _) = score(&run.cued, &neutral, &run.ranges, config.forward);
+        let run = replay(&rows, config, &m, &neutral, &ranges, false).map_err(|e| format!("{e:#}"))?;
+        let (s, _) = score(&run.cued, &neutral, &ranges, config.forward);
         let summary = json!({
             "algorithm": config.algorithm,
             "force_rms": s.force_total(),

@@ -102,7 +102,7 @@ pub fn evaluate(
     let mut traces = Vec::new();
     let (mut limited, mut counts) = (0, Counts::default());
     for rows in drives {
-        let r = replay(rows, config, &rig.mechanism, &rig.neutral, preview)?;
+        let r = replay(rows, config, &rig.mechanism, &rig.neutral, &rig.ranges, preview)?;
         let (s, t) = score(&r.cued, &rig.neutral, &rig.ranges, config.forward);
         limited += r.limited;
         if let Some(c) = &r.counts {
