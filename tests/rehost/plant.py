@@ -11,7 +11,10 @@ electrically (the pins as `models.gpio.Gpio` says the chip drives them, not its 
 - Switches at positions, as `Plant::trainer_model`: carriages 1-4 have an index flag 60 steps wide from 0, the
   linear actuators 5-6 a home end switch at 0 and below, and a far end at 240,000 steps. A switch is a contact to
   ground: closed it pulls the pin low, open it leaves the pin to the pull the firmware configured (PA1-PA6 home,
-  PA7/PA8 far ends; a floating read is counted by the GPIO model). The e-stop chain (PA0, normally closed, an
+  PA7/PA8 far ends; a floating read is counted by the GPIO model). A home switch's contact bounces as a
+  microswitch's does: after each change of its position's state it returns to the old level and back twice
+  (`BOUNCE_US` after the first edge; 1.6 ms in all, within the 1-5 ms such switches are specified for), so that the
+  firmware's debounce, not the plant, decides where it latched. The e-stop chain (PA0, normally closed, an
   external pull-up on the board) reads high when opened (`open_estop`).
 - Supply sense follows the relays at once: LOGIC_OK (PA9) is driven high while LOGIC_EN (PB14) is, POWER_OK (PC14)
   while POWER_EN (PB15) is; otherwise they are left to their pull-downs.
@@ -31,6 +34,8 @@ STEP = [0, 1, 2, 3, 4, 5]
 DIR = [6, 7, 8, 9, 10, 12]
 ENABLE_N, LOGIC_EN, POWER_EN = 13, 14, 15
 FLAG_WIDTH, FAR_LIMIT = 60, 240_000
+BOUNCE_US = (150, 400, 900, 1_600)  # a contact's changes after its first edge: old, new, old, new level
+CYCLES_PER_US = 96  # SYSCLK, machine.py
 PORT_A, PORT_C = 0, 2
 ESTOP, LOGIC_OK, POWER_OK = 0, 9, 14  # PA0, PA9, PC14
 WIRED_A = {ESTOP, 1, 2, 3, 4, 5, 6, 7, 8, LOGIC_OK}  # the switches and LOGIC_OK on port A
@@ -59,8 +64,21 @@ class Plant:
         self.clear_timing()
         self.levels = {}  # (port letter, pin) -> the level last seen on it
         self.switch_edges = [0] * 6  # changes of each home switch
+        self.contact = [None] * 6  # each home switch closed (True) or open, as its axis's position puts it
+        self.bouncing = [[] for _ in range(6)]  # each home switch's bounce still to come: (time, level)
+        self.bounces = 0  # contact changes that bounced
         m.gpio["b"].on_change = self._portb
         self._update()
+        m.timed.append(self)
+
+    # -- a timed model of the machine's scheduler: the contacts' bounce --
+    def advance(self, now):
+        for a, events in enumerate(self.bouncing):
+            while events and events[0][0] <= now:
+                self._drive("a", 1 + a, events.pop(0)[1])
+
+    def next_event(self, now):
+        return min((events[0][0] for events in self.bouncing if events), default=now + (1 << 40))
 
     def reset_counts(self):
         self.steps = [0] * 6
@@ -153,7 +171,18 @@ class Plant:
         for a in range(6):
             p = self.position[a]
             home = 0 <= p < FLAG_WIDTH if a < 4 else p <= 0
-            self._drive("a", 1 + a, 0 if home else None)
+            level, old = (0 if home else None), (None if home else 0)
+            if home == self.contact[a]:
+                if not self.bouncing[a]:  # driven again (a reset or a pull set since), unless it is bouncing
+                    self._drive("a", 1 + a, level)
+                continue
+            if self.contact[a] is not None:  # a change of the contact, not the state it was found in
+                now = self.m.now
+                self.bouncing[a] = [(now + t * CYCLES_PER_US, old if k % 2 == 0 else level)
+                                    for k, t in enumerate(BOUNCE_US)]
+                self.bounces += 1
+            self.contact[a] = home
+            self._drive("a", 1 + a, level)
         for a, pin in ((4, 7), (5, 8)):
             self._drive("a", pin, 0 if self.position[a] >= FAR_LIMIT else None)
         self._drive("a", ESTOP, 1 if self.estop_open else 0)

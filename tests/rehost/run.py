@@ -265,12 +265,11 @@ def homing_check(m, plant, cli, port, name="serial-home"):
     """`device home` through the plant's switches: each axis approaches its switch, backs off, approaches slowly
     and is given its home position where the debounced switch trips, then the platform moves to the home pose.
     Where the device's count and the STEP edges put each axis then gives the plant position the device latched:
-    on the switch, past its edge by the debounce (3 ms) and the 1 ms sampling and tick, less the periods the device
-    has planned but the pins not yet played (the step ring's one period and the queued one): 2-4 ms, a step or two
-    at the slow approach's rate (it was 8-9 ms with a six-period ring); up to 10 ms more when the edge comes between
-    two of the inputs task's
-    waits and its 10 ms sweep finds it (firmware/src/app/inputs.rs)."""
-    edges0, exti0 = list(plant.switch_edges), m.exti.edges
+    on the switch, past its first edge by the contact's bounce (1.6 ms), the debounce (3 ms) and the 1 ms sampling
+    and tick, less the periods the device has planned but the pins not yet played (the step ring's one period and
+    the queued one): 4-5 ms, two or three steps at the slow approach's rate; up to 10 ms more when the edge comes
+    between two of the inputs task's waits and its 10 ms sweep finds it (firmware/src/app/inputs.rs)."""
+    edges0, exti0, bounces0 = list(plant.switch_edges), m.exti.edges, plant.bounces
     plant.clear_timing()
     en = cli.run("device", "enable", *port)
     m.run(m.now + int(0.6 * SYSCLK))
@@ -289,10 +288,11 @@ def homing_check(m, plant, cli, port, name="serial-home"):
     timed, timing_said = timing(plant, SLOT_US, both_ways=True)
     CHECKS.check(name, home.code == 0 and status.get("state") == "Ready" and status.get("homed") and timed
                  and on_switch and all(0 < t <= 22 for t in past_ms) and all(e >= 4 for e in edges)
-                 and m.exti.edges - exti0 >= sum(edges),
+                 and m.exti.edges - exti0 >= sum(edges) and plant.bounces - bounces0 >= 4 * 6,
                  f"{en}; `device home` exit {home.code} after {home.sim_s:.2f} simulated s: state "
                  f"{status.get('state')}, homed {status.get('homed')}; home switches PA1-PA6 changed {edges} times "
-                 f"(fast approach, back-off, slow approach, clear), {m.exti.edges - exti0} EXTI edges; plant at "
+                 f"(fast approach, back-off, slow approach, clear; {plant.bounces - bounces0} contact changes each "
+                 f"bounced 4 times over 1.6 ms), {m.exti.edges - exti0} EXTI edges; plant at "
                  f"{plant.position}, device counts {dev}: latched at {latched} (on the switch: {on_switch}), "
                  f"{past_ms} ms past the switch edge at the slow approach's speed (more than 0, at most 22 ms: the debounce, "
                  f"at most one 10 ms sweep); {timing_said}" + ("" if home.code == 0 else f"; {home}"))
