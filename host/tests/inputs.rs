@@ -3,8 +3,12 @@
 
 mod common;
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
+#[cfg(unix)]
+use std::time::Instant;
 
+/// A directory of this run's own (the FIFO tests: Unix only).
+#[cfg(unix)]
 fn dir(name: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("ringpod-inputs-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
