@@ -288,3 +288,94 @@ fn the_plant_moves_by_the_edges_the_drivers_count() {
     assert_eq!(plant.steps_received, [180, 80, 3, 14, 400, 350]);
     assert_eq!(plant.steps_while_disabled, 60 + 3 + 7 + 200 + 150);
 }
+
+/// The renderer's words, written the plain way: every step's closed-form time ([`AxisMove::step_ns`]) divided
+/// by the slot, each step looked up in its slot. `carry` holds the resets past the buffer's end, as the renderer's.
+fn plain_render(timing: &PulseTiming, carry: &mut [u32; 4], moves: &[AxisMove; 6], out: &mut [u32]) -> ([u32; 6], u32) {
+    let slots = timing.slots;
+    out.fill(0);
+    for (w, c) in out.iter_mut().zip(carry.iter_mut()) {
+        *w |= std::mem::take(c);
+    }
+    let (mut steps, mut collisions) = ([0u32; 6], 0u32);
+    let slot_ns = timing.slot_ns.max(1);
+    for (a, m) in moves.iter().enumerate() {
+        let high = (m.direction == Direction::Forward) != (MAP.dir_forward_low & (1 << a) != 0);
+        let dir = (1u32 << MAP.dir[a]) << if high { 0 } else { 16 };
+        match m.dir_change_ns {
+            Some(t) => out[((t / slot_ns) as usize).min(slots - 1)] |= dir,
+            None if m.count > 0 => out[0] |= dir,
+            None => {}
+        }
+        let bit = 1u32 << MAP.step[a];
+        for k in 0..m.count {
+            let s = (m.step_ns(k) / slot_ns) as usize;
+            if s >= slots {
+                collisions += 1;
+                continue;
+            }
+            collisions += u32::from(out[s] & bit != 0);
+            out[s] |= bit;
+            steps[a] += 1;
+            let end = s + timing.pulse_slots;
+            match out.get_mut(end) {
+                Some(w) => *w |= bit << 16,
+                None => carry[end - slots] |= bit << 16,
+            }
+        }
+    }
+    (steps, collisions)
+}
+
+/// Any move, valid or not: windows inside, at the end of or past the period, counts from none to more than the
+/// one-division slots hold, DIR changes anywhere.
+fn any_move() -> impl Strategy<Value = AxisMove> {
+    let period = prop_oneof![Just(1_000_000u32), 1u32..=2_000_000, Just(u32::MAX)];
+    let count = prop_oneof![0u32..=3, 0u32..=250, 2_000u32..=2_500];
+    (
+        period,
+        0.0..1.2f64,
+        count,
+        any::<bool>(),
+        prop::option::of(any::<u32>()),
+    )
+        .prop_map(|(period, start, count, forward, dir_change_ns)| AxisMove {
+            direction: if forward {
+                Direction::Forward
+            } else {
+                Direction::Backward
+            },
+            dir_change_ns,
+            start_ns: (f64::from(period) * start).min(f64::from(u32::MAX)) as u32,
+            count,
+            period_ns: period,
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(3_000))]
+
+    /// The renderer's buffers, carries and reports are the plain rendering's, for any grid and any moves (its
+    /// slots computed by one division a step, its collision checks skipped where steps are a slot apart).
+    #[test]
+    fn the_renderer_equals_the_plain_rendering(
+        slot_ns in prop_oneof![Just(2_500u32), 1u32..=20_000],
+        slots in 2usize..=400,
+        pulse_slots in 1usize..=4,
+        periods in prop::collection::vec(prop::array::uniform6(any_move()), 1..4),
+    ) {
+        prop_assume!(pulse_slots < slots);
+        let timing = PulseTiming { slot_ns, slots, pulse_slots };
+        let mut renderer = PulseRenderer::new(MAP, timing).unwrap();
+        let mut carry = [0u32; 4];
+        let (mut got, mut want) = (vec![0u32; slots], vec![0u32; slots]);
+        let idle = AxisMove { direction: Direction::Forward, dir_change_ns: None, start_ns: 0, count: 0, period_ns: 1 };
+        for moves in periods.iter().chain([[idle; 6]].iter()) {
+            let report = renderer.render(moves, &mut got).unwrap();
+            let (steps, collisions) = plain_render(&timing, &mut carry, moves, &mut want);
+            prop_assert_eq!(&got, &want);
+            prop_assert_eq!(report.steps, steps);
+            prop_assert_eq!(report.collisions, collisions);
+        }
+    }
+}

@@ -197,6 +197,10 @@ impl PulseRenderer {
 
     /// Fills `out` (at least [`PulseTiming::slots`] words; only those are written) with the words of one period.
     /// A buffer too short renders nothing and reports `None`: the caller's buffer is sized from the same timing.
+    ///
+    /// Never inlined: its machine code is then the same in every program that links it (the firmware, the QEMU
+    /// measurements), instead of depending on the registers free at each caller after LTO.
+    #[inline(never)]
     pub fn render(&mut self, moves: &[AxisMove; 6], out: &mut [u32]) -> Option<RenderReport> {
         let slots = self.timing.slots;
         let out = out.get_mut(..slots)?;
@@ -209,7 +213,6 @@ impl PulseRenderer {
         // u32 divisions: one instruction each on the M4F (u64 ones are software), one per step rendered.
         let slot_ns = self.timing.slot_ns.max(1);
         for (a, m) in moves.iter().enumerate() {
-            let step_bit = 1u32 << (self.map.step[a] & 15);
             match m.dir_change_ns {
                 Some(t) => {
                     let s = ((t / slot_ns) as usize).min(slots - 1);
@@ -219,29 +222,140 @@ impl PulseRenderer {
                 None if m.count > 0 => out[0] |= self.map.dir_word(a, m.direction),
                 None => {}
             }
+            if m.count == 0 {
+                continue;
+            }
+            let axis = AxisPins {
+                step: 1u32 << (self.map.step[a] & 15),
+                slot_ns,
+                pulse_slots: self.timing.pulse_slots,
+            };
+            // Steps at least a slot apart land in distinct slots (`floor(a + d) - floor(a) >= floor(d)`), so a
+            // collision is impossible and the loop need not look for one; closer steps take the checked loop.
+            let (steps, collisions) = if m.spacing_ns() >= slot_ns {
+                axis.render::<false>(m, out, &mut self.carry)
+            } else {
+                axis.render::<true>(m, out, &mut self.carry)
+            };
+            report.steps[a] = steps;
+            report.collisions += collisions;
+        }
+        Some(report)
+    }
+}
+
+/// What one axis's step loop needs, kept in registers.
+#[derive(Clone, Copy)]
+struct AxisPins {
+    /// The STEP pin's set bit (its reset bit is 16 higher).
+    step: u32,
+    slot_ns: u32,
+    pulse_slots: usize,
+}
+
+impl AxisPins {
+    /// Sets the STEP bit at each step's slot and resets it `pulse_slots` later (in `carry` past the buffer's end);
+    /// returns the steps rendered and the collisions (a step past the buffer's end, or with `CHECK`, into a slot
+    /// that already holds one). Without `CHECK` the caller has proved that no two steps share a slot.
+    #[inline(always)]
+    fn render<const CHECK: bool>(self, m: &AxisMove, out: &mut [u32], carry: &mut [u32; 4]) -> (u32, u32) {
+        let mut tally = Tally::default();
+        let Some(mut steps) = StepSlots::new(m, self.slot_ns) else {
             for t in m.times() {
-                let s = (t / slot_ns) as usize;
-                let Some(word) = out.get_mut(s) else {
-                    report.collisions += 1;
-                    continue;
-                };
-                if *word & step_bit != 0 {
-                    report.collisions += 1;
-                }
-                *word |= step_bit;
-                report.steps[a] += 1;
-                let end = s + self.timing.pulse_slots;
-                let reset = step_bit << 16;
-                match out.get_mut(end) {
-                    Some(w) => *w |= reset,
-                    None => {
-                        if let Some(c) = self.carry.get_mut(end - slots) {
-                            *c |= reset;
-                        }
-                    }
+                self.place::<CHECK>((t / self.slot_ns) as usize, out, carry, &mut tally);
+            }
+            return (m.count - tally.missed, tally.missed + tally.doubled);
+        };
+        // The steps whose pulse ends inside the buffer, in a loop that keeps neither the carry nor a count of
+        // missed steps in a register: all steps but the last few, since the slots are in order.
+        let slots = out.len();
+        let mut left = m.count;
+        let mut doubled = 0u32;
+        while left > 0 {
+            let s = steps.advance();
+            left -= 1;
+            let end = s.wrapping_add(self.pulse_slots);
+            let (Some(word), true) = (out.get_mut(s), end < slots) else {
+                self.place::<CHECK>(s, out, carry, &mut tally);
+                break;
+            };
+            if CHECK && *word & self.step != 0 {
+                doubled += 1;
+            }
+            *word |= self.step;
+            if let Some(w) = out.get_mut(end) {
+                *w |= self.step << 16;
+            }
+        }
+        for _ in 0..left {
+            self.place::<CHECK>(steps.advance(), out, carry, &mut tally);
+        }
+        (m.count - tally.missed, tally.missed + tally.doubled + doubled)
+    }
+
+    /// One step at slot `s` with every case: its pulse ending in the next buffer (`carry`), or no slot for it.
+    #[inline(always)]
+    fn place<const CHECK: bool>(self, s: usize, out: &mut [u32], carry: &mut [u32; 4], tally: &mut Tally) {
+        let slots = out.len();
+        let Some(word) = out.get_mut(s) else {
+            tally.missed += 1;
+            return;
+        };
+        if CHECK && *word & self.step != 0 {
+            tally.doubled += 1;
+        }
+        *word |= self.step;
+        let end = s + self.pulse_slots;
+        match out.get_mut(end) {
+            Some(w) => *w |= self.step << 16,
+            None => {
+                if let Some(c) = carry.get_mut(end - slots) {
+                    *c |= self.step << 16;
                 }
             }
         }
-        Some(report)
+    }
+}
+
+/// Steps of one axis that found no slot, and steps into a slot already holding one.
+#[derive(Default)]
+struct Tally {
+    missed: u32,
+    doubled: u32,
+}
+
+/// The slots of a move's steps, one division each. Step `k` is at `start + floor((2k + 1) span / 2n)` ns
+/// ([`AxisMove::step_ns`]), in slot `floor(that / slot)`; an integer added to a floor is the floor of the sum, and
+/// nested floors of integer quotients are the floor of one quotient, so the slot is
+/// `floor((2n start + (2k + 1) span) / (2n slot))`: a numerator growing by `2 span` a step over a fixed
+/// denominator, where the times would need a quotient, a remainder and a division by the slot each.
+struct StepSlots {
+    numerator: u32,
+    increment: u32,
+    denominator: u32,
+}
+
+impl StepSlots {
+    /// `None` when a numerator or the denominator exceeds `u32` (about 2,000 steps in a 1 ms period), so that
+    /// the M4F divides in one instruction.
+    fn new(m: &AxisMove, slot_ns: u32) -> Option<Self> {
+        let span = m.period_ns.saturating_sub(m.start_ns);
+        let twice = m.count.max(1).checked_mul(2)?;
+        // Every numerator of a step is below `2n period` (or is `2n start`, the window empty).
+        twice.checked_mul(m.period_ns.max(m.start_ns))?;
+        Some(Self {
+            numerator: twice * m.start_ns + span,
+            increment: 2 * span,
+            denominator: twice.checked_mul(slot_ns)?,
+        })
+    }
+
+    /// The next step's slot; past the last step, meaningless slots.
+    #[inline(always)]
+    fn advance(&mut self) -> usize {
+        let s = self.numerator / self.denominator;
+        // Wraps only past the last step, whose numerator is never divided.
+        self.numerator = self.numerator.wrapping_add(self.increment);
+        s as usize
     }
 }

@@ -103,6 +103,14 @@ impl AxisMove {
         self.start_ns.saturating_add(offset)
     }
 
+    /// The least time between two consecutive steps (ns): `span / count`, since the times of
+    /// [`AxisMove::step_ns`] are `floor` of points exactly `span / count` apart and
+    /// `floor(x + d) - floor(x) >= floor(d)`. 0 when the window is empty (a start at or past the period's end puts
+    /// every step at the start).
+    pub fn spacing_ns(&self) -> u32 {
+        self.period_ns.saturating_sub(self.start_ns) / self.count.max(1)
+    }
+
     /// Times of all steps (ns from the period start), the values of [`AxisMove::step_ns`] without a division
     /// each: the numerator `(2k + 1) span` grows by `2 span` a step, so its quotient by `2 count` grows by
     /// `span / count` and its remainder by `2 (span % count)`, carried when it reaches `2 count`. The pulse
@@ -162,11 +170,13 @@ impl Iterator for StepTimes {
             return Some(self.axis.step_ns(k));
         }
         let t = self.axis.start_ns.saturating_add(self.quotient);
-        self.quotient += self.step;
+        // A step's quotient is at most the span; only the one past the last step can exceed u32 (a span near
+        // 2^32), and it is never returned, so it wraps.
+        self.quotient = self.quotient.wrapping_add(self.step);
         self.remainder += self.carry;
         if self.remainder >= self.den {
             self.remainder -= self.den;
-            self.quotient += 1;
+            self.quotient = self.quotient.wrapping_add(1);
         }
         Some(t)
     }

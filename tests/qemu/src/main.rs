@@ -187,10 +187,33 @@ fn controller_costs(report: &dyn Fn(&str, u32, u32)) {
     report("control tick at 2 kHz (the same work, half the period)", tick, n);
 }
 
-/// The step generator's CPU work for one period of step buffers.
+/// The step generator's CPU work for one period of step buffers, idle, at typical rates, at the trainer model's
+/// fastest motion and at the top rate.
 fn render_costs(report: &dyn Fn(&str, u32, u32)) {
-    // The step generator's CPU work: one period's pulse buffer at 100 k steps/s on all six axes (100 steps each in
-    // 1 ms), DIR reversing on every axis.
+    let rows: [(&str, [i64; 6]); 4] = [
+        ("render one period of step buffers, idle (no steps)", [0; 6]),
+        (
+            "render one period of step buffers, typical motion (6 axes x 10 k steps/s)",
+            [10; 6],
+        ),
+        (
+            "render one period of step buffers, the trainer's fastest motion (4 x 10 k, 2 x 96 k steps/s)",
+            [10, 10, 10, 10, 96, 96],
+        ),
+        (
+            "render one period of step buffers (6 axes x 100 k steps/s, 1 kHz)",
+            [100; 6],
+        ),
+    ];
+    for (name, per_period) in rows {
+        let (total, periods) = render_cost(per_period);
+        report(name, total, periods);
+    }
+}
+
+/// SysTick counts of rendering 20 periods of `per_period` steps on each axis, DIR reversing every period, and the
+/// number of periods.
+fn render_cost(per_period: [i64; 6]) -> (u32, u32) {
     let scheduler = SchedulerConfig::default();
     let timing = PulseTiming::new(&scheduler, STEP_SLOT_NS, MAX_STEP_SLOTS).unwrap_or_else(|_| fail("pulse timing"));
     let map = PortMap {
@@ -201,24 +224,21 @@ fn render_costs(report: &dyn Fn(&str, u32, u32)) {
     let mut renderer = PulseRenderer::new(map, timing).unwrap_or_else(|_| fail("pulse renderer"));
     let mut plan = StepScheduler::new(scheduler, [0; 6]);
     let mut buffer = [0u32; MAX_STEP_SLOTS];
-    let (mut render_total, mut rendered) = (0u32, 0u32);
-    for k in 0..20i64 {
-        let target = if k % 2 == 0 { 100 } else { 0 };
-        let moves = plan.plan(&[target; 6]);
-        render_total += counts(|| {
+    let (mut total, mut rendered) = (0u32, 0i64);
+    let periods = 20u32;
+    for k in 0..periods {
+        let target = if k % 2 == 0 { per_period } else { [0; 6] };
+        let moves = plan.plan(&target);
+        total += counts(|| {
             if let Some(r) = renderer.render(black_box(&moves), &mut buffer) {
-                rendered += r.steps.iter().sum::<u32>();
+                rendered += r.steps.iter().map(|&n| i64::from(n)).sum::<i64>();
             }
         });
     }
-    if rendered != 20 * 600 {
+    if rendered != i64::from(periods) * per_period.iter().sum::<i64>() {
         fail("rendered steps");
     }
-    report(
-        "render one period of step buffers (6 axes x 100 k steps/s, 1 kHz)",
-        render_total,
-        20,
-    );
+    (total, periods)
 }
 
 /// SysTick counts of the control ticks and of the setpoint frames of 500 ticks of a stream moving

@@ -287,10 +287,14 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         pose: &Pose<T>,
         guard: &mut SlowCheckGuard<T>,
     ) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
-        self.solve(pose, &mut guard.scratch)?;
-        guard.scratch.direct(self.n);
+        // The configuration solved into; evaluating the slow checks there makes it the reference, and the next
+        // pose goes into the other.
+        let current = guard.current & 1;
+        let c = &mut guard.configs[current];
+        self.solve(pose, c)?;
+        c.direct(self.n);
         let (slow, _) = self.slow_margins(guard);
-        let c = &guard.scratch;
+        let c = &guard.configs[current];
         Ok((c.q, self.report_with(pose, c, &slow)))
     }
 
