@@ -69,3 +69,71 @@ pub(crate) fn take_from_bytes<'de, T: Deserialize<'de>>(bytes: &'de [u8]) -> pos
     let value = T::deserialize(&mut deserializer)?;
     Ok((value, deserializer.finalize()?))
 }
+
+#[cfg(test)]
+#[allow(clippy::expect_used, clippy::panic)]
+mod tests {
+    use super::*;
+    use crate::controller::{Controller, ControllerConfig};
+    use crate::protocol::{DeviceMessage, Response, RigSource, MAX_PAYLOAD};
+
+    /// The largest message (a rig) and one of many fields (the status), as a device sends them.
+    fn responses() -> [Response; 2] {
+        let config = ControllerConfig::trainer_model();
+        let status = Controller::new(config).map(|c| c.status());
+        let status = status.unwrap_or_else(|e| panic!("the trainer model runs: {e:?}"));
+        [
+            Response {
+                id: 7,
+                body: DeviceMessage::Rig {
+                    rig: config.rig(),
+                    source: RigSource::Stored,
+                    pending: true,
+                },
+            },
+            Response {
+                id: u32::MAX,
+                body: DeviceMessage::Status(status),
+            },
+        ]
+    }
+
+    #[test]
+    fn writes_the_bytes_postcard_writes_and_refuses_the_buffers_it_refuses() {
+        for response in responses() {
+            let (mut ours, mut theirs) = ([0u8; MAX_PAYLOAD], [0u8; MAX_PAYLOAD]);
+            let len = to_slice(&response, &mut ours).expect("fits");
+            let expected = postcard::to_slice(&response, &mut theirs).expect("fits");
+            assert_eq!(&ours[..len], &expected[..]);
+            for short in 0..len {
+                assert!(
+                    to_slice(&response, &mut ours[..short]).is_err(),
+                    "{short} of {len} bytes"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn reads_what_postcard_reads_and_leaves_the_same_remainder() {
+        for response in responses() {
+            let mut bytes = [0u8; MAX_PAYLOAD + 3];
+            let len = to_slice(&response, &mut bytes).expect("fits");
+            bytes[len..len + 3].copy_from_slice(&[1, 2, 3]);
+            let with_rest = &bytes[..len + 3];
+            assert_eq!(take_from_bytes::<Response>(with_rest), Ok((response, &[1u8, 2, 3][..])));
+            assert_eq!(
+                take_from_bytes::<Response>(with_rest),
+                postcard::take_from_bytes::<Response>(with_rest)
+            );
+            for cut in 0..len {
+                assert_eq!(
+                    take_from_bytes::<Response>(&bytes[..cut]),
+                    postcard::take_from_bytes::<Response>(&bytes[..cut]),
+                    "cut at {cut} of {len}"
+                );
+                assert!(take_from_bytes::<Response>(&bytes[..cut]).is_err());
+            }
+        }
+    }
+}
