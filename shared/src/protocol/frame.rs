@@ -4,6 +4,8 @@ use core::fmt;
 
 use serde::{de::DeserializeOwned, Serialize};
 
+use super::wire;
+
 /// Largest postcard payload of any message (bytes): a rig record with six chains (`HostMessage::SetRig`,
 /// `DeviceMessage::Rig`) is the largest, about 560 (tested in `tests/rig_record.rs`).
 pub const MAX_PAYLOAD: usize = 768;
@@ -52,14 +54,11 @@ const SMALL_PAYLOAD: usize = 96;
 /// Encodes `message` into `out` as one frame, delimiter included; returns its length.
 pub fn encode<M: Serialize>(message: &M, out: &mut [u8]) -> Result<usize, FrameError> {
     let mut small = [0u8; SMALL_PAYLOAD + 4];
-    if let Ok(payload) = postcard::to_slice(message, &mut small[..SMALL_PAYLOAD]) {
-        let len = payload.len();
+    if let Ok(len) = wire::to_slice(message, &mut small[..SMALL_PAYLOAD]) {
         return seal(&mut small, len, out);
     }
     let mut raw = [0u8; MAX_PAYLOAD + 4];
-    let len = postcard::to_slice(message, &mut raw[..MAX_PAYLOAD])
-        .map_err(|_| FrameError::TooLong)?
-        .len();
+    let len = wire::to_slice(message, &mut raw[..MAX_PAYLOAD]).map_err(|_| FrameError::TooLong)?;
     seal(&mut raw, len, out)
 }
 
@@ -99,7 +98,7 @@ pub fn unframe<'a>(frame: &[u8], scratch: &'a mut [u8]) -> Result<&'a [u8], Fram
 
 /// A message from a whole payload (no bytes left over).
 pub fn parse<M: DeserializeOwned>(payload: &[u8]) -> Result<M, FrameError> {
-    match postcard::take_from_bytes::<M>(payload) {
+    match wire::take_from_bytes::<M>(payload) {
         Ok((message, [])) => Ok(message),
         _ => Err(FrameError::Payload),
     }

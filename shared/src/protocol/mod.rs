@@ -12,6 +12,7 @@ mod frame;
 mod messages;
 mod rig;
 mod settings;
+pub(crate) mod wire;
 
 pub use field::{ConfigRefusal, Field, FieldName};
 pub use frame::{decode, encode, parse, unframe, FrameError, FrameReader, MAX_FRAME, MAX_PAYLOAD};

@@ -16,7 +16,7 @@ use sequential_storage::cache::NoCache;
 use sequential_storage::map::{fetch_item, store_item};
 
 use crate::controller::ControllerConfig;
-use crate::protocol::{ControlSettings, RigRecord, RigSource, Settings, StreamSettings};
+use crate::protocol::{wire, ControlSettings, RigRecord, RigSource, Settings, StreamSettings};
 
 mod v2;
 
@@ -104,10 +104,10 @@ pub async fn restore<F: NorFlash>(
 /// The record in `bytes`, of this version or migrated from version 2. The version is the first field of every
 /// version, so it is read first and decides the layout.
 fn read(bytes: &[u8]) -> Option<Record> {
-    match postcard::take_from_bytes::<u16>(bytes).ok()?.0 {
-        RECORD_VERSION => postcard::from_bytes::<Record>(bytes).ok(),
+    match wire::take_from_bytes::<u16>(bytes).ok()?.0 {
+        RECORD_VERSION => wire::take_from_bytes::<Record>(bytes).ok().map(|(record, _)| record),
         2 => {
-            let old = postcard::from_bytes::<v2::Record>(bytes).ok()?;
+            let (old, _) = wire::take_from_bytes::<v2::Record>(bytes).ok()?;
             Some(Record {
                 version: RECORD_VERSION,
                 rig: old.rig(),
@@ -133,10 +133,10 @@ pub async fn store<F: NorFlash>(
         control: config.control(),
     };
     let mut bytes = [0u8; RECORD_BUFFER];
-    let Ok(encoded) = postcard::to_slice(&record, &mut bytes) else {
+    let Ok(len) = wire::to_slice(&record, &mut bytes) else {
         return Err(sequential_storage::Error::ItemTooBig);
     };
-    let encoded: &[u8] = encoded;
+    let encoded: &[u8] = &bytes[..len];
     let mut buf = [0u8; RECORD_BUFFER];
     store_item(flash, range, &mut NoCache::new(), &mut buf, &CONFIG_KEY, &encoded).await
 }

@@ -7,7 +7,8 @@
 //!    and to the USB host on the emulated OTG FS core.
 //! 2. A Python venv in `target/rehost-venv` with the pinned emulator (`tests/rehost/requirements.txt`), made again
 //!    whenever that file changes.
-//! 3. The models' unit tests (`python -m unittest`), counted as one check, then `tests/rehost/run.py`, whose checks
+//! 3. The firmware's flash against its budget (`size`), counted as one check.
+//! 4. The models' unit tests (`python -m unittest`), counted as one check, then `tests/rehost/run.py`, whose checks
 //!    print `PASS`/`FAIL` lines. The last line is the sum, `N passed, N failed`; the exit status is 1 when anything
 //!    failed.
 //!
@@ -16,6 +17,7 @@
 
 mod mutants;
 mod prepare;
+mod size;
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
@@ -87,6 +89,30 @@ fn main() -> ExitCode {
         return mutants::run(&python, &cli, &args[1..]);
     }
     let (mut passed, mut failed) = (0, 0);
+    match size::measure(&elf) {
+        Ok(m) if m.flash <= size::FLASH_BUDGET => {
+            println!(
+                "PASS firmware-size: flash {} B (budget {} B), RAM {} B",
+                m.flash,
+                size::FLASH_BUDGET,
+                m.ram
+            );
+            passed += 1;
+        }
+        Ok(m) => {
+            println!(
+                "FAIL firmware-size: flash {} B, over its budget of {} B (RAM {} B)",
+                m.flash,
+                size::FLASH_BUDGET,
+                m.ram
+            );
+            failed += 1;
+        }
+        Err(e) => {
+            println!("FAIL firmware-size: {e}");
+            failed += 1;
+        }
+    }
     match unit_tests(&python) {
         Ok(n) => {
             println!("PASS model-unit-tests: {n} tests of tests/rehost/models (python -m unittest)");
