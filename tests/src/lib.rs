@@ -5,6 +5,7 @@ pub mod busy;
 pub mod emulator;
 pub mod scenario;
 pub mod setup;
+pub mod wine;
 
 /// The simulated plant lives in the core, where the host's simulator uses it too.
 pub use ringpod_core::sim as plant;
