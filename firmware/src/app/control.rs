@@ -26,6 +26,21 @@ pub trait Machine {
 /// rest of a longer hold-up is passed.
 const CATCH_UP: u32 = 10;
 
+/// Waits for the next period, unless a stall owes periods: device time the time driver lost (an erase,
+/// `settings`), periods gone already, each passed at once before the timer's next (`true`). Counted apart from the
+/// timer's deadline, which a stall longer than the time since the start (a save soon after a reset) would take
+/// below zero, where the excess would be lost.
+async fn next_period(owed_us: &mut u64, tick_us: u32, due: Instant, shared: &Shared) -> bool {
+    *owed_us += u64::from(shared.clock_lost_us.swap(0, Ordering::Relaxed));
+    let owed = *owed_us >= u64::from(tick_us);
+    if owed {
+        *owed_us -= u64::from(tick_us);
+    } else {
+        Timer::at(due).await;
+    }
+    owed
+}
+
 /// Runs the control loop at the controller's rate, forever, each tick held [`TickPhase`]'s lead before the step
 /// generator's next period boundary so that its moves are taken at that boundary.
 pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
@@ -38,16 +53,7 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
     let mut n = 0u32;
     let mut owed_us = 0u64;
     loop {
-        // Device time a stall cost the time driver (an erase, `settings`): periods gone already, each passed before
-        // the timer's next. Kept apart from `due`, which a stall longer than the time since the start (a save soon
-        // after a reset) would take below zero, where the excess would be lost.
-        owed_us += u64::from(shared.clock_lost_us.swap(0, Ordering::Relaxed));
-        let owed = owed_us >= u64::from(tick_us);
-        if owed {
-            owed_us -= u64::from(tick_us);
-        } else {
-            Timer::at(due).await;
-        }
+        let owed = next_period(&mut owed_us, tick_us, due, shared).await;
         // After a hold-up the periods it cost are caught up at once (mostly as passes), so that the controller's
         // clocks lose none of them; the phase is only judged on a tick that ran on time, and by when it was due:
         // a tick that starts late behind a link frame is jitter the lead covers, not a phase to correct.
