@@ -173,3 +173,31 @@ pub fn run(python: &Path, cli: &Path, only: &[String]) -> ExitCode {
         ExitCode::FAILURE
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every mutant still applies to the sources as they are: each `find` occurs exactly once in its file (a
+    /// change of the firmware that moves a line a mutant edits would otherwise leave that fault untried until
+    /// someone runs `--mutants`).
+    #[test]
+    fn every_mutant_applies_to_the_sources_as_they_are() {
+        let text = std::fs::read_to_string(repo().join("tests/rehost/mutants.toml")).unwrap();
+        let list: List = toml::from_str(&text).unwrap();
+        assert!(list.mutant.len() >= 13, "{}", list.mutant.len());
+        for mutant in &list.mutant {
+            for edit in &mutant.edit {
+                let source = std::fs::read_to_string(repo().join(&edit.file)).unwrap();
+                assert_eq!(
+                    source.matches(&edit.find).count(),
+                    1,
+                    "{}: {:?} in {}",
+                    mutant.name,
+                    edit.find,
+                    edit.file
+                );
+            }
+        }
+    }
+}
