@@ -25,7 +25,16 @@ class PtyBridge:
         self.to_board = self.to_host = 0
         usart.on_tx = self.out.append
 
+    def hang_up(self):
+        """The port gone, as Linux's CDC-ACM driver hangs up /dev/ttyACM* when the device leaves the bus: a client
+        that holds it open reads EIO from then on."""
+        os.close(self.slave)
+        os.close(self.master)
+        self.master = None
+
     def poll(self):
+        if self.master is None:
+            return
         try:
             data = os.read(self.master, 4096)
         except (BlockingIOError, OSError):  # nothing to read; EIO while no client has the port open

@@ -190,6 +190,7 @@ def cable_check(checks, m, link, plant):
         if not pulled and link.bridge.to_board - since > 2_000 and moves:
             pulled.append(m.now)
             link.host.unplug()
+            link.bridge.hang_up()
 
     r = link.cli.run("stream", *port, "--motion", "demo", "--duration", "4", "--rate", "50", "--quiet",
                      "--report-json", sim_limit_s=30, during=during, expect=(6,))
@@ -206,6 +207,8 @@ def cable_check(checks, m, link, plant):
     while link.host.enumerations == enumerations and m.now - start < 2 * SYSCLK:
         m.run(m.now + SYSCLK // 100)
     again_ms = (m.now - start) * 1000 / SYSCLK
+    m.observers.remove(link.bridge.poll)
+    port = link.open_port()  # the port the enumeration made
     st = link.cli.run("device", "status", *port)
     try:
         status = json.loads(st.stdout)
