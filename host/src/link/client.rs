@@ -211,6 +211,22 @@ impl<T: Transport> Client<T> {
         self.wait_response(id)
     }
 
+    /// Sends a request that may be lost and sent again, and waits `per_try` (not the whole timeout) for its answer;
+    /// its id is kept in `tries`, so that the caller can drop the late answers to the tries before.
+    fn try_once(
+        &mut self,
+        body: HostMessage,
+        per_try: Duration,
+        tries: &mut Vec<u32>,
+    ) -> Result<DeviceMessage, ClientError> {
+        let id = self.send(body)?;
+        tries.push(id);
+        let timeout = std::mem::replace(&mut self.timeout, per_try);
+        let answer = self.wait_response(id);
+        self.timeout = timeout;
+        answer
+    }
+
     /// Sends a request and takes the answer its [`Endpoint`] names; a Nack is [`ClientError::Device`], any other
     /// message [`ClientError::Unexpected`].
     pub fn call<E: Endpoint>(&mut self, endpoint: E) -> Result<E::Answer, ClientError> {
@@ -230,22 +246,14 @@ impl<T: Transport> Client<T> {
     pub fn hello(&mut self) -> Result<Device, ClientError> {
         let patience = self.timeout.max(super::patience(Duration::from_secs(5)));
         let per_try = Duration::from_millis(500);
-        let timeout = self.timeout;
-        self.timeout = per_try;
         let mut tries = Vec::new();
         let answer = loop {
-            let id = match self.send(Hello.request()) {
-                Ok(id) => id,
-                Err(e) => break Err(e),
-            };
-            tries.push(id);
-            match self.wait_response(id) {
+            match self.try_once(Hello.request(), per_try, &mut tries) {
                 Err(ClientError::Timeout(_)) if per_try * tries.len() as u32 <= patience => continue,
                 Err(ClientError::Timeout(_)) => break Err(ClientError::Timeout(patience)),
                 other => break other,
             }
         };
-        self.timeout = timeout;
         self.pump()?;
         self.inbox.retain(|r| !tries.contains(&r.id));
         let version = match Hello.answer(answer?) {
@@ -330,15 +338,10 @@ impl<T: Transport> Client<T> {
         let limit = super::patience(limit);
         let per_try = super::patience(Duration::from_millis(250));
         let pause = Duration::from_millis(50);
-        let timeout = std::mem::replace(&mut self.timeout, per_try);
         let mut tries = Vec::new();
         let mut waited = Duration::ZERO;
         let outcome = loop {
-            let answer = self.send(GetStatus.request()).and_then(|id| {
-                tries.push(id);
-                self.wait_response(id)
-            });
-            match answer {
+            match self.try_once(GetStatus.request(), per_try, &mut tries) {
                 Ok(DeviceMessage::Nack(NackReason::NotConnected)) => break Ok(true),
                 Err(ClientError::Io(_)) => break Ok(false),
                 Err(ClientError::Timeout(_)) => waited += per_try,
@@ -351,7 +354,6 @@ impl<T: Transport> Client<T> {
             self.transport.elapse(pause);
             waited += pause;
         };
-        self.timeout = timeout;
         if matches!(outcome, Ok(true)) {
             self.pump()?;
         }
