@@ -23,6 +23,8 @@ electrically (the pins as `models.gpio.Gpio` says the chip drives them, not its 
 
 from collections import Counter
 
+from machine import SYSCLK
+
 TRAINER_MODEL_PARKED = [-500, -400, -300, -200, 8_000, 9_000]  # shared/src/model.rs
 # shared/src/model.rs, CARRIAGE_HOMING and LINEAR_HOMING: where the firmware puts each axis when its switch trips on
 # the slow approach (the carriages' index at 0 rad; the end switch at -66.31 mm x 1,600 steps/mm), the slow
@@ -35,7 +37,7 @@ DIR = [6, 7, 8, 9, 10, 12]
 ENABLE_N, LOGIC_EN, POWER_EN = 13, 14, 15
 FLAG_WIDTH, FAR_LIMIT = 60, 240_000
 BOUNCE_US = (150, 400, 900, 1_600)  # a contact's changes after its first edge: old, new, old, new level
-CYCLES_PER_US = 96  # SYSCLK, machine.py
+CYCLES_PER_US = SYSCLK // 1_000_000
 PORT_A, PORT_C = 0, 2
 ESTOP, LOGIC_OK, POWER_OK = 0, 9, 14  # PA0, PA9, PC14
 WIRED_A = {ESTOP, 1, 2, 3, 4, 5, 6, 7, 8, LOGIC_OK}  # the switches and LOGIC_OK on port A
