@@ -194,6 +194,9 @@ pub enum CueError {
         /// Why.
         reason: std::io::Error,
     },
+    /// The bench's floor could not be found.
+    #[error("the floor: {0}")]
+    Floor(super::optimal::floor::FloorError),
     /// The command's other errors: the mechanism, the cueing file, the picture, the JSON.
     #[error(transparent)]
     Cli(#[from] CliError),

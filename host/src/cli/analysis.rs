@@ -274,6 +274,10 @@ pub struct CueArgs {
     /// envelope (a small coordinate search, see the book's Motion cueing chapter).
     #[arg(long, requires = "compare")]
     pub tune: bool,
+    /// With --compare: add the floor, the least perceived force error any motion inside the envelope's ranges
+    /// can give, found with the whole drive known (one programme per axis over the drive), and its motion scored.
+    #[arg(long, requires = "compare")]
+    pub floor: bool,
     /// With `algorithm = "optimal"`: the reference over the horizon is the drive's own next samples (a recorded
     /// drive's preview) rather than the last sample held, as a live game gives it.
     #[arg(long)]

@@ -144,6 +144,7 @@ impl CueArgs {
             tune: self.tune,
             json: self.json,
             preview: self.preview,
+            floor: self.floor,
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
         })

@@ -2,6 +2,8 @@
 //! platform, scored by what the rider perceives ([`score`]), printed as a table and written as JSON, with a
 //! picture of the perceived forces. `--tune` first searches the first file's classical washout for the best score
 //! on the same drives and envelope ([`tune`]), so that a comparison is against the best classical tuning.
+//! `--floor` adds the least error any motion inside the envelope's ranges can give ([`super::optimal::floor`]),
+//! so that both are measured against what the rig allows, not only against each other.
 
 mod picture;
 pub mod score;
@@ -9,13 +11,13 @@ pub mod tune;
 
 use std::path::{Path, PathBuf};
 
-use ringpod_core::cueing::{Algorithm, CueConfig};
+use ringpod_core::cueing::{Algorithm, CueConfig, Forward, Telemetry};
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use serde::Serialize;
 
 use super::cue::{read_drive, replay, CueError};
 use super::mechanism::{AnyMechanism, Selected};
-use super::optimal::{Counts, Ranges};
+use super::optimal::{floor, Counts, Ranges};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
 use score::{score, Score, Trace};
@@ -36,6 +38,8 @@ pub struct Options<'a> {
     pub json: bool,
     /// The optimal cueing sees each drive's next samples.
     pub preview: bool,
+    /// Add the floor: the least error any motion inside the ranges can give, the whole drive known.
+    pub floor: bool,
     /// The platform: a preset by name...
     pub mechanism: &'a str,
     /// ...or a rig file.
@@ -75,6 +79,21 @@ pub struct Report {
     pub tuned: Option<String>,
     /// The algorithms compared.
     pub entries: Vec<Entry>,
+    /// With `--floor`: the least error any motion inside the ranges can give.
+    pub floor: Option<FloorReport>,
+}
+
+/// The floor ([`floor`]) of every drive together.
+#[derive(Debug, Serialize)]
+pub struct FloorReport {
+    /// The least RMS perceived specific-force error on the optimiser's model, x, y, z (m/s^2).
+    pub force_rms: [f64; 3],
+    /// The three axes together (m/s^2).
+    pub force_total: f64,
+    /// Each drive's, x, y, z (m/s^2), in the order of the drives.
+    pub drives: Vec<[f64; 3]>,
+    /// The largest share of each range the floor's motion used: x, y, z, roll, pitch.
+    pub envelope_share: [f64; 5],
 }
 
 /// A drive's rows.
@@ -124,6 +143,49 @@ pub fn evaluate(
         },
         traces,
     ))
+}
+
+/// The floor of the drives on the optimiser's model, every drive's samples together. Its motion is not scored:
+/// bounded by the ranges alone, it swings the tilt at any rate and reaches corners of the ranges' box outside the
+/// coupled envelope, so the bench would score the limiter and the finite differences of a motion no cueing
+/// makes, not the floor.
+fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward) -> Result<FloorReport, CueError> {
+    let (mut sum, mut n) = ([0.0; 3], 0usize);
+    let mut envelope_share = [0.0f64; 5];
+    let mut each = Vec::new();
+    for rows in drives {
+        let t: Vec<f64> = rows.iter().map(|(_, v)| v[0]).collect();
+        let samples: Vec<Telemetry<f64>> = rows
+            .iter()
+            .map(|(_, v)| Telemetry {
+                force: [v[1], v[2], v[3]],
+                rate: [v[4], v[5], v[6]],
+            })
+            .collect();
+        let f = floor::floor(&t, &samples, &rig.ranges, forward).map_err(CueError::Floor)?;
+        let m = t.len().saturating_sub(1);
+        for (total, rms) in sum.iter_mut().zip(f.force_rms) {
+            *total += rms * rms * m as f64;
+        }
+        n += m;
+        each.push(f.force_rms);
+        for offset in &f.offsets {
+            for (i, share) in envelope_share.iter_mut().enumerate() {
+                let (lo, hi) = rig.ranges[i];
+                let edge = if offset[i] >= 0.0 { hi } else { lo };
+                if edge != 0.0 {
+                    *share = share.max(offset[i] / edge);
+                }
+            }
+        }
+    }
+    let force_rms = sum.map(|v| (v / n.max(1) as f64).sqrt());
+    Ok(FloorReport {
+        force_total: force_rms.iter().map(|r| r * r).sum::<f64>().sqrt(),
+        force_rms,
+        drives: each,
+        envelope_share,
+    })
 }
 
 /// The scores of several drives as one: RMS weighted by samples, the largest peaks and shares, the sums.
@@ -198,12 +260,14 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         entries.push(e);
         traces.push(t);
     }
+    let floor = args.floor.then(|| floor_of(&drives, &rig, a.forward)).transpose()?;
     let report = Report {
         drives: args.inputs.iter().map(|p| p.display().to_string()).collect(),
         mechanism: selected.name,
         ranges: rig.ranges,
         tuned,
         entries,
+        floor,
     };
     let json = serde_json::to_string_pretty(&report).map_err(CliError::from)? + "\n";
     crate::out::file::write(args.out, json.as_bytes()).map_err(|reason| CueError::Output {
@@ -270,12 +334,76 @@ fn table(r: &Report) -> String {
         e.solve_ms
             .map_or("-".into(), |t| format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2]))
     });
-    if let [a, b] = r.entries.as_slice() {
-        let ratio = b.total.force_total() / a.total.force_total().max(1e-12);
+    if let Some(f) = &r.floor {
+        let [x, y, z] = f.force_rms;
         s += &format!(
-            "{} / {} perceived force error (RMS, all axes): {ratio:.3}\n",
-            b.name, a.name
+            "floor: the least perceived force error RMS x y z, all axes, of any motion inside the ranges \
+             (the optimiser's model, the whole drive known): {x:.3} {y:.3} {z:.3}, {:.3} m/s^2\n",
+            f.force_total
         );
     }
+    if let [a, rest @ ..] = r.entries.as_slice() {
+        for b in rest {
+            let ratio = b.total.force_total() / a.total.force_total().max(1e-12);
+            s += &format!(
+                "{} / {} perceived force error (RMS, all axes): {ratio:.3}\n",
+                b.name, a.name
+            );
+        }
+        if let Some(f) = &r.floor {
+            let ratio = f.force_total / a.total.force_total().max(1e-12);
+            s += &format!("floor / {} perceived force error (RMS, all axes): {ratio:.3}\n", a.name);
+        }
+    }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// On the shipped example drive, neither the classical washout nor the optimal cueing perceives less force
+    /// error than the floor, which keeps to the ranges; the table says it and its ratio.
+    #[test]
+    fn no_cueing_on_the_bench_beats_the_floor() {
+        let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs");
+        let out = std::env::temp_dir().join(format!("ringpod-floor-{}.json", std::process::id()));
+        let (classical, optimal) = (docs.join("drives/classical.toml"), docs.join("drives/optimal.toml"));
+        let inputs = [docs.join("drive-telemetry.csv")];
+        let options = Options {
+            configs: [&classical, &optimal],
+            inputs: &inputs,
+            out: &out,
+            plot: None,
+            tune: false,
+            json: false,
+            preview: false,
+            floor: true,
+            mechanism: "trainer-model",
+            geometry: None,
+        };
+        let (table, code) = run(&options).unwrap();
+        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        std::fs::remove_file(&out).unwrap();
+        assert_eq!(code, 0);
+        let floor = report["floor"]["force_total"].as_f64().unwrap();
+        assert!(floor > 0.1, "{report}");
+        for e in report["entries"].as_array().unwrap() {
+            let rms: Vec<f64> = e["total"]["force_rms"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|v| v.as_f64().unwrap())
+                .collect();
+            let total = rms.iter().map(|r| r * r).sum::<f64>().sqrt();
+            assert!(floor < total, "floor {floor} against {}: {total}", e["name"]);
+        }
+        for share in report["floor"]["envelope_share"].as_array().unwrap() {
+            assert!(share.as_f64().unwrap() <= 1.0 + 1e-4, "{report}");
+        }
+        assert!(
+            table.contains("floor / classical.toml perceived force error"),
+            "{table}"
+        );
+    }
 }

@@ -12,6 +12,7 @@
 //! alongside on the same samples gives its *change* over the sample, carried on from where the platform is.
 //! Taking the washout's position instead would jump between two different trajectories: felt as a false cue.
 
+pub mod floor;
 pub mod model;
 pub mod qp;
 
