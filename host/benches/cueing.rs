@@ -29,7 +29,7 @@ fn one_sample(c: &mut Criterion) {
         (-0.454, 0.384),
         (-0.358, 0.358),
     ];
-    let mut o = optimal::Optimal::new(config, &ranges).expect("the defaults are valid");
+    let mut o = optimal::Optimal::new(config, &ranges.into()).expect("the defaults are valid");
     o.begin(&sample(0.0)).expect("finite");
     let mut t = 0.0;
     c.bench_function("optimal cueing: one sample (three axes)", |b| {

@@ -118,7 +118,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         config,
         &mechanism,
         &neutral,
-        &super::cue_engine::ranges(&mechanism, &neutral),
+        &super::cue_engine::envelope(&mechanism, &neutral),
         args.preview,
     )?;
     errors.append(&mut cue_errors);
@@ -203,7 +203,7 @@ pub enum CueError {
 }
 
 /// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`
-/// (whose envelope about home is `ranges`, [`super::cue_engine::ranges`]: scanned once by the caller, however
+/// (whose envelope about home is `envelope`, [`super::cue_engine::envelope`]: scanned once by the caller, however
 /// many configurations it replays), every pose limited into the envelope; with `preview`, the optimal cueing sees the drive's next samples (the
 /// reference over its horizon) rather than the last sample held.
 pub fn replay(
@@ -211,11 +211,11 @@ pub fn replay(
     config: cueing::CueConfig,
     mechanism: &RingPlatform<f64>,
     neutral: &Pose<f64>,
-    ranges: &super::optimal::Ranges,
+    envelope: &super::optimal::Envelope,
     preview: bool,
 ) -> Result<Replay, CueError> {
     let margins = EnvelopeMargins::default();
-    let mut washout = super::cue_engine::Engine::new(config, ranges).map_err(CueError::Washout)?;
+    let mut washout = super::cue_engine::Engine::new(config, envelope).map_err(CueError::Washout)?;
     // A recorded drive's next samples, for the optimal cueing's preview.
     let preview = washout.horizon().filter(|_| preview);
     let mut errors = Vec::new();

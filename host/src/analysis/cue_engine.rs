@@ -5,7 +5,7 @@ use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telem
 use ringpod_core::kinematics::{Pose, RingPlatform};
 
 use super::mechanism::AnyMechanism;
-use super::optimal::{Counts, Optimal, Ranges};
+use super::optimal::{Counts, Envelope, Optimal, Ranges};
 
 /// A running cueing.
 pub enum Engine {
@@ -20,12 +20,20 @@ pub fn ranges(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Ranges {
     super::workspace::ranges_about_home(&AnyMechanism::Ring(Box::new(*mechanism)), neutral.to_array())
 }
 
+/// The envelope about `neutral` the optimal cueing plans in: the ranges, and the rig for the tilt's shared room.
+pub fn envelope(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Envelope {
+    Envelope {
+        ranges: ranges(mechanism, neutral),
+        rig: Some((*mechanism, *neutral)),
+    }
+}
+
 impl Engine {
-    /// The engine of `config` for a platform whose envelope about home is `ranges`.
-    pub fn new(config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
+    /// The engine of `config` for a platform whose envelope about home is `envelope`.
+    pub fn new(config: CueConfig, envelope: &Envelope) -> Result<Self, ConfigError> {
         Ok(match config.algorithm {
             Algorithm::Classical => Self::Classical(Box::new(Washout::new(config)?)),
-            Algorithm::Optimal => Self::Optimal(Box::new(Optimal::new(config, ranges)?)),
+            Algorithm::Optimal => Self::Optimal(Box::new(Optimal::new(config, envelope)?)),
         })
     }
 

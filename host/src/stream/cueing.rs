@@ -7,13 +7,13 @@
 use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout, HANDOVER_S};
 
 use crate::analysis::cue_engine::Engine;
-use crate::analysis::optimal::{Counts, Ranges};
+use crate::analysis::optimal::{Counts, Envelope};
 
 /// A stream's cueing.
 pub struct LiveCueing {
     config: CueConfig,
     /// The platform's envelope about home, once the stream knows the rig.
-    ranges: Option<Ranges>,
+    envelope: Option<Envelope>,
     /// The running engine; none while the optimal cueing waits for the envelope.
     engine: Option<Engine>,
     /// The engine has taken no sample yet (its next is a first one).
@@ -44,7 +44,7 @@ impl LiveCueing {
         };
         Ok(Self {
             config,
-            ranges: None,
+            envelope: None,
             engine,
             fresh: true,
             fading: None,
@@ -55,11 +55,11 @@ impl LiveCueing {
     }
 
     /// The platform's envelope about home: the optimal cueing plans in it.
-    pub fn place(&mut self, ranges: Ranges) {
-        self.ranges = Some(ranges);
+    pub fn place(&mut self, envelope: Envelope) {
+        self.envelope = Some(envelope);
         if self.engine.is_none() {
             // The configuration was checked when it was taken: the engine accepts it.
-            self.engine = Engine::new(self.config, &ranges).ok();
+            self.engine = Engine::new(self.config, &envelope).ok();
             self.fresh = true;
         }
     }
@@ -87,7 +87,7 @@ impl LiveCueing {
         if config == self.config {
             return Ok(false);
         }
-        let new = match (&self.engine, self.ranges, config.algorithm) {
+        let new = match (&self.engine, self.envelope, config.algorithm) {
             (Some(Engine::Classical(w)), _, Algorithm::Classical) => {
                 Some(Engine::Classical(Box::new(w.retuned(config)?)))
             }
@@ -211,7 +211,7 @@ mod tests {
     use super::*;
     use ringpod_core::cueing::G;
 
-    fn ranges() -> Ranges {
+    fn ranges() -> crate::analysis::optimal::Ranges {
         [(-0.05, 0.05), (-0.05, 0.05), (-0.03, 0.03), (-0.3, 0.3), (-0.3, 0.3)]
     }
 
@@ -227,7 +227,7 @@ mod tests {
     #[test]
     fn a_change_of_algorithm_blends_in_without_a_jump() {
         let mut c = LiveCueing::new(CueConfig::default()).unwrap();
-        c.place(ranges());
+        c.place(ranges().into());
         c.begin(&braking()).unwrap();
         let mut last = [0.0; 6];
         for _ in 0..50 {
@@ -263,7 +263,7 @@ mod tests {
         let mut c = LiveCueing::new(optimal).unwrap();
         assert!(c.engine.is_none());
         assert_eq!(c.begin(&braking()).unwrap(), [0.0; 6]);
-        c.place(ranges());
+        c.place(ranges().into());
         c.begin(&braking()).unwrap();
         let o = (0..30).map(|_| c.step(&braking(), 0.01).unwrap()).last().unwrap();
         // Braking: nose down, gravity's share backwards (the optimiser may move either way meanwhile).
@@ -279,7 +279,7 @@ mod tests {
             ..CueConfig::default()
         };
         let mut c = LiveCueing::new(optimal).unwrap();
-        c.place(ranges());
+        c.place(ranges().into());
         c.begin(&braking()).unwrap();
         let steps = |c: &mut LiveCueing, n: usize| {
             for _ in 0..n {

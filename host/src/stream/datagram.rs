@@ -9,7 +9,7 @@ use ringpod_core::cueing::{self, SampleError, Telemetry, G};
 use ringpod_core::kinematics::Pose;
 
 use super::cueing::LiveCueing;
-use crate::analysis::optimal::Ranges;
+use crate::analysis::optimal::Envelope;
 use crate::games::{self, numbers};
 use crate::out::console;
 
@@ -241,15 +241,15 @@ impl Decoder {
         }
     }
 
-    /// Cues around `home` (the home pose of the rig the device runs), within `ranges` about it (the optimal
+    /// Cues around `home` (the home pose of the rig the device runs), within `envelope` about it (the optimal
     /// cueing plans in them: given when [`Decoder::cues`]); front-end strings are offsets from it; a pose source
     /// has no neutral.
-    pub fn centre_on(&mut self, home: Pose<f64>, ranges: Option<Ranges>) {
+    pub fn centre_on(&mut self, home: Pose<f64>, envelope: Option<Envelope>) {
         match self {
             Decoder::Telemetry { neutral, washout, .. } => {
                 *neutral = Some(home);
-                if let Some(ranges) = ranges {
-                    washout.place(ranges);
+                if let Some(envelope) = envelope {
+                    washout.place(envelope);
                 }
             }
             Decoder::Template { neutral, .. } => *neutral = Some(home),

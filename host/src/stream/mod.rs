@@ -258,11 +258,11 @@ pub fn run<T: Transport>(
     if let Source::Live(live) = &mut source {
         let home = Pose::from_array(home);
         // The envelope's scan only for a decoder that cues (the optimal cueing plans in it).
-        let ranges = live.decoder.cues().then(|| {
+        let envelope = live.decoder.cues().then(|| {
             let mechanism = ringpod_core::kinematics::RingPlatform::new(&envelope.platform.geometry);
-            crate::analysis::cue_engine::ranges(&mechanism, &home)
+            crate::analysis::cue_engine::envelope(&mechanism, &home)
         });
-        live.decoder.centre_on(home, ranges);
+        live.decoder.centre_on(home, envelope);
     }
     let bar = progress_bar(&source, options.quiet);
     let limits = envelope.limits;

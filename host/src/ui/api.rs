@@ -55,10 +55,10 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
     let m = RingPlatform::<f64>::new(geometry);
     let neutral = Pose::from_array(home);
     // One scan of the envelope for both algorithms' replays and scores.
-    let ranges = crate::analysis::cue_engine::ranges(&m, &neutral);
+    let envelope = crate::analysis::cue_engine::envelope(&m, &neutral);
     let scored = |config: CueConfig| -> Result<(Replay, Value), String> {
-        let run = replay(&rows, config, &m, &neutral, &ranges, false).map_err(|e| format!("{e:#}"))?;
-        let (s, _) = score(&run.cued, &neutral, &ranges, config.forward);
+        let run = replay(&rows, config, &m, &neutral, &envelope, false).map_err(|e| format!("{e:#}"))?;
+        let (s, _) = score(&run.cued, &neutral, &envelope.ranges, config.forward);
         let summary = json!({
             "algorithm": config.algorithm,
             "force_rms": s.force_total(),

@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use super::cue::{read_drive, replay, CueError};
 use super::mechanism::{AnyMechanism, Selected};
-use super::optimal::{floor, Counts, Ranges};
+use super::optimal::{floor, Counts, Envelope, Ranges};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
 use score::{score, Score, Trace};
@@ -106,7 +106,7 @@ pub struct Rig {
     /// Its home (the neutral pose).
     pub neutral: Pose<f64>,
     /// Its envelope about home.
-    pub ranges: Ranges,
+    pub envelope: Envelope,
 }
 
 /// Cues every drive by `config` and scores it; with each drive's perceived forces.
@@ -121,8 +121,8 @@ pub fn evaluate(
     let mut traces = Vec::new();
     let (mut limited, mut counts) = (0, Counts::default());
     for rows in drives {
-        let r = replay(rows, config, &rig.mechanism, &rig.neutral, &rig.ranges, preview)?;
-        let (s, t) = score(&r.cued, &rig.neutral, &rig.ranges, config.forward);
+        let r = replay(rows, config, &rig.mechanism, &rig.neutral, &rig.envelope, preview)?;
+        let (s, t) = score(&r.cued, &rig.neutral, &rig.envelope.ranges, config.forward);
         limited += r.limited;
         if let Some(c) = &r.counts {
             counts.add(c);
@@ -162,7 +162,7 @@ fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward) -> Result<FloorReport,
                 rate: [v[4], v[5], v[6]],
             })
             .collect();
-        let f = floor::floor(&t, &samples, &rig.ranges, forward).map_err(CueError::Floor)?;
+        let f = floor::floor(&t, &samples, &rig.envelope.ranges, forward).map_err(CueError::Floor)?;
         let m = t.len().saturating_sub(1);
         for (total, rms) in sum.iter_mut().zip(f.force_rms) {
             *total += rms * rms * m as f64;
@@ -171,7 +171,7 @@ fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward) -> Result<FloorReport,
         each.push(f.force_rms);
         for offset in &f.offsets {
             for (i, share) in envelope_share.iter_mut().enumerate() {
-                let (lo, hi) = rig.ranges[i];
+                let (lo, hi) = rig.envelope.ranges[i];
                 let edge = if offset[i] >= 0.0 { hi } else { lo };
                 if edge != 0.0 {
                     *share = share.max(offset[i] / edge);
@@ -233,7 +233,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     };
     let neutral = Pose::from_array(selected.home);
     let rig = Rig {
-        ranges: super::cue_engine::ranges(&mechanism, &neutral),
+        envelope: super::cue_engine::envelope(&mechanism, &neutral),
         mechanism: *mechanism,
         neutral,
     };
@@ -264,7 +264,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     let report = Report {
         drives: args.inputs.iter().map(|p| p.display().to_string()).collect(),
         mechanism: selected.name,
-        ranges: rig.ranges,
+        ranges: rig.envelope.ranges,
         tuned,
         entries,
         floor,

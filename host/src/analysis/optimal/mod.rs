@@ -15,18 +15,36 @@
 pub mod floor;
 pub mod model;
 pub mod qp;
+pub mod tilt;
 
 use std::time::Instant;
 
 use nalgebra::DVector;
 use ringpod_core::cueing::{self, ConfigError, CueConfig, SampleError, Telemetry, Washout, G};
+use ringpod_core::kinematics::{Pose, RingPlatform};
 
 use model::{Discrete, Linear};
 use qp::{AxisQp, Bound, Spec};
 
-/// The envelope an optimiser plans in: per axis of the platform's offset `[x, y, z, alpha, beta]` the range
-/// about home (m, rad) in which the pose passes every check, found one axis at a time.
+/// Per axis of the platform's offset `[x, y, z, alpha, beta]` the range about home (m, rad) in which the pose
+/// passes every check, found one axis at a time.
 pub type Ranges = [(f64, f64); 5];
+
+/// The envelope an optimiser plans in: the ranges, and the rig about its neutral pose where it is known, from
+/// which the roll and pitch's shared room is scanned ([`tilt`]). Without the rig each angle keeps to its range.
+#[derive(Debug, Clone, Copy)]
+pub struct Envelope {
+    /// Each axis's range about home.
+    pub ranges: Ranges,
+    /// The rig and its neutral pose.
+    pub rig: Option<(RingPlatform<f64>, Pose<f64>)>,
+}
+
+impl From<Ranges> for Envelope {
+    fn from(ranges: Ranges) -> Self {
+        Self { ranges, rig: None }
+    }
+}
 
 /// What the optimal cueing did, sample by sample.
 #[derive(Debug, Clone, Default, serde::Serialize)]
@@ -118,17 +136,26 @@ pub struct Optimal {
     config: CueConfig,
     classical: Washout<f64>,
     axes: [Axis; 3],
+    /// The roll and pitch's shared room, where the rig is known.
+    tilt: Option<tilt::Sharing>,
     counts: Counts,
 }
 
 impl Optimal {
-    /// Sets the programmes up for `config` in `ranges` (the envelope about home).
-    pub fn new(config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
+    /// Sets the programmes up for `config` in `envelope` (about home).
+    pub fn new(config: CueConfig, envelope: &Envelope) -> Result<Self, ConfigError> {
         let classical = Washout::new(config)?;
+        let ranges = &envelope.ranges;
+        let tilt = envelope.rig.map(|(mechanism, neutral)| {
+            let base = [X, Y].map(|i| angle_bounds(i, &config, ranges));
+            let closing = [X, Y].map(|i| config.tilt_rate_deg[i].to_radians());
+            tilt::Sharing::new(mechanism, neutral, config.forward, base, closing)
+        });
         Ok(Self {
             config,
             classical,
             axes: [X, Y, Z].map(|i| Axis::new(i, &config, ranges)),
+            tilt,
             counts: Counts::default(),
         })
     }
@@ -175,7 +202,13 @@ impl Optimal {
         let mut fell_back = false;
         let mut late = false;
         let h = self.config.optimal.step_s;
-        for i in 0..3 {
+        let order = self.tilt.as_mut().map_or([X, Y, Z], |t| t.order(sample.force));
+        for i in order {
+            let yaw = self.classical.channels().yaw;
+            if let Some(t) = self.tilt.as_mut().filter(|_| i != Z) {
+                let (lo, hi) = t.bound_over(i, i == order[0], &self.axes, h, yaw, dt);
+                self.axes[i].qp.set_state_bound(tilt::ANGLE_BOUND, lo, hi);
+            }
             let classical = self.classical_channels(i);
             let axis = &mut self.axes[i];
             let (d_model, d_perception) = axis.at(dt);
@@ -245,8 +278,8 @@ impl Optimal {
     /// The same cueing under another configuration from here on: the platform's and the perception's states
     /// carried (the models are the same whatever the configuration), the programmes set up anew; the counts
     /// start again (the old cueing keeps its own while it fades out).
-    pub fn retuned(&self, config: CueConfig, ranges: &Ranges) -> Result<Self, ConfigError> {
-        let mut new = Self::new(config, ranges)?;
+    pub fn retuned(&self, config: CueConfig, envelope: &Envelope) -> Result<Self, ConfigError> {
+        let mut new = Self::new(config, envelope)?;
         new.classical = self.classical.retuned(config)?;
         for (n, o) in new.axes.iter_mut().zip(&self.axes) {
             n.x.copy_from(&o.x);
@@ -271,6 +304,20 @@ fn stimulus(i: usize, s: &Telemetry<f64>) -> DVector<f64> {
     }
 }
 
+/// Horizontal axis `i`'s own interval on its angle: its share of the range, within the tilt limit. x's angle
+/// is minus the pitch (index 4 of the ranges), y's the roll (index 3); the tilt keys are per force axis (x 0,
+/// y 1).
+fn angle_bounds(i: usize, config: &CueConfig, ranges: &Ranges) -> (f64, f64) {
+    let tilt = config.optimal.tilt_share;
+    let (lo, hi) = if i == X {
+        (-ranges[4].1 * tilt, -ranges[4].0 * tilt)
+    } else {
+        (ranges[3].0 * tilt, ranges[3].1 * tilt)
+    };
+    let limit = config.tilt_limit_deg[i].to_radians();
+    (lo.max(-limit), hi.min(limit))
+}
+
 /// Axis `i`'s weights (per output), effort weights (per input) and bounds.
 fn cost_and_bounds(i: usize, config: &CueConfig, ranges: &Ranges) -> (Vec<f64>, Vec<f64>, Vec<Bound>) {
     let o = &config.optimal;
@@ -289,15 +336,7 @@ fn cost_and_bounds(i: usize, config: &CueConfig, ranges: &Ranges) -> (Vec<f64>, 
             ],
         );
     }
-    // x's angle is minus the pitch (index 4 of the ranges), y's the roll (index 3); the tilt keys are per force
-    // axis (x 0, y 1), the rotation keys per rotation (roll 0, pitch 1).
-    let tilt = o.tilt_share;
-    let (alo, ahi) = if i == X {
-        (-ranges[4].1 * tilt, -ranges[4].0 * tilt)
-    } else {
-        (ranges[3].0 * tilt, ranges[3].1 * tilt)
-    };
-    let limit = config.tilt_limit_deg[i].to_radians();
+    let (alo, ahi) = angle_bounds(i, config, ranges);
     let rot = 1 - i;
     (
         vec![
@@ -313,8 +352,8 @@ fn cost_and_bounds(i: usize, config: &CueConfig, ranges: &Ranges) -> (Vec<f64>, 
             speed(3),
             Bound::State {
                 output: 4,
-                lo: alo.max(-limit),
-                hi: ahi.min(limit),
+                lo: alo,
+                hi: ahi,
             },
             Bound::Input { mask: 1, limit: a },
             Bound::Input {
@@ -456,7 +495,7 @@ mod tests {
 
     #[test]
     fn braking_is_cued_by_moving_back_and_pitching_nose_down() {
-        let mut o = Optimal::new(patient(), &ranges()).unwrap();
+        let mut o = Optimal::new(patient(), &ranges().into()).unwrap();
         o.begin(&sample(0.0)).unwrap();
         let r = &mut o.axes[X];
         let reference = r.reference(&stimulus(X, &sample(-6.0)), &[], X);
@@ -497,14 +536,14 @@ mod tests {
 
     #[test]
     fn a_late_solve_follows_the_last_plan_then_the_washouts_change_without_a_jump() {
-        let mut o = Optimal::new(patient(), &ranges()).unwrap();
+        let mut o = Optimal::new(patient(), &ranges().into()).unwrap();
         o.begin(&sample(0.0)).unwrap();
         let solved = largest_steps(&mut o, 100, |_| -6.0);
         assert_eq!(o.counts().fallbacks, 0);
         // From here every solve is late: 0.01 ms is less than any solve takes.
         let mut hurried = patient();
         hurried.optimal.budget_ms = 0.01;
-        let mut o = o.retuned(hurried, &ranges()).unwrap();
+        let mut o = o.retuned(hurried, &ranges().into()).unwrap();
         let fell_back = largest_steps(&mut o, 300, |k| if k < 150 { -6.0 } else { 2.0 });
         let c = o.counts();
         assert_eq!((c.samples, c.fallbacks), (300, 300));

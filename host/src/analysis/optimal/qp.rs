@@ -73,6 +73,8 @@ pub struct AxisQp {
     /// Constraint bounds `b = b0 - bx x0`.
     b0: DVector<f64>,
     bx: DMatrix<f64>,
+    /// Each bound's first constraint row.
+    bound_rows: Vec<usize>,
     inputs: usize,
     outputs: usize,
     steps: usize,
@@ -115,7 +117,7 @@ impl AxisQp {
             p[(i, i)] += 2.0 * spec.input_weight[i % nu];
         }
         let q_of_error = gyw * 2.0;
-        let (a, b0, bx) = constraints(spec, &psi, &gy, nx, nu, ny);
+        let (a, b0, bx, bound_rows) = constraints(spec, &psi, &gy, nx, nu, ny);
         // One slack per state bound, shared by the horizon's steps, priced far above any cue: the programme is
         // feasible from any state (a state a fallback left outside a bound, or one the model's linearisation
         // did not foresee), and a plan that can keep within every bound does.
@@ -149,10 +151,22 @@ impl AxisQp {
             q_of_error,
             b0,
             bx,
+            bound_rows,
             inputs: nu,
             outputs: ny,
             steps: n,
             slacks,
+        }
+    }
+
+    /// Moves state bound `index` (its place in the spec's bounds) to `lo..=hi` from the next solve on.
+    pub fn set_state_bound(&mut self, index: usize, lo: f64, hi: f64) {
+        let Some(&start) = self.bound_rows.get(index) else {
+            return;
+        };
+        for k in 0..self.steps {
+            self.b0[start + 2 * k] = hi;
+            self.b0[start + 2 * k + 1] = -lo;
         }
     }
 
@@ -192,7 +206,7 @@ impl AxisQp {
     }
 }
 
-/// The constraints `A U <= b0 - bx x0`.
+/// The constraints `A U <= b0 - bx x0`, and each bound's first row.
 fn constraints(
     spec: &Spec,
     psi: &DMatrix<f64>,
@@ -200,7 +214,7 @@ fn constraints(
     nx: usize,
     nu: usize,
     ny: usize,
-) -> (DMatrix<f64>, DVector<f64>, DMatrix<f64>) {
+) -> (DMatrix<f64>, DVector<f64>, DMatrix<f64>, Vec<usize>) {
     let n = spec.steps;
     let slacks = spec.bounds.iter().filter(|b| matches!(b, Bound::State { .. })).count();
     // Each bound two rows a step; each slack its own row (at least zero).
@@ -210,7 +224,9 @@ fn constraints(
     let mut bx = DMatrix::zeros(rows, nx);
     let mut r = 0;
     let mut slack = n * nu;
+    let mut starts = Vec::with_capacity(spec.bounds.len());
     for bound in spec.bounds {
+        starts.push(r);
         for k in 0..n {
             match *bound {
                 Bound::State { output, lo, hi } => {
@@ -243,7 +259,7 @@ fn constraints(
         a[(r, j)] = -1.0;
         r += 1;
     }
-    (a, b0, bx)
+    (a, b0, bx, starts)
 }
 
 /// A dense matrix as compressed columns (the upper triangle only, for the cost's matrix), zeros left out.
