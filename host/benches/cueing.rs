@@ -1,8 +1,10 @@
-//! One sample of the optimal cueing (its three axes' solves) on the trainer model's envelope, at the default
-//! horizon: the time the 2 ms budget of a 100 Hz sample is measured against.
+//! One sample of the optimal cueing (its three axes' solves and the search of the tilt's room) on the trainer
+//! model's envelope, at the default horizon: the time the 2 ms budget of a 100 Hz sample is measured against.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use ringpod_core::cueing::{Algorithm, CueConfig, Telemetry, G};
+use ringpod_core::kinematics::presets::{Preset, TRAINER_MODEL};
+use ringpod_core::kinematics::{Pose, RingPlatform};
 
 // The optimal cueing's module as the binary builds it (the host is a binary crate: no library to link).
 #[allow(dead_code, unused_imports)]
@@ -29,7 +31,15 @@ fn one_sample(c: &mut Criterion) {
         (-0.454, 0.384),
         (-0.358, 0.358),
     ];
-    let mut o = optimal::Optimal::new(config, &ranges.into()).expect("the defaults are valid");
+    // With the rig: each sample also searches the tilt's shared room.
+    let envelope = optimal::Envelope {
+        ranges,
+        rig: Some((
+            RingPlatform::new(&TRAINER_MODEL),
+            Pose::from_array(Preset::TrainerModel.home()),
+        )),
+    };
+    let mut o = optimal::Optimal::new(config, &envelope).expect("the defaults are valid");
     o.begin(&sample(0.0)).expect("finite");
     let mut t = 0.0;
     c.bench_function("optimal cueing: one sample (three axes)", |b| {
