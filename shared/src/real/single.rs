@@ -25,23 +25,28 @@ pub(super) fn sincosf(x: f32) -> (f32, f32) {
     const DP2: f32 = 2.418_756_5e-4;
     const DP3: f32 = 3.774_895e-8;
     let ax = libm::fabsf(x);
-    if !ax.is_finite() {
-        return (f32::NAN, f32::NAN);
-    }
-    if ax > 8192.0 {
+    // Also true for NaN.
+    if !(ax <= 8192.0) {
+        if !ax.is_finite() {
+            return (f32::NAN, f32::NAN);
+        }
         return sincosf(libm::remainderf(x, core::f32::consts::TAU));
     }
-    let mut j = (ax * FOUR_OVER_PI) as u32;
+    let octants = ax * FOUR_OVER_PI;
+    if octants < 1.0 {
+        // Octant 0 (every pose angle within pi/4, the common case): the reduction would subtract zero, so the
+        // polynomials take `x` as it is. The sine's is odd and the cosine's even, and IEEE rounding is symmetric,
+        // so this is bit for bit the general path's result, without its reduction and quadrant selection.
+        return kernels(x);
+    }
+    let mut j = octants as u32;
     let mut y = j as f32;
     // Map zeros to the origin: octants 1, 3, 5, 7 round up to the next even one.
     if j & 1 != 0 {
         j += 1;
         y += 1.0;
     }
-    let z = ((ax - y * DP1) - y * DP2) - y * DP3;
-    let zz = z * z;
-    let s = ((-1.951_529_6e-4 * zz + 8.332_161e-3) * zz - 1.666_665_5e-1) * zz * z + z;
-    let c = ((2.443_315_7e-5 * zz - 1.388_731_6e-3) * zz + 4.166_664_6e-2) * zz * zz - 0.5 * zz + 1.0;
+    let (s, c) = kernels(((ax - y * DP1) - y * DP2) - y * DP3);
     let (sin, cos) = match (j >> 1) & 3 {
         0 => (s, c),
         1 => (c, -s),
@@ -49,6 +54,15 @@ pub(super) fn sincosf(x: f32) -> (f32, f32) {
         _ => (-c, s),
     };
     (if x < 0.0 { -sin } else { sin }, cos)
+}
+
+/// Cephes' minimax polynomials of the sine and the cosine on `[-pi/4, pi/4]`.
+#[inline(always)]
+fn kernels(z: f32) -> (f32, f32) {
+    let zz = z * z;
+    let s = ((-1.951_529_6e-4 * zz + 8.332_161e-3) * zz - 1.666_665_5e-1) * zz * z + z;
+    let c = ((2.443_315_7e-5 * zz - 1.388_731_6e-3) * zz + 4.166_664_6e-2) * zz * zz - 0.5 * zz + 1.0;
+    (s, c)
 }
 
 pub(super) fn sinf(x: f32) -> f32 {
@@ -117,13 +131,16 @@ pub(super) fn atan2f(y: f32, x: f32) -> f32 {
     const FRAC_PI_4: f32 = core::f32::consts::FRAC_PI_4;
     const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
     const PI: f32 = core::f32::consts::PI;
-    let (ax, ay) = (libm::fabsf(x), libm::fabsf(y));
-    // Also false for NaN: both must be finite and one of them non-zero.
-    if !(ax < f32::INFINITY && ay < f32::INFINITY && (ax > 0.0 || ay > 0.0)) {
+    // Magnitudes as bits: for non-negative floats the bits order as the values do, with the infinities above every
+    // finite value and NaN above them. So the larger magnitude alone tells whether both are zero, or either is
+    // infinite or NaN: one test where comparisons of the floats took a dozen instructions.
+    let (bx, by) = (x.to_bits() & 0x7fff_ffff, y.to_bits() & 0x7fff_ffff);
+    let swapped = by > bx;
+    let (small, large) = if swapped { (bx, by) } else { (by, bx) };
+    if large.wrapping_sub(1) >= 0x7f7f_ffff {
         return libm::atan2f(y, x);
     }
-    let swapped = ay > ax;
-    let t = if swapped { ax / ay } else { ay / ax };
+    let t = f32::from_bits(small) / f32::from_bits(large);
     let (base, t) = if t > TAN_PI_8 {
         (FRAC_PI_4, (t - 1.0) / (t + 1.0))
     } else {
