@@ -93,6 +93,23 @@ fn round_trip<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>, e: [f64; 6]) -> Result
 proptest! {
     #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
 
+    /// IK alone solves without the configuration the checks read: the same actuators, bit for bit, or the same
+    /// error, as IK with the checks, for the rod, radial and elbow chains, in `f32` and `f64`, inside the
+    /// workspace and well beyond it.
+    #[test]
+    fn ik_alone_equals_ik_with_the_checks(pose in trainer_pose(), scale in 1.0..4.0f64) {
+        let home = presets::TRAINER_MODEL_HOME_Z;
+        let p = Pose::new(pose.x * scale, pose.y * scale, home + (pose.z - home) * scale, pose.alpha * scale,
+            pose.beta * scale, pose.gamma);
+        for geometry in [&presets::TRAINER_MODEL, &presets::TRAINER_ELBOW] {
+            let m64 = RingPlatform::<f64>::new(geometry);
+            let m32 = RingPlatform::<f32>::new(geometry);
+            prop_assert_eq!(m64.inverse(&p), m64.inverse_checked(&p).map(|(q, _)| q));
+            let p32 = p.cast::<f32>();
+            prop_assert_eq!(m32.inverse(&p32), m32.inverse_checked(&p32).map(|(q, _)| q));
+        }
+    }
+
     #[test]
     fn trainer_ik_fk_round_trip(pose in trainer_pose(), e in offsets()) {
         round_trip(&trainer(), &pose, e)?;

@@ -295,4 +295,120 @@ mod tests {
         assert_eq!(atan2f(f32::INFINITY, 1.0), libm::atan2f(f32::INFINITY, 1.0));
         assert!(atan2f(f32::NAN, 1.0).is_nan() && atan2f(1.0, f32::NAN).is_nan());
     }
+
+    /// `atan2f` as it tested its inputs on the floats, the form its bit tests replaced: the reference that they
+    /// change nothing.
+    fn atan2f_float_tests(y: f32, x: f32) -> f32 {
+        let (ax, ay) = (libm::fabsf(x), libm::fabsf(y));
+        if !(ax < f32::INFINITY && ay < f32::INFINITY && (ax > 0.0 || ay > 0.0)) {
+            return libm::atan2f(y, x);
+        }
+        let swapped = ay > ax;
+        let t = if swapped { ax / ay } else { ay / ax };
+        let (base, t) = if t > 0.414_213_57 {
+            (core::f32::consts::FRAC_PI_4, (t - 1.0) / (t + 1.0))
+        } else {
+            (0.0, t)
+        };
+        let z = t * t;
+        let poly = (((8.053_744_5e-2 * z - 1.387_768_6e-1) * z + 1.997_771_1e-1) * z - 3.333_295e-1) * z * t + t;
+        let mut angle = base + poly;
+        if swapped {
+            angle = core::f32::consts::FRAC_PI_2 - angle;
+        }
+        if x < 0.0 {
+            angle = core::f32::consts::PI - angle;
+        }
+        if y.is_sign_negative() {
+            -angle
+        } else {
+            angle
+        }
+    }
+
+    /// `sincosf` as it reduced every argument, octant 0 included: the reference that the shortcut changes nothing.
+    fn sincosf_always_reduced(x: f32) -> (f32, f32) {
+        let ax = libm::fabsf(x);
+        if !ax.is_finite() {
+            return (f32::NAN, f32::NAN);
+        }
+        if ax > 8192.0 {
+            return sincosf(libm::remainderf(x, core::f32::consts::TAU));
+        }
+        let mut j = (ax * 1.273_239_5) as u32;
+        let mut y = j as f32;
+        if j & 1 != 0 {
+            j += 1;
+            y += 1.0;
+        }
+        let (s, c) = kernels(((ax - y * 0.785_156_25) - y * 2.418_756_5e-4) - y * 3.774_895e-8);
+        let (sin, cos) = match (j >> 1) & 3 {
+            0 => (s, c),
+            1 => (c, -s),
+            2 => (-s, -c),
+            _ => (-c, s),
+        };
+        (if x < 0.0 { -sin } else { sin }, cos)
+    }
+
+    /// Equal bits, or both NaN.
+    fn same(a: f32, b: f32) -> bool {
+        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+    }
+
+    /// Special values and their neighbours: zeros, subnormals, the switch points, infinities, NaN.
+    const EDGES: [f32; 14] = [
+        0.0,
+        -0.0,
+        f32::MIN_POSITIVE,
+        1e-45,
+        -1e-45,
+        0.785_398_1,
+        0.785_398_2,
+        -0.785_398_2,
+        1.0,
+        8192.0,
+        -8192.001,
+        f32::MAX,
+        f32::INFINITY,
+        f32::NAN,
+    ];
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(20_000))]
+
+        #[test]
+        fn arc_tangent_bit_tests_change_no_result(y in proptest::num::f32::ANY, x in proptest::num::f32::ANY) {
+            proptest::prop_assert!(same(atan2f(y, x), atan2f_float_tests(y, x)), "atan2f({y:e}, {x:e})");
+        }
+
+        #[test]
+        fn arc_tangent_bit_tests_change_no_angle_of_a_pose(y in -1.0f32..1.0, x in -1.0f32..1.0) {
+            proptest::prop_assert!(same(atan2f(y, x), atan2f_float_tests(y, x)), "atan2f({y:e}, {x:e})");
+        }
+
+        #[test]
+        fn sine_and_cosine_without_reduction_in_octant_0_change_no_result(x in proptest::num::f32::ANY) {
+            let ((s, c), (rs, rc)) = (sincosf(x), sincosf_always_reduced(x));
+            proptest::prop_assert!(same(s, rs) && same(c, rc), "sincosf({x:e})");
+        }
+
+        #[test]
+        fn sine_and_cosine_of_pose_angles_unchanged(x in -4.0f32..4.0) {
+            let ((s, c), (rs, rc)) = (sincosf(x), sincosf_always_reduced(x));
+            proptest::prop_assert!(same(s, rs) && same(c, rc), "sincosf({x:e})");
+        }
+    }
+
+    #[test]
+    fn special_values_keep_their_results() {
+        for a in EDGES.iter().flat_map(|&v| [v, -v]) {
+            let (s, c) = sincosf(a);
+            let (rs, rc) = sincosf_always_reduced(a);
+            assert!(same(s, rs) && same(c, rc), "sincosf({a:e})");
+            for b in EDGES.iter().flat_map(|&v| [v, -v]) {
+                assert!(same(atan2f(a, b), atan2f_float_tests(a, b)), "atan2f({a:e}, {b:e})");
+            }
+        }
+    }
 }
