@@ -19,7 +19,7 @@ pub use self::guard::SlowCheckGuard;
 pub use self::statics::ActuatorLoads;
 pub use self::tipping::{Loaded, TipOver, TipOverError, GRAVITY};
 use super::geometry::{Branch, ChainKind, RingGeometry};
-use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
+use super::{Actuators, AxisKind, Check, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
 
 /// A chain's kind without an elbow chain's dimensions (those are in the platform's `arms`): what the per-pose code
@@ -295,6 +295,13 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         self.solve(pose, &mut c)?;
         c.direct(self.n);
         Ok((c.q, self.report(pose, &c)))
+    }
+
+    /// IK and the checks in their order, each evaluated only while every one before it left its room: a point of
+    /// the envelope search outside the workspace mostly fails the reach check, and then skips the joint cones,
+    /// the singularity index (a 6x6 decomposition) and the stability.
+    fn inverse_within(&self, pose: &Pose<T>, room: &[T; 6]) -> Result<Actuators<T>, Check> {
+        self.within(pose, room)
     }
 
     /// IK and the checks, the joint cones and the singularity index proved by [`SlowCheckGuard`] when they can be.
