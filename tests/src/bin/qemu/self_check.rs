@@ -93,7 +93,7 @@ pub(crate) const BUDGETS: [(&str, u64); 11] = [
     ("trainer IK (f32)", 840),
     ("IK + all", 3_260),
     ("setpoint frame", 5_750),
-    ("FK", 14_100),
+    ("FK", 14_000),
     ("limited into the envelope", 14_450),
     ("step buffers, idle", 900),
     ("step buffers, typical", 2_700),
