@@ -5,6 +5,9 @@
 //! (Rust never contracts them into fused operations), so they give the same bits on every target, and the tests
 //! below hold each to the correctly rounded value.
 
+/// 4 / pi, the octants per radian.
+const FOUR_OVER_PI: f32 = 1.273_239_5;
+
 /// Sine and cosine in single precision, for `f32` (the MCU's scalar).
 ///
 /// `libm::sinf` and `cosf` (musl's) evaluate their kernels in `f64`, which a Cortex-M4F has no hardware for: about
@@ -20,10 +23,6 @@
 /// through musl's `f64` reduction (`rem_pio2_large`), about 8 KB of software floating point in the firmware for
 /// arguments it never sees. NaN and infinities give NaN, as `libm` does.
 pub(super) fn sincosf(x: f32) -> (f32, f32) {
-    const FOUR_OVER_PI: f32 = 1.273_239_5;
-    const DP1: f32 = 0.785_156_25;
-    const DP2: f32 = 2.418_756_5e-4;
-    const DP3: f32 = 3.774_895e-8;
     let ax = libm::fabsf(x);
     // On the bits, which order as the values for a magnitude, with NaN above every number: beyond 8192, an
     // infinity or NaN.
@@ -40,7 +39,17 @@ pub(super) fn sincosf(x: f32) -> (f32, f32) {
         // so this is bit for bit the general path's result, without its reduction and quadrant selection.
         return kernels(x);
     }
-    let mut j = octants as u32;
+    reduced(ax, x)
+}
+
+/// Sine and cosine of `x` (magnitude `ax`, at most 8192) through the reduction by multiples of pi/4.
+#[inline(always)]
+fn reduced(ax: f32, x: f32) -> (f32, f32) {
+    // pi/4 in three parts, the first two with trailing zero bits: their products with the octant are exact.
+    const DP1: f32 = 0.785_156_25;
+    const DP2: f32 = 2.418_756_5e-4;
+    const DP3: f32 = 3.774_895e-8;
+    let mut j = (ax * FOUR_OVER_PI) as u32;
     let mut y = j as f32;
     // Map zeros to the origin: octants 1, 3, 5, 7 round up to the next even one.
     if j & 1 != 0 {
@@ -128,10 +137,6 @@ pub(super) fn asinf(x: f32) -> f32 {
 /// flash for a call's saving of a few instructions at each.
 #[inline(never)]
 pub(super) fn atan2f(y: f32, x: f32) -> f32 {
-    const TAN_PI_8: f32 = 0.414_213_57;
-    const FRAC_PI_4: f32 = core::f32::consts::FRAC_PI_4;
-    const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
-    const PI: f32 = core::f32::consts::PI;
     // Magnitudes as bits: for non-negative floats the bits order as the values do, with the infinities above every
     // finite value and NaN above them. So the larger magnitude alone tells whether both are zero, or either is
     // infinite or NaN: one test where comparisons of the floats took a dozen instructions.
@@ -141,7 +146,16 @@ pub(super) fn atan2f(y: f32, x: f32) -> f32 {
     if large.wrapping_sub(1) >= 0x7f7f_ffff {
         return libm::atan2f(y, x);
     }
-    let t = f32::from_bits(small) / f32::from_bits(large);
+    atan2_of_ratio(f32::from_bits(small) / f32::from_bits(large), swapped, y, x)
+}
+
+/// `atan2(y, x)` from `t`, the smaller magnitude over the larger (`0 <= t <= 1`), and whether `|y|` is the larger.
+#[inline(always)]
+fn atan2_of_ratio(t: f32, swapped: bool, y: f32, x: f32) -> f32 {
+    const TAN_PI_8: f32 = 0.414_213_57;
+    const FRAC_PI_4: f32 = core::f32::consts::FRAC_PI_4;
+    const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
+    const PI: f32 = core::f32::consts::PI;
     let (base, t) = if t > TAN_PI_8 {
         (FRAC_PI_4, (t - 1.0) / (t + 1.0))
     } else {
@@ -297,34 +311,15 @@ mod tests {
         assert!(atan2f(f32::NAN, 1.0).is_nan() && atan2f(1.0, f32::NAN).is_nan());
     }
 
-    /// `atan2f` as it tested its inputs on the floats, the form its bit tests replaced: the reference that they
-    /// change nothing.
+    /// `atan2f` as it tested its inputs on the floats, the form its bit tests replaced (the arctangent of the ratio
+    /// is the same code): the reference that they change nothing.
     fn atan2f_float_tests(y: f32, x: f32) -> f32 {
         let (ax, ay) = (libm::fabsf(x), libm::fabsf(y));
         if !(ax < f32::INFINITY && ay < f32::INFINITY && (ax > 0.0 || ay > 0.0)) {
             return libm::atan2f(y, x);
         }
         let swapped = ay > ax;
-        let t = if swapped { ax / ay } else { ay / ax };
-        let (base, t) = if t > 0.414_213_57 {
-            (core::f32::consts::FRAC_PI_4, (t - 1.0) / (t + 1.0))
-        } else {
-            (0.0, t)
-        };
-        let z = t * t;
-        let poly = (((8.053_744_5e-2 * z - 1.387_768_6e-1) * z + 1.997_771_1e-1) * z - 3.333_295e-1) * z * t + t;
-        let mut angle = base + poly;
-        if swapped {
-            angle = core::f32::consts::FRAC_PI_2 - angle;
-        }
-        if x < 0.0 {
-            angle = core::f32::consts::PI - angle;
-        }
-        if y.is_sign_negative() {
-            -angle
-        } else {
-            angle
-        }
+        atan2_of_ratio(if swapped { ax / ay } else { ay / ax }, swapped, y, x)
     }
 
     /// `sincosf` as it reduced every argument, octant 0 included: the reference that the shortcut changes nothing.
@@ -336,20 +331,7 @@ mod tests {
         if ax > 8192.0 {
             return sincosf(libm::remainderf(x, core::f32::consts::TAU));
         }
-        let mut j = (ax * 1.273_239_5) as u32;
-        let mut y = j as f32;
-        if j & 1 != 0 {
-            j += 1;
-            y += 1.0;
-        }
-        let (s, c) = kernels(((ax - y * 0.785_156_25) - y * 2.418_756_5e-4) - y * 3.774_895e-8);
-        let (sin, cos) = match (j >> 1) & 3 {
-            0 => (s, c),
-            1 => (c, -s),
-            2 => (-s, -c),
-            _ => (-c, s),
-        };
-        (if x < 0.0 { -sin } else { sin }, cos)
+        reduced(ax, x)
     }
 
     /// Equal bits, or both NaN.
