@@ -93,6 +93,48 @@ fn round_trip<M: Mechanism<f64>>(m: &M, pose: &Pose<f64>, e: [f64; 6]) -> Result
 proptest! {
     #![proptest_config(ProptestConfig { cases: 3000, ..ProptestConfig::default() })]
 
+    /// IK alone solves without the configuration the checks read: the same actuators, bit for bit, or the same
+    /// error, as IK with the checks, for the rod, radial and elbow chains, in `f32` and `f64`, inside the
+    /// workspace and well beyond it.
+    #[test]
+    fn ik_alone_equals_ik_with_the_checks(pose in trainer_pose(), scale in 1.0..4.0f64) {
+        let home = presets::TRAINER_MODEL_HOME_Z;
+        let p = Pose::new(pose.x * scale, pose.y * scale, home + (pose.z - home) * scale, pose.alpha * scale,
+            pose.beta * scale, pose.gamma);
+        for geometry in [&presets::TRAINER_MODEL, &presets::TRAINER_ELBOW] {
+            let m64 = RingPlatform::<f64>::new(geometry);
+            let m32 = RingPlatform::<f32>::new(geometry);
+            prop_assert_eq!(m64.inverse(&p), m64.inverse_checked(&p).map(|(q, _)| q));
+            let p32 = p.cast::<f32>();
+            prop_assert_eq!(m32.inverse(&p32), m32.inverse_checked(&p32).map(|(q, _)| q));
+        }
+    }
+
+    /// The checks evaluated in order up to the first short of its room find what the full report finds: the same
+    /// actuators, or the same first check (reach when there is no IK), with rooms from negative to wide.
+    #[test]
+    fn checks_up_to_the_first_short_equal_the_full_report(
+        pose in trainer_pose(),
+        scale in 1.0..4.0f64,
+        room in prop::array::uniform6(-0.05..0.1f64),
+    ) {
+        let home = presets::TRAINER_MODEL_HOME_Z;
+        let p = Pose::new(pose.x * scale, pose.y * scale, home + (pose.z - home) * scale, pose.alpha * scale,
+            pose.beta * scale, pose.gamma);
+        fn full<T: ringpod_core::Real>(m: &RingPlatform<T>, p: &Pose<T>, room: &[T; 6]) -> Result<Actuators<T>, Check> {
+            match m.inverse_checked(p) {
+                Ok((q, report)) => report.first_below(room).map_or(Ok(q), Err),
+                Err(_) => Err(Check::Reach),
+            }
+        }
+        for geometry in [&presets::TRAINER_MODEL, &presets::TRAINER_ELBOW, &presets::ROTOPOD_CH4] {
+            let m64 = RingPlatform::<f64>::new(geometry);
+            prop_assert_eq!(m64.inverse_within(&p, &room), full(&m64, &p, &room));
+            let (m32, p32, room32) = (RingPlatform::<f32>::new(geometry), p.cast::<f32>(), room.map(|r| r as f32));
+            prop_assert_eq!(m32.inverse_within(&p32, &room32), full(&m32, &p32, &room32));
+        }
+    }
+
     #[test]
     fn trainer_ik_fk_round_trip(pose in trainer_pose(), e in offsets()) {
         round_trip(&trainer(), &pose, e)?;

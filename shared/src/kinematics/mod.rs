@@ -100,6 +100,18 @@ pub trait Mechanism<T: Real> {
         Ok((q, self.workspace(pose, &q)))
     }
 
+    /// IK and the workspace checks, in the order of [`Check::ALL`], against the room each must leave: the actuators
+    /// when every check leaves it, else the first check short of it ([`Check::Reach`] when the pose has no IK).
+    /// What [`WorkspaceReport::first_below`] finds in [`Mechanism::inverse_checked`]'s report, which the default
+    /// evaluates; a mechanism may stop at the first check short of its room (the envelope search's points outside
+    /// need no more).
+    fn inverse_within(&self, pose: &Pose<T>, room: &[T; 6]) -> Result<Actuators<T>, Check> {
+        match self.inverse_checked(pose) {
+            Ok((q, report)) => report.first_below(room).map_or(Ok(q), Err),
+            Err(_) => Err(Check::Reach),
+        }
+    }
+
     /// [`Mechanism::inverse_checked`] for a sequence of nearby poses (a control loop's): checks that change slowly
     /// may be proved from where `guard` last evaluated them instead of evaluated again. Every check still passes
     /// exactly when it would have; a proved margin is reported as its lower bound. The default evaluates everything.

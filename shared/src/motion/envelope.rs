@@ -20,8 +20,6 @@
 //! (per axis, under acceleration limits, not exactly on the straight line) stays inside too. The host limits its
 //! poses with the same code in `f64` before it sends them, so a board sees few setpoints to limit.
 
-use core::cmp::Ordering;
-
 use crate::kinematics::{Actuators, Check, Mechanism, Pose, WorkspaceReport};
 use crate::Real;
 
@@ -49,14 +47,12 @@ impl EnvelopeMargins {
     /// The first check whose margin is below its required room (a check that does not apply passes), or `None`
     /// when the report passes them all. NaN never passes.
     pub fn first_short<T: Real>(&self, report: &WorkspaceReport<T>) -> Option<Check> {
-        Check::ALL.into_iter().find(|c| match report.margin(*c) {
-            None => false,
-            // NaN compares as nothing: it never passes.
-            Some(m) => !matches!(
-                m.partial_cmp(&T::of(f64::from(self.of(*c)))),
-                Some(Ordering::Greater | Ordering::Equal)
-            ),
-        })
+        report.first_below(&self.room())
+    }
+
+    /// The margins in the scalar type of a mechanism.
+    pub fn room<T: Real>(&self) -> [T; 6] {
+        self.0.map(|m| T::of(f64::from(m)))
     }
 }
 
@@ -78,22 +74,6 @@ impl<T: Real> Limited<T> {
     /// Whether the target had to be limited.
     pub fn is_limited(&self) -> bool {
         self.bound_by.is_some()
-    }
-}
-
-/// Why a pose fails the envelope: no IK (reach), or the first check short of its margin.
-fn evaluate<T: Real, M: Mechanism<T>>(
-    mechanism: &M,
-    pose: &Pose<T>,
-    margins: &EnvelopeMargins,
-) -> Result<Actuators<T>, Check> {
-    match mechanism.inverse_checked(pose) {
-        Ok((q, report)) => match margins.first_short(&report) {
-            None => Ok(q),
-            Some(check) => Err(check),
-        },
-        // No solution: the rods do not reach (or the pose is not finite, which the caller refuses first).
-        Err(_) => Err(Check::Reach),
     }
 }
 
@@ -119,7 +99,11 @@ pub fn limit<T: Real, M: Mechanism<T>>(
     margins: &EnvelopeMargins,
     evaluations: u8,
 ) -> Limited<T> {
-    let first = match evaluate(mechanism, to, margins) {
+    // Why a pose fails the envelope: no IK (the reach check; or the pose is not finite, which the caller refuses
+    // first), or the first check short of its margin.
+    let room = margins.room();
+    let evaluate = |pose: &Pose<T>| mechanism.inverse_within(pose, &room);
+    let first = match evaluate(to) {
         Ok(q) => {
             return Limited {
                 pose: *to,
@@ -141,7 +125,7 @@ pub fn limit<T: Real, M: Mechanism<T>>(
     for k in (1..=scan).rev() {
         let s = T::of(f64::from(k) / f64::from(scan + 1));
         let pose = along(centre, to, s);
-        match evaluate(mechanism, &pose, margins) {
+        match evaluate(&pose) {
             Ok(q) => {
                 lo = s;
                 best = Some((pose, q));
@@ -157,7 +141,7 @@ pub fn limit<T: Real, M: Mechanism<T>>(
     for _ in 0..budget.saturating_sub(scan) {
         let mid = (lo + hi) * half;
         let pose = along(centre, to, mid);
-        match evaluate(mechanism, &pose, margins) {
+        match evaluate(&pose) {
             Ok(q) => {
                 lo = mid;
                 best = Some((pose, q));

@@ -5,6 +5,9 @@
 //! (Rust never contracts them into fused operations), so they give the same bits on every target, and the tests
 //! below hold each to the correctly rounded value.
 
+/// 4 / pi, the octants per radian.
+const FOUR_OVER_PI: f32 = 1.273_239_5;
+
 /// Sine and cosine in single precision, for `f32` (the MCU's scalar).
 ///
 /// `libm::sinf` and `cosf` (musl's) evaluate their kernels in `f64`, which a Cortex-M4F has no hardware for: about
@@ -20,17 +23,32 @@
 /// through musl's `f64` reduction (`rem_pio2_large`), about 8 KB of software floating point in the firmware for
 /// arguments it never sees. NaN and infinities give NaN, as `libm` does.
 pub(super) fn sincosf(x: f32) -> (f32, f32) {
-    const FOUR_OVER_PI: f32 = 1.273_239_5;
+    let ax = libm::fabsf(x);
+    // On the bits, which order as the values for a magnitude, with NaN above every number: beyond 8192, an
+    // infinity or NaN.
+    if ax.to_bits() > 8192f32.to_bits() {
+        if !ax.is_finite() {
+            return (f32::NAN, f32::NAN);
+        }
+        return sincosf(libm::remainderf(x, core::f32::consts::TAU));
+    }
+    let octants = ax * FOUR_OVER_PI;
+    if octants < 1.0 {
+        // Octant 0 (every pose angle within pi/4, the common case): the reduction would subtract zero, so the
+        // polynomials take `x` as it is. The sine's is odd and the cosine's even, and IEEE rounding is symmetric,
+        // so this is bit for bit the general path's result, without its reduction and quadrant selection.
+        return kernels(x);
+    }
+    reduced(ax, x)
+}
+
+/// Sine and cosine of `x` (magnitude `ax`, at most 8192) through the reduction by multiples of pi/4.
+#[inline(always)]
+fn reduced(ax: f32, x: f32) -> (f32, f32) {
+    // pi/4 in three parts, the first two with trailing zero bits: their products with the octant are exact.
     const DP1: f32 = 0.785_156_25;
     const DP2: f32 = 2.418_756_5e-4;
     const DP3: f32 = 3.774_895e-8;
-    let ax = libm::fabsf(x);
-    if !ax.is_finite() {
-        return (f32::NAN, f32::NAN);
-    }
-    if ax > 8192.0 {
-        return sincosf(libm::remainderf(x, core::f32::consts::TAU));
-    }
     let mut j = (ax * FOUR_OVER_PI) as u32;
     let mut y = j as f32;
     // Map zeros to the origin: octants 1, 3, 5, 7 round up to the next even one.
@@ -38,10 +56,7 @@ pub(super) fn sincosf(x: f32) -> (f32, f32) {
         j += 1;
         y += 1.0;
     }
-    let z = ((ax - y * DP1) - y * DP2) - y * DP3;
-    let zz = z * z;
-    let s = ((-1.951_529_6e-4 * zz + 8.332_161e-3) * zz - 1.666_665_5e-1) * zz * z + z;
-    let c = ((2.443_315_7e-5 * zz - 1.388_731_6e-3) * zz + 4.166_664_6e-2) * zz * zz - 0.5 * zz + 1.0;
+    let (s, c) = kernels(((ax - y * DP1) - y * DP2) - y * DP3);
     let (sin, cos) = match (j >> 1) & 3 {
         0 => (s, c),
         1 => (c, -s),
@@ -49,6 +64,15 @@ pub(super) fn sincosf(x: f32) -> (f32, f32) {
         _ => (-c, s),
     };
     (if x < 0.0 { -sin } else { sin }, cos)
+}
+
+/// Cephes' minimax polynomials of the sine and the cosine on `[-pi/4, pi/4]`.
+#[inline(always)]
+fn kernels(z: f32) -> (f32, f32) {
+    let zz = z * z;
+    let s = ((-1.951_529_6e-4 * zz + 8.332_161e-3) * zz - 1.666_665_5e-1) * zz * z + z;
+    let c = ((2.443_315_7e-5 * zz - 1.388_731_6e-3) * zz + 4.166_664_6e-2) * zz * zz - 0.5 * zz + 1.0;
+    (s, c)
 }
 
 pub(super) fn sinf(x: f32) -> f32 {
@@ -113,17 +137,25 @@ pub(super) fn asinf(x: f32) -> f32 {
 /// flash for a call's saving of a few instructions at each.
 #[inline(never)]
 pub(super) fn atan2f(y: f32, x: f32) -> f32 {
+    // Magnitudes as bits: for non-negative floats the bits order as the values do, with the infinities above every
+    // finite value and NaN above them. So the larger magnitude alone tells whether both are zero, or either is
+    // infinite or NaN: one test where comparisons of the floats took a dozen instructions.
+    let (bx, by) = (x.to_bits() & 0x7fff_ffff, y.to_bits() & 0x7fff_ffff);
+    let swapped = by > bx;
+    let (small, large) = if swapped { (bx, by) } else { (by, bx) };
+    if large.wrapping_sub(1) >= 0x7f7f_ffff {
+        return libm::atan2f(y, x);
+    }
+    atan2_of_ratio(f32::from_bits(small) / f32::from_bits(large), swapped, y, x)
+}
+
+/// `atan2(y, x)` from `t`, the smaller magnitude over the larger (`0 <= t <= 1`), and whether `|y|` is the larger.
+#[inline(always)]
+fn atan2_of_ratio(t: f32, swapped: bool, y: f32, x: f32) -> f32 {
     const TAN_PI_8: f32 = 0.414_213_57;
     const FRAC_PI_4: f32 = core::f32::consts::FRAC_PI_4;
     const FRAC_PI_2: f32 = core::f32::consts::FRAC_PI_2;
     const PI: f32 = core::f32::consts::PI;
-    let (ax, ay) = (libm::fabsf(x), libm::fabsf(y));
-    // Also false for NaN: both must be finite and one of them non-zero.
-    if !(ax < f32::INFINITY && ay < f32::INFINITY && (ax > 0.0 || ay > 0.0)) {
-        return libm::atan2f(y, x);
-    }
-    let swapped = ay > ax;
-    let t = if swapped { ax / ay } else { ay / ax };
     let (base, t) = if t > TAN_PI_8 {
         (FRAC_PI_4, (t - 1.0) / (t + 1.0))
     } else {
@@ -277,5 +309,89 @@ mod tests {
         assert_eq!(atan2f(-0.0, -0.0), libm::atan2f(-0.0, -0.0));
         assert_eq!(atan2f(f32::INFINITY, 1.0), libm::atan2f(f32::INFINITY, 1.0));
         assert!(atan2f(f32::NAN, 1.0).is_nan() && atan2f(1.0, f32::NAN).is_nan());
+    }
+
+    /// `atan2f` as it tested its inputs on the floats, the form its bit tests replaced (the arctangent of the ratio
+    /// is the same code): the reference that they change nothing.
+    fn atan2f_float_tests(y: f32, x: f32) -> f32 {
+        let (ax, ay) = (libm::fabsf(x), libm::fabsf(y));
+        if !(ax < f32::INFINITY && ay < f32::INFINITY && (ax > 0.0 || ay > 0.0)) {
+            return libm::atan2f(y, x);
+        }
+        let swapped = ay > ax;
+        atan2_of_ratio(if swapped { ax / ay } else { ay / ax }, swapped, y, x)
+    }
+
+    /// `sincosf` as it reduced every argument, octant 0 included: the reference that the shortcut changes nothing.
+    fn sincosf_always_reduced(x: f32) -> (f32, f32) {
+        let ax = libm::fabsf(x);
+        if !ax.is_finite() {
+            return (f32::NAN, f32::NAN);
+        }
+        if ax > 8192.0 {
+            return sincosf(libm::remainderf(x, core::f32::consts::TAU));
+        }
+        reduced(ax, x)
+    }
+
+    /// Equal bits, or both NaN.
+    fn same(a: f32, b: f32) -> bool {
+        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+    }
+
+    /// Special values and their neighbours: zeros, subnormals, the switch points, infinities, NaN.
+    const EDGES: [f32; 14] = [
+        0.0,
+        -0.0,
+        f32::MIN_POSITIVE,
+        1e-45,
+        -1e-45,
+        f32::from_bits(core::f32::consts::FRAC_PI_4.to_bits() - 1),
+        core::f32::consts::FRAC_PI_4,
+        -core::f32::consts::FRAC_PI_4,
+        1.0,
+        8192.0,
+        -8192.001,
+        f32::MAX,
+        f32::INFINITY,
+        f32::NAN,
+    ];
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(20_000))]
+
+        #[test]
+        fn arc_tangent_bit_tests_change_no_result(y in proptest::num::f32::ANY, x in proptest::num::f32::ANY) {
+            proptest::prop_assert!(same(atan2f(y, x), atan2f_float_tests(y, x)), "atan2f({y:e}, {x:e})");
+        }
+
+        #[test]
+        fn arc_tangent_bit_tests_change_no_angle_of_a_pose(y in -1.0f32..1.0, x in -1.0f32..1.0) {
+            proptest::prop_assert!(same(atan2f(y, x), atan2f_float_tests(y, x)), "atan2f({y:e}, {x:e})");
+        }
+
+        #[test]
+        fn sine_and_cosine_without_reduction_in_octant_0_change_no_result(x in proptest::num::f32::ANY) {
+            let ((s, c), (rs, rc)) = (sincosf(x), sincosf_always_reduced(x));
+            proptest::prop_assert!(same(s, rs) && same(c, rc), "sincosf({x:e})");
+        }
+
+        #[test]
+        fn sine_and_cosine_of_pose_angles_unchanged(x in -4.0f32..4.0) {
+            let ((s, c), (rs, rc)) = (sincosf(x), sincosf_always_reduced(x));
+            proptest::prop_assert!(same(s, rs) && same(c, rc), "sincosf({x:e})");
+        }
+    }
+
+    #[test]
+    fn special_values_keep_their_results() {
+        for a in EDGES.iter().flat_map(|&v| [v, -v]) {
+            let (s, c) = sincosf(a);
+            let (rs, rc) = sincosf_always_reduced(a);
+            assert!(same(s, rs) && same(c, rc), "sincosf({a:e})");
+            for b in EDGES.iter().flat_map(|&v| [v, -v]) {
+                assert!(same(atan2f(a, b), atan2f_float_tests(a, b)), "atan2f({a:e}, {b:e})");
+            }
+        }
     }
 }

@@ -19,7 +19,7 @@ pub use self::guard::SlowCheckGuard;
 pub use self::statics::ActuatorLoads;
 pub use self::tipping::{Loaded, TipOver, TipOverError, GRAVITY};
 use super::geometry::{Branch, ChainKind, RingGeometry};
-use super::{Actuators, AxisKind, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
+use super::{Actuators, AxisKind, Check, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
 
 /// A chain's kind without an elbow chain's dimensions (those are in the platform's `arms`): what the per-pose code
@@ -178,77 +178,87 @@ impl<T: Real> RingPlatform<T> {
         let pose = pose.validated()?;
         c.rotation = pose.rotation();
         self.place_joints(&pose, c);
-        let q = &mut c.q.0;
-        let tiny = self.rr * T::of(T::EPS * 16.0);
         for i in 0..self.n {
-            let a = c.joints[i];
-            let chain = i as u8;
-            let rho2 = a.x * a.x + a.y * a.y;
-            let rho = rho2.sqrt_();
-            if rho <= tiny {
-                return Err(KinematicsError::Unreachable {
-                    chain,
-                    reason: Reach::Centre,
-                });
-            }
-            match self.kinds[i] {
-                Shape::Rod(branch) => {
-                    let h2 = self.rod * self.rod - a.z * a.z;
-                    if h2 <= T::zero() {
-                        return Err(KinematicsError::Unreachable {
-                            chain,
-                            reason: Reach::Height,
-                        });
-                    }
-                    // (2 Rr rho sin phi)^2 factors into (h^2 - (Rr - rho)^2) ((Rr + rho)^2 - h^2): both factors
-                    // non-negative is the reach condition, and the factored form keeps sin phi accurate near 0 and
-                    // pi, where the cosine rule alone would lose half the digits.
-                    let inner = h2 - (self.rr - rho) * (self.rr - rho);
-                    let outer = (self.rr + rho) * (self.rr + rho) - h2;
-                    if inner < T::zero() || outer < T::zero() {
-                        return Err(KinematicsError::Unreachable {
-                            chain,
-                            reason: Reach::Ring,
-                        });
-                    }
-                    let sine = (inner * outer).sqrt_();
-                    let cosine = self.rr * self.rr + rho2 - h2;
-                    let sine = match branch {
-                        Branch::Plus => sine,
-                        Branch::Minus => -sine,
-                    };
-                    let (cx, cy) = (a.x * cosine - a.y * sine, a.y * cosine + a.x * sine);
-                    q[i] = cy.atan2_(cx);
-                    let scale = T::one() / (rho2 + rho2);
-                    c.carriages[i] = Vector3::new(cx * scale, cy * scale, T::zero());
-                }
-                Shape::Radial => {
-                    q[i] = a.y.atan2_(a.x);
-                    let scale = self.rr / rho;
-                    c.carriages[i] = Vector3::new(a.x * scale, a.y * scale, T::zero());
-                    if let Some(k) = self.length_axis[i] {
-                        q[k] = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
-                    }
-                }
-                Shape::Elbow => {
-                    // The carriage is on the joint's radius, as a radial chain's; the arm is a planar dyad there.
-                    q[i] = a.y.atan2_(a.x);
-                    let (cq, sq) = (a.x / rho, a.y / rho);
-                    c.carriages[i] = Vector3::new(self.rr * cq, self.rr * sq, T::zero());
-                    if let Some(arm) = &self.arms[i] {
-                        let s = arm.shoulder(rho, a.z).ok_or(KinematicsError::Unreachable {
-                            chain,
-                            reason: Reach::Dyad,
-                        })?;
-                        q[arm.axis] = s.angle;
-                        c.bases[i] = arm.elbow(cq, sq, s.cos, s.sin);
-                        continue;
-                    }
-                }
-            }
-            c.bases[i] = c.carriages[i];
+            let (carriage, base) = self.chain(i, &c.joints[i], &mut c.q.0)?;
+            c.carriages[i] = carriage;
+            c.bases[i] = base;
         }
         Ok(())
+    }
+
+    /// Chain `i`'s actuators for its platform joint `a` into `q`, and its carriage and the start of its last link
+    /// (the carriage, or an elbow chain's elbow).
+    ///
+    /// Always inlined: IK alone keeps only the actuators, and the compiler drops the rest where it sees it unused.
+    #[inline(always)]
+    fn chain(&self, i: usize, a: &Vector3<T>, q: &mut [T; 6]) -> Result<(Vector3<T>, Vector3<T>), KinematicsError> {
+        let chain = i as u8;
+        let tiny = self.rr * T::of(T::EPS * 16.0);
+        let rho2 = a.x * a.x + a.y * a.y;
+        let rho = rho2.sqrt_();
+        if rho <= tiny {
+            return Err(KinematicsError::Unreachable {
+                chain,
+                reason: Reach::Centre,
+            });
+        }
+        match self.kinds[i] {
+            Shape::Rod(branch) => {
+                let h2 = self.rod * self.rod - a.z * a.z;
+                if h2 <= T::zero() {
+                    return Err(KinematicsError::Unreachable {
+                        chain,
+                        reason: Reach::Height,
+                    });
+                }
+                // (2 Rr rho sin phi)^2 factors into (h^2 - (Rr - rho)^2) ((Rr + rho)^2 - h^2): both factors
+                // non-negative is the reach condition, and the factored form keeps sin phi accurate near 0 and
+                // pi, where the cosine rule alone would lose half the digits.
+                let inner = h2 - (self.rr - rho) * (self.rr - rho);
+                let outer = (self.rr + rho) * (self.rr + rho) - h2;
+                if inner < T::zero() || outer < T::zero() {
+                    return Err(KinematicsError::Unreachable {
+                        chain,
+                        reason: Reach::Ring,
+                    });
+                }
+                let sine = (inner * outer).sqrt_();
+                let cosine = self.rr * self.rr + rho2 - h2;
+                let sine = match branch {
+                    Branch::Plus => sine,
+                    Branch::Minus => -sine,
+                };
+                let (cx, cy) = (a.x * cosine - a.y * sine, a.y * cosine + a.x * sine);
+                q[i] = cy.atan2_(cx);
+                let scale = T::one() / (rho2 + rho2);
+                let carriage = Vector3::new(cx * scale, cy * scale, T::zero());
+                Ok((carriage, carriage))
+            }
+            Shape::Radial => {
+                q[i] = a.y.atan2_(a.x);
+                let scale = self.rr / rho;
+                let carriage = Vector3::new(a.x * scale, a.y * scale, T::zero());
+                if let Some(k) = self.length_axis[i] {
+                    q[k] = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
+                }
+                Ok((carriage, carriage))
+            }
+            Shape::Elbow => {
+                // The carriage is on the joint's radius, as a radial chain's; the arm is a planar dyad there.
+                q[i] = a.y.atan2_(a.x);
+                let (cq, sq) = (a.x / rho, a.y / rho);
+                let carriage = Vector3::new(self.rr * cq, self.rr * sq, T::zero());
+                let Some(arm) = &self.arms[i] else {
+                    return Ok((carriage, carriage));
+                };
+                let s = arm.shoulder(rho, a.z).ok_or(KinematicsError::Unreachable {
+                    chain,
+                    reason: Reach::Dyad,
+                })?;
+                q[arm.axis] = s.angle;
+                Ok((carriage, arm.elbow(cq, sq, s.cos, s.sin)))
+            }
+        }
     }
 }
 
@@ -267,10 +277,16 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         self.rr
     }
 
+    /// IK alone keeps no configuration: only the rotation and the actuators, so nothing of the 348 bytes that
+    /// the checks need is cleared or stored.
     fn inverse(&self, pose: &Pose<T>) -> Result<Actuators<T>, KinematicsError> {
-        let mut c = Configuration::zeroed();
-        self.solve(pose, &mut c)?;
-        Ok(c.q)
+        let pose = pose.validated()?;
+        let (r, p) = (pose.rotation(), pose.position());
+        let mut q = [T::zero(); 6];
+        for i in 0..self.n {
+            self.chain(i, &(r * self.points[i] + p), &mut q)?;
+        }
+        Ok(Actuators(q))
     }
 
     /// IK and the checks on what it found (the rotation, joints and carriages are not computed twice).
@@ -279,6 +295,13 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         self.solve(pose, &mut c)?;
         c.direct(self.n);
         Ok((c.q, self.report(pose, &c)))
+    }
+
+    /// IK and the checks in their order, each evaluated only while every one before it left its room: a point of
+    /// the envelope search outside the workspace mostly fails the reach check, and then skips the joint cones,
+    /// the singularity index (a 6x6 decomposition) and the stability.
+    fn inverse_within(&self, pose: &Pose<T>, room: &[T; 6]) -> Result<Actuators<T>, Check> {
+        self.within(pose, room)
     }
 
     /// IK and the checks, the joint cones and the singularity index proved by [`SlowCheckGuard`] when they can be.

@@ -88,13 +88,13 @@ pub(crate) fn core_on_m4f(t: &mut Tally) {
 /// under `-icount` are exact and repeatable for a given build, so these hold or fail deterministically; they keep
 /// the control path from growing back unnoticed.
 pub(crate) const BUDGETS: [(&str, u64); 11] = [
-    ("control tick: pipeline", 6_000),
-    ("control tick at 2 kHz", 5_750),
-    ("trainer IK (f32)", 1_250),
-    ("IK + all", 3_400),
-    ("setpoint frame", 6_300),
-    ("FK", 15_200),
-    ("limited into the envelope", 19_500),
+    ("control tick: pipeline", 5_800),
+    ("control tick at 2 kHz", 5_550),
+    ("trainer IK (f32)", 840),
+    ("IK + all", 3_260),
+    ("setpoint frame", 5_750),
+    ("FK", 14_000),
+    ("limited into the envelope", 14_450),
     ("step buffers, idle", 900),
     ("step buffers, typical", 2_700),
     ("step buffers, the trainer's fastest", 6_100),
