@@ -225,10 +225,7 @@ pub fn replay(
     let mut held = *neutral;
     for (line, v) in rows {
         let t = v[0];
-        let sample = Telemetry {
-            force: [v[1], v[2], v[3]],
-            rate: [v[4], v[5], v[6]],
-        };
+        let sample = super::cue_engine::row_sample(v);
         let offset = match last_t {
             // The first row (and the first after a gap) starts the washout at neutral and is its first input.
             None => washout.begin(&sample),

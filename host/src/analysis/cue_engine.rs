@@ -102,11 +102,15 @@ pub fn ahead(rows: &[(usize, Vec<f64>)], t: f64, steps: usize, h: f64) -> Vec<Te
         .map(|k| {
             let at = t + k as f64 * h;
             let i = rows.partition_point(|(_, v)| v[0] <= at).saturating_sub(1);
-            let v = &rows[i].1;
-            Telemetry {
-                force: [v[1], v[2], v[3]],
-                rate: [v[4], v[5], v[6]],
-            }
+            row_sample(&rows[i].1)
         })
         .collect()
+}
+
+/// A telemetry row's sample (`t, ax, ay, az, wx, wy, wz`: the values after the time).
+pub fn row_sample(v: &[f64]) -> Telemetry<f64> {
+    Telemetry {
+        force: [v[1], v[2], v[3]],
+        rate: [v[4], v[5], v[6]],
+    }
 }

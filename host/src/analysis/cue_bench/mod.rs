@@ -155,13 +155,7 @@ fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward) -> Result<FloorReport,
     let mut each = Vec::new();
     for rows in drives {
         let t: Vec<f64> = rows.iter().map(|(_, v)| v[0]).collect();
-        let samples: Vec<Telemetry<f64>> = rows
-            .iter()
-            .map(|(_, v)| Telemetry {
-                force: [v[1], v[2], v[3]],
-                rate: [v[4], v[5], v[6]],
-            })
-            .collect();
+        let samples: Vec<Telemetry<f64>> = rows.iter().map(|(_, v)| super::cue_engine::row_sample(v)).collect();
         let f = floor::floor(&t, &samples, &rig.envelope.ranges, forward).map_err(CueError::Floor)?;
         let m = t.len().saturating_sub(1);
         for (total, rms) in sum.iter_mut().zip(f.force_rms) {
@@ -170,13 +164,7 @@ fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward) -> Result<FloorReport,
         n += m;
         each.push(f.force_rms);
         for offset in &f.offsets {
-            for (i, share) in envelope_share.iter_mut().enumerate() {
-                let (lo, hi) = rig.envelope.ranges[i];
-                let edge = if offset[i] >= 0.0 { hi } else { lo };
-                if edge != 0.0 {
-                    *share = share.max(offset[i] / edge);
-                }
-            }
+            score::widen_shares(&mut envelope_share, offset, &rig.envelope.ranges);
         }
     }
     let force_rms = sum.map(|v| (v / n.max(1) as f64).sqrt());

@@ -99,6 +99,17 @@ pub struct Trace {
     pub platform: [f64; 3],
 }
 
+/// Widens each axis's largest share of its range about home (x, y, z, roll, pitch; 1 = the range's edge) to
+/// cover `offset` from home.
+pub fn widen_shares(shares: &mut [f64; 5], offset: &[f64], ranges: &Ranges) {
+    for (i, share) in shares.iter_mut().enumerate() {
+        let edge = if offset[i] >= 0.0 { ranges[i].1 } else { ranges[i].0 };
+        if edge != 0.0 {
+            *share = share.max(offset[i] / edge);
+        }
+    }
+}
+
 /// Scores a cued drive about `neutral` in `ranges`, the platform facing `forward`; with each sample's perceived
 /// forces.
 pub fn score(cued: &[Cued], neutral: &Pose<f64>, ranges: &Ranges, forward: Forward) -> (Score, Vec<Trace>) {
@@ -151,13 +162,8 @@ pub fn score(cued: &[Cued], neutral: &Pose<f64>, ranges: &Ranges, forward: Forwa
         for i in 0..2 {
             rotation_runs[i].add(false_cue(pp.rate[i], pv.rate[i], rotation_threshold[i]), dt);
         }
-        for (i, share) in s.envelope_share.iter_mut().enumerate() {
-            let off = pb[i] - n[i];
-            let edge = if off >= 0.0 { ranges[i].1 } else { ranges[i].0 };
-            if edge != 0.0 {
-                *share = share.max(off / edge);
-            }
-        }
+        let offset: [f64; 5] = core::array::from_fn(|i| pb[i] - n[i]);
+        widen_shares(&mut s.envelope_share, &offset, ranges);
     }
     let m = (cued.len() - 1) as f64;
     s.force_rms = sum_f.map(|v| (v / m).sqrt());

@@ -337,6 +337,7 @@ fn cost_and_bounds(i: usize, config: &CueConfig, ranges: &Ranges) -> (Vec<f64>, 
         );
     }
     let (alo, ahi) = angle_bounds(i, config, ranges);
+    // The rotation keys are per rotation (roll 0, pitch 1): x's is the pitch, y's the roll.
     let rot = 1 - i;
     (
         vec![

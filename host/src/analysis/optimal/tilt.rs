@@ -124,8 +124,10 @@ impl Sharing {
         };
         let translation = [axes[X].x[0], axes[1].x[0], axes[Z].x[0]];
         // The vehicle's roll is y's angle, its pitch minus x's.
+        // The other's angles to hold beside: one when it stays where it is.
+        let others: &[f64] = if a == b { &[a] } else { &[a, b] };
         let holds = |angle: f64| {
-            [a, b].iter().all(|&o| {
+            others.iter().all(|&o| {
                 let (roll, pitch) = if i == X { (o, -angle) } else { (angle, -o) };
                 let offset = cueing::to_platform(self.forward, translation, roll, pitch, yaw);
                 let pose = cueing::pose(&self.neutral, &offset);
