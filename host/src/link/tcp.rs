@@ -147,21 +147,18 @@ pub fn serve(mut device: SimDevice, addr: SocketAddr, stop: &dyn Fn() -> bool) -
     let mut buf = [0u8; 1024];
     while !stop() {
         match listener.accept() {
-            Ok((stream, _)) if client.is_none() => {
+            Ok((stream, _)) => {
                 stream.set_nodelay(true)?;
                 stream.set_nonblocking(true)?;
-                client = Some(stream);
+                admit(&mut client, stream, &mut |bytes| device.send(bytes))?;
             }
-            // Dropped: the second client reads a closed connection.
-            Ok(_) => {}
             Err(e) if e.kind() == ErrorKind::WouldBlock => {}
             Err(e) => return Err(e),
         }
         if let Some(stream) = client.as_mut() {
-            match read_ready(stream, &mut buf) {
-                Ok(n) => device.send(&buf[..n])?,
+            if !drain(stream, &mut |bytes| device.send(bytes))? {
                 // The client went away: wait for the next.
-                Err(_) => client = None,
+                client = None;
             }
         }
         // A real-time simulator: this sleeps to keep pace with the wall clock.
@@ -179,6 +176,37 @@ pub fn serve(mut device: SimDevice, addr: SocketAddr, stop: &dyn Fn() -> bool) -
             }
         }
     }
+    Ok(())
+}
+
+/// Passes everything the client has sent to `feed`, until nothing more has arrived. `false` when the client has
+/// closed the connection (or it broke), after the bytes it sent before.
+fn drain(stream: &mut TcpStream, feed: &mut dyn FnMut(&[u8]) -> std::io::Result<()>) -> std::io::Result<bool> {
+    let mut buf = [0u8; 1024];
+    loop {
+        match read_ready(stream, &mut buf) {
+            Ok(0) => return Ok(true),
+            Ok(n) => feed(&buf[..n])?,
+            Err(_) => return Ok(false),
+        }
+    }
+}
+
+/// A new connection takes the controller when nobody holds it, or when the one who held it has gone: a program
+/// that exits just before the next one connects has closed its connection, but the server may not have read that
+/// yet. Otherwise the new one is closed at once, as a second program that opens a busy serial port is refused.
+fn admit(
+    client: &mut Option<TcpStream>,
+    new: TcpStream,
+    feed: &mut dyn FnMut(&[u8]) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    if let Some(held) = client.as_mut() {
+        if drain(held, feed)? {
+            // Dropped: the newcomer reads a closed connection.
+            return Ok(());
+        }
+    }
+    *client = Some(new);
     Ok(())
 }
 
@@ -223,6 +251,41 @@ mod tests {
             }
         };
         assert_eq!(err.kind(), ErrorKind::ConnectionAborted);
+    }
+
+    /// Two connected pairs: (client side, server side), the server side non-blocking as `serve` makes it.
+    fn pair(listener: &TcpListener) -> (TcpStream, TcpStream) {
+        let near = TcpStream::connect(listener.local_addr().unwrap()).unwrap();
+        let (far, _) = listener.accept().unwrap();
+        far.set_nonblocking(true).unwrap();
+        (near, far)
+    }
+
+    #[test]
+    fn a_newcomer_takes_over_from_a_client_that_has_gone_and_is_refused_beside_one_that_stays() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let mut fed = Vec::new();
+        // The first client says its last words and closes; the server has not read either yet.
+        let (mut first, held) = pair(&listener);
+        first.write_all(b"bye").unwrap();
+        drop(first);
+        std::thread::sleep(Duration::from_millis(50));
+        let (_second, newcomer) = pair(&listener);
+        let newcomer_port = newcomer.peer_addr().unwrap();
+        let mut client = Some(held);
+        admit(&mut client, newcomer, &mut |b| {
+            fed.extend_from_slice(b);
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(client.as_ref().unwrap().peer_addr().unwrap(), newcomer_port);
+        assert_eq!(fed, b"bye", "the first client's last bytes still reach the controller");
+        // A third arrives while the second stays: it is refused, the second keeps the controller.
+        let (mut third, refused) = pair(&listener);
+        admit(&mut client, refused, &mut |_| Ok(())).unwrap();
+        assert_eq!(client.as_ref().unwrap().peer_addr().unwrap(), newcomer_port);
+        third.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        assert_eq!(third.read(&mut [0u8; 4]).unwrap_or(0), 0);
     }
 
     #[test]
