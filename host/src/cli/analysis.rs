@@ -278,6 +278,11 @@ pub struct CueArgs {
     /// can give, found with the whole drive known (one programme per axis over the drive), and its motion scored.
     #[arg(long, requires = "compare")]
     pub floor: bool,
+    /// With --floor: also the floor inside an outer polytope of the rig's whole envelope, every axis planned
+    /// together as the rig couples them (one programme over the drive with every face at every sample: tens
+    /// of seconds on a few minutes of drive).
+    #[arg(long, requires = "floor")]
+    pub envelope_floor: bool,
     /// With `algorithm = "optimal"`: the reference over the horizon is the drive's own next samples (a recorded
     /// drive's preview) rather than the last sample held, as a live game gives it.
     #[arg(long)]

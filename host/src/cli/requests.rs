@@ -145,6 +145,7 @@ impl CueArgs {
             json: self.json,
             preview: self.preview,
             floor: self.floor,
+            envelope_floor: self.envelope_floor,
             mechanism: &self.mechanism,
             geometry: self.geometry.as_deref(),
         })

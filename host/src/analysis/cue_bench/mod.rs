@@ -17,6 +17,8 @@ use serde::Serialize;
 
 use super::cue::{read_drive, replay, CueError};
 use super::mechanism::{AnyMechanism, Selected};
+use super::optimal::floor::Room;
+use super::optimal::polytope::{self, Polytope};
 use super::optimal::{floor, Counts, Envelope, Ranges};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
@@ -40,6 +42,8 @@ pub struct Options<'a> {
     pub preview: bool,
     /// Add the floor: the least error any motion inside the ranges can give, the whole drive known.
     pub floor: bool,
+    /// With the floor: also the floor inside the outer polytope of the rig's whole envelope.
+    pub envelope_floor: bool,
     /// The platform: a preset by name...
     pub mechanism: &'a str,
     /// ...or a rig file.
@@ -86,7 +90,7 @@ pub struct Report {
 /// The floor ([`floor`]) of every drive together.
 #[derive(Debug, Serialize)]
 pub struct FloorReport {
-    /// The least RMS perceived specific-force error on the optimiser's model, x, y, z (m/s^2).
+    /// The least RMS perceived specific-force error on the optimiser's model, x, y, z (m/s^2), inside the ranges.
     pub force_rms: [f64; 3],
     /// The three axes together (m/s^2).
     pub force_total: f64,
@@ -94,6 +98,26 @@ pub struct FloorReport {
     pub drives: Vec<[f64; 3]>,
     /// The largest share of each range the floor's motion used: x, y, z, roll, pitch.
     pub envelope_share: [f64; 5],
+    /// With `--envelope-floor`: the floor inside an outer polytope of the rig's whole envelope, the axes coupled
+    /// as the rig couples them.
+    pub envelope: Option<EnvelopeFloor>,
+}
+
+/// The floor inside the envelope's outer polytope ([`polytope`]).
+#[derive(Debug, Serialize)]
+pub struct EnvelopeFloor {
+    /// x, y, z (m/s^2).
+    pub force_rms: [f64; 3],
+    /// The three axes together (m/s^2).
+    pub force_total: f64,
+    /// Each drive's, x, y, z (m/s^2).
+    pub drives: Vec<[f64; 3]>,
+    /// The polytope's faces.
+    pub faces: usize,
+    /// How far from settled its support search ended (a share of a face's reach), before its slack.
+    pub last_gain: f64,
+    /// The slack added to every face's support (a share of its reach).
+    pub slack: f64,
 }
 
 /// A drive's rows.
@@ -149,31 +173,69 @@ pub fn evaluate(
 /// bounded by the ranges alone, it swings the tilt at any rate and reaches corners of the ranges' box outside the
 /// coupled envelope, so the bench would score the limiter and the finite differences of a motion no cueing
 /// makes, not the floor.
-fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward) -> Result<FloorReport, CueError> {
-    let (mut sum, mut n) = ([0.0; 3], 0usize);
+fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward, coupled: bool) -> Result<FloorReport, CueError> {
+    let ranges = &rig.envelope.ranges;
+    let outer = coupled.then(|| Polytope::of(&rig.mechanism, &rig.neutral, ranges, &polytope::directions(3), RAYS));
+    let (mut within_ranges, mut within_envelope) = (Sums::default(), Sums::default());
     let mut envelope_share = [0.0f64; 5];
-    let mut each = Vec::new();
     for rows in drives {
         let t: Vec<f64> = rows.iter().map(|(_, v)| v[0]).collect();
         let samples: Vec<Telemetry<f64>> = rows.iter().map(|(_, v)| super::cue_engine::row_sample(v)).collect();
-        let f = floor::floor(&t, &samples, &rig.envelope.ranges, forward).map_err(CueError::Floor)?;
-        let m = t.len().saturating_sub(1);
-        for (total, rms) in sum.iter_mut().zip(f.force_rms) {
-            *total += rms * rms * m as f64;
-        }
-        n += m;
-        each.push(f.force_rms);
+        let f = floor::floor(&t, &samples, Room::Ranges(ranges), forward).map_err(CueError::Floor)?;
+        within_ranges.add(&f);
         for offset in &f.offsets {
-            score::widen_shares(&mut envelope_share, offset, &rig.envelope.ranges);
+            score::widen_shares(&mut envelope_share, offset, ranges);
+        }
+        if let Some(outer) = &outer {
+            let f = floor::floor(&t, &samples, Room::Envelope(outer), forward).map_err(CueError::Floor)?;
+            within_envelope.add(&f);
         }
     }
-    let force_rms = sum.map(|v| (v / n.max(1) as f64).sqrt());
+    let (force_rms, force_total) = within_ranges.rms();
+    let (envelope_rms, envelope_total) = within_envelope.rms();
     Ok(FloorReport {
-        force_total: force_rms.iter().map(|r| r * r).sum::<f64>().sqrt(),
         force_rms,
-        drives: each,
+        force_total,
+        drives: within_ranges.each,
         envelope_share,
+        envelope: outer.map(|outer| EnvelopeFloor {
+            force_rms: envelope_rms,
+            force_total: envelope_total,
+            drives: within_envelope.each,
+            faces: outer.faces.len(),
+            last_gain: outer.last_gain,
+            slack: polytope::SLACK,
+        }),
     })
+}
+
+/// Rays spread through the envelope to find the polytope's supports from: with every face's own direction and
+/// the climb, enough that the supports no longer grow (the search's last gain, reported).
+const RAYS: usize = 2000;
+
+/// Floors of several drives added up: squares weighted by samples.
+#[derive(Default)]
+struct Sums {
+    sum: [f64; 3],
+    n: usize,
+    each: Vec<[f64; 3]>,
+}
+
+impl Sums {
+    fn add(&mut self, f: &floor::Floor) {
+        let m = f.offsets.len().saturating_sub(1);
+        for (total, rms) in self.sum.iter_mut().zip(f.force_rms) {
+            *total += rms * rms * m as f64;
+        }
+        self.n += m;
+        self.each.push(f.force_rms);
+    }
+
+    /// Per axis, and the three together.
+    fn rms(&self) -> ([f64; 3], f64) {
+        let per = self.sum.map(|v| (v / self.n.max(1) as f64).sqrt());
+        (per, per.iter().map(|r| r * r).sum::<f64>().sqrt())
+    }
 }
 
 /// The scores of several drives as one: RMS weighted by samples, the largest peaks and shares, the sums.
@@ -248,7 +310,10 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         entries.push(e);
         traces.push(t);
     }
-    let floor = args.floor.then(|| floor_of(&drives, &rig, a.forward)).transpose()?;
+    let floor = args
+        .floor
+        .then(|| floor_of(&drives, &rig, a.forward, args.envelope_floor))
+        .transpose()?;
     let report = Report {
         drives: args.inputs.iter().map(|p| p.display().to_string()).collect(),
         mechanism: selected.name,
@@ -329,6 +394,14 @@ fn table(r: &Report) -> String {
              (the optimiser's model, the whole drive known): {x:.3} {y:.3} {z:.3}, {:.3} m/s^2\n",
             f.force_total
         );
+        if let Some(e) = &f.envelope {
+            let [x, y, z] = e.force_rms;
+            s += &format!(
+                "floor inside the envelope's outer polytope ({} faces, the axes coupled): {x:.3} {y:.3} {z:.3}, \
+                 {:.3} m/s^2\n",
+                e.faces, e.force_total
+            );
+        }
     }
     if let [a, rest @ ..] = r.entries.as_slice() {
         for b in rest {
@@ -341,6 +414,13 @@ fn table(r: &Report) -> String {
         if let Some(f) = &r.floor {
             let ratio = f.force_total / a.total.force_total().max(1e-12);
             s += &format!("floor / {} perceived force error (RMS, all axes): {ratio:.3}\n", a.name);
+            if let Some(e) = &f.envelope {
+                let ratio = e.force_total / a.total.force_total().max(1e-12);
+                s += &format!(
+                    "envelope floor / {} perceived force error (RMS, all axes): {ratio:.3}\n",
+                    a.name
+                );
+            }
         }
     }
     s
@@ -367,6 +447,7 @@ mod tests {
             json: false,
             preview: false,
             floor: true,
+            envelope_floor: false,
             mechanism: "trainer-model",
             geometry: None,
         };

@@ -16,6 +16,7 @@ use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, S
 use ringpod_core::cueing::{self, Forward, Telemetry};
 
 use super::model::{self, Discrete, Linear};
+use super::polytope::Polytope;
 use super::{stimulus, Ranges, X, Y, Z};
 
 /// The price of each input squared, so that the programme has one solution where several motions perceive
@@ -30,13 +31,8 @@ pub enum FloorError {
     #[error("row {0} is not 0 to 1 s after the row before: the floor needs a drive without gaps")]
     Interval(usize),
     /// The solver ended without a solution.
-    #[error("the {axis} axis's programme ended without a solution ({status})")]
-    Solver {
-        /// Which axis.
-        axis: &'static str,
-        /// Clarabel's status.
-        status: String,
-    },
+    #[error("the floor's programme ended without a solution ({0})")]
+    Solver(String),
 }
 
 /// The floor of one drive.
@@ -48,33 +44,215 @@ pub struct Floor {
     pub offsets: Vec<[f64; 6]>,
 }
 
-/// The floor of a drive (`samples` at times `t`) in `ranges`, the platform facing `forward`.
-pub fn floor(t: &[f64], samples: &[Telemetry<f64>], ranges: &Ranges, forward: Forward) -> Result<Floor, FloorError> {
+/// What bounds the floor's motion.
+#[derive(Debug, Clone, Copy)]
+pub enum Room<'a> {
+    /// Each axis's range about home, found with the other axes at home: every axis on its own.
+    Ranges(&'a Ranges),
+    /// An outer polytope of the rig's envelope: the axes together, as the rig couples them.
+    Envelope(&'a Polytope),
+}
+
+/// The floor of a drive (`samples` at times `t`) in `room`, the platform facing `forward`.
+pub fn floor(t: &[f64], samples: &[Telemetry<f64>], room: Room, forward: Forward) -> Result<Floor, FloorError> {
     if let Some(k) = (1..t.len()).find(|&k| !(t[k] - t[k - 1] > 0.0 && t[k] - t[k - 1] <= 1.0)) {
         return Err(FloorError::Interval(k));
     }
-    let mut force_rms = [0.0; 3];
-    let mut paths = Vec::with_capacity(3);
-    for (i, name) in [(X, "x"), (Y, "y"), (Z, "z")] {
-        let (p, angle, rms) = axis(i, t, samples, ranges).map_err(|status| FloorError::Solver {
-            axis: name,
-            status: format!("{status:?}"),
-        })?;
-        force_rms[i] = rms;
-        paths.push((p, angle));
+    let n = t.len().saturating_sub(1);
+    let mut base = 0;
+    let parts = [X, Y, Z].map(|i| {
+        let part = Part::new(i, base);
+        base += n * part.block();
+        part
+    });
+    let variables = base;
+    let mut qp = Sparse::default();
+    for part in &parts {
+        part.dynamics(&mut qp, t, samples);
     }
-    let offsets = (0..t.len())
-        .map(|k| {
-            let translation = [paths[X].0[k], paths[Y].0[k], paths[Z].0[k]];
-            // x's angle is minus the pitch, y's the roll (as the optimal cueing's axes).
-            cueing::to_platform(forward, translation, paths[Y].1[k], -paths[X].1[k], 0.0)
-        })
+    qp.equalities = qp.b.len();
+    match room {
+        Room::Ranges(ranges) => {
+            for part in &parts {
+                part.bound(&mut qp, ranges, n);
+            }
+        }
+        Room::Envelope(polytope) => within(&mut qp, &parts, polytope, forward, n),
+    }
+    let x = solve(&qp, variables)?;
+    let mut force_rms = [0.0; 3];
+    for part in &parts {
+        let sum: f64 = (0..n).map(|k| x[part.error(k)].powi(2)).sum();
+        force_rms[part.i] = (sum / n.max(1) as f64).sqrt();
+    }
+    let offsets = std::iter::once([0.0; 6])
+        .chain((0..n).map(|k| {
+            let [px, py, pz, roll, pitch] = vehicle(&parts, &x, k);
+            cueing::to_platform(forward, [px, py, pz], roll, pitch, 0.0)
+        }))
         .collect();
     Ok(Floor { force_rms, offsets })
 }
 
-/// One axis's sparse programme, as Clarabel takes it: `min z'Pz/2 + q'z` with `A z + s = b`, the first
-/// `equalities` rows' `s` zero and the rest's at least zero.
+/// Bounds the programme by every face of the polytope at every sample. (Adding only the faces a solution
+/// crossed, round by round, was measured slower: the solutions swing across most faces before they settle, and
+/// each round is a whole solve.)
+fn within(qp: &mut Sparse, parts: &[Part; 3], polytope: &Polytope, forward: Forward, n: usize) {
+    // The platform's offset is linear in the vehicle's axes: column j is vehicle axis j's.
+    let columns: [[f64; 6]; 5] = core::array::from_fn(|j| {
+        let e: [f64; 5] = core::array::from_fn(|m| f64::from(u8::from(m == j)));
+        cueing::to_platform(forward, [e[0], e[1], e[2]], e[3], e[4], 0.0)
+    });
+    // a . (L v) <= b as a row on the vehicle's axes: (L' a) . v.
+    let rows: Vec<([f64; 5], f64)> = polytope
+        .faces
+        .iter()
+        .map(|(a, b)| (core::array::from_fn(|j| (0..5).map(|m| columns[j][m] * a[m]).sum()), *b))
+        .collect();
+    for k in 0..n {
+        for (on, b) in &rows {
+            face_row(qp, parts, k, on, *b);
+        }
+    }
+}
+
+/// Where each vehicle axis's bounded output sits in the programme: `[px, py, pz, roll, pitch]` as (axis,
+/// output, sign). x's angle is minus the pitch, y's the roll.
+const VEHICLE: [(usize, usize, f64); 5] = [(X, 2, 1.0), (Y, 2, 1.0), (Z, 1, 1.0), (Y, 4, 1.0), (X, 4, -1.0)];
+
+/// The vehicle's axes `[px, py, pz, roll, pitch]` at sample `k` of the solution `x`.
+fn vehicle(parts: &[Part; 3], x: &[f64], k: usize) -> [f64; 5] {
+    VEHICLE.map(|(i, output, sign)| {
+        let part = &parts[i];
+        let c = &part.model.c;
+        sign * (0..c.ncols())
+            .map(|col| c[(output, col)] * x[part.state(k) + col])
+            .sum::<f64>()
+    })
+}
+
+/// The row `on . v(k) <= b` on the vehicle's axes at sample `k`.
+fn face_row(qp: &mut Sparse, parts: &[Part; 3], k: usize, on: &[f64; 5], b: f64) {
+    let row = qp.b.len();
+    // Two outputs of one axis may share a state: sum before pushing.
+    let mut entries: Vec<(usize, f64)> = Vec::new();
+    for ((i, output, sign), weight) in VEHICLE.iter().zip(on) {
+        let part = &parts[*i];
+        let c = &part.model.c;
+        for col in 0..c.ncols() {
+            let v = sign * weight * c[(*output, col)];
+            let at = part.state(k) + col;
+            match entries.iter_mut().find(|(c, _)| *c == at) {
+                Some(e) => e.1 += v,
+                None => entries.push((at, v)),
+            }
+        }
+    }
+    for (col, v) in entries {
+        qp.a.push(row, col, v);
+    }
+    qp.b.push(b);
+}
+
+/// One axis's part of the programme: per sample after the first its state, the input held over the interval
+/// before it, and its error, from `base` on.
+struct Part {
+    i: usize,
+    model: Linear,
+    perception: Linear,
+    base: usize,
+}
+
+impl Part {
+    fn new(i: usize, base: usize) -> Self {
+        let (model, perception) = if i == Z {
+            (model::vertical(), model::perception(false))
+        } else {
+            (model::horizontal(), model::perception(true))
+        };
+        Self {
+            i,
+            model,
+            perception,
+            base,
+        }
+    }
+
+    fn block(&self) -> usize {
+        let (nx, nu, _) = self.model.dims();
+        nx + nu + 1
+    }
+
+    fn state(&self, k: usize) -> usize {
+        self.base + k * self.block()
+    }
+
+    fn input(&self, k: usize) -> usize {
+        self.state(k) + self.model.dims().0
+    }
+
+    fn error(&self, k: usize) -> usize {
+        self.block() - 1 + self.state(k)
+    }
+
+    /// The dynamics and the error's definition, as equalities; the error's square and the effort as the cost.
+    fn dynamics(&self, qp: &mut Sparse, t: &[f64], samples: &[Telemetry<f64>]) {
+        let (nx, nu, _) = self.model.dims();
+        let model = &self.model;
+        let reference = vehicle_perceived(&self.perception, t, samples, self.i);
+        let mut discrete = None;
+        for k in 0..t.len().saturating_sub(1) {
+            let d = discretised(&mut discrete, model, t[k + 1] - t[k]);
+            // x_k - A x_(k-1) - B u = 0 (the platform at neutral before the first interval).
+            for r in 0..nx {
+                let row = qp.b.len();
+                qp.a.push(row, self.state(k) + r, 1.0);
+                for c in 0..nx {
+                    if k > 0 {
+                        qp.a.push(row, self.state(k - 1) + c, -d.a[(r, c)]);
+                    }
+                }
+                for c in 0..nu {
+                    qp.a.push(row, self.input(k) + c, -d.b[(r, c)]);
+                }
+                qp.b.push(0.0);
+            }
+            // e - (C x + D u) = -reference: the perceived force's error.
+            let row = qp.b.len();
+            qp.a.push(row, self.error(k), 1.0);
+            for c in 0..nx {
+                qp.a.push(row, self.state(k) + c, -model.c[(0, c)]);
+            }
+            for c in 0..nu {
+                qp.a.push(row, self.input(k) + c, -model.d[(0, c)]);
+            }
+            qp.b.push(-reference[k + 1]);
+            qp.p.push(self.error(k), self.error(k), 2.0);
+            for c in 0..nu {
+                qp.p.push(self.input(k) + c, self.input(k) + c, 2.0 * EFFORT);
+            }
+        }
+    }
+
+    /// Each bounded output within its range, at every sample.
+    fn bound(&self, qp: &mut Sparse, ranges: &Ranges, n: usize) {
+        let nx = self.model.dims().0;
+        for (output, (lo, hi)) in bounded_outputs(self.i, ranges) {
+            for k in 0..n {
+                for (sign, limit) in [(1.0, hi), (-1.0, -lo)] {
+                    let row = qp.b.len();
+                    for c in 0..nx {
+                        qp.a.push(row, self.state(k) + c, sign * self.model.c[(output, c)]);
+                    }
+                    qp.b.push(limit);
+                }
+            }
+        }
+    }
+}
+
+/// The sparse programme, as Clarabel takes it: `min z'Pz/2 + q'z` with `A z + s = b`, the first `equalities`
+/// rows' `s` zero and the rest's at least zero.
 #[derive(Default)]
 struct Sparse {
     p: Triplets,
@@ -99,89 +277,9 @@ impl Triplets {
         }
     }
 
-    fn csc(self, rows: usize, cols: usize) -> CscMatrix<f64> {
-        CscMatrix::new_from_triplets(rows, cols, self.rows, self.cols, self.vals)
+    fn csc(&self, rows: usize, cols: usize) -> CscMatrix<f64> {
+        CscMatrix::new_from_triplets(rows, cols, self.rows.clone(), self.cols.clone(), self.vals.clone())
     }
-}
-
-/// Axis `i`: its positions and angles at every sample (neutral at the first) and the RMS error it leaves.
-fn axis(
-    i: usize,
-    t: &[f64],
-    samples: &[Telemetry<f64>],
-    ranges: &Ranges,
-) -> Result<(Vec<f64>, Vec<f64>, f64), SolverStatus> {
-    let (model, perception) = if i == Z {
-        (model::vertical(), model::perception(false))
-    } else {
-        (model::horizontal(), model::perception(true))
-    };
-    let (nx, nu, _) = model.dims();
-    let reference = vehicle_perceived(&perception, t, samples, i);
-    // Per sample after the first: its state, the input held over the interval before it, its error.
-    let block = nx + nu + 1;
-    let n = t.len().saturating_sub(1);
-    let (state, input, error) = (
-        |k: usize| k * block,
-        |k: usize| k * block + nx,
-        |k: usize| k * block + nx + nu,
-    );
-    let mut qp = Sparse::default();
-    let mut discrete = None;
-    for k in 0..n {
-        let d = discretised(&mut discrete, &model, t[k + 1] - t[k]);
-        // x_k - A x_(k-1) - B u = 0 (the platform at neutral before the first interval).
-        for r in 0..nx {
-            let row = qp.b.len();
-            qp.a.push(row, state(k) + r, 1.0);
-            for c in 0..nx {
-                if k > 0 {
-                    qp.a.push(row, state(k - 1) + c, -d.a[(r, c)]);
-                }
-            }
-            for c in 0..nu {
-                qp.a.push(row, input(k) + c, -d.b[(r, c)]);
-            }
-            qp.b.push(0.0);
-        }
-        // e - (C x + D u) = -reference: the perceived force's error.
-        let row = qp.b.len();
-        qp.a.push(row, error(k), 1.0);
-        for c in 0..nx {
-            qp.a.push(row, state(k) + c, -model.c[(0, c)]);
-        }
-        for c in 0..nu {
-            qp.a.push(row, input(k) + c, -model.d[(0, c)]);
-        }
-        qp.b.push(-reference[k + 1]);
-        qp.p.push(error(k), error(k), 2.0);
-        for c in 0..nu {
-            qp.p.push(input(k) + c, input(k) + c, 2.0 * EFFORT);
-        }
-    }
-    qp.equalities = qp.b.len();
-    for (output, (lo, hi)) in bounded_outputs(i, ranges) {
-        for k in 0..n {
-            for (sign, limit) in [(1.0, hi), (-1.0, -lo)] {
-                let row = qp.b.len();
-                for c in 0..nx {
-                    qp.a.push(row, state(k) + c, sign * model.c[(output, c)]);
-                }
-                qp.b.push(limit);
-            }
-        }
-    }
-    let x = solve(qp, n * block)?;
-    let angle_of = |k: usize| if i == Z { 0.0 } else { x[state(k) + 2] + x[state(k) + 3] };
-    let mut p = vec![0.0];
-    let mut angle = vec![0.0];
-    let mut sum = 0.0;
-    for k in 0..n {
-        p.push(x[state(k)]);
-        angle.push(angle_of(k));
-        sum += x[error(k)].powi(2);
-    }
-    Ok((p, angle, (sum / n.max(1) as f64).sqrt()))
 }
 
 /// The bounded outputs of axis `i`'s model and their ranges: the position, and on x and y the angle (x's is
@@ -194,7 +292,7 @@ fn bounded_outputs(i: usize, ranges: &Ranges) -> Vec<(usize, (f64, f64))> {
     }
 }
 
-fn solve(qp: Sparse, variables: usize) -> Result<Vec<f64>, SolverStatus> {
+fn solve(qp: &Sparse, variables: usize) -> Result<Vec<f64>, FloorError> {
     let rows = qp.b.len();
     let settings = DefaultSettings {
         verbose: false,
@@ -207,11 +305,13 @@ fn solve(qp: Sparse, variables: usize) -> Result<Vec<f64>, SolverStatus> {
     ];
     let q = vec![0.0; variables];
     let (p, a) = (qp.p.csc(variables, variables), qp.a.csc(rows, variables));
-    let mut solver = DefaultSolver::new(&p, &q, &a, &qp.b, &cones, settings).map_err(|_| SolverStatus::Unsolved)?;
+    let failed = |status: SolverStatus| FloorError::Solver(format!("{status:?}"));
+    let mut solver =
+        DefaultSolver::new(&p, &q, &a, &qp.b, &cones, settings).map_err(|_| failed(SolverStatus::Unsolved))?;
     solver.solve();
     match solver.solution.status {
         SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(solver.solution.x.clone()),
-        status => Err(status),
+        status => Err(failed(status)),
     }
 }
 
@@ -245,19 +345,27 @@ fn discretised<'a>(cache: &'a mut Option<(f64, Discrete)>, linear: &Linear, dt: 
 
 #[cfg(test)]
 mod tests {
+    use super::super::polytope::directions;
     use super::*;
     use ringpod_core::cueing::perception::Perception;
     use ringpod_core::cueing::G;
+    use ringpod_core::kinematics::presets::{Preset, TRAINER_MODEL};
+    use ringpod_core::kinematics::{Pose, RingPlatform};
 
     /// 6 s at 100 Hz: at rest, then braking at 3 m/s^2 and turning left at 2 m/s^2 from 1 s to 4 s, ramped
     /// over half a second, with `sign` on the braking (-1 accelerates instead).
     fn drive(sign: f64) -> (Vec<f64>, Vec<Telemetry<f64>>) {
+        drive_of(3.0 * sign, 2.0)
+    }
+
+    /// The same with braking `brake` and a left turn's force `turn` (m/s^2).
+    fn drive_of(brake: f64, turn: f64) -> (Vec<f64>, Vec<Telemetry<f64>>) {
         let t: Vec<f64> = (0..600).map(|k| f64::from(k) * 0.01).collect();
         let ramp = |t: f64| ((t - 1.0) / 0.5).clamp(0.0, 1.0) * ((4.5 - t) / 0.5).clamp(0.0, 1.0);
         let samples = t
             .iter()
             .map(|&t| Telemetry {
-                force: [-3.0 * sign * ramp(t), 2.0 * ramp(t), G],
+                force: [-brake * ramp(t), turn * ramp(t), G],
                 rate: [0.0; 3],
             })
             .collect();
@@ -273,7 +381,7 @@ mod tests {
     #[test]
     fn where_the_ranges_hold_the_drive_the_floor_is_no_error_and_keeps_to_them() {
         let (t, samples) = drive(1.0);
-        let f = floor(&t, &samples, &wide(), Forward::PlusX).unwrap();
+        let f = floor(&t, &samples, Room::Ranges(&wide()), Forward::PlusX).unwrap();
         assert!(f.force_rms.iter().all(|r| *r < 1e-3), "{:?}", f.force_rms);
         // Braking pitches the nose up (beta > 0), a left turn's force rolls the platform left (alpha > 0).
         let held = f.offsets[300];
@@ -285,7 +393,7 @@ mod tests {
         }
         // Accelerating needs the nose down, which the pitch's range does not allow: on x the floor is an error.
         let (t, samples) = drive(-1.0);
-        let f = floor(&t, &samples, &wide(), Forward::PlusX).unwrap();
+        let f = floor(&t, &samples, Room::Ranges(&wide()), Forward::PlusX).unwrap();
         assert!(f.force_rms[0] > 0.5 && f.force_rms[1] < 1e-3, "{:?}", f.force_rms);
     }
 
@@ -295,7 +403,7 @@ mod tests {
     fn without_room_the_floor_is_what_the_vehicle_perceives() {
         let (t, samples) = drive(1.0);
         let none = [(-1e-9, 1e-9); 5];
-        let f = floor(&t, &samples, &none, Forward::PlusX).unwrap();
+        let f = floor(&t, &samples, Room::Ranges(&none), Forward::PlusX).unwrap();
         let mut p = Perception::<f64>::new();
         let less_g = |s: &Telemetry<f64>| [s.force[0], s.force[1], s.force[2] - G];
         p.begin(less_g(&samples[0]), [0.0; 3]);
@@ -316,13 +424,60 @@ mod tests {
         }
     }
 
+    /// Inside the trainer model's outer polytope, the floor's motion keeps every face, facing either way, and
+    /// it perceives no more error than the best motion inside a box the polytope holds.
+    #[test]
+    fn inside_the_envelope_the_floor_keeps_every_face_and_beats_any_box_it_holds() {
+        let mechanism = RingPlatform::new(&TRAINER_MODEL);
+        let neutral = Pose::from_array(Preset::TrainerModel.home());
+        let ranges: Ranges = [
+            (-0.129, 0.129),
+            (-0.055, 0.095),
+            (-0.067, 0.059),
+            (-0.454, 0.384),
+            (-0.358, 0.358),
+        ];
+        let outer = Polytope::of(&mechanism, &neutral, &ranges, &directions(2), 200);
+        let inner = ranges.map(|(lo, hi)| (0.4 * lo, 0.4 * hi));
+        for corner in 0..32 {
+            let c: [f64; 5] = core::array::from_fn(|j| if corner >> j & 1 == 1 { inner[j].1 } else { inner[j].0 });
+            assert!(outer.holds(&c), "{c:?}");
+        }
+        // Braking and turning harder than the envelope's room for tilt: the motion presses on its faces.
+        let (t, samples) = drive_of(5.0, 4.0);
+        let total = |f: &Floor| f.force_rms.iter().map(|r| r * r).sum::<f64>().sqrt();
+        for forward in [Forward::PlusX, Forward::PlusY, Forward::MinusY] {
+            let f = floor(&t, &samples, Room::Envelope(&outer), forward).unwrap();
+            let mut nearest = f64::MIN;
+            for o in &f.offsets {
+                for (a, b) in &outer.faces {
+                    let at: f64 = a.iter().zip(o).map(|(p, q)| p * q).sum();
+                    assert!(at <= b + 1e-6, "{forward:?}: {o:?} crosses {a:?} <= {b}");
+                    nearest = nearest.max(at - b);
+                }
+            }
+            // Held on the polytope's own faces, not short of them.
+            assert!(nearest > -1e-4, "{forward:?}: {nearest}");
+            let boxed = floor(&t, &samples, Room::Ranges(&inner), forward).unwrap();
+            assert!(
+                total(&f) <= total(&boxed) + 1e-6,
+                "{:?} against {:?}",
+                f.force_rms,
+                boxed.force_rms
+            );
+            // It does use the room past the box: the braking's pitch goes further.
+            let pitch = f.offsets.iter().map(|o| o[3].abs().max(o[4].abs())).fold(0.0, f64::max);
+            assert!(pitch > 0.4 * 0.358, "{pitch}");
+        }
+    }
+
     #[test]
     fn a_gap_in_the_drive_is_said() {
         let (mut t, samples) = drive(1.0);
         for v in &mut t[200..] {
             *v += 2.0;
         }
-        let e = floor(&t, &samples, &wide(), Forward::PlusX).unwrap_err();
+        let e = floor(&t, &samples, Room::Ranges(&wide()), Forward::PlusX).unwrap_err();
         assert_eq!(e, FloorError::Interval(200));
     }
 }

@@ -14,6 +14,7 @@
 
 pub mod floor;
 pub mod model;
+pub mod polytope;
 pub mod qp;
 pub mod tilt;
 
