@@ -447,7 +447,7 @@ mod tests {
             json: false,
             preview: false,
             floor: true,
-            envelope_floor: false,
+            envelope_floor: true,
             mechanism: "trainer-model",
             geometry: None,
         };
@@ -457,6 +457,8 @@ mod tests {
         assert_eq!(code, 0);
         let floor = report["floor"]["force_total"].as_f64().unwrap();
         assert!(floor > 0.1, "{report}");
+        let coupled = report["floor"]["envelope"]["force_total"].as_f64().unwrap();
+        assert!(coupled > 0.1, "{report}");
         for e in report["entries"].as_array().unwrap() {
             let rms: Vec<f64> = e["total"]["force_rms"]
                 .as_array()
@@ -466,12 +468,18 @@ mod tests {
                 .collect();
             let total = rms.iter().map(|r| r * r).sum::<f64>().sqrt();
             assert!(floor < total, "floor {floor} against {}: {total}", e["name"]);
+            assert!(
+                coupled < total,
+                "envelope floor {coupled} against {}: {total}",
+                e["name"]
+            );
         }
         for share in report["floor"]["envelope_share"].as_array().unwrap() {
             assert!(share.as_f64().unwrap() <= 1.0 + 1e-4, "{report}");
         }
         assert!(
-            table.contains("floor / classical.toml perceived force error"),
+            table.contains("floor / classical.toml perceived force error")
+                && table.contains("envelope floor / classical.toml perceived force error"),
             "{table}"
         );
     }
