@@ -90,12 +90,9 @@ pub struct Report {
 /// The floor ([`floor`]) of every drive together.
 #[derive(Debug, Serialize)]
 pub struct FloorReport {
-    /// The least RMS perceived specific-force error on the optimiser's model, x, y, z (m/s^2), inside the ranges.
-    pub force_rms: [f64; 3],
-    /// The three axes together (m/s^2).
-    pub force_total: f64,
-    /// Each drive's, x, y, z (m/s^2), in the order of the drives.
-    pub drives: Vec<[f64; 3]>,
+    /// Inside the ranges.
+    #[serde(flatten)]
+    pub figures: FloorFigures,
     /// The largest share of each range the floor's motion used: x, y, z, roll, pitch.
     pub envelope_share: [f64; 5],
     /// With `--envelope-floor`: the floor inside an outer polytope of the rig's whole envelope, the axes coupled
@@ -103,20 +100,28 @@ pub struct FloorReport {
     pub envelope: Option<EnvelopeFloor>,
 }
 
-/// The floor inside the envelope's outer polytope ([`polytope`]).
+/// A floor's figures over every drive.
 #[derive(Debug, Serialize)]
-pub struct EnvelopeFloor {
-    /// x, y, z (m/s^2).
+pub struct FloorFigures {
+    /// The least RMS perceived specific-force error on the optimiser's model, x, y, z (m/s^2).
     pub force_rms: [f64; 3],
     /// The three axes together (m/s^2).
     pub force_total: f64,
-    /// Each drive's, x, y, z (m/s^2).
+    /// Each drive's, x, y, z (m/s^2), in the order of the drives.
     pub drives: Vec<[f64; 3]>,
+}
+
+/// The floor inside the envelope's outer polytope ([`polytope`]).
+#[derive(Debug, Serialize)]
+pub struct EnvelopeFloor {
+    /// Its figures.
+    #[serde(flatten)]
+    pub figures: FloorFigures,
     /// The polytope's faces.
     pub faces: usize,
-    /// How far from settled its support search ended (a share of a face's reach), before its slack.
+    /// How far from settled its support search ended (a share of a face's support), before its slack.
     pub last_gain: f64,
-    /// The slack added to every face's support (a share of its reach).
+    /// The slack added to every face's support (in the ranges' scale).
     pub slack: f64,
 }
 
@@ -191,17 +196,11 @@ fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward, coupled: bool) -> Resu
             within_envelope.add(&f);
         }
     }
-    let (force_rms, force_total) = within_ranges.rms();
-    let (envelope_rms, envelope_total) = within_envelope.rms();
     Ok(FloorReport {
-        force_rms,
-        force_total,
-        drives: within_ranges.each,
+        figures: within_ranges.figures(),
         envelope_share,
         envelope: outer.map(|outer| EnvelopeFloor {
-            force_rms: envelope_rms,
-            force_total: envelope_total,
-            drives: within_envelope.each,
+            figures: within_envelope.figures(),
             faces: outer.faces.len(),
             last_gain: outer.last_gain,
             slack: polytope::SLACK,
@@ -231,10 +230,13 @@ impl Sums {
         self.each.push(f.force_rms);
     }
 
-    /// Per axis, and the three together.
-    fn rms(&self) -> ([f64; 3], f64) {
-        let per = self.sum.map(|v| (v / self.n.max(1) as f64).sqrt());
-        (per, per.iter().map(|r| r * r).sum::<f64>().sqrt())
+    fn figures(self) -> FloorFigures {
+        let force_rms = self.sum.map(|v| (v / self.n.max(1) as f64).sqrt());
+        FloorFigures {
+            force_rms,
+            force_total: force_rms.iter().map(|r| r * r).sum::<f64>().sqrt(),
+            drives: self.each,
+        }
     }
 }
 
@@ -388,18 +390,18 @@ fn table(r: &Report) -> String {
             .map_or("-".into(), |t| format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2]))
     });
     if let Some(f) = &r.floor {
-        let [x, y, z] = f.force_rms;
+        let [x, y, z] = f.figures.force_rms;
         s += &format!(
             "floor: the least perceived force error RMS x y z, all axes, of any motion inside the ranges \
              (the optimiser's model, the whole drive known): {x:.3} {y:.3} {z:.3}, {:.3} m/s^2\n",
-            f.force_total
+            f.figures.force_total
         );
         if let Some(e) = &f.envelope {
-            let [x, y, z] = e.force_rms;
+            let [x, y, z] = e.figures.force_rms;
             s += &format!(
                 "floor inside the envelope's outer polytope ({} faces, the axes coupled): {x:.3} {y:.3} {z:.3}, \
                  {:.3} m/s^2\n",
-                e.faces, e.force_total
+                e.faces, e.figures.force_total
             );
         }
     }
@@ -412,10 +414,10 @@ fn table(r: &Report) -> String {
             );
         }
         if let Some(f) = &r.floor {
-            let ratio = f.force_total / a.total.force_total().max(1e-12);
+            let ratio = f.figures.force_total / a.total.force_total().max(1e-12);
             s += &format!("floor / {} perceived force error (RMS, all axes): {ratio:.3}\n", a.name);
             if let Some(e) = &f.envelope {
-                let ratio = e.force_total / a.total.force_total().max(1e-12);
+                let ratio = e.figures.force_total / a.total.force_total().max(1e-12);
                 s += &format!(
                     "envelope floor / {} perceived force error (RMS, all axes): {ratio:.3}\n",
                     a.name
