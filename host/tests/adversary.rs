@@ -484,3 +484,37 @@ fn the_monitor_without_a_terminal_says_so() {
     assert_eq!(code, 1, "{stderr}");
     assert!(stderr.contains("draws on a terminal"), "{stderr}");
 }
+
+/// Class: a drive too short to score (a header alone, or one row) is refused by the bench, naming it, with or
+/// without the floor: scored, it would come out as zeros, a perfect cueing.
+#[test]
+fn a_drive_too_short_to_score_is_refused() {
+    let dir = scratch("short-drive");
+    let docs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/drives");
+    let (classical, optimal) = (docs.join("classical.toml"), docs.join("optimal.toml"));
+    let out = dir.join("bench.json");
+    for (name, text) in [
+        ("header.csv", "t,ax,ay,az,wx,wy,wz\n"),
+        ("one.csv", "t,ax,ay,az,wx,wy,wz\n0.0,0,0,9.80665,0,0,0\n"),
+    ] {
+        let input = dir.join(name);
+        std::fs::write(&input, text).unwrap();
+        for floor in [&[][..], &["--floor"][..], &["--floor", "--envelope-floor"][..]] {
+            let mut args = vec![
+                "cue",
+                "--compare",
+                classical.to_str().unwrap(),
+                optimal.to_str().unwrap(),
+                "--input",
+                input.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ];
+            args.extend(floor);
+            let (code, _, stderr) = run(&args);
+            assert_eq!(code, 1, "{name} {floor:?}: {stderr}");
+            assert!(stderr.contains(name) && stderr.contains("two rows or more"), "{stderr}");
+            assert!(!out.exists(), "{name} {floor:?}: a report was written");
+        }
+    }
+}

@@ -290,6 +290,12 @@ pub fn read_drive(path: &Path) -> Result<Vec<(usize, Vec<f64>)>, CueError> {
     };
     let (rows, errors, _) = read_input(&args)?;
     match errors.first() {
+        // A drive of one sample has no interval to perceive anything over: its scores would be zeros, as
+        // if the cueing were perfect.
+        None if rows.len() < 2 => Err(CueError::Input {
+            path: path.to_path_buf(),
+            reason: format!("a drive to score needs two rows or more; it has {}", rows.len()),
+        }),
         None => Ok(rows),
         Some(e) => Err(CueError::Input {
             path: path.to_path_buf(),

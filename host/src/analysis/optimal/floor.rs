@@ -26,6 +26,9 @@ const EFFORT: f64 = 1e-9;
 /// Why a floor could not be found.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FloorError {
+    /// The drive has fewer than two samples: no interval to perceive anything over.
+    #[error("the drive has {0} samples; the floor needs two or more")]
+    TooShort(usize),
     /// The drive has an interval that is not a step forward of at most a second (a gap starts the cueing
     /// again at neutral: the floor is of one continuous drive).
     #[error("row {0} is not 0 to 1 s after the row before: the floor needs a drive without gaps")]
@@ -55,6 +58,9 @@ pub enum Room<'a> {
 
 /// The floor of a drive (`samples` at times `t`) in `room`, the platform facing `forward`.
 pub fn floor(t: &[f64], samples: &[Telemetry<f64>], room: Room, forward: Forward) -> Result<Floor, FloorError> {
+    if t.len() < 2 || samples.len() != t.len() {
+        return Err(FloorError::TooShort(t.len().min(samples.len())));
+    }
     if let Some(k) = (1..t.len()).find(|&k| !(t[k] - t[k - 1] > 0.0 && t[k] - t[k - 1] <= 1.0)) {
         return Err(FloorError::Interval(k));
     }
@@ -472,12 +478,17 @@ mod tests {
     }
 
     #[test]
-    fn a_gap_in_the_drive_is_said() {
+    fn a_gap_or_a_drive_too_short_is_said() {
         let (mut t, samples) = drive(1.0);
         for v in &mut t[200..] {
             *v += 2.0;
         }
         let e = floor(&t, &samples, Room::Ranges(&wide()), Forward::PlusX).unwrap_err();
         assert_eq!(e, FloorError::Interval(200));
+        // One sample, or none: nothing to solve, said rather than handed to the solver.
+        for n in [0, 1] {
+            let e = floor(&t[..n], &samples[..n], Room::Ranges(&wide()), Forward::PlusX).unwrap_err();
+            assert_eq!(e, FloorError::TooShort(n));
+        }
     }
 }
