@@ -485,17 +485,28 @@ fn the_monitor_without_a_terminal_says_so() {
     assert!(stderr.contains("draws on a terminal"), "{stderr}");
 }
 
-/// Class: a drive too short to score (a header alone, or one row) is refused by the bench, naming it, with or
-/// without the floor: scored, it would come out as zeros, a perfect cueing.
+/// Class: a drive the bench cannot score is refused, naming it, with or without the floor: too short (a header
+/// alone, or one row: scored, it would come out as zeros, a perfect cueing), or with a row beyond any vehicle's
+/// (the vehicle's own perceived force would be scored from it).
 #[test]
-fn a_drive_too_short_to_score_is_refused() {
+fn a_drive_the_bench_cannot_score_is_refused() {
     let dir = scratch("short-drive");
     let docs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/drives");
     let (classical, optimal) = (docs.join("classical.toml"), docs.join("optimal.toml"));
     let out = dir.join("bench.json");
-    for (name, text) in [
-        ("header.csv", "t,ax,ay,az,wx,wy,wz\n"),
-        ("one.csv", "t,ax,ay,az,wx,wy,wz\n0.0,0,0,9.80665,0,0,0\n"),
+    let implausible = "t,ax,ay,az,wx,wy,wz\n0.0,0,0,9.80665,0,0,0\n0.01,1e30,0,9.80665,0,0,0\n0.02,0,0,9.80665,0,0,0\n";
+    for (name, text, said) in [
+        ("header.csv", "t,ax,ay,az,wx,wy,wz\n", "two rows or more"),
+        (
+            "one.csv",
+            "t,ax,ay,az,wx,wy,wz\n0.0,0,0,9.80665,0,0,0\n",
+            "two rows or more",
+        ),
+        (
+            "implausible.csv",
+            implausible,
+            "line 3: a value is beyond any vehicle's",
+        ),
     ] {
         let input = dir.join(name);
         std::fs::write(&input, text).unwrap();
@@ -513,7 +524,7 @@ fn a_drive_too_short_to_score_is_refused() {
             args.extend(floor);
             let (code, _, stderr) = run(&args);
             assert_eq!(code, 1, "{name} {floor:?}: {stderr}");
-            assert!(stderr.contains(name) && stderr.contains("two rows or more"), "{stderr}");
+            assert!(stderr.contains(name) && stderr.contains(said), "{stderr}");
             assert!(!out.exists(), "{name} {floor:?}: a report was written");
         }
     }

@@ -576,7 +576,7 @@ fn the_simulator_stops_on_sigint_and_sigterm_even_started_with_sigint_ignored() 
 
 /// Class (adversary): a live source's garbage is unreadable, never sent, and never ends the session. A pose
 /// datagram that is not finite (NaN, infinity, 1e400, a yaw of 1e300 that f32 makes infinite), one of 65,000 digits,
-/// a telemetry datagram whose time is NaN or 1e300, and three seconds of nothing but garbage after a good start
+/// a telemetry datagram whose time is NaN or 1e300 or whose force is 1e30, and three seconds of nothing but garbage after a good start
 /// (longer than the stream timeout): every later good datagram is applied, the garbage is counted by number, and
 /// the exit code says input was unreadable (3).
 #[test]
@@ -626,7 +626,13 @@ fn a_live_sources_garbage_is_unreadable_and_the_session_goes_on() {
 
     // Telemetry whose first time is garbage: the samples after it are cued.
     let (child, mut stderr, addr) = spawn_live_stream(&["--telemetry-udp", "127.0.0.1:0", "--udp-idle", "0.5"]);
-    for first in ["nan 0 0 9.81 0 0 0", "1e300 0 0 9.81 0 0 0", "0.0 nan 0 9.81 0 0 0"] {
+    // The last is finite but beyond any vehicle's (a misread packet): refused as well.
+    for first in [
+        "nan 0 0 9.81 0 0 0",
+        "1e300 0 0 9.81 0 0 0",
+        "0.0 nan 0 9.81 0 0 0",
+        "0.0 1e30 0 9.81 0 0 0",
+    ] {
         socket.send_to(first.as_bytes(), &addr).unwrap();
     }
     for k in 0..50 {
@@ -638,7 +644,8 @@ fn a_live_sources_garbage_is_unreadable_and_the_session_goes_on() {
     }
     let (out, report, said) = ended(child, &mut stderr);
     assert_eq!(out.status.code(), Some(3), "{said}");
-    assert_eq!(report["datagrams"]["unreadable"], 3, "{said}");
+    assert_eq!(report["datagrams"]["unreadable"], 4, "{said}");
+    assert!(said.contains("beyond any vehicle's"), "{said}");
     assert!(report["setpoints_applied"].as_u64().unwrap() >= 50, "{said}");
     assert!(report["rejected"].as_object().unwrap().is_empty(), "{said}");
 }

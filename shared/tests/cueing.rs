@@ -210,6 +210,23 @@ fn bad_samples_and_bad_parameters_are_refused_by_name() {
     let mut inf = good;
     inf.rate[2] = f64::INFINITY;
     assert_eq!(w.step(&inf, 0.01), Err(SampleError::NonFinite));
+    // Beyond any vehicle's, on any axis, either sign; at the bound itself, taken.
+    for (i, v) in [(0, 1.0001e4), (2, -1e30), (3, 1.0001e3), (5, -2e3)] {
+        let mut huge = good;
+        if i < 3 {
+            huge.force[i] = v;
+        } else {
+            huge.rate[i - 3] = v;
+        }
+        assert_eq!(w.step(&huge, 0.01), Err(SampleError::Implausible), "{i} {v}");
+        assert_eq!(w.begin(&huge), Err(SampleError::Implausible), "{i} {v}");
+    }
+    assert_eq!(w.offset(), [0.0; 6], "refused samples change nothing");
+    let mut edge = Washout::<f64>::new(CueConfig::default()).unwrap();
+    let mut hard = good;
+    hard.force[1] = -1e4;
+    hard.rate[0] = 1e3;
+    assert!(edge.step(&hard, 0.01).is_ok());
     for dt in [0.0, -0.01, 2.0, f64::NAN] {
         assert!(w.step(&good, dt).is_err(), "dt {dt}");
     }

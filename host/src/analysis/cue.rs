@@ -242,10 +242,10 @@ pub fn replay(
                 limited += usize::from(l.is_limited());
                 l.pose
             }
-            Err(SampleError::NonFinite) => {
+            Err(e @ (SampleError::NonFinite | SampleError::Implausible)) => {
                 errors.push(InputError {
                     line: *line,
-                    reason: "a value is not finite: the platform holds".into(),
+                    reason: format!("{e}: the platform holds"),
                 });
                 held
             }
@@ -289,6 +289,18 @@ pub fn read_drive(path: &Path) -> Result<Vec<(usize, Vec<f64>)>, CueError> {
         geometry: None,
     };
     let (rows, errors, _) = read_input(&args)?;
+    // A row the cueing would refuse is no drive to score: the vehicle's own perceived force is scored from it.
+    let refused = rows.iter().find_map(|(line, v)| {
+        cueing::check(&super::cue_engine::row_sample(v))
+            .err()
+            .map(|e| (*line, e))
+    });
+    if let Some((line, e)) = refused {
+        return Err(CueError::Input {
+            path: path.to_path_buf(),
+            reason: format!("line {line}: {e}"),
+        });
+    }
     match errors.first() {
         // A drive of one sample has no interval to perceive anything over: its scores would be zeros, as
         // if the cueing were perfect.

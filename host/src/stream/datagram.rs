@@ -204,15 +204,15 @@ impl Decoder {
         };
         let offset = match dt.map(|dt| washout.step(&sample, dt)) {
             // The first sample: the washout's first input, at neutral.
-            None => washout.begin(&sample).map_err(|_| "a value is not finite".to_string()),
+            None => washout.begin(&sample).map_err(|e| e.to_string()),
             Some(Ok(offset)) => Ok(offset),
-            Some(Err(SampleError::NonFinite)) => Err("a value is not finite".to_string()),
+            Some(Err(e @ (SampleError::NonFinite | SampleError::Implausible))) => Err(e.to_string()),
             Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| dt > 0.0) => {
                 // A pause of more than a second: wash out to neutral and start again from here, this sample the
                 // first input.
                 *gaps += 1;
                 washout.reset();
-                washout.begin(&sample).map_err(|_| "a value is not finite".to_string())
+                washout.begin(&sample).map_err(|e| e.to_string())
             }
             Some(Err(SampleError::Interval)) => Err("its time is not after the last one's".to_string()),
         };

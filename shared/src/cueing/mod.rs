@@ -50,13 +50,46 @@ pub struct Telemetry<T> {
     pub rate: [T; 3],
 }
 
+/// The largest specific force a sample may carry on an axis (m/s^2): a thousand g, beyond any vehicle's, a
+/// crash's included. A larger one is a misread packet or a broken plugin; taken, it would fill every channel's
+/// filters with a number that rings through them long after.
+pub const MAX_FORCE: f64 = 1e4;
+
+/// The largest angular rate a sample may carry (rad/s), on the same grounds: some 160 turns a second.
+pub const MAX_RATE: f64 = 1e3;
+
 /// Why a sample was not taken (the caller holds the last pose).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SampleError {
     /// A number is NaN or infinite.
     NonFinite,
+    /// A number is beyond any vehicle's ([`MAX_FORCE`], [`MAX_RATE`]).
+    Implausible,
     /// The interval is not positive, or longer than a second (a gap: the washout holds).
     Interval,
+}
+
+/// Whether a sample can be taken: every value finite and within any vehicle's.
+pub fn check<T: Real>(sample: &Telemetry<T>) -> Result<(), SampleError> {
+    if !sample.force.iter().chain(&sample.rate).all(|v| v.finite()) {
+        return Err(SampleError::NonFinite);
+    }
+    let within = |v: &T, limit: f64| v.to_f64().abs() <= limit;
+    if sample.force.iter().all(|v| within(v, MAX_FORCE)) && sample.rate.iter().all(|v| within(v, MAX_RATE)) {
+        Ok(())
+    } else {
+        Err(SampleError::Implausible)
+    }
+}
+
+impl core::fmt::Display for SampleError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            Self::NonFinite => "a value is not finite",
+            Self::Implausible => "a value is beyond any vehicle's (1000 g, or 1000 rad/s)",
+            Self::Interval => "the interval is not after the last sample, or longer than a second",
+        })
+    }
 }
 
 /// The washout's channels, in vehicle axes, before they are turned to the platform's.
@@ -174,14 +207,6 @@ impl<T: Real> Washout<T> {
         &self.channels
     }
 
-    fn check(sample: &Telemetry<T>) -> Result<(), SampleError> {
-        if sample.force.iter().chain(&sample.rate).all(|v| v.finite()) {
-            Ok(())
-        } else {
-            Err(SampleError::NonFinite)
-        }
-    }
-
     /// The inputs of each filter for a (smoothed) sample: scaled and limited.
     fn inputs(&self, s: &Telemetry<T>) -> Inputs<T> {
         let cfg = &self.config;
@@ -208,9 +233,10 @@ impl<T: Real> Washout<T> {
     /// Takes the first sample of a stream (or the first after [`Washout::reset`]), which has no interval before
     /// it: the smoothing starts on it and every filter holds it as its last input, so that the next interval's
     /// input runs from this sample's value (not from zero, as if the vehicle had been at rest). No time passes:
-    /// the offset is unchanged. A sample that is not finite is refused and changes nothing.
+    /// the offset is unchanged. A sample that is not finite, or beyond any vehicle's, is refused and changes
+    /// nothing.
     pub fn begin(&mut self, sample: &Telemetry<T>) -> Result<[T; 6], SampleError> {
-        Self::check(sample)?;
+        check(sample)?;
         let s = self.smoother.begin(sample);
         self.started = true;
         self.last = Some(*sample);
@@ -237,7 +263,7 @@ impl<T: Real> Washout<T> {
     // One index runs through the parallel per-axis arrays of a channel (input, scale, limit, filter, output).
     #[allow(clippy::needless_range_loop)]
     pub fn step(&mut self, sample: &Telemetry<T>, dt: T) -> Result<[T; 6], SampleError> {
-        Self::check(sample)?;
+        check(sample)?;
         if !(dt.finite() && dt > T::zero() && dt <= T::one()) {
             return Err(SampleError::Interval);
         }
