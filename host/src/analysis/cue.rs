@@ -98,7 +98,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     // An output that is the input (or the cueing file) would destroy it: refused before anything is read.
     let inputs: Vec<&Path> = [Some(args.input), args.config].into_iter().flatten().collect();
     for out in [Some(args.out), args.plot].into_iter().flatten() {
-        crate::out::file::not_an_input(out, &inputs).map_err(|e| CliError::file(out, e))?;
+        crate::out::file::check_output(out, &inputs).map_err(|e| CliError::file(out, e))?;
     }
     let config = load_config(args.config, args.profile).map_err(CliError::from)?;
     let (rows, mut errors, capture) = read_input(args)?;

@@ -1,7 +1,7 @@
 //! Files a command writes, whole or not at all: written to a temporary file beside the target and renamed over it
 //! when complete (`tempfile`'s `NamedTempFile::persist`, a rename on the same file system), so that a full disk, an
 //! error or a stop half-way leaves the target as it was (or absent), never a partial file under its name. A file
-//! that is one of the command's inputs is refused before anything runs.
+//! that is one of the command's inputs, or whose folder does not exist, is refused before anything runs.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -34,7 +34,9 @@ impl Pending {
         let temp = tempfile::Builder::new()
             .prefix(&format!(".{name}."))
             .suffix(&suffix)
-            .tempfile_in(folder(target))?;
+            .tempfile_in(folder(target))
+            // tempfile's message names the hidden temporary file, which the user never asked for.
+            .map_err(|e| std::io::Error::new(e.kind(), e.kind().to_string()))?;
         Ok(Self {
             temp,
             target: target.to_path_buf(),
@@ -77,8 +79,14 @@ pub fn same_file(output: &Path, input: &Path) -> bool {
     }
 }
 
-/// Refuses an output that is one of the inputs: writing it would destroy what is being read.
-pub fn not_an_input(output: &Path, inputs: &[&Path]) -> Result<(), String> {
+/// Refuses, before anything runs, an output that cannot be written where it is named (its folder is not a
+/// folder: found only at the end of a long run, it would lose the run) or that is one of the inputs (writing it
+/// would destroy what is being read).
+pub fn check_output(output: &Path, inputs: &[&Path]) -> Result<(), String> {
+    let dir = folder(output);
+    if !dir.is_dir() {
+        return Err(format!("{} is not a folder to write in", dir.display()));
+    }
     match inputs.iter().find(|i| same_file(output, i)) {
         Some(i) => Err(format!(
             "{} is also an input ({}): writing it would destroy what is read; name another file",
@@ -120,7 +128,7 @@ mod tests {
         let a = dir.path().join("a.csv");
         std::fs::write(&a, "x").unwrap();
         let spelled = dir.path().join(".").join("a.csv");
-        assert!(not_an_input(&spelled, &[&a]).is_err());
+        assert!(check_output(&spelled, &[&a]).is_err());
         // A file's identity (device and inode) is known on Unix only: elsewhere a hard link is another name.
         #[cfg(unix)]
         {
@@ -129,8 +137,27 @@ mod tests {
             assert!(same_file(&linked, &a), "a hard link is the same file");
         }
         assert!(
-            not_an_input(&dir.path().join("c.csv"), &[&a]).is_ok(),
+            check_output(&dir.path().join("c.csv"), &[&a]).is_ok(),
             "a new file is no input"
         );
+    }
+
+    #[test]
+    fn an_output_in_no_folder_is_refused_before_anything_runs_and_a_write_there_names_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let nowhere = dir.path().join("missing").join("out.json");
+        let said = check_output(&nowhere, &[]).unwrap_err();
+        assert!(said.contains("missing") && said.contains("not a folder"), "{said}");
+        // A file where the folder should be is no folder either.
+        let file = dir.path().join("file");
+        std::fs::write(&file, "x").unwrap();
+        assert!(check_output(&file.join("out.json"), &[]).is_err());
+        assert!(check_output(&dir.path().join("out.json"), &[]).is_ok());
+        assert!(
+            check_output(Path::new("bare-name.json"), &[]).is_ok(),
+            "the current folder"
+        );
+        let e = write(&nowhere, b"x").unwrap_err().to_string();
+        assert!(!e.contains(".out.json."), "{e}");
     }
 }

@@ -345,7 +345,7 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
     console::on_failure(signals.flag());
     let read = inputs(&job.input);
     for out in [&job.record, &job.capture].into_iter().flatten() {
-        crate::out::file::not_an_input(out, &read).map_err(|e| CliError::file(out, e))?;
+        crate::out::file::check_output(out, &read).map_err(|e| CliError::file(out, e))?;
     }
     let (mut source, input_errors) = open(&job.input)?;
     if let (Some(path), Source::Live(udp)) = (&job.capture, &mut source) {

@@ -274,7 +274,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     let mut inputs: Vec<&Path> = args.inputs.iter().map(PathBuf::as_path).collect();
     inputs.extend(args.configs);
     for out in [Some(args.out), args.plot].into_iter().flatten() {
-        crate::out::file::not_an_input(out, &inputs).map_err(|e| CliError::file(out, e))?;
+        crate::out::file::check_output(out, &inputs).map_err(|e| CliError::file(out, e))?;
     }
     let configs = [0, 1].map(|i| load_config(Some(args.configs[i]), None));
     let [a, b] = configs;
