@@ -21,6 +21,14 @@ fn folder(target: &Path) -> &Path {
     }
 }
 
+/// tempfile's error names the hidden temporary file (`... at path "/x/.out.json.XWGYjr.json"`), which the user
+/// never asked for: the system's own message before it (the caller names the target).
+fn without_temporary_name(e: std::io::Error) -> std::io::Error {
+    let said = e.to_string();
+    let own = said.split(" at path ").next().unwrap_or(&said).to_owned();
+    std::io::Error::new(e.kind(), own)
+}
+
 impl Pending {
     /// Opens a temporary file beside `target` (named after it, with its extension: some writers choose the
     /// format by the extension).
@@ -35,8 +43,7 @@ impl Pending {
             .prefix(&format!(".{name}."))
             .suffix(&suffix)
             .tempfile_in(folder(target))
-            // tempfile's message names the hidden temporary file, which the user never asked for.
-            .map_err(|e| std::io::Error::new(e.kind(), e.kind().to_string()))?;
+            .map_err(without_temporary_name)?;
         Ok(Self {
             temp,
             target: target.to_path_buf(),
@@ -157,7 +164,9 @@ mod tests {
             check_output(Path::new("bare-name.json"), &[]).is_ok(),
             "the current folder"
         );
-        let e = write(&nowhere, b"x").unwrap_err().to_string();
-        assert!(!e.contains(".out.json."), "{e}");
+        let e = write(&nowhere, b"x").unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::NotFound);
+        assert!(!e.to_string().contains(".out.json."), "{e}");
+        assert!(e.to_string().contains("(os error"), "the system's own message: {e}");
     }
 }
