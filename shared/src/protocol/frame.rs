@@ -79,12 +79,21 @@ pub fn decode<M: DeserializeOwned>(frame: &[u8]) -> Result<M, FrameError> {
 }
 
 /// The checked payload of one frame (its bytes up to, not including, the delimiter), COBS-decoded into `scratch`
-/// (at least as long as the frame).
+/// (at least as long as the frame). A frame holding a delimiter is not one.
+///
+/// Copied, then decoded in place: `cobs::decode` runs its streaming decoder's state machine per byte, about 950
+/// instructions for a setpoint frame on the M4F, where the in-place decoder copies each run in a plain loop.
 pub fn unframe<'a>(frame: &[u8], scratch: &'a mut [u8]) -> Result<&'a [u8], FrameError> {
     if frame.is_empty() || frame.len() > MAX_FRAME {
         return Err(FrameError::Cobs);
     }
-    let report = cobs::decode(frame, scratch).map_err(|_| FrameError::Cobs)?;
+    let raw = scratch.get_mut(..frame.len()).ok_or(FrameError::Cobs)?;
+    raw.copy_from_slice(frame);
+    let report = cobs::decode_in_place_report(raw).map_err(|_| FrameError::Cobs)?;
+    // The decoder stops at a delimiter; bytes after one are not part of the frame.
+    if report.parsed_size() != frame.len() {
+        return Err(FrameError::Cobs);
+    }
     let len = report.frame_size();
     if len < 5 {
         return Err(FrameError::TooShort);
