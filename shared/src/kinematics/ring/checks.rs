@@ -236,13 +236,7 @@ impl<T: Real> RingPlatform<T> {
 
     /// The scale-free singularity index of the wrench matrix (moments divided by the ring radius).
     pub(super) fn singularity_of(&self, c: &Configuration<T>) -> T {
-        let inv = T::one() / self.rr;
-        let mut rows = self.wrench_rows(c);
-        for row in &mut rows {
-            for m in &mut row[3..] {
-                *m *= inv;
-            }
-        }
+        let mut rows = self.wrench_rows_scaled(c, T::one() / self.rr);
         hadamard_ratio_in_place(&mut rows).0
     }
 

@@ -59,6 +59,9 @@ pub struct RingPlatform<T: Real> {
     n: usize,
     points: [Vector3<T>; 6],
     kinds: [Shape; 6],
+    /// The chain of each wrench-matrix row from `n` on (the tangent force of a radial or elbow chain, in chain
+    /// order); `u8::MAX` past the last.
+    tangent_rows: [u8; 6],
     /// Actuator index of the length of each radial chain.
     length_axis: [Option<usize>; 6],
     axes: [AxisKind; 6],
@@ -98,8 +101,17 @@ impl<T: Real> RingPlatform<T> {
                 next_length += 1;
             }
         }
+        let mut tangent_rows = [u8::MAX; 6];
+        let planar = chains
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| Shape::of(&c.kind).is_planar());
+        for (slot, (i, _)) in tangent_rows.iter_mut().zip(planar) {
+            *slot = i as u8;
+        }
         let l = &geometry.limits;
         Self {
+            tangent_rows,
             geometry: *geometry,
             rr: T::of(geometry.ring_radius),
             rod: T::of(geometry.rod_length),
