@@ -133,8 +133,12 @@ impl<T: Real> RingPlatform<T> {
                 Ok(())
             }
         };
-        self.solve(pose, c).map_err(|_| Check::Reach)?;
+        // The reach margin needs only the joints: a point short of it (most of the envelope search's points
+        // outside) skips the chains' solves (their atan2). A pose has no IK or is short of its reach room alike
+        // as before: either is the reach check's.
+        self.place(pose, c).map_err(|_| Check::Reach)?;
         leaves(Check::Reach, self.reach_of(&c.joints))?;
+        self.solve_chains(c).map_err(|_| Check::Reach)?;
         let (spacing, order, ring_order) = self.spacing_and_order(&c.q);
         leaves(Check::CarriageSpacing, spacing)?;
         leaves(Check::RodCrossing, order)?;

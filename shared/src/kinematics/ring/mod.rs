@@ -187,9 +187,22 @@ impl<T: Real> RingPlatform<T> {
     /// The actuators go into `c` as well: returned in a `Result`, the compiler moved them through a copy at an odd
     /// offset, a `memcpy` call on the M4F (measured).
     fn solve(&self, pose: &Pose<T>, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
+        self.place(pose, c)?;
+        self.solve_chains(c)
+    }
+
+    /// The first half of [`RingPlatform::solve`]: the rotation and the platform joints of a valid pose into `c`.
+    #[inline(always)]
+    fn place(&self, pose: &Pose<T>, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
         let pose = pose.validated()?;
         c.rotation = pose.rotation();
         self.place_joints(&pose, c);
+        Ok(())
+    }
+
+    /// The second half of [`RingPlatform::solve`]: each chain's actuators, carriage and base from its joint in `c`.
+    #[inline(always)]
+    fn solve_chains(&self, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
         for i in 0..self.n {
             let (carriage, base) = self.chain(i, &c.joints[i], &mut c.q.0)?;
             c.carriages[i] = carriage;
