@@ -201,7 +201,10 @@ impl<T: Real> RingPlatform<T> {
     }
 
     /// The second half of [`RingPlatform::solve`]: each chain's actuators, carriage and base from its joint in `c`.
-    #[inline(always)]
+    ///
+    /// Never inlined: the envelope search's checks call it after their reach check, and a copy of the per-chain
+    /// code there took 1 KB of flash.
+    #[inline(never)]
     fn solve_chains(&self, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
         for i in 0..self.n {
             let (carriage, base) = self.chain(i, &c.joints[i], &mut c.q.0)?;
