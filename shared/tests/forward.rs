@@ -191,3 +191,53 @@ fn a_guess_below_the_ring_or_off_by_turns_is_answered_rightly() {
         Err(KinematicsError::NearSingularity)
     );
 }
+
+/// Without the workspace acceptance FK gives what it gives with it, but for a solution outside a check, which it
+/// returns: the other acceptance tests (distance, branches, singularity) are the same. Poses from home to beyond
+/// the workspace, guesses from near to far (so that every error class comes up), `f32` and `f64`.
+#[test]
+fn fk_without_the_workspace_acceptance_differs_only_outside() {
+    let m = trainer();
+    let m32 = RingPlatform::<f32>::new(&presets::TRAINER_MODEL);
+    let home = trainer_home().to_array();
+    let mut rng = Lcg(0x5eed_f0f0);
+    let mut tally = [0u32; 3];
+    for k in 0..4_000 {
+        let reach = if k % 2 == 0 { 0.1 } else { 0.25 };
+        let pose = Pose::from_array(std::array::from_fn(|i| {
+            home[i] + rng.uniform() * if i < 3 { reach * 0.6 } else { reach * 4.0 }
+        }));
+        let Ok(q) = m.inverse(&pose) else { continue };
+        let off = if k % 3 == 0 { 0.2 } else { 0.01 };
+        let p = pose.to_array();
+        let guess = Pose::from_array(std::array::from_fn(|i| p[i] + rng.uniform() * off));
+        let inside = NewtonOptions::default();
+        let relaxed = NewtonOptions {
+            inside: false,
+            ..inside
+        };
+        let (checked, unchecked) = (m.forward(&q, &guess, &inside), m.forward(&q, &guess, &relaxed));
+        match checked {
+            Err(KinematicsError::Outside(_)) => {
+                assert!(unchecked.is_ok(), "{pose:?}: {unchecked:?}");
+                tally[0] += 1;
+            }
+            other => {
+                tally[usize::from(other.is_ok()) + 1] += 1;
+                assert_eq!(unchecked, other, "{pose:?}");
+            }
+        }
+        let (q32, guess32) = (Actuators(q.0.map(|v| v as f32)), guess.cast::<f32>());
+        let inside32 = NewtonOptions::<f32>::default();
+        let relaxed32 = NewtonOptions {
+            inside: false,
+            ..inside32
+        };
+        match m32.forward(&q32, &guess32, &inside32) {
+            Err(KinematicsError::Outside(_)) => assert!(m32.forward(&q32, &guess32, &relaxed32).is_ok()),
+            other => assert_eq!(m32.forward(&q32, &guess32, &relaxed32), other, "{pose:?}"),
+        }
+    }
+    // Every class came up: outside, other errors, inside.
+    assert!(tally.iter().all(|&n| n > 20), "{tally:?}");
+}

@@ -112,6 +112,16 @@ pub trait Mechanism<T: Real> {
         }
     }
 
+    /// [`Mechanism::inverse_within`] with the memory of `guard` to work in: a mechanism may evaluate the checks in
+    /// the configuration `guard` keeps for the pose being checked, which its IK overwrites, instead of clearing a
+    /// new one per call (the envelope search evaluates up to eight poses a setpoint). The slow checks' reference in
+    /// `guard` is left as it is, so [`Mechanism::inverse_guarded`] proves exactly what it would have. The default
+    /// ignores `guard`.
+    fn inverse_within_in(&self, pose: &Pose<T>, room: &[T; 6], guard: &mut Self::Guard) -> Result<Actuators<T>, Check> {
+        let _ = guard;
+        self.inverse_within(pose, room)
+    }
+
     /// [`Mechanism::inverse_checked`] for a sequence of nearby poses (a control loop's): checks that change slowly
     /// may be proved from where `guard` last evaluated them instead of evaluated again. Every check still passes
     /// exactly when it would have; a proved margin is reported as its lower bound. The default evaluates everything.

@@ -99,10 +99,23 @@ pub fn limit<T: Real, M: Mechanism<T>>(
     margins: &EnvelopeMargins,
     evaluations: u8,
 ) -> Limited<T> {
+    limit_in(mechanism, &mut M::Guard::default(), centre, to, margins, evaluations)
+}
+
+/// [`limit`] evaluating in the memory of a guard (see [`Mechanism::inverse_within_in`]): a control loop passes its
+/// own, so that no evaluation clears a configuration of its own. The result is [`limit`]'s.
+pub fn limit_in<T: Real, M: Mechanism<T>>(
+    mechanism: &M,
+    guard: &mut M::Guard,
+    centre: &Pose<T>,
+    to: &Pose<T>,
+    margins: &EnvelopeMargins,
+    evaluations: u8,
+) -> Limited<T> {
     // Why a pose fails the envelope: no IK (the reach check; or the pose is not finite, which the caller refuses
     // first), or the first check short of its margin.
     let room = margins.room();
-    let evaluate = |pose: &Pose<T>| mechanism.inverse_within(pose, &room);
+    let mut evaluate = |pose: &Pose<T>| mechanism.inverse_within_in(pose, &room, guard);
     let first = match evaluate(to) {
         Ok(q) => {
             return Limited {

@@ -142,10 +142,13 @@ fn kinematics_costs(report: &dyn Fn(&str, u32, u32)) {
         }));
     }
     let mut limited = 0u32;
+    // The guard of a control loop, whose configuration being checked the search works in (as the pipeline's).
+    let mut guard = Default::default();
     let limit = counts(|| {
         for p in &outside {
-            let l = envelope::limit(
+            let l = envelope::limit_in(
                 &trainer,
+                &mut guard,
                 &centre,
                 black_box(p),
                 &config.margins,

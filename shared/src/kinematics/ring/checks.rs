@@ -54,14 +54,13 @@ impl<T: Real> Configuration<T> {
         }
     }
 
-    /// The directions of the first `n` chains' last links, from their joints and bases.
+    /// The directions of the first `n` chains' last links, from their joints and bases (a link of no length points
+    /// up, as in a cleared configuration: one reused gives what a new one would).
     pub fn direct(&mut self, n: usize) {
         for i in 0..n.min(6) {
             let d = self.joints[i] - self.bases[i];
             let len = length(&d);
-            if len > T::zero() {
-                self.dirs[i] = d / len;
-            }
+            self.dirs[i] = if len > T::zero() { d / len } else { Vector3::z() };
         }
     }
 }
@@ -121,7 +120,12 @@ impl<T: Real> RingPlatform<T> {
     /// Never inlined: inlined, it changed how LTO inlined IK with all the checks beside it (measured under QEMU:
     /// +85 instructions there, and FK +83), for 250 fewer instructions of the envelope search's eight calls.
     #[inline(never)]
-    pub(super) fn within(&self, pose: &Pose<T>, room: &[T; 6]) -> Result<Actuators<T>, Check> {
+    pub(super) fn within(
+        &self,
+        pose: &Pose<T>,
+        room: &[T; 6],
+        c: &mut Configuration<T>,
+    ) -> Result<Actuators<T>, Check> {
         let leaves = |check: Check, margin: T| {
             if short_of(margin, room[check.index()]) {
                 Err(check)
@@ -129,16 +133,19 @@ impl<T: Real> RingPlatform<T> {
                 Ok(())
             }
         };
-        let mut c = Configuration::zeroed();
-        self.solve(pose, &mut c).map_err(|_| Check::Reach)?;
+        // The reach margin needs only the joints: a point short of it (most of the envelope search's points
+        // outside) skips the chains' solves (their atan2). A pose has no IK or is short of its reach room alike
+        // as before: either is the reach check's.
+        self.place(pose, c).map_err(|_| Check::Reach)?;
         leaves(Check::Reach, self.reach_of(&c.joints))?;
+        self.solve_chains(c).map_err(|_| Check::Reach)?;
         let (spacing, order, ring_order) = self.spacing_and_order(&c.q);
         leaves(Check::CarriageSpacing, spacing)?;
         leaves(Check::RodCrossing, order)?;
         c.direct(self.n);
-        leaves(Check::JointCones, self.cone_margin(&c))?;
-        leaves(Check::Singularity, self.singularity_of(&c) - self.min_index)?;
-        leaves(Check::Stability, self.stability_margin(pose, &c, ring_order.as_ref()))?;
+        leaves(Check::JointCones, self.cone_margin(c))?;
+        leaves(Check::Singularity, self.singularity_of(c) - self.min_index)?;
+        leaves(Check::Stability, self.stability_margin(pose, c, ring_order.as_ref()))?;
         Ok(c.q)
     }
 
@@ -233,13 +240,7 @@ impl<T: Real> RingPlatform<T> {
 
     /// The scale-free singularity index of the wrench matrix (moments divided by the ring radius).
     pub(super) fn singularity_of(&self, c: &Configuration<T>) -> T {
-        let inv = T::one() / self.rr;
-        let mut rows = self.wrench_rows(c);
-        for row in &mut rows {
-            for m in &mut row[3..] {
-                *m *= inv;
-            }
-        }
+        let mut rows = self.wrench_rows_scaled(c, T::one() / self.rr);
         hadamard_ratio_in_place(&mut rows).0
     }
 

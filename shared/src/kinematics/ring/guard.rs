@@ -52,6 +52,14 @@ impl<T: Real> Default for SlowCheckGuard<T> {
     }
 }
 
+impl<T: Real> SlowCheckGuard<T> {
+    /// The configuration of the pose being checked: what the next IK overwrites, so memory to work in between two
+    /// guarded checks (the reference stays as it is).
+    pub(super) fn checked(&mut self) -> &mut Configuration<T> {
+        &mut self.configs[self.current & 1]
+    }
+}
+
 impl<T: Real> RingPlatform<T> {
     /// The slow margins of the guard's current configuration: proved from its reference when the bounds allow,
     /// else evaluated (and the reference moved there). Returns whether they were evaluated.
@@ -105,5 +113,94 @@ impl<T: Real> RingPlatform<T> {
         // Two for each unit row moving up to twice as far as its raw row.
         let index = at.index - (rows + rows) - slack;
         (cones >= T::zero() && index >= self.min_index).then_some(SlowMargins { cones, index })
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use nalgebra::{Matrix3, Vector3};
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::kinematics::presets::{Preset, PresetGeometry};
+    use crate::kinematics::{Actuators, Mechanism, Pose};
+
+    /// A guard whose configuration being checked holds `value` in every entry: what IK does not overwrite, the
+    /// checks would read.
+    fn filled<T: Real>(value: f64) -> SlowCheckGuard<T> {
+        let x = T::of(value);
+        let v = Vector3::new(x, x, x);
+        let c = Configuration {
+            q: Actuators([x; 6]),
+            rotation: Matrix3::from_element(x),
+            joints: [v; 6],
+            carriages: [v; 6],
+            bases: [v; 6],
+            dirs: [v; 6],
+        };
+        SlowCheckGuard {
+            configs: [c; 2],
+            current: 0,
+            at: None,
+        }
+    }
+
+    /// Every ring preset's mechanism in `f32` and `f64` at a pose `offset` (in units of the ring radius and of a
+    /// radian) from its home: the checks in a reused configuration filled with NaN, with a huge value and with the
+    /// last pose's configuration give what they give in a new one, whichever room stops them.
+    fn compare<T: Real>(offset: &[f64; 6]) {
+        let rooms: [[T; 6]; 3] = [
+            [T::of(-1e9); 6],
+            [T::zero(); 6],
+            crate::motion::EnvelopeMargins::default().room(),
+        ];
+        for preset in Preset::ALL {
+            let PresetGeometry::Ring(g) = preset.geometry() else {
+                continue;
+            };
+            let m = RingPlatform::<T>::new(g);
+            let rr = g.ring_radius;
+            let home = preset.home();
+            let pose = Pose::from_array(core::array::from_fn(|i| {
+                T::of(home[i] + offset[i] * if i < 3 { rr } else { 1.0 })
+            }));
+            let home = Pose::from_array(home.map(T::of));
+            let mut used = SlowCheckGuard::<T>::default();
+            let _ = m.inverse_within_in(&home, &rooms[0], &mut used);
+            for room in &rooms {
+                let fresh = m.inverse_within(&pose, room);
+                for guard in [&mut filled(f64::NAN), &mut filled(1e30), &mut used] {
+                    assert_eq!(
+                        m.inverse_within_in(&pose, room, guard),
+                        fresh,
+                        "{} at {pose:?}",
+                        preset.name()
+                    );
+                }
+            }
+            // Working in the guard leaves its reference alone: the next guarded check proves what it would have.
+            let mut guard = SlowCheckGuard::<T>::default();
+            let _ = m.inverse_guarded(&home, &mut guard);
+            let mut untouched = guard;
+            let _ = m.inverse_within_in(&pose, &rooms[0], &mut guard);
+            assert_eq!(
+                m.inverse_guarded(&home, &mut guard),
+                m.inverse_guarded(&home, &mut untouched)
+            );
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3_000))]
+        #[test]
+        fn a_reused_configuration_checks_as_a_new_one(
+            t in prop::array::uniform3(-0.5f64..0.5),
+            r in prop::array::uniform3(-0.8f64..0.8),
+        ) {
+            let offset = [t[0], t[1], t[2] * 0.5, r[0], r[1], r[2] * 4.0];
+            compare::<f32>(&offset);
+            compare::<f64>(&offset);
+        }
     }
 }

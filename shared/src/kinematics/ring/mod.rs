@@ -59,6 +59,9 @@ pub struct RingPlatform<T: Real> {
     n: usize,
     points: [Vector3<T>; 6],
     kinds: [Shape; 6],
+    /// The chain of each wrench-matrix row from `n` on (the tangent force of a radial or elbow chain, in chain
+    /// order); `u8::MAX` past the last.
+    tangent_rows: [u8; 6],
     /// Actuator index of the length of each radial chain.
     length_axis: [Option<usize>; 6],
     axes: [AxisKind; 6],
@@ -98,8 +101,17 @@ impl<T: Real> RingPlatform<T> {
                 next_length += 1;
             }
         }
+        let mut tangent_rows = [u8::MAX; 6];
+        let planar = chains
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| Shape::of(&c.kind).is_planar());
+        for (slot, (i, _)) in tangent_rows.iter_mut().zip(planar) {
+            *slot = i as u8;
+        }
         let l = &geometry.limits;
         Self {
+            tangent_rows,
             geometry: *geometry,
             rr: T::of(geometry.ring_radius),
             rod: T::of(geometry.rod_length),
@@ -175,9 +187,25 @@ impl<T: Real> RingPlatform<T> {
     /// The actuators go into `c` as well: returned in a `Result`, the compiler moved them through a copy at an odd
     /// offset, a `memcpy` call on the M4F (measured).
     fn solve(&self, pose: &Pose<T>, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
+        self.place(pose, c)?;
+        self.solve_chains(c)
+    }
+
+    /// The first half of [`RingPlatform::solve`]: the rotation and the platform joints of a valid pose into `c`.
+    #[inline(always)]
+    fn place(&self, pose: &Pose<T>, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
         let pose = pose.validated()?;
         c.rotation = pose.rotation();
         self.place_joints(&pose, c);
+        Ok(())
+    }
+
+    /// The second half of [`RingPlatform::solve`]: each chain's actuators, carriage and base from its joint in `c`.
+    ///
+    /// Never inlined: the envelope search's checks call it after their reach check, and a copy of the per-chain
+    /// code there took 1 KB of flash.
+    #[inline(never)]
+    fn solve_chains(&self, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
         for i in 0..self.n {
             let (carriage, base) = self.chain(i, &c.joints[i], &mut c.q.0)?;
             c.carriages[i] = carriage;
@@ -301,7 +329,19 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
     /// the envelope search outside the workspace mostly fails the reach check, and then skips the joint cones,
     /// the singularity index (a 6x6 decomposition) and the stability.
     fn inverse_within(&self, pose: &Pose<T>, room: &[T; 6]) -> Result<Actuators<T>, Check> {
-        self.within(pose, room)
+        self.within(pose, room, &mut Configuration::zeroed())
+    }
+
+    /// [`Mechanism::inverse_within`] in the guard's configuration of the pose being checked: IK writes every entry
+    /// the checks read (`shared/tests` fill it with NaN first and compare), so nothing is cleared (a 348-byte
+    /// `memclr`, 155 instructions on the M4F, per evaluation).
+    fn inverse_within_in(
+        &self,
+        pose: &Pose<T>,
+        room: &[T; 6],
+        guard: &mut SlowCheckGuard<T>,
+    ) -> Result<Actuators<T>, Check> {
+        self.within(pose, room, guard.checked())
     }
 
     /// IK and the checks, the joint cones and the singularity index proved by [`SlowCheckGuard`] when they can be.

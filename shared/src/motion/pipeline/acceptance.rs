@@ -40,8 +40,9 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             }
         };
         let config = &self.config;
-        let limited = envelope::limit(
+        let limited = envelope::limit_in(
             &self.mechanism,
+            &mut self.guard,
             &self.centre,
             &sp.pose,
             &config.margins,

@@ -4,9 +4,9 @@
 use std::path::Path;
 use std::process::Command;
 
-/// Most flash the firmware may take: what it takes now (192,916 B) and about 0.7 KiB for layout noise between
+/// Most flash the firmware may take: what it takes now (194,812 B) and about 1 KiB for layout noise between
 /// compiler versions. The goal it must never pass is 196,608 B, three quarters of the program area.
-pub const FLASH_BUDGET: u64 = 193_536;
+pub const FLASH_BUDGET: u64 = 195_840;
 
 /// What the ELF takes of each memory (bytes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
