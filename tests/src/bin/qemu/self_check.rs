@@ -91,7 +91,8 @@ pub(crate) const BUDGETS: [(&str, u64); 11] = [
     ("control tick: pipeline", 5_800),
     ("control tick at 2 kHz", 5_550),
     ("trainer IK (f32)", 840),
-    ("IK + all", 2_930),
+    // Measured 2,792 and, in another layout of the same source, 3,018: the budget covers the larger.
+    ("IK + all", 3_170),
     ("setpoint frame", 5_230),
     ("FK", 11_850),
     ("limited into the envelope", 12_200),
