@@ -66,15 +66,19 @@ fn ensure_target() -> Result<(), String> {
 
 /// Cargo for the Windows target, with Wine as the runner of what it builds.
 fn cargo(args: &[&str]) -> Command {
+    // Cargo's own options go before a `--`: what follows it is the test programs' (`--exact NAME`), which refuse
+    // `--target`.
+    let (own, programs) = args.split_at(args.iter().position(|a| *a == "--").unwrap_or(args.len()));
     let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
     c.current_dir(repo())
-        .args(args)
+        .args(own)
         .args(["--target", TARGET])
         // Wine runs what cargo runs, given as a configuration value and not as the environment variable
         // `CARGO_TARGET_X86_64_PC_WINDOWS_GNU_RUNNER`: the test programs inherit the environment, and assert_cmd
         // starts `ringpod.exe` through the runner that variable names, which inside Wine does not exist.
         .args(["--config", "target.x86_64-pc-windows-gnu.runner = \"wine\""])
-        .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER", "x86_64-w64-mingw32-gcc");
+        .env("CARGO_TARGET_X86_64_PC_WINDOWS_GNU_LINKER", "x86_64-w64-mingw32-gcc")
+        .args(programs);
     wine_env(&mut c);
     c
 }
@@ -350,5 +354,19 @@ mod tests {
         let mut ok = Command::new("sh");
         ok.args(["-c", "true"]);
         assert_eq!(tee(ok).unwrap(), (true, String::new()));
+    }
+
+    /// A test run again alone: its `--exact NAME` reaches the test program, cargo's target and runner stay cargo's.
+    #[test]
+    fn a_test_run_again_gets_its_name_and_cargo_its_target() {
+        let c = cargo(&["test", "-p", "ringpod", "--test", "cli", "--", "--exact", "a::b"]);
+        let args: Vec<_> = c.get_args().map(|a| a.to_string_lossy().into_owned()).collect();
+        let at = |word: &str| args.iter().position(|a| a == word).unwrap();
+        assert!(at("--target") < at("--") && at("--config") < at("--"), "{args:?}");
+        assert_eq!(&args[at("--")..], ["--", "--exact", "a::b"], "{args:?}");
+        // Without a `--`, everything is cargo's.
+        let c = cargo(&["build", "-p", "ringpod"]);
+        assert_eq!(c.get_args().next().unwrap(), "build");
+        assert!(c.get_args().any(|a| a == "--target"));
     }
 }
