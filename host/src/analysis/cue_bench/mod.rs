@@ -5,23 +5,23 @@
 //! `--floor` adds the least error any motion inside the envelope's ranges can give ([`super::optimal::floor`]),
 //! so that both are measured against what the rig allows, not only against each other.
 
+mod floors;
 mod picture;
 pub mod score;
 pub mod tune;
 
 use std::path::{Path, PathBuf};
 
-use ringpod_core::cueing::{Algorithm, CueConfig, Forward, Telemetry};
+use ringpod_core::cueing::{Algorithm, CueConfig};
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use serde::Serialize;
 
 use super::cue::{read_drive, replay, CueError};
 use super::mechanism::{AnyMechanism, Selected};
-use super::optimal::floor::Room;
-use super::optimal::polytope::{self, Polytope};
-use super::optimal::{floor, Counts, Envelope, Ranges};
+use super::optimal::{Counts, Envelope, Ranges};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
+use floors::{floor_of, FloorReport};
 use score::{score, Score, Trace};
 
 /// What the bench is asked to do.
@@ -87,44 +87,6 @@ pub struct Report {
     pub floor: Option<FloorReport>,
 }
 
-/// The floor ([`floor`]) of every drive together.
-#[derive(Debug, Serialize)]
-pub struct FloorReport {
-    /// Inside the ranges.
-    #[serde(flatten)]
-    pub figures: FloorFigures,
-    /// The largest share of each range the floor's motion used: x, y, z, roll, pitch.
-    pub envelope_share: [f64; 5],
-    /// With `--envelope-floor`: the floor inside an outer polytope of the rig's whole envelope, the axes coupled
-    /// as the rig couples them.
-    pub envelope: Option<EnvelopeFloor>,
-}
-
-/// A floor's figures over every drive.
-#[derive(Debug, Serialize)]
-pub struct FloorFigures {
-    /// The least RMS perceived specific-force error on the optimiser's model, x, y, z (m/s^2).
-    pub force_rms: [f64; 3],
-    /// The three axes together (m/s^2).
-    pub force_total: f64,
-    /// Each drive's, x, y, z (m/s^2), in the order of the drives.
-    pub drives: Vec<[f64; 3]>,
-}
-
-/// The floor inside the envelope's outer polytope ([`polytope`]).
-#[derive(Debug, Serialize)]
-pub struct EnvelopeFloor {
-    /// Its figures.
-    #[serde(flatten)]
-    pub figures: FloorFigures,
-    /// The polytope's faces.
-    pub faces: usize,
-    /// How far from settled its support search ended (a share of a face's support), before its slack.
-    pub last_gain: f64,
-    /// The slack added to every face's support (in the ranges' scale).
-    pub slack: f64,
-}
-
 /// A drive's rows.
 pub type Rows = Vec<(usize, Vec<f64>)>;
 
@@ -172,72 +134,6 @@ pub fn evaluate(
         },
         traces,
     ))
-}
-
-/// The floor of the drives on the optimiser's model, every drive's samples together. Its motion is not scored:
-/// bounded by the ranges alone, it swings the tilt at any rate and reaches corners of the ranges' box outside the
-/// coupled envelope, so the bench would score the limiter and the finite differences of a motion no cueing
-/// makes, not the floor.
-fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward, coupled: bool) -> Result<FloorReport, CueError> {
-    let ranges = &rig.envelope.ranges;
-    let outer = coupled.then(|| Polytope::of(&rig.mechanism, &rig.neutral, ranges, &polytope::directions(3), RAYS));
-    let (mut within_ranges, mut within_envelope) = (Sums::default(), Sums::default());
-    let mut envelope_share = [0.0f64; 5];
-    for rows in drives {
-        let t: Vec<f64> = rows.iter().map(|(_, v)| v[0]).collect();
-        let samples: Vec<Telemetry<f64>> = rows.iter().map(|(_, v)| super::cue_engine::row_sample(v)).collect();
-        let f = floor::floor(&t, &samples, Room::Ranges(ranges), forward).map_err(CueError::Floor)?;
-        within_ranges.add(&f);
-        for offset in &f.offsets {
-            score::widen_shares(&mut envelope_share, offset, ranges);
-        }
-        if let Some(outer) = &outer {
-            let f = floor::floor(&t, &samples, Room::Envelope(outer), forward).map_err(CueError::Floor)?;
-            within_envelope.add(&f);
-        }
-    }
-    Ok(FloorReport {
-        figures: within_ranges.figures(),
-        envelope_share,
-        envelope: outer.map(|outer| EnvelopeFloor {
-            figures: within_envelope.figures(),
-            faces: outer.faces.len(),
-            last_gain: outer.last_gain,
-            slack: polytope::SLACK,
-        }),
-    })
-}
-
-/// Rays spread through the envelope to find the polytope's supports from: with every face's own direction and
-/// the climb, enough that the supports no longer grow (the search's last gain, reported).
-const RAYS: usize = 2000;
-
-/// Floors of several drives added up: squares weighted by samples.
-#[derive(Default)]
-struct Sums {
-    sum: [f64; 3],
-    n: usize,
-    each: Vec<[f64; 3]>,
-}
-
-impl Sums {
-    fn add(&mut self, f: &floor::Floor) {
-        let m = f.offsets.len().saturating_sub(1);
-        for (total, rms) in self.sum.iter_mut().zip(f.force_rms) {
-            *total += rms * rms * m as f64;
-        }
-        self.n += m;
-        self.each.push(f.force_rms);
-    }
-
-    fn figures(self) -> FloorFigures {
-        let force_rms = self.sum.map(|v| (v / self.n.max(1) as f64).sqrt());
-        FloorFigures {
-            force_rms,
-            force_total: force_rms.iter().map(|r| r * r).sum::<f64>().sqrt(),
-            drives: self.each,
-        }
-    }
 }
 
 /// The scores of several drives as one: RMS weighted by samples, the largest peaks and shares, the sums.
@@ -426,63 +322,4 @@ fn table(r: &Report) -> String {
         }
     }
     s
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// On the shipped example drive, neither the classical washout nor the optimal cueing perceives less force
-    /// error than the floor, which keeps to the ranges; the table says it and its ratio.
-    #[test]
-    fn no_cueing_on_the_bench_beats_the_floor() {
-        let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs");
-        let out = std::env::temp_dir().join(format!("ringpod-floor-{}.json", std::process::id()));
-        let (classical, optimal) = (docs.join("drives/classical.toml"), docs.join("drives/optimal.toml"));
-        let inputs = [docs.join("drive-telemetry.csv")];
-        let options = Options {
-            configs: [&classical, &optimal],
-            inputs: &inputs,
-            out: &out,
-            plot: None,
-            tune: false,
-            json: false,
-            preview: false,
-            floor: true,
-            envelope_floor: true,
-            mechanism: "trainer-model",
-            geometry: None,
-        };
-        let (table, code) = run(&options).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-        std::fs::remove_file(&out).unwrap();
-        assert_eq!(code, 0);
-        let floor = report["floor"]["force_total"].as_f64().unwrap();
-        assert!(floor > 0.1, "{report}");
-        let coupled = report["floor"]["envelope"]["force_total"].as_f64().unwrap();
-        assert!(coupled > 0.1, "{report}");
-        for e in report["entries"].as_array().unwrap() {
-            let rms: Vec<f64> = e["total"]["force_rms"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|v| v.as_f64().unwrap())
-                .collect();
-            let total = rms.iter().map(|r| r * r).sum::<f64>().sqrt();
-            assert!(floor < total, "floor {floor} against {}: {total}", e["name"]);
-            assert!(
-                coupled < total,
-                "envelope floor {coupled} against {}: {total}",
-                e["name"]
-            );
-        }
-        for share in report["floor"]["envelope_share"].as_array().unwrap() {
-            assert!(share.as_f64().unwrap() <= 1.0 + 1e-4, "{report}");
-        }
-        assert!(
-            table.contains("floor / classical.toml perceived force error")
-                && table.contains("envelope floor / classical.toml perceived force error"),
-            "{table}"
-        );
-    }
 }
