@@ -52,6 +52,17 @@ pub enum CliError {
     /// A command for ring platforms was given another mechanism.
     #[error("cueing moves a ring platform; {0} is not one")]
     NotARing(String),
+    /// Cueing about a neutral pose outside the platform's own workspace.
+    #[error(
+        "cueing moves the platform about its home, and {name}'s home fails the {check} check (`ringpod check`): no \
+         pose about it is inside the envelope; give the rig a home inside its workspace"
+    )]
+    NeutralOutside {
+        /// The mechanism.
+        name: String,
+        /// The check its home fails.
+        check: ringpod_core::kinematics::workspace::Check,
+    },
     /// A file could not be written.
     #[error("{}: {reason}", path.display())]
     File {

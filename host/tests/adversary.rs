@@ -159,7 +159,7 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
 
 /// The source's own geometries are analysed whether or not they can be driven: chapter 5's trainer (its home pose
 /// fails the carriage spacing) answers `ik`, `check` and `workspace`, and `rig check` says why it cannot be
-/// driven; the rotopod of chapters 3-4 is driven: `stream --sim --mechanism rotopod-ch4` homes its six carriages on
+/// driven (nor cued); the rotopod of chapters 3-4 is driven: `stream --sim --mechanism rotopod-ch4` homes its six carriages on
 /// one ring and follows the demo.
 #[test]
 fn every_mechanism_of_the_source_is_analysed_and_the_rotopod_driven() {
@@ -201,6 +201,36 @@ fn every_mechanism_of_the_source_is_analysed_and_the_rotopod_driven() {
     ]);
     assert_eq!(code, 1, "not drivable: {stderr}");
     assert_eq!(stderr.matches("carriage-spacing").count(), 1, "{stderr}");
+    // Nor cued: every pose about a home outside the envelope would be cut towards it, none inside.
+    let drives = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs");
+    let drive = drives.join("drive-telemetry.csv").display().to_string();
+    let classical = drives.join("drives/classical.toml").display().to_string();
+    let (poses, report) = (dir.join("ch5.csv"), dir.join("ch5.json"));
+    let (poses_arg, report_arg) = (poses.display().to_string(), report.display().to_string());
+    for args in [
+        vec!["cue", "--geometry", &ch5, "--input", &drive, "--out", &poses_arg],
+        vec![
+            "cue",
+            "--compare",
+            &classical,
+            &classical,
+            "--geometry",
+            &ch5,
+            "--input",
+            &drive,
+            "--out",
+            &report_arg,
+        ],
+    ] {
+        let (code, _, stderr) = run(&args);
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        assert_eq!(
+            stderr.matches("home fails the carriage-spacing check").count(),
+            1,
+            "{stderr}"
+        );
+    }
+    assert!(!poses.exists() && !report.exists(), "an output was written");
 
     let (code, stdout, stderr) = run(&[
         "stream",

@@ -107,6 +107,13 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         return Err(CliError::NotARing(selected.name).into());
     };
     let neutral = Pose::from_array(selected.home);
+    if let Some(check) = super::cue_engine::neutral_fails(&mechanism, &neutral) {
+        return Err(CliError::NeutralOutside {
+            name: selected.name,
+            check,
+        }
+        .into());
+    }
     let Replay {
         cued,
         limited,

@@ -2,7 +2,9 @@
 //! behind one interface for `cue`, the bench and the workbench.
 
 use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout};
+use ringpod_core::kinematics::workspace::Check;
 use ringpod_core::kinematics::{Pose, RingPlatform};
+use ringpod_core::motion::{envelope, EnvelopeMargins};
 
 use super::mechanism::AnyMechanism;
 use super::optimal::{Counts, Envelope, Optimal, Ranges};
@@ -18,6 +20,13 @@ pub enum Engine {
 /// The envelope about `neutral` the optimal cueing plans in: each axis's range from the workspace scan.
 pub fn ranges(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Ranges {
     super::workspace::ranges_about_home(&AnyMechanism::Ring(Box::new(*mechanism)), neutral.to_array())
+}
+
+/// Which check `neutral` fails, if any. Every cueing moves the platform about its neutral pose and the envelope
+/// limiter cuts each pose back along the ray from it, so from a neutral pose outside the envelope no pose is
+/// inside: every one would be cut towards, or held at, a pose the platform cannot take.
+pub fn neutral_fails(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Option<Check> {
+    envelope::limit(mechanism, neutral, neutral, &EnvelopeMargins::default(), 1).bound_by
 }
 
 /// The envelope about `neutral` the optimal cueing plans in: the ranges, and the rig for the tilt's shared room.

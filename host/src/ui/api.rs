@@ -54,6 +54,12 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
     let (rows, mut errors) = crate::input::table::read(text, &TELEMETRY_COLUMNS)?;
     let m = RingPlatform::<f64>::new(geometry);
     let neutral = Pose::from_array(home);
+    if let Some(check) = crate::analysis::cue_engine::neutral_fails(&m, &neutral) {
+        return Err(format!(
+            "the rig's home fails the {check} check: cueing moves the platform about its home, and no pose about \
+             this one is inside the envelope"
+        ));
+    }
     // One scan of the envelope for both algorithms' replays and scores.
     let envelope = crate::analysis::cue_engine::envelope(&m, &neutral);
     let scored = |config: CueConfig| -> Result<(Replay, Value), String> {
@@ -185,6 +191,22 @@ mod tests {
             unreachable!("the trainer model is a ring platform")
         };
         (*g, Preset::TrainerModel.home())
+    }
+
+    /// A rig whose home is outside its own workspace (chapter 5's trainer) is not cued: no pose about it is
+    /// inside the envelope.
+    #[test]
+    fn a_home_outside_the_workspace_is_not_cued() {
+        let PresetGeometry::Ring(g) = Preset::TrainerCh5.geometry() else {
+            unreachable!("chapter 5's trainer is a ring platform")
+        };
+        let request = CueRequest {
+            compare: true,
+            config: cue_defaults()["config"].clone(),
+            drive: None,
+        };
+        let e = cue(&request, &g, Preset::TrainerCh5.home()).unwrap_err();
+        assert!(e.contains("home fails the carriage-spacing check"), "{e}");
     }
 
     #[test]
