@@ -205,7 +205,7 @@ mod tests {
             config: cue_defaults()["config"].clone(),
             drive: None,
         };
-        let e = cue(&request, &g, Preset::TrainerCh5.home()).unwrap_err();
+        let e = cue(&request, g, Preset::TrainerCh5.home()).unwrap_err();
         assert!(e.contains("home fails the carriage-spacing check"), "{e}");
     }
 
