@@ -11,17 +11,7 @@ use cortex_m_semihosting::debug;
 use ringpod_core::kinematics::presets::TRAINER_MODEL;
 use ringpod_core::kinematics::{Mechanism, RingPlatform};
 use ringpod_core::selfcheck;
-use ringpod_qemu::halt;
-
-#[inline(never)]
-fn marker_start() {
-    black_box(1);
-}
-
-#[inline(never)]
-fn marker_end() {
-    black_box(2);
-}
+use ringpod_qemu::{halt, marker_end, marker_start};
 
 #[entry]
 fn main() -> ! {
