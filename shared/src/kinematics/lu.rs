@@ -100,8 +100,8 @@ fn eliminate<T: Real, const K: usize>(lu: &mut [[T; 6]; 6], perm: &mut [u8; 6], 
         }
     }
     let pivot = lu[p][K];
-    // Zero, infinite or NaN, by two comparisons of its magnitude: `finite()` tests the bits in core registers and
-    // took a dozen instructions a column on the M4F (measured).
+    // Zero, infinite or NaN, by two comparisons of the magnitude the search kept (a NaN fails both), where
+    // `pivot == 0 || !pivot.finite()` took the absolute value again.
     if !(largest > T::zero() && largest <= T::max_value().unwrap_or(T::one())) {
         return false;
     }
