@@ -89,14 +89,20 @@ impl<'a, T: Real> Lu6<'a, T> {
 /// Pivots on column `K` and eliminates it below the diagonal; false when the pivot is zero or not finite.
 #[inline(always)]
 fn eliminate<T: Real, const K: usize>(lu: &mut [[T; 6]; 6], perm: &mut [u8; 6], odd: &mut bool) -> bool {
+    // The largest magnitude so far is kept, not reloaded through the index of its row.
     let mut p = K;
+    let mut largest = lu[K][K].abs();
     for i in K + 1..6 {
-        if lu[i][K].abs() > lu[p][K].abs() {
+        let magnitude = lu[i][K].abs();
+        if magnitude > largest {
+            largest = magnitude;
             p = i;
         }
     }
     let pivot = lu[p][K];
-    if pivot == T::zero() || !pivot.finite() {
+    // Zero, infinite or NaN, by two comparisons of the magnitude the search kept (a NaN fails both), where
+    // `pivot == 0 || !pivot.finite()` took the absolute value again.
+    if !(largest > T::zero() && largest <= T::max_value().unwrap_or(T::one())) {
         return false;
     }
     if p != K {
@@ -148,6 +154,12 @@ mod tests {
             let lu = Lu6::in_place(&mut rows);
             let det = m.lu().determinant();
             assert!((lu.determinant() - det).abs() <= 1e-12 * det.abs().max(1e-3), "{det}");
+            // Partial pivoting: each pivot is its column's largest, so no multiplier exceeds 1 in magnitude.
+            for i in 1..6 {
+                for j in 0..i {
+                    assert!(lu.lu[i][j].abs() <= 1.0, "multiplier {} at ({i}, {j})", lu.lu[i][j]);
+                }
+            }
             let x = lu.solve(&b).expect("a random matrix is regular");
             let residual = m * nalgebra::Vector6::from(x) - nalgebra::Vector6::from(b);
             assert!(residual.amax() < 1e-9, "{residual}");
@@ -167,6 +179,25 @@ mod tests {
         assert_eq!(lu.solve(&[1.0; 6]), None);
         rows[4][4] = f64::NAN;
         assert!(Lu6::in_place(&mut rows).determinant().is_nan());
+        // An infinite pivot (first in its column, or reached after others) is not a regular matrix's either.
+        for at in [0, 3, 5] {
+            for inf in [f64::INFINITY, f64::NEG_INFINITY] {
+                let mut rows = [[0.0f64; 6]; 6];
+                for (i, row) in rows.iter_mut().enumerate() {
+                    row[i] = 1.0;
+                }
+                rows[at][at] = inf;
+                let lu = Lu6::in_place(&mut rows);
+                assert!(lu.determinant().is_nan(), "{at} {inf}");
+                assert_eq!(lu.solve(&[1.0; 6]), None);
+            }
+        }
+        // The smallest normal pivot is a pivot.
+        let mut tiny = [[0.0f64; 6]; 6];
+        for (i, row) in tiny.iter_mut().enumerate() {
+            row[i] = if i == 2 { f64::MIN_POSITIVE } else { 1.0 };
+        }
+        assert_eq!(Lu6::in_place(&mut tiny).determinant(), f64::MIN_POSITIVE);
         let mut swapped = [
             [0.0, 1.0, 0.0, 0.0, 0.0, 0.0],
             [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],

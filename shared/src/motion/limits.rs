@@ -33,7 +33,9 @@ impl AxisTracker {
     pub fn step(&mut self, error: f32, stop_distance: f32, dt: f32, vmax: f32, amax: f32) -> f32 {
         let adt = amax * dt;
         let d = libm::fabsf(stop_distance);
-        let stop = if adt > 0.0 {
+        // An axis with no error is not sent anywhere (the speed it asks for is 0, whatever `stop` is, since `stop`
+        // is never negative): the braking bound, a root and two divisions, is left out for it.
+        let stop = if adt > 0.0 && error != 0.0 {
             // Braking from v covers dt (v + (v - a dt) + ... ) down to the last positive speed. With n whole braking
             // steps (n a dt <= v < (n + 1) a dt) that is dt (n + 1) (v - n a dt / 2), so the fastest speed that stops
             // within d is d / ((n + 1) dt) + n a dt / 2; the continuous estimate picks n.
@@ -62,5 +64,52 @@ impl AxisTracker {
             self.velocity - libm::copysignf(adt, self.velocity)
         };
         self.velocity
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The step with the braking bound taken for every axis, the form that skips it for an axis with no error
+    /// replaced.
+    fn always_bounded(v: f32, error: f32, stop_distance: f32, dt: f32, vmax: f32, amax: f32) -> f32 {
+        let adt = amax * dt;
+        let d = libm::fabsf(stop_distance);
+        let stop = if adt > 0.0 {
+            let k = crate::real::sqrtf(0.25 + 2.0 * d / (adt * dt)) - 0.5;
+            let k = k.max_(0.0);
+            let n = if k < 8_388_608.0 { (k as i32) as f32 } else { k };
+            (d / ((n + 1.0) * dt) + n * adt * 0.5).min_((n + 1.0) * adt)
+        } else {
+            0.0
+        };
+        let reach = libm::fabsf(error) / dt;
+        let wanted = libm::copysignf(reach.min_(stop).min_(vmax), error);
+        wanted.max_(v - adt).min_(v + adt)
+    }
+
+    fn same(a: f32, b: f32) -> bool {
+        a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(20_000))]
+
+        #[test]
+        fn an_axis_without_error_gets_the_speed_the_bound_would_give(
+            v in prop_oneof![Just(0.0f32), -2.0f32..2.0, any::<f32>()],
+            error in prop_oneof![Just(0.0f32), Just(-0.0f32), -1.0f32..1.0, any::<f32>()],
+            stop_distance in prop_oneof![Just(0.0f32), -1.0f32..1.0, any::<f32>()],
+            dt in prop_oneof![Just(0.001f32), Just(0.0005f32), 0.0f32..0.1],
+            vmax in prop_oneof![0.0f32..10.0, any::<f32>()],
+            amax in prop_oneof![Just(0.0f32), 0.0f32..100.0, any::<f32>()],
+        ) {
+            let mut t = AxisTracker { velocity: v };
+            let got = t.step(error, stop_distance, dt, vmax, amax);
+            let want = always_bounded(v, error, stop_distance, dt, vmax, amax);
+            prop_assert!(same(got, want) && same(t.velocity, want), "{got:e} {want:e}");
+        }
     }
 }

@@ -135,9 +135,12 @@ macro_rules! impl_real {
             fn round_(self) -> Self {
                 $round(self)
             }
+            /// One comparison of the magnitude (a NaN fails it, an infinity exceeds the largest finite value):
+            /// `is_finite` tests the exponent's bits, which on the M4F first moves the value to a core register,
+            /// about a dozen instructions where this is four (measured).
             #[inline]
             fn finite(self) -> bool {
-                self.is_finite()
+                self.abs() <= <$t>::MAX
             }
             const EPS: f64 = <$t>::EPSILON as f64;
         }
@@ -198,5 +201,49 @@ pub(crate) fn wrap_once<T: Real>(a: T) -> T {
         a + T::two_pi()
     } else {
         a
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Real;
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(20_000))]
+
+        #[test]
+        fn finite_is_is_finite(bits in proptest::num::u32::ANY, wide in proptest::num::u64::ANY) {
+            let (x, y) = (f32::from_bits(bits), f64::from_bits(wide));
+            proptest::prop_assert_eq!(x.finite(), x.is_finite(), "{:e}", x);
+            proptest::prop_assert_eq!(y.finite(), y.is_finite(), "{:e}", y);
+        }
+    }
+
+    #[test]
+    fn finite_at_the_edges() {
+        for v in [
+            0.0,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::MAX,
+            f32::INFINITY,
+            f32::NAN,
+        ] {
+            for x in [v, -v] {
+                assert_eq!(x.finite(), x.is_finite(), "{x:e}");
+            }
+        }
+        for v in [
+            0.0,
+            f64::MIN_POSITIVE,
+            f64::from_bits(1),
+            f64::MAX,
+            f64::INFINITY,
+            f64::NAN,
+        ] {
+            for x in [v, -v] {
+                assert_eq!(x.finite(), x.is_finite(), "{x:e}");
+            }
+        }
     }
 }

@@ -2,6 +2,8 @@
 
 #![no_std]
 
+use core::hint::black_box;
+
 use cortex_m_semihosting::{debug, hprintln};
 
 /// Reports `ERROR what` and ends the run with a failure.
@@ -23,4 +25,17 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     hprintln!("ERROR panic: {}", info);
     debug::exit(debug::EXIT_FAILURE);
     halt()
+}
+
+/// Where a profiled stretch begins: `tests/qemu/profile` counts the instructions between a call of this and one of
+/// [`marker_end`] (it finds them by name in QEMU's trace, so neither is ever inlined).
+#[inline(never)]
+pub fn marker_start() {
+    black_box(1);
+}
+
+/// Where a profiled stretch ends (see [`marker_start`]).
+#[inline(never)]
+pub fn marker_end() {
+    black_box(2);
 }

@@ -125,9 +125,12 @@ impl<M: Mechanism<f32>> Pipeline<M> {
                 continue;
             }
             let v_prev = self.actuator_velocity[i];
-            let hi = limits.actuator_velocity[i].min_(v_prev + limits.actuator_acceleration[i] * dt) * dt;
-            let lo = (-limits.actuator_velocity[i]).max_(v_prev - limits.actuator_acceleration[i] * dt) * dt;
-            let bound = if d > 0.0 { hi / d } else { lo / d };
+            // Only the limit in the direction of the move is computed.
+            let bound = if d > 0.0 {
+                limits.actuator_velocity[i].min_(v_prev + limits.actuator_acceleration[i] * dt) * dt / d
+            } else {
+                (-limits.actuator_velocity[i]).max_(v_prev - limits.actuator_acceleration[i] * dt) * dt / d
+            };
             scale = scale.min_(bound.max_(0.0));
         }
         scale

@@ -14,22 +14,12 @@ use ringpod_core::motion::Setpoint;
 use ringpod_core::protocol::{self, HostMessage, Request};
 use ringpod_core::selfcheck::{self, Digest};
 use ringpod_core::Real;
-use ringpod_qemu::{fail, halt};
+use ringpod_qemu::{fail, halt, marker_end, marker_start};
 
 /// Ticks streamed before the measured ones (the stream settles into its steady state).
 const LEAD: u32 = 200;
 /// Ticks measured.
 const MEASURED: u32 = 100;
-
-#[inline(never)]
-fn marker_start() {
-    black_box(1);
-}
-
-#[inline(never)]
-fn marker_end() {
-    black_box(2);
-}
 
 #[entry]
 fn main() -> ! {
