@@ -72,8 +72,8 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    /// The step with the braking bound taken for every axis, the form that skips it for an axis with no error
-    /// replaced.
+    /// The step with the braking bound taken for every axis: what the step, which leaves the bound out for an
+    /// axis with no error, must give bit for bit.
     fn always_bounded(v: f32, error: f32, stop_distance: f32, dt: f32, vmax: f32, amax: f32) -> f32 {
         let adt = amax * dt;
         let d = libm::fabsf(stop_distance);

@@ -143,6 +143,32 @@ mod tests {
 
     use super::super::{run, Options};
 
+    /// Runs the bench with the floor on `inputs` (trainer model, no tuning): its table and its report.
+    fn bench(
+        configs: [&Path; 2],
+        inputs: &[std::path::PathBuf],
+        out: &Path,
+        envelope: bool,
+    ) -> (String, serde_json::Value) {
+        let options = Options {
+            configs,
+            inputs,
+            out,
+            plot: None,
+            tune: false,
+            json: false,
+            preview: false,
+            floor: true,
+            envelope_floor: envelope,
+            mechanism: "trainer-model",
+            geometry: None,
+        };
+        let (table, code) = run(&options).unwrap();
+        assert_eq!(code, 0, "{table}");
+        let report = serde_json::from_str(&std::fs::read_to_string(out).unwrap()).unwrap();
+        (table, report)
+    }
+
     /// On the shipped example drive, neither the classical washout nor the optimal cueing perceives less force
     /// error than the floor, which keeps to the ranges; the table says it and its ratio.
     #[test]
@@ -151,23 +177,8 @@ mod tests {
         let out = std::env::temp_dir().join(format!("ringpod-floor-{}.json", std::process::id()));
         let (classical, optimal) = (docs.join("drives/classical.toml"), docs.join("drives/optimal.toml"));
         let inputs = [docs.join("drive-telemetry.csv")];
-        let options = Options {
-            configs: [&classical, &optimal],
-            inputs: &inputs,
-            out: &out,
-            plot: None,
-            tune: false,
-            json: false,
-            preview: false,
-            floor: true,
-            envelope_floor: true,
-            mechanism: "trainer-model",
-            geometry: None,
-        };
-        let (table, code) = run(&options).unwrap();
-        let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        let (table, report) = bench([&classical, &optimal], &inputs, &out, true);
         std::fs::remove_file(&out).unwrap();
-        assert_eq!(code, 0);
         let floor = report["floor"]["force_total"].as_f64().unwrap();
         assert!(floor > 0.1, "{report}");
         let coupled = report["floor"]["envelope"]["force_total"].as_f64().unwrap();
@@ -228,23 +239,7 @@ mod tests {
         let classical = docs.join("drives/classical.toml");
         let floor_of = |inputs: &[std::path::PathBuf]| {
             let out = dir.join("report.json");
-            let options = Options {
-                configs: [&classical, &classical],
-                inputs,
-                out: &out,
-                plot: None,
-                tune: false,
-                json: false,
-                preview: false,
-                floor: true,
-                envelope_floor: false,
-                mechanism: "trainer-model",
-                geometry: None,
-            };
-            let (_, code) = run(&options).unwrap();
-            assert_eq!(code, 0);
-            let report: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-            report["floor"]["force_rms"].clone()
+            bench([&classical, &classical], inputs, &out, false).1["floor"]["force_rms"].clone()
         };
         let gapped = floor_of(&files[..1]);
         let apart = floor_of(&files[1..]);
