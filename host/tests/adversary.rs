@@ -469,6 +469,10 @@ fn huge_and_tiny_numbers_are_said_readably() {
         vec!["stream", "--sim", "--motion", "demo", "--rate=1e308"],
         vec!["stream", "--sim", "--motion", "demo", "--duration=-1e-320"],
         vec!["stream", "--sim", "--udp", "127.0.0.1:0", "--udp-idle=1e308"],
+        vec!["rates", "--pose-rates=1e300,0,0,0,0,0"],
+        vec!["rates", "--pose-rates=0,0,0,0,0,-1e300"],
+        vec!["rates", "--actuator-rates=0,0,0,0,1e300,0"],
+        vec!["rates", "--degrees", "--actuator-rates=0,0,0,0,0,1e300"],
     ] {
         let (code, _, stderr) = run(&args);
         assert_eq!(code, 1, "{args:?}: {stderr}");

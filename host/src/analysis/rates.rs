@@ -89,13 +89,19 @@ pub fn run(o: &Options) -> Result<Outcome, CliError> {
     let out = |v: &Vector6<f64>, pose_axis: bool| -> [f64; 6] {
         std::array::from_fn(|i| if is_angle(i, pose_axis) { v[i] * angle } else { v[i] })
     };
+    let given = |what, text, pose_axis| -> Result<Vector6<f64>, CliError> {
+        let v = to_si(numbers::six(what, text)?, pose_axis);
+        let si: [f64; 6] = std::array::from_fn(|i| v[i]);
+        numbers::rates_in_range(what, &si, |i| is_angle(i, pose_axis), mechanism.characteristic_length())?;
+        Ok(v)
+    };
     let (p_rates, q_rates) = match o.given {
         Given::PoseRates(text) => {
-            let p = to_si(numbers::six("pose-rates", text)?, true);
+            let p = given("pose-rates", text, true)?;
             (p, j.actuator_rates(&p)?)
         }
         Given::ActuatorRates(text) => {
-            let qd = to_si(numbers::six("actuator-rates", text)?, false);
+            let qd = given("actuator-rates", text, false)?;
             (j.pose_rates(&qd)?, qd)
         }
     };

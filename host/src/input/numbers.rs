@@ -104,6 +104,36 @@ pub fn pose_in_range(what: &'static str, pose: &[f64; 6], length: f64) -> Result
     Ok(())
 }
 
+/// Checks rates given on the command line (SI: m/s, and rad/s where `angular`) against sane ranges for a mechanism
+/// of characteristic length `length`: a hundred times that length a second, and [`MAX_TURNING`] rad/s. The rates
+/// are linear in them, so a larger one says nothing more; it is a mistake (1e300 came back as 300 digits).
+pub fn rates_in_range(
+    what: &'static str,
+    rates: &[f64; 6],
+    angular: impl Fn(usize) -> bool,
+    length: f64,
+) -> Result<(), BadNumber> {
+    for (i, v) in rates.iter().enumerate() {
+        let (limit, unit) = if angular(i) {
+            (MAX_TURNING, "rad/s")
+        } else {
+            (MAX_LENGTHS * length, "m/s")
+        };
+        if !v.is_finite() || v.abs() > limit {
+            return Err(BadNumber::new(
+                what,
+                format!(
+                    "value {} = {} {unit} is out of range (at most {} {unit} either way)",
+                    i + 1,
+                    readable(*v),
+                    readable(limit)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Checks one length or height given on the command line (m).
 pub fn length_in_range(what: &'static str, value: f64, length: f64) -> Result<(), BadNumber> {
     let limit = MAX_LENGTHS * length;
