@@ -82,6 +82,17 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
             ),
             "ring_radius",
         ),
+        (
+            write("spec.toml", good.replace("surge = 0.05", "surge = 1e300").as_bytes()),
+            "spec.surge",
+        ),
+        (
+            write(
+                "tilt.toml",
+                good.replace("roll_deg = 20.0", "roll_deg = 400.0").as_bytes(),
+            ),
+            "spec.roll_deg",
+        ),
         (write("binary.toml", &[0xff, 0xfe, 0x00, 0x80, 0x13, 0x37]), "UTF-8"),
         (dir.join("missing.toml").display().to_string(), MISSING),
         (dir.display().to_string(), DIRECTORY),

@@ -74,8 +74,19 @@ impl RigFile {
             Some(s) => {
                 let si = s.si();
                 let names = ["surge", "sway", "heave", "roll_deg", "pitch_deg"];
-                if let Some(i) = si.iter().position(|v| !(v.is_finite() && *v >= 0.0)) {
-                    return err(format!("spec.{}", names[i]), "a range is a finite number >= 0");
+                // The same sane ranges as a pose on the command line: a hundred ring radii, a whole turn.
+                let length = crate::input::numbers::MAX_LENGTHS * m.characteristic_length();
+                let limit = |i: usize| if i < 3 { length } else { crate::input::numbers::MAX_TILT };
+                if let Some(i) = (0..5).find(|&i| !(si[i].is_finite() && (0.0..=limit(i)).contains(&si[i]))) {
+                    let most = if i < 3 {
+                        format!("{} m", crate::input::numbers::readable(length))
+                    } else {
+                        "360 deg".to_owned()
+                    };
+                    return err(
+                        format!("spec.{}", names[i]),
+                        format!("a range is a finite number from 0 to {most}"),
+                    );
                 }
                 Some(si)
             }
