@@ -93,6 +93,20 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
             ),
             "spec.roll_deg",
         ),
+        (
+            write(
+                "gear.toml",
+                good.replace("gear_ratio = 8.0", "gear_ratio = 1e300").as_bytes(),
+            ),
+            "drives[0].gear_ratio",
+        ),
+        (
+            write(
+                "torque.toml",
+                good.replace("[[0.0, 0.016],", "[[0.0, 1e300],").as_bytes(),
+            ),
+            "drives[0].pull_out",
+        ),
         (write("binary.toml", &[0xff, 0xfe, 0x00, 0x80, 0x13, 0x37]), "UTF-8"),
         (dir.join("missing.toml").display().to_string(), MISSING),
         (dir.display().to_string(), DIRECTORY),

@@ -27,6 +27,13 @@ use serde::{Deserialize, Serialize};
 
 use super::{err, RigError};
 
+/// The largest values a drive's numbers can take: far past any motor, gear or screw a platform uses, and where a
+/// number stops being a drive's and is a broken one.
+const MAX_RPM: f64 = 1e6;
+const MAX_TORQUE: f64 = 1e4;
+const MAX_GEAR: f64 = 1e4;
+const MAX_LEAD: f64 = 1.0;
+
 /// One `[[drives]]` entry as written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -128,14 +135,18 @@ pub fn check(specs: &[DriveSpec], axes: &[AxisKind; 6]) -> Result<[Option<Drive>
             );
         }
         for (j, p) in d.pull_out.iter().enumerate() {
-            if !(p[0].is_finite() && p[1].is_finite() && p[1] >= 0.0) {
-                return err(key("pull_out"), format!("point {}: finite, torque >= 0", j + 1));
+            if !((0.0..=MAX_RPM).contains(&p[0]) && (0.0..=MAX_TORQUE).contains(&p[1])) {
+                return err(
+                    key("pull_out"),
+                    format!("point {}: speed 0 to 1e6 rpm, torque 0 to 1e4 N m", j + 1),
+                );
             }
             if j > 0 && p[0] <= d.pull_out[j - 1][0] {
                 return err(key("pull_out"), format!("point {}: speeds must rise", j + 1));
             }
         }
-        let positive = |v: Option<f64>| v.filter(|x| x.is_finite() && *x > 0.0);
+        // Positive and at most `most`: a gear of 1e300 or a lead of a kilometre a turn is a broken number.
+        let positive = |v: Option<f64>, most: f64| v.filter(|x| *x > 0.0 && *x <= most);
         for &axis in &d.axes {
             if !(1..=6).contains(&axis) {
                 return err(key("axes"), format!("{axis} is not an axis (1 to 6)"));
@@ -143,13 +154,15 @@ pub fn check(specs: &[DriveSpec], axes: &[AxisKind; 6]) -> Result<[Option<Drive>
             let transmission = match (axes[axis - 1], d.gear_ratio, d.lead) {
                 (_, Some(_), Some(_)) => return err(key("lead"), "a drive has a gear_ratio or a lead, not both"),
                 (AxisKind::Ring | AxisKind::Angle, Some(g), None) => Transmission::Gear(
-                    positive(Some(g)).ok_or_else(|| RigError::new(key("gear_ratio"), "a positive number"))?,
+                    positive(Some(g), MAX_GEAR)
+                        .ok_or_else(|| RigError::new(key("gear_ratio"), "a positive number, at most 1e4"))?,
                 ),
                 (AxisKind::Ring | AxisKind::Angle, _, _) => {
                     return err(key("gear_ratio"), format!("axis {axis} turns: give its gear_ratio"))
                 }
                 (AxisKind::Linear, None, Some(l)) => Transmission::Lead(
-                    positive(Some(l)).ok_or_else(|| RigError::new(key("lead"), "a positive length (m)"))?,
+                    positive(Some(l), MAX_LEAD)
+                        .ok_or_else(|| RigError::new(key("lead"), "a positive length (m), at most 1 m a turn"))?,
                 ),
                 (AxisKind::Linear, _, _) => {
                     return err(
