@@ -57,6 +57,9 @@ fn finite<const N: usize>(key: &str, v: &[f64; N]) -> Result<(), RigError> {
     }
 }
 
+/// The largest translation range a `[spec]` may ask for (m).
+const MAX_SPEC_TRAVEL: f64 = 1e3;
+
 fn positive(key: &str, v: f64) -> Result<(), RigError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
@@ -74,15 +77,16 @@ impl RigFile {
             Some(s) => {
                 let si = s.si();
                 let names = ["surge", "sway", "heave", "roll_deg", "pitch_deg"];
-                // The same sane ranges as a pose on the command line: a hundred ring radii, a whole turn.
-                let length = crate::input::numbers::MAX_LENGTHS * m.characteristic_length();
-                let limit = |i: usize| if i < 3 { length } else { crate::input::numbers::MAX_TILT };
-                if let Some(i) = (0..5).find(|&i| !(si[i].is_finite() && (0.0..=limit(i)).contains(&si[i]))) {
-                    let most = if i < 3 {
-                        format!("{} m", crate::input::numbers::readable(length))
+                // A kilometre of travel, a whole turn: past any platform, where the number is a broken one.
+                let limit = |i: usize| {
+                    if i < 3 {
+                        MAX_SPEC_TRAVEL
                     } else {
-                        "360 deg".to_owned()
-                    };
+                        crate::input::numbers::MAX_TILT
+                    }
+                };
+                if let Some(i) = (0..5).find(|&i| !(si[i].is_finite() && (0.0..=limit(i)).contains(&si[i]))) {
+                    let most = if i < 3 { "1000 m" } else { "360 deg" };
                     return err(
                         format!("spec.{}", names[i]),
                         format!("a range is a finite number from 0 to {most}"),
