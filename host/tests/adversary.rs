@@ -69,42 +69,26 @@ fn a_bad_rig_file_is_said_once_with_its_path() {
         std::fs::write(&path, bytes).unwrap();
         path.display().to_string()
     };
+    // The exported rig with one value changed.
+    let edited = |name: &str, from: &str, to: &str| write(name, good.replace(from, to).as_bytes());
     let cases = [
         (write("syntax.toml", b"ring_radius = = 3\n"), "line 1"),
+        (edited("typo.toml", "rod_length", "rod_lenght"), "rod_lenght"),
         (
-            write("typo.toml", good.replace("rod_length", "rod_lenght").as_bytes()),
-            "rod_lenght",
-        ),
-        (
-            write(
-                "nan.toml",
-                good.replace("ring_radius = ", "ring_radius = nan #").as_bytes(),
-            ),
+            edited("nan.toml", "ring_radius = ", "ring_radius = nan #"),
             "ring_radius",
         ),
+        (edited("spec.toml", "surge = 0.05", "surge = 1e300"), "spec.surge"),
         (
-            write("spec.toml", good.replace("surge = 0.05", "surge = 1e300").as_bytes()),
-            "spec.surge",
-        ),
-        (
-            write(
-                "tilt.toml",
-                good.replace("roll_deg = 20.0", "roll_deg = 400.0").as_bytes(),
-            ),
+            edited("tilt.toml", "roll_deg = 20.0", "roll_deg = 400.0"),
             "spec.roll_deg",
         ),
         (
-            write(
-                "gear.toml",
-                good.replace("gear_ratio = 8.0", "gear_ratio = 1e300").as_bytes(),
-            ),
+            edited("gear.toml", "gear_ratio = 8.0", "gear_ratio = 1e300"),
             "drives[0].gear_ratio",
         ),
         (
-            write(
-                "torque.toml",
-                good.replace("[[0.0, 0.016],", "[[0.0, 1e300],").as_bytes(),
-            ),
+            edited("torque.toml", "[[0.0, 0.016],", "[[0.0, 1e300],"),
             "drives[0].pull_out",
         ),
         (write("binary.toml", &[0xff, 0xfe, 0x00, 0x80, 0x13, 0x37]), "UTF-8"),
