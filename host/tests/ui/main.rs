@@ -38,14 +38,22 @@ fn stop_from_any_page_preempts_the_queue_and_is_answered_at_once() {
     let bench = Workbench::start(&[]);
     let mut a = bench.page();
     homed(&mut a);
-    // Three streams asked in one burst: the first runs, the others wait in the device thread's queue.
+    // Three streams asked in one burst: the first runs; the others wait in the device thread's queue, or, when
+    // the page's socket takes one only after the first has begun streaming, are refused at once.
     let motion = json!({ "do": "motion", "motion": "demo", "seconds": 8, "rate_hz": 100 });
     let ids: Vec<u64> = (0..3).map(|_| a.send(motion.clone())).collect();
+    let mut answers = Vec::new();
+    let mut keep = |m: &Value| {
+        if m["type"] == "reply" && ids.contains(&m["id"].as_u64().unwrap_or(0)) {
+            answers.push(m.clone());
+        }
+    };
     a.until(Duration::from_secs(30), |m| {
+        keep(m);
         m["type"] == "frame" && m["streaming"] == true && state(m) == Some("Running")
     })
     .unwrap();
-    a.watch(Duration::from_secs(2));
+    a.watch(Duration::from_secs(2)).iter().for_each(&mut keep);
     // STOP from another page.
     let mut b = bench.page();
     let stop = b.send(json!({ "do": "halt" }));
@@ -57,12 +65,9 @@ fn stop_from_any_page_preempts_the_queue_and_is_answered_at_once() {
         });
     assert_eq!(answer["ok"], true, "{answer}");
     // The queued streams are answered as cancelled, the running one as interrupted; none runs.
-    let mut answers = Vec::new();
     let mut running_after = Vec::new();
     a.until(Duration::from_secs(20), |m| {
-        if m["type"] == "reply" && ids.contains(&m["id"].as_u64().unwrap_or(0)) {
-            answers.push(m.clone());
-        }
+        keep(m);
         if m["type"] == "frame" && m["streaming"] == true && asked.elapsed() > Duration::from_secs(1) {
             running_after.push(m["t"].clone());
         }
@@ -85,15 +90,17 @@ fn stop_from_any_page_preempts_the_queue_and_is_answered_at_once() {
         "streaming 1 s after STOP at device times {running_after:?}"
     );
     let text = |id: u64| {
-        answers
-            .iter()
-            .find(|m| m["id"] == id)
-            .map(|m| m["text"].as_str().unwrap_or("").to_owned())
-            .unwrap_or_else(|| panic!("request {id} not answered: {answers:?}"))
+        let of_id: Vec<_> = answers.iter().filter(|m| m["id"] == id).collect();
+        assert_eq!(of_id.len(), 1, "request {id} answered once: {answers:?}");
+        of_id[0]["text"].as_str().unwrap_or("").to_owned()
     };
     assert!(text(ids[0]).starts_with("interrupted"), "{}", text(ids[0]));
     for id in &ids[1..] {
-        assert!(text(*id).contains("cancelled"), "{}", text(*id));
+        let text = text(*id);
+        assert!(
+            text.contains("cancelled") || text.starts_with("a stream is running"),
+            "{text}"
+        );
     }
 }
 
