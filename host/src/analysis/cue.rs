@@ -107,27 +107,17 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         return Err(CliError::NotARing(selected.name).into());
     };
     let neutral = Pose::from_array(selected.home);
-    if let Some(check) = super::cue_engine::neutral_fails(&mechanism, &neutral) {
-        return Err(CliError::NeutralOutside {
-            name: selected.name,
-            check,
-        }
-        .into());
-    }
+    let envelope = super::cue_engine::envelope(&mechanism, &neutral).map_err(|check| CliError::NeutralOutside {
+        name: selected.name.clone(),
+        check,
+    })?;
     let Replay {
         cued,
         limited,
         errors: mut cue_errors,
         counts,
         ..
-    } = replay(
-        &rows,
-        config,
-        &mechanism,
-        &neutral,
-        &super::cue_engine::envelope(&mechanism, &neutral),
-        args.preview,
-    )?;
+    } = replay(&rows, config, &mechanism, &neutral, &envelope, args.preview)?;
     errors.append(&mut cue_errors);
     errors.sort_by_key(|e| e.line);
     write_poses(args.out, &cued)?;

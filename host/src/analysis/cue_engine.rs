@@ -22,19 +22,18 @@ pub fn ranges(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Ranges {
     super::workspace::ranges_about_home(&AnyMechanism::Ring(Box::new(*mechanism)), neutral.to_array())
 }
 
-/// Which check `neutral` fails, if any. Every cueing moves the platform about its neutral pose and the envelope
-/// limiter cuts each pose back along the ray from it, so from a neutral pose outside the envelope no pose is
-/// inside: every one would be cut towards, or held at, a pose the platform cannot take.
-pub fn neutral_fails(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Option<Check> {
-    envelope::limit(mechanism, neutral, neutral, &EnvelopeMargins::default(), 1).bound_by
-}
-
-/// The envelope about `neutral` the optimal cueing plans in: the ranges, and the rig for the tilt's shared room.
-pub fn envelope(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Envelope {
-    Envelope {
+/// The envelope about `neutral` the optimal cueing plans in: the ranges, and the rig for the tilt's shared room;
+/// or the check `neutral` fails. Every cueing moves the platform about its neutral pose and the envelope limiter
+/// cuts each pose back along the ray from it, so from a neutral pose outside the envelope no pose is inside: every
+/// one would be cut towards, or held at, a pose the platform cannot take.
+pub fn envelope(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Result<Envelope, Check> {
+    if let Some(check) = envelope::limit(mechanism, neutral, neutral, &EnvelopeMargins::default(), 1).bound_by {
+        return Err(check);
+    }
+    Ok(Envelope {
         ranges: ranges(mechanism, neutral),
         rig: Some((*mechanism, *neutral)),
-    }
+    })
 }
 
 impl Engine {

@@ -248,22 +248,32 @@ pub fn run<T: Transport>(
             return Ok(ending::report(s, ending::unmoved(status), input_errors, None, None));
         }
     }
+    let home = envelope.platform.home;
+    if let Source::Live(live) = &mut source {
+        let home = Pose::from_array(home);
+        // The envelope's scan only for a decoder that cues (the optimal cueing plans in it); before anything moves,
+        // so that a rig whose home no cueing can move about is refused with the platform as it was.
+        let envelope = live
+            .decoder
+            .cues()
+            .then(|| {
+                let mechanism = ringpod_core::kinematics::RingPlatform::new(&envelope.platform.geometry);
+                crate::analysis::cue_engine::envelope(&mechanism, &home).map_err(|check| {
+                    ClientError::Unexpected(format!(
+                        "the device's home fails the {check} check (`ringpod check`): cueing moves the platform \
+                         about its home, and no pose about it is inside the envelope"
+                    ))
+                })
+            })
+            .transpose()?;
+        live.decoder.centre_on(home, envelope);
+    }
     let (baseline, restore_hz) = prepare(
         client,
         options.home,
         recorder.is_some() || options.telemetry,
         options.telemetry_hz,
     )?;
-    let home = envelope.platform.home;
-    if let Source::Live(live) = &mut source {
-        let home = Pose::from_array(home);
-        // The envelope's scan only for a decoder that cues (the optimal cueing plans in it).
-        let envelope = live.decoder.cues().then(|| {
-            let mechanism = ringpod_core::kinematics::RingPlatform::new(&envelope.platform.geometry);
-            crate::analysis::cue_engine::envelope(&mechanism, &home)
-        });
-        live.decoder.centre_on(home, envelope);
-    }
     let bar = progress_bar(&source, options.quiet);
     let limits = envelope.limits;
     let mut s = Streamer::new(

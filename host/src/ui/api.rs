@@ -54,14 +54,13 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
     let (rows, mut errors) = crate::input::table::read(text, &TELEMETRY_COLUMNS)?;
     let m = RingPlatform::<f64>::new(geometry);
     let neutral = Pose::from_array(home);
-    if let Some(check) = crate::analysis::cue_engine::neutral_fails(&m, &neutral) {
-        return Err(format!(
+    // One scan of the envelope for both algorithms' replays and scores.
+    let envelope = crate::analysis::cue_engine::envelope(&m, &neutral).map_err(|check| {
+        format!(
             "the rig's home fails the {check} check: cueing moves the platform about its home, and no pose about \
              this one is inside the envelope"
-        ));
-    }
-    // One scan of the envelope for both algorithms' replays and scores.
-    let envelope = crate::analysis::cue_engine::envelope(&m, &neutral);
+        )
+    })?;
     let scored = |config: CueConfig| -> Result<(Replay, Value), String> {
         let run = replay(&rows, config, &m, &neutral, &envelope, false).map_err(|e| format!("{e:#}"))?;
         let (s, _) = score(&run.cued, &neutral, &envelope.ranges, config.forward);

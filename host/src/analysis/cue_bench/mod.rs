@@ -180,15 +180,11 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         return Err(CliError::NotARing(selected.name).into());
     };
     let neutral = Pose::from_array(selected.home);
-    if let Some(check) = super::cue_engine::neutral_fails(&mechanism, &neutral) {
-        return Err(CliError::NeutralOutside {
-            name: selected.name,
-            check,
-        }
-        .into());
-    }
     let rig = Rig {
-        envelope: super::cue_engine::envelope(&mechanism, &neutral),
+        envelope: super::cue_engine::envelope(&mechanism, &neutral).map_err(|check| CliError::NeutralOutside {
+            name: selected.name.clone(),
+            check,
+        })?,
         mechanism: *mechanism,
         neutral,
     };
