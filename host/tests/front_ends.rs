@@ -22,12 +22,14 @@ fn each_preset_streams_its_front_ends_strings() {
     ] {
         let record = std::env::temp_dir().join(format!("ringpod-front-{preset}-{}.csv", std::process::id()));
         let record_arg = record.to_str().unwrap();
+        // The session ends with STOP, which brings the platform to rest where it is: the pause before it lets the
+        // platform reach the last pose, also when a loaded machine delivers the datagrams in a burst.
         let (child, mut stderr, addr) = spawn_live_stream(&[
             "--udp",
             "127.0.0.1:0",
             "--fast",
             "--udp-idle",
-            "0.4",
+            "1",
             "--pose-format",
             preset,
             "--record",
