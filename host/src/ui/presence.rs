@@ -4,7 +4,8 @@
 //! ends it) and the platform comes to rest where it is. When no page is left for [`GRACE`], the operator has gone:
 //! the workbench does what STOP does, bringing whatever moves to rest and powering down. The grace lets a reload
 //! or a second tab taking over keep the platform powered; a page counts as gone when its socket closes or when it
-//! has not answered the pings for [`HEARD_WITHIN`] (a killed browser, a machine that went to sleep).
+//! has answered none of [`UNANSWERED`] pings in a row (a killed browser, a machine that went to sleep): see
+//! [`Heartbeat`].
 
 use std::collections::BTreeSet;
 use std::sync::{Mutex, PoisonError};
@@ -14,8 +15,35 @@ use std::time::{Duration, Instant};
 pub const GRACE: Duration = Duration::from_secs(2);
 /// How often a page is pinged (a browser answers by itself, also for a tab in the background).
 pub const PING_EVERY: Duration = Duration::from_secs(1);
-/// A page not heard from (a message or a pong) for this long is taken as gone.
-pub const HEARD_WITHIN: Duration = Duration::from_secs(5);
+/// A page that has answered none of this many pings in a row (a message or a pong answers) is taken as gone.
+pub const UNANSWERED: u32 = 5;
+/// How long a page that answers nothing lasts: [`UNANSWERED`] pings.
+pub const HEARD_WITHIN: Duration = Duration::from_secs(PING_EVERY.as_secs() * UNANSWERED as u64);
+
+/// One page's liveness, counted in the pings the workbench sent rather than in time: a workbench that could not
+/// send its pings (its machine busy with a game, its threads held up) has not asked the page anything, and does
+/// not take the page's silence over that time as its going away.
+#[derive(Debug, Default)]
+pub struct Heartbeat {
+    /// Pings sent since the page was last heard.
+    unanswered: u32,
+}
+
+impl Heartbeat {
+    /// The page said something (a message or a pong).
+    pub fn heard(&mut self) {
+        self.unanswered = 0;
+    }
+
+    /// Time for a ping: whether to send it, or `false` when the page has answered none of [`UNANSWERED`].
+    pub fn ping(&mut self) -> bool {
+        if self.unanswered >= UNANSWERED {
+            return false;
+        }
+        self.unanswered += 1;
+        true
+    }
+}
 
 /// The pages connected now.
 #[derive(Default)]
@@ -71,6 +99,20 @@ impl Presence {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_page_is_gone_after_the_pings_it_left_unanswered_however_long_they_took() {
+        let mut h = Heartbeat::default();
+        for _ in 0..UNANSWERED {
+            assert!(h.ping());
+        }
+        h.heard();
+        for _ in 0..UNANSWERED {
+            assert!(h.ping(), "an answer starts the count again");
+        }
+        assert!(!h.ping(), "none of {UNANSWERED} answered");
+        assert!(!h.ping(), "and it stays gone");
+    }
 
     #[test]
     fn the_last_page_gone_for_the_grace_is_said_once_and_a_return_within_it_is_not() {

@@ -11,7 +11,7 @@ use axum::response::Response;
 use serde_json::{json, Value};
 
 use super::outbox::{Next, Outbox, MOST_WAITING};
-use super::presence::{HEARD_WITHIN, PING_EVERY};
+use super::presence::{Heartbeat, HEARD_WITHIN, PING_EVERY};
 use super::request::{self, Job, Request};
 use super::App;
 
@@ -89,7 +89,10 @@ async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
 
 async fn converse(app: &App, page: u64, outbox: &Outbox, ws: &mut WebSocket) -> End {
     let mut ping = tokio::time::interval(PING_EVERY);
-    let mut heard = Instant::now();
+    // After a stall, one ping at once and the next a period later (not a burst of the missed ones, which would
+    // count as unanswered before the page could answer).
+    ping.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut heartbeat = Heartbeat::default();
     loop {
         tokio::select! {
             next = outbox.next() => match next {
@@ -110,7 +113,7 @@ async fn converse(app: &App, page: u64, outbox: &Outbox, ws: &mut WebSocket) -> 
                 }
             },
             _ = ping.tick() => {
-                if heard.elapsed() > HEARD_WITHIN {
+                if !heartbeat.ping() {
                     return End::Close(1001, "no answer to the pings: taken as gone".into());
                 }
                 if let Err(end) = send(ws, Message::Ping(Default::default())).await {
@@ -118,7 +121,7 @@ async fn converse(app: &App, page: u64, outbox: &Outbox, ws: &mut WebSocket) -> 
                 }
             },
             incoming = ws.recv() => {
-                heard = Instant::now();
+                heartbeat.heard();
                 match incoming {
                     Some(Ok(Message::Text(text))) => {
                         if let Some(answer) = take(app, page, &text) {

@@ -172,6 +172,31 @@ fn a_page_killed_during_homing_leaves_the_platform_powered_down() {
     assert_eq!(state(&f), Some("Off"), "{f}");
 }
 
+/// A page that answers no ping (a browser frozen, a machine asleep) is closed as gone, once it has left five
+/// unanswered, one a second; a page that reads answers them and stays.
+#[test]
+fn a_page_that_answers_no_ping_is_taken_as_gone() {
+    let bench = Workbench::start(&[]);
+    let mut quiet = bench.page();
+    let mut awake = bench.page();
+    let started = Instant::now();
+    awake.watch(Duration::from_secs(8));
+    let end = quiet.until(Duration::from_secs(5), |_| false).unwrap_err();
+    // The close frame, or, when the frames the page left unread filled the connection so that the close frame
+    // could not follow them, the connection reset (Linux's and Windows' error numbers).
+    assert!(
+        end.starts_with("closed 1001 no answer to the pings")
+            || end.contains("(os error 104)")
+            || end.contains("(os error 10054)"),
+        "{end}"
+    );
+    assert!(started.elapsed() >= Duration::from_secs(5), "{:?}", started.elapsed());
+    assert!(
+        awake.until(Duration::from_secs(5), |m| m["type"] == "frame").is_ok(),
+        "the page that answered was closed"
+    );
+}
+
 #[test]
 fn a_reload_within_the_grace_keeps_the_platform_powered() {
     let bench = Workbench::start(&[]);
