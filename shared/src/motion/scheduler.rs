@@ -275,12 +275,19 @@ impl StepScheduler {
             dir_change_ns = Some(change as u32);
         }
         // The first step sits half a gap into the window, so a window starting at `earliest` is always late enough.
-        let start = earliest.clamp(0, t.period - 1);
+        // Not `clamp`: it asserts its bounds are ordered, a test and a panic path (the period is at least 1).
+        let start = earliest.max(0).min(t.period - 1);
         let room = (t.period - start) as u32 / t.spacing as u32;
-        let count = want.unsigned_abs().min(u64::from(room)) as u32;
+        let magnitude = want.unsigned_abs();
+        let (count, short) = if magnitude <= u64::from(room) {
+            (magnitude as u32, false)
+        } else {
+            (room, true)
+        };
         if count == 0 {
+            // No room (a step is wanted): short.
             self.last_step[i] = forget(last);
-            return (idle, true);
+            return (idle, short);
         }
         let m = AxisMove {
             direction,
@@ -295,7 +302,7 @@ impl StepScheduler {
         // instructions on the M4F.
         self.position[i] = self.position[i].wrapping_add(m.signed());
         self.last_step[i] = forget(m.step_ns(count - 1) as i32);
-        (m, u64::from(count) < want.unsigned_abs())
+        (m, short)
     }
 }
 

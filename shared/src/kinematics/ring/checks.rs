@@ -192,7 +192,6 @@ impl<T: Real> RingPlatform<T> {
     /// then minus the smallest angle by which the order is broken.
     pub(super) fn ring_order_margins(&self, q: &Actuators<T>) -> (T, T) {
         let two_pi = T::two_pi();
-        let mut spacing = T::max_value().unwrap_or(T::one());
         let mut smallest = two_pi;
         let mut largest = T::zero();
         let mut total = T::zero();
@@ -209,10 +208,18 @@ impl<T: Real> RingPlatform<T> {
                 gap += two_pi;
             }
             total += gap;
-            spacing = spacing.min_(gap - self.spacing[0]).min_(self.spacing[1] - gap);
             smallest = smallest.min_(gap);
             largest = largest.max_(gap);
         }
+        // The least `gap - spacing[0]` is the smallest gap's and the least `spacing[1] - gap` the largest's (a
+        // subtraction rounds monotonically), so the spacing margin takes two comparisons in all where it took two
+        // a chain (four instructions each on the M4F). A NaN gap is left out of both, as it was of the margin;
+        // with no gap the margin is the largest value, as before.
+        let spacing = if smallest <= largest {
+            (smallest - self.spacing[0]).min_(self.spacing[1] - largest)
+        } else {
+            T::max_value().unwrap_or(T::one())
+        };
         // A carriage that passed its neighbour by d leaves a gap of 2pi - d behind it.
         let order = if total < two_pi + T::pi() {
             smallest
@@ -298,5 +305,94 @@ impl<T: Real> RingPlatform<T> {
             margin = margin.min_(cross / len);
         }
         margin
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::kinematics::presets::{Preset, PresetGeometry};
+
+    /// The spacing and crossing margins as they were computed, the spacing taken of every gap: what
+    /// [`RingPlatform::ring_order_margins`] must give.
+    fn every_gap<T: Real>(m: &RingPlatform<T>, q: &Actuators<T>) -> (T, T) {
+        let two_pi = T::two_pi();
+        let mut spacing = T::max_value().unwrap_or(T::one());
+        let (mut smallest, mut largest, mut total) = (two_pi, T::zero(), T::zero());
+        for i in 0..m.n {
+            let diff = q.0[(i + 1) % m.n] - q.0[i];
+            let mut gap = if diff.abs() <= T::two_pi() {
+                wrap_once(diff)
+            } else {
+                wrap_pi(diff)
+            };
+            if gap < T::zero() {
+                gap += two_pi;
+            }
+            total += gap;
+            spacing = spacing.min_(gap - m.spacing[0]).min_(m.spacing[1] - gap);
+            smallest = smallest.min_(gap);
+            largest = largest.max_(gap);
+        }
+        let order = if total < two_pi + T::pi() {
+            smallest
+        } else {
+            -(two_pi - largest)
+        };
+        (spacing, order)
+    }
+
+    /// Equal as values, or both NaN.
+    fn same<T: Real>(a: (T, T), b: (T, T)) -> bool {
+        let eq = |x: T, y: T| x == y || (x.partial_cmp(&x).is_none() && y.partial_cmp(&y).is_none());
+        eq(a.0, b.0) && eq(a.1, b.1)
+    }
+
+    fn compare<T: Real>(angles: &[f64; 6]) {
+        for preset in Preset::ALL {
+            let PresetGeometry::Ring(g) = preset.geometry() else {
+                continue;
+            };
+            let m = RingPlatform::<T>::new(g);
+            let q = Actuators(angles.map(T::of));
+            let (new, old) = (m.ring_order_margins(&q), every_gap(&m, &q));
+            assert!(same(new, old), "{}: {new:?} != {old:?} at {q:?}", preset.name());
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(5_000))]
+
+        /// Angles of IK (within a half turn), of a wound-up carriage, and any bits at all (NaN and infinities).
+        #[test]
+        fn the_spacing_margin_from_the_extreme_gaps_is_that_of_every_gap(
+            within in prop::array::uniform6(-core::f64::consts::PI..=core::f64::consts::PI),
+            wound in prop::array::uniform6(-40.0f64..40.0),
+            bits in prop::array::uniform6(any::<u64>()),
+        ) {
+            for angles in [within, wound, bits.map(f64::from_bits)] {
+                compare::<f32>(&angles);
+                compare::<f64>(&angles);
+            }
+        }
+    }
+
+    /// Carriages on top of each other, in a broken order and with one NaN angle.
+    #[test]
+    fn the_spacing_margin_at_the_edges() {
+        let pi = core::f64::consts::PI;
+        for angles in [
+            [0.0; 6],
+            [0.0, 0.0, pi, pi, -pi, -pi],
+            [0.5, 0.1, 2.0, -2.0, 1.0, 3.0],
+            [f64::NAN, 0.1, 2.0, -2.0, 1.0, 3.0],
+            [f64::NAN; 6],
+            [pi, -pi, pi, -pi, pi, -pi],
+        ] {
+            compare::<f32>(&angles);
+            compare::<f64>(&angles);
+        }
     }
 }
