@@ -204,7 +204,11 @@ fn positions_at_the_ends_of_i64_move_toward_the_target_and_carry_once_a_period()
         let moves = s.plan(&targets);
         for i in 0..6 {
             let after = s.position()[i];
-            assert_eq!(i128::from(after), i128::from(before[i]) + i128::from(moves[i].signed()), "axis {i}");
+            assert_eq!(
+                i128::from(after),
+                i128::from(before[i]) + i128::from(moves[i].signed()),
+                "axis {i}"
+            );
             let (lo, hi) = (before[i].min(targets[i]), before[i].max(targets[i]));
             assert!(lo <= after && after <= hi, "axis {i}: {after} outside [{lo}, {hi}]");
             assert!(moves[i].signed().abs() <= fastest);

@@ -135,11 +135,22 @@ mod tests {
         }
         around(core::f32::consts::PI, f32::next_up, f32::next_down);
         around(core::f64::consts::PI, f64::next_up, f64::next_down);
-        for x in [0.0, -0.0, f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MAX, f32::MIN_POSITIVE] {
+        for x in [
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+        ] {
             assert_eq!(crossing(x), rounded(x), "{x:e}");
             assert_eq!(crossing(f64::from(x)), rounded(f64::from(x)), "{x:e}");
         }
-        assert_eq!((crossing(core::f32::consts::PI), crossing(-core::f32::consts::PI)), (1, -1));
+        assert_eq!(
+            (crossing(core::f32::consts::PI), crossing(-core::f32::consts::PI)),
+            (1, -1)
+        );
         assert_eq!(crossing(core::f32::consts::PI.next_down()), 0);
     }
 }
