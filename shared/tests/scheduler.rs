@@ -188,3 +188,33 @@ proptest! {
         }
     }
 }
+
+/// Positions at the ends of `i64` and targets beyond their reach: the new position is never past the target (the
+/// scheduler adds a move's count without saturation, since it cannot overflow), and a period in which several
+/// axes fall short counts once.
+#[test]
+fn positions_at_the_ends_of_i64_move_toward_the_target_and_carry_once_a_period() {
+    let config = SchedulerConfig::default();
+    let fastest = i64::from(config.max_steps_per_period());
+    let start = [i64::MAX - 1, i64::MIN + 1, i64::MAX, i64::MIN, 0, -5];
+    let mut s = StepScheduler::new(config, start);
+    let targets = [i64::MIN, i64::MAX, i64::MAX, i64::MIN, i64::MAX, i64::MIN];
+    for period in 1..=3u32 {
+        let before = s.position();
+        let moves = s.plan(&targets);
+        for i in 0..6 {
+            let after = s.position()[i];
+            assert_eq!(
+                i128::from(after),
+                i128::from(before[i]) + i128::from(moves[i].signed()),
+                "axis {i}"
+            );
+            let (lo, hi) = (before[i].min(targets[i]), before[i].max(targets[i]));
+            assert!(lo <= after && after <= hi, "axis {i}: {after} outside [{lo}, {hi}]");
+            assert!(moves[i].signed().abs() <= fastest);
+        }
+        assert_eq!(s.carried(), period, "four axes short, one period");
+    }
+    assert_eq!(s.position()[2], i64::MAX);
+    assert_eq!(s.position()[3], i64::MIN);
+}

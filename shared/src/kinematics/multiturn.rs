@@ -10,6 +10,22 @@ use super::{Actuators, AxisKind, KinematicsError, Mechanism, Pose};
 use crate::real::wrap_pi;
 use crate::Real;
 
+/// The whole turn in `x`, an angle that is a multiple of a turn up to rounding: 1 from half a turn up, -1 from half
+/// a turn down, else 0 (NaN too). That is `round(x / 2pi)` clamped to one turn, by two comparisons where the
+/// division and the rounding took about twenty instructions on the M4F: `x / 2pi >= 1/2` exactly when `x >= pi`,
+/// since the float pi is half the float 2pi and the float below pi divides to at least an ulp of 1/2 below it in
+/// either type (a test holds the two to each other over any bits).
+#[inline]
+fn crossing<T: Real>(x: T) -> i32 {
+    if x >= T::pi() {
+        1
+    } else if x <= -T::pi() {
+        -1
+    } else {
+        0
+    }
+}
+
 /// Actuator positions with whole turns kept apart for the ring axes.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MultiTurn<T> {
@@ -31,15 +47,13 @@ impl<T: Real> MultiTurn<T> {
     /// Moves to `next` (an IK solution, ring angles in `(-pi, pi]`) along the branch nearest the current position:
     /// a ring axis never jumps by a turn; a step of more than half a turn is taken the short way round.
     pub fn follow(&mut self, next: &Actuators<T>, axes: &[AxisKind; 6]) {
-        let two_pi = T::two_pi();
         for (i, kind) in axes.iter().enumerate() {
             let (cur, nxt) = (self.within.0[i], next.0[i]);
             if *kind == AxisKind::Ring {
                 let nxt = wrap_pi(nxt);
                 let delta = wrap_pi(nxt - cur);
                 // cur + delta equals nxt up to a whole turn: that turn is the crossing of +-pi.
-                let crossed = ((cur + delta - nxt) / two_pi).round_to_i64().clamp(-1, 1) as i32;
-                self.turns[i] = self.turns[i].saturating_add(crossed);
+                self.turns[i] = self.turns[i].saturating_add(crossing(cur + delta - nxt));
                 self.within.0[i] = nxt;
             } else {
                 self.within.0[i] = nxt;
@@ -83,5 +97,60 @@ impl<T: Real> MultiTurn<T> {
         };
         let frac = (within * per_turn / T::two_pi()).round_to_i64();
         whole.saturating_add(frac)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::crossing;
+    use crate::Real;
+
+    /// The crossing as it was computed: the turns of the quotient, rounded and clamped.
+    fn rounded<T: Real>(x: T) -> i32 {
+        (x / T::two_pi()).round_to_i64().clamp(-1, 1) as i32
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(20_000))]
+
+        #[test]
+        fn crossing_is_the_rounded_quotient(bits in proptest::num::u32::ANY, wide in proptest::num::u64::ANY) {
+            let (x, y) = (f32::from_bits(bits), f64::from_bits(wide));
+            proptest::prop_assert_eq!(crossing(x), rounded(x), "{:e}", x);
+            proptest::prop_assert_eq!(crossing(y), rounded(y), "{:e}", y);
+        }
+    }
+
+    /// Around both half turns, to the ulp, and the special values.
+    #[test]
+    fn crossing_at_the_half_turns() {
+        fn around<T: Real>(v: T, up: impl Fn(T) -> T, down: impl Fn(T) -> T) {
+            let (mut a, mut b) = (v, v);
+            for _ in 0..64 {
+                for x in [a, b, -a, -b] {
+                    assert_eq!(crossing(x), rounded(x), "{x:?}");
+                }
+                (a, b) = (up(a), down(b));
+            }
+        }
+        around(core::f32::consts::PI, f32::next_up, f32::next_down);
+        around(core::f64::consts::PI, f64::next_up, f64::next_down);
+        for x in [
+            0.0,
+            -0.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            f32::MAX,
+            f32::MIN_POSITIVE,
+        ] {
+            assert_eq!(crossing(x), rounded(x), "{x:e}");
+            assert_eq!(crossing(f64::from(x)), rounded(f64::from(x)), "{x:e}");
+        }
+        assert_eq!(
+            (crossing(core::f32::consts::PI), crossing(-core::f32::consts::PI)),
+            (1, -1)
+        );
+        assert_eq!(crossing(core::f32::consts::PI.next_down()), 0);
     }
 }

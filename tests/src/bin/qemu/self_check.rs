@@ -88,13 +88,13 @@ pub(crate) fn core_on_m4f(t: &mut Tally) {
 /// under `-icount` are exact and repeatable for a given build, so these hold or fail deterministically; they keep
 /// the control path from growing back unnoticed.
 pub(crate) const BUDGETS: [(&str, u64); 11] = [
-    ("control tick: pipeline", 5_630),
-    ("control tick at 2 kHz", 5_380),
+    ("control tick: pipeline", 5_200),
+    ("control tick at 2 kHz", 4_970),
     ("trainer IK (f32)", 815),
-    ("IK + all", 2_850),
-    ("setpoint frame", 5_100),
+    ("IK + all", 2_800),
+    ("setpoint frame", 5_040),
     ("FK", 11_150),
-    ("limited into the envelope", 11_830),
+    ("limited into the envelope", 11_580),
     ("step buffers, idle", 900),
     ("step buffers, typical", 2_700),
     ("step buffers, the trainer's fastest", 6_100),
