@@ -12,7 +12,7 @@ use crate::Real;
 
 /// The whole turn in `x`, an angle that is a multiple of a turn up to rounding: 1 from half a turn up, -1 from half
 /// a turn down, else 0 (NaN too). That is `round(x / 2pi)` clamped to one turn, by two comparisons where the
-/// division and the rounding took about twenty instructions on the M4F: `x / 2pi >= 1/2` exactly when `x >= pi`,
+/// division and the rounding take about twenty instructions on the M4F: `x / 2pi >= 1/2` exactly when `x >= pi`,
 /// since the float pi is half the float 2pi and the float below pi divides to at least an ulp of 1/2 below it in
 /// either type (a test holds the two to each other over any bits).
 #[inline]
@@ -105,7 +105,7 @@ mod tests {
     use super::crossing;
     use crate::Real;
 
-    /// The crossing as it was computed: the turns of the quotient, rounded and clamped.
+    /// The crossing by its definition: the turns of the quotient, rounded and clamped.
     fn rounded<T: Real>(x: T) -> i32 {
         (x / T::two_pi()).round_to_i64().clamp(-1, 1) as i32
     }

@@ -229,7 +229,7 @@ impl StepScheduler {
     /// Plans one period toward `targets` (steps at the end of the period).
     ///
     /// Never inlined, and the moves made as the array it returns: the caller's result is then its own return
-    /// slot, where moves built apart (`array::from_fn`, or an array filled in a loop) were copied out (a 144-byte
+    /// slot, where moves built apart (`array::from_fn`, or an array filled in a loop) would be copied out (a 144-byte
     /// `memcpy`, 134 instructions on the M4F a period).
     #[inline(never)]
     pub fn plan(&mut self, targets: &[i64; 6]) -> [AxisMove; 6] {

@@ -199,8 +199,8 @@ impl<T: Real> RingPlatform<T> {
             let diff = q.0[(i + 1) % self.n] - q.0[i];
             // IK's angles are within (-pi, pi], so one exact addition wraps their difference into [0, 2pi) (a
             // difference down to -pi, or wrapped below 0 from above pi, takes a turn); other inputs (a multi-turn
-            // angle) take the general wrap. Two comparisons where wrapping into (-pi, pi] and then into [0, 2pi)
-            // took three, for the same gaps.
+            // angle) take the general wrap. Two comparisons, one fewer than wrapping into (-pi, pi] and then into
+            // [0, 2pi), for the same gaps.
             let gap = if diff.abs() <= T::two_pi() {
                 let gap = if diff > T::pi() { diff - two_pi } else { diff };
                 if gap < T::zero() {
@@ -221,9 +221,9 @@ impl<T: Real> RingPlatform<T> {
             largest = largest.max_(gap);
         }
         // The least `gap - spacing[0]` is the smallest gap's and the least `spacing[1] - gap` the largest's (a
-        // subtraction rounds monotonically), so the spacing margin takes two comparisons in all where it took two
-        // a chain (four instructions each on the M4F). A NaN gap is left out of both, as it was of the margin;
-        // with no gap the margin is the largest value, as before.
+        // subtraction rounds monotonically), so the spacing margin takes two comparisons in all rather than two a
+        // chain (four instructions each on the M4F). A NaN gap is left out of both, as `min_` leaves it out of a
+        // margin taken gap by gap; with no gap the margin is the largest value.
         let spacing = if smallest <= largest {
             (smallest - self.spacing[0]).min_(self.spacing[1] - largest)
         } else {
@@ -332,7 +332,7 @@ mod tests {
     use crate::kinematics::presets::{Preset, PresetGeometry};
     use crate::real::wrap_once;
 
-    /// The spacing and crossing margins as they were computed, the spacing taken of every gap: what
+    /// The spacing and crossing margins taken gap by gap, the spacing of every gap: what
     /// [`RingPlatform::ring_order_margins`] must give.
     fn every_gap<T: Real>(m: &RingPlatform<T>, q: &Actuators<T>) -> (T, T) {
         let two_pi = T::two_pi();
@@ -361,7 +361,7 @@ mod tests {
         (spacing, order)
     }
 
-    /// The stability margin as it was computed, edge (k, k + 1 mod n) after edge: what
+    /// The stability margin edge (k, k + 1 mod n) after edge: what
     /// [`RingPlatform::stability_margin`] must give.
     fn edge_by_edge<T: Real>(
         m: &RingPlatform<T>,
