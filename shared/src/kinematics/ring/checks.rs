@@ -30,6 +30,8 @@ pub(super) struct Configuration<T: Real> {
     pub bases: [Vector3<T>; 6],
     /// Unit vector along each chain's last link, toward the platform joint.
     pub dirs: [Vector3<T>; 6],
+    /// The reach margin ([`RingPlatform::reach_of`] the joints), which IK's chains give at little cost.
+    pub reach: T,
 }
 
 /// The checks that cost the most and change slowly with the pose: the joint-cone margin (rad) and the raw
@@ -42,7 +44,8 @@ pub(super) struct SlowMargins<T> {
 
 impl<T: Real> Configuration<T> {
     /// Everything at zero, to be filled in place (these arrays are too large to move around on the M4F: each move
-    /// is a `memcpy` call).
+    /// is a `memcpy` call). One `memclr`: nothing of a chain past the platform's is read, so no entry needs another
+    /// value.
     pub fn zeroed() -> Self {
         Self {
             q: Actuators([T::zero(); 6]),
@@ -50,18 +53,28 @@ impl<T: Real> Configuration<T> {
             joints: [Vector3::zeros(); 6],
             carriages: [Vector3::zeros(); 6],
             bases: [Vector3::zeros(); 6],
-            dirs: [Vector3::z(); 6],
+            dirs: [Vector3::zeros(); 6],
+            reach: T::zero(),
         }
     }
 
-    /// The directions of the first `n` chains' last links, from their joints and bases (a link of no length points
-    /// up, as in a cleared configuration: one reused gives what a new one would).
+    /// The directions of the first `n` chains' last links, from their joints and bases.
     pub fn direct(&mut self, n: usize) {
         for i in 0..n.min(6) {
-            let d = self.joints[i] - self.bases[i];
-            let len = length(&d);
-            self.dirs[i] = if len > T::zero() { d / len } else { Vector3::z() };
+            self.dirs[i] = direction(&self.joints[i], &self.bases[i]);
         }
+    }
+}
+
+/// The unit vector from a chain's base to its platform joint; a link of no length points up.
+#[inline(always)]
+pub(super) fn direction<T: Real>(joint: &Vector3<T>, base: &Vector3<T>) -> Vector3<T> {
+    let d = joint - base;
+    let len = length(&d);
+    if len > T::zero() {
+        d / len
+    } else {
+        Vector3::z()
     }
 }
 
@@ -81,6 +94,7 @@ impl<T: Real> RingPlatform<T> {
             };
         }
         c.direct(self.n);
+        c.reach = self.reach_of(&c.joints);
         c
     }
 
@@ -103,7 +117,7 @@ impl<T: Real> RingPlatform<T> {
         let (spacing, order, ring_order) = self.spacing_and_order(&c.q);
         WorkspaceReport::new(
             [
-                Some(self.reach_of(&c.joints)),
+                Some(c.reach),
                 Some(spacing),
                 Some(order),
                 Some(slow.cones),
@@ -142,7 +156,6 @@ impl<T: Real> RingPlatform<T> {
         let (spacing, order, ring_order) = self.spacing_and_order(&c.q);
         leaves(Check::CarriageSpacing, spacing)?;
         leaves(Check::RodCrossing, order)?;
-        c.direct(self.n);
         leaves(Check::JointCones, self.cone_margin(c))?;
         leaves(Check::Singularity, self.singularity_of(c) - self.min_index)?;
         leaves(Check::Stability, self.stability_margin(pose, c, ring_order.as_ref()))?;
@@ -165,16 +178,8 @@ impl<T: Real> RingPlatform<T> {
         for (i, (a, kind)) in joints.iter().zip(&self.kinds).enumerate().take(self.n) {
             let rho = (a.x * a.x + a.y * a.y).sqrt_();
             let m = match kind {
-                Shape::Rod(_) => {
-                    let h = (self.rod * self.rod - a.z * a.z).max_(T::zero()).sqrt_();
-                    (self.rod - a.z.abs())
-                        .min_(h - (self.rr - rho).abs())
-                        .min_(self.rr + rho - h)
-                }
-                Shape::Radial => {
-                    let s = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
-                    (s - self.stroke[0]).min_(self.stroke[1] - s)
-                }
+                Shape::Rod(_) => self.rod_reach(rho, a.z, self.rod * self.rod - a.z * a.z),
+                Shape::Radial => self.stroke_reach(self.radial_length(rho, a.z)),
                 Shape::Elbow => match &self.arms[i] {
                     Some(arm) => arm.reach(rho, a.z),
                     None => T::zero(),
@@ -183,6 +188,28 @@ impl<T: Real> RingPlatform<T> {
             margin = margin.min_(m);
         }
         margin
+    }
+
+    /// A rod chain's reach margin from its joint's distance from the axis `rho`, its height `z` and
+    /// `h2 = L^2 - z^2`: the slack of `|z| < L` and `|Rr - rho| <= h <= Rr + rho`.
+    #[inline(always)]
+    pub(super) fn rod_reach(&self, rho: T, z: T, h2: T) -> T {
+        let h = h2.max_(T::zero()).sqrt_();
+        (self.rod - z.abs())
+            .min_(h - (self.rr - rho).abs())
+            .min_(self.rr + rho - h)
+    }
+
+    /// A radial chain's length, from its joint's distance from the axis and its height.
+    #[inline(always)]
+    pub(super) fn radial_length(&self, rho: T, z: T) -> T {
+        ((self.rr - rho) * (self.rr - rho) + z * z).sqrt_()
+    }
+
+    /// A radial chain's reach margin: the slack of its length within the stroke.
+    #[inline(always)]
+    pub(super) fn stroke_reach(&self, length: T) -> T {
+        (length - self.stroke[0]).min_(self.stroke[1] - length)
     }
 
     /// Spacing and crossing margins from the counter-clockwise central angles between neighbouring carriages.
@@ -256,75 +283,61 @@ impl<T: Real> RingPlatform<T> {
 
     /// The scale-free singularity index of the wrench matrix (moments divided by the ring radius): Hadamard's ratio
     /// `|det W| / prod_i |w_i|`, the determinant through a planar chain's joint when there is one (see
-    /// [`RingPlatform::determinant_through_joint`]), else by LU.
+    /// [`RingPlatform::through_joint`]), else by LU.
     pub(super) fn singularity_of(&self, c: &Configuration<T>) -> T {
-        let rows = self.wrench_rows_scaled(c, T::one() / self.rr);
-        match self.tangent_rows[0] {
-            k if usize::from(k) < self.n && self.n < 6 => {
-                // The product of the squared norms under one root, where six roots each cost five instructions on
-                // the M4F.
-                let squares = rows.iter().fold(T::one(), |p, row| {
-                    p * row.iter().fold(T::zero(), |s, v| s + *v * *v)
-                });
-                let norms = squares.sqrt_();
-                if norms == T::zero() || !norms.finite() {
-                    return T::zero();
-                }
-                let det = self.determinant_through_joint(&rows, c, usize::from(k));
-                if det.finite() {
-                    (det / norms).abs()
-                } else {
-                    T::zero()
-                }
-            }
-            _ => hadamard_ratio_in_place(&mut { rows }).0,
+        let Some((det, squares)) = self.through_joint(c) else {
+            return hadamard_ratio_in_place(&mut self.wrench_rows_scaled(c, T::one() / self.rr)).0;
+        };
+        // The product of the squared norms under one root, where six roots each cost five instructions on the M4F.
+        let norms = squares.sqrt_();
+        if norms == T::zero() || !norms.finite() || !det.finite() {
+            return T::zero();
         }
+        (det / norms).abs()
     }
 
-    /// `det W` of the wrench rows, by the lines through the joint `A` of planar chain `k` (whose tangent row is row
-    /// `n`, the first tangent row).
+    /// `det W` of the wrench rows (moments divided by the ring radius) and the product of their squared norms, by
+    /// the lines through the joint `A` of the first planar chain `k`, whose tangent row is row `n`; `None` for a
+    /// platform without one.
     ///
     /// Both of chain `k`'s lines pass through `A`: its last link ends there and its tangent force acts there.
-    /// Taking every moment about `A` instead of the ring centre subtracts `A x f / Rr` from each row's moment, a
+    /// Taking every moment about `A` instead of the ring centre subtracts `A x f` from each row's moment, a
     /// multiple of its force columns, which leaves the determinant as it is; those two rows then have no moment,
     /// and Laplace's expansion along them leaves one 4x4 determinant per force column. With the other four rows'
     /// forces `f_i` and moments about `A` `m_i`, and `g_i = (-1)^i det` of the moments without row `i` (the
     /// cofactors of a 4x3 matrix), those are the components of `D = sum_i g_i f_i`, and
-    /// `det W = +-(u x v) . D` for the chain's direction `u` and tangent `v` (the sign of the row order `k`,
-    /// `n`, then the rest). About 130 operations without a division or a pivot's branch, where the LU's
-    /// elimination with partial pivoting took about 500 instructions on the M4F. Without pivoting, its error is
-    /// bounded by the rounding of each product (the minors of unit rows are at most 1, by Hadamard's
-    /// inequality); tested against the LU over the workspace of every ring preset.
-    fn determinant_through_joint(&self, rows: &[[T; 6]; 6], c: &Configuration<T>, k: usize) -> T {
-        let a = c.joints[k] / self.rr;
-        let t = self.n;
-        // The other four rows in their order, moments about `A`: `m - a x f`.
-        let mut others = [[T::zero(); 6]; 4];
-        let mut slot = 0;
-        for (r, row) in rows.iter().enumerate() {
-            if r != k && r != t {
-                if let Some(o) = others.get_mut(slot) {
-                    let f = Vector3::new(row[0], row[1], row[2]);
-                    let m = Vector3::new(row[3], row[4], row[5]) - a.cross(&f);
-                    *o = [f.x, f.y, f.z, m.x, m.y, m.z];
-                }
-                slot += 1;
-            }
+    /// `det W = +-(u x v) . D / Rr^3` for the chain's direction `u` and tangent `v` (the sign of the row order
+    /// `k`, `n`, then the rest; a moment column divided by `Rr` divides the determinant by it). About 200
+    /// operations without a division or a pivot's branch, where the wrench matrix and its LU with partial pivoting
+    /// took about 700 instructions on the M4F. Without pivoting, its error is bounded by the rounding of each
+    /// product (the minors of unit rows are at most 1, by Hadamard's inequality); tested against the LU over the
+    /// workspace of every ring preset.
+    pub(super) fn through_joint(&self, c: &Configuration<T>) -> Option<(T, T)> {
+        let (k, t) = (usize::from(self.tangent_rows[0]), self.n);
+        if k >= t || t >= 6 {
+            return None;
         }
-        let f = |i: usize| Vector3::new(others[i][0], others[i][1], others[i][2]);
-        let m = |i: usize| Vector3::new(others[i][3], others[i][4], others[i][5]);
-        let (m01, m23) = (m(0).cross(&m(1)), m(2).cross(&m(3)));
-        let g = [m(1).dot(&m23), -m(0).dot(&m23), m(3).dot(&m01), -m(2).dot(&m01)];
-        let d = f(0) * g[0] + f(1) * g[1] + f(2) * g[2] + f(3) * g[3];
-        let u = Vector3::new(rows[k][0], rows[k][1], rows[k][2]);
-        let v = Vector3::new(rows[t][0], rows[t][1], rows[t][2]);
-        let det = u.cross(&v).dot(&d);
+        let inv = T::one() / self.rr;
+        let inv2 = inv * inv;
+        let square = |f: &Vector3<T>, m: &Vector3<T>| f.dot(f) + m.dot(m) * inv2;
+        let a = c.joints[k];
+        let (u, b) = self.line(c, k);
+        let (v, _) = self.line(c, t);
+        let mut squares = square(&u, &b.cross(&u)) * square(&v, &a.cross(&v));
+        let mut f = [Vector3::zeros(); 4];
+        let mut m = [Vector3::zeros(); 4];
+        for (j, &r) in self.others.iter().enumerate() {
+            let (fj, p) = self.line(c, usize::from(r));
+            squares *= square(&fj, &p.cross(&fj));
+            f[j] = fj;
+            m[j] = (p - a).cross(&fj);
+        }
+        let (m01, m23) = (m[0].cross(&m[1]), m[2].cross(&m[3]));
+        let g = [m[1].dot(&m23), -m[0].dot(&m23), m[3].dot(&m01), -m[2].dot(&m01)];
+        let d = f[0] * g[0] + f[1] * g[1] + f[2] * g[2] + f[3] * g[3];
+        let det = u.cross(&v).dot(&d) * (inv2 * inv);
         // Row k to the front passes k rows, row t to second place t - 1 more.
-        if (k + t) % 2 == 0 {
-            -det
-        } else {
-            det
-        }
+        Some((if (k + t) % 2 == 0 { -det } else { det }, squares))
     }
 
     /// The chains in the order their carriages come around the ring (counter-clockwise from angle 0).
@@ -397,8 +410,8 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::kinematics::Mechanism;
     use crate::kinematics::presets::{Preset, PresetGeometry};
+    use crate::kinematics::Mechanism;
     use crate::real::wrap_once;
 
     /// The spacing and crossing margins taken gap by gap, the spacing of every gap: what
@@ -544,8 +557,7 @@ mod tests {
                 continue;
             };
             let (m, wide) = (RingPlatform::<T>::new(g), RingPlatform::<f64>::new(g));
-            let k = usize::from(m.tangent_rows[0]);
-            if k >= m.n {
+            if m.through_joint(&Configuration::zeroed()).is_none() {
                 continue;
             }
             let rr = g.ring_radius;
@@ -563,12 +575,16 @@ mod tests {
                 let widened = Pose::from_array(pose.to_array().map(T::to_f64));
                 let reference = wide.configuration(&widened, &Actuators(q.0.map(T::to_f64)));
                 let rows = wide.wrench_rows_scaled(&reference, 1.0 / rr);
-                let norms: f64 = rows.iter().map(|r| r.iter().map(|v| v * v).sum::<f64>().sqrt()).product();
+                let norms: f64 = rows
+                    .iter()
+                    .map(|r| r.iter().map(|v| v * v).sum::<f64>().sqrt())
+                    .product();
                 let lu = crate::kinematics::velocity::Lu6::in_place(&mut { rows }).determinant();
-                let through = wide.determinant_through_joint(&rows, &reference, k);
+                let (through, squares) = wide.through_joint(&reference).unwrap();
                 assert!(
-                    (through - lu).abs() <= 1e-12 * norms,
-                    "{}: {through} against the LU's {lu} at {widened:?}, {q:?}",
+                    (through - lu).abs() <= 1e-12 * norms && (squares.sqrt() - norms).abs() <= 1e-12 * norms,
+                    "{}: {through} against the LU's {lu}, norms {} against {norms} at {widened:?}, {q:?}",
+                    squares.sqrt(),
                     preset.name()
                 );
                 // Within what the LU itself gives in `f32` (7e-7 at worst over 25,000 poses of the workspace).
@@ -601,6 +617,53 @@ mod tests {
             prop_assert!(compare_index::<f32>(&offset, &angles, &lengths) >= 4);
             prop_assert!(compare_index::<f64>(&offset, &angles, &lengths) >= 4);
         }
+    }
+
+    fn compare_reach<T: Real>(offset: &[f64; 6]) -> usize {
+        let mut solved = 0;
+        for preset in Preset::ALL {
+            let PresetGeometry::Ring(g) = preset.geometry() else {
+                continue;
+            };
+            let m = RingPlatform::<T>::new(g);
+            let (rr, home) = (g.ring_radius, preset.home());
+            let pose = Pose::from_array(core::array::from_fn(|i| {
+                T::of(home[i] + offset[i] * if i < 3 { rr } else { 1.0 })
+            }));
+            let mut c = Configuration::zeroed();
+            if m.solve(&pose, &mut c).is_ok() {
+                let (chains, joints) = (c.reach, m.reach_of(&c.joints));
+                assert!(
+                    chains == joints,
+                    "{}: {chains:?} != {joints:?} at {pose:?}",
+                    preset.name()
+                );
+                solved += 1;
+            }
+        }
+        solved
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(3_000))]
+
+        /// The reach margin the chains' solve gives is bit for bit that of the joints, wherever IK has a solution
+        /// (inside the workspace and far beyond it).
+        #[test]
+        fn the_reach_from_the_chains_is_that_of_the_joints(
+            t in prop::array::uniform3(-0.5f64..0.5),
+            r in prop::array::uniform3(-0.8f64..0.8),
+        ) {
+            let offset = [t[0], t[1], t[2], r[0], r[1], r[2]];
+            compare_reach::<f32>(&offset);
+            compare_reach::<f64>(&offset);
+        }
+    }
+
+    #[test]
+    fn the_reach_from_the_chains_at_home() {
+        assert!(compare_reach::<f32>(&[0.0; 6]) >= 5);
+        assert!(compare_reach::<f64>(&[0.0; 6]) >= 5);
     }
 
     /// A singular wrench matrix (two chains' lines the same), rows of no length and entries that are not finite

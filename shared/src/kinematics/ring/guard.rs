@@ -138,6 +138,7 @@ mod tests {
             carriages: [v; 6],
             bases: [v; 6],
             dirs: [v; 6],
+            reach: x,
         };
         SlowCheckGuard {
             configs: [c; 2],

@@ -13,7 +13,7 @@ mod tipping;
 use nalgebra::{Matrix6, Vector3, Vector6};
 
 use self::arm::Arm;
-use self::checks::Configuration;
+use self::checks::{direction, Configuration};
 pub use self::dynamics::{BodyMotion, MotionState, Payload};
 pub use self::guard::SlowCheckGuard;
 pub use self::statics::ActuatorLoads;
@@ -21,6 +21,9 @@ pub use self::tipping::{Loaded, TipOver, TipOverError, GRAVITY};
 use super::geometry::{Branch, ChainKind, RingGeometry};
 use super::{Actuators, AxisKind, Check, Jacobians, KinematicsError, Mechanism, Pose, Reach, WorkspaceReport};
 use crate::Real;
+
+/// A chain's solution besides its actuators: its carriage, the start of its last link and its reach margin.
+type ChainSolution<T> = (Vector3<T>, Vector3<T>, T);
 
 /// A chain's kind without an elbow chain's dimensions (those are in the platform's `arms`): what the per-pose code
 /// branches on, a byte instead of a whole [`ChainKind`] per chain (the firmware keeps several platforms in RAM).
@@ -62,6 +65,9 @@ pub struct RingPlatform<T: Real> {
     /// The chain of each wrench-matrix row from `n` on (the tangent force of a radial or elbow chain, in chain
     /// order); `u8::MAX` past the last.
     tangent_rows: [u8; 6],
+    /// The wrench rows other than the first planar chain's two (its own and the first tangent row), in order: the
+    /// rows that keep a moment about its joint (`checks::through_joint`).
+    others: [u8; 4],
     /// Actuator index of the length of each radial chain.
     length_axis: [Option<usize>; 6],
     axes: [AxisKind; 6],
@@ -109,9 +115,18 @@ impl<T: Real> RingPlatform<T> {
         for (slot, (i, _)) in tangent_rows.iter_mut().zip(planar) {
             *slot = i as u8;
         }
+        let mut others = [u8::MAX; 4];
+        let first = usize::from(tangent_rows[0]);
+        for (slot, r) in others
+            .iter_mut()
+            .zip((0..6u8).filter(|&r| usize::from(r) != first && usize::from(r) != n))
+        {
+            *slot = r;
+        }
         let l = &geometry.limits;
         Self {
             tangent_rows,
+            others,
             geometry: *geometry,
             rr: T::of(geometry.ring_radius),
             rod: T::of(geometry.rod_length),
@@ -200,26 +215,34 @@ impl<T: Real> RingPlatform<T> {
         Ok(())
     }
 
-    /// The second half of [`RingPlatform::solve`]: each chain's actuators, carriage and base from its joint in `c`.
+    /// The second half of [`RingPlatform::solve`]: each chain's actuators, carriage, base and direction from its
+    /// joint in `c`, and the reach margin. The direction is taken here, while the chain's joint and base are still in registers, rather
+    /// than in a loop of its own that loads them again.
     ///
     /// Never inlined: the envelope search's checks call it after their reach check, and a copy of the per-chain
     /// code there took 1 KB of flash.
     #[inline(never)]
     fn solve_chains(&self, c: &mut Configuration<T>) -> Result<(), KinematicsError> {
+        let mut reach = T::max_value().unwrap_or(T::one());
         for i in 0..self.n {
-            let (carriage, base) = self.chain(i, &c.joints[i], &mut c.q.0)?;
+            let joint = c.joints[i];
+            let (carriage, base, margin) = self.chain(i, &joint, &mut c.q.0)?;
             c.carriages[i] = carriage;
             c.bases[i] = base;
+            c.dirs[i] = direction(&joint, &base);
+            reach = reach.min_(margin);
         }
+        c.reach = reach;
         Ok(())
     }
 
-    /// Chain `i`'s actuators for its platform joint `a` into `q`, and its carriage and the start of its last link
-    /// (the carriage, or an elbow chain's elbow).
+    /// Chain `i`'s actuators for its platform joint `a` into `q`, its carriage, the start of its last link (the
+    /// carriage, or an elbow chain's elbow) and its reach margin, from the joint's distance from the axis and the
+    /// rod's or actuator's length that IK computes anyway (as [`RingPlatform::reach_of`] gives it).
     ///
     /// Always inlined: IK alone keeps only the actuators, and the compiler drops the rest where it sees it unused.
     #[inline(always)]
-    fn chain(&self, i: usize, a: &Vector3<T>, q: &mut [T; 6]) -> Result<(Vector3<T>, Vector3<T>), KinematicsError> {
+    fn chain(&self, i: usize, a: &Vector3<T>, q: &mut [T; 6]) -> Result<ChainSolution<T>, KinematicsError> {
         let chain = i as u8;
         let tiny = self.rr * T::of(T::EPS * 16.0);
         let rho2 = a.x * a.x + a.y * a.y;
@@ -260,16 +283,17 @@ impl<T: Real> RingPlatform<T> {
                 q[i] = cy.atan2_(cx);
                 let scale = T::one() / (rho2 + rho2);
                 let carriage = Vector3::new(cx * scale, cy * scale, T::zero());
-                Ok((carriage, carriage))
+                Ok((carriage, carriage, self.rod_reach(rho, a.z, h2)))
             }
             Shape::Radial => {
                 q[i] = a.y.atan2_(a.x);
                 let scale = self.rr / rho;
                 let carriage = Vector3::new(a.x * scale, a.y * scale, T::zero());
+                let length = self.radial_length(rho, a.z);
                 if let Some(k) = self.length_axis[i] {
-                    q[k] = ((self.rr - rho) * (self.rr - rho) + a.z * a.z).sqrt_();
+                    q[k] = length;
                 }
-                Ok((carriage, carriage))
+                Ok((carriage, carriage, self.stroke_reach(length)))
             }
             Shape::Elbow => {
                 // The carriage is on the joint's radius, as a radial chain's; the arm is a planar dyad there.
@@ -277,14 +301,14 @@ impl<T: Real> RingPlatform<T> {
                 let (cq, sq) = (a.x / rho, a.y / rho);
                 let carriage = Vector3::new(self.rr * cq, self.rr * sq, T::zero());
                 let Some(arm) = &self.arms[i] else {
-                    return Ok((carriage, carriage));
+                    return Ok((carriage, carriage, T::zero()));
                 };
                 let s = arm.shoulder(rho, a.z).ok_or(KinematicsError::Unreachable {
                     chain,
                     reason: Reach::Dyad,
                 })?;
                 q[arm.axis] = s.angle;
-                Ok((carriage, arm.elbow(cq, sq, s.cos, s.sin)))
+                Ok((carriage, arm.elbow(cq, sq, s.cos, s.sin), arm.reach(rho, a.z)))
             }
         }
     }
@@ -321,7 +345,6 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
     fn inverse_checked(&self, pose: &Pose<T>) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
         let mut c = Configuration::zeroed();
         self.solve(pose, &mut c)?;
-        c.direct(self.n);
         Ok((c.q, self.report(pose, &c)))
     }
 
@@ -355,7 +378,6 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
         let current = guard.current & 1;
         let c = &mut guard.configs[current];
         self.solve(pose, c)?;
-        c.direct(self.n);
         let (slow, _) = self.slow_margins(guard);
         let c = &guard.configs[current];
         Ok((c.q, self.report_with(pose, c, &slow)))

@@ -40,24 +40,29 @@ impl<T: Real> RingPlatform<T> {
     /// Each row is computed where it goes (the row of chain `i` at `i`, the tangent rows from `n` on by
     /// `tangent_rows`): a matrix cleared first and filled in chain order cost a 144-byte `memclr` on the M4F.
     pub(super) fn wrench_rows_scaled(&self, c: &Configuration<T>, scale: T) -> [[T; 6]; 6] {
-        let inv = T::one() / self.rr;
         core::array::from_fn(|r| {
-            let (u, p) = if r < self.n {
-                (c.dirs[r], c.bases[r])
-            } else {
-                match self
-                    .tangent_rows
-                    .get(r - self.n)
-                    .and_then(|&i| c.carriages.get(usize::from(i)).zip(c.joints.get(usize::from(i))))
-                {
-                    // The ring's tangent at the carriage, (-sin q, cos q, 0), through the platform joint.
-                    Some((b, a)) => (Vector3::new(-b.y * inv, b.x * inv, T::zero()), *a),
-                    None => (Vector3::zeros(), Vector3::zeros()),
-                }
-            };
+            let (u, p) = self.line(c, r);
             let m = p.cross(&u);
             [u.x, u.y, u.z, m.x * scale, m.y * scale, m.z * scale]
         })
+    }
+
+    /// Wrench row `r`'s line: its direction and a point on it (rows past the last are zero).
+    #[inline(always)]
+    pub(super) fn line(&self, c: &Configuration<T>, r: usize) -> (Vector3<T>, Vector3<T>) {
+        if r < self.n {
+            return (c.dirs[r], c.bases[r]);
+        }
+        let inv = T::one() / self.rr;
+        match self
+            .tangent_rows
+            .get(r - self.n)
+            .and_then(|&i| c.carriages.get(usize::from(i)).zip(c.joints.get(usize::from(i))))
+        {
+            // The ring's tangent at the carriage, (-sin q, cos q, 0), through the platform joint.
+            Some((b, a)) => (Vector3::new(-b.y * inv, b.x * inv, T::zero()), *a),
+            None => (Vector3::zeros(), Vector3::zeros()),
+        }
     }
 
     /// External wrench of a mass at the centre of mass under gravity: `[F; M about the ring centre]` (N, N m).
