@@ -343,9 +343,14 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
 
     /// IK and the checks on what it found (the rotation, joints and carriages are not computed twice).
     fn inverse_checked(&self, pose: &Pose<T>) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
-        let mut c = Configuration::zeroed();
-        self.solve(pose, &mut c)?;
-        Ok((c.q, self.report(pose, &c)))
+        let pose = pose.validated()?;
+        let mut c = Configuration {
+            rotation: pose.rotation(),
+            ..Configuration::zeroed()
+        };
+        self.place_joints(&pose, &mut c);
+        self.solve_chains(&mut c)?;
+        Ok((c.q, self.report(&pose, &c)))
     }
 
     /// IK and the checks in their order, each evaluated only while every one before it left its room: a point of
