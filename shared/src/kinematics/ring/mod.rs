@@ -116,12 +116,13 @@ impl<T: Real> RingPlatform<T> {
             *slot = i as u8;
         }
         let mut others = [u8::MAX; 4];
-        let first = usize::from(tangent_rows[0]);
-        for (slot, r) in others
-            .iter_mut()
-            .zip((0..6u8).filter(|&r| usize::from(r) != first && usize::from(r) != n))
-        {
-            *slot = r;
+        let first = tangent_rows[0];
+        let mut slot = 0;
+        for r in 0..6u8 {
+            if r != first && usize::from(r) != n && slot < 4 {
+                others[slot] = r;
+                slot += 1;
+            }
         }
         let l = &geometry.limits;
         Self {
