@@ -88,13 +88,13 @@ pub(crate) fn core_on_m4f(t: &mut Tally) {
 /// under `-icount` are exact and repeatable for a given build, so these hold or fail deterministically; they keep
 /// the control path from growing back unnoticed.
 pub(crate) const BUDGETS: [(&str, u64); 11] = [
-    ("control tick: pipeline", 5_200),
-    ("control tick at 2 kHz", 4_970),
+    ("control tick: pipeline", 5_000),
+    ("control tick at 2 kHz", 4_790),
     ("trainer IK (f32)", 815),
-    ("IK + all", 2_800),
-    ("setpoint frame", 5_040),
-    ("FK", 11_150),
-    ("limited into the envelope", 11_580),
+    ("IK + all", 2_080),
+    ("setpoint frame", 4_540),
+    ("FK", 11_460),
+    ("limited into the envelope", 10_330),
     ("step buffers, idle", 900),
     ("step buffers, typical", 2_700),
     ("step buffers, the trainer's fastest", 6_100),

@@ -4,9 +4,9 @@
 use std::path::Path;
 use std::process::Command;
 
-/// Most flash the firmware may take: its 194,172 B and about 1.6 KiB for layout noise between compiler versions.
-/// The goal it must never pass is 196,608 B, three quarters of the program area.
-pub const FLASH_BUDGET: u64 = 195_840;
+/// Most flash the firmware may take: the goal, 196,608 B, three quarters of the program area (the firmware takes
+/// 195,580 B, so about 1 KiB is left for layout noise between compiler versions).
+pub const FLASH_BUDGET: u64 = 196_608;
 
 /// What the ELF takes of each memory (bytes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
