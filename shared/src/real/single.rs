@@ -129,8 +129,8 @@ pub(crate) fn sqrtf(x: f32) -> f32 {
 #[inline(never)]
 pub(super) fn asinf(x: f32) -> f32 {
     let a = libm::fabsf(x);
-    // Also NaN, which fails the comparison.
-    if !(a <= 1.0) {
+    // A NaN passes through the polynomial as NaN.
+    if a > 1.0 {
         return f32::NAN;
     }
     let (z, r, upper) = if a > 0.5 {
@@ -140,7 +140,7 @@ pub(super) fn asinf(x: f32) -> f32 {
         (a * a, a, false)
     };
     let poly =
-        ((((4.216_32e-2 * z + 2.418_131_1e-2) * z + 4.547_002_6e-2) * z + 7.495_300_3e-2) * z + 1.666_675_2e-1) * z * r
+        ((((4.216_32e-2 * z + 2.418_131e-2) * z + 4.547_002_6e-2) * z + 7.495_300_3e-2) * z + 1.666_675_2e-1) * z * r
             + r;
     let angle = if upper {
         core::f32::consts::FRAC_PI_2 - (poly + poly)

@@ -3,8 +3,9 @@
 //!
 //! The control tick runs these for every commanded pose, so each is written for the Cortex-M4F: no check repeats
 //! the rotation, the joints or the carriages, the cone margins take two `asin` instead of twelve (`asin` is
-//! increasing, so the smallest angle is the `asin` of the smallest sine), and the singularity index decomposes its
-//! 6x6 matrix on plain arrays.
+//! increasing, so the smallest angle is the `asin` of the smallest sine), and the singularity index takes its
+//! determinant through a planar chain's joint without pivoting (a platform of six rod chains decomposes its 6x6
+//! matrix on plain arrays).
 
 use nalgebra::{Matrix3, Vector3};
 
