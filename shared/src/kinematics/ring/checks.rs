@@ -411,6 +411,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
+    use crate::kinematics::geometry::{Branch, Chain, ChainKind, RingGeometry};
     use crate::kinematics::presets::{Preset, PresetGeometry};
     use crate::kinematics::Mechanism;
     use crate::real::wrap_once;
@@ -549,55 +550,100 @@ mod tests {
     }
 
     /// The determinant through a planar chain's joint against the LU's of the same rows, in `f64` (signed, so a
-    /// wrong row-order sign fails), and the index of both scalar types against the LU's index in `f64`, for every
-    /// ring preset with a planar chain, at IK's actuators and at any others.
+    /// wrong row-order sign fails), and the index in `T` against the LU's index in `f64` of the same inputs, at IK's
+    /// actuators when the pose has them and at `any` others; false for a platform without a planar chain.
+    fn compare_index_on<T: Real>(g: &RingGeometry, home: &[f64; 6], offset: &[f64; 6], any: &[f64; 6]) -> bool {
+        let (m, wide) = (RingPlatform::<T>::new(g), RingPlatform::<f64>::new(g));
+        if m.through_joint(&Configuration::zeroed()).is_none() {
+            return false;
+        }
+        let rr = g.ring_radius;
+        let pose = core::array::from_fn(|i| home[i] + offset[i] * if i < 3 { rr } else { 1.0 });
+        let solved = wide.inverse(&Pose::from_array(pose)).ok().map(|q| q.0);
+        for q in solved.into_iter().chain([*any]) {
+            // The reference takes the inputs as rounded to `T`: what is compared is the arithmetic.
+            let (pose, q) = (Pose::from_array(pose.map(T::of)), Actuators(q.map(T::of)));
+            let c = m.configuration(&pose, &q);
+            let widened = Pose::from_array(pose.to_array().map(T::to_f64));
+            let reference = wide.configuration(&widened, &Actuators(q.0.map(T::to_f64)));
+            let rows = wide.wrench_rows_scaled(&reference, 1.0 / rr);
+            let norms: f64 = rows
+                .iter()
+                .map(|r| r.iter().map(|v| v * v).sum::<f64>().sqrt())
+                .product();
+            let lu = crate::kinematics::velocity::Lu6::in_place(&mut { rows }).determinant();
+            let (through, squares) = wide.through_joint(&reference).unwrap();
+            assert!(
+                (through - lu).abs() <= 1e-12 * norms && (squares.sqrt() - norms).abs() <= 1e-12 * norms,
+                "{}: {through} against the LU's {lu}, norms {} against {norms} at {widened:?}, {q:?}",
+                squares.sqrt(),
+                g.name
+            );
+            // Within what the LU itself gives in `f32` (7e-7 at worst over 25,000 poses of the workspace).
+            let (index, old) = (m.singularity_of(&c).to_f64(), (lu / norms).abs());
+            let tolerance = if T::EPS > 1e-10 { 1e-6 } else { 1e-12 };
+            assert!(
+                (index - old).abs() <= tolerance,
+                "{}: index {index} against the LU's {old} at {widened:?}, {q:?}",
+                g.name
+            );
+        }
+        true
+    }
+
+    /// Platforms with the planar chain first, last, among rods and alone with others of its kind: every place the
+    /// first planar chain and its tangent row can take among the rows.
+    fn mixed_platforms() -> [RingGeometry; 5] {
+        let chain = |kind: ChainKind, k: usize, n: usize| {
+            let angle = core::f64::consts::TAU * k as f64 / n as f64 + 0.3;
+            Chain {
+                kind,
+                platform_point: [0.6 * libm::cos(angle), 0.6 * libm::sin(angle), 0.0],
+            }
+        };
+        let (plus, minus) = (ChainKind::Rod(Branch::Plus), ChainKind::Rod(Branch::Minus));
+        let elbow = ChainKind::Elbow(crate::kinematics::presets::TRAINER_ELBOW_ARM);
+        let limits = crate::kinematics::presets::TRAINER_MODEL.limits;
+        let kinds: [&[ChainKind]; 5] = [
+            &[plus, minus, plus, minus, ChainKind::Radial],
+            &[ChainKind::Radial, plus, minus, plus, minus],
+            &[ChainKind::Radial; 3],
+            &[plus, ChainKind::Radial, minus, ChainKind::Radial],
+            &[plus, minus, elbow, plus, minus],
+        ];
+        kinds.map(|kinds| {
+            let chains: Vec<Chain> = kinds
+                .iter()
+                .enumerate()
+                .map(|(k, &kind)| chain(kind, k, kinds.len()))
+                .collect();
+            RingGeometry::new("mixed", 1.0, 1.2, &chains, limits).unwrap()
+        })
+    }
+
     fn compare_index<T: Real>(offset: &[f64; 6], angles: &[f64; 6], lengths: &[f64; 2]) -> usize {
+        let mut any = *angles;
         let mut compared = 0;
         for preset in Preset::ALL {
             let PresetGeometry::Ring(g) = preset.geometry() else {
                 continue;
             };
-            let (m, wide) = (RingPlatform::<T>::new(g), RingPlatform::<f64>::new(g));
-            if m.through_joint(&Configuration::zeroed()).is_none() {
-                continue;
-            }
-            let rr = g.ring_radius;
-            let home = preset.home();
-            let pose = core::array::from_fn(|i| home[i] + offset[i] * if i < 3 { rr } else { 1.0 });
-            let mut any = *angles;
             // The radial chains' lengths and the elbow chains' shoulders take the last two actuators.
-            any[4] = lengths[0] * rr;
+            any[4] = lengths[0] * g.ring_radius;
             any[5] = lengths[1];
-            let solved = wide.inverse(&Pose::from_array(pose)).ok().map(|q| q.0);
-            for q in solved.into_iter().chain([any]) {
-                // The reference takes the inputs as rounded to `T`: what is compared is the arithmetic.
-                let (pose, q) = (Pose::from_array(pose.map(T::of)), Actuators(q.map(T::of)));
-                let c = m.configuration(&pose, &q);
-                let widened = Pose::from_array(pose.to_array().map(T::to_f64));
-                let reference = wide.configuration(&widened, &Actuators(q.0.map(T::to_f64)));
-                let rows = wide.wrench_rows_scaled(&reference, 1.0 / rr);
-                let norms: f64 = rows
-                    .iter()
-                    .map(|r| r.iter().map(|v| v * v).sum::<f64>().sqrt())
-                    .product();
-                let lu = crate::kinematics::velocity::Lu6::in_place(&mut { rows }).determinant();
-                let (through, squares) = wide.through_joint(&reference).unwrap();
-                assert!(
-                    (through - lu).abs() <= 1e-12 * norms && (squares.sqrt() - norms).abs() <= 1e-12 * norms,
-                    "{}: {through} against the LU's {lu}, norms {} against {norms} at {widened:?}, {q:?}",
-                    squares.sqrt(),
-                    preset.name()
-                );
-                // Within what the LU itself gives in `f32` (7e-7 at worst over 25,000 poses of the workspace).
-                let (index, old) = (m.singularity_of(&c).to_f64(), (lu / norms).abs());
-                let tolerance = if T::EPS > 1e-10 { 1e-6 } else { 1e-12 };
-                assert!(
-                    (index - old).abs() <= tolerance,
-                    "{}: index {index} against the LU's {old} at {widened:?}, {q:?}",
-                    preset.name()
-                );
-                compared += 1;
-            }
+            compared += usize::from(compare_index_on::<T>(g, &preset.home(), offset, &any));
+        }
+        for g in mixed_platforms() {
+            let home = [0.0, 0.0, 0.9, 0.0, 0.0, 0.0];
+            // The last actuators are lengths or a shoulder, whichever the platform has.
+            let any = core::array::from_fn(|i| {
+                if i < g.chains().len() {
+                    angles[i]
+                } else {
+                    lengths[i % 2]
+                }
+            });
+            compared += usize::from(compare_index_on::<T>(&g, &home, offset, &any));
         }
         compared
     }
@@ -615,8 +661,8 @@ mod tests {
             lengths in prop::array::uniform2(0.1f64..4.0),
         ) {
             let offset = [t[0], t[1], t[2], r[0], r[1], r[2]];
-            prop_assert!(compare_index::<f32>(&offset, &angles, &lengths) >= 4);
-            prop_assert!(compare_index::<f64>(&offset, &angles, &lengths) >= 4);
+            prop_assert!(compare_index::<f32>(&offset, &angles, &lengths) >= 9);
+            prop_assert!(compare_index::<f64>(&offset, &angles, &lengths) >= 9);
         }
     }
 
