@@ -362,11 +362,16 @@ impl<'a, T: Transport> Streamer<'a, T> {
         Ok(())
     }
 
-    /// Holds the last pose until the platform has arrived there (the device's commanded pose equals its target),
-    /// at least 250 ms and at most 10 s: a platform slowed by its limits can be far behind its source when the
-    /// source ends, and stopping before it arrives would leave it wherever braking ends.
+    /// Holds the last pose until the platform has arrived there (the device's commanded pose equals its target
+    /// and no longer moves), at least 250 ms and at most 10 s: a platform slowed by its limits can be far behind
+    /// its source when the source ends, and stopping before it arrives would leave it wherever braking ends.
+    ///
+    /// Within 2 um (or 2 urad) of the target is not yet there: the trackers cover that in their last tick or two,
+    /// and a stop then left the trainer model's linear actuators a step short of where the source ended (a step is
+    /// 0.6 um). So the pose must also be the one of the check before, 50 ms earlier: the trackers are at rest.
     pub(super) fn settle(&mut self) -> Result<(), StreamError> {
         let last = self.last_sent;
+        let mut before = None;
         for k in 1..=1000u32 {
             self.elapse(Duration::from_millis(10))?;
             self.send(last, Kind::Settle, NO_AUX)?;
@@ -375,14 +380,15 @@ impl<'a, T: Transport> Streamer<'a, T> {
                 self.collect(0)?;
                 let s = self.client.status()?;
                 let (p, t) = (s.pose.to_array(), s.target.to_array());
-                let arrived = (0..6).all(|i| {
+                let near = (0..6).all(|i| {
                     let d = t[i] - p[i];
                     let d = if i == 5 { d.sin().atan2(d.cos()) } else { d };
                     d.abs() <= 2e-6
                 });
-                if arrived {
+                if near && before == Some(p) {
                     break;
                 }
+                before = Some(p);
             }
         }
         Ok(())
