@@ -217,8 +217,8 @@ impl<T: Real> RingPlatform<T> {
     }
 
     /// The second half of [`RingPlatform::solve`]: each chain's actuators, carriage, base and direction from its
-    /// joint in `c`, and the reach margin. The direction is taken here, while the chain's joint and base are still in registers, rather
-    /// than in a loop of its own that loads them again.
+    /// joint in `c`, and the reach margin. The direction is taken here, while the chain's joint and base are still
+    /// in registers, rather than in a loop of its own that loads them again.
     ///
     /// Never inlined: the envelope search's checks call it after their reach check, and a copy of the per-chain
     /// code there took 1 KB of flash.
@@ -344,6 +344,8 @@ impl<T: Real> Mechanism<T> for RingPlatform<T> {
 
     /// IK and the checks on what it found (the rotation, joints and carriages are not computed twice).
     fn inverse_checked(&self, pose: &Pose<T>) -> Result<(Actuators<T>, WorkspaceReport<T>), KinematicsError> {
+        // `solve` with its `place` opened up: the rotation goes into the configuration as it is made, so the
+        // `memclr` clearing the rest is 36 bytes shorter (38 instructions of IK with the checks, measured).
         let pose = pose.validated()?;
         let mut c = Configuration {
             rotation: pose.rotation(),
