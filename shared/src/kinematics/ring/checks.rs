@@ -477,9 +477,7 @@ mod tests {
             let m = RingPlatform::<T>::new(g);
             let rr = g.ring_radius;
             let home = preset.home();
-            let pose = Pose::from_array(core::array::from_fn(|i| {
-                T::of(home[i] + offset[i] * if i < 3 { rr } else { 1.0 })
-            }));
+            let pose = Pose::from_array(super::super::away_from(&home, offset, rr).map(T::of));
             // Carriages where IK puts them, and at any angles (in and out of order, on top of each other).
             let mut c = Configuration::zeroed();
             let solved = m.solve(&pose, &mut c).is_ok();
@@ -558,7 +556,7 @@ mod tests {
             return false;
         }
         let rr = g.ring_radius;
-        let pose = core::array::from_fn(|i| home[i] + offset[i] * if i < 3 { rr } else { 1.0 });
+        let pose = super::super::away_from(home, offset, rr);
         let solved = wide.inverse(&Pose::from_array(pose)).ok().map(|q| q.0);
         for q in solved.into_iter().chain([*any]) {
             // The reference takes the inputs as rounded to `T`: what is compared is the arithmetic.
@@ -674,9 +672,7 @@ mod tests {
             };
             let m = RingPlatform::<T>::new(g);
             let (rr, home) = (g.ring_radius, preset.home());
-            let pose = Pose::from_array(core::array::from_fn(|i| {
-                T::of(home[i] + offset[i] * if i < 3 { rr } else { 1.0 })
-            }));
+            let pose = Pose::from_array(super::super::away_from(&home, offset, rr).map(T::of));
             let mut c = Configuration::zeroed();
             if m.solve(&pose, &mut c).is_ok() {
                 let (chains, joints) = (c.reach, m.reach_of(&c.joints));

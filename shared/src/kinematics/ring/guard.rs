@@ -163,9 +163,7 @@ mod tests {
             let m = RingPlatform::<T>::new(g);
             let rr = g.ring_radius;
             let home = preset.home();
-            let pose = Pose::from_array(core::array::from_fn(|i| {
-                T::of(home[i] + offset[i] * if i < 3 { rr } else { 1.0 })
-            }));
+            let pose = Pose::from_array(super::super::away_from(&home, offset, rr).map(T::of));
             let home = Pose::from_array(home.map(T::of));
             let mut used = SlowCheckGuard::<T>::default();
             let _ = m.inverse_within_in(&home, &rooms[0], &mut used);

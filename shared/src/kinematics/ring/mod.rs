@@ -315,6 +315,12 @@ impl<T: Real> RingPlatform<T> {
     }
 }
 
+/// A pose `offset` from `home` in the tests: translations in ring radii `rr`, rotations in radians.
+#[cfg(test)]
+fn away_from(home: &[f64; 6], offset: &[f64; 6], rr: f64) -> [f64; 6] {
+    core::array::from_fn(|i| home[i] + offset[i] * if i < 3 { rr } else { 1.0 })
+}
+
 impl<T: Real> Mechanism<T> for RingPlatform<T> {
     type Guard = SlowCheckGuard<T>;
 
