@@ -8,11 +8,12 @@
 //! homing solves it, from the sample's commanded pose (a few milliseconds from the counted one, so Newton's method
 //! converges in an iteration or two).
 //!
-//! Step counts are homed coordinates only once the device has homed: the pose is solved in the states that imply it
-//! (Ready, Running, Stopping). In the others (powering up, homing, jogging) where the seat is is not known from
-//! the steps, and the sample's pose becomes its target, where the device is taking it: during homing the commanded
-//! pose is a placeholder that jumps when homing finds the axes, and a record's derivatives or a VR view must not
-//! see that jump as motion.
+//! Step counts are homed coordinates only once the device has homed: from the first sample of a state that implies
+//! it (Ready, Running, Stopping) until homing or a jog starts again, the pose is solved from them, also through the
+//! shutdown after a STOP, a fault and the power-down (the steps still say where the seat was left). Before that
+//! (powering up, homing, jogging) where the seat is is not known from the steps, and the sample's pose becomes its
+//! target, where the device is taking it: during homing the commanded pose is a placeholder that jumps when homing
+//! finds the axes, and a record's derivatives or a VR view must not see that jump as motion.
 
 use ringpod_core::controller::axis_scale;
 use ringpod_core::kinematics::{Actuators, AxisKind, Mechanism, NewtonOptions, Pose, RingPlatform};
@@ -30,6 +31,8 @@ pub struct Followed {
     at_zero: Actuators<f32>,
     /// Samples whose steps gave no pose (the solve failed): they kept the device's pose.
     pub unsolved: u64,
+    /// Whether the counted steps are homed coordinates now.
+    homed: bool,
 }
 
 impl Followed {
@@ -52,22 +55,25 @@ impl Followed {
             axes,
             at_zero,
             unsolved: 0,
+            homed: false,
         })
     }
 
-    /// The pose the sample's counted steps put the platform in, homed states only.
-    pub fn pose(&self, sample: &Telemetry) -> Option<Pose<f32>> {
-        if !matches!(sample.state, State::Ready | State::Running | State::Stopping) {
-            return None;
-        }
+    /// The pose the sample's counted steps put the platform in.
+    fn pose(&self, sample: &Telemetry) -> Option<Pose<f32>> {
         let q = actuators_at_steps(&self.scales, &self.axes, &self.at_zero, &sample.steps);
         let solved = self.mechanism.forward(&q, &sample.pose, &NewtonOptions::default());
         solved.ok().map(|s| s.pose)
     }
 
-    /// Replaces the sample's pose by the counted one where there is one (its target before homing).
+    /// Replaces the sample's pose by the counted one where the steps are homed coordinates (its target before).
     pub fn apply(&mut self, sample: &mut Telemetry) {
-        if !matches!(sample.state, State::Ready | State::Running | State::Stopping) {
+        match sample.state {
+            State::Ready | State::Running | State::Stopping => self.homed = true,
+            State::Homing | State::Jogging => self.homed = false,
+            _ => {}
+        }
+        if !self.homed {
             sample.pose = sample.target;
             return;
         }

@@ -172,6 +172,13 @@ impl Transport for SimDevice {
 
     fn elapse(&mut self, dt: Duration) {
         self.owed_us += dt.as_micros() as u64;
+        // Tied to the wall clock, the device's periods are the wall's, as a board's are: a caller that let less
+        // time pass than the wall did (its own work between two calls) still has every period run. Without this
+        // the lag grew by that work at each call until every period was one to pass, and the platform froze.
+        if let Some(due) = self.due() {
+            let behind = Instant::now().saturating_duration_since(due).as_micros() as u64;
+            self.owed_us = self.owed_us.max(behind);
+        }
         while self.owed_us >= self.tick_us {
             self.owed_us -= self.tick_us;
             if self.held_up() {

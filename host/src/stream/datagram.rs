@@ -47,6 +47,9 @@ pub enum Decoder {
     },
 }
 
+/// A sample this much older than the last (s) is not out of order: the game's clock started again.
+const RESTARTED_S: f64 = 1.0;
+
 /// How often the cueing file is looked at while streaming.
 pub const WATCH_EVERY: Duration = Duration::from_millis(500);
 
@@ -207,9 +210,9 @@ impl Decoder {
             None => washout.begin(&sample).map_err(|e| e.to_string()),
             Some(Ok(offset)) => Ok(offset),
             Some(Err(e @ (SampleError::NonFinite | SampleError::Implausible))) => Err(e.to_string()),
-            Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| dt > 0.0) => {
-                // A pause of more than a second: wash out to neutral and start again from here, this sample the
-                // first input.
+            Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| dt > 0.0 || dt < -RESTARTED_S) => {
+                // A pause of more than a second, or the game's clock started again (a restarted game or session,
+                // a replay): wash out to neutral and start again from here, this sample the first input.
                 *gaps += 1;
                 washout.reset();
                 washout.begin(&sample).map_err(|e| e.to_string())
@@ -219,6 +222,15 @@ impl Decoder {
         let offset = offset?;
         *last = Some((t, now));
         Ok(cueing::pose(&neutral, &offset))
+    }
+
+    /// Starts the cueing again at neutral on the next sample, as after a pause: the platform has just been led in to
+    /// neutral, and what the washout integrated meanwhile (the heading above all) must not become a step.
+    pub fn restart(&mut self) {
+        if let Decoder::Telemetry { washout, last, .. } = self {
+            washout.reset();
+            *last = None;
+        }
     }
 
     /// A telemetry source paused for `dt` more seconds (until `now`): the pose of the vehicle at rest through the

@@ -10,7 +10,8 @@ use super::prepare::telemetry_rate;
 use super::report::{CaptureReport, DatagramReport, RecordReport, Report};
 use super::session::{Stop, StreamError, Streamer};
 use super::{exit, InputError};
-use crate::link::client::Transport;
+use crate::link::client::{ClientError, Transport};
+use crate::out::console;
 
 /// How a run ended: why it stopped early, the device's status at rest, a lost link in words, what `--record`
 /// wrote.
@@ -35,7 +36,20 @@ pub(super) fn wind_down<T: Transport>(
         Err(StreamError::Stop(stop)) => (Some(stop), None),
         Err(StreamError::Client(e)) => (None, Some(e)),
     };
-    let status = if transport.is_none() { stop_and_rest(s) } else { None };
+    // A link that stalled may come back: the stop is given all the same (a closed one cannot).
+    let stalled = matches!(transport, Some(ClientError::Timeout(_)));
+    let status = if transport.is_none() || stalled {
+        stop_and_rest(s)
+    } else {
+        None
+    };
+    // The stall is over when the stop was confirmed: the run still ended because of it.
+    let transport = transport.map(|e| match (&status, e) {
+        (Some(_), ClientError::Timeout(t)) => ClientError::Unexpected(format!(
+            "no answer from the device within {t:?} (the link came back, and the stop was confirmed)"
+        )),
+        (_, e) => e,
+    });
     // The samples of the stop and the ramp to rest.
     let _ = s.record();
     let mut record = record_path.map(|path| record_report(s, path));
@@ -54,7 +68,7 @@ pub(super) fn wind_down<T: Transport>(
     let (status, transport) = match (status, transport) {
         (Some(st), None) => (Some(st), None),
         (None, None) => (None, Some("the device did not answer after the stop".to_string())),
-        (_, Some(e)) => (None, Some(e.to_string())),
+        (st, Some(e)) => (st, Some(e.to_string())),
     };
     Ending {
         stop,
@@ -131,12 +145,58 @@ fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
             break;
         }
     }
-    let _ = s.client.stop();
-    let status = s.client.wait_for(Duration::from_secs(10), |st| {
-        !matches!(st.state, State::Running | State::Stopping)
-    });
+    let status = stop_confirmed(s);
     s.client.cancel = cancel;
-    status.ok()
+    status
+}
+
+/// How long a stop the device does not answer is given again (the device comes to rest by itself when the stream
+/// stops; this is for the stop to be confirmed and the run reported as it ended).
+const STOP_PATIENCE: Duration = Duration::from_secs(30);
+
+/// Stops and waits up to 10 s for rest; through a stalled link, the stop is sent again every second for up to
+/// [`STOP_PATIENCE`], saying so. The status at rest, or none when the device never answered.
+fn stop_confirmed<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
+    let patience = crate::link::patience(STOP_PATIENCE);
+    let started = std::time::Instant::now();
+    let mut said = false;
+    loop {
+        let answered = match s.client.stop() {
+            Err(ClientError::Timeout(_)) => false,
+            // Refused (not running): the device answered; so did an accepted stop.
+            Ok(()) | Err(ClientError::Device(_)) => true,
+            Err(_) => return None,
+        };
+        if answered {
+            let status = s.client.wait_for(Duration::from_secs(10), |st| {
+                !matches!(st.state, State::Running | State::Stopping)
+            });
+            match status {
+                Ok(st) => {
+                    if said {
+                        let after = started.elapsed().as_secs_f64();
+                        s.bar
+                            .suspend(|| console::err(&format!("the stop was confirmed after {after:.1} s")));
+                    }
+                    return Some(st);
+                }
+                Err(ClientError::Timeout(_)) => {}
+                Err(_) => return None,
+            }
+        }
+        if started.elapsed() >= patience {
+            return None;
+        }
+        if !said {
+            said = true;
+            s.bar.suspend(|| {
+                console::err(&format!(
+                    "STOP pending: the device does not answer; the stop is sent again every second for up to {patience:?}"
+                ))
+            });
+        }
+        s.client.transport().elapse(Duration::from_secs(1));
+    }
 }
 
 /// What `--record` wrote: its rows (in the file under its name: a record that failed is not put there), the

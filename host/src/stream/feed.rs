@@ -100,6 +100,8 @@ impl<T: Transport> Streamer<'_, T> {
         self.bar.suspend(|| console::err(&format!("streaming: {listening}")));
         // The largest UDP payload: no datagram is ever cut.
         let mut buf = vec![0u8; 65_536];
+        // A game started first: what it sent while the platform powered up and homed is no motion to follow now.
+        report.before_ready += drop_queued(source, &mut buf);
         let mut wall = Instant::now();
         let mut last_pose = Instant::now();
         let mut last_idle = Instant::now();
@@ -151,14 +153,41 @@ impl<T: Transport> Streamer<'_, T> {
                 let pose = self.start_and_lead_in(pose)?;
                 // The lead-in ran on the device's clock; the samples come on the wall clock.
                 self.client.transport().keep_pace();
+                // What came during the lead-in is dropped, and the cueing starts again at neutral (where the
+                // platform now is) on the next sample: a backlog replayed in a burst, or the heading integrated
+                // over the lead-in, would be a step.
+                report.before_ready += drop_queued(source, &mut buf);
+                source.decoder.restart();
+                // The lead-in let its own time pass: the device's clock is already there. Only here: after any
+                // other sample the time its work took is the next interval's, or the intervals sent would add up
+                // to less than the wall's.
+                wall = Instant::now();
                 pose
             };
             self.send(pose, Kind::Input(Some(number)), NO_AUX)?;
             self.bar.inc(1);
-            // The lead-in let its own time pass: the device's clock is already there.
-            wall = Instant::now();
         }
     }
+}
+
+/// Drops the datagrams queued in the socket (captured all the same) and returns how many; shared memory holds no
+/// queue, only the game's newest sample.
+fn drop_queued(source: &mut LiveSource, buf: &mut [u8]) -> u32 {
+    let mut dropped = 0;
+    // Bounded: a flood does not keep the stream from starting (the socket's reads wait a millisecond).
+    for _ in 0..100_000 {
+        if !matches!(source.receiver, super::live::Receiver::Udp(_)) {
+            break;
+        }
+        match source.receiver.receive(buf) {
+            Ok(Some(arrival)) => {
+                capture(source, buf, Some(&arrival));
+                dropped += 1;
+            }
+            Ok(None) | Err(_) => break,
+        }
+    }
+    dropped
 }
 
 /// `--capture`: a datagram as it came (from any sender, readable or not), a shared-memory sample as a line of the

@@ -26,6 +26,9 @@ const IN_FLIGHT: usize = 16;
 /// stalls it about 2 s, a busy machine stalls the simulator), which the device catches up by itself.
 const HOLD_UP_PATIENCE: Duration = Duration::from_secs(5);
 
+/// How long without an answer is a stalled link, said as it happens.
+const STALLED: Duration = Duration::from_millis(500);
+
 /// Why streaming ended early.
 pub(super) enum Stop {
     /// The device stopped streaming or faulted: the reason.
@@ -207,8 +210,18 @@ impl<'a, T: Transport> Streamer<'a, T> {
         let step = Duration::from_micros(200);
         let patience = self.client.timeout.max(crate::link::patience(HOLD_UP_PATIENCE));
         let mut waited = Duration::ZERO;
+        let mut stalled = false;
+        let stall = crate::link::patience(STALLED);
         while let Some(&(id, number, pose)) = self.in_flight.front() {
             let Some(answer) = self.client.take_response(id)? else {
+                if !stalled && waited >= stall {
+                    stalled = true;
+                    self.bar.suspend(|| {
+                        console::err(&format!(
+                            "the link is stalled: no answer from the device for {stall:?} (the stream ends after {patience:?} without one)"
+                        ))
+                    });
+                }
                 if self.in_flight.len() <= keep {
                     break;
                 }
@@ -228,6 +241,12 @@ impl<'a, T: Transport> Streamer<'a, T> {
                 waited += step;
                 continue;
             };
+            if stalled {
+                stalled = false;
+                let waited = waited.as_secs_f64();
+                self.bar
+                    .suspend(|| console::err(&format!("the link answered again after {waited:.1} s")));
+            }
             self.in_flight.pop_front();
             self.answered(setpoint_answer(answer)?, number, pose)?;
         }

@@ -23,6 +23,8 @@ use crate::link::{self, Target};
 use crate::stream::command::{self as job, Datagrams, Input};
 use crate::stream::{self, Motion, Source};
 
+mod stop;
+
 /// Why the device thread could not start, or a page's request was not done (sent back to the page in words).
 #[derive(Debug, thiserror::Error)]
 pub enum WorkerError {
@@ -141,12 +143,14 @@ pub fn run(
         hub: hub.clone(),
         mechanism,
         cancel: Arc::new(AtomicBool::new(false)),
+        pending_stop: None,
     };
     let mut last_sample = Instant::now();
     while !hub.closing.load(Ordering::SeqCst) {
         while let Ok(job) = jobs.try_recv() {
             device.serve(&job);
         }
+        device.resend_stop();
         // The samples were published by the tap; none is kept. A device that stopped sending (a restart, a
         // hello by another program on a shared link) is asked again once a second.
         if device.client.take_telemetry().is_ok_and(|s| !s.is_empty()) {
@@ -191,6 +195,8 @@ struct Device {
     mechanism: Arc<Mutex<RingPlatform<f64>>>,
     /// The cancel flag of the request being served.
     cancel: Arc<AtomicBool>,
+    /// A STOP the device has not confirmed (its link stalled or cut): kept, and given again until it is.
+    pending_stop: Option<stop::PendingStop>,
 }
 
 impl Device {
@@ -199,6 +205,15 @@ impl Device {
             Ok(flag) => flag,
             Err(why) => return self.hub.reply(job.page, job.id, job.request.is_halt(), why),
         };
+        // Nothing moves before the STOP given last is confirmed.
+        if self.pending_stop.is_some() && !job.request.is_halt() {
+            return self.hub.reply(
+                job.page,
+                job.id,
+                false,
+                "refused: a STOP is pending (the device has not confirmed it yet)",
+            );
+        }
         self.cancel = cancel;
         let result = match &job.request {
             Request::Enable => self.client.enable().map(|()| "enabling".to_owned()).map_err(Into::into),
@@ -215,12 +230,20 @@ impl Device {
                 .clear()
                 .map(|()| "fault cleared".to_owned())
                 .map_err(Into::into),
-            Request::Halt => self.halt().map(|text| {
-                // The STOP was answered when it arrived; this says the platform is at rest.
-                self.hub
-                    .publish(&json!({ "type": "halted", "page": job.page, "id": job.id, "text": text }));
-                text
-            }),
+            Request::Halt => match self.halt() {
+                Ok(text) => {
+                    // The STOP was answered when it arrived; this says the platform is at rest.
+                    self.pending_stop = None;
+                    self.hub
+                        .publish(&json!({ "type": "halted", "page": job.page, "id": job.id, "text": text }));
+                    Ok(text)
+                }
+                Err(WorkerError::Client(e @ (ClientError::Timeout(_) | ClientError::Io(_)))) => {
+                    self.keep_stop(&e);
+                    Err(WorkerError::Client(e))
+                }
+                Err(e) => Err(e),
+            },
             Request::Jog { axis, distance } => self.commission(*axis, Some(*distance)),
             Request::Buzz { axis } => self.commission(*axis, None),
             Request::Park => self.park(job.page),

@@ -98,6 +98,41 @@ fn before_homing_the_pose_is_where_the_device_takes_it() {
     assert_eq!(followed.unsolved, 0);
 }
 
+/// After a STOP the device ramps to rest and shuts down: the seat is where the steps are, not where the last
+/// setpoint asked, through the shutdown and the power-down; homing again (or a jog) voids the steps' coordinates.
+#[test]
+fn after_a_stop_the_pose_is_still_the_counted_one() {
+    let (config, mut followed) = trainer();
+    let played = near_home(&config, [0.0; 3], [0.0, 0.0, 12.0]);
+    let commanded = near_home(&config, [0.0; 3], [0.0, 0.0, 16.0]);
+    let steps = steps_at(&config, &played);
+    let mut running = sample(State::Running, commanded, steps);
+    followed.apply(&mut running);
+    use ringpod_core::safety::{FaultReason, Supplies};
+    for state in [
+        State::ShuttingDown(ringpod_core::safety::supervisor::Shutdown::Drivers),
+        State::Off,
+        State::Fault(FaultReason::EStop, Supplies::Both),
+    ] {
+        let mut s = sample(state, commanded, steps);
+        followed.apply(&mut s);
+        let (lin, ang) = distance(&s.pose, &played);
+        assert!(
+            lin < 1e-4 && ang < 1e-3,
+            "{state:?}: followed {:?}, played {:?}",
+            s.pose,
+            played
+        );
+    }
+    let mut homing = sample(State::Homing, commanded, steps);
+    homing.target = played;
+    followed.apply(&mut homing);
+    let mut off = sample(State::Off, commanded, steps);
+    off.target = commanded;
+    followed.apply(&mut off);
+    assert_eq!(off.pose, commanded, "homing voided the counted coordinates");
+}
+
 #[test]
 fn steps_that_give_no_pose_keep_the_device_pose_and_are_counted() {
     let (config, mut followed) = trainer();

@@ -51,6 +51,7 @@ function connect() {
     else if (m.type === "frame") showFrame(m);
     else if (m.type === "reply") showReply(m);
     else if (m.type === "halted") { state.halted = m; log(m.text); }
+    else if (m.type === "stop_pending") showStopPending(m);
     else if (m.type === "report") log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
   };
 }
@@ -90,10 +91,18 @@ function halt() {
   send({ do: "halt" });
 }
 $("halt").addEventListener("click", halt);
+// Only where a space is typed does it stay a space: on a checkbox, a select, a number field or a button it is the
+// STOP, and their own use of it (a toggle, a click on release) is kept from happening.
+const TEXT_INPUTS = ["text", "search", "url", "email", "password", "tel"];
+function typing(el) {
+  return el.tagName === "TEXTAREA" || el.isContentEditable || (el.tagName === "INPUT" && TEXT_INPUTS.includes(el.type));
+}
 document.addEventListener("keydown", (e) => {
-  const typing = ["INPUT", "TEXTAREA", "SELECT"].includes(document.activeElement.tagName);
-  if (e.code === "Space" && !typing) { e.preventDefault(); halt(); }
-});
+  if (e.code === "Space" && !typing(document.activeElement)) { e.preventDefault(); e.stopPropagation(); if (!e.repeat) halt(); }
+}, true);
+document.addEventListener("keyup", (e) => {
+  if (e.code === "Space" && !typing(document.activeElement)) { e.preventDefault(); e.stopPropagation(); }
+}, true);
 
 // ---- Live ----
 const view = new View3d($("view3d"));
@@ -129,9 +138,39 @@ function lamp(on, label, alarm) {
 // A pose value as the table shows it: mm for a position, degrees for an angle.
 const show = (v, i) => (i < 3 ? v * 1000 : v * 180 / Math.PI).toFixed(2);
 
+// ---- the link's health: what is shown is as old as the newest frame ----
+// Telemetry comes at 50 frames a second: none for half a second is a stalled link, none for five a lost one. The
+// values shown are then greyed, the header says how old they are, and the log says when it began and ended.
+const STALLED_MS = 500, LOST_MS = 5000;
+let lastFrameAt = 0, stalledSince = 0;
+setInterval(() => {
+  if (!lastFrameAt || !state.connected) return;
+  const age = Date.now() - lastFrameAt;
+  if (age < STALLED_MS) return;
+  if (!stalledSince) { stalledSince = lastFrameAt; log("no telemetry from the device for half a second: the link is stalled", true); }
+  state.link = age >= LOST_MS ? "lost" : "stalled";
+  document.body.classList.add("stale");
+  $("link").textContent = `link ${state.link}: no telemetry for ${(age / 1000).toFixed(1)} s; the values shown are that old`;
+}, 250);
+
+function showStopPending(m) {
+  const was = state.stopPending;
+  state.stopPending = m.pending;
+  document.body.classList.toggle("stop-pending", m.pending);
+  $("stop-pending").textContent = m.pending ? "STOP pending: not yet confirmed by the device" : "";
+  if (m.pending !== was) log(m.text, m.pending);
+}
+
 function showFrame(f) {
   state.frame = f;
   state.frames++;
+  lastFrameAt = Date.now();
+  state.link = "live";
+  if (stalledSince) {
+    log(`telemetry back after ${((lastFrameAt - stalledSince) / 1000).toFixed(1)} s`);
+    stalledSince = 0;
+    document.body.classList.remove("stale");
+  }
   const s = $("state");
   s.textContent = f.state;
   s.className = "state " + f.state.split(/[ :(]/)[0].toLowerCase();

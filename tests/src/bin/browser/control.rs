@@ -120,18 +120,29 @@ pub async fn stop_button(c: &Client) -> Result<String, String> {
     Ok(format!("Running -> Off; replies: {replies}"))
 }
 
+/// The space bar is STOP with the focus anywhere but where a space is typed: on the page, a checkbox (which it does
+/// not toggle), a select and a number field.
 pub async fn space_bar(c: &Client) -> Result<String, String> {
     tab(c, "control").await?;
-    click(c, "[data-do=enable]").await?;
-    until(c, &format!("{STATE} !== 'Off'"), Duration::from_secs(10)).await?;
-    c.find(Locator::Css("body"))
-        .await
-        .map_err(|e| e.to_string())?
-        .send_keys(" ")
-        .await
-        .map_err(|e| e.to_string())?;
-    until(c, &format!("{STATE} === 'Off'"), Duration::from_secs(20)).await?;
-    Ok("enabled, then space: Off".into())
+    for focus in ["body", "#file-degrees", "#motion", "#motion-seconds"] {
+        click(c, "[data-do=enable]").await?;
+        until(c, &format!("{STATE} !== 'Off'"), Duration::from_secs(10)).await?;
+        let before = js(c, "document.getElementById('file-degrees').checked").await?;
+        c.find(Locator::Css(focus))
+            .await
+            .map_err(|e| e.to_string())?
+            .send_keys(" ")
+            .await
+            .map_err(|e| e.to_string())?;
+        until(c, &format!("{STATE} === 'Off'"), Duration::from_secs(20))
+            .await
+            .map_err(|e| format!("space on {focus}: {e}"))?;
+        let after = js(c, "document.getElementById('file-degrees').checked").await?;
+        if before != after {
+            return Err(format!("space on {focus} toggled the checkbox"));
+        }
+    }
+    Ok("enabled, then space on the page, a checkbox, a select and a number field: Off each time".into())
 }
 
 pub async fn udp_session(c: &Client) -> Result<String, String> {
