@@ -240,6 +240,7 @@ impl StreamArgs {
                 host_limits: !self.device_limits_only,
                 telemetry: self.motion_compensation.is_some(),
                 telemetry_hz: self.record_hz,
+                resend_stop: true,
                 quiet: self.quiet,
             },
             record: self.record.clone(),

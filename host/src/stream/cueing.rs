@@ -22,6 +22,9 @@ pub struct LiveCueing {
     fading: Option<(Engine, f64)>,
     /// A change that came during a handover: taken when it ends.
     pending: Option<CueConfig>,
+    /// The offset the cueing had when it started again at neutral (a pause, a restarted game), and the time since
+    /// (s): blended out over [`HANDOVER_S`], so that the heading the yaw followed, or a tilt held, does not jump.
+    restarted_from: Option<([f64; 6], f64)>,
     /// The optimal cueing's counts of the engines that faded out.
     retired: Counts,
     /// Whether an optimal cueing has run.
@@ -49,6 +52,7 @@ impl LiveCueing {
             fresh: true,
             fading: None,
             pending: None,
+            restarted_from: None,
             retired: Counts::default(),
             optimal_ran: false,
         })
@@ -169,7 +173,13 @@ impl LiveCueing {
             old.step(sample, dt, &[])?;
             *elapsed += dt;
         }
+        if let Some((_, elapsed)) = &mut self.restarted_from {
+            *elapsed += dt;
+        }
         let offset = self.offset();
+        if self.restarted_from.is_some_and(|(_, e)| e >= HANDOVER_S) {
+            self.restarted_from = None;
+        }
         if self.fading.as_ref().is_some_and(|(_, e)| *e >= HANDOVER_S) {
             self.fade_out();
             if let Some(config) = self.pending.take() {
@@ -183,18 +193,27 @@ impl LiveCueing {
     /// the optimal cueing waits for the envelope (no sample is cued before the stream knows its rig).
     pub fn offset(&self) -> [f64; 6] {
         let new = self.engine.as_ref().map_or([0.0; 6], Engine::offset);
-        match &self.fading {
+        let running = match &self.fading {
             None => new,
             Some((old, elapsed)) => {
                 let w = weight(*elapsed);
                 let old = old.offset();
                 core::array::from_fn(|i| old[i] + w * (new[i] - old[i]))
             }
+        };
+        match self.restarted_from {
+            None => running,
+            Some((held, elapsed)) => {
+                let w = weight(elapsed);
+                core::array::from_fn(|i| held[i] + w * (running[i] - held[i]))
+            }
         }
     }
 
-    /// Back to neutral (a gap): the handover ends, a pending change is taken.
+    /// Back to neutral (a gap, a restarted game): the handover ends, a pending change is taken, and the offset the
+    /// cueing had is blended out over [`HANDOVER_S`] rather than left in one step.
     pub fn reset(&mut self) {
+        self.restarted_from = Some((self.offset(), 0.0));
         self.fade_out();
         if let Some(config) = self.pending.take() {
             let _ = self.retune(config);
@@ -252,6 +271,34 @@ mod tests {
             !c.retune(optimal).unwrap(),
             "the same configuration again changes nothing"
         );
+    }
+
+    /// A pause after a long left turn: the heading the yaw followed is not left in one step when the cueing starts
+    /// again at neutral; it is blended out over the handover, and the cueing is then at neutral.
+    #[test]
+    fn a_restart_after_a_pause_blends_out_the_heading() {
+        let mut c = LiveCueing::new(CueConfig::default()).unwrap();
+        let turning = Telemetry {
+            force: [0.0, 0.0, G],
+            rate: [0.0, 0.0, 0.3],
+        };
+        c.begin(&turning).unwrap();
+        let before = (0..300).map(|_| c.step(&turning, 0.01).unwrap()).last().unwrap();
+        assert!(before[5].abs() > 0.3, "the heading followed: {before:?}");
+        c.reset();
+        let rest = Telemetry {
+            force: [0.0, 0.0, G],
+            rate: [0.0; 3],
+        };
+        let first = c.begin(&rest).unwrap();
+        assert!((first[5] - before[5]).abs() < 1e-9, "{first:?} after {before:?}");
+        let mut last = first;
+        for _ in 0..150 {
+            let next = c.step(&rest, 0.01).unwrap();
+            assert!((next[5] - last[5]).abs() < 0.02, "{} -> {}", last[5], next[5]);
+            last = next;
+        }
+        assert!(last[5].abs() < 1e-9, "at neutral after the handover: {last:?}");
     }
 
     #[test]

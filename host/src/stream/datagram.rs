@@ -224,15 +224,6 @@ impl Decoder {
         Ok(cueing::pose(&neutral, &offset))
     }
 
-    /// Starts the cueing again at neutral on the next sample, as after a pause: the platform has just been led in to
-    /// neutral, and what the washout integrated meanwhile (the heading above all) must not become a step.
-    pub fn restart(&mut self) {
-        if let Decoder::Telemetry { washout, last, .. } = self {
-            washout.reset();
-            *last = None;
-        }
-    }
-
     /// A telemetry source paused for `dt` more seconds (until `now`): the pose of the vehicle at rest through the
     /// washout (washing out to neutral), or `None` for a pose source (the platform holds).
     pub fn idle(&mut self, dt: f64, now: Instant) -> Option<Pose<f64>> {

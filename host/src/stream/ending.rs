@@ -29,8 +29,9 @@ pub(super) fn wind_down<T: Transport>(
     outcome: Result<(), StreamError>,
     record_path: Option<String>,
     restore_hz: Option<u16>,
-    telemetry_hz: Option<u16>,
+    options: &super::Options,
 ) -> Ending {
+    let telemetry_hz = options.telemetry_hz;
     let (stop, transport) = match outcome {
         Ok(()) => (None, None),
         Err(StreamError::Stop(stop)) => (Some(stop), None),
@@ -39,7 +40,7 @@ pub(super) fn wind_down<T: Transport>(
     // A link that stalled may come back: the stop is given all the same (a closed one cannot).
     let stalled = matches!(transport, Some(ClientError::Timeout(_)));
     let status = if transport.is_none() || stalled {
-        stop_and_rest(s)
+        stop_and_rest(s, options.resend_stop)
     } else {
         None
     };
@@ -136,7 +137,7 @@ pub(super) fn report<T: Transport>(
 
 /// Collects the answers still in flight (a device that stopped streaming has refused them), stops, and waits up
 /// to 10 s for rest; the status at rest, or none when the device did not answer.
-fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
+fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>, resend: bool) -> Option<Status> {
     // The collection and the wait for rest run to their ends even after a signal (each bounded by its patience):
     // the platform is brought to rest, then reported.
     let cancel = s.client.cancel.take();
@@ -145,7 +146,7 @@ fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
             break;
         }
     }
-    let status = stop_confirmed(s);
+    let status = stop_confirmed(s, resend);
     s.client.cancel = cancel;
     status
 }
@@ -155,9 +156,13 @@ fn stop_and_rest<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
 const STOP_PATIENCE: Duration = Duration::from_secs(30);
 
 /// Stops and waits up to 10 s for rest; through a stalled link, the stop is sent again every second for up to
-/// [`STOP_PATIENCE`], saying so. The status at rest, or none when the device never answered.
-fn stop_confirmed<T: Transport>(s: &mut Streamer<'_, T>) -> Option<Status> {
-    let patience = crate::link::patience(STOP_PATIENCE);
+/// [`STOP_PATIENCE`] when `resend`, saying so. The status at rest, or none when the device never answered.
+fn stop_confirmed<T: Transport>(s: &mut Streamer<'_, T>, resend: bool) -> Option<Status> {
+    let patience = if resend {
+        crate::link::patience(STOP_PATIENCE)
+    } else {
+        Duration::ZERO
+    };
     let started = std::time::Instant::now();
     let mut said = false;
     loop {

@@ -96,12 +96,13 @@ impl<T: Transport> Streamer<'_, T> {
         errors: &mut Vec<InputError>,
     ) -> Result<(), StreamError> {
         source.receiver.start().map_err(ClientError::Io)?;
-        let listening = source.receiver.describe();
-        self.bar.suspend(|| console::err(&format!("streaming: {listening}")));
         // The largest UDP payload: no datagram is ever cut.
         let mut buf = vec![0u8; 65_536];
-        // A game started first: what it sent while the platform powered up and homed is no motion to follow now.
+        // A game started first: what it sent while the platform powered up and homed is no motion to follow now
+        // (replayed in a burst, seconds of it would be played in milliseconds).
         report.before_ready += drop_queued(source, &mut buf);
+        let listening = source.receiver.describe();
+        self.bar.suspend(|| console::err(&format!("streaming: {listening}")));
         let mut wall = Instant::now();
         let mut last_pose = Instant::now();
         let mut last_idle = Instant::now();
@@ -119,7 +120,7 @@ impl<T: Transport> Streamer<'_, T> {
             capture(source, &buf, got.as_ref());
             // A changed cueing file takes over here, between two samples.
             source.decoder.poll_config(now);
-            self.elapse(now - wall)?;
+            self.caught_up(now - wall)?;
             wall = now;
             // Only a readable sample of the source counts as the source being there: a stranger's datagrams and
             // unreadable ones (a flood of them included) leave the pause logic below running.
@@ -153,11 +154,6 @@ impl<T: Transport> Streamer<'_, T> {
                 let pose = self.start_and_lead_in(pose)?;
                 // The lead-in ran on the device's clock; the samples come on the wall clock.
                 self.client.transport().keep_pace();
-                // What came during the lead-in is dropped, and the cueing starts again at neutral (where the
-                // platform now is) on the next sample: a backlog replayed in a burst, or the heading integrated
-                // over the lead-in, would be a step.
-                report.before_ready += drop_queued(source, &mut buf);
-                source.decoder.restart();
                 // The lead-in let its own time pass: the device's clock is already there. Only here: after any
                 // other sample the time its work took is the next interval's, or the intervals sent would add up
                 // to less than the wall's.

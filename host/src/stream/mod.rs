@@ -73,6 +73,9 @@ pub struct Options {
     /// The device's telemetry rate for this run (Hz, its `stream.telemetry_hz`; set back afterwards), so that a
     /// record can be taken at the control rate; `None` keeps the device's.
     pub telemetry_hz: Option<u16>,
+    /// A stop the device does not answer at the end (a stalled link) is given again every second until it does,
+    /// for up to 30 s: the CLI's; the workbench keeps its STOP pending itself.
+    pub resend_stop: bool,
 }
 
 /// A ring platform and its home pose.
@@ -287,7 +290,7 @@ pub fn run<T: Transport>(
     );
     let (outcome, datagrams, capture) = feed::feed(&mut s, &mut source, fast, home, &limits, &mut input_errors);
     s.bar.finish_and_clear();
-    let ending = ending::wind_down(&mut s, outcome, record_path, restore_hz, options.telemetry_hz);
+    let ending = ending::wind_down(&mut s, outcome, record_path, restore_hz, options);
     Ok(ending::report(s, ending, input_errors, datagrams, capture))
 }
 

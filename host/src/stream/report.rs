@@ -33,8 +33,8 @@ pub struct DatagramReport {
     pub unreadable_by_kind: std::collections::BTreeMap<String, u64>,
     /// Datagrams from other senders than `--udp-from`, ignored.
     pub other_senders: u32,
-    /// Datagrams that arrived before the platform was ready to follow them (while it powered up, homed or was led
-    /// in to the first): not cued; the cueing starts at neutral on the first one after.
+    /// Datagrams that arrived before the platform was ready to follow them (while it powered up and homed): not
+    /// read; the cueing starts at neutral on the first one after.
     pub before_ready: u32,
     /// Telemetry: pauses of more than a second after which the washout started again at neutral.
     pub telemetry_gaps: u32,

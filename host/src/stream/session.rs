@@ -158,6 +158,19 @@ impl<'a, T: Transport> Streamer<'a, T> {
         Ok(())
     }
 
+    /// Lets `dt` that has already passed on the wall clock pass on the device's too, in one call: a live source's
+    /// interval between two arrivals. In slices, a device tied to the wall clock would catch up with the first and
+    /// then run the others ahead of it.
+    pub(super) fn caught_up(&mut self, dt: Duration) -> Result<(), Stop> {
+        if (self.interrupted)() {
+            return Err(Stop::Interrupted);
+        }
+        self.client.transport().elapse(dt);
+        let _ = self.record();
+        self.clock_us = self.clock_us.saturating_add((dt.as_micros() as u64).max(1));
+        Ok(())
+    }
+
     /// Limits a pose into the envelope (host side, f64) on the ray from the centre, as the device does.
     pub(super) fn limit(&mut self, pose: Pose<f64>) -> Pose<f64> {
         if !self.host_limits || !pose.to_array().iter().all(|c| c.is_finite()) {

@@ -29,6 +29,9 @@ pub struct Hub {
     cancel: Mutex<Arc<AtomicBool>>,
     /// The page whose stream runs (0: none).
     pub streaming: AtomicU64,
+    /// A stream is queued or runs: set when a page's stream request is taken, cleared when the device thread is
+    /// done with it, so that two pages asking at the same moment do not both run, one after the other.
+    pub stream_claimed: AtomicBool,
     /// The newest rig message, for a page that connects later.
     pub rig: Mutex<Option<String>>,
     /// The rig the device runs, for the computations and the Rig panel.
@@ -53,6 +56,7 @@ impl Hub {
             epoch: AtomicU64::new(0),
             cancel: Mutex::new(Arc::new(AtomicBool::new(false))),
             streaming: AtomicU64::new(0),
+            stream_claimed: AtomicBool::new(false),
             rig: Mutex::new(None),
             record: Mutex::new(None),
             cue_file,

@@ -77,6 +77,14 @@ impl Request {
     pub fn is_halt(&self) -> bool {
         *self == Self::Halt
     }
+
+    /// Whether the request runs a stream (one at a time: a second one asked before the first ends is refused).
+    pub fn is_stream(&self) -> bool {
+        matches!(
+            self,
+            Self::Motion { .. } | Self::File { .. } | Self::Udp { .. } | Self::Park
+        )
+    }
 }
 
 /// A request of one page (its connection number) with the number the page gave it, and the STOP generation it

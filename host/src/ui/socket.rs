@@ -197,6 +197,8 @@ fn take(app: &App, page: u64, text: &str) -> Option<Value> {
         taken
     } else if app.hub.streaming.load(Ordering::SeqCst) != 0 {
         return answer(id, false, "a stream is running: STOP ends it");
+    } else if request.is_stream() && app.hub.stream_claimed.swap(true, Ordering::SeqCst) {
+        return answer(id, false, "another stream was asked first: STOP ends it");
     } else {
         queue(app, page, id, app.hub.epoch(), request)
     };

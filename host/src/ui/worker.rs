@@ -200,7 +200,15 @@ struct Device {
 }
 
 impl Device {
+    /// Serves a page's request; a stream's claim ends with it (run, refused or cancelled).
     fn serve(&mut self, job: &Job) {
+        self.serve_job(job);
+        if job.request.is_stream() {
+            self.hub.stream_claimed.store(false, Ordering::SeqCst);
+        }
+    }
+
+    fn serve_job(&mut self, job: &Job) {
         let cancel = match self.hub.begin(job) {
             Ok(flag) => flag,
             Err(why) => return self.hub.reply(job.page, job.id, job.request.is_halt(), why),
@@ -463,6 +471,7 @@ impl Device {
             host_limits: true,
             telemetry: true,
             telemetry_hz: None,
+            resend_stop: false,
             quiet: true,
         };
         let report = stream::run(

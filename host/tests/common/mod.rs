@@ -4,6 +4,7 @@
 #![allow(dead_code)]
 
 pub mod packets;
+pub mod proxy;
 #[cfg(unix)]
 pub mod simulator;
 

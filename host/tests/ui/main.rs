@@ -1,6 +1,9 @@
 //! `ringpod ui --sim` driven over its WebSocket and HTTP as a page (or a hostile client) drives it.
 
+#[path = "../common/proxy.rs"]
+mod proxy;
 mod requests;
+mod stall;
 mod workbench;
 
 use std::time::{Duration, Instant};
@@ -98,10 +101,42 @@ fn stop_from_any_page_preempts_the_queue_and_is_answered_at_once() {
     for id in &ids[1..] {
         let text = text(*id);
         assert!(
-            text.contains("cancelled") || text.starts_with("a stream is running"),
+            text.contains("cancelled")
+                || text.starts_with("a stream is running")
+                || text.starts_with("another stream was asked first"),
             "{text}"
         );
     }
+}
+
+/// Two pages ask for a motion at the same moment: one runs, the other is refused at once (it does not run after
+/// the first, unasked for by then).
+#[test]
+fn of_two_streams_asked_at_once_from_two_pages_one_is_refused() {
+    let bench = Workbench::start(&[]);
+    let (mut a, mut b) = (bench.page(), bench.page());
+    let number = |p: &mut Page| p.until(Duration::from_secs(10), |m| m["type"] == "hello").unwrap()["page"].clone();
+    let (pa, pb) = (number(&mut a), number(&mut b));
+    homed(&mut a);
+    let motion = json!({ "do": "motion", "motion": "heave", "seconds": 2, "rate_hz": 100 });
+    let (ida, idb) = (a.send(motion.clone()), b.send(motion));
+    let ra = a
+        .until(Duration::from_secs(60), |m| is_reply(m, ida) && m["page"] == pa)
+        .unwrap();
+    let rb = b
+        .until(Duration::from_secs(60), |m| is_reply(m, idb) && m["page"] == pb)
+        .unwrap();
+    let refused: Vec<_> = [&ra, &rb].into_iter().filter(|r| r["ok"] == false).collect();
+    assert_eq!(refused.len(), 1, "{ra}\n{rb}");
+    assert!(
+        refused[0]["text"]
+            .as_str()
+            .unwrap()
+            .starts_with("another stream was asked first")
+            || refused[0]["text"].as_str().unwrap().starts_with("a stream is running"),
+        "{}",
+        refused[0]
+    );
 }
 
 #[test]

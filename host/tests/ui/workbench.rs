@@ -28,10 +28,15 @@ impl Workbench {
     /// `ringpod ui --sim --listen 127.0.0.1:0 ARGS`, once it printed its URL. `RINGPOD_UI_BIN` names another
     /// build to try the tests on (an older one, to see them fail).
     pub fn start(args: &[&str]) -> Self {
+        Self::on(&[&["--sim"][..], args].concat())
+    }
+
+    /// `ringpod ui --listen 127.0.0.1:0 ARGS` (the device named in them), once it printed its URL.
+    pub fn on(args: &[&str]) -> Self {
         let bin =
             std::env::var_os("RINGPOD_UI_BIN").map_or_else(|| assert_cmd::cargo::cargo_bin("ringpod"), Into::into);
         let mut child = Command::new(bin)
-            .args(["ui", "--sim", "--listen", "127.0.0.1:0"])
+            .args(["ui", "--listen", "127.0.0.1:0"])
             .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())

@@ -52,6 +52,7 @@ fn stream(fake: Fake, capture: Option<(Box<crate::input::capture::CaptureWriter>
         quiet: true,
         telemetry: false,
         telemetry_hz: None,
+        resend_stop: true,
     };
     crate::stream::run(&mut client, source, Vec::new(), &options, true, &|| false, None).unwrap()
 }

@@ -1,0 +1,75 @@
+//! A link that stalls mid-stream (`--port tcp://` through a proxy that holds the bytes): the CLI says so as it
+//! happens, and a stop given in the stall is given again until the device confirms it when the link comes back.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use common::proxy::Proxy;
+
+/// `ringpod simulate --tcp`, killed when dropped.
+struct Server(Child, String);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn serve() -> Server {
+    let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["simulate", "--tcp", "127.0.0.1:0"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    Server(child, line.trim().to_owned())
+}
+
+/// Ctrl-C 1.5 s into a 6 s stall of the link: the CLI says the link stalled and that the stop is pending, gives it
+/// again until the link returns, and reports the platform at rest (exit 130, state Ready) instead of a lost link.
+#[test]
+#[cfg(unix)]
+fn ctrl_c_in_a_stalled_link_is_confirmed_when_the_link_returns() {
+    let server = serve();
+    let proxy = Proxy::to(&server.1);
+    let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["stream", "--port", &proxy.addr, "--motion", "demo", "--duration", "60"])
+        .args(["--report-json", "--quiet"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Powering up and homing take about 10 s of the simulator's real time; the demo motion runs after them.
+    std::thread::sleep(Duration::from_secs(15));
+    proxy.stall(true);
+    std::thread::sleep(Duration::from_millis(1500));
+    assert!(Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    std::thread::sleep(Duration::from_millis(4500));
+    proxy.stall(false);
+    let mut said = String::new();
+    let mut stderr = child.stderr.take().unwrap();
+    let out = {
+        let status = child.wait().unwrap();
+        std::io::Read::read_to_string(&mut stderr, &mut said).unwrap();
+        let mut stdout = String::new();
+        std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
+        (status, stdout)
+    };
+    let report: serde_json::Value = serde_json::from_str(&out.1).unwrap_or_else(|e| panic!("{e}: {said}"));
+    assert_eq!(out.0.code(), Some(130), "{report}\n{said}");
+    assert_eq!(report["state"], "Ready", "{report}\n{said}");
+    assert!(said.contains("the link is stalled"), "{said}");
+    assert!(said.contains("STOP pending"), "{said}");
+    assert!(said.contains("the stop was confirmed after"), "{said}");
+}
