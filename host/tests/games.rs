@@ -71,9 +71,10 @@ impl Game {
             Game::Outsim2 => packets::outsim2::packet(0x1ff, ms, [0.0, 0.0, yaw], [0.0; 3], [-left, forward, 0.0]),
             // Car axes x right, y forward, z up; yaw rate positive to the left; no time (the arrival time).
             Game::Beamng => packets::beamng::packet([-left, forward, 0.0], [0.0, 0.0, 1.0], [0.0; 3], [0.0, 0.0, yaw]),
-            // g-forces lateral (right) and longitudinal; level: right = world x, forward = world z.
+            // g-forces lateral (left, as real recordings show) and longitudinal; level: right = world x, forward =
+            // world z.
             Game::Codemasters => {
-                packets::codemasters::packet(s, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], -left / G, forward / G)
+                packets::codemasters::packet(s, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], left / G, forward / G)
             }
             Game::F1 => packets::f1::packet(
                 2024,
