@@ -40,8 +40,14 @@
 //! | rate | 0: the motion packet has no angular rates (the cue comes from the forces alone) |
 //! | time | `m_sessionTime` |
 //!
-//! The signs of the three g-force components are assumed, not published: check them with a capture (accelerating
-//! must give force x > 0, a left turn force y > 0).
+//! The signs of the three g-force components are assumed, not published: EA's specifications (F1 23 to 25) call
+//! `m_gForceLateral` "Lateral G-Force component" and say no more, and no recording of continuous motion packets
+//! was found published to settle them by its own kinematics (the world velocity's derivative projected on
+//! `m_worldRightDir` against `m_gForceLateral`), only single packets, which cannot. Lateral is read as positive
+//! right, the sense the name of the vector beside it suggests. Caution: Codemasters' DiRT games, whose packet
+//! F1 2017's began with, send their lateral g positive *left* (their real recordings show it, see
+//! [`super::codemasters`]); if F1's engine kept that sense, ringpod's F1 sway and roll point the wrong way. A
+//! capture of a real lap settles it: in a left corner, force y must be positive.
 
 use super::{add, gravity_from_axes, Format, Le, Sample, Telemetry, Unreadable, G};
 
