@@ -235,6 +235,23 @@ fn every_format_drives_the_stream_end_to_end() {
     });
 }
 
+/// F1 sends its other packet types (here car telemetry, id 6) to the motion packet's port: live, one among the
+/// drive is skipped and counted apart, no input error, exit 0, named and with `auto`.
+#[test]
+fn the_games_other_packets_are_skipped_live() {
+    let mut telemetry = Game::F1.packet(300, 0.0, 0.0, 0.0);
+    telemetry[6] = 6;
+    for format in ["f1", "auto"] {
+        let (code, report, said) = session(format, Game::F1, Some(telemetry.clone()), &[]);
+        assert_eq!(code, Some(0), "{format}: {report} {said}");
+        let d = &report["datagrams"];
+        assert_eq!(d["skipped"], 1, "{format}: {report}");
+        assert_eq!(d["unreadable"], 0, "{format}: {report}");
+        assert_eq!(d["received"], SAMPLES + 1, "{format}: {report}");
+        assert_eq!(report["setpoints_applied"], SAMPLES, "{format}: {report}");
+    }
+}
+
 /// The optimal cueing live: the drive through `docs/drives/optimal.toml` (its 2 ms budget on whatever this
 /// machine gives a test), every datagram one setpoint applied (none rejected: what leaves the coupled envelope
 /// is limited on the host), the corner cued as the washout cues it, and its counts in the report adding up: one
