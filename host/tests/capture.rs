@@ -237,6 +237,81 @@ fn a_wireshark_pcapng_capture_is_cued() {
     assert!(last_pose(&poses)[0] < 0.0);
 }
 
+/// A Forza drive with a 20 s pause in the game's menu, as Wireshark saves it: Forza keeps sending at 60 Hz with
+/// `IsRaceOn` 0 and its clock running. Both parts of the drive are cued, the menu's packets skipped and counted,
+/// the pause reported, exit 0.
+#[test]
+fn a_forza_drive_with_a_pause_in_the_menu_is_cued_whole() {
+    use common::packets::forza;
+    let d = dir("forza-pause");
+    let mut file = pcapng_header();
+    // 2 s braking at 4 m/s^2 (car space Z forward), 20 s in the menu, 2 s braking again.
+    let parts = [(1, 0u32, 120u32), (0, 120, 1320), (1, 1320, 1440)];
+    for (race_on, from, to) in parts {
+        for k in from..to {
+            let ms = k * 1000 / 60;
+            let packet = forza::packet(forza::SLED, race_on, ms, [0.0, 0.0, -4.0], [0.0; 3], [0.0; 3]);
+            file.extend(epb(T0_NS + u64::from(ms) * 1_000_000, &ethernet_ipv4(17, 0, &packet)));
+        }
+    }
+    let path = d.join("forza.pcapng");
+    std::fs::write(&path, &file).unwrap();
+    let poses = d.join("poses.csv");
+    for format in ["forza", "auto"] {
+        let (code, summary, said) = cue(&path, &poses, &["--telemetry-format", format]);
+        assert_eq!(code, Some(0), "{format}: {summary} {said}");
+        assert_eq!(summary["rows"], 240, "{format}: {summary}");
+        assert_eq!(summary["input_errors"], serde_json::json!([]), "{format}: {summary}");
+        let c = &summary["capture"];
+        assert_eq!(
+            c["skipped"]["the game's packets without motion (other types, menus)"], 1200,
+            "{c}"
+        );
+        let pauses = summary["pauses"].as_array().unwrap();
+        assert_eq!(pauses.len(), 1, "{format}: {summary}");
+        assert_eq!(
+            pauses[0]["line"], 1321,
+            "{format}: the packet after the menu: {summary}"
+        );
+        assert!(
+            (pauses[0]["seconds"].as_f64().unwrap() - 20.0).abs() < 0.02,
+            "{summary}"
+        );
+        // Braking after the pause: the platform moves back again.
+        assert!(last_pose(&poses)[0] < 0.0, "{format}");
+    }
+}
+
+/// An F1 session's capture: each frame's motion packet among the other packet types the game sends to the same
+/// port (session, lap data, car telemetry). Every motion packet is cued, the others skipped and counted, exit 0.
+#[test]
+fn an_f1_capture_with_every_packet_type_is_cued_whole() {
+    let d = dir("f1-session");
+    let mut file = pcapng_header();
+    for k in 0..60u64 {
+        let t = k as f32 / 60.0;
+        for (id, len) in [(1u8, 753), (2, 1285), (0, 1349), (6, 1352)] {
+            let mut p = common::packets::f1::packet(2024, id, 3, t, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -0.4, 0.0]);
+            p.resize(len, 0);
+            file.extend(epb(T0_NS + k * 16_666_667 + u64::from(id), &ethernet_ipv4(17, 0, &p)));
+        }
+    }
+    let path = d.join("f1.pcapng");
+    std::fs::write(&path, &file).unwrap();
+    let poses = d.join("poses.csv");
+    for format in ["f1", "auto"] {
+        let (code, summary, said) = cue(&path, &poses, &["--telemetry-format", format]);
+        assert_eq!(code, Some(0), "{format}: {summary} {said}");
+        assert_eq!(summary["rows"], 60, "{format}: {summary}");
+        let c = &summary["capture"];
+        assert_eq!(
+            c["skipped"]["the game's packets without motion (other types, menus)"], 180,
+            "{c}"
+        );
+        assert!(last_pose(&poses)[0] < 0.0, "{format}: braking moves the platform back");
+    }
+}
+
 /// Damaged or foreign captures: refused with a message (or, cut off in a packet, cued up to it and said).
 #[test]
 fn damaged_captures_are_refused_with_a_message() {

@@ -43,9 +43,9 @@ pub struct CaptureSummary {
     pub skipped: BTreeMap<String, usize>,
 }
 
-/// Why a datagram of the game was not cued: another of its packet types (F1's session, lap data, ...), which
-/// carries no motion. Not an error.
-pub const GAME_PACKETS: &str = "the game's other packets (not motion)";
+/// Why a datagram of the game was not cued: another of its packet types (F1's session, lap data, ...) or the game
+/// in its menus (Forza's `IsRaceOn` 0), which carry no motion. Not an error.
+pub const GAME_PACKETS: &str = "the game's packets without motion (other types, menus)";
 
 /// A telemetry row as `cue` reads it from a CSV: its packet number and `t ax ay az wx wy wz`.
 pub type Row = (usize, Vec<f64>);

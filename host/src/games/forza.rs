@@ -22,8 +22,10 @@
 //! Forza Horizon 4 and 5 send the Sled fields, 12 bytes of their own, the Dash fields and one more byte: 324 bytes.
 //! Motion is in the Sled fields, at the same offsets in all four sizes.
 //!
-//! `IsRaceOn = 0` (menus, paused, the race stopped) is unreadable, not a car at rest: the stream's idle path then
-//! washes out to neutral as it does when a game stops sending.
+//! `IsRaceOn = 0` (menus, paused, the race stopped) is no motion, not a car at rest, and no error either: the game
+//! keeps sending while the player is in its menus, so such a packet is skipped ([`Unreadable::Skipped`]) and
+//! counted apart; the stream's idle path then washes out to neutral as it does when a game stops sending, and
+//! `cue` rests through the pause.
 //!
 //! ## Conversion
 //!
@@ -73,7 +75,7 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
     match le.i32(0) {
         1 => {}
         0 => {
-            return Err(Unreadable::NoMotion {
+            return Err(Unreadable::Skipped {
                 format: Format::Forza,
                 why: "IsRaceOn is 0: in the menus, paused or the race stopped".into(),
             })
@@ -144,7 +146,7 @@ mod tests {
     #[test]
     fn paused_and_wrong_packets_are_refused() {
         let paused = packet(SLED, 0, [0.0; 3], [0.0; 3], [0.0; 3]);
-        assert!(matches!(decode(&paused), Err(Unreadable::NoMotion { .. })));
+        assert!(matches!(decode(&paused), Err(Unreadable::Skipped { .. })));
         let odd = packet(SLED, 7, [0.0; 3], [0.0; 3], [0.0; 3]);
         assert!(matches!(decode(&odd), Err(Unreadable::Header { .. })));
         let good = packet(DASH_FM7, 1, [0.0; 3], [0.0; 3], [0.0; 3]);
