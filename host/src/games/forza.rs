@@ -45,9 +45,15 @@
 //! | rate yaw | `-AngularVelocityY` |
 //! | time | `TimestampMS / 1000` |
 //!
-//! The documentation gives the axes, not the sense of the rotations nor whether the acceleration holds gravity:
-//! those are assumed as above; check with a capture (accelerating gives force x > 0, a left turn force y > 0 and
-//! yaw rate > 0, a nose-up hill at rest force x > 0).
+//! The documentation gives the axes, not the sense of the rotations nor whether the acceleration holds gravity.
+//! Two real Forza Motorsport 7 laps (forza-telemetry, `austinbaccus/forza-telemetry`, `data/laguna-seca.csv` and
+//! `data/nurburgring.csv`) settle all but one by their own kinematics and the tracks' real directions: a positive
+//! `AngularVelocityY` turns right (anticlockwise Laguna Seca integrates to -2 pi, the clockwise Nürburgring to
+//! +2 pi), `AccelerationX` is positive right (it follows `VelocityZ * AngularVelocityY`), `AccelerationZ` forwards
+//! (it follows the speed's derivative), gravity is not in the acceleration, and a positive `Pitch` and
+//! `AngularVelocityX` are nose down (`Pitch` against the road's slope: -0.998). The roll angle's sense is still
+//! assumed (body roll and road banking confound it; the roll rate agrees with the angle's derivative): check it
+//! with a capture (at rest on a camber sloping down to the right, force y > 0).
 
 use super::{add, gravity_from_attitude, Format, Le, Sample, Telemetry, Unreadable};
 
