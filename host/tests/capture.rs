@@ -282,13 +282,16 @@ fn a_forza_drive_with_a_pause_in_the_menu_is_cued_whole() {
     }
 }
 
+/// A Forza row's motion fields: `TimestampMS`, acceleration, angular velocity, yaw, pitch and roll.
+type ForzaRow = (u32, [f32; 3], [f32; 3], [f32; 3]);
+
 /// The first 14 rows of a real Forza Motorsport 7 lap of Laguna Seca: forza-telemetry (Austin Baccus, MIT License,
 /// "Copyright (c) 2021 Austin Baccus"), `github.com/austinbaccus/forza-telemetry`, `data/laguna-seca.csv` at commit
 /// a0dff69: `TimestampMS`, `AccelerationX/Y/Z`, `AngularVelocityX/Y/Z`, `Yaw`, `Pitch`, `Roll`, as logged from the
 /// game's Data Out. After its first row the game paused for 20.3 s; then the car climbs to Turn 1, a left kink,
 /// at 56-64 m/s (its heading turns 0.21 rad left, `Yaw` falling as it does over the anticlockwise lap).
 #[rustfmt::skip]
-const LAGUNA_SECA: [(u32, [f32; 3], [f32; 3], [f32; 3]); 14] = [
+const LAGUNA_SECA: [ForzaRow; 14] = [
     (105962421, [-2.1221318, 0.26743877, -2.733962], [0.007933499, 0.002314907, 0.047476143], [-2.5394783, -0.043695558, -0.0018316997]),
     (105982718, [-0.1516254, 3.939925, -4.28901], [-0.051847145, -0.0009081103, -0.0014404207], [-2.5394187, -0.050641254, 0.0014512936]),
     (105982828, [-0.08327532, -1.0727226, -3.6704316], [-0.011708598, -2.7091883e-6, -0.009476445], [-2.5394907, -0.05006072, 0.0012305158]),
