@@ -237,6 +237,138 @@ fn a_wireshark_pcapng_capture_is_cued() {
     assert!(last_pose(&poses)[0] < 0.0);
 }
 
+/// A Forza drive with a 20 s pause in the game's menu, as Wireshark saves it: Forza keeps sending at 60 Hz with
+/// `IsRaceOn` 0 and its clock running. Both parts of the drive are cued, the menu's packets skipped and counted,
+/// the pause reported, exit 0.
+#[test]
+fn a_forza_drive_with_a_pause_in_the_menu_is_cued_whole() {
+    use common::packets::forza;
+    let d = dir("forza-pause");
+    let mut file = pcapng_header();
+    // 2 s braking at 4 m/s^2 (car space Z forward), 20 s in the menu, 2 s braking again.
+    let parts = [(1, 0u32, 120u32), (0, 120, 1320), (1, 1320, 1440)];
+    for (race_on, from, to) in parts {
+        for k in from..to {
+            let ms = k * 1000 / 60;
+            let packet = forza::packet(forza::SLED, race_on, ms, [0.0, 0.0, -4.0], [0.0; 3], [0.0; 3]);
+            file.extend(epb(T0_NS + u64::from(ms) * 1_000_000, &ethernet_ipv4(17, 0, &packet)));
+        }
+    }
+    let path = d.join("forza.pcapng");
+    std::fs::write(&path, &file).unwrap();
+    let poses = d.join("poses.csv");
+    for format in ["forza", "auto"] {
+        let (code, summary, said) = cue(&path, &poses, &["--telemetry-format", format]);
+        assert_eq!(code, Some(0), "{format}: {summary} {said}");
+        assert_eq!(summary["rows"], 240, "{format}: {summary}");
+        assert_eq!(summary["input_errors"], serde_json::json!([]), "{format}: {summary}");
+        let c = &summary["capture"];
+        assert_eq!(
+            c["skipped"]["the game's packets without motion (other types, menus)"], 1200,
+            "{c}"
+        );
+        let pauses = summary["pauses"].as_array().unwrap();
+        assert_eq!(pauses.len(), 1, "{format}: {summary}");
+        assert_eq!(
+            pauses[0]["line"], 1321,
+            "{format}: the packet after the menu: {summary}"
+        );
+        assert!(
+            (pauses[0]["seconds"].as_f64().unwrap() - 20.0).abs() < 0.02,
+            "{summary}"
+        );
+        // Braking after the pause: the platform moves back again.
+        assert!(last_pose(&poses)[0] < 0.0, "{format}");
+    }
+}
+
+/// A Forza row's motion fields: `TimestampMS`, acceleration, angular velocity, yaw, pitch and roll.
+type ForzaRow = (u32, [f32; 3], [f32; 3], [f32; 3]);
+
+/// The first 14 rows of a real Forza Motorsport 7 lap of Laguna Seca: forza-telemetry (Austin Baccus, MIT License,
+/// "Copyright (c) 2021 Austin Baccus"), `github.com/austinbaccus/forza-telemetry`, `data/laguna-seca.csv` at commit
+/// a0dff69: `TimestampMS`, `AccelerationX/Y/Z`, `AngularVelocityX/Y/Z`, `Yaw`, `Pitch`, `Roll`, as logged from the
+/// game's Data Out. After its first row the game paused for 20.3 s; then the car climbs to Turn 1, a left kink,
+/// at 56-64 m/s (its heading turns 0.21 rad left, `Yaw` falling as it does over the anticlockwise lap).
+#[rustfmt::skip]
+const LAGUNA_SECA: [ForzaRow; 14] = [
+    (105962421, [-2.1221318, 0.26743877, -2.733962], [0.007933499, 0.002314907, 0.047476143], [-2.5394783, -0.043695558, -0.0018316997]),
+    (105982718, [-0.1516254, 3.939925, -4.28901], [-0.051847145, -0.0009081103, -0.0014404207], [-2.5394187, -0.050641254, 0.0014512936]),
+    (105982828, [-0.08327532, -1.0727226, -3.6704316], [-0.011708598, -2.7091883e-6, -0.009476445], [-2.5394907, -0.05006072, 0.0012305158]),
+    (105982937, [-5.7388973, 3.8094172, -0.23267293], [-0.063534506, -0.22932602, -0.09312778], [-2.5501423, -0.057508823, -0.0053437985]),
+    (105983046, [-15.221707, 3.9150503, 3.1514926], [-0.0692549, -0.42893708, -0.051040106], [-2.5879524, -0.0664587, -0.0107511375]),
+    (105983140, [-15.657779, 2.8247707, 5.3592577], [-0.074907385, -0.086303085, 0.0326446], [-2.6247241, -0.07236691, -0.009702182]),
+    (105983265, [-4.720371, 4.5331306, 7.5716405], [-0.11756057, 0.010523499, 0.054731183], [-2.62385, -0.08313476, -0.00320681]),
+    (105983375, [-1.319216, 3.3794131, 9.253114], [-0.032351527, -0.03387612, -0.010494449], [-2.6242628, -0.089737415, -0.0012174621]),
+    (105983484, [-6.6353736, 4.390136, 10.774042], [-0.101385176, -0.22956549, -0.02913884], [-2.6389403, -0.0970247, -0.002472094]),
+    (105983593, [-10.349028, 2.2927942, 10.7442465], [0.08370036, -0.19475761, -0.018750433], [-2.6632643, -0.10172155, -0.0034456807]),
+    (105983687, [-10.879368, -3.8616219, 11.114133], [-0.0006026947, -0.27840155, -0.04235768], [-2.6875415, -0.092995495, 0.0002917871]),
+    (105983796, [-16.110498, 3.729642, 10.532394], [-0.046206262, -0.22342199, -0.004531618], [-2.7145724, -0.09791153, -0.0014752041]),
+    (105983921, [-12.654116, -2.2237518, 9.732622], [-0.010193082, -0.19198637, -0.0013354998], [-2.7395246, -0.09974552, 0.0016728309]),
+    (105984031, [-8.961039, 1.2503269, 4.2490206], [0.059324585, 0.0039602052, 0.09544514], [-2.7485256, -0.09792113, 0.0056137103]),
+];
+
+/// The real lap's start, its motion fields as the recording has them in Sled packets (the other fields the
+/// builder's): cued whole, the 20.3 s pause reported, exit 0; through Turn 1 the platform turns and tilts left.
+#[test]
+fn a_real_forza_lap_with_a_pause_is_cued_whole_and_turns_left() {
+    use common::packets::forza;
+    let d = dir("forza-laguna-seca");
+    let mut file = pcapng_header();
+    for (ms, accel, ang_vel, ypr) in LAGUNA_SECA {
+        let packet = forza::packet(forza::SLED, 1, ms, accel, ang_vel, ypr);
+        file.extend(epb(T0_NS + u64::from(ms) * 1_000_000, &ethernet_ipv4(17, 0, &packet)));
+    }
+    let path = d.join("laguna-seca.pcapng");
+    std::fs::write(&path, &file).unwrap();
+    let poses = d.join("poses.csv");
+    let (code, summary, said) = cue(&path, &poses, &["--telemetry-format", "forza"]);
+    assert_eq!(code, Some(0), "{summary} {said}");
+    assert_eq!(summary["rows"], 14, "{summary}");
+    let pauses = summary["pauses"].as_array().unwrap();
+    assert_eq!(pauses.len(), 1, "{summary}");
+    assert_eq!(pauses[0]["line"], 2, "{summary}");
+    assert!(
+        (pauses[0]["seconds"].as_f64().unwrap() - 20.297).abs() < 1e-6,
+        "{summary}"
+    );
+    // x, y, z, alpha (roll), beta (pitch), gamma (yaw): turned left with the car's heading, right side down for
+    // the force to the left.
+    let last = last_pose(&poses);
+    assert!(last[5] > 0.1, "turned left: {last:?}");
+    assert!(last[3] > 0.0, "tilted for a force to the left: {last:?}");
+}
+
+/// An F1 session's capture: each frame's motion packet among the other packet types the game sends to the same
+/// port (session, lap data, car telemetry). Every motion packet is cued, the others skipped and counted, exit 0.
+#[test]
+fn an_f1_capture_with_every_packet_type_is_cued_whole() {
+    let d = dir("f1-session");
+    let mut file = pcapng_header();
+    for k in 0..60u64 {
+        let t = k as f32 / 60.0;
+        for (id, len) in [(1u8, 753), (2, 1285), (0, 1349), (6, 1352)] {
+            let mut p = common::packets::f1::packet(2024, id, 3, t, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -0.4, 0.0]);
+            p.resize(len, 0);
+            file.extend(epb(T0_NS + k * 16_666_667 + u64::from(id), &ethernet_ipv4(17, 0, &p)));
+        }
+    }
+    let path = d.join("f1.pcapng");
+    std::fs::write(&path, &file).unwrap();
+    let poses = d.join("poses.csv");
+    for format in ["f1", "auto"] {
+        let (code, summary, said) = cue(&path, &poses, &["--telemetry-format", format]);
+        assert_eq!(code, Some(0), "{format}: {summary} {said}");
+        assert_eq!(summary["rows"], 60, "{format}: {summary}");
+        let c = &summary["capture"];
+        assert_eq!(
+            c["skipped"]["the game's packets without motion (other types, menus)"], 180,
+            "{c}"
+        );
+        assert!(last_pose(&poses)[0] < 0.0, "{format}: braking moves the platform back");
+    }
+}
+
 /// Damaged or foreign captures: refused with a message (or, cut off in a packet, cued up to it and said).
 #[test]
 fn damaged_captures_are_refused_with_a_message() {

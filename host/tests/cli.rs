@@ -553,7 +553,8 @@ fn cue_reports_bad_rows_and_refuses_bad_parameters_by_name() {
     let dir = std::env::temp_dir().join(format!("ringpod-cue-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("drive.csv");
-    // A NaN at 3 s (the platform holds), and a 2 s gap after 12 s (the washout starts again at neutral).
+    // A NaN at 3 s (the platform holds: an input error), and a 2 s pause after 12 s (the washout rests through it
+    // and starts again at neutral: reported, not an error).
     let csv = drive_csv(&mut |t, v| {
         if (t - 3.0).abs() < 1e-9 {
             v[0] = f64::NAN;
@@ -579,10 +580,13 @@ fn cue_reports_bad_rows_and_refuses_bad_parameters_by_name() {
     assert_eq!(out.status.code(), Some(3));
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let errors = summary["input_errors"].as_array().unwrap();
-    assert_eq!(errors.len(), 2, "{errors:?}");
+    assert_eq!(errors.len(), 1, "{errors:?}");
     assert_eq!(errors[0]["line"], 302, "the row of t = 3 s");
     assert!(errors[0]["reason"].as_str().unwrap().contains("not finite"));
-    assert!(errors[1]["reason"].as_str().unwrap().contains("neutral"));
+    let pauses = summary["pauses"].as_array().unwrap();
+    assert_eq!(pauses.len(), 1, "{summary}");
+    assert_eq!(pauses[0]["line"], 1203, "the row of t = 14 s, after the rows it lacks");
+    assert!((pauses[0]["seconds"].as_f64().unwrap() - 2.0).abs() < 1e-6, "{summary}");
     for (toml, key) in [
         ("tilt_rate_deg = -3.0\n", "tilt_rate_deg"),
         ("tilt_rate = 3.0\n", "tilt_rate"),

@@ -71,9 +71,10 @@ impl Game {
             Game::Outsim2 => packets::outsim2::packet(0x1ff, ms, [0.0, 0.0, yaw], [0.0; 3], [-left, forward, 0.0]),
             // Car axes x right, y forward, z up; yaw rate positive to the left; no time (the arrival time).
             Game::Beamng => packets::beamng::packet([-left, forward, 0.0], [0.0, 0.0, 1.0], [0.0; 3], [0.0, 0.0, yaw]),
-            // g-forces lateral (right) and longitudinal; level: right = world x, forward = world z.
+            // g-forces lateral (left, as real recordings show) and longitudinal; level: right = world x, forward =
+            // world z.
             Game::Codemasters => {
-                packets::codemasters::packet(s, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], -left / G, forward / G)
+                packets::codemasters::packet(s, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], left / G, forward / G)
             }
             Game::F1 => packets::f1::packet(
                 2024,
@@ -232,6 +233,23 @@ fn every_format_drives_the_stream_end_to_end() {
             }
         }
     });
+}
+
+/// F1 sends its other packet types (here car telemetry, id 6) to the motion packet's port: live, one among the
+/// drive is skipped and counted apart, no input error, exit 0, named and with `auto`.
+#[test]
+fn the_games_other_packets_are_skipped_live() {
+    let mut telemetry = Game::F1.packet(300, 0.0, 0.0, 0.0);
+    telemetry[6] = 6;
+    for format in ["f1", "auto"] {
+        let (code, report, said) = session(format, Game::F1, Some(telemetry.clone()), &[]);
+        assert_eq!(code, Some(0), "{format}: {report} {said}");
+        let d = &report["datagrams"];
+        assert_eq!(d["skipped"], 1, "{format}: {report}");
+        assert_eq!(d["unreadable"], 0, "{format}: {report}");
+        assert_eq!(d["received"], SAMPLES + 1, "{format}: {report}");
+        assert_eq!(report["setpoints_applied"], SAMPLES, "{format}: {report}");
+    }
 }
 
 /// The optimal cueing live: the drive through `docs/drives/optimal.toml` (its 2 ms budget on whatever this

@@ -10,6 +10,7 @@ use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
+use super::cue_engine::Pause;
 use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
@@ -32,9 +33,10 @@ pub struct Summary {
     pub poses: usize,
     /// Poses the envelope limited.
     pub limited: usize,
-    /// Rows that could not be used: unreadable, not finite (the platform held), or after a gap of more than a
-    /// second (the washout went back to neutral).
+    /// Rows that could not be used: unreadable, not finite (the platform held), or not after the row before.
     pub input_errors: Vec<InputError>,
+    /// Pauses of more than a second (the washout rested through them and started again at neutral): not errors.
+    pub pauses: Vec<Pause>,
     /// A packet capture's input: what it held (its input errors are numbered by packet).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub capture: Option<super::cue_capture::CaptureSummary>,
@@ -61,6 +63,8 @@ pub struct Replay {
     pub limited: usize,
     /// Rows that could not be used, by line.
     pub errors: Vec<InputError>,
+    /// Pauses of more than a second, each ended by its line.
+    pub pauses: Vec<Pause>,
     /// The optimal cueing's counts (solves, fallbacks, solve times); none for the classical washout.
     pub counts: Option<super::optimal::Counts>,
 }
@@ -116,7 +120,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         limited,
         errors: mut cue_errors,
         counts,
-        ..
+        pauses,
     } = replay(&rows, config, &mechanism, &neutral, &envelope, args.preview)?;
     errors.append(&mut cue_errors);
     errors.sort_by_key(|e| e.line);
@@ -129,6 +133,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         poses: cued.len(),
         limited,
         input_errors: errors,
+        pauses,
         capture,
         optimal: counts,
     };
@@ -161,6 +166,12 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
             );
         }
         let unit = if summary.capture.is_some() { "packet" } else { "line" };
+        for p in &summary.pauses {
+            s += &format!(
+                "{unit} {}: after a pause of {:.1} s, cued again from neutral\n",
+                p.line, p.seconds
+            );
+        }
         for e in &summary.input_errors {
             s += &format!("{unit} {}: {}\n", e.line, e.reason);
         }
@@ -215,7 +226,7 @@ pub fn replay(
     let mut washout = super::cue_engine::Engine::new(config, envelope).map_err(CueError::Washout)?;
     // A recorded drive's next samples, for the optimal cueing's preview.
     let preview = washout.horizon().filter(|_| preview);
-    let mut errors = Vec::new();
+    let (mut errors, mut pauses) = (Vec::new(), Vec::new());
     let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
     let mut limited = 0;
     let mut last_t: Option<f64> = None;
@@ -231,6 +242,7 @@ pub fn replay(
                 washout.step(&sample, t - l, &ahead)
             }
         };
+        let dt = last_t.map_or(0.0, |l| t - l);
         last_t = Some(t);
         let pose = match offset {
             Ok(offset) => {
@@ -246,10 +258,18 @@ pub fn replay(
                 });
                 held
             }
-            Err(SampleError::Interval) => {
+            Err(SampleError::Interval) if dt <= 0.0 => {
                 errors.push(InputError {
                     line: *line,
-                    reason: "more than a second after the row before: the washout starts again at neutral".into(),
+                    reason: "its time is not after the row before's: the platform holds".into(),
+                });
+                held
+            }
+            Err(SampleError::Interval) => {
+                // A pause (a game's menu): the washout has rested to neutral through it, and starts again here.
+                pauses.push(Pause {
+                    line: *line,
+                    seconds: dt,
                 });
                 washout.reset();
                 // This row starts the washout again: its first input.
@@ -264,6 +284,7 @@ pub fn replay(
         cued,
         limited,
         errors,
+        pauses,
         counts: washout.counts().cloned(),
     })
 }
@@ -544,6 +565,11 @@ mod tests {
 
     /// Cues `rows` of telemetry (`t, ax`) on the trainer model and returns the poses' x.
     fn cue_x(name: &str, rows: &[(f64, f64)]) -> Vec<f64> {
+        cue_rows(name, rows).2
+    }
+
+    /// Cues `rows` of telemetry (`t, ax`) on the trainer model: its JSON summary, exit code and the poses' x.
+    fn cue_rows(name: &str, rows: &[(f64, f64)]) -> (serde_json::Value, u8, Vec<f64>) {
         let dir = std::env::temp_dir().join(format!("ringpod-cue-{name}-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let (input, out) = (dir.join("in.csv"), dir.join("out.csv"));
@@ -561,19 +587,56 @@ mod tests {
             config: None,
             profile: None,
             plot: None,
-            json: false,
+            json: true,
             preview: false,
             mechanism: "trainer-model",
             geometry: None,
         };
-        run(&options).unwrap();
+        let (summary, code) = run(&options).unwrap();
         let poses = std::fs::read_to_string(&out).unwrap();
         std::fs::remove_dir_all(&dir).unwrap();
-        poses
+        let x = poses
             .lines()
             .skip(1)
             .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
-            .collect()
+            .collect();
+        (serde_json::from_str(&summary).unwrap(), code, x)
+    }
+
+    /// A drive with a 20 s pause (a game's menu): both parts cued, the pause reported, no input error, exit 0; the
+    /// row after it starts again at neutral. A row whose time is not after the one before's is an input error.
+    #[test]
+    fn a_pause_is_a_pause_not_an_input_error() {
+        let braking = |from: f64| (0..100).map(move |k| (from + f64::from(k) * 0.01, -6.0));
+        let rows: Vec<(f64, f64)> = braking(0.0).chain(braking(21.0)).collect();
+        let (summary, code, x) = cue_rows("pause", &rows);
+        assert_eq!(code, 0, "{summary}");
+        assert_eq!(summary["input_errors"], serde_json::json!([]), "{summary}");
+        let pauses = summary["pauses"].as_array().unwrap();
+        assert_eq!(pauses.len(), 1, "{summary}");
+        assert_eq!(
+            pauses[0]["line"], 102,
+            "the row after it (line 1 is the header): {summary}"
+        );
+        assert!(
+            (pauses[0]["seconds"].as_f64().unwrap() - 20.01).abs() < 1e-6,
+            "{summary}"
+        );
+        assert_eq!(x.len(), 200);
+        // Braking moves the platform back; the row after the pause is at neutral, and braking moves it again.
+        assert!(
+            x[99] < -1e-3 && x[100].abs() < 1e-9 && x[199] < -1e-3,
+            "{} {} {}",
+            x[99],
+            x[100],
+            x[199]
+        );
+
+        let mut repeated = rows.clone();
+        repeated[50].0 = repeated[49].0;
+        let (summary, code, _) = cue_rows("repeated", &repeated);
+        assert_eq!(code, EXIT_INPUT_ERRORS, "{summary}");
+        assert_eq!(summary["input_errors"][0]["line"], 52, "{summary}");
     }
 
     #[test]

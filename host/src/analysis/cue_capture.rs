@@ -8,7 +8,8 @@
 //! carries one, as the live path (`stream --telemetry-udp`) takes it, else the packet's capture time (from the first
 //! datagram taken), the live path's arrival time. A datagram the format cannot read, or whose time is not after the
 //! last one's, is an input error named by its packet number (as the live path counts an unreadable datagram);
-//! packets that are not UDP, go to another port, are IP fragments or are cut short are skipped and counted.
+//! packets that are not UDP, go to another port, are IP fragments or are cut short are skipped and counted, as are
+//! the game's other packets (F1 sends session, lap data, ... to the motion packet's port: [`GAME_PACKETS`]).
 
 use std::collections::BTreeMap;
 
@@ -38,9 +39,13 @@ pub struct CaptureSummary {
     pub ports: BTreeMap<u16, usize>,
     /// The senders of the datagrams taken (address and port) and their datagrams.
     pub senders: BTreeMap<String, usize>,
-    /// Packets not taken, by why.
+    /// Packets not taken, by why; among them the datagrams that are the game's other packets ([`GAME_PACKETS`]).
     pub skipped: BTreeMap<String, usize>,
 }
+
+/// Why a datagram of the game was not cued: another of its packet types (F1's session, lap data, ...) or the game
+/// in its menus (Forza's `IsRaceOn` 0), which carry no motion. Not an error.
+pub const GAME_PACKETS: &str = "the game's packets without motion (other types, menus)";
 
 /// A telemetry row as `cue` reads it from a CSV: its packet number and `t ax ay az wx wy wz`.
 pub type Row = (usize, Vec<f64>);
@@ -98,7 +103,11 @@ pub fn rows(
     for d in taken {
         let mut refuse = |reason: String| errors.push(InputError { line: d.number, reason });
         let sample = match reader.read(&d.payload) {
-            Ok(sample) => sample,
+            Ok(Some(sample)) => sample,
+            Ok(None) => {
+                *summary.skipped.entry(GAME_PACKETS.into()).or_default() += 1;
+                continue;
+            }
             Err(reason) => {
                 refuse(reason);
                 continue;

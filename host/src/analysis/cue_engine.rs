@@ -122,3 +122,13 @@ pub fn row_sample(v: &[f64]) -> Telemetry<f64> {
         rate: [v[4], v[5], v[6]],
     }
 }
+
+/// A pause in a drive: more than a second between two rows (a game's menu, its pause). The washout rests through it
+/// and starts again at neutral from the row after it, as the live stream glides to neutral while a game is silent.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Pause {
+    /// The row after the pause (its line, or its packet in a capture).
+    pub line: usize,
+    /// How long the drive paused (s).
+    pub seconds: f64,
+}

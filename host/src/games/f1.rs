@@ -22,8 +22,10 @@
 //! `m_worldForwardDirX/Y/Z` and `m_worldRightDirX/Y/Z` (6 i16, normalised: divide by 32767),
 //! `m_gForceLateral`, `m_gForceLongitudinal`, `m_gForceVertical` (3 f32, g), `m_yaw`, `m_pitch`, `m_roll` (3 f32,
 //! rad). F1 23, 24 and 25 use this same layout; F1 22 and earlier (format 2022 and below) had another header and
-//! are refused, as is every other packet id (the motion packet is "only sent while player is in control"; the
-//! extended motion packet, id 13, carries the player's angular velocity but no g-forces).
+//! are refused. Every other packet id (session, lap data, car telemetry, ...: the game sends them all to the same
+//! port) is skipped, not an error ([`Unreadable::Skipped`]; the motion packet is "only sent while player is in
+//! control"; the extended motion packet, id 13, carries the player's angular velocity but no g-forces). A motion
+//! packet while spectating (`m_playerCarIndex` 255) has no player's car: refused, saying so.
 //!
 //! ## Conversion
 //!
@@ -40,8 +42,14 @@
 //! | rate | 0: the motion packet has no angular rates (the cue comes from the forces alone) |
 //! | time | `m_sessionTime` |
 //!
-//! The signs of the three g-force components are assumed, not published: check them with a capture (accelerating
-//! must give force x > 0, a left turn force y > 0).
+//! The signs of the three g-force components are assumed, not published: EA's specifications (F1 23 to 25) call
+//! `m_gForceLateral` "Lateral G-Force component" and say no more, and no recording of continuous motion packets
+//! was found published to settle them by its own kinematics (the world velocity's derivative projected on
+//! `m_worldRightDir` against `m_gForceLateral`), only single packets, which cannot. Lateral is read as positive
+//! right, the sense the name of the vector beside it suggests. Caution: Codemasters' DiRT games, whose packet
+//! F1 2017's began with, send their lateral g positive *left* (their real recordings show it, see
+//! [`super::codemasters`]); if F1's engine kept that sense, ringpod's F1 sway and roll point the wrong way. A
+//! capture of a real lap settles it: in a left corner, force y must be positive.
 
 use super::{add, gravity_from_axes, Format, Le, Sample, Telemetry, Unreadable, G};
 
@@ -53,6 +61,8 @@ pub const CAR: usize = 60;
 pub const CARS: usize = 22;
 /// The motion packet's size.
 pub const MOTION_SIZE: usize = HEADER + CAR * CARS;
+/// `m_playerCarIndex` while the game spectates: there is no player's car.
+pub const SPECTATING: u8 = 255;
 
 /// Whether the first bytes are an F1 23/24/25 header: the packet format, its year and a known packet id.
 pub fn header_fits(bytes: &[u8]) -> bool {
@@ -82,7 +92,7 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
     }
     let id = bytes[6];
     if id != 0 {
-        return Err(Unreadable::NoMotion {
+        return Err(Unreadable::Skipped {
             format,
             why: format!("packet id {id}, not the motion packet (0)"),
         });
@@ -95,10 +105,18 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
         });
     }
     let player = usize::from(bytes[27]);
+    if player == usize::from(SPECTATING) {
+        return Err(Unreadable::NoMotion {
+            format,
+            why: "player car index 255: the game is spectating, and ringpod cues the player's own car only: \
+                  drive a car (a session of your own, not a spectated one) to cue it"
+                .into(),
+        });
+    }
     if player >= CARS {
         return Err(Unreadable::NoMotion {
             format,
-            why: format!("player car index {player}: not a car (spectating?)"),
+            why: format!("player car index {player}: not one of the {CARS} cars"),
         });
     }
     let at = HEADER + CAR * player;
@@ -167,7 +185,7 @@ mod tests {
         // Another packet type of F1 (car telemetry, id 6) is F1's, but no motion.
         let telemetry = packet(2024, 6, 2, LEVEL_F, LEVEL_R, [0.0; 3]);
         assert_eq!(recognise(&telemetry[..1352.min(telemetry.len())]), Some(Format::F1));
-        assert!(matches!(decode(&telemetry), Err(Unreadable::NoMotion { .. })));
+        assert!(matches!(decode(&telemetry), Err(Unreadable::Skipped { .. })));
         // F1 22 (format 2022) and F1 2019.
         for old in [2022u16, 2019] {
             let mut p = good.clone();
@@ -178,9 +196,16 @@ mod tests {
         // Wrong sizes.
         assert!(decode(&good[..1348]).is_err());
         assert!(decode(&good[..20]).is_err());
-        // Spectating: no player car.
+        // Spectating: no player car, said by name with what to do; another index beyond the cars.
         let mut p = good.clone();
-        p[27] = 255;
+        p[27] = SPECTATING;
+        let e = decode(&p).unwrap_err();
+        assert!(matches!(e, Unreadable::NoMotion { .. }), "{e}");
+        assert!(
+            e.to_string().contains("spectating") && e.to_string().contains("drive a car"),
+            "{e}"
+        );
+        p[27] = 22;
         assert!(matches!(decode(&p), Err(Unreadable::NoMotion { .. })));
         // Not finite.
         let mut p = good;

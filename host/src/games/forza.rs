@@ -22,8 +22,10 @@
 //! Forza Horizon 4 and 5 send the Sled fields, 12 bytes of their own, the Dash fields and one more byte: 324 bytes.
 //! Motion is in the Sled fields, at the same offsets in all four sizes.
 //!
-//! `IsRaceOn = 0` (menus, paused, the race stopped) is unreadable, not a car at rest: the stream's idle path then
-//! washes out to neutral as it does when a game stops sending.
+//! `IsRaceOn = 0` (menus, paused, the race stopped) is no motion, not a car at rest, and no error either: the game
+//! keeps sending while the player is in its menus, so such a packet is skipped ([`Unreadable::Skipped`]) and
+//! counted apart; the stream's idle path then washes out to neutral as it does when a game stops sending, and
+//! `cue` rests through the pause.
 //!
 //! ## Conversion
 //!
@@ -43,9 +45,15 @@
 //! | rate yaw | `-AngularVelocityY` |
 //! | time | `TimestampMS / 1000` |
 //!
-//! The documentation gives the axes, not the sense of the rotations nor whether the acceleration holds gravity:
-//! those are assumed as above; check with a capture (accelerating gives force x > 0, a left turn force y > 0 and
-//! yaw rate > 0, a nose-up hill at rest force x > 0).
+//! The documentation gives the axes, not the sense of the rotations nor whether the acceleration holds gravity.
+//! Two real Forza Motorsport 7 laps (forza-telemetry, `austinbaccus/forza-telemetry`, `data/laguna-seca.csv` and
+//! `data/nurburgring.csv`) settle all but one by their own kinematics and the tracks' real directions: a positive
+//! `AngularVelocityY` turns right (anticlockwise Laguna Seca integrates to -2 pi, the clockwise Nürburgring to
+//! +2 pi), `AccelerationX` is positive right (it follows `VelocityZ * AngularVelocityY`), `AccelerationZ` forwards
+//! (it follows the speed's derivative), gravity is not in the acceleration, and a positive `Pitch` and
+//! `AngularVelocityX` are nose down (`Pitch` against the road's slope: -0.998). The roll angle's sense is still
+//! assumed (body roll and road banking confound it; the roll rate agrees with the angle's derivative): check it
+//! with a capture (at rest on a camber sloping down to the right, force y > 0).
 
 use super::{add, gravity_from_attitude, Format, Le, Sample, Telemetry, Unreadable};
 
@@ -73,7 +81,7 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
     match le.i32(0) {
         1 => {}
         0 => {
-            return Err(Unreadable::NoMotion {
+            return Err(Unreadable::Skipped {
                 format: Format::Forza,
                 why: "IsRaceOn is 0: in the menus, paused or the race stopped".into(),
             })
@@ -144,7 +152,7 @@ mod tests {
     #[test]
     fn paused_and_wrong_packets_are_refused() {
         let paused = packet(SLED, 0, [0.0; 3], [0.0; 3], [0.0; 3]);
-        assert!(matches!(decode(&paused), Err(Unreadable::NoMotion { .. })));
+        assert!(matches!(decode(&paused), Err(Unreadable::Skipped { .. })));
         let odd = packet(SLED, 7, [0.0; 3], [0.0; 3], [0.0; 3]);
         assert!(matches!(decode(&odd), Err(Unreadable::Header { .. })));
         let good = packet(DASH_FM7, 1, [0.0; 3], [0.0; 3], [0.0; 3]);

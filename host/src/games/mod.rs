@@ -15,8 +15,10 @@
 //! | `xplane` | [`xplane`] | X-Plane 10, 11 and 12 (`DATA` packets) |
 //!
 //! A datagram is decoded whole or refused whole ([`Unreadable`], saying why): a wrong size or header, a value that is
-//! not finite, a packet of the format that carries no motion (another F1 packet, Forza in the menus, F1 spectating),
-//! is never half-used.
+//! not finite, a packet of the format that carries no motion (F1 spectating, a data set missing), is never
+//! half-used. Another of the game's packet types (F1's session, lap data, car telemetry, ...) or the game in its
+//! menus (Forza's `IsRaceOn` 0) is no error: it is [`Unreadable::Skipped`], and the reader passes it over
+//! ([`Reader::read`] gives `None`).
 //!
 //! ## Recognising a format (`auto`)
 //!
@@ -162,13 +164,22 @@ pub enum Unreadable {
         /// Which value.
         what: &'static str,
     },
-    /// A packet of the format that carries no motion of the player's vehicle: another packet type, the game in its
-    /// menus or paused, spectating.
+    /// A packet of the format that carries no motion of the player's vehicle where it should: spectating, a
+    /// section or data set missing.
     #[error("{format}: {why}")]
     NoMotion {
         /// The format.
         format: Format,
         /// Why.
+        why: String,
+    },
+    /// Another of the game's packet types, which carry no motion by design (a game sends them all to one port), or
+    /// the game in its menus: skipped and counted apart, not an error.
+    #[error("{format}: {why}, skipped")]
+    Skipped {
+        /// The format.
+        format: Format,
+        /// What the packet is.
         why: String,
     },
     /// The size fits several layouts of the format that read differently, and the packet does not say which.

@@ -7,6 +7,10 @@
 //! datagram is read in the format that recognises it; the first of a format after another format's is read
 //! without its time (its arrival time stands in, so that no interval is taken across two formats' clocks). A locked format that refuses [`UNLOCK_AFTER`] datagrams
 //! in a row (the game was changed, or the lock was wrong) is dropped, and the format is recognised again.
+//!
+//! Another of the game's packet types ([`Unreadable::Skipped`]: F1's session, lap data, ... between its motion
+//! packets) is read as nothing (`Ok(None)`): neither an error nor a sample, and it neither breaks nor extends
+//! `auto`'s run, nor counts against a lock.
 
 use super::outsim2::Opts;
 use super::{decode_with, parse_telemetry, recognise, Format, Sample, TelemetryFormat, Unreadable};
@@ -95,12 +99,12 @@ impl Reader {
         self.news = Some(news);
     }
 
-    /// One datagram: its sample, or why it is not used.
-    pub fn read(&mut self, bytes: &[u8]) -> Result<Sample, String> {
+    /// One datagram: its sample, `None` for another of the game's packets (skipped), or why it is not used.
+    pub fn read(&mut self, bytes: &[u8]) -> Result<Option<Sample>, String> {
         self.datagrams += 1;
         match self.asked {
-            TelemetryFormat::Text => parse_telemetry(bytes).map(|(time, telemetry)| Sample { time, telemetry }),
-            TelemetryFormat::Game(f) => decode_with(f, bytes, self.outsim_opts).map_err(|e| e.to_string()),
+            TelemetryFormat::Text => parse_telemetry(bytes).map(|(time, telemetry)| Some(Sample { time, telemetry })),
+            TelemetryFormat::Game(f) => skipping(decode_with(f, bytes, self.outsim_opts)),
             TelemetryFormat::Auto => match self.locked {
                 Some(f) => self.locked_read(f, bytes),
                 None => self.seek(bytes),
@@ -108,11 +112,13 @@ impl Reader {
         }
     }
 
-    fn locked_read(&mut self, f: Format, bytes: &[u8]) -> Result<Sample, String> {
-        let read = decode_with(f, bytes, self.outsim_opts).map_err(|e| e.to_string());
-        if read.is_ok() {
-            self.refused_in_row = 0;
-            self.previous = Some(f);
+    fn locked_read(&mut self, f: Format, bytes: &[u8]) -> Result<Option<Sample>, String> {
+        let read = skipping(decode_with(f, bytes, self.outsim_opts));
+        if let Ok(sample) = read {
+            if sample.is_some() {
+                self.refused_in_row = 0;
+                self.previous = Some(f);
+            }
             return read;
         }
         self.refused_in_row += 1;
@@ -132,13 +138,14 @@ impl Reader {
         read
     }
 
-    fn seek(&mut self, bytes: &[u8]) -> Result<Sample, String> {
+    fn seek(&mut self, bytes: &[u8]) -> Result<Option<Sample>, String> {
         let Some(f) = recognise(bytes) else {
             self.run = None;
             return Err(Unreadable::Unrecognised(bytes.len()).to_string());
         };
         let sample = match decode_with(f, bytes, self.outsim_opts) {
             Ok(sample) => sample,
+            Err(Unreadable::Skipped { .. }) => return Ok(None),
             Err(e) => {
                 self.run = None;
                 return Err(e.to_string());
@@ -164,22 +171,37 @@ impl Reader {
         // After another format's datagram, the arrival time: the two clocks are not one.
         let switched = self.previous.is_some_and(|p| p != f);
         self.previous = Some(f);
-        Ok(if switched {
+        Ok(Some(if switched {
             Sample { time: None, ..sample }
         } else {
             sample
-        })
+        }))
     }
 }
 
-/// The format `auto` reads a whole capture in: the first run of [`LOCK_AFTER`] datagrams of one format, else
+/// A decoded datagram as the reader gives it: another of the game's packets is nothing, not an error.
+fn skipping(decoded: Result<Sample, Unreadable>) -> Result<Option<Sample>, String> {
+    match decoded {
+        Ok(sample) => Ok(Some(sample)),
+        Err(Unreadable::Skipped { .. }) => Ok(None),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// The format `auto` reads a whole capture in: the first run of [`LOCK_AFTER`] datagrams of one format (the
+/// game's other packets between them passed over), else
 /// the longest run (a capture shorter than that), with the index of the run's first datagram; `None` when no
 /// datagram is any game's.
 pub fn detect<'a>(payloads: impl IntoIterator<Item = &'a [u8]>, outsim_opts: Option<Opts>) -> Option<(Format, usize)> {
     let mut best: Option<(Format, usize, u32)> = None;
     let mut run: Option<(Format, usize, u32)> = None;
     for (i, bytes) in payloads.into_iter().enumerate() {
-        let f = recognise(bytes).filter(|f| decode_with(*f, bytes, outsim_opts).is_ok());
+        let decoded = recognise(bytes).map(|f| (f, decode_with(f, bytes, outsim_opts)));
+        // Another of the game's packets between its motion packets: the run goes on.
+        if matches!(decoded, Some((_, Err(Unreadable::Skipped { .. })))) {
+            continue;
+        }
+        let f = decoded.and_then(|(f, d)| d.is_ok().then_some(f));
         run = match (f, run) {
             (Some(f), Some((g, start, n))) if g == f => Some((f, start, n + 1)),
             (Some(f), _) => Some((f, i, 1)),

@@ -163,13 +163,14 @@ pub fn parse_pose(bytes: &[u8], degrees: bool) -> Result<Pose<f64>, String> {
 }
 
 impl Decoder {
-    /// The pose a datagram asks for, arriving at `now`.
-    pub fn decode(&mut self, bytes: &[u8], now: Instant) -> Result<Pose<f64>, String> {
+    /// The pose a datagram asks for, arriving at `now`; `None` for another of the game's packets, which carries no
+    /// motion (skipped: neither a pose nor an error).
+    pub fn decode(&mut self, bytes: &[u8], now: Instant) -> Result<Option<Pose<f64>>, String> {
         match self {
-            Decoder::Poses { degrees } => parse_pose(bytes, *degrees),
+            Decoder::Poses { degrees } => parse_pose(bytes, *degrees).map(Some),
             Decoder::Template { template, neutral } => {
                 let neutral = neutral.ok_or("the platform's neutral pose is not known yet")?;
-                Ok(cueing::pose(&neutral, &template.read(bytes)?))
+                Ok(Some(cueing::pose(&neutral, &template.read(bytes)?)))
             }
             Decoder::Telemetry { reader, .. } => {
                 let read = reader.read(bytes);
@@ -177,7 +178,11 @@ impl Decoder {
                 if let Some(news) = reader.news() {
                     console::err(&format!("telemetry: {news}"));
                 }
-                self.cue(read, now)
+                match read {
+                    Ok(None) => Ok(None),
+                    Ok(Some(sample)) => self.cue(Ok(sample), now).map(Some),
+                    Err(e) => self.cue(Err(e), now).map(Some),
+                }
             }
         }
     }

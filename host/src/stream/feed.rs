@@ -269,10 +269,15 @@ fn read(
     let number = report.received as usize;
     let decoded = match got {
         Arrival::Datagram { len, .. } => source.decoder.decode(&buf[..len], now),
-        Arrival::Sample(sample) => source.decoder.cue(sample, now),
+        Arrival::Sample(sample) => source.decoder.cue(sample, now).map(Some),
     };
     match decoded {
-        Ok(pose) => Some((number, pose)),
+        Ok(Some(pose)) => Some((number, pose)),
+        // Another of the game's packets: counted apart; no motion, so the source pauses as far as cueing goes.
+        Ok(None) => {
+            report.skipped += 1;
+            None
+        }
         Err(reason) => {
             report.unreadable += 1;
             // The first few of each kind, cut to a line: a source can send anything, for as long as it likes.

@@ -31,6 +31,9 @@ pub struct DatagramReport {
     pub unreadable: u32,
     /// The unreadable datagrams by the kind of their reason (its numbers as `#`): they add up to `unreadable`.
     pub unreadable_by_kind: std::collections::BTreeMap<String, u64>,
+    /// Telemetry: datagrams of the game without motion (F1's other packet types, Forza in its menus), skipped: not
+    /// errors.
+    pub skipped: u32,
     /// Datagrams from other senders than `--udp-from`, ignored.
     pub other_senders: u32,
     /// Datagrams that arrived before the platform was ready to follow them (while it powered up and homed): not

@@ -107,3 +107,63 @@ proptest! {
         }
     }
 }
+
+/// F1's other packet `id` (session, lap data, car telemetry, ...) at session time `t`: the header as the game writes
+/// it, then `len` bytes in all.
+fn f1_other(id: u8, t: f32, len: usize) -> Vec<u8> {
+    let mut p = packets::f1::packet(2024, id, 3, t, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0; 3]);
+    p.resize(len, 0);
+    p
+}
+
+/// A session's capture as F1 sends it to one port: each frame's motion packet among its session, lap data,
+/// event, participants, car telemetry, car status and extended motion packets. Every motion packet is cued, the
+/// others are skipped and counted, no input error, in `auto` and named.
+#[test]
+fn a_real_f1_session_cues_every_motion_packet_and_skips_the_others() {
+    // F1 24's sizes of packets 1, 2, 3, 4, 6, 7 and 13.
+    let others = [
+        (1u8, 753),
+        (2, 1285),
+        (3, 45),
+        (4, 1350),
+        (6, 1352),
+        (7, 1239),
+        (13, 237),
+    ];
+    let mut frames = Vec::new();
+    for k in 0..30u64 {
+        let t = k as f32 / 20.0;
+        for (id, len) in others.iter().take(1 + k as usize % others.len()) {
+            frames.push((k * 50_000, frame(&f1_other(*id, t, *len))));
+        }
+        let motion = packets::f1::packet(2024, 0, 3, t, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -0.5, 0.0]);
+        frames.push((k * 50_000 + 1_000, frame(&motion)));
+    }
+    let pcap = spec::pcap(false, RAW, &frames);
+    for format in [TelemetryFormat::Auto, TelemetryFormat::Game(crate::games::Format::F1)] {
+        let (rows, errors, summary) = rows(&pcap, format, None, None).unwrap();
+        assert!(errors.is_empty(), "{format:?}: {errors:?}");
+        assert_eq!(rows.len(), 30, "{format:?}");
+        assert!(rows.iter().all(|r| r.1[1] < -4.0), "braking in every row");
+        assert_eq!(summary.datagrams, frames.len());
+        assert_eq!(
+            summary.skipped.get(GAME_PACKETS),
+            Some(&(frames.len() - 30)),
+            "{:?}",
+            summary.skipped
+        );
+        assert_eq!(summary.telemetry_format, "f1");
+    }
+}
+
+/// A motion packet while spectating (player car index 255) is refused by name, with what to do.
+#[test]
+fn an_f1_motion_packet_while_spectating_is_refused_by_name() {
+    let mut spectating = packets::f1::packet(2024, 0, 3, 1.0, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0; 3]);
+    spectating[27] = crate::games::f1::SPECTATING;
+    let pcap = spec::pcap(false, RAW, &[(0, frame(&spectating))]);
+    let (rows, errors, _) = rows(&pcap, TelemetryFormat::Game(crate::games::Format::F1), None, None).unwrap();
+    assert!(rows.is_empty());
+    assert!(errors[0].reason.contains("spectating"), "{errors:?}");
+}

@@ -17,7 +17,8 @@ fn a_stray_datagram_does_not_choose_the_format() {
     for k in 0..100 {
         let s = r
             .read(&f1(1.0 + k as f32 / 60.0))
-            .unwrap_or_else(|e| panic!("F1 packet {k}: {e}"));
+            .unwrap_or_else(|e| panic!("F1 packet {k}: {e}"))
+            .expect("a sample");
         // The arrival time for the first after the stray (another format's clock), the game's own after.
         assert_eq!(s.time.is_some(), k > 0, "{k}");
         assert!(s.telemetry.force[0] < -4.0, "{s:?}");
@@ -80,7 +81,37 @@ fn outsim_opts_reach_the_decoder() {
             .unwrap_err()
             .contains("--outsim-opts"));
         let mut r = Reader::new(format, Some(opts));
-        let times: Vec<_> = (0..6).map(|_| r.read(&bytes).unwrap().time).collect();
-        assert_eq!(times.last(), Some(&Some(2.5)), "{format:?}");
+        let times: Vec<_> = (0..6).map(|_| r.read(&bytes).unwrap().map(|s| s.time)).collect();
+        assert_eq!(times.last(), Some(&Some(Some(2.5))), "{format:?}");
     }
+}
+
+/// F1 sends its other packet types to the motion packet's port between its motion packets: `auto` still locks
+/// onto F1 (they neither break its run nor count against the lock), reads every motion packet, and passes the
+/// others over as nothing, not as errors.
+#[test]
+fn the_games_other_packets_are_skipped_not_refused() {
+    let other = |id: u8, t: f32| {
+        let mut p = packets::f1::packet(2024, id, 3, t, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0; 3]);
+        p.truncate(700);
+        p
+    };
+    let mut stream = Vec::new();
+    for k in 0..(2 * UNLOCK_AFTER) {
+        let t = k as f32 / 60.0;
+        stream.extend([other(1, t), other(2, t), f1(t), other(6, t)]);
+    }
+    for format in [TelemetryFormat::Auto, TelemetryFormat::Game(Format::F1)] {
+        let mut r = Reader::new(format, None);
+        let read: Vec<_> = stream.iter().map(|p| r.read(p)).collect();
+        assert!(read.iter().all(Result::is_ok), "{format:?}");
+        assert_eq!(
+            read.iter().flatten().flatten().count(),
+            2 * UNLOCK_AFTER as usize,
+            "{format:?}"
+        );
+        assert_eq!(r.format(), TelemetryFormat::Game(Format::F1), "{format:?}");
+    }
+    // Offline, the run of motion packets names F1 from the first of them.
+    assert_eq!(detect(stream.iter().map(Vec::as_slice), None), Some((Format::F1, 2)));
 }

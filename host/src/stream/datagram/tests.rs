@@ -33,7 +33,7 @@ fn auto_names_the_format_once_and_holds_to_it() {
     // Braking at 6 m/s^2 (heading 0 faces world +y): the platform moves back, as with the text format.
     let mut pose = None;
     for k in 0..100 {
-        pose = Some(d.decode(&outsim(k * 10, [0.0, -6.0, 0.0]), now).unwrap());
+        pose = d.decode(&outsim(k * 10, [0.0, -6.0, 0.0]), now).unwrap();
     }
     assert!(
         matches!(&d, Decoder::Telemetry { reader, .. } if reader.format() == TelemetryFormat::Game(Format::Outsim))
@@ -103,14 +103,14 @@ fn a_telemetry_stream_is_cued_and_a_pause_washes_out() {
     let mut pose = neutral;
     for k in 0..100 {
         let text = format!("{} -6 0 {G} 0 0 0", f64::from(k) * 0.01);
-        pose = d.decode(text.as_bytes(), now).unwrap();
+        pose = d.decode(text.as_bytes(), now).unwrap().expect("a pose");
     }
     assert!(pose.x < 0.0 && pose.beta > 0.0, "{pose:?}");
     // Not finite: refused, nothing changes.
     assert!(d.decode(b"1.0 NaN 0 9.8 0 0 0", now).is_err());
     // Three seconds later: the washout starts again at neutral.
     let text = format!("4.0 0 0 {G} 0 0 0");
-    assert_eq!(d.decode(text.as_bytes(), now).unwrap(), neutral);
+    assert_eq!(d.decode(text.as_bytes(), now).unwrap(), Some(neutral));
     assert_eq!(d.gaps(), 1);
 }
 
@@ -148,7 +148,7 @@ fn reload_run(name: &str, initial: &str, change: Option<&str>) -> ([f64; 6], Dec
         d.poll_config(now);
         let (ax, ay) = (3.0 * (0.7 * t).sin(), 4.0 * (1.3 * t).sin());
         let text = format!("{t} {ax} {ay} {G} 0 0 {}", 0.4 * (0.3 * t).sin());
-        let p = d.decode(text.as_bytes(), now).unwrap().to_array();
+        let p = d.decode(text.as_bytes(), now).unwrap().expect("a pose").to_array();
         if let Some(l) = last.filter(|_| (1.5..3.5).contains(&t)) {
             for i in 0..6 {
                 worst[i] = worst[i].max((p[i] - l[i]).abs());
