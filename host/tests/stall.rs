@@ -32,7 +32,7 @@ fn serve() -> Server {
     Server(child, line.trim().to_owned())
 }
 
-/// Ctrl-C 1.5 s into a 6 s stall of the link: the CLI says the link stalled and that the stop is pending, gives it
+/// Ctrl-C 1.5 s into a 9.5 s stall of the link: the CLI says the link stalled and that the stop is pending, gives it
 /// again until the link returns, and reports the platform at rest (exit 130, state Ready) instead of a lost link.
 #[test]
 #[cfg(unix)]
@@ -55,7 +55,8 @@ fn ctrl_c_in_a_stalled_link_is_confirmed_when_the_link_returns() {
         .status()
         .unwrap()
         .success());
-    std::thread::sleep(Duration::from_millis(4500));
+    // Longer than the answers in flight are waited for (5 s): the stop itself goes unanswered and is given again.
+    std::thread::sleep(Duration::from_millis(8000));
     proxy.stall(false);
     let mut said = String::new();
     let mut stderr = child.stderr.take().unwrap();

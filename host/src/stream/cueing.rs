@@ -273,32 +273,37 @@ mod tests {
         );
     }
 
-    /// A pause after a long left turn: the heading the yaw followed is not left in one step when the cueing starts
-    /// again at neutral; it is blended out over the handover, and the cueing is then at neutral.
+    /// A pause after a long braking: the tilt the washout held (nose down, gravity's share backwards) is not left
+    /// in one step when the cueing starts again at neutral; it is blended out over the handover, the heading kept.
     #[test]
-    fn a_restart_after_a_pause_blends_out_the_heading() {
+    fn a_restart_after_a_pause_blends_out_what_was_held() {
         let mut c = LiveCueing::new(CueConfig::default()).unwrap();
-        let turning = Telemetry {
-            force: [0.0, 0.0, G],
-            rate: [0.0, 0.0, 0.3],
-        };
-        c.begin(&turning).unwrap();
-        let before = (0..300).map(|_| c.step(&turning, 0.01).unwrap()).last().unwrap();
-        assert!(before[5].abs() > 0.3, "the heading followed: {before:?}");
+        c.begin(&braking()).unwrap();
+        let before = (0..300).map(|_| c.step(&braking(), 0.01).unwrap()).last().unwrap();
+        assert!(before[4] > 0.02, "the tilt held: {before:?}");
         c.reset();
         let rest = Telemetry {
             force: [0.0, 0.0, G],
             rate: [0.0; 3],
         };
         let first = c.begin(&rest).unwrap();
-        assert!((first[5] - before[5]).abs() < 1e-9, "{first:?} after {before:?}");
+        for i in 0..6 {
+            assert!(
+                (first[i] - before[i]).abs() < 1e-9,
+                "axis {i}: {first:?} after {before:?}"
+            );
+        }
         let mut last = first;
         for _ in 0..150 {
             let next = c.step(&rest, 0.01).unwrap();
-            assert!((next[5] - last[5]).abs() < 0.02, "{} -> {}", last[5], next[5]);
+            assert!((next[4] - last[4]).abs() < 0.005, "{} -> {}", last[4], next[4]);
             last = next;
         }
-        assert!(last[5].abs() < 1e-9, "at neutral after the handover: {last:?}");
+        assert!(
+            last[..5].iter().all(|v| v.abs() < 1e-9),
+            "at neutral after the handover: {last:?}"
+        );
+        assert_eq!(last[5], before[5], "the heading is kept");
     }
 
     #[test]

@@ -187,6 +187,12 @@ fn take(app: &App, page: u64, text: &str) -> Option<Value> {
         Err(e) => return answer(e.id, false, &e.why),
     };
     let taken = if request.is_halt() {
+        // Pending until the device confirms it (the device thread says so, or keeps giving it).
+        app.hub.publish(&json!({
+            "type": "stop_pending",
+            "pending": true,
+            "text": "STOP given: pending until the device confirms it"
+        }));
         let taken = stop(app, page, id);
         app.hub.reply(
             page,

@@ -238,20 +238,7 @@ impl Device {
                 .clear()
                 .map(|()| "fault cleared".to_owned())
                 .map_err(Into::into),
-            Request::Halt => match self.halt() {
-                Ok(text) => {
-                    // The STOP was answered when it arrived; this says the platform is at rest.
-                    self.pending_stop = None;
-                    self.hub
-                        .publish(&json!({ "type": "halted", "page": job.page, "id": job.id, "text": text }));
-                    Ok(text)
-                }
-                Err(WorkerError::Client(e @ (ClientError::Timeout(_) | ClientError::Io(_)))) => {
-                    self.keep_stop(&e);
-                    Err(WorkerError::Client(e))
-                }
-                Err(e) => Err(e),
-            },
+            Request::Halt => self.stop(job),
             Request::Jog { axis, distance } => self.commission(*axis, Some(*distance)),
             Request::Buzz { axis } => self.commission(*axis, None),
             Request::Park => self.park(job.page),

@@ -108,10 +108,20 @@ fn a_telemetry_stream_is_cued_and_a_pause_washes_out() {
     assert!(pose.x < 0.0 && pose.beta > 0.0, "{pose:?}");
     // Not finite: refused, nothing changes.
     assert!(d.decode(b"1.0 NaN 0 9.8 0 0 0", now).is_err());
-    // Three seconds later: the washout starts again at neutral.
+    // Three seconds later: the washout starts again at neutral, blending out over a second what it held (no
+    // step from the last pose).
     let text = format!("4.0 0 0 {G} 0 0 0");
-    assert_eq!(d.decode(text.as_bytes(), now).unwrap(), Some(neutral));
+    assert_eq!(d.decode(text.as_bytes(), now).unwrap(), Some(pose));
     assert_eq!(d.gaps(), 1);
+    let mut last = pose;
+    for k in 1..=150 {
+        let text = format!("{} 0 0 {G} 0 0 0", 4.0 + f64::from(k) * 0.01);
+        last = d.decode(text.as_bytes(), now).unwrap().expect("a pose");
+    }
+    assert!(
+        (last.x - neutral.x).abs() < 1e-9 && (last.beta - neutral.beta).abs() < 1e-9,
+        "{last:?}"
+    );
 }
 
 /// Streams a drive of text datagrams at 100 Hz for 4 s, the cueing file rewritten with `change` at 2 s (if

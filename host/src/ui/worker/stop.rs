@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use serde_json::json;
 
-use super::{Device, WorkerError};
+use super::{Device, Job, WorkerError};
 use crate::link::client::ClientError;
 
 /// A STOP given while the device did not answer.
@@ -38,6 +38,44 @@ impl Device {
             .publish(&json!({ "type": "stop_pending", "pending": true, "text": text }));
     }
 
+    /// A page's STOP: brought to rest and powered down, confirmed to the pages; kept pending when the device does not
+    /// answer.
+    pub(super) fn stop(&mut self, job: &Job) -> Result<String, WorkerError> {
+        match self.halt() {
+            Ok(text) => {
+                // The STOP was answered when it arrived; this says the platform is at rest.
+                self.pending_stop = None;
+                self.confirm_stop(job.page, job.id, &text);
+                Ok(text)
+            }
+            Err(WorkerError::Client(e @ (ClientError::Timeout(_) | ClientError::Io(_)))) => {
+                self.keep_stop(&e);
+                Err(WorkerError::Client(e))
+            }
+            Err(e) => {
+                self.pending_stop = None;
+                self.refused_stop(&e);
+                Err(e)
+            }
+        }
+    }
+
+    /// The device answered the STOP and did not power down: it is not lost, it is answered; the pages see why.
+    fn refused_stop(&self, e: &WorkerError) {
+        let text = format!("STOP: the device answered but did not power down: {e:#}");
+        self.hub
+            .publish(&json!({ "type": "stop_pending", "pending": false, "text": text }));
+    }
+
+    /// The device confirmed the STOP (`page`'s request `id`, 0 for one given again): the pages are told.
+    pub(super) fn confirm_stop(&self, page: u64, id: u64, text: &str) {
+        let confirmed = format!("STOP confirmed: {text}");
+        self.hub
+            .publish(&json!({ "type": "stop_pending", "pending": false, "text": confirmed }));
+        self.hub
+            .publish(&json!({ "type": "halted", "page": page, "id": id, "text": text }));
+    }
+
     /// Sends a pending STOP again when it is due; once the device confirms (at rest, powering down), says so.
     pub(super) fn resend_stop(&mut self) {
         let Some(pending) = &mut self.pending_stop else {
@@ -52,21 +90,15 @@ impl Device {
             Ok(text) => {
                 self.pending_stop = None;
                 let text = format!(
-                    "STOP confirmed {:.1} s after it was given (sent again {resent} times): {text}",
+                    "{text}, {:.1} s after it was given (sent again {resent} times)",
                     given.elapsed().as_secs_f64()
                 );
-                self.hub
-                    .publish(&json!({ "type": "stop_pending", "pending": false, "text": text.clone() }));
-                self.hub
-                    .publish(&json!({ "type": "halted", "page": 0, "id": 0, "text": text }));
+                self.confirm_stop(0, 0, &text);
             }
             Err(WorkerError::Client(e @ (ClientError::Timeout(_) | ClientError::Io(_)))) => self.keep_stop(&e),
-            // The device answered and refused: the STOP is not lost, it is answered; the pages see why.
             Err(e) => {
                 self.pending_stop = None;
-                let text = format!("STOP: the device answered but did not power down: {e:#}");
-                self.hub
-                    .publish(&json!({ "type": "stop_pending", "pending": false, "text": text }));
+                self.refused_stop(&e);
             }
         }
     }
