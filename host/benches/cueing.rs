@@ -8,7 +8,7 @@ use ringpod_core::kinematics::{Pose, RingPlatform};
 
 // The optimal cueing's module as the binary builds it (the host is a binary crate: no library to link).
 #[allow(dead_code, unused_imports)]
-#[path = "../src/analysis/optimal/mod.rs"]
+#[path = "../src/cueing/optimal/mod.rs"]
 mod optimal;
 
 fn sample(t: f64) -> Telemetry<f64> {

@@ -151,7 +151,7 @@ mod tests {
                 addr: "127.0.0.1:9".parse().unwrap(),
                 reason: io(),
             }),
-            Box::new(crate::analysis::cue::CueError::Output {
+            Box::new(crate::cueing::offline::CueError::Output {
                 path: "/x.csv".into(),
                 reason: io(),
             }),

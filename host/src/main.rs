@@ -2,6 +2,7 @@
 
 mod analysis;
 mod cli;
+mod cueing;
 mod device;
 mod error;
 mod games;
@@ -98,8 +99,8 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
         C::Monitor { port, sim, frames } => device::monitor(&link::Target::named(port.as_deref(), *sim)?, *frames)?,
         C::Cue(args) => {
             let (text, code) = match args.bench() {
-                Some(bench) => analysis::cue_bench::run(&bench)?,
-                None => analysis::cue::run(&args.options()?)?,
+                Some(bench) => cueing::bench::run(&bench)?,
+                None => cueing::offline::run(&args.options()?)?,
             };
             print(&text);
             code

@@ -1,20 +1,15 @@
 //! The offline questions: kinematics (`presets`, `ik`, `check`, `fk`, `loads`; `branches`: the tool carrier's
 //! assemblies for `ik --branch`), `rates`, `structure`, `reactions`,
 //! paper 003's Gram determinants over a slice (`gram`), tip-over (`check --tip-over`), the drawing of a platform at a pose (`draw`),
-//! `workspace` and `cue`, paper 002's matrix method and equation of motion (`dynamics`), each on any preset's mechanism or a rig file, answered as text or JSON without a device.
+//! `workspace`, paper 002's matrix method and equation of motion (`dynamics`), each on any preset's mechanism or a rig file, answered as text or JSON without a device.
 
 pub mod branches;
-pub mod cue;
-pub mod cue_bench;
-pub mod cue_capture;
-pub mod cue_engine;
 pub mod demand;
 pub mod draw;
 pub mod dynamics;
 pub mod gram;
 pub mod kinematics;
 pub mod mechanism;
-pub mod optimal;
 pub mod placement;
 pub mod rates;
 pub mod reactions;

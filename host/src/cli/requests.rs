@@ -133,10 +133,10 @@ impl WorkspaceArgs {
 
 impl CueArgs {
     /// The bench's options, with --compare.
-    pub fn bench(&self) -> Option<crate::analysis::cue_bench::Options<'_>> {
+    pub fn bench(&self) -> Option<crate::cueing::bench::Options<'_>> {
         let c = self.compare.as_deref()?;
         let [a, b] = c else { return None };
-        Some(crate::analysis::cue_bench::Options {
+        Some(crate::cueing::bench::Options {
             configs: [a, b],
             inputs: &self.input,
             out: &self.out,
@@ -152,11 +152,11 @@ impl CueArgs {
     }
 
     /// The options `cue` takes (one input: several are for --compare).
-    pub fn options(&self) -> Result<crate::analysis::cue::Options<'_>, RequestError> {
+    pub fn options(&self) -> Result<crate::cueing::offline::Options<'_>, RequestError> {
         let [input] = self.input.as_slice() else {
             return Err(RequestError::CueOneInput);
         };
-        Ok(crate::analysis::cue::Options {
+        Ok(crate::cueing::offline::Options {
             input,
             out: &self.out,
             config: self.config.as_deref(),

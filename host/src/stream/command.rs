@@ -269,7 +269,7 @@ pub(crate) fn telemetry_decoder(
     profile: &Option<String>,
 ) -> Result<datagram::Decoder, SourceError> {
     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
-    let washout = super::cueing::LiveCueing::new(config).map_err(SourceError::Washout)?;
+    let washout = crate::cueing::live::LiveCueing::new(config).map_err(SourceError::Washout)?;
     let outsim_opts =
         crate::games::outsim2::Opts::chosen(format, outsim_opts, cue_config.as_deref(), profile.as_deref())?;
     Ok(datagram::Decoder::Telemetry {

@@ -8,8 +8,8 @@ use std::time::{Duration, Instant, SystemTime};
 use ringpod_core::cueing::{self, SampleError, Telemetry, G};
 use ringpod_core::kinematics::Pose;
 
-use super::cueing::LiveCueing;
-use crate::analysis::optimal::Envelope;
+use crate::cueing::live::LiveCueing;
+use crate::cueing::optimal::Envelope;
 use crate::games::{self, numbers};
 use crate::out::console;
 
@@ -308,7 +308,7 @@ impl Decoder {
     }
 
     /// What the optimal cueing did (telemetry cued by it only).
-    pub fn optimal_counts(&self) -> Option<crate::analysis::optimal::Counts> {
+    pub fn optimal_counts(&self) -> Option<crate::cueing::optimal::Counts> {
         match self {
             Decoder::Telemetry { washout, .. } => washout.optimal_counts(),
             _ => None,

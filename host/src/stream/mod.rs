@@ -8,7 +8,6 @@
 
 mod admit;
 pub mod command;
-pub mod cueing;
 pub mod datagram;
 pub mod derivatives;
 mod ending;
@@ -261,7 +260,7 @@ pub fn run<T: Transport>(
             .cues()
             .then(|| {
                 let mechanism = ringpod_core::kinematics::RingPlatform::new(&envelope.platform.geometry);
-                crate::analysis::cue_engine::envelope(&mechanism, &home).map_err(|check| {
+                crate::cueing::engine::envelope(&mechanism, &home).map_err(|check| {
                     ClientError::Unexpected(format!(
                         "the device's home fails the {check} check (`ringpod check`): cueing moves the platform \
                          about its home, and no pose about it is inside the envelope"

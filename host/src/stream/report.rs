@@ -54,7 +54,7 @@ pub struct DatagramReport {
     /// Telemetry cued by the optimal cueing: samples planned, fallbacks (late solves among them; the axes that
     /// followed their last plan and those that took the classical washout's change), solve time p50/p99/max.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub optimal: Option<crate::analysis::optimal::CountsReport>,
+    pub optimal: Option<crate::cueing::optimal::CountsReport>,
     /// `--telemetry-shm`: the game, its mappings, and its samples, repeats, torn reads and stalls.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shared_memory: Option<super::live::ShmReport>,

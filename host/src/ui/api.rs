@@ -8,10 +8,10 @@ use serde::Deserialize;
 use serde_json::{json, Value};
 
 use super::frame::RigView;
-use crate::analysis::cue::{delivered_forces, replay, Replay, TELEMETRY_COLUMNS};
-use crate::analysis::cue_bench::score::score;
 use crate::analysis::placement::place;
 use crate::analysis::workspace::{classify, Cell};
+use crate::cueing::bench::score::score;
+use crate::cueing::offline::{delivered_forces, replay, Replay, TELEMETRY_COLUMNS};
 
 /// The example drive the Cueing panel replays until the user gives one (a braking, a lane change, a bump).
 pub const EXAMPLE_DRIVE: &str = include_str!("../../../docs/drive-telemetry.csv");
@@ -55,7 +55,7 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
     let m = RingPlatform::<f64>::new(geometry);
     let neutral = Pose::from_array(home);
     // One scan of the envelope for both algorithms' replays and scores.
-    let envelope = crate::analysis::cue_engine::envelope(&m, &neutral).map_err(|check| {
+    let envelope = crate::cueing::engine::envelope(&m, &neutral).map_err(|check| {
         format!(
             "the rig's home fails the {check} check: cueing moves the platform about its home, and no pose about \
              this one is inside the envelope"

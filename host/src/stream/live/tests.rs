@@ -79,7 +79,7 @@ fn a_games_shared_memory_is_streamed_captured_and_counted() {
     assert_eq!((c.packets, c.error.as_deref()), (shm.counts.samples, None));
     let bytes = std::fs::read(&capture_path).unwrap();
     let (rows, errors, _) =
-        crate::analysis::cue_capture::rows(&bytes, crate::games::TelemetryFormat::Text, None, None).unwrap();
+        crate::cueing::capture::rows(&bytes, crate::games::TelemetryFormat::Text, None, None).unwrap();
     assert!(errors.is_empty(), "{errors:?}");
     assert_eq!(rows.len() as u64, shm.counts.samples);
     let row = &rows[rows.len() / 2].1;

@@ -10,7 +10,7 @@ use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
-use super::cue_engine::Pause;
+use super::engine::Pause;
 use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
@@ -39,7 +39,7 @@ pub struct Summary {
     pub pauses: Vec<Pause>,
     /// A packet capture's input: what it held (its input errors are numbered by packet).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub capture: Option<super::cue_capture::CaptureSummary>,
+    pub capture: Option<super::capture::CaptureSummary>,
     /// The optimal cueing's samples planned and its fallbacks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal: Option<super::optimal::Counts>,
@@ -111,7 +111,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         return Err(CliError::NotARing(selected.name).into());
     };
     let neutral = Pose::from_array(selected.home);
-    let envelope = super::cue_engine::envelope(&mechanism, &neutral).map_err(|check| CliError::NeutralOutside {
+    let envelope = super::engine::envelope(&mechanism, &neutral).map_err(|check| CliError::NeutralOutside {
         name: selected.name.clone(),
         check,
     })?;
@@ -211,7 +211,7 @@ pub enum CueError {
 }
 
 /// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`
-/// (whose envelope about home is `envelope`, [`super::cue_engine::envelope`]: scanned once by the caller, however
+/// (whose envelope about home is `envelope`, [`super::engine::envelope`]: scanned once by the caller, however
 /// many configurations it replays), every pose limited into the envelope; with `preview`, the optimal cueing sees the drive's next samples (the
 /// reference over its horizon) rather than the last sample held.
 pub fn replay(
@@ -223,7 +223,7 @@ pub fn replay(
     preview: bool,
 ) -> Result<Replay, CueError> {
     let margins = EnvelopeMargins::default();
-    let mut washout = super::cue_engine::Engine::new(config, envelope).map_err(CueError::Washout)?;
+    let mut washout = super::engine::Engine::new(config, envelope).map_err(CueError::Washout)?;
     // A recorded drive's next samples, for the optimal cueing's preview.
     let preview = washout.horizon().filter(|_| preview);
     let (mut errors, mut pauses) = (Vec::new(), Vec::new());
@@ -233,12 +233,12 @@ pub fn replay(
     let mut held = *neutral;
     for (line, v) in rows {
         let t = v[0];
-        let sample = super::cue_engine::row_sample(v);
+        let sample = super::engine::row_sample(v);
         let offset = match last_t {
             // The first row (and the first after a gap) starts the washout at neutral and is its first input.
             None => washout.begin(&sample),
             Some(l) => {
-                let ahead = preview.map_or_else(Vec::new, |(n, h)| super::cue_engine::ahead(rows, t, n, h));
+                let ahead = preview.map_or_else(Vec::new, |(n, h)| super::engine::ahead(rows, t, n, h));
                 washout.step(&sample, t - l, &ahead)
             }
         };
@@ -308,11 +308,9 @@ pub fn read_drive(path: &Path) -> Result<Vec<(usize, Vec<f64>)>, CueError> {
     };
     let (rows, errors, _) = read_input(&args)?;
     // A row the cueing would refuse is no drive to score: the vehicle's own perceived force is scored from it.
-    let refused = rows.iter().find_map(|(line, v)| {
-        cueing::check(&super::cue_engine::row_sample(v))
-            .err()
-            .map(|e| (*line, e))
-    });
+    let refused = rows
+        .iter()
+        .find_map(|(line, v)| cueing::check(&super::engine::row_sample(v)).err().map(|e| (*line, e)));
     if let Some((line, e)) = refused {
         return Err(CueError::Input {
             path: path.to_path_buf(),
@@ -334,7 +332,7 @@ pub fn read_drive(path: &Path) -> Result<Vec<(usize, Vec<f64>)>, CueError> {
     }
 }
 
-/// The telemetry rows of the input: a CSV, or a packet capture ([`super::cue_capture`]).
+/// The telemetry rows of the input: a CSV, or a packet capture ([`super::capture`]).
 #[allow(clippy::type_complexity)]
 fn read_input(
     args: &Options,
@@ -342,7 +340,7 @@ fn read_input(
     (
         Vec<(usize, Vec<f64>)>,
         Vec<InputError>,
-        Option<super::cue_capture::CaptureSummary>,
+        Option<super::capture::CaptureSummary>,
     ),
     CueError,
 > {
@@ -363,7 +361,7 @@ fn read_input(
         let opts = crate::games::outsim2::Opts::chosen(format, args.outsim_opts, args.config, args.profile)
             .map_err(CliError::from)?;
         let (rows, errors, summary) =
-            super::cue_capture::rows(&bytes, format, args.udp_port, opts).map_err(|e| bad(e.to_string()))?;
+            super::capture::rows(&bytes, format, args.udp_port, opts).map_err(|e| bad(e.to_string()))?;
         return Ok((rows, errors, Some(summary)));
     }
     if args.telemetry_format.is_some() || args.udp_port.is_some() || args.outsim_opts.is_some() {

@@ -6,8 +6,8 @@ use ringpod_core::cueing::{Forward, G};
 use ringpod_core::kinematics::Pose;
 use serde::Serialize;
 
-use crate::analysis::cue::{delivered_forces, Cued};
-use crate::analysis::optimal::Ranges;
+use crate::cueing::offline::{delivered_forces, Cued};
+use crate::cueing::optimal::Ranges;
 
 /// False cues on one axis: the platform's perceived cue above the threshold and opposite in sign to the
 /// vehicle's.

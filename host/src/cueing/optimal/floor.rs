@@ -515,7 +515,7 @@ mod tests {
         };
         let mechanism = RingPlatform::new(g);
         let neutral = Pose::from_array(Preset::RotopodCh4.home());
-        let ranges = crate::analysis::cue_engine::ranges(&mechanism, &neutral);
+        let ranges = crate::cueing::engine::ranges(&mechanism, &neutral);
         let outer = Polytope::of(&mechanism, &neutral, &ranges, &directions(3), 2000);
         let (t, samples) = example_drive();
         let f = floor(&t, &samples, Room::Envelope(&outer), Forward::PlusX).unwrap();

@@ -6,8 +6,8 @@ use ringpod_core::kinematics::workspace::Check;
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 
-use super::mechanism::AnyMechanism;
 use super::optimal::{Counts, Envelope, Optimal, Ranges};
+use crate::analysis::mechanism::AnyMechanism;
 
 /// A running cueing.
 pub enum Engine {
@@ -19,7 +19,7 @@ pub enum Engine {
 
 /// The envelope about `neutral` the optimal cueing plans in: each axis's range from the workspace scan.
 pub fn ranges(mechanism: &RingPlatform<f64>, neutral: &Pose<f64>) -> Ranges {
-    super::workspace::ranges_about_home(&AnyMechanism::Ring(Box::new(*mechanism)), neutral.to_array())
+    crate::analysis::workspace::ranges_about_home(&AnyMechanism::Ring(Box::new(*mechanism)), neutral.to_array())
 }
 
 /// The envelope about `neutral` the optimal cueing plans in: the ranges, and the rig for the tilt's shared room;

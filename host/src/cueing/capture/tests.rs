@@ -100,7 +100,7 @@ proptest! {
                 prop_assert!(errors.iter().all(|e| e.reason.len() <= 300), "{errors:?}");
             }
             if let Ok(text) = std::str::from_utf8(bytes) {
-                if let Ok((rows, errors)) = crate::input::table::read(text, &crate::analysis::cue::TELEMETRY_COLUMNS) {
+                if let Ok((rows, errors)) = crate::input::table::read(text, &crate::cueing::offline::TELEMETRY_COLUMNS) {
                     prop_assert!(rows.len() + errors.len() <= text.lines().count());
                 }
             }

@@ -6,8 +6,8 @@
 
 use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout, HANDOVER_S};
 
-use crate::analysis::cue_engine::Engine;
-use crate::analysis::optimal::{Counts, Envelope};
+use crate::cueing::engine::Engine;
+use crate::cueing::optimal::{Counts, Envelope};
 
 /// A stream's cueing.
 pub struct LiveCueing {
@@ -230,7 +230,7 @@ mod tests {
     use super::*;
     use ringpod_core::cueing::G;
 
-    fn ranges() -> crate::analysis::optimal::Ranges {
+    fn ranges() -> crate::cueing::optimal::Ranges {
         [(-0.05, 0.05), (-0.05, 0.05), (-0.03, 0.03), (-0.3, 0.3), (-0.3, 0.3)]
     }
 

@@ -16,9 +16,9 @@ use ringpod_core::cueing::{Algorithm, CueConfig};
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use serde::Serialize;
 
-use super::cue::{read_drive, replay, CueError};
-use super::mechanism::{AnyMechanism, Selected};
+use super::offline::{read_drive, replay, CueError};
 use super::optimal::{Counts, Envelope, Ranges};
+use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
 use floors::{floor_of, FloorReport};
@@ -181,7 +181,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     };
     let neutral = Pose::from_array(selected.home);
     let rig = Rig {
-        envelope: super::cue_engine::envelope(&mechanism, &neutral).map_err(|check| CliError::NeutralOutside {
+        envelope: super::engine::envelope(&mechanism, &neutral).map_err(|check| CliError::NeutralOutside {
             name: selected.name.clone(),
             check,
         })?,

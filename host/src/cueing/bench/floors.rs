@@ -4,8 +4,8 @@
 use ringpod_core::cueing::{Forward, Telemetry};
 use serde::Serialize;
 
-use super::super::cue::CueError;
-use super::super::cue_engine::row_sample;
+use super::super::engine::row_sample;
+use super::super::offline::CueError;
 use super::super::optimal::floor::{self, Room};
 use super::super::optimal::polytope::{self, Polytope};
 use super::{score, Rig, Rows};

@@ -9,7 +9,7 @@
 use ringpod_core::cueing::CueConfig;
 
 use super::{evaluate, Rig, Rows};
-use crate::analysis::cue::CueError;
+use crate::cueing::offline::CueError;
 
 /// The factors tried on each parameter.
 pub const FACTORS: [f64; 6] = [0.4, 0.6, 0.8, 1.25, 1.6, 2.5];
