@@ -132,7 +132,11 @@ fn game(addr: String, seconds: f64) -> std::thread::JoinHandle<()> {
             if t > seconds {
                 return;
             }
-            let ax = if (t / 2.0) as u32 % 2 == 0 { 6.0 } else { -6.0 };
+            let ax = if ((t / 2.0) as u32).is_multiple_of(2) {
+                6.0
+            } else {
+                -6.0
+            };
             let line = format!("{t} {ax} {} 9.81 0 0 {}", 3.0 * t.sin(), 0.3 * t.sin());
             let _ = socket.send_to(line.as_bytes(), &addr);
             k += 1;

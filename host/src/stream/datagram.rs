@@ -215,7 +215,7 @@ impl Decoder {
             None => washout.begin(&sample).map_err(|e| e.to_string()),
             Some(Ok(offset)) => Ok(offset),
             Some(Err(e @ (SampleError::NonFinite | SampleError::Implausible))) => Err(e.to_string()),
-            Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| dt > 0.0 || dt < -RESTARTED_S) => {
+            Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| !(-RESTARTED_S..=0.0).contains(&dt)) => {
                 // A pause of more than a second, or the game's clock started again (a restarted game or session,
                 // a replay): wash out to neutral and start again from here, this sample the first input.
                 *gaps += 1;

@@ -249,3 +249,24 @@ fn a_cueing_file_caught_half_way_through_a_save_is_ignored_until_whole() {
     assert_eq!(washout.config().tilt_limit_deg, [8.0; 2]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A game restarted (or a session begun again): its clock goes back to 0. The cueing starts again from there, as
+/// after a pause, and every sample is read; a sample a little older than the last is out of order and refused.
+#[test]
+fn a_game_clock_that_starts_again_starts_the_cueing_again() {
+    let mut d = decoder(TelemetryFormat::Text);
+    let now = Instant::now();
+    for k in 0..300 {
+        let text = format!("{} -3 0 {G} 0 0 0", 10.0 + f64::from(k) * 0.01);
+        d.decode(text.as_bytes(), now).unwrap().expect("a pose");
+    }
+    assert!(
+        d.decode(format!("12.5 -3 0 {G} 0 0 0").as_bytes(), now).is_err(),
+        "out of order"
+    );
+    for k in 0..100 {
+        let text = format!("{} -3 0 {G} 0 0 0", f64::from(k) * 0.01);
+        d.decode(text.as_bytes(), now).unwrap().expect("read after the restart");
+    }
+    assert_eq!(d.gaps(), 1);
+}
