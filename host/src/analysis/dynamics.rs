@@ -306,6 +306,10 @@ fn motion_file(path: &Path) -> Result<Vec<(f64, MotionState<f64>)>, CliError> {
 /// `dynamics` from its arguments: the mechanism selected, the numbers checked (a positive duration and step, a
 /// finite amplitude, a mass and inertia as `loads` takes them).
 pub fn command(args: &Request) -> Result<Outcome, CliError> {
+    // Every file it reads and every one it writes: no output may be an input or another output.
+    let inputs: Vec<&Path> = [args.file, args.input, args.geometry].into_iter().flatten().collect();
+    let outputs: Vec<&Path> = [args.table, args.plot].into_iter().flatten().collect();
+    crate::out::file::check_outputs(&outputs, &inputs).map_err(|(out, e)| CliError::file(out, e))?;
     if let Some(path) = args.file {
         return run_file(path, args.table, args.plot);
     }

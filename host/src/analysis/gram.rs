@@ -129,6 +129,8 @@ pub fn run(args: &Options) -> Result<String, CliError> {
     if !(args.z.is_finite() && (-0.4..=0.0).contains(&args.z)) {
         return Err(BadNumber::given("z", args.z, "the mechanism reaches heights from -0.4 to 0 m").into());
     }
+    let outputs: Vec<&std::path::Path> = [Some(args.out), args.table].into_iter().flatten().collect();
+    crate::out::file::check_outputs(&outputs, &[]).map_err(|(out, e)| CliError::file(out, e))?;
     let slice = scan(args.z, args.step);
     plot::save(args.out, (1200, 1060), &SlicePicture { slice: &slice })?;
     let reachable = slice.cells.iter().flatten().count();

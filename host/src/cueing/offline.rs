@@ -100,10 +100,12 @@ pub struct Options<'a> {
 /// Runs the command; returns the summary as text and the exit code.
 pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     // An output that is the input (or the cueing file) would destroy it: refused before anything is read.
-    let inputs: Vec<&Path> = [Some(args.input), args.config].into_iter().flatten().collect();
-    for out in [Some(args.out), args.plot].into_iter().flatten() {
-        crate::out::file::check_output(out, &inputs).map_err(|e| CliError::file(out, e))?;
-    }
+    let inputs: Vec<&Path> = [Some(args.input), args.config, args.geometry]
+        .into_iter()
+        .flatten()
+        .collect();
+    let outputs: Vec<&Path> = [Some(args.out), args.plot].into_iter().flatten().collect();
+    crate::out::file::check_outputs(&outputs, &inputs).map_err(|(out, e)| CliError::file(out, e))?;
     let config = load_config(args.config, args.profile).map_err(CliError::from)?;
     let (rows, mut errors, capture) = read_input(args)?;
     let selected = Selected::of(args.mechanism, args.geometry)?;

@@ -104,9 +104,42 @@ pub fn check_output(output: &Path, inputs: &[&Path]) -> Result<(), String> {
     }
 }
 
+/// [`check_output`] for each of a command's outputs, and no two of them one file (both reported written, one
+/// would be lost).
+pub fn check_outputs<'a>(outputs: &[&'a Path], inputs: &[&Path]) -> Result<(), (&'a Path, String)> {
+    for (k, out) in outputs.iter().enumerate() {
+        check_output(out, inputs).map_err(|e| (*out, e))?;
+        if let Some(other) = outputs[..k].iter().find(|o| *o == out || same_file(out, o)) {
+            return Err((
+                *out,
+                format!(
+                    "{} is also another output ({}): one would replace the other; name two files",
+                    out.display(),
+                    other.display()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn two_outputs_on_one_path_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
+        assert!(check_outputs(&[&a, &b], &[]).is_ok());
+        let (out, said) = check_outputs(&[&a, &b, &a], &[]).unwrap_err();
+        assert_eq!(out, a.as_path());
+        assert!(said.contains("also another output"), "{said}");
+        // Another spelling of the same file, once it exists.
+        std::fs::write(&a, "x").unwrap();
+        let spelled = dir.path().join(".").join("a.csv");
+        assert!(check_outputs(&[&a, &spelled], &[]).is_err());
+    }
 
     #[test]
     fn a_write_replaces_the_target_whole_and_leaves_no_temporary_file() {

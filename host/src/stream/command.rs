@@ -343,10 +343,20 @@ pub fn run(job: &Job) -> Result<u8, JobError> {
     let signals = Signals::install()?;
     // A closed or full standard output or error ends the run as a stop does (and wakes any wait for the device).
     console::on_failure(signals.flag());
-    let read = inputs(&job.input);
-    for out in [&job.record, &job.capture].into_iter().flatten() {
-        crate::out::file::check_output(out, &read).map_err(|e| CliError::file(out, e))?;
+    let mut read = inputs(&job.input);
+    if let Device::Sim {
+        platform: Some(crate::device::Platform::File(rig)),
+        ..
+    } = &job.device
+    {
+        read.push(rig.as_path());
     }
+    let outputs: Vec<&std::path::Path> = [&job.record, &job.capture]
+        .into_iter()
+        .flatten()
+        .map(|p| p.as_path())
+        .collect();
+    crate::out::file::check_outputs(&outputs, &read).map_err(|(out, e)| CliError::file(out, e))?;
     let (mut source, input_errors) = open(&job.input)?;
     if let (Some(path), Source::Live(udp)) = (&job.capture, &mut source) {
         let local = udp.receiver.local_addr()?;

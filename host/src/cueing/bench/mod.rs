@@ -169,9 +169,9 @@ fn combined(scores: &[Score]) -> Score {
 pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     let mut inputs: Vec<&Path> = args.inputs.iter().map(PathBuf::as_path).collect();
     inputs.extend(args.configs);
-    for out in [Some(args.out), args.plot].into_iter().flatten() {
-        crate::out::file::check_output(out, &inputs).map_err(|e| CliError::file(out, e))?;
-    }
+    inputs.extend(args.geometry);
+    let outputs: Vec<&Path> = [Some(args.out), args.plot].into_iter().flatten().collect();
+    crate::out::file::check_outputs(&outputs, &inputs).map_err(|(out, e)| CliError::file(out, e))?;
     let configs = [0, 1].map(|i| load_config(Some(args.configs[i]), None));
     let [a, b] = configs;
     let (a, b) = (a.map_err(CliError::from)?, b.map_err(CliError::from)?);
