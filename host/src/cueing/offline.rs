@@ -156,9 +156,9 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         );
         if let Some(o) = &summary.optimal {
             s += &format!(
-                "optimal cueing: {} samples planned, {} fell back ({} late; axes that followed their last plan {}, \
-                 that took the classical washout's change {})\n",
-                o.samples, o.fallbacks, o.late, o.followed_plan, o.took_classical
+                "optimal cueing: {} samples planned, {} fell back (axes that followed their last plan {}, that took \
+                 the classical washout's change {}); {} took longer than the budget\n",
+                o.samples, o.fallbacks, o.followed_plan, o.took_classical, o.late
             );
         }
         if let Some(c) = &summary.capture {

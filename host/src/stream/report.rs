@@ -51,8 +51,9 @@ pub struct DatagramReport {
     /// Telemetry: changes of the `--cue-config` file refused (a key out of range; the running configuration
     /// stayed).
     pub cue_refused: u32,
-    /// Telemetry cued by the optimal cueing: samples planned, fallbacks (late solves among them; the axes that
-    /// followed their last plan and those that took the classical washout's change), solve time p50/p99/max.
+    /// Telemetry cued by the optimal cueing: samples planned, fallbacks (the axes that followed their last plan and
+    /// those that took the classical washout's change), samples whose solves took longer than the budget (counted
+    /// only), solve time p50/p99/max.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal: Option<crate::cueing::optimal::CountsReport>,
     /// `--telemetry-shm`: the game, its mappings, and its samples, repeats, torn reads and stalls.

@@ -60,8 +60,13 @@ pub struct OptimalConfig {
     /// translations' share: on a small rig sustained force is mostly tilt, and the best cueing uses nearly all of
     /// the tilt range and little translation, a mix whose poses stay inside the coupled envelope.
     pub tilt_share: f64,
-    /// A solve that takes longer than this falls back to the classical washout for its sample (ms; default 2).
+    /// The time a solve may take (ms; default 2, a 100 Hz sample's share): a longer one is counted as late. Counted
+    /// only: the solver is bounded by [`OptimalConfig::iterations`], work and not a clock, so that the same drive
+    /// gives the same motion on any machine under any load.
     pub budget_ms: f64,
+    /// The solver's work per solve: interior-point iterations (default 60). A solve that has not converged within
+    /// them falls back to its last plan, then to the classical washout.
+    pub iterations: u32,
 }
 
 impl Default for OptimalConfig {
@@ -82,6 +87,7 @@ impl Default for OptimalConfig {
             envelope_share: 0.5,
             tilt_share: 0.5,
             budget_ms: 2.0,
+            iterations: 60,
         }
     }
 }
@@ -155,6 +161,9 @@ impl OptimalConfig {
         }
         if !ok(self.budget_ms, 0.01, 1000.0) {
             return err("optimal.budget_ms", "0.01 to 1000 ms");
+        }
+        if !(1..=200).contains(&self.iterations) {
+            return err("optimal.iterations", "1 to 200 iterations");
         }
         Ok(())
     }

@@ -358,10 +358,17 @@ pub const PARAMS: &[Param] = &[
     ),
     param(
         "optimal.budget_ms",
-        "optimal: solve budget",
+        "optimal: solve time counted late after",
         one(&["algorithm"]),
         "ms",
         Values::Range(0.01, 1000.0),
+    ),
+    param(
+        "optimal.iterations",
+        "optimal: solver iterations",
+        one(&["algorithm"]),
+        "",
+        Values::Numbers(&[1, 5, 10, 15, 20, 30, 40, 60, 100, 200]),
     ),
 ];
 
