@@ -3,42 +3,18 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use common::proxy::Proxy;
-
-/// `ringpod simulate --tcp`, killed when dropped.
-struct Server(Child, String);
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn serve() -> Server {
-    let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-        .args(["simulate", "--tcp", "127.0.0.1:0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    Server(child, line.trim().to_owned())
-}
+use common::proxy::{Proxy, Served};
 
 /// Ctrl-C 1.5 s into a 9.5 s stall of the link: the CLI says the link stalled and that the stop is pending, gives it
 /// again until the link returns, and reports the platform at rest (exit 130, state Ready) instead of a lost link.
 #[test]
 #[cfg(unix)]
 fn ctrl_c_in_a_stalled_link_is_confirmed_when_the_link_returns() {
-    let server = serve();
-    let proxy = Proxy::to(&server.1);
+    let server = Served::start();
+    let proxy = Proxy::to(&server.addr);
     let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
         .args(["stream", "--port", &proxy.addr, "--motion", "demo", "--duration", "60"])
         .args(["--report-json", "--quiet"])

@@ -1,7 +1,9 @@
 //! Files a command writes, whole or not at all: written to a temporary file beside the target and renamed over it
 //! when complete (`tempfile`'s `NamedTempFile::persist`, a rename on the same file system), so that a full disk, an
 //! error or a stop half-way leaves the target as it was (or absent), never a partial file under its name. A file
-//! that is one of the command's inputs, or whose folder does not exist, is refused before anything runs.
+//! that is one of the command's inputs, or whose folder does not exist, is refused before anything runs. A link is
+//! written through to its file; what is not a regular file (a device, a FIFO, a folder) is refused by name, never
+//! replaced; a file written over keeps its permissions.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -33,6 +35,9 @@ impl Pending {
     /// Opens a temporary file beside `target` (named after it, with its extension: some writers choose the
     /// format by the extension).
     pub fn beside(target: &Path) -> std::io::Result<Self> {
+        let resolved = through_link(target);
+        let target = resolved.as_path();
+        not_special(target)?;
         let name = target
             .file_name()
             .map_or("out".into(), |n| n.to_string_lossy().into_owned());
@@ -55,11 +60,43 @@ impl Pending {
         self.temp.as_file_mut()
     }
 
-    /// Flushes the file to the disk and renames it to the target.
+    /// Flushes the file to the disk and renames it to the target, with the target's permissions (a new file's:
+    /// read by all, written by its owner).
     pub fn commit(self) -> std::io::Result<()> {
         self.temp.as_file().sync_all()?;
+        match std::fs::metadata(&self.target) {
+            Ok(m) => self.temp.as_file().set_permissions(m.permissions())?,
+            #[cfg(unix)]
+            Err(_) => {
+                use std::os::unix::fs::PermissionsExt;
+                self.temp
+                    .as_file()
+                    .set_permissions(std::fs::Permissions::from_mode(0o644))?;
+            }
+            #[cfg(not(unix))]
+            Err(_) => {}
+        }
         self.temp.persist(&self.target).map_err(|e| e.error)?;
         Ok(())
+    }
+}
+
+/// The file a link points to (a link's chain followed), or `target` itself.
+fn through_link(target: &Path) -> PathBuf {
+    match std::fs::symlink_metadata(target) {
+        Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(target).unwrap_or_else(|_| target.to_path_buf()),
+        _ => target.to_path_buf(),
+    }
+}
+
+/// Refuses a target that exists and is not a regular file: renamed over, a device or a FIFO would be replaced.
+fn not_special(target: &Path) -> std::io::Result<()> {
+    match std::fs::metadata(target) {
+        Ok(m) if !m.is_file() => Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "not a regular file (a device, a FIFO or a folder): name a file to write",
+        )),
+        _ => Ok(()),
     }
 }
 
@@ -90,6 +127,7 @@ pub fn same_file(output: &Path, input: &Path) -> bool {
 /// folder: found only at the end of a long run, it would lose the run) or that is one of the inputs (writing it
 /// would destroy what is being read).
 pub fn check_output(output: &Path, inputs: &[&Path]) -> Result<(), String> {
+    not_special(&through_link(output)).map_err(|e| format!("{}: {e}", output.display()))?;
     let dir = folder(output);
     if !dir.is_dir() {
         return Err(format!("{} is not a folder to write in", dir.display()));
@@ -126,6 +164,41 @@ pub fn check_outputs<'a>(outputs: &[&'a Path], inputs: &[&Path]) -> Result<(), (
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A device, a FIFO or a folder is refused by name and left as it is; a link is written through to its file,
+    /// and stays a link; a file written over keeps its permissions, a new one is read by all.
+    #[test]
+    #[cfg(unix)]
+    fn what_is_not_a_regular_file_is_refused_and_a_file_keeps_its_permissions() {
+        use std::os::unix::fs::{FileTypeExt, PermissionsExt};
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("fifo");
+        assert!(std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success());
+        for special in [Path::new("/dev/null"), fifo.as_path(), dir.path()] {
+            assert!(check_output(special, &[]).is_err(), "{}", special.display());
+            assert!(write(special, b"x").is_err(), "{}", special.display());
+        }
+        assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        let file = dir.path().join("run.csv");
+        std::fs::write(&file, "old").unwrap();
+        let link = dir.path().join("link.csv");
+        std::os::unix::fs::symlink(&file, &link).unwrap();
+        write(&link, b"through").unwrap();
+        assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+        assert_eq!(std::fs::read_to_string(&file).unwrap(), "through");
+        for mode in [0o644, 0o600, 0o664] {
+            std::fs::set_permissions(&file, std::fs::Permissions::from_mode(mode)).unwrap();
+            write(&file, b"again").unwrap();
+            assert_eq!(std::fs::metadata(&file).unwrap().permissions().mode() & 0o777, mode);
+        }
+        let new = dir.path().join("new.csv");
+        write(&new, b"new").unwrap();
+        assert_eq!(std::fs::metadata(&new).unwrap().permissions().mode() & 0o777, 0o644);
+    }
 
     #[test]
     fn two_outputs_on_one_path_are_refused() {

@@ -7,6 +7,38 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
+/// `ringpod simulate --tcp 127.0.0.1:0`, killed when dropped; `addr` is what it serves (`tcp://127.0.0.1:PORT`).
+pub struct Served {
+    child: std::process::Child,
+    pub addr: String,
+}
+
+impl Drop for Served {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Served {
+    pub fn start() -> Self {
+        use std::io::BufRead;
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args(["simulate", "--tcp", "127.0.0.1:0"])
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut line = String::new();
+        std::io::BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .unwrap();
+        Self {
+            child,
+            addr: line.trim().to_owned(),
+        }
+    }
+}
+
 /// The proxy: `addr` is what the host connects to (`tcp://127.0.0.1:PORT`).
 pub struct Proxy {
     pub addr: String,

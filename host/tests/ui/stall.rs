@@ -1,41 +1,20 @@
 //! The workbench on a device behind a link that stalls (`--port tcp://` through a proxy that holds the bytes): a
 //! STOP given in the stall is shown as pending, given again, and lands when the link returns.
 
-use std::io::{BufRead, BufReader};
-use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 
 use serde_json::json;
 
-use super::proxy::Proxy;
+use super::proxy::{Proxy, Served};
 use super::workbench::Workbench;
 use super::{homed, state};
-
-/// `ringpod simulate --tcp`, killed when dropped.
-struct Server(Child, String);
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 /// STOP 1.5 s into a 6 s stall, a demo motion running: the pages are told the STOP is pending; when the link
 /// returns the device comes to rest and powers down (Off, supplies and drivers off), and the pages are told so.
 #[test]
 fn a_stop_given_while_the_link_stalls_lands_when_it_returns() {
-    let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
-        .args(["simulate", "--tcp", "127.0.0.1:0"])
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut line = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    let server = Server(child, line.trim().to_owned());
-    let proxy = Proxy::to(&server.1);
+    let server = Served::start();
+    let proxy = Proxy::to(&server.addr);
     let bench = Workbench::on(&["--port", &proxy.addr]);
     let mut page = bench.page();
     homed(&mut page);
