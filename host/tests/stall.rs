@@ -1,5 +1,7 @@
 //! A link that stalls mid-stream (`--port tcp://` through a proxy that holds the bytes): the CLI says so as it
 //! happens, and a stop given in the stall is given again until the device confirms it when the link comes back.
+//! Unix only: the test interrupts the stream with SIGINT, as Ctrl-C does.
+#![cfg(unix)]
 
 mod common;
 
@@ -11,7 +13,6 @@ use common::proxy::{Proxy, Served};
 /// Ctrl-C 1.5 s into a 9.5 s stall of the link: the CLI says the link stalled and that the stop is pending, gives it
 /// again until the link returns, and reports the platform at rest (exit 130, state Ready) instead of a lost link.
 #[test]
-#[cfg(unix)]
 fn ctrl_c_in_a_stalled_link_is_confirmed_when_the_link_returns() {
     let server = Served::start();
     let proxy = Proxy::to(&server.addr);
