@@ -158,7 +158,11 @@ function showStopPending(m) {
   state.stopPending = m.pending;
   document.body.classList.toggle("stop-pending", m.pending);
   $("stop-pending").textContent = m.pending ? "STOP pending: not yet confirmed by the device" : "";
-  if (m.pending !== was) log(m.text, m.pending);
+  // Given and confirmed within a moment is the usual case; a STOP the device did not answer is said once, in red,
+  // however often it is sent again.
+  const unanswered = m.pending && m.text.startsWith("STOP pending");
+  if (m.pending !== was || (unanswered && !state.stopUnanswered)) log(m.text, unanswered);
+  state.stopUnanswered = m.pending && (state.stopUnanswered || unanswered);
 }
 
 function showFrame(f) {
