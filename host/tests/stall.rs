@@ -51,3 +51,32 @@ fn ctrl_c_in_a_stalled_link_is_confirmed_when_the_link_returns() {
     assert!(said.contains("STOP pending"), "{said}");
     assert!(said.contains("the stop was confirmed after"), "{said}");
 }
+
+/// SIGINT while the CLI greets a port that never answers (a listening socket nobody serves): it ends at once with
+/// 130, not after the 5 s the greeting waits for.
+#[test]
+fn a_signal_while_connecting_to_a_silent_port_ends_at_once() {
+    let silent = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let port = format!("tcp://{}", silent.local_addr().unwrap());
+    let child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+        .args(["stream", "--port", &port, "--motion", "demo", "--quiet"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(1000));
+    let asked = std::time::Instant::now();
+    assert!(Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap()
+        .success());
+    let out = child.wait_with_output().unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{said}");
+    assert!(
+        asked.elapsed() < Duration::from_millis(1500),
+        "{:?}: {said}",
+        asked.elapsed()
+    );
+}

@@ -189,13 +189,21 @@ impl<T: Transport> Client<T> {
             .map(|r| r.body))
     }
 
-    /// Waits for the response to request `id`, up to the timeout.
+    /// Waits for the response to request `id`, up to the timeout; a raised cancel flag (Ctrl-C) ends the wait at
+    /// once, so that a device that does not answer (a silent port, a stalled link) does not hold a signal back.
     pub fn wait_response(&mut self, id: u32) -> Result<DeviceMessage, ClientError> {
         let step = Duration::from_micros(200);
         let mut waited = Duration::ZERO;
         loop {
             if let Some(body) = self.take_response(id)? {
                 return Ok(body);
+            }
+            if self
+                .cancel
+                .as_ref()
+                .is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst))
+            {
+                return Err(ClientError::Interrupted);
             }
             if waited >= self.timeout {
                 return Err(ClientError::Timeout(self.timeout));
