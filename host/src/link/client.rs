@@ -114,6 +114,13 @@ impl<T: Transport> Client<T> {
         }
     }
 
+    /// Whether the cancel flag (Ctrl-C, a STOP) is raised: long waits end at once.
+    pub fn cancelled(&self) -> bool {
+        self.cancel
+            .as_ref()
+            .is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst))
+    }
+
     /// The transport (to let time pass).
     pub fn transport(&mut self) -> &mut T {
         &mut self.transport
@@ -198,11 +205,7 @@ impl<T: Transport> Client<T> {
             if let Some(body) = self.take_response(id)? {
                 return Ok(body);
             }
-            if self
-                .cancel
-                .as_ref()
-                .is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst))
-            {
+            if self.cancelled() {
                 return Err(ClientError::Interrupted);
             }
             if waited >= self.timeout {
@@ -389,11 +392,7 @@ impl<T: Transport> Client<T> {
             if done(&s) {
                 return Ok(s);
             }
-            if self
-                .cancel
-                .as_ref()
-                .is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst))
-            {
+            if self.cancelled() {
                 return Err(ClientError::Interrupted);
             }
             if waited >= limit {

@@ -127,7 +127,8 @@ pub fn same_file(output: &Path, input: &Path) -> bool {
 /// folder: found only at the end of a long run, it would lose the run) or that is one of the inputs (writing it
 /// would destroy what is being read).
 pub fn check_output(output: &Path, inputs: &[&Path]) -> Result<(), String> {
-    not_special(&through_link(output)).map_err(|e| format!("{}: {e}", output.display()))?;
+    // The metadata of a link is its file's: a link to a device is refused as the device is.
+    not_special(output).map_err(|e| format!("{}: {e}", output.display()))?;
     let dir = folder(output);
     if !dir.is_dir() {
         return Err(format!("{} is not a folder to write in", dir.display()));

@@ -170,11 +170,11 @@ impl<T: Transport> Streamer<'_, T> {
 /// queue, only the game's newest sample.
 fn drop_queued(source: &mut LiveSource, buf: &mut [u8]) -> u32 {
     let mut dropped = 0;
+    if !matches!(source.receiver, super::live::Receiver::Udp(_)) {
+        return dropped;
+    }
     // Bounded: a flood does not keep the stream from starting (the socket's reads wait a millisecond).
     for _ in 0..100_000 {
-        if !matches!(source.receiver, super::live::Receiver::Udp(_)) {
-            break;
-        }
         match source.receiver.receive(buf) {
             Ok(Some(arrival)) => {
                 capture(source, buf, Some(&arrival));

@@ -239,12 +239,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
                     break;
                 }
                 // A stopping signal ends the wait at once: the run's loop stops and the ending counts the rest.
-                if self
-                    .client
-                    .cancel
-                    .as_ref()
-                    .is_some_and(|c| c.load(std::sync::atomic::Ordering::SeqCst))
-                {
+                if self.client.cancelled() {
                     break;
                 }
                 if waited >= patience {
