@@ -7,7 +7,7 @@ use serde::{de::DeserializeOwned, Serialize};
 use super::wire;
 
 /// Largest postcard payload of any message (bytes): a rig record with six chains (`HostMessage::SetRig`,
-/// `DeviceMessage::Rig`) is the largest, about 560 (tested in `tests/rig_record.rs`).
+/// `DeviceMessage::Rig`) is the largest, about 560 (tested in `tests/suite/rig_record.rs`).
 pub const MAX_PAYLOAD: usize = 768;
 /// Largest encoded frame including the delimiter (bytes).
 pub const MAX_FRAME: usize = cobs::max_encoding_length(MAX_PAYLOAD + 4) + 1;
