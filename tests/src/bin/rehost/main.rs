@@ -3,8 +3,8 @@
 //!
 //! 1. The `thumbv7em-none-eabihf` standard library (the preflight the QEMU runner uses), then
 //!    `cargo build -p ringpod-firmware --target thumbv7em-none-eabihf --profile firmware`.
-//!    Then the host CLI (`cargo build -p ringpod`), which run.py drives over ptys bridged to the emulated USART1
-//!    and to the USB host on the emulated OTG FS core.
+//!    Then the host CLI, the release build the README's main command makes (`ringpod_tests::cli`), which run.py
+//!    drives over ptys bridged to the emulated USART1 and to the USB host on the emulated OTG FS core.
 //! 2. A Python venv in `target/rehost-venv` with the pinned emulator (`tests/rehost/requirements.txt`), made again
 //!    whenever that file changes.
 //! 3. The firmware's flash against its budget (`size`), counted as one check.
@@ -23,7 +23,8 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, ExitCode};
 
-use prepare::{build_cli, build_firmware, repo, run_py, venv};
+use prepare::{build_firmware, repo, run_py, venv};
+use ringpod_tests::cli;
 use ringpod_tests::setup;
 
 /// The models' unit tests: Ok(number of tests) when all passed.
@@ -75,7 +76,7 @@ fn checks(python: &Path, elf: &Path, cli: &Path) -> Result<(u32, u32, bool), Str
 fn main() -> ExitCode {
     let prepared = setup::ensure_target()
         .and_then(|()| build_firmware())
-        .and_then(|elf| Ok((elf, build_cli()?, venv()?)));
+        .and_then(|elf| Ok((elf, cli::build_release()?, venv()?)));
     let (elf, cli, python) = match prepared {
         Ok(p) => p,
         Err(e) => {
