@@ -1,6 +1,5 @@
-//! A runner's independent sections, run as child processes of the runner itself, as many at once as the machine has
-//! cores. An emulator section keeps one core busy (QEMU's CPU thread) or waits on a pty, so on two cores two sections
-//! side by side take the time of about one. Each child prints its own `PASS`/`FAIL` lines and ends with
+//! A runner's independent sections, run as child processes of the runner itself, `jobs` at a time (the runner
+//! decides how many its sections bear side by side). Each child prints its own `PASS`/`FAIL` lines and ends with
 //! `N passed, N failed`; the parent prints each section's output whole as it ends and sums the counts.
 
 use std::collections::VecDeque;

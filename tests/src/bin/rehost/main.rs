@@ -12,6 +12,7 @@
 //!    print `PASS`/`FAIL` lines. The last line is the sum, `N passed, N failed`; the exit status is 1 when anything
 //!    failed.
 //!
+//! Other arguments go to run.py (`-- --until serial-status` stops after that check; `-- --help` lists them).
 //! `-- --mutants [NAME...]`: instead, the firmware faults of `tests/rehost/mutants.toml`, each built from a copy of
 //! the sources and run up to the check meant to catch it (`mutants`).
 
@@ -57,8 +58,9 @@ fn tally(line: &str) -> Option<(u32, u32)> {
 }
 
 /// run.py, its lines passed through as they come, except its count, which is returned.
-fn checks(python: &Path, elf: &Path, cli: &Path) -> Result<(u32, u32, bool), String> {
-    let mut child = run_py(python, elf, cli, &[])?;
+fn checks(python: &Path, elf: &Path, cli: &Path, args: &[String]) -> Result<(u32, u32, bool), String> {
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let mut child = run_py(python, elf, cli, &args)?;
     let mut count = None;
     if let Some(out) = child.stdout.take() {
         for line in BufReader::new(out).lines().map_while(Result::ok) {
@@ -125,7 +127,7 @@ fn main() -> ExitCode {
         }
     }
     let mut ok = failed == 0;
-    match checks(&python, &elf, &cli) {
+    match checks(&python, &elf, &cli, &args) {
         Ok((p, f, exited_ok)) => {
             passed += p;
             failed += f;
