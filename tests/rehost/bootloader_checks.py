@@ -45,13 +45,17 @@ class SystemMemory:
         m.uc.mem_write(SYSTEM_MEMORY, b"\xff" * SYSTEM_MEMORY_SIZE)
         m.uc.mem_write(SYSTEM_MEMORY, struct.pack("<II", ROM_SP, ROM_RESET | 1))
         m.uc.mem_write(ROM_RESET, WFI_LOOP)
-        m.uc.hook_add(UC_HOOK_CODE, m._wfe, None, ROM_RESET, ROM_RESET)
         self.entries = []
+        # One hook: the entry is recorded, then the WFI sleeps (a hook that stops the CPU, as the WFI's does, ends
+        # the instruction's hooks there: Unicorn runs no later hook of the same instruction).
         m.uc.hook_add(UC_HOOK_CODE, self._reset_handler, None, ROM_RESET, ROM_RESET)
 
     def _reset_handler(self, uc, addr, size, ud):
-        if self.entries and self.entries[-1][3] == len(self.m.resets):
-            return  # the loop going round again in the same start
+        if not self.entries or self.entries[-1][3] != len(self.m.resets):  # not the loop going round again
+            self._entered(uc)
+        self.m._wfe(uc, addr, size, ud)
+
+    def _entered(self, uc):
         msp = uc.reg_read(A.UC_ARM_REG_MSP)
         self.entries.append((self.m.now, msp, self.m.read(SYSCFG_MEMRMP, 4) & 3, len(self.m.resets)))
         m = self.m
@@ -114,7 +118,8 @@ def bootloader_entry_checks(checks, m, cli, port, rom, log, usb=None):
     from machine import SYSCLK
 
     resets0 = len(m.resets)
-    cli.run("device", "disable", *port)
+    # Off already when the e-stop check's `device clear` left it so (then refused, exit 1)
+    cli.run("device", "disable", *port, expect=(0, 1))
     m.run(m.now + SYSCLK // 2)  # drivers, power, logic off
     off = cli.run("device", "status", *port)
     lines = len(log.lines)
