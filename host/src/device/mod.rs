@@ -136,6 +136,11 @@ fn status<T: link::client::Transport>(client: &mut Client<T>) -> Result<String, 
     Ok(serde_json::to_string_pretty(&json)?)
 }
 
+/// The firmware a device of this host's protocol runs, in a few words (`ports`, the workbench).
+pub fn firmware_text(firmware: &Firmware) -> String {
+    format!("{firmware}, protocol {PROTOCOL_VERSION}")
+}
+
 /// The firmware a device runs, as `device status` gives it: ringpod's version, the protocol (this host's: the
 /// handshake agreed), and the flashed image's length and CRC-32C (`null` for the simulated controller).
 pub fn firmware_json(firmware: &Firmware) -> serde_json::Value {
@@ -230,7 +235,7 @@ fn identify(port: &str) -> String {
     };
     let mut client = Client::new(transport);
     match client.hello_once(link::patience(std::time::Duration::from_millis(500))) {
-        Ok(device) => format!("{}, protocol {PROTOCOL_VERSION}", device.firmware),
+        Ok(device) => firmware_text(&device.firmware),
         Err(ClientError::VersionMismatch { device, firmware, .. }) => {
             let runs = firmware.map_or_else(|| "firmware".to_owned(), |f| f.to_string());
             format!("{runs}, protocol {device}: not this ringpod's (protocol {PROTOCOL_VERSION}), run `ringpod flash`")
