@@ -34,6 +34,9 @@ pub enum DeviceAction {
     Rig,
     /// Restart the controller (supplies off) once it has stored everything: a loaded rig or setting runs.
     Restart,
+    /// Restart into the MCU's ROM bootloader (USB DFU, 0483:df11; supplies off) once everything is stored, to be
+    /// flashed (`ringpod flash` does this itself). Asked without a handshake: a board of any protocol version takes it.
+    Bootloader,
     /// `aux N on|off`: switch auxiliary output N (1 or 2: AUX1 on PC15, AUX2 on PC13). On only while homed and
     /// holding or streaming (Ready, Running); a fault, an e-stop, a disable, homing or a jog switches both off.
     Aux,

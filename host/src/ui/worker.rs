@@ -176,6 +176,9 @@ fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlat
     // The frames and motion compensation show the pose of the counted steps of the rig the device runs now.
     client.followed = crate::link::followed::Followed::of(&record);
     let mut view = RigView::of(&geometry, record.home, source.to_string());
+    view.firmware = client
+        .device
+        .map_or_else(String::new, |d| crate::device::firmware_text(&d.firmware));
     // The name the user gave the rig (its file's `name`), not the geometry's generic one.
     if !record.name().trim().is_empty() {
         record.name().clone_into(&mut view.name);

@@ -27,3 +27,4 @@ mod stall;
 mod stream;
 mod tcp;
 mod ui;
+mod versions;

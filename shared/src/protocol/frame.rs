@@ -14,6 +14,11 @@ pub const MAX_FRAME: usize = cobs::max_encoding_length(MAX_PAYLOAD + 4) + 1;
 
 const CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI);
 
+/// The frames' CRC-32C of `bytes` (also the flashed image's, `firmware::image_crc`: one table in the firmware).
+pub(super) fn crc32c(bytes: &[u8]) -> u32 {
+    CRC.checksum(bytes)
+}
+
 /// Why a frame could not be encoded or decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]

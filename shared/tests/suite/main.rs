@@ -12,6 +12,7 @@ mod common;
 mod latency_example;
 
 mod aux;
+mod bootloader;
 mod continuous_yaw;
 mod cueing;
 mod cueing_tuning;

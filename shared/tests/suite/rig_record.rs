@@ -216,7 +216,7 @@ fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
     // Off: taken, reported as pending, handed out once for storing; the restart waits for it.
     assert_eq!(ask(&mut c, HostMessage::SetRig(rig)), DeviceMessage::Ack);
     assert_eq!(ask(&mut c, HostMessage::Restart), DeviceMessage::Ack);
-    assert!(!c.restart_due(), "the rig is not stored yet");
+    assert_eq!(c.restart_due(), None, "the rig is not stored yet");
     match ask(&mut c, HostMessage::GetRig) {
         DeviceMessage::Rig {
             rig: running,
@@ -232,7 +232,7 @@ fn the_controller_takes_a_rig_only_when_off_and_only_one_that_can_run() {
     }
     assert_eq!(c.take_unsaved().map(|config| config.rig()), Some(rig));
     assert_eq!(c.take_unsaved(), None);
-    assert!(c.restart_due());
+    assert_eq!(c.restart_due(), Some(ringpod_core::controller::Restart::Controller));
 }
 
 /// The stream's hot path reads a setpoint request straight from its payload: the same request as the full

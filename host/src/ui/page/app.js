@@ -111,7 +111,7 @@ const liveCharts = [];
 
 function showRig(rig) {
   state.rig = rig;
-  $("rig-name").textContent = `${rig.name} (${rig.source})`;
+  $("rig-name").textContent = `${rig.name} (${rig.source})` + (rig.firmware ? ` · ${rig.firmware}` : "");
   const axis = $("jog-axis");
   axis.innerHTML = "";
   rig.axes.forEach((kind, i) => {
