@@ -52,6 +52,7 @@ function connect() {
     else if (m.type === "reply") showReply(m);
     else if (m.type === "halted") { state.halted = m; log(m.text); }
     else if (m.type === "stop_pending") showStopPending(m);
+    else if (m.type === "notice") showNotice(m);
     else if (m.type === "report") log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
   };
 }
@@ -70,14 +71,24 @@ function send(request) {
   return id;
 }
 
+// Each line numbered from the page's first (the oldest go past 200 lines; the numbers stay those they were given).
+let logged = 0;
 function log(text, error) {
   const li = document.createElement("li");
+  li.value = ++logged;
   li.textContent = `${new Date().toLocaleTimeString()}  ${text}`;
   if (error) li.className = "error";
   const list = $("log");
   list.appendChild(li);
   while (list.children.length > 200) list.removeChild(list.firstChild);
   list.scrollTop = list.scrollHeight;
+}
+
+// What the workbench did on its own (a stream stopped because its page went away, a STOP's outcome): a page that
+// opens later (a reload) is told what happened before it, at the time it happened.
+function showNotice(m) {
+  if (m.earlier) log(`before this page opened, at ${new Date(m.at_ms).toLocaleTimeString()}: ${m.text}`);
+  else log(m.text, true);
 }
 
 function showReply(m) {
