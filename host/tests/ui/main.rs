@@ -3,6 +3,7 @@
 #[path = "../common/proxy.rs"]
 mod proxy;
 mod requests;
+mod runs;
 mod stall;
 mod workbench;
 
