@@ -299,6 +299,7 @@ fn a_file_that_is_not_a_text_file_is_refused_at_once() {
             vec!["plot", file, "--out", &picture],
             vec!["loads", "--mass", "0.1", "--input", file],
             vec!["rig", "check", file],
+            vec!["dynamics", "--file", file],
         ] {
             let started = std::time::Instant::now();
             let (code, _, stderr) = run(&args);
@@ -442,6 +443,33 @@ fn a_non_finite_row_of_a_load_input_is_left_out_by_line() {
     assert_eq!(errors.len(), 1, "{json}");
     assert_eq!(errors[0]["line"], 2);
     assert!(stdout.contains("drives_keep_up") && !stdout.contains("NaN"), "{stdout}");
+}
+
+/// A load input none of whose rows the platform reaches: there is no peak, margin or "keep up" of no row; the
+/// input is refused, naming why its first row was left out.
+#[test]
+fn a_load_input_with_no_reachable_row_is_refused() {
+    let dir = scratch("loads-unreachable");
+    let mut csv = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for k in 0..20 {
+        csv += &format!("{},0,0,5,0,0,0\n", k as f64 * 0.01);
+    }
+    let path = dir.join("far.csv");
+    std::fs::write(&path, csv).unwrap();
+    for json in [false, true] {
+        let mut args = vec!["loads", "--mass", "1", "--input", path.to_str().unwrap()];
+        if json {
+            args.push("--json");
+        }
+        let (code, stdout, stderr) = run(&args);
+        assert_eq!(code, 1, "{args:?}: {stdout}{stderr}");
+        assert!(stdout.is_empty(), "{stdout}");
+        assert!(
+            stderr.contains("none of its 20 rows is a pose the platform reaches") && stderr.contains("line 2"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("NaN") && !stderr.contains("keep up"), "{stderr}");
+    }
 }
 
 /// Class: options that would do nothing with the others given are refused, not silently ignored.
