@@ -488,6 +488,11 @@ fn an_option_that_would_be_ignored_is_refused() {
             vec!["stream", "--sim", "--motion", "demo", "--udp-from", "127.0.0.1"],
             2,
         ),
+        (vec!["stream", "--sim", "--input", "x.csv", "--pose-format", "flypt"], 2),
+        (
+            vec!["stream", "--sim", "--motion", "demo", "--pose-format", "simtools"],
+            2,
+        ),
         (
             vec!["workspace", "--section", "xz", "--z", "0.1", "--out", "/tmp/x.svg"],
             1,
@@ -598,5 +603,47 @@ fn a_drive_the_bench_cannot_score_is_refused() {
             assert!(stderr.contains(name) && stderr.contains(said), "{stderr}");
             assert!(!out.exists(), "{name} {floor:?}: a report was written");
         }
+    }
+}
+
+/// Class: refusals say what and where, once: a folder that is not there is refused when the workbench starts, an
+/// option is named with its two dashes, a file that cannot be written is named with the reason.
+#[test]
+fn refusals_name_what_they_refuse_once() {
+    let started = std::time::Instant::now();
+    let (code, _, stderr) = run(&[
+        "ui",
+        "--sim",
+        "--listen",
+        "127.0.0.1:0",
+        "--files",
+        "/nonexistent/poses",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("/nonexistent/poses") && stderr.contains(MISSING),
+        "{stderr}"
+    );
+    assert!(started.elapsed() < std::time::Duration::from_secs(20));
+    let (code, _, stderr) = run(&["stream", "--sim", "--mechanism", "tool5-ex", "--motion", "demo"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains(" --mechanism: tool5-ex is not a ring platform"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("---"), "{stderr}");
+    // sysfs takes no new file, even from root.
+    if cfg!(target_os = "linux") {
+        let (code, _, stderr) = run(&[
+            "dynamics",
+            "-m",
+            "trainer-model",
+            "--duration",
+            "0.1",
+            "--table",
+            "/sys/ringpod-table.csv",
+        ]);
+        assert_eq!(code, 1, "{stderr}");
+        assert!(stderr.contains("/sys/ringpod-table.csv: "), "{stderr}");
     }
 }

@@ -168,6 +168,11 @@ impl RigFile {
         positive("ring_radius", self.ring_radius)?;
         positive("rod_length", self.rod_length)?;
         finite("home", &self.home)?;
+        // A finite number far beyond any pose (a yaw of 1e300) is out of range, not "NaN or infinite" as the
+        // kinematics, overflowing on it, would say.
+        if let Err(e) = crate::input::numbers::pose_in_range("home", &self.home, self.ring_radius) {
+            return err("home", e.reason);
+        }
         let n = self.chains.len();
         if !(3..=6).contains(&n) {
             return err("chains", format!("{n} chains; a ring platform has 3 to 6"));
