@@ -66,6 +66,16 @@ pub struct DeviceArgs {
     pub watch: bool,
 }
 
+/// `--files DIR`: a folder there is, said at the start (a misspelt one would show only when a page asks for a
+/// file). clap names the option and the value; this says what is wrong with it.
+fn existing_dir(text: &str) -> Result<std::path::PathBuf, String> {
+    match std::fs::metadata(text) {
+        Ok(m) if m.is_dir() => Ok(text.into()),
+        Ok(_) => Err("not a folder".into()),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 #[derive(Debug, clap::Args)]
 pub struct UiArgs {
     /// The controller.
@@ -76,7 +86,7 @@ pub struct UiArgs {
     #[arg(long, default_value = "127.0.0.1:8080")]
     pub listen: std::net::SocketAddr,
     /// Let the page stream pose files under DIR by name. Without it the page streams only the files picked in it.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", value_parser = existing_dir)]
     pub files: Option<std::path::PathBuf>,
     /// VR motion compensation (Windows): write the pose the seat followed, whenever the device reports it (every
     /// run from the page, and at rest), where OpenXR-MotionCompensation's virtual tracker of this type reads it, as

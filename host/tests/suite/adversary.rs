@@ -299,6 +299,7 @@ fn a_file_that_is_not_a_text_file_is_refused_at_once() {
             vec!["plot", file, "--out", &picture],
             vec!["loads", "--mass", "0.1", "--input", file],
             vec!["rig", "check", file],
+            vec!["dynamics", "--file", file],
         ] {
             let started = std::time::Instant::now();
             let (code, _, stderr) = run(&args);
@@ -444,6 +445,33 @@ fn a_non_finite_row_of_a_load_input_is_left_out_by_line() {
     assert!(stdout.contains("drives_keep_up") && !stdout.contains("NaN"), "{stdout}");
 }
 
+/// A load input none of whose rows the platform reaches: there is no peak, margin or "keep up" of no row; the
+/// input is refused, naming why its first row was left out.
+#[test]
+fn a_load_input_with_no_reachable_row_is_refused() {
+    let dir = scratch("loads-unreachable");
+    let mut csv = String::from("t,x,y,z,alpha,beta,gamma\n");
+    for k in 0..20 {
+        csv += &format!("{},0,0,5,0,0,0\n", k as f64 * 0.01);
+    }
+    let path = dir.join("far.csv");
+    std::fs::write(&path, csv).unwrap();
+    for json in [false, true] {
+        let mut args = vec!["loads", "--mass", "1", "--input", path.to_str().unwrap()];
+        if json {
+            args.push("--json");
+        }
+        let (code, stdout, stderr) = run(&args);
+        assert_eq!(code, 1, "{args:?}: {stdout}{stderr}");
+        assert!(stdout.is_empty(), "{stdout}");
+        assert!(
+            stderr.contains("none of its 20 rows is a pose the platform reaches") && stderr.contains("line 2"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("NaN") && !stderr.contains("keep up"), "{stderr}");
+    }
+}
+
 /// Class: options that would do nothing with the others given are refused, not silently ignored.
 #[test]
 fn an_option_that_would_be_ignored_is_refused() {
@@ -458,6 +486,11 @@ fn an_option_that_would_be_ignored_is_refused() {
         ),
         (
             vec!["stream", "--sim", "--motion", "demo", "--udp-from", "127.0.0.1"],
+            2,
+        ),
+        (vec!["stream", "--sim", "--input", "x.csv", "--pose-format", "flypt"], 2),
+        (
+            vec!["stream", "--sim", "--motion", "demo", "--pose-format", "simtools"],
             2,
         ),
         (
@@ -570,5 +603,47 @@ fn a_drive_the_bench_cannot_score_is_refused() {
             assert!(stderr.contains(name) && stderr.contains(said), "{stderr}");
             assert!(!out.exists(), "{name} {floor:?}: a report was written");
         }
+    }
+}
+
+/// Class: refusals say what and where, once: a folder that is not there is refused when the workbench starts, an
+/// option is named with its two dashes, a file that cannot be written is named with the reason.
+#[test]
+fn refusals_name_what_they_refuse_once() {
+    let started = std::time::Instant::now();
+    let (code, _, stderr) = run(&[
+        "ui",
+        "--sim",
+        "--listen",
+        "127.0.0.1:0",
+        "--files",
+        "/nonexistent/poses",
+    ]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(
+        stderr.contains("/nonexistent/poses") && stderr.contains(MISSING),
+        "{stderr}"
+    );
+    assert!(started.elapsed() < std::time::Duration::from_secs(20));
+    let (code, _, stderr) = run(&["stream", "--sim", "--mechanism", "tool5-ex", "--motion", "demo"]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(
+        stderr.contains(" --mechanism: tool5-ex is not a ring platform"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("---"), "{stderr}");
+    // sysfs takes no new file, even from root.
+    if cfg!(target_os = "linux") {
+        let (code, _, stderr) = run(&[
+            "dynamics",
+            "-m",
+            "trainer-model",
+            "--duration",
+            "0.1",
+            "--table",
+            "/sys/ringpod-table.csv",
+        ]);
+        assert_eq!(code, 1, "{stderr}");
+        assert!(stderr.contains("/sys/ringpod-table.csv: "), "{stderr}");
     }
 }

@@ -185,6 +185,11 @@ fn a_motion_file_is_followed_and_a_bad_one_refused() {
         (text.replace("\n0.02,", "\n0.005,"), "line 4: time is not increasing"),
         (text.replace("\n0.03,", "\n0.03,x"), "line 5"),
         ("t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n".to_owned(), "at least 3"),
+        // As `loads` and `stream` take it: no peak force of a pose of garbage.
+        (
+            text.replacen(",0.015\n", ",1e300\n", 1),
+            "line 5: gamma = 1e300 is out of range",
+        ),
     ] {
         std::fs::write(&bad, file).unwrap();
         let out = ringpod()

@@ -102,6 +102,7 @@ fn a_fifo_as_an_input_file_is_refused_at_once() {
     for args in [
         vec!["stream", "--sim", "--fast", "--quiet", "--input", &path],
         vec!["cue", "--input", &path, "--out", &out],
+        vec!["dynamics", "--file", &path],
     ] {
         let o = within(&args, Duration::from_secs(20)).unwrap_or_else(|| panic!("{args:?} waited on the FIFO"));
         let stderr = String::from_utf8_lossy(&o.stderr);

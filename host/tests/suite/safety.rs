@@ -449,3 +449,28 @@ fn an_output_that_is_an_input_is_refused_before_anything_runs() {
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(std::fs::read_to_string(&telemetry).unwrap(), drive);
 }
+
+/// A file of which every fifth row the device refuses (a yaw jump): the first refusals are said each on a line, the
+/// rest counted in a line or two, and every one is in the report; the counts said add up to the report's.
+#[test]
+fn many_refusals_are_said_in_a_few_lines_and_all_reported() {
+    let jumps: Vec<(usize, &str)> = (1..40).map(|k| (k * 5, "0,0,0.227,0,0,1.2")).collect();
+    let file = folder("flood").join("jumps.csv");
+    std::fs::write(&file, poses(&jumps)).unwrap();
+    let (code, report, stderr) = stream(&["--input", file.to_str().unwrap()]);
+    assert_ne!(code, 0, "{report}");
+    let refusals = report["refusals"].as_array().unwrap().len();
+    assert!(refusals >= 30, "{report}");
+    let lines = stderr
+        .lines()
+        .filter(|l| l.contains(": refused by the device:"))
+        .count();
+    assert_eq!(lines, 10, "{stderr}");
+    let counted: usize = stderr
+        .lines()
+        .filter(|l| l.contains("more setpoints refused by the device"))
+        .map(|l| l.split_whitespace().next().unwrap().parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(lines + counted, refusals, "{stderr}");
+    assert!(stderr.lines().count() < 20, "{stderr}");
+}

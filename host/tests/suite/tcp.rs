@@ -70,12 +70,31 @@ fn one_client_at_a_time_the_second_is_closed_at_once() {
     let mut second = std::net::TcpStream::connect(address).unwrap();
     second.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
     let started = Instant::now();
-    let mut buf = [0u8; 16];
-    // Closed: end of stream (or a reset), well before the timeout.
-    let n = second.read(&mut buf).unwrap_or(0);
-    assert_eq!(n, 0);
+    // Told, then closed: end of stream, well before the timeout.
+    let mut told = Vec::new();
+    let _ = second.read_to_end(&mut told);
+    assert_eq!(
+        String::from_utf8_lossy(&told),
+        "ringpod simulate: busy with another client\n"
+    );
     assert!(started.elapsed() < Duration::from_secs(4));
+    // A command on the busy simulator says so, not that "the peer closed the connection".
+    let out = ringpod(&["device", "status", "--port", &server.1]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(said.contains("the simulator is busy with another client"), "{said}");
     drop(first);
+}
+
+/// An address the simulator cannot listen on (a port another program holds) is named with the reason.
+#[test]
+fn an_address_that_cannot_be_listened_on_is_named() {
+    let held = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = held.local_addr().unwrap().to_string();
+    let out = ringpod(&["simulate", "--tcp", &addr]);
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{said}");
+    assert!(said.contains(&format!("cannot listen on {addr}")), "{said}");
 }
 
 #[test]

@@ -43,6 +43,10 @@ fn a_file_is_read_only_when_picked_or_under_the_named_directory_and_never_quoted
             !text.contains("root:") && !text.contains("SECRET"),
             "{request}: the answer quotes the file: {text}"
         );
+        // The file is named once.
+        if let Some(name) = request["name"].as_str() {
+            assert!(!text.contains(&format!("{name}: {name}")), "{request}: {text}");
+        }
     }
     // A file the user picked comes as its text, and is followed.
     let text = "t,x,y,z,alpha,beta,gamma\n0,0,0,0.227,0,0,0\n0.5,0,0,0.229,0,0,0\n";
