@@ -2,12 +2,13 @@
 //! and the browser's runs and the Windows build under Wine, arranged so that two cores are both at work:
 //!
 //! 1. `cargo test --no-run`: the workspace's test programs, built with both cores.
-//! 2. Then two lanes side by side. Lane one, its output as it comes: `cargo test` (most of its tests wait on a child
-//!    `ringpod` in real time), the QEMU suite, the rehost run and the browser tests, each keeping about one core
-//!    busy. Lane two: the Windows runner, its cross-build on one job (`CARGO_BUILD_JOBS=1`) in a target folder of
-//!    its own (`target/windows`: a cross-build holds the build folder's lock for minutes, and the runners of lane
-//!    one build in it), then its programs under Wine; its output is written to `target/windows-runner.log` as it
-//!    comes and printed whole once lane one is over.
+//! 2. `cargo test` alone: most of its tests wait on a child `ringpod` in real time, and a build beside them would
+//!    starve their answers.
+//! 3. Then two lanes side by side. Lane one, its output as it comes: the QEMU suite, the rehost run and the browser
+//!    tests, each keeping about one core busy. Lane two: the Windows runner, its cross-build on one job
+//!    (`CARGO_BUILD_JOBS=1`) in a target folder of its own (`target/windows`: a cross-build holds the build folder's
+//!    lock for minutes, and the runners of lane one build in it), then its programs under Wine; its output is
+//!    written to `target/windows-runner.log` as it comes and printed whole once lane one is over.
 //!
 //! Each part runs whatever the others gave. The last lines name each part with its result and time, and the exit
 //! status is 1 when any part failed. On a system other than Linux only `cargo test` runs: the emulators, the
@@ -99,6 +100,11 @@ fn main() -> ExitCode {
     if !ready {
         return summary(&parts);
     }
+    // cargo test alone: most of its tests wait on a child `ringpod` in real time, and a build beside them starves
+    // their answers.
+    let mut test = cargo();
+    test.args(["test", "--no-fail-fast"]);
+    parts.push(part("cargo test", test));
     let log = target_dir().join("windows-runner.log");
     let started = Instant::now();
     let mut windows = windows_lane(&log);
@@ -109,9 +115,6 @@ fn main() -> ExitCode {
         ),
         Err(e) => println!("FAIL {e}"),
     }
-    let mut test = cargo();
-    test.args(["test", "--no-fail-fast"]);
-    parts.push(part("cargo test", test));
     for name in ["qemu", "rehost", "browser"] {
         parts.push(part(&format!("the {name} runner"), runner(name)));
     }
