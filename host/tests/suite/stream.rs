@@ -1,8 +1,8 @@
 //! `ringpod stream` against the simulated controller: the same core as the firmware behind the real framed bytes.
 
 #[cfg(unix)]
-#[cfg(unix)]
 use crate::common::simulator::Simulator;
+#[cfg(unix)]
 use crate::common::spawn_sim_stream;
 use crate::common::{numbers, spawn_live_stream};
 use assert_cmd::Command;

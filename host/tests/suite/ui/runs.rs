@@ -1,12 +1,12 @@
 //! The Runs panel's record over HTTP, as the page sends it: the file's bytes.
 
-use std::io::{Read, Write};
+use std::io::Write;
 use std::net::TcpStream;
 use std::time::Duration;
 
 use serde_json::Value;
 
-use super::workbench::Workbench;
+use super::workbench::{answer, Workbench};
 
 /// POSTs `body` to `/api/run` as the page does: the status and the answer's JSON.
 fn post_record(bench: &Workbench, body: &[u8]) -> (u16, Value) {
@@ -22,18 +22,8 @@ fn post_record(bench: &Workbench, body: &[u8]) -> (u16, Value) {
     )
     .unwrap();
     s.write_all(body).unwrap();
-    let mut answer = String::new();
-    s.read_to_string(&mut answer).unwrap();
-    let status = answer
-        .split_whitespace()
-        .nth(1)
-        .and_then(|c| c.parse().ok())
-        .unwrap_or(0);
-    let json = answer
-        .split_once("\r\n\r\n")
-        .and_then(|(_, b)| serde_json::from_str(b).ok())
-        .unwrap_or(Value::Null);
-    (status, json)
+    let (status, answer) = answer(&mut s);
+    (status, serde_json::from_str(&answer).unwrap_or(Value::Null))
 }
 
 /// 80 s at 100 Hz as `stream --record` writes it (full-precision floats, as a real record's): 2.6 MB.

@@ -145,7 +145,7 @@ impl Page {
 
 /// One HTTP/1.1 request by hand (to choose its `Host`): the status code and the body.
 pub fn http(addr: &str, method: &str, path: &str, host: &str, body: Option<&Value>) -> (u16, String) {
-    use std::io::{Read, Write};
+    use std::io::Write;
     let mut s = TcpStream::connect(addr).unwrap();
     s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
     let body = body.map(Value::to_string).unwrap_or_default();
@@ -156,6 +156,12 @@ pub fn http(addr: &str, method: &str, path: &str, host: &str, body: Option<&Valu
         body.len()
     )
     .unwrap();
+    answer(&mut s)
+}
+
+/// The whole answer on `s`, read to its end: the status code and the body.
+pub fn answer(s: &mut TcpStream) -> (u16, String) {
+    use std::io::Read;
     let mut answer = String::new();
     s.read_to_string(&mut answer).unwrap();
     let status = answer
