@@ -338,6 +338,11 @@ pub(crate) mod testing {
         a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-4 * (1.0 + y.abs()))
     }
 
+    /// The dot product, for the recordings' kinematics.
+    pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+        a.iter().zip(b).map(|(x, y)| x * y).sum()
+    }
+
     /// Decodes and checks that `auto` recognises the same format.
     pub fn decoded(format: Format, bytes: &[u8]) -> Sample {
         assert_eq!(recognise(bytes), Some(format), "{} bytes", bytes.len());

@@ -81,7 +81,7 @@ impl Game {
                 s,
                 [0.0, 0.0, 1.0],
                 [1.0, 0.0, 0.0],
-                [-left / G, forward / G, 0.0],
+                [left / G, forward / G, 0.0],
             ),
             // Car space X right, Y up, Z forward; a turn to the left is negative about Y (left-handed).
             Game::ForzaSled | Game::ForzaDash => {
@@ -106,12 +106,7 @@ const FOREIGN_AFTER: u32 = 30;
 /// One session: the real binary, the drive sent in real time (each packet at its own time after the first, so
 /// that a late one does not delay the rest), and `foreign` sent after sample 30; `more` arguments. Returns the exit
 /// code, the report and stderr.
-fn session(
-    format: &str,
-    game: Game,
-    foreign: Option<Vec<u8>>,
-    more: &[&str],
-) -> (Option<i32>, serde_json::Value, String) {
+fn session(format: &str, game: Game, foreign: &[Vec<u8>], more: &[&str]) -> (Option<i32>, serde_json::Value, String) {
     use std::io::Read;
     let mut args = vec![
         "--fast",
@@ -131,8 +126,10 @@ fn session(
         let due = start + Duration::from_millis(10 * u64::from(k));
         std::thread::sleep(due.saturating_duration_since(Instant::now()));
         socket.send_to(&game.packet(10 * k, forward, left, yaw), &addr).unwrap();
-        if let (Some(bytes), FOREIGN_AFTER) = (&foreign, k) {
-            socket.send_to(bytes, &addr).unwrap();
+        if k == FOREIGN_AFTER {
+            for bytes in foreign {
+                socket.send_to(bytes, &addr).unwrap();
+            }
         }
     }
     let out = child.wait_with_output().unwrap();
@@ -202,7 +199,7 @@ fn every_format_drives_the_stream_end_to_end() {
             let foreign = next.packet(300, 4.0, 0.0, 0.0);
             runs.push(scope.spawn(move || {
                 let what = format!("{game:?} as {}", game.format());
-                let (code, report, said) = session(game.format(), game, Some(foreign), &[]);
+                let (code, report, said) = session(game.format(), game, &[foreign], &[]);
                 assert_eq!(code, Some(3), "{what}: one unreadable datagram: {report} {said}");
                 assert_eq!(report["outcome"], "input_errors", "{what}: {report}");
                 assert_eq!(
@@ -217,7 +214,7 @@ fn every_format_drives_the_stream_end_to_end() {
             }
             runs.push(scope.spawn(move || {
                 let what = format!("{game:?} as auto");
-                let (code, report, said) = session("auto", game, None, &[]);
+                let (code, report, said) = session("auto", game, &[], &[]);
                 assert_eq!(code, Some(0), "{what}: {report} {said}");
                 assert_eq!(report["outcome"], "followed", "{what}: {report}");
                 let named = format!("telemetry: the datagrams are {} (", game.format());
@@ -233,19 +230,21 @@ fn every_format_drives_the_stream_end_to_end() {
     });
 }
 
-/// F1 sends its other packet types (here car telemetry, id 6) to the motion packet's port: live, one among the
-/// drive is skipped and counted apart, no input error, exit 0, named and with `auto`.
+/// F1 sends its other packet types to the motion packet's port: live, one of each id (F1 24's, at their specified
+/// sizes) among the drive is skipped and counted apart, no input error, exit 0, named and with `auto`.
 #[test]
 fn the_games_other_packets_are_skipped_live() {
-    let mut telemetry = Game::F1.packet(300, 0.0, 0.0, 0.0);
-    telemetry[6] = 6;
+    let others: Vec<Vec<u8>> = packets::f1::other_ids(2024)
+        .iter()
+        .map(|&(id, _)| packets::f1::other(2024, id, 0.3))
+        .collect();
     for format in ["f1", "auto"] {
-        let (code, report, said) = session(format, Game::F1, Some(telemetry.clone()), &[]);
+        let (code, report, said) = session(format, Game::F1, &others, &[]);
         assert_eq!(code, Some(0), "{format}: {report} {said}");
         let d = &report["datagrams"];
-        assert_eq!(d["skipped"], 1, "{format}: {report}");
+        assert_eq!(d["skipped"], others.len(), "{format}: {report}");
         assert_eq!(d["unreadable"], 0, "{format}: {report}");
-        assert_eq!(d["received"], SAMPLES + 1, "{format}: {report}");
+        assert_eq!(d["received"], SAMPLES as usize + others.len(), "{format}: {report}");
         assert_eq!(report["setpoints_applied"], SAMPLES, "{format}: {report}");
     }
 }
@@ -258,7 +257,7 @@ fn the_games_other_packets_are_skipped_live() {
 #[test]
 fn the_optimal_cueing_runs_live() {
     let config = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/drives/optimal.toml");
-    let (code, report, said) = session("outsim", Game::Outsim, None, &["--cue-config", config]);
+    let (code, report, said) = session("outsim", Game::Outsim, &[], &["--cue-config", config]);
     assert_eq!(code, Some(0), "{report} {said}");
     assert_eq!(report["outcome"], "followed", "{report}");
     assert_eq!(report["state"], "Ready", "{report}");

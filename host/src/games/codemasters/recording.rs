@@ -6,7 +6,7 @@
 //! as f64 from the game's f32 exactly): its datagrams 11173 to 11181, about 0.14 s of a left-hand corner at 20 m/s.
 //! Each row below is one datagram's 66 floats, written back as the f32 the game sent.
 
-use super::super::testing::decoded;
+use super::super::testing::{decoded, dot};
 use super::super::{Format, G};
 
 /// Datagrams 11173..=11181 of the run, one row each: channel `i` is float `i` of the packet.
@@ -25,10 +25,6 @@ const RUN: [[f32; 66]; 9] = [
 
 fn datagram(row: &[f32; 66]) -> Vec<u8> {
     row.iter().flat_map(|v| v.to_le_bytes()).collect()
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 fn channels(row: &[f32; 66], first: usize) -> [f64; 3] {

@@ -196,6 +196,87 @@ pub mod f1 {
         assert_eq!(w.0.len(), 1349);
         w.0
     }
+
+    /// The packet ids other than motion (0) that each format sends, with their sizes in bytes: EA's "F1 23 UDP
+    /// Specification", "F1 24 UDP Specification" and the "C++ structures for F1 25 UDP specification" (each
+    /// packet's heading, "Size: N bytes"): session, lap data, event, participants, car setups, car telemetry,
+    /// car status, final classification, lobby info, car damage, session history, tyre sets, extended motion,
+    /// and from F1 24 time trial, from F1 25 lap positions.
+    pub fn other_ids(format: u16) -> &'static [(u8, usize)] {
+        match format {
+            2023 => &[
+                (1, 644),
+                (2, 1131),
+                (3, 45),
+                (4, 1306),
+                (5, 1107),
+                (6, 1352),
+                (7, 1239),
+                (8, 1020),
+                (9, 1218),
+                (10, 953),
+                (11, 1460),
+                (12, 231),
+                (13, 217),
+            ],
+            2024 => &[
+                (1, 753),
+                (2, 1285),
+                (3, 45),
+                (4, 1350),
+                (5, 1133),
+                (6, 1352),
+                (7, 1239),
+                (8, 1020),
+                (9, 1306),
+                (10, 953),
+                (11, 1460),
+                (12, 231),
+                (13, 237),
+                (14, 101),
+            ],
+            _ => &[
+                (1, 753),
+                (2, 1285),
+                (3, 45),
+                (4, 1284),
+                (5, 1133),
+                (6, 1352),
+                (7, 1239),
+                (8, 1042),
+                (9, 954),
+                (10, 1041),
+                (11, 1460),
+                (12, 231),
+                (13, 273),
+                (14, 101),
+                (15, 1131),
+            ],
+        }
+    }
+
+    /// Another packet type of `format`: the `PacketHeader` field by field (player in slot 3, no second player),
+    /// then the packet's body at its specified size: the event's string code ("SSTA", session started), otherwise
+    /// zeros (ringpod reads no field of the body, only the header's id).
+    pub fn other(format: u16, id: u8, time: f32) -> Vec<u8> {
+        let (_, size) = *other_ids(format)
+            .iter()
+            .find(|(i, _)| *i == id)
+            .unwrap_or_else(|| panic!("no packet id {id} in format {format}"));
+        let mut w = Writer::default();
+        w.u16(format).u8((format - 2000) as u8).u8(1).u8(5).u8(1).u8(id);
+        w.bytes(&0x1234_5678_9abc_def0u64.to_le_bytes())
+            .f32(time)
+            .u32(3000)
+            .u32(3000)
+            .u8(3)
+            .u8(255);
+        if id == 3 {
+            w.bytes(b"SSTA");
+        }
+        w.0.resize(size, 0);
+        w.0
+    }
 }
 
 /// Forza's Data Out.
