@@ -27,13 +27,14 @@
 //! `scssdk_value.h`: "In local space the X points to right, Y up and Z backwards"; pitch "stored in unit range
 //! where <-0.25,0.25> corresponds to <-90,90> ... positive values pointing up"; roll "stored in unit range where
 //! <-0.5,0.5> corresponds to <-180,180>. The angle is measured in counterclockwise when looking in direction of the
-//! roll axis". Whether the acceleration includes gravity is not stated: assumed not (gravity's reaction added from
-//! pitch and roll); the rotations' senses assumed right-handed about the published axes; the roll axis taken as
-//! pointing forward (so a positive roll lifts the right side).
+//! roll axis". Whether the acceleration includes gravity is not stated; a real snapshot of a truck at rest shows it
+//! does not (0.16 m/s^2 up where gravity would be 9.8: TruckSim-Telemetry's buffer, the test in `ets2/tests.rs`), so
+//! gravity's reaction is added from pitch and roll; the rotations' senses assumed right-handed about the published
+//! axes; the roll axis taken as pointing forward (so a positive roll lifts the right side).
 //!
 //! | ringpod | from | |
 //! |---|---|---|
-//! | force x | `-accelerationZ + g sin(2 pi pitch)` | published axes; gravity assumed absent |
+//! | force x | `-accelerationZ + g sin(2 pi pitch)` | published axes; no gravity in it (a real snapshot at rest) |
 //! | force y | `-accelerationX + g cos(2 pi pitch) sin(-2 pi roll)` | as x; roll axis assumed forward |
 //! | force z | `accelerationY + g cos(2 pi pitch) cos(2 pi roll)` | as x |
 //! | rate roll | `-2 pi av_accelerationZ` | published unit (rotations/s); sense assumed right-handed |

@@ -77,3 +77,31 @@ fn an_inactive_plugin_or_a_short_map_is_refused() {
         Err(Unreadable::Size { .. })
     ));
 }
+
+/// A real snapshot of the plugin's memory, a Scania S standing still (speed -0.0008 m/s, engine off) on a level
+/// road: TruckSim-Telemetry's `dev/buffers/sdk_data_1_10` (Kniffen, MIT licence, `github.com/kniffen/TruckSim-Telemetry`,
+/// removed in commit 559246b; its decoded form is the same repository's `docs/data/truck.md`), the fields ringpod
+/// reads at their offsets, as the game wrote them. The linear acceleration's up component is 0.16 m/s^2, not
+/// 9.8: gravity is not in `truck.local.acceleration.linear`, and ringpod's vertical force at rest is gravity's
+/// reaction alone (counted twice it would be 19.8, left out 0.16).
+#[test]
+fn a_real_truck_at_rest_has_no_gravity_in_its_acceleration() {
+    let mut p = Page::zeros(16 * 1024);
+    p.put(0, &[1])
+        .u64(zones::TIME, 1)
+        .u32(zones::REVISION, 10)
+        .f32s(
+            zones::ANGULAR_VELOCITY,
+            &[-0.000_189_367_04, -0.000_012_564_577, 0.000_434_524],
+        )
+        .f32s(zones::ACCELERATION, &[0.001_310_421_9, 0.162_592_01, 0.008_456_057])
+        .f64s(
+            zones::PITCH,
+            &[-0.002_085_370_477_288_961_4, 0.001_831_818_721_257_150_2],
+        );
+    let read = decode(&p.0).unwrap();
+    let [x, y, z] = read.sample.telemetry.force;
+    assert!((z - 9.97).abs() < 0.05, "{read:?}");
+    // The placement's pitch (0.75 degrees nose down) and roll (0.66 degrees) give gravity's small x and y shares.
+    assert!((x + 0.13).abs() < 0.02 && (y + 0.11).abs() < 0.02, "{read:?}");
+}
