@@ -42,7 +42,7 @@
 //! *left*, as in Codemasters' DiRT games ([`super::codemasters`]); projected on `m_worldForwardDir` against
 //! `m_gForceLongitudinal` at +0.87 to +0.995, positive forwards; projected on the car's up (right x forward, whose
 //! world y is +0.96 to +1.00: the world is right-handed, y up) against `m_gForceVertical` at +0.69 to +0.88,
-//! positive up, and its mean is 0.00 to 0.07 g, so no gravity is in any of them. ringpod adds gravity's reaction
+//! positive up, and its mean is -0.01 to 0.07 g, so no gravity is in any of them. ringpod adds gravity's reaction
 //! from the direction vectors' up (y) components:
 //!
 //! | ringpod | from |

@@ -40,6 +40,11 @@
 //! | rate pitch | `-Q` |
 //! | rate yaw | `-R` |
 //! | time | real time (data set 1), if sent |
+//!
+//! X-Plane 12 is reported to send data set 16 as P, Q, R in deg/s (ArduPilot's X-Plane link,
+//! `libraries/SITL/SIM_XPlane.cpp`, reads it so for version 12 and as Q, P, R in rad/s for 11; X-Plane 12's own
+//! `Data.txt` headers read `Q,deg/s`). The packet does not carry the version; no X-Plane 12 recording was found to
+//! settle it, so the rates are read as X-Plane 10 and 11 send them (the book says to leave row 16 off with 12).
 
 use super::{Format, Le, Sample, Telemetry, Unreadable, G};
 

@@ -42,8 +42,10 @@
 //! | rate yaw | `localAngularVel[1]` | assumed (about up) |
 //! | time | none: the arrival time is used | the page has no time |
 //!
-//! A drive captured in each game is the check: accelerating must give force x > 0, a left turn force y > 0 and a
-//! positive yaw rate, the car at rest force z = 9.81 (twice that would mean `accG` includes gravity).
+//! A real snapshot of ACC's page with the car at rest (0.0012 km/h) shows `accG` (0, 0, 0): no gravity in it, as
+//! assumed (acc-manager-server's README, `github.com/madmak2005/acc-manager-server`); no published recording of a
+//! drive was found to settle the senses. A drive captured in each game is the check: accelerating must give force
+//! x > 0, a left turn force y > 0 and a positive yaw rate.
 
 use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
 use crate::games::{add, gravity_from_attitude, Telemetry, G};

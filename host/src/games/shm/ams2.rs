@@ -30,7 +30,7 @@
 //!
 //! | ringpod | from | |
 //! |---|---|---|
-//! | force x | `-mLocalAcceleration[2] + g sin(pitch)` | assumed |
+//! | force x | `-mLocalAcceleration[2] + g sin(pitch)` | assumed (no gravity in it: real snapshots, below) |
 //! | force y | `-mLocalAcceleration[0] + g cos(pitch) sin(roll)` | assumed |
 //! | force z | `mLocalAcceleration[1] + g cos(pitch) cos(roll)` | assumed |
 //! | rate roll | `-mAngularVelocity[2]` | assumed |
@@ -38,8 +38,10 @@
 //! | rate yaw | `mAngularVelocity[1]` | assumed |
 //! | time | none: the arrival time is used | the structure has no simulation clock |
 //!
-//! A drive captured in the game is the check: accelerating must give force x > 0, a left turn force y > 0 and a
-//! positive yaw rate.
+//! Two real snapshots of cars at rest (sim-to-motec's `stm/ams2/test/ams2_inrace.bin` and `ams2_mp4_inpits.bin`,
+//! versions 13 and 14, `github.com/GeekyDeaks/sim-to-motec`) read `mLocalAcceleration` below 0.002 m/s^2 on every
+//! axis: no gravity in it, as assumed. The axes' senses need a drive captured in the game: accelerating must give
+//! force x > 0, a left turn force y > 0 and a positive yaw rate.
 
 use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
 use crate::games::{add, gravity_from_attitude, Telemetry};

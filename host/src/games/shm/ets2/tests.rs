@@ -79,9 +79,9 @@ fn an_inactive_plugin_or_a_short_map_is_refused() {
 }
 
 /// A real snapshot of the plugin's memory, a Scania S standing still (speed -0.0008 m/s, engine off) on a level
-/// road: TruckSim-Telemetry's `dev/buffers/sdk_data_1_10` (Kniffen, MIT licence, `github.com/kniffen/TruckSim-Telemetry`,
-/// removed in commit 559246b; its decoded form is the same repository's `docs/data/truck.md`), the fields ringpod
-/// reads at their offsets, as the game wrote them. The linear acceleration's up component is 0.16 m/s^2, not
+/// road: TruckSim-Telemetry's `dev/buffers/sdk_data_1_10` (Kniffen, MIT licence,
+/// `github.com/kniffen/TruckSim-Telemetry`, removed in commit 559246b; its decoded form is the same repository's
+/// `docs/data/truck.md`), the fields ringpod reads at their offsets, as the game wrote them. The linear acceleration's up component is 0.16 m/s^2, not
 /// 9.8: gravity is not in `truck.local.acceleration.linear`, and ringpod's vertical force at rest is gravity's
 /// reaction alone (counted twice it would be 19.8, left out 0.16).
 #[test]
