@@ -165,6 +165,21 @@ pub mod f1 {
         w.f32s(&g_lat_long_vert).f32s(&[0.1, 0.0, 0.0]);
     }
 
+    /// The `PacketHeader` (29 bytes): format, game year, version 1.05, packet version 1, `id`, a session, `time`,
+    /// frame 3000, the player in slot `player`, no second player.
+    fn header(format: u16, id: u8, player: u8, time: f32) -> Writer {
+        let mut w = Writer::default();
+        w.u16(format).u8((format - 2000) as u8).u8(1).u8(5).u8(1).u8(id);
+        w.bytes(&0x1234_5678_9abc_def0u64.to_le_bytes())
+            .f32(time)
+            .u32(3000)
+            .u32(3000)
+            .u8(player)
+            .u8(255);
+        assert_eq!(w.0.len(), 29);
+        w
+    }
+
     /// A packet of `format` (2023..2025) and id `id` at session time `time` (s), laid out as the motion packet
     /// with the player in slot `player`, every other car level and braking hard (so that reading the wrong car
     /// shows).
@@ -177,15 +192,7 @@ pub mod f1 {
         right: [f32; 3],
         g: [f32; 3],
     ) -> Vec<u8> {
-        let mut w = Writer::default();
-        w.u16(format).u8((format - 2000) as u8).u8(1).u8(5).u8(1).u8(id);
-        w.bytes(&0x1234_5678_9abc_def0u64.to_le_bytes())
-            .f32(time)
-            .u32(3000)
-            .u32(3000)
-            .u8(player)
-            .u8(255);
-        assert_eq!(w.0.len(), 29);
+        let mut w = header(format, id, player, time);
         for i in 0..22u8 {
             if i == player {
                 car(&mut w, forward, right, g);
@@ -263,14 +270,7 @@ pub mod f1 {
             .iter()
             .find(|(i, _)| *i == id)
             .unwrap_or_else(|| panic!("no packet id {id} in format {format}"));
-        let mut w = Writer::default();
-        w.u16(format).u8((format - 2000) as u8).u8(1).u8(5).u8(1).u8(id);
-        w.bytes(&0x1234_5678_9abc_def0u64.to_le_bytes())
-            .f32(time)
-            .u32(3000)
-            .u32(3000)
-            .u8(3)
-            .u8(255);
+        let mut w = header(format, id, 3, time);
         if id == 3 {
             w.bytes(b"SSTA");
         }
