@@ -188,7 +188,7 @@ impl Game for Rf2 {
     }
 }
 
-/// AMS2's `$pcars2$` (the senses ringpod's module assumes: x right, y up, z back).
+/// AMS2's `$pcars2$` (the car's axes x left, y up, z back, as Project CARS's recording shows).
 struct Ams2(Mapping);
 
 impl Game for Ams2 {
@@ -200,8 +200,8 @@ impl Game for Ams2 {
         p.i32(0, 14);
         p.i32(7320, 2 * n as i32 - 1);
         p.f32s(6908, &[m.pitch, 0.0, m.roll]);
-        p.f32s(6944, &[-m.rate[1], m.rate[2], -m.rate[0]]);
-        p.f32s(6956, &[-m.accel[1], m.accel[2], -m.accel[0]]);
+        p.f32s(6944, &[m.rate[1], m.rate[2], -m.rate[0]]);
+        p.f32s(6956, &[m.accel[1], m.accel[2], -m.accel[0]]);
         p.i32(7320, 2 * n as i32);
     }
 }

@@ -3,7 +3,7 @@ use super::super::{decode as decode_game, Game, Unreadable};
 use super::*;
 
 /// `SharedMemory` of `SharedMemory.h`, through `mSequenceNumber` (every member at most 4 bytes).
-fn shared_memory() -> Layout {
+pub(super) fn shared_memory() -> Layout {
     use C::{F32, I32, I8};
     layout(
         4,
@@ -46,11 +46,11 @@ fn shared_memory() -> Layout {
 fn page(sequence: u32, m: &super::super::testing::Moment) -> Vec<u8> {
     let l = shared_memory();
     let mut p = Page::zeros(l.size);
-    // Assumed axes: x right, y up, z back; orientation (pitch, heading, roll).
+    // The car's axes x left, y up, z back; orientation (pitch, heading, roll).
     p.u32(l.at("mVersion, mBuildVersionNumber"), 14)
         .f32s(l.at("mOrientation"), &[m.pitch, 1.0, m.roll])
-        .f32s(l.at("mAngularVelocity"), &[-m.rate[1], m.rate[2], -m.rate[0]])
-        .f32s(l.at("mLocalAcceleration"), &[-m.accel[1], m.accel[2], -m.accel[0]])
+        .f32s(l.at("mAngularVelocity"), &[m.rate[1], m.rate[2], -m.rate[0]])
+        .f32s(l.at("mLocalAcceleration"), &[m.accel[1], m.accel[2], -m.accel[0]])
         .u32(l.at("mSequenceNumber"), sequence);
     p.0
 }
