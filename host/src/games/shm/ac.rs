@@ -34,18 +34,23 @@
 //!
 //! | ringpod | from | |
 //! |---|---|---|
-//! | force x | `g accG[2] + g sin(pitch)` | assumed |
-//! | force y | `g accG[0] + g cos(pitch) sin(roll)` | assumed |
-//! | force z | `g accG[1] + g cos(pitch) cos(roll)` | assumed |
+//! | force x | `g accG[2] + g sin(pitch)` | AC: a real recording (below); ACC: assumed |
+//! | force y | `g accG[0] + g cos(pitch) sin(roll)` | AC: a real recording; ACC: assumed |
+//! | force z | `g accG[1] + g cos(pitch) cos(roll)` | AC: a real recording (no gravity); ACC: a snapshot at rest |
 //! | rate roll | `localAngularVel[2]` | assumed (about forward) |
 //! | rate pitch | `localAngularVel[0]` | assumed (about left) |
 //! | rate yaw | `localAngularVel[1]` | assumed (about up) |
 //! | time | none: the arrival time is used | the page has no time |
 //!
-//! A real snapshot of ACC's page with the car at rest (0.0012 km/h) shows `accG` (0, 0, 0): no gravity in it, as
-//! assumed (acc-manager-server's README, `github.com/madmak2005/acc-manager-server`); no published recording of a
-//! drive was found to settle the senses. A drive captured in each game is the check: accelerating must give force
-//! x > 0, a left turn force y > 0 and a positive yaw rate.
+//! A real lap of AC settles `accG`'s senses: AC's UDP remote telemetry sends the same vector in the same order
+//! (its document names the three floats vertical, horizontal and frontal, but they are x, y, z), and a recording
+//! of it at Monza (Python_UDP_Receiver, CC0, 8,641 datagrams) has `accG[0]` follow the path's centripetal
+//! acceleration towards the car's left (correlation 0.997, slope 1.00; the outer wheels turn faster), `accG[1]`
+//! average 0.006 g (no gravity) and `accG[2]` follow the speed's derivative (0.991). Two corners are kept as a test
+//! (`ac/recording.rs`). The angles' and rates' senses stay assumed (the datagram has neither). ACC runs another
+//! engine: of its page only a snapshot at rest (0.0012 km/h) is published, showing `accG` (0, 0, 0), no gravity
+//! (acc-manager-server's README, `github.com/madmak2005/acc-manager-server`). A drive captured in each game is the
+//! check: accelerating must give force x > 0, a left turn force y > 0 and a positive yaw rate.
 
 use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
 use crate::games::{add, gravity_from_attitude, Telemetry, G};
@@ -106,5 +111,7 @@ pub fn decode(game: Game, page: &[u8]) -> Result<Read, Unreadable> {
     })
 }
 
+#[cfg(test)]
+mod recording;
 #[cfg(test)]
 mod tests;

@@ -3,7 +3,7 @@ use super::super::{decode as decode_game, Game, Unreadable};
 use super::*;
 
 /// `SPageFilePhysics` as AC's `SharedFileOut.h` declares it (`#pragma pack(4)`), and ACC's additions.
-fn physics(game: Game) -> Layout {
+pub(super) fn physics(game: Game) -> Layout {
     use C::{F32, I32};
     let mut members = vec![
         ("packetId", I32, 1),
