@@ -1,12 +1,14 @@
 //! Two corners of a real Assetto Corsa lap at Monza, as AC's UDP telemetry sent them.
 //!
 //! Source: Python_UDP_Receiver (vthinsel, CC0 1.0 Universal, `github.com/vthinsel/Python_UDP_Receiver`, commit
-//! 7483eb5), `AssettoCorsa_monza_A8LMS`: 8,641 `RTCarInfo` datagrams of AC's remote telemetry (an Audi R8 LMS at
+//! 7483eb5), `AssettoCorsa_monza_A8LMS`: 8,641 `RTCarInfo` datagrams of AC's remote telemetry (a car at
 //! Monza, about 58 a second), each with its arrival time. Its records 4313 to 4320 (a right-hand corner at 33 m/s)
 //! and 1667 to 1674 (a left-hand one at 13 m/s, braking). The datagram's three `accG` floats (bytes 28 to 39, which
 //! Kunos' document names vertical, horizontal and frontal) are the car's `accG` vector in the shared memory's order
-//! x, y, z: over the lap the first follows the path's centripetal acceleration (correlation -0.997, slope -1.00),
-//! the second averages 0.006 g (vertical, no gravity) and the third the speed's derivative (0.991, slope 0.99).
+//! x, y, z: over the lap the first follows the path's centripetal acceleration, positive to the car's left
+//! (correlation -0.997, slope -1.00 against the path's turn in the world's x-z plane, which at clockwise Monza is
+//! to the right), the second averages 0.006 g (vertical, no gravity) and the third the speed's derivative (0.991,
+//! slope 0.99).
 
 use super::super::super::G;
 use super::super::testing::Page;
