@@ -158,7 +158,7 @@ pub enum Command {
         #[arg(long, value_name = "FILE.md")]
         table: Option<std::path::PathBuf>,
         /// Also draw figs. 3 and 5, the largest constraint reaction without and with projection (.png or .svg),
-        /// for a load of 1 N down and 0.1 N m about each axis (the paper does not say which it used).
+        /// for a load of 1 N down and 0.1 N m about each axis (the paper gives 1 N, not its direction).
         #[arg(long, value_name = "FILE")]
         reactions: Option<std::path::PathBuf>,
     },
