@@ -7,7 +7,7 @@ mod stream;
 
 pub use analysis::{
     CheckArgs, Common, CueArgs, DrawArgs, DynamicsArgs, FkArgs, LoadsArgs, PoseArgs, RatesArgs, ReactionsArgs,
-    RigAction, StructureArgs, WorkspaceArgs,
+    RigAction, StabilityArgs, StructureArgs, WorkspaceArgs,
 };
 pub use device::{ControllerArgs, DeviceAction, DeviceArgs, UiArgs};
 pub use requests::platform;
@@ -138,6 +138,11 @@ pub enum Command {
     /// Lagrange equation gives the drive torques and forces, the energies and the drives' power, each force checked
     /// against the ring platform's own inverse dynamics. Exits 0, or 3 when they differ by more than 1e-6.
     Dynamics(DynamicsArgs),
+    /// A vehicle's static stability (chapter 5.2's tests): the tip-over angles climbing, descending and on a lateral
+    /// slope, the body's roll, and the critical rollover speed in a turn, rigid or on a rolling suspension; with
+    /// --experiment each run on the simulated trainer model, the platform tilting toward the computed angle, and the
+    /// record's tip-over compared with it. Exits 0, or 3 when a record does not show the tip-over where computed.
+    Stability(StabilityArgs),
     /// Loads of a tool wrench on the five-DOF tool carrier (paper 003's projection method): drive forces and
     /// torques, the X guide's bearing load, the frame pivots' forces and the constraint couple.
     Reactions(ReactionsArgs),
@@ -199,7 +204,7 @@ impl Command {
             Self::Device(args) => args.action == DeviceAction::Inputs && args.watch,
             _ => matches!(
                 self,
-                Self::Stream(_) | Self::Ui(_) | Self::Simulate { .. } | Self::Monitor { .. }
+                Self::Stream(_) | Self::Ui(_) | Self::Simulate { .. } | Self::Monitor { .. } | Self::Stability(_)
             ),
         }
     }

@@ -402,3 +402,25 @@ impl super::UiArgs {
         })
     }
 }
+
+impl super::StabilityArgs {
+    /// The options `stability` takes; `stopped` ends an experiment early.
+    pub fn options<'a>(&'a self, stopped: &'a dyn Fn() -> bool) -> crate::experiment::stability::Options<'a> {
+        crate::experiment::stability::Options {
+            track: self.track,
+            wheelbase: self.wheelbase,
+            cg_height: self.cg_height,
+            cg_from_rear: self.cg_from_rear,
+            roll: self
+                .roll_stiffness
+                .zip(self.mass)
+                .zip(self.roll_centre_height)
+                .map(|((k, m), h)| (k, m, h)),
+            radius: self.turn_radius,
+            experiment: self.experiment.as_deref(),
+            rate_deg_s: self.rate,
+            json: self.json,
+            stopped,
+        }
+    }
+}
