@@ -6,6 +6,9 @@ use ringpod_core::vehicle::{gravity_in_platform, Roll, Vehicle, VehicleError, GR
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 
+/// The gravity in a platform tilted by an angle one way.
+type Tilt = dyn Fn(f64) -> [f64; 3];
+
 /// A passenger car: track 1.5 m, wheelbase 2.7 m, centre of gravity 0.6 m up and 1.2 m ahead of the rear axle.
 fn car() -> Vehicle {
     Vehicle::new(1.5, 2.7, 0.6, 1.2).unwrap()
@@ -68,7 +71,7 @@ fn the_margin_on_a_tilted_platform_crosses_zero_at_the_computed_angles() {
     for v in [car(), sprung_car()] {
         let s = v.stability();
         // The slope as a roll of the platform, the climb as a negative pitch (the +X nose up).
-        let cases: [(&dyn Fn(f64) -> [f64; 3], f64); 3] = [
+        let cases: [(&Tilt, f64); 3] = [
             (&|a| gravity_in_platform(a, 0.0), s.slope),
             (&|a| gravity_in_platform(-a, 0.0), s.slope),
             (&|a| gravity_in_platform(0.0, -a), s.incline),
