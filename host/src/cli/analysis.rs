@@ -100,6 +100,24 @@ pub struct DynamicsArgs {
     /// read them, instead of the built-in motion (rates and accelerations by differences of the samples).
     #[arg(long, value_name = "MOTION.csv", conflicts_with_all = ["file", "amplitude", "duration", "step"])]
     pub input: Option<std::path::PathBuf>,
+    /// With --file: forward dynamics instead of the drives' swing: the mechanism let go at rest from its sketch under
+    /// constant drive forces (--force), the equation of motion integrated with the loop equations over the file's
+    /// duration and step.
+    #[arg(long, requires = "file")]
+    pub forward: bool,
+    /// With --forward: the drives' constant forces or torques `F1,F2,...` (N, N m; default zeros).
+    #[arg(long, requires = "forward", allow_hyphen_values = true, value_name = "F1,F2,...")]
+    pub force: Option<String>,
+    /// With --file: follow a point of a link along the motion (paper 002's eqs. 5 and 6): `LINK:X,Y,Z`, the link
+    /// by its pair's name and the point in the base at the sketch (m). Repeat for more points.
+    #[arg(long, requires = "file", allow_hyphen_values = true, value_name = "LINK:X,Y,Z")]
+    pub point: Vec<String>,
+    /// With --point: write the points' positions, velocities and accelerations (CSV) ...
+    #[arg(long, requires = "point", value_name = "FILE.csv")]
+    pub paths: Option<std::path::PathBuf>,
+    /// ... and draw them (.png or .svg).
+    #[arg(long, requires = "point", value_name = "FILE")]
+    pub paths_plot: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Args)]

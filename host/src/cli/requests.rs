@@ -112,6 +112,12 @@ impl super::DynamicsArgs {
             plot: self.plot.as_deref(),
             file: self.file.as_deref(),
             input: self.input.as_deref(),
+            file_options: crate::analysis::dynamics::FileOptions {
+                forward: self.forward.then(|| self.force.as_deref().unwrap_or("")),
+                points: &self.point,
+                paths: self.paths.as_deref(),
+                paths_plot: self.paths_plot.as_deref(),
+            },
         }
     }
 }
