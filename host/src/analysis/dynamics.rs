@@ -56,8 +56,7 @@ impl Options<'_> {
 mod file;
 mod paths;
 
-pub use file::run_file;
-pub use paths::FileOptions;
+pub use paths::{run_file, FileOptions};
 
 /// Relative agreement with the ring platform's inverse dynamics that the command asks for.
 pub const AGREEMENT: f64 = 1e-6;

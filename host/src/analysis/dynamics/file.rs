@@ -13,9 +13,7 @@ use ringpod_core::screws::matrix::{
 };
 use serde::Deserialize;
 
-use super::{report, Row};
 use crate::error::CliError;
-use crate::out::Outcome;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -327,6 +325,34 @@ fn build(f: &File) -> Result<Built, CliError> {
         })
         .collect::<Result<Vec<_>, CliError>>()?;
     let m = &f.motion;
+    let drives = drives(m, &first)?;
+    let mechanism =
+        Mechanism::new(&pairs, &closures, &drives).map_err(|e| bad(format!("the mechanism: {}", refused(e))))?;
+    let bodies = bodies(f, &link, &frames)?;
+    let elements = elements(f, &first, &q)?;
+    let model = Model::new(mechanism, &bodies, &elements, v3(&f.gravity))
+        .map_err(|e| bad(format!("the model: {}", refused(e))))?;
+    let swing = drives
+        .iter()
+        .zip(m.amplitude.iter().zip(&m.frequency))
+        .enumerate()
+        .map(|(k, (d, (a, w)))| (q[*d], *a, *w, m.speed.get(k).copied().unwrap_or(0.0)))
+        .collect();
+    let name = f.name.as_deref().map_or_else(|| "mechanism".into(), shown);
+    Ok(Built {
+        model,
+        q,
+        swing,
+        duration: m.duration,
+        step: m.step,
+        name,
+        links: links.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
+        frames,
+    })
+}
+
+/// The motion's drives (each a pair's first variable), its numbers checked.
+fn drives(m: &MotionFile, first: &HashMap<&str, usize>) -> Result<Vec<usize>, CliError> {
     if m.drives.len() > MAX_DRIVES
         || m.amplitude.len() != m.drives.len()
         || m.frequency.len() != m.drives.len()
@@ -362,10 +388,16 @@ fn build(f: &File) -> Result<Built, CliError> {
                 .into(),
         ));
     }
-    let mechanism =
-        Mechanism::new(&pairs, &closures, &drives).map_err(|e| bad(format!("the mechanism: {}", refused(e))))?;
-    let bodies = f
-        .body
+    Ok(drives)
+}
+
+/// The bodies, each on its link's frame at the sketch.
+fn bodies(
+    f: &File,
+    link: &dyn Fn(&str) -> Result<usize, CliError>,
+    frames: &[Matrix4<f64>],
+) -> Result<Vec<Body>, CliError> {
+    f.body
         .iter()
         .map(|b| {
             if let Some(why) = body_refused(b) {
@@ -380,98 +412,24 @@ fn build(f: &File) -> Result<Built, CliError> {
                 inertia: back * pseudo_inertia(b.mass, &v3(&b.centre), &tensor) * back.transpose(),
             })
         })
-        .collect::<Result<Vec<_>, CliError>>()?;
-    let elements = elements(f, &first, &q)?;
-    let model = Model::new(mechanism, &bodies, &elements, v3(&f.gravity))
-        .map_err(|e| bad(format!("the model: {}", refused(e))))?;
-    let swing = drives
-        .iter()
-        .zip(m.amplitude.iter().zip(&m.frequency))
-        .enumerate()
-        .map(|(k, (d, (a, w)))| (q[*d], *a, *w, m.speed.get(k).copied().unwrap_or(0.0)))
-        .collect();
-    let name = f.name.as_deref().map_or_else(|| "mechanism".into(), shown);
-    Ok(Built {
-        model,
-        q,
-        swing,
-        duration: m.duration,
-        step: m.step,
-        name,
-        links: links.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
-        frames,
-    })
+        .collect::<Result<Vec<_>, CliError>>()
 }
 
-/// `dynamics --file`: the file's mechanism along its drives' swing (inverse dynamics) or let go under constant
-/// drive forces (`--forward`), its table, plot and energy, and the paths of the points asked.
-pub fn run_file(
-    path: &Path,
-    table: Option<&Path>,
-    plot: Option<&Path>,
-    o: &super::FileOptions,
-) -> Result<Outcome, CliError> {
+/// A mechanism file read and built.
+pub(super) fn read(path: &Path) -> Result<Built, CliError> {
     // Bounded, and never waiting in open() for a FIFO's writer, as every settings file is read.
     let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
         .map_err(|e| bad(format!("{}: {e}", path.display())))?;
     // TOML's message spans lines (the line quoted, a caret under the fault): kept as it is.
     let file: File = toml::from_str(&text).map_err(|e| CliError::Dynamics(format!("{}: {e}", path.display())))?;
-    let b = build(&file)?;
-    let points = super::paths::points(o.points, &b)?;
-    let (rows, traced) = match o.forward {
-        Some(forces) => super::paths::forward(&b, forces, &points)?,
-        None => swing(&b, &points)?,
-    };
-    let mut out = match o.forward {
-        Some(_) => super::paths::forward_report(&b, &rows, table, plot)?,
-        None => report(&b.name, &rows, b.swing.len(), table, plot)?,
-    };
-    super::paths::report(&mut out.text, &b.name, &points, &rows, &traced, o)?;
-    Ok(out)
+    build(&file)
 }
 
-/// The drives' value, rate and acceleration at `t` (`k` 0, 1, 2) of their swing and steady rate.
-fn drive_at(b: &Built, t: f64, k: usize) -> [f64; MAX_DRIVES] {
-    std::array::from_fn(|i| match b.swing.get(i) {
-        Some((u0, a, f, v)) => {
-            let w = 2.0 * std::f64::consts::PI * f;
-            let s = (w * t).sin();
-            let c = (w * t).cos();
-            [u0 + v * t + a * s, v + a * w * c, -a * w * w * s][k]
-        }
-        None => 0.0,
-    })
-}
-
-/// Inverse dynamics along the drives' swing, and the points' positions, velocities and accelerations.
-fn swing(b: &Built, points: &[super::paths::Point]) -> Result<(Vec<Row>, Vec<super::paths::Traced>), CliError> {
-    let d = b.swing.len();
-    let mut guess = b.q;
-    let (mut rows, mut traced) = (Vec::new(), Vec::new());
-    for k in 0..=(b.duration / b.step).floor() as usize {
-        let t = k as f64 * b.step;
-        let (u, ud, udd) = (drive_at(b, t, 0), drive_at(b, t, 1), drive_at(b, t, 2));
-        let fail = |e: LoopError| bad(format!("at t = {t} s: {}", in_words(e)));
-        let s = b
-            .model
-            .solve_point(&guess, &u[..d], &ud[..d], &udd[..d])
-            .map_err(fail)?;
-        let e = b.model.energy(&s.frames, &s.state);
-        let power = s.forces.iter().zip(&ud).map(|(f, v)| f * v).sum::<f64>() + b.model.element_power(&s.state);
-        traced.push(super::paths::trace(b, points, &s.frames, &s.state.qd, &s.qdd));
-        rows.push(Row {
-            t,
-            u,
-            ud,
-            udd,
-            forces: s.forces,
-            kinetic: e.kinetic,
-            potential: e.gravity + e.springs,
-            power,
-        });
-        guess = s.state.q;
-    }
-    Ok((rows, traced))
+/// A mechanism file's text built (the tests' way in).
+#[cfg(test)]
+pub(super) fn parse(text: &str) -> Result<Built, CliError> {
+    let file: File = toml::from_str(text).map_err(|e| bad(e.to_string()))?;
+    build(&file)
 }
 
 #[cfg(test)]
@@ -541,144 +499,5 @@ mod tests {
         }
         let named = FOUR_BAR.replacen("name = \"four-bar\"", "name = \"four\\u001b]0;x\\u0007bar\"", 1);
         assert_eq!(built(&named).unwrap().name, "four\\u{1b}]0;x\\u{7}bar");
-    }
-
-    const SWASH: &str = include_str!("../../../../docs/dynamics/swash-plate.toml");
-    const SUSPENSION: &str = include_str!("../../../../docs/dynamics/front-suspension.toml");
-
-    /// The swash plate's output angle for the shaft's angle theta: `-atan(tan 15 deg sin theta)` (the four axes meet
-    /// at one point: a spherical four-bar; the sign is the fork's frame turning about +Z).
-    fn swash_output(theta: f64) -> (f64, f64) {
-        let t = 15f64.to_radians().tan();
-        let psi = -(t * theta.sin()).atan();
-        // d psi / d theta.
-        let rate = -t * theta.cos() / (1.0 + t * t * theta.sin() * theta.sin());
-        (psi, rate)
-    }
-
-    /// Around a whole turn of the shaft the loop closes on the closed form's output angle.
-    #[test]
-    fn the_swash_plate_follows_its_closed_form() {
-        let b = built(SWASH).unwrap();
-        let mut guess = b.q;
-        let mut widest: f64 = 0.0;
-        for k in 0..=360 {
-            let theta = (k as f64).to_radians();
-            let q = b.model.closed(&guess, &[theta]).unwrap();
-            let (psi, _) = swash_output(theta);
-            assert!((q[3] - psi).abs() < 1e-9, "{k} deg: {} vs {psi}", q[3]);
-            widest = widest.max(q[3].abs());
-            guess = q;
-        }
-        assert!((widest - 15f64.to_radians()).abs() < 1e-9);
-    }
-
-    /// A link point's path and velocity along the swing (eqs. 5, 6): the output lever's tip 0.15 m out turns with
-    /// the closed form's angle, `0.15 (-sin psi, cos psi, 0)`, at `psi' = dpsi/dtheta * omega`.
-    #[test]
-    fn a_link_points_path_and_velocity_match_the_closed_form() {
-        let b = built(SWASH).unwrap();
-        let points = super::super::paths::points(&["output:0,0.15,0".to_string()], &b).unwrap();
-        let (rows, traced) = swing(&b, &points).unwrap();
-        let omega = b.swing[0].3;
-        assert_eq!(rows.len(), 201);
-        for (r, s) in rows.iter().zip(&traced) {
-            let (psi, dpsi) = swash_output(omega * r.t);
-            let [at, velocity, _] = s[0];
-            let want = Vector3::new(-0.15 * psi.sin(), 0.15 * psi.cos(), 0.0);
-            assert!((at - want).norm() < 1e-9, "t = {}: {at:?} vs {want:?}", r.t);
-            let want = Vector3::new(-psi.cos(), -psi.sin(), 0.0) * 0.15 * dpsi * omega;
-            assert!((velocity - want).norm() < 1e-7, "t = {}: {velocity:?} vs {want:?}", r.t);
-        }
-    }
-
-    /// Forward dynamics under a constant torque on the shaft, no spring, damper or change of height: every joule of
-    /// the torque's work `tau (theta - theta_0)` is the kinetic energy, at every sample.
-    #[test]
-    fn forward_dynamics_turns_the_shafts_work_into_kinetic_energy() {
-        let b = built(SWASH).unwrap();
-        let (rows, _) = super::super::paths::forward(&b, "0.05", &[]).unwrap();
-        let first = &rows[0];
-        assert_eq!((first.kinetic, first.u[0], first.ud[0]), (0.0, 0.0, 0.0));
-        let last = rows.last().unwrap();
-        assert!(last.ud[0] > 10.0, "{}", last.ud[0]);
-        for r in &rows {
-            let work = 0.05 * (r.u[0] - first.u[0]);
-            assert!((r.kinetic - work).abs() < 1e-7, "t = {}: {} vs {work}", r.t, r.kinetic);
-            assert!((r.potential - first.potential).abs() < 1e-9);
-        }
-        // The drive forces' count is checked.
-        let e = super::super::paths::forward(&b, "0.05,1", &[])
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
-        assert!(e.contains("one finite force per drive (1)"), "{e}");
-        let e = super::super::paths::forward(&b, "x", &[])
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_default();
-        assert!(e.contains("numbers separated by commas"), "{e}");
-    }
-
-    /// The front suspension closes at its sketch and along the bump its links stay rigid: the ball joints 0.3015 m
-    /// apart on the upright, the tie rod 0.32 m from the rack, and the wheel centre rises and falls by the arm's
-    /// 0.4 m x 0.08 rad.
-    #[test]
-    fn the_front_suspension_moves_its_wheel_with_rigid_links() {
-        let b = built(SUSPENSION).unwrap();
-        let specs = [
-            "upright:0,0.65,0.10",
-            "upright:0,0.62,0.40",
-            "upright:0.12,0.62,0.15",
-            "upright:0,0.75,0.28",
-        ];
-        let points = super::super::paths::points(&specs.map(String::from), &b).unwrap();
-        let (_, traced) = swing(&b, &points).unwrap();
-        let kingpin = (0.3f64 * 0.3 + 0.03 * 0.03).sqrt();
-        let rack = Vector3::new(0.12, 0.30, 0.15);
-        let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
-        for s in &traced {
-            assert!(((s[0][0] - s[1][0]).norm() - kingpin).abs() < 1e-9);
-            assert!(((s[2][0] - rack).norm() - 0.32).abs() < 1e-9);
-            // The lower ball on its arm's circle about the pivot axis (along X through (0, 0.25, 0.10)).
-            let arm = s[0][0] - Vector3::new(s[0][0].x, 0.25, 0.10);
-            assert!((arm.norm() - 0.4).abs() < 1e-9 && s[0][0].x.abs() < 1e-9);
-            low = low.min(s[3][0].z);
-            high = high.max(s[3][0].z);
-        }
-        assert!((high - 0.28 - 0.4 * 0.08f64.sin()).abs() < 2e-3, "{high}");
-        assert!((0.28 - low - 0.4 * 0.08f64.sin()).abs() < 2e-3, "{low}");
-    }
-
-    /// A spherical pair sketched at its gimbal lock is refused by its name, in the mechanism's words; points that are
-    /// not `LINK:X,Y,Z` on a link of the file are refused.
-    #[test]
-    fn a_spherical_pair_at_its_gimbal_lock_and_bad_points_are_refused() {
-        let locked = "at = [0.0, 1.5707963267948966, 0.0]";
-        assert!(SUSPENSION.contains(locked));
-        for at in ["at = [0.0, 0.0, 0.0]", "at = [0.3, 3.141592653589793, 0.0]", "at = []"] {
-            let e = built(&SUSPENSION.replacen(locked, at, 1))
-                .err()
-                .map(|e| e.to_string())
-                .unwrap_or_default();
-            assert!(
-                e.contains("pair `upright`: a spherical pair sketched at theta") && e.contains("gimbal lock"),
-                "{e}"
-            );
-            assert!(!e.contains("platform"), "{e}");
-        }
-        let b = built(SWASH).unwrap();
-        for (spec, says) in [
-            ("wheel:0,0,0", "names no pair"),
-            ("output", "written LINK:X,Y,Z"),
-            ("output:0,0", "three numbers"),
-            ("output:0,x,0", "three numbers"),
-            ("output:0,nan,0", "finite"),
-        ] {
-            let e = super::super::paths::points(&[spec.to_string()], &b)
-                .err()
-                .map(|e| e.to_string());
-            assert!(e.as_deref().unwrap_or_default().contains(says), "{spec}: {e:?}");
-        }
     }
 }
