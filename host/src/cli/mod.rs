@@ -136,7 +136,9 @@ pub enum Command {
     /// Paper 002's matrix method on a ring platform (trainer-ch5, rotopod-ch4, or a rig file of rod and radial
     /// chains): pairs, link matrices and loops closed by Gauss-Newton, moved along a built-in motion about home; the
     /// Lagrange equation gives the drive torques and forces, the energies and the drives' power, each force checked
-    /// against the ring platform's own inverse dynamics. Exits 0, or 3 when they differ by more than 1e-6.
+    /// against the ring platform's own inverse dynamics. Exits 0, or 3 when they differ by more than 1e-6. With
+    /// --file: any mechanism of the paper's pairs (docs/dynamics/), its drives swung or, with --forward, let go under
+    /// constant forces, and the paths of link points (--point).
     Dynamics(DynamicsArgs),
     /// A vehicle's static stability (chapter 5.2's tests): the tip-over angles climbing, descending and on a lateral
     /// slope, the body's roll, and the critical rollover speed in a turn, rigid or on a rolling suspension; with
