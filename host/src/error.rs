@@ -37,6 +37,12 @@ pub enum CliError {
     /// A tip-over analysis has no answer.
     #[error("tip-over: {0}")]
     TipOver(ringpod_core::kinematics::TipOverError),
+    /// A vehicle that cannot be analysed.
+    #[error("vehicle: {0}")]
+    Vehicle(#[from] ringpod_core::vehicle::VehicleError),
+    /// An experiment on the simulated platform could not run.
+    #[error("experiment: {0}")]
+    Experiment(String),
     /// JSON output failed.
     #[error("JSON output: {0}")]
     Json(#[from] serde_json::Error),

@@ -5,6 +5,7 @@ mod cli;
 mod cueing;
 mod device;
 mod error;
+mod experiment;
 mod flash;
 mod games;
 mod input;
@@ -85,6 +86,10 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
             &args.wrench,
         ))?,
         C::Stream(args) => stream::command::run(&args.job()?)?,
+        C::Stability(args) => {
+            let signals = signals::Signals::install()?;
+            answer(experiment::stability::run(&args.options(&|| signals.received())))?
+        }
         C::Device(args) => {
             let (target, action) = args.request()?;
             device::run(&target, &action)?

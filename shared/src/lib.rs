@@ -32,5 +32,6 @@ pub mod selfcheck;
 #[cfg(feature = "sim")]
 pub mod sim;
 pub mod store;
+pub mod vehicle;
 
 pub use real::Real;

@@ -54,8 +54,9 @@ impl Options<'_> {
 }
 
 mod file;
+mod paths;
 
-pub use file::run_file;
+pub use paths::{run_file, FileOptions};
 
 /// Relative agreement with the ring platform's inverse dynamics that the command asks for.
 pub const AGREEMENT: f64 = 1e-6;
@@ -283,6 +284,8 @@ pub struct Request<'a> {
     pub file: Option<&'a Path>,
     /// A motion file (`t,x,y,z,alpha,beta,gamma`), instead of the built-in motion.
     pub input: Option<&'a Path>,
+    /// With a mechanism file: forward dynamics, link points.
+    pub file_options: FileOptions<'a>,
 }
 
 /// A motion file's timed poses as motion states (rates and accelerations by differences, as `loads` takes
@@ -314,10 +317,14 @@ fn motion_file(path: &Path) -> Result<Vec<(f64, MotionState<f64>)>, CliError> {
 pub fn command(args: &Request) -> Result<Outcome, CliError> {
     // Every file it reads and every one it writes: no output may be an input or another output.
     let inputs: Vec<&Path> = [args.file, args.input, args.geometry].into_iter().flatten().collect();
-    let outputs: Vec<&Path> = [args.table, args.plot].into_iter().flatten().collect();
+    let f = &args.file_options;
+    let outputs: Vec<&Path> = [args.table, args.plot, f.paths, f.paths_plot]
+        .into_iter()
+        .flatten()
+        .collect();
     crate::out::file::check_outputs(&outputs, &inputs).map_err(|(out, e)| CliError::file(out, e))?;
     if let Some(path) = args.file {
-        return run_file(path, args.table, args.plot);
+        return run_file(path, args.table, args.plot, f);
     }
     let selected = crate::analysis::mechanism::Selected::of(args.mechanism, args.geometry)?;
     let crate::analysis::mechanism::AnyMechanism::Ring(ring) = &selected.mechanism else {

@@ -1,5 +1,5 @@
 //! Arguments of the commands that compute on a platform: `rig`, `ik`, `fk`, `check`, `loads`, `reactions`,
-//! `rates`, `structure`, `draw`, `workspace`, `cue`, `dynamics`.
+//! `rates`, `structure`, `draw`, `workspace`, `cue`, `dynamics`, `stability`.
 
 use clap::{Args, Subcommand};
 
@@ -100,6 +100,62 @@ pub struct DynamicsArgs {
     /// read them, instead of the built-in motion (rates and accelerations by differences of the samples).
     #[arg(long, value_name = "MOTION.csv", conflicts_with_all = ["file", "amplitude", "duration", "step"])]
     pub input: Option<std::path::PathBuf>,
+    /// With --file: forward dynamics instead of the drives' swing: the mechanism let go at rest from its sketch under
+    /// constant drive forces (--force), the equation of motion integrated with the loop equations over the file's
+    /// duration and step.
+    #[arg(long, requires = "file")]
+    pub forward: bool,
+    /// With --forward: the drives' constant forces or torques `F1,F2,...` (N, N m; default zeros).
+    #[arg(long, requires = "forward", allow_hyphen_values = true, value_name = "F1,F2,...")]
+    pub force: Option<String>,
+    /// With --file: follow a point of a link along the motion (paper 002's eqs. 5 and 6): `LINK:X,Y,Z`, the link
+    /// by its pair's name and the point in the base at the sketch (m). Repeat for more points.
+    #[arg(long, requires = "file", allow_hyphen_values = true, value_name = "LINK:X,Y,Z")]
+    pub point: Vec<String>,
+    /// With --point: write the points' positions, velocities and accelerations (CSV) ...
+    #[arg(long, requires = "point", value_name = "FILE.csv")]
+    pub paths: Option<std::path::PathBuf>,
+    /// ... and draw them (.png or .svg).
+    #[arg(long, requires = "point", value_name = "FILE")]
+    pub paths_plot: Option<std::path::PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct StabilityArgs {
+    /// Track (m): between the wheels' contact centres across.
+    #[arg(long, allow_hyphen_values = true)]
+    pub track: f64,
+    /// Wheelbase (m).
+    #[arg(long, allow_hyphen_values = true)]
+    pub wheelbase: f64,
+    /// Height of the centre of gravity above the ground (m).
+    #[arg(long, allow_hyphen_values = true)]
+    pub cg_height: f64,
+    /// Distance of the centre of gravity ahead of the rear axle (m). Default: half the wheelbase.
+    #[arg(long, allow_hyphen_values = true)]
+    pub cg_from_rear: Option<f64>,
+    /// The suspension's roll stiffness, both axles (N m/rad): the body rolls about its roll axis. Default: rigid.
+    #[arg(long, allow_hyphen_values = true, requires_all = ["mass", "roll_centre_height"])]
+    pub roll_stiffness: Option<f64>,
+    /// With --roll-stiffness: the sprung mass (kg).
+    #[arg(long, allow_hyphen_values = true, requires = "roll_stiffness")]
+    pub mass: Option<f64>,
+    /// With --roll-stiffness: the roll axis's height above the ground (m).
+    #[arg(long, allow_hyphen_values = true, requires = "roll_stiffness")]
+    pub roll_centre_height: Option<f64>,
+    /// The turn's radius for the critical speed (m).
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    pub turn_radius: f64,
+    /// Run each test on the simulated trainer model (incline, slope, turn), writing each motion and run record into
+    /// this directory; exit 3 when a record does not show the tip-over where computed.
+    #[arg(long, value_name = "DIR")]
+    pub experiment: Option<std::path::PathBuf>,
+    /// With --experiment: the platform's tilt rate (deg/s).
+    #[arg(long, default_value_t = 2.0, requires = "experiment", allow_hyphen_values = true)]
+    pub rate: f64,
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Args)]

@@ -7,7 +7,7 @@ mod stream;
 
 pub use analysis::{
     CheckArgs, Common, CueArgs, DrawArgs, DynamicsArgs, FkArgs, LoadsArgs, PoseArgs, RatesArgs, ReactionsArgs,
-    RigAction, StructureArgs, WorkspaceArgs,
+    RigAction, StabilityArgs, StructureArgs, WorkspaceArgs,
 };
 pub use device::{ControllerArgs, DeviceAction, DeviceArgs, UiArgs};
 pub use requests::platform;
@@ -136,8 +136,15 @@ pub enum Command {
     /// Paper 002's matrix method on a ring platform (trainer-ch5, rotopod-ch4, or a rig file of rod and radial
     /// chains): pairs, link matrices and loops closed by Gauss-Newton, moved along a built-in motion about home; the
     /// Lagrange equation gives the drive torques and forces, the energies and the drives' power, each force checked
-    /// against the ring platform's own inverse dynamics. Exits 0, or 3 when they differ by more than 1e-6.
+    /// against the ring platform's own inverse dynamics. Exits 0, or 3 when they differ by more than 1e-6. With
+    /// --file: any mechanism of the paper's pairs (docs/dynamics/), its drives swung or, with --forward, let go under
+    /// constant forces, and the paths of link points (--point).
     Dynamics(DynamicsArgs),
+    /// A vehicle's static stability (chapter 5.2's tests): the tip-over angles climbing, descending and on a lateral
+    /// slope, the body's roll, and the critical rollover speed in a turn, rigid or on a rolling suspension; with
+    /// --experiment each run on the simulated trainer model, the platform tilting toward the computed angle, and the
+    /// record's tip-over compared with it. Exits 0, or 3 when a record does not show the tip-over where computed.
+    Stability(StabilityArgs),
     /// Loads of a tool wrench on the five-DOF tool carrier (paper 003's projection method): drive forces and
     /// torques, the X guide's bearing load, the frame pivots' forces and the constraint couple.
     Reactions(ReactionsArgs),
@@ -158,7 +165,7 @@ pub enum Command {
         #[arg(long, value_name = "FILE.md")]
         table: Option<std::path::PathBuf>,
         /// Also draw figs. 3 and 5, the largest constraint reaction without and with projection (.png or .svg),
-        /// for a load of 1 N down and 0.1 N m about each axis (the paper does not say which it used).
+        /// for a load of 1 N down and 0.1 N m about each axis (the paper gives 1 N, not its direction).
         #[arg(long, value_name = "FILE")]
         reactions: Option<std::path::PathBuf>,
     },
@@ -199,7 +206,7 @@ impl Command {
             Self::Device(args) => args.action == DeviceAction::Inputs && args.watch,
             _ => matches!(
                 self,
-                Self::Stream(_) | Self::Ui(_) | Self::Simulate { .. } | Self::Monitor { .. }
+                Self::Stream(_) | Self::Ui(_) | Self::Simulate { .. } | Self::Monitor { .. } | Self::Stability(_)
             ),
         }
     }

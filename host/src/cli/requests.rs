@@ -112,6 +112,12 @@ impl super::DynamicsArgs {
             plot: self.plot.as_deref(),
             file: self.file.as_deref(),
             input: self.input.as_deref(),
+            file_options: crate::analysis::dynamics::FileOptions {
+                forward: self.forward.then(|| self.force.as_deref().unwrap_or("")),
+                points: &self.point,
+                paths: self.paths.as_deref(),
+                paths_plot: self.paths_plot.as_deref(),
+            },
         }
     }
 }
@@ -400,5 +406,27 @@ impl super::UiArgs {
             files: self.files.clone(),
             motion_compensation: self.motion_compensation,
         })
+    }
+}
+
+impl super::StabilityArgs {
+    /// The options `stability` takes; `stopped` ends an experiment early.
+    pub fn options<'a>(&'a self, stopped: &'a dyn Fn() -> bool) -> crate::experiment::stability::Options<'a> {
+        crate::experiment::stability::Options {
+            track: self.track,
+            wheelbase: self.wheelbase,
+            cg_height: self.cg_height,
+            cg_from_rear: self.cg_from_rear,
+            roll: self
+                .roll_stiffness
+                .zip(self.mass)
+                .zip(self.roll_centre_height)
+                .map(|((k, m), h)| (k, m, h)),
+            radius: self.turn_radius,
+            experiment: self.experiment.as_deref(),
+            rate_deg_s: self.rate,
+            json: self.json,
+            stopped,
+        }
     }
 }

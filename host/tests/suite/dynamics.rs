@@ -215,3 +215,79 @@ fn a_motion_file_is_followed_and_a_bad_one_refused() {
         "the built-in motion's amplitude with a motion file"
     );
 }
+
+/// Paper 002's swash plate on the command line: the paths of a link point (`--point`, `--paths`) are the closed
+/// form's, the lever's tip 0.15 m out swinging `-atan(tan 15 deg sin(omega t))` about Z; forward dynamics (`--forward
+/// --force`) turns the shaft's work into kinetic energy and draws its plot; bad points and forces are refused with
+/// exit 1 and nothing written, and the options that need a file without one are usage errors.
+#[test]
+fn the_swash_plate_on_the_command_line_forward_and_with_paths() {
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/dynamics/swash-plate.toml");
+    let paths = scratch("swash-paths.csv");
+    let picture = scratch("swash-paths.svg");
+    let out = ringpod()
+        .args(["dynamics", "--file", file, "--point", "output:0,0.15,0", "--paths"])
+        .arg(&paths)
+        .arg("--paths-plot")
+        .arg(&picture)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    // Sampled every 1 ms: the swing's +-0.15 sin 15 deg = +-0.038823 m to the samples' nearest, its peak speed
+    // 0.15 tan 15 deg omega = 2.272825 m/s at theta = 0.
+    assert!(text.contains("point output:0,0.15,0: x -0.03881"), "{text}");
+    assert!(text.contains("peak speed 2.272825 m/s"), "{text}");
+    let table = std::fs::read_to_string(&paths).unwrap();
+    let mut lines = table.lines();
+    assert!(lines.next().unwrap().starts_with("t,p1_x,p1_y,p1_z,p1_vx"));
+    let tan = 15f64.to_radians().tan();
+    let mut rows = 0;
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap()).collect();
+        let psi = -(tan * (56.548668 * v[0]).sin()).atan();
+        assert!(
+            (v[1] + 0.15 * psi.sin()).abs() < 1e-8 && (v[2] - 0.15 * psi.cos()).abs() < 1e-8,
+            "{line}"
+        );
+        rows += 1;
+    }
+    assert_eq!(rows, 201);
+    assert!(std::fs::read_to_string(&picture).unwrap().contains("<svg"));
+    let plot = scratch("swash-forward.png");
+    let out = ringpod()
+        .args(["dynamics", "--file", file, "--forward", "--force", "0.05", "--plot"])
+        .arg(&plot)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("forward dynamics from rest at the sketch under drive forces [0.05]"),
+        "{text}"
+    );
+    assert!(std::fs::metadata(&plot).unwrap().len() > 1000);
+    for (args, says) in [
+        (vec!["--point", "wheel:0,0,0"], "names no pair"),
+        (vec!["--point", "output:1,2"], "three numbers"),
+        (vec!["--forward", "--force", "1,2"], "one finite force per drive (1)"),
+    ] {
+        let written = scratch("never.csv");
+        let out = ringpod()
+            .args(["dynamics", "--file", file])
+            .args(&args)
+            .arg("--table")
+            .arg(&written)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains(says), "{args:?}");
+        assert!(!written.exists(), "{args:?}");
+    }
+    for args in [
+        vec!["dynamics", "--forward"],
+        vec!["dynamics", "--point", "output:0,0,0"],
+    ] {
+        ringpod().args(&args).assert().code(2);
+    }
+}

@@ -103,7 +103,7 @@ pub const TRAINER_CH3: RingGeometry = unwrap_geometry(RingGeometry::new(
 /// linear actuators of 0.2..1.2. The rods' carriages sit inside their pair (chapter 5's branches put them 141 deg
 /// from the radial carriages at every height, past the 120 deg limit); the chapter's own pose, heave 0.172, tilts the
 /// rods past the joint cones and lies near a type 2 singularity, so the home is the middle of the heave that passes
-/// every check (0.39..0.55).
+/// every check (0.375..0.565).
 pub const TRAINER_CH4: RingGeometry = unwrap_geometry(RingGeometry::new(
     "trainer-ch4",
     3.0,

@@ -36,6 +36,7 @@ mod screws;
 mod selfcheck;
 mod settings;
 mod source_numbers;
+mod stability;
 mod store;
 mod structure;
 mod supervisor;

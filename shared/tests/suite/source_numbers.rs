@@ -143,7 +143,7 @@ const CH42_A: [[f64; 6]; 6] = [
 const CH42_B: [f64; 6] = [-1.566, -1.566, 1.663, -1.66, 5.588, -5.598];
 
 /// Chapter 4.2's matrices are the Jacobians at chapter 5's carriage angles (copied into this case with `L = 1`,
-/// `z = 0.172`, where the rods would have to be 0.847 long) and the radial lengths 0.783 that do hold; its
+/// `z = 0.172`, where the rods would have to be 0.8461 long) and the radial lengths 0.783 that do hold; its
 /// planarity rows are ringpod's times 2.5 and -2.5 (a constraint times a constant: the same velocities), and its
 /// first row's beta, -0.688, is a slip for -0.344 (`-2 z a_x`, as the mirror row's 0.344).
 #[test]
@@ -181,10 +181,12 @@ fn ch4_2_printed_matrices_are_the_jacobians_at_chapter_5s_angles() {
         let got = SCALE[i] * j.b[(ROW[i], COL[i])];
         assert!((got - CH42_B[i]).abs() < tol, "B[{i}]: {got} vs {}", CH42_B[i]);
     }
-    // The copied angles do not close the rods of length 1: they would need 0.847.
+    // The copied angles do not close the rods of length 1: they would need 0.8461.
     let f = m.residuals(&pose, &q);
     let needed = (f[0] + 1.0).sqrt();
-    assert!((needed - 0.8465).abs() < 1e-3, "{needed}");
+    assert!((needed - 0.8461).abs() < 5e-5, "{needed}");
+    // The radial lengths that do hold: 0.783056, printed 0.783.
+    assert!((s - 0.783_056).abs() < 5e-7, "{s}");
 }
 
 /// Degrees and minutes.
@@ -330,4 +332,42 @@ fn ch4_2_preset_at_the_chapters_pose_and_at_home() {
         .unwrap()
         .1
         .all_pass());
+}
+
+/// Chapter 4.2's mechanism (`trainer-ch4`) at the centre passes every check from heave 0.375 to 0.565 and fails
+/// just outside; its home (0.47) is the middle.
+#[test]
+fn ch4_2_preset_heave_range() {
+    let m = RingPlatform::<f64>::new(&presets::TRAINER_CH4);
+    let report = |z: f64| m.inverse_checked(&Pose::new(0.0, 0.0, z, 0.0, 0.0, 0.0));
+    let passes = |z: f64| report(z).is_ok_and(|(_, r)| r.all_pass());
+    for i in 0..=190 {
+        let z = 0.375 + i as f64 * 1e-3;
+        assert!(passes(z), "{z}");
+    }
+    // Below, the joint cones; above, the carriages crowd closer than the spacing allows.
+    for (z, check) in [(0.374, Check::JointCones), (0.5665, Check::CarriageSpacing)] {
+        let (_, r) = report(z).unwrap();
+        assert_eq!(r.first_failure(), Some(check), "{z}");
+    }
+    assert!((presets::TRAINER_CH4_HOME_Z - (0.375 + 0.565) / 2.0).abs() < 1e-12);
+}
+
+/// Chapter 5.2's table and text in the model's limits: 0.05 m/s on every position axis, +-20 deg of pitch and roll,
+/// a yaw rate of 1.9 rad/s (fig. 5.11), above the 1.1 rad/s the chapter gives as the largest yaw rate from which a
+/// driver recovers a skid; chapter 5.3.1's FL20 of 1.8 deg full steps is the 200 steps per turn of the drives' scale.
+#[test]
+fn ch5_2_table_and_ch5_3_motor_in_the_models_limits() {
+    use ringpod_core::motion::{AxisScale, MotionLimits};
+    let m = MotionLimits::TRAINER_MODEL;
+    assert_eq!(&m.pose_velocity[..3], &[0.05; 3]);
+    assert_eq!(m.pose_velocity[5], 1.9);
+    assert!(m.pose_velocity[5] > 1.1);
+    let deg = std::f64::consts::PI / 180.0;
+    assert_eq!(
+        presets::TRAINER_MODEL_RANGES,
+        [0.05, 0.05, 0.04, 20.0 * deg, 20.0 * deg]
+    );
+    // 360 / 1.8 full steps, 1/16 microsteps, the 8:1 ring gear.
+    assert_eq!(AxisScale::MODEL_CARRIAGE.steps_per_turn, (360.0 / 1.8) as i64 * 16 * 8);
 }

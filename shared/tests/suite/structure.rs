@@ -209,6 +209,14 @@ fn trainer_wrench_determinant_has_the_sources_value_and_sign() {
     // Each radial chain's wrenches are the source's: its tangent force (the carriage's) and the line B -> A.
     let tangent = Vector6::new(0.894427, -0.447214, 0.0, 0.447214, 0.894427, -2.236068);
     assert!((a[2].wrenches[0] - tangent).norm() < 1e-5, "{:?}", a[2].wrenches[0]);
+    // Chain 3's line B3 -> A3: its moment about O is B3 x u = (2.132, -1.066, 0) (the matrix prints 2.13, -1.066,
+    // 0.003 from its rounded entries); the text prints (2.13, 0.894, 2.235), the tangent force's last two.
+    let line = a[2].wrenches[1];
+    let s = if line[2] > 0.0 { 1.0 } else { -1.0 };
+    let want = Vector6::new(-0.271_486, -0.542_973, 0.794_654, 2.132_282, -1.066_141, 0.0);
+    assert!((line * s - want).norm() < 1e-5, "{line:?}");
+    let text = [2.13, 0.894, 2.235];
+    assert!((s * line[4] - text[1]).abs() > 1.9 && (s * line[5] - text[2]).abs() > 2.2);
 }
 
 #[test]

@@ -13,9 +13,7 @@ use ringpod_core::screws::matrix::{
 };
 use serde::Deserialize;
 
-use super::{describe, report, Row};
 use crate::error::CliError;
-use crate::out::Outcome;
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -97,6 +95,9 @@ struct MotionFile {
     drives: Vec<String>,
     amplitude: Vec<f64>,
     frequency: Vec<f64>,
+    /// A steady rate of each drive under its swing (rad/s or m/s; default none): a crank that turns round.
+    #[serde(default)]
+    speed: Vec<f64>,
     duration: f64,
     step: f64,
 }
@@ -105,7 +106,7 @@ struct MotionFile {
 /// tonnes; beyond that the number is a mistake (1e308 kg came back as a 300-digit force), as `loads --mass` takes it.
 const MOST_MASS: f64 = 1e6;
 
-fn bad(what: String) -> CliError {
+pub(super) fn bad(what: String) -> CliError {
     CliError::Dynamics(shown(&what))
 }
 
@@ -148,6 +149,10 @@ fn body_refused(b: &BodyFile) -> Option<String> {
     None
 }
 
+/// `|sin theta|` below which a spherical pair's sketch is at its gimbal lock (`Rz(psi) Rx(theta) Rz(phi)` at theta
+/// 0 or pi).
+const GIMBAL_LOCK: f64 = 1e-3;
+
 /// Why a file's mechanism or model is refused, in words.
 fn refused(e: LoopError) -> &'static str {
     match e {
@@ -172,14 +177,32 @@ fn joint(name: &str, pitch: f64) -> Result<Joint, CliError> {
     })
 }
 
-/// The model of a file, the variables at its sketch, its drives' swing and sampling.
-struct Built {
-    model: Model,
-    q: [f64; MAX_VARIABLES],
-    swing: Vec<(f64, f64, f64)>,
-    duration: f64,
-    step: f64,
-    name: String,
+/// Why a file's mechanism has no answer at a point, in its own words (not a ring platform's).
+pub(super) fn in_words(e: LoopError) -> &'static str {
+    match e {
+        LoopError::Shape => "the mechanism's shape does not fit the matrix method's limits",
+        LoopError::Singular => {
+            "the drives do not determine the mechanism here (a dead centre, or a Hooke's joint or spherical pair at its \
+             gimbal lock)"
+        }
+        LoopError::NoConvergence => "the loops did not close from the previous point (the motion jumps or leaves the \
+                                     mechanism's reach)",
+        LoopError::NonFinite => "a value is not finite",
+    }
+}
+
+/// The model of a file, the variables at its sketch, its drives' swing and sampling, and its links by name with
+/// their frames at the sketch.
+pub(super) struct Built {
+    pub(super) model: Model,
+    pub(super) q: [f64; MAX_VARIABLES],
+    /// Each drive's value at the sketch, amplitude, frequency and steady rate.
+    pub(super) swing: Vec<(f64, f64, f64, f64)>,
+    pub(super) duration: f64,
+    pub(super) step: f64,
+    pub(super) name: String,
+    pub(super) links: HashMap<String, usize>,
+    pub(super) frames: Vec<Matrix4<f64>>,
 }
 
 /// The pairs sketched: each placed on its parent link, the links by name, every link's frame at the sketch, each
@@ -220,6 +243,15 @@ fn sketch(f: &File) -> Result<Sketched<'_>, CliError> {
             )));
         }
         values[..pf.at.len()].copy_from_slice(&pf.at);
+        if j == Joint::Spherical && values[1].sin().abs() < GIMBAL_LOCK {
+            return Err(bad(format!(
+                "pair `{}`: a spherical pair sketched at theta = {} (its second Euler angle, `at[1]`) is at its gimbal \
+                 lock: its first and third angles turn about one axis, and the loops cannot tell them apart; sketch it \
+                 with theta away from 0 and pi, e.g. `at = [0.0, 1.5707963, 0.0]`",
+                pf.name,
+                crate::input::numbers::readable(values[1])
+            )));
+        }
         if count + j.variables() > MAX_VARIABLES || links.insert(&pf.name, p + 1).is_some() {
             return Err(bad(format!(
                 "pair `{}`: a repeated name, or past {MAX_VARIABLES} variables",
@@ -293,9 +325,41 @@ fn build(f: &File) -> Result<Built, CliError> {
         })
         .collect::<Result<Vec<_>, CliError>>()?;
     let m = &f.motion;
-    if m.drives.len() > MAX_DRIVES || m.amplitude.len() != m.drives.len() || m.frequency.len() != m.drives.len() {
+    let drives = drives(m, &first)?;
+    let mechanism =
+        Mechanism::new(&pairs, &closures, &drives).map_err(|e| bad(format!("the mechanism: {}", refused(e))))?;
+    let bodies = bodies(f, &link, &frames)?;
+    let elements = elements(f, &first, &q)?;
+    let model = Model::new(mechanism, &bodies, &elements, v3(&f.gravity))
+        .map_err(|e| bad(format!("the model: {}", refused(e))))?;
+    let swing = drives
+        .iter()
+        .zip(m.amplitude.iter().zip(&m.frequency))
+        .enumerate()
+        .map(|(k, (d, (a, w)))| (q[*d], *a, *w, m.speed.get(k).copied().unwrap_or(0.0)))
+        .collect();
+    let name = f.name.as_deref().map_or_else(|| "mechanism".into(), shown);
+    Ok(Built {
+        model,
+        q,
+        swing,
+        duration: m.duration,
+        step: m.step,
+        name,
+        links: links.into_iter().map(|(k, v)| (k.to_owned(), v)).collect(),
+        frames,
+    })
+}
+
+/// The motion's drives (each a pair's first variable), its numbers checked.
+fn drives(m: &MotionFile, first: &HashMap<&str, usize>) -> Result<Vec<usize>, CliError> {
+    if m.drives.len() > MAX_DRIVES
+        || m.amplitude.len() != m.drives.len()
+        || m.frequency.len() != m.drives.len()
+        || !(m.speed.is_empty() || m.speed.len() == m.drives.len())
+    {
         return Err(bad(format!(
-            "motion: one amplitude and one frequency per drive, at most {MAX_DRIVES} drives"
+            "motion: one amplitude and one frequency per drive (and one speed each, if any), at most {MAX_DRIVES} drives"
         )));
     }
     let drives = m
@@ -310,16 +374,30 @@ fn build(f: &File) -> Result<Built, CliError> {
         .collect::<Result<Vec<_>, _>>()?;
     let positive =
         m.duration.is_finite() && m.duration > 0.0 && m.step.is_finite() && m.step > 0.0 && m.duration / m.step <= 1e6;
-    if !positive || !m.amplitude.iter().chain(&m.frequency).all(|v| v.is_finite()) {
+    if !positive
+        || !m
+            .amplitude
+            .iter()
+            .chain(&m.frequency)
+            .chain(&m.speed)
+            .all(|v| v.is_finite())
+    {
         return Err(bad(
-            "motion: a positive duration and step (at most a million samples), finite amplitudes and frequencies"
+            "motion: a positive duration and step (at most a million samples), finite amplitudes, frequencies and \
+             speeds"
                 .into(),
         ));
     }
-    let mechanism =
-        Mechanism::new(&pairs, &closures, &drives).map_err(|e| bad(format!("the mechanism: {}", refused(e))))?;
-    let bodies = f
-        .body
+    Ok(drives)
+}
+
+/// The bodies, each on its link's frame at the sketch.
+fn bodies(
+    f: &File,
+    link: &dyn Fn(&str) -> Result<usize, CliError>,
+    frames: &[Matrix4<f64>],
+) -> Result<Vec<Body>, CliError> {
+    f.body
         .iter()
         .map(|b| {
             if let Some(why) = body_refused(b) {
@@ -334,71 +412,24 @@ fn build(f: &File) -> Result<Built, CliError> {
                 inertia: back * pseudo_inertia(b.mass, &v3(&b.centre), &tensor) * back.transpose(),
             })
         })
-        .collect::<Result<Vec<_>, CliError>>()?;
-    let elements = elements(f, &first, &q)?;
-    let model = Model::new(mechanism, &bodies, &elements, v3(&f.gravity))
-        .map_err(|e| bad(format!("the model: {}", refused(e))))?;
-    let swing = drives
-        .iter()
-        .zip(m.amplitude.iter().zip(&m.frequency))
-        .map(|(d, (a, w))| (q[*d], *a, *w))
-        .collect();
-    let name = f.name.as_deref().map_or_else(|| "mechanism".into(), shown);
-    Ok(Built {
-        model,
-        q,
-        swing,
-        duration: m.duration,
-        step: m.step,
-        name,
-    })
+        .collect::<Result<Vec<_>, CliError>>()
 }
 
-/// `dynamics --file`: the file's mechanism along its drives' swing, its inverse dynamics, table, plot and energy.
-pub fn run_file(path: &Path, table: Option<&Path>, plot: Option<&Path>) -> Result<Outcome, CliError> {
+/// A mechanism file read and built.
+pub(super) fn read(path: &Path) -> Result<Built, CliError> {
     // Bounded, and never waiting in open() for a FIFO's writer, as every settings file is read.
     let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
         .map_err(|e| bad(format!("{}: {e}", path.display())))?;
     // TOML's message spans lines (the line quoted, a caret under the fault): kept as it is.
     let file: File = toml::from_str(&text).map_err(|e| CliError::Dynamics(format!("{}: {e}", path.display())))?;
-    let b = build(&file)?;
-    let d = b.swing.len();
-    let at = |t: f64, k: usize| -> [f64; MAX_DRIVES] {
-        std::array::from_fn(|i| match b.swing.get(i) {
-            Some((u0, a, f)) => {
-                let w = 2.0 * std::f64::consts::PI * f;
-                let s = (w * t).sin();
-                let c = (w * t).cos();
-                [u0 + a * s, a * w * c, -a * w * w * s][k]
-            }
-            None => 0.0,
-        })
-    };
-    let mut guess = b.q;
-    let mut rows = Vec::new();
-    for k in 0..=(b.duration / b.step).floor() as usize {
-        let t = k as f64 * b.step;
-        let (u, ud, udd) = (at(t, 0), at(t, 1), at(t, 2));
-        let fail = |e: LoopError| bad(format!("at t = {t} s: {}", describe(e)));
-        let s = b
-            .model
-            .solve_point(&guess, &u[..d], &ud[..d], &udd[..d])
-            .map_err(fail)?;
-        let e = b.model.energy(&s.frames, &s.state);
-        let power = s.forces.iter().zip(&ud).map(|(f, v)| f * v).sum::<f64>() + b.model.element_power(&s.state);
-        rows.push(Row {
-            t,
-            u,
-            ud,
-            udd,
-            forces: s.forces,
-            kinetic: e.kinetic,
-            potential: e.gravity + e.springs,
-            power,
-        });
-        guess = s.state.q;
-    }
-    report(&b.name, &rows, d, table, plot)
+    build(&file)
+}
+
+/// A mechanism file's text built (the tests' way in).
+#[cfg(test)]
+pub(super) fn parse(text: &str) -> Result<Built, CliError> {
+    let file: File = toml::from_str(text).map_err(|e| bad(e.to_string()))?;
+    build(&file)
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Paper 003's figs. 3 and 5: the largest constraint reaction `r_max = max |r_Ci|` over the slice, without and with
-//! the actuation wrenches projected onto the complement of the constraints' span. The paper does not say which load
-//! it applied; ringpod's is [`FIG_LOAD`] (1 N down at `F` and a couple of 0.1 N m about each axis: a pure force would
-//! leave fig. 5 blank, its projected constraint reactions being zero).
+//! the actuation wrenches projected onto the complement of the constraints' span. The paper gives the load as 1 N and
+//! not its direction; ringpod's is [`FIG_LOAD`] (1 N down at `F` and a couple of 0.1 N m about each axis: a pure force
+//! would leave fig. 5 blank, its projected constraint reactions being zero).
 
 use std::fmt::Write as _;
 use std::path::Path;

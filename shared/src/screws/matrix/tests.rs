@@ -64,6 +64,49 @@ fn hooke_matches_the_papers_tables_but_for_the_misprinted_entry() {
     assert!((Joint::Hooke.generator(1, &[phi, theta]) - q2).amax() < 1e-15);
 }
 
+/// Table 1's spherical matrix as printed, with `(theta, phi, psi)` as it names them.
+fn printed_spherical(theta: f64, phi: f64, psi: f64) -> nalgebra::Matrix3<f64> {
+    let (st, ct, sf, cf, ss, cs) = (theta.sin(), theta.cos(), phi.sin(), phi.cos(), psi.sin(), psi.cos());
+    nalgebra::Matrix3::new(
+        -ct * cf * cs + st * ss,
+        -st * cf * cs + ct * ss,
+        sf * cs,
+        -st * cs + ct * cf * ss,
+        st * ss * cf - ct * cs,
+        sf * ss,
+        ct * sf,
+        -st * sf,
+        -cf,
+    )
+}
+
+/// The print's spherical matrix is no rotation: at zero angles it is `-I` (a point reflection, determinant -1), and
+/// elsewhere its determinant wanders (0.0096 at (0.3, 0.5, 0.7), -0.476 at (0.5, 0.2, 0.1); from -1 to 1.18 over
+/// every angle) and its rows are not orthonormal. ringpod's pair is `Rz(psi) Rx(theta) Rz(phi)`, a rotation at
+/// every angle.
+#[test]
+fn the_papers_spherical_matrix_is_no_rotation() {
+    assert!((printed_spherical(0.0, 0.0, 0.0) + nalgebra::Matrix3::identity()).amax() < 1e-15);
+    assert!((printed_spherical(0.3, 0.5, 0.7).determinant() - 0.009_574_5).abs() < 1e-7);
+    assert!((printed_spherical(0.5, 0.2, 0.1).determinant() + 0.475_629).abs() < 1e-6);
+    let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
+    for i in 0..24 {
+        for j in 0..24 {
+            for k in 0..24 {
+                let a = |n: i32| -core::f64::consts::PI + f64::from(n) * core::f64::consts::TAU / 24.0;
+                let m = printed_spherical(a(i), a(j), a(k));
+                low = low.min(m.determinant());
+                high = high.max(m.determinant());
+                let r = Joint::Spherical.transform(&[a(i), a(j), a(k)]);
+                let r = r.fixed_view::<3, 3>(1, 1);
+                assert!((r * r.transpose() - nalgebra::Matrix3::identity()).amax() < 1e-14);
+                assert!((r.determinant() - 1.0).abs() < 1e-14);
+            }
+        }
+    }
+    assert!((low + 1.0).abs() < 1e-12 && high > 1.1 && high < 1.19, "{low} {high}");
+}
+
 #[test]
 fn screw_and_cylindrical_share_the_revolute_axes() {
     let (g, s) = (0.9, 0.03);
