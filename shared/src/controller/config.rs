@@ -38,6 +38,8 @@ pub struct ControllerConfig {
     pub inputs: InputConfig,
     /// Telemetry samples per second while a host is connected (0: none).
     pub telemetry_hz: u16,
+    /// After a lost stream, how long without a frame from any host before the device powers down (ms).
+    pub host_gone_ms: u16,
     /// The rig's name (UTF-8, zero-padded), as `device rig show` reports it.
     pub rig_name: [u8; RIG_NAME_LEN],
 }
@@ -173,6 +175,7 @@ impl ControllerConfig {
             switches: model::HOMING,
             inputs: InputConfig::default(),
             telemetry_hz: model::TELEMETRY_HZ,
+            host_gone_ms: crate::safety::HOST_GONE_MS,
             rig_name: [0; RIG_NAME_LEN],
         };
         config.rig_name = RigRecord::new(

@@ -39,6 +39,7 @@ impl ControllerConfig {
             follow: c.follow,
             margins: c.margins.0,
             telemetry_hz: self.telemetry_hz,
+            host_gone_ms: self.host_gone_ms,
         }
     }
 
@@ -109,11 +110,15 @@ impl ControllerConfig {
                 if s.telemetry_hz > 2_000 {
                     return Err(field(FieldName::TelemetryHz));
                 }
+                if !(1_000..=60_000).contains(&s.host_gone_ms) {
+                    return Err(field(FieldName::HostGoneMs));
+                }
                 c.stream_timeout_us = u32::from(s.timeout_ms) * 1000;
                 c.gross_jump_us = u32::from(s.gross_jump_ms) * 1000;
                 c.follow = s.follow;
                 c.margins.0 = s.margins;
                 next.telemetry_hz = s.telemetry_hz;
+                next.host_gone_ms = s.host_gone_ms;
             }
             Settings::Control(s) => {
                 if !matches!(s.tick_hz, 500 | 1_000 | 2_000) {
