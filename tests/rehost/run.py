@@ -394,7 +394,7 @@ def main():
     ap.add_argument("--usb-full", action="store_true",
                     help="also homing over USB, and the cable pulled mid-stream and plugged again (usb_checks.py)")
     ap.add_argument("--until", help="stop after this check (the mutants' runs)")
-    ap.add_argument("--max-sim-s", type=float, default=60.0, help="stop the run past this many simulated seconds")
+    ap.add_argument("--max-sim-s", type=float, default=90.0, help="stop the run past this many simulated seconds")
     ap.add_argument("--max-wall-s", type=float, default=2400.0, help="stop the run past this many wall seconds")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the book's Emulation chapter")
     args = ap.parse_args()

@@ -179,11 +179,11 @@ def silent_check(checks, m, cli, port, plant, bridge, name, power_down):
     m.run(m.now + SYSCLK // 20)  # what the host had written before it died, read from its port
     last_rx = motion.rx_at
     lost = last_rx + int((timeout_ms or 0) * SYSCLK / 1000)  # where the device's stream timeout runs out
-    said = [f"{timeout}", f"{gone}"]
+    said = []
     ok = killed is not None and timeout_ms is not None and gone.code == 0
     if not ok:
         motion.close()
-        checks.check(name, False, f"no stream to take the host from: killed at {killed}; {'; '.join(said)}")
+        checks.check(name, False, f"no stream to take the host from: killed at {killed}; {timeout}; {gone}")
         return
     # the stop: the last STEP edge after the host's last byte
     m.run(lost + int(0.5 * GONE_MS * SYSCLK / 1000))
@@ -239,6 +239,8 @@ def silent_check(checks, m, cli, port, plant, bridge, name, power_down):
                     f"homed {back.get('homed')}, ENABLE, LOGIC, POWER {_odr(m)}"
                     + (f"; an output changed before the time at {[round(ms(t - asked), 1) for t in early]} ms" if early else ""))
     motion.close()
+    said.append(f"(`device config get stream.timeout_ms` {timeout_ms}, `device config set stream.host_gone_ms "
+                f"{GONE_MS}` exit {gone.code})")
     checks.check(name, ok, "; ".join(said))
 
 
