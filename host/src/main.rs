@@ -5,6 +5,7 @@ mod cli;
 mod cueing;
 mod device;
 mod error;
+mod flash;
 mod games;
 mod input;
 mod link;
@@ -89,6 +90,7 @@ fn run(command: &cli::Command) -> anyhow::Result<u8> {
             device::run(&target, &action)?
         }
         C::Ports => device::ports()?,
+        C::Flash { image, port, dfu } => flash::command::run(image.as_deref(), port.as_deref(), dfu.as_deref()),
         C::Ui(args) => ui::run(args.options()?)?,
         C::Simulate {
             geometry,

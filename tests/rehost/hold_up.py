@@ -11,7 +11,7 @@
   stops and must be homed again, and the host's run ends on it (`device_stopped`, exit 5; `transport_lost`, exit 6,
   when the emulated board answers later than the host's patience). A board's hold-up
   while it moves is therefore a fault by design; a hold-up of device time that the ring outlives is the core's and
-  the simulator's check (`Controller::pass`, host/tests/link.rs), where the stream goes on. A ring that cannot be
+  the simulator's check (`Controller::pass`, host/tests/suite/link.rs), where the stream goes on. A ring that cannot be
   lapped (the DMA in normal mode, re-armed each period) would let the board ride through: not built.
 """
 

@@ -22,7 +22,7 @@ from qiling import Qiling
 from qiling.const import QL_ARCH, QL_OS, QL_VERBOSE
 from qiling.extensions.mcu.stm32f4 import stm32f411
 from qiling.hw.peripheral import QlPeripheral
-from unicorn import UC_HOOK_CODE, UC_HOOK_INTR, UC_HOOK_MEM_WRITE, Uc, UcError
+from unicorn import UC_HOOK_CODE, UC_HOOK_INTR, UC_HOOK_MEM_WRITE, UC_PROT_READ, UC_QUERY_PAGE_SIZE, Uc, UcError
 from unicorn import arm_const as A
 
 from elf import Elf
@@ -64,6 +64,13 @@ UPDATE_REQUESTS = {
     "tim5": [("dma1", 0, 6), ("dma1", 6, 6)],
 }
 QILING_PERIPHERALS = ["pwr", "syscfg", "dbgmcu", "usart2", "usart6"]
+# RM0383 39.1: the 96-bit unique device ID at 0x1FFF7A10 (X and Y on the wafer, 16 bits each; the wafer number;
+# the lot number, seven ASCII characters), in the page after system memory that also holds the OTP area (RM0383
+# 3.8, 0x1FFF7800-0x1FFF7A0F, erased: 0xFF). Qiling's profile maps system memory up to 0x1FFF77FF only. This
+# board's ID:
+UID_ADDR = 0x1FFF_7A10
+UID = struct.pack("<HHB", 35, 65, 7) + b"RINGPOD"
+OTP_BASE, OTP_SIZE = 0x1FFF_7800, 0x210
 USART1_IRQ = 37  # RM0383 10.2: USART1 global interrupt; on APB2, clocked at SYSCLK here
 
 
@@ -98,10 +105,29 @@ class Machine:
         for addr, data in self.elf.segments:
             if FLASH_BASE <= addr < FLASH_BASE + FLASH_SIZE:
                 self.uc.mem_write(addr, data)
+        self._map_uid()
         self._paint_ram()
         self._hooks()
         self._cpu_reset()
         self.rcc.set_reset_flags(POWER_ON)
+
+    def _map_uid(self):
+        """The OTP area and the unique ID (see `UID`): the Unicorn page that holds them mapped read-only, when the
+        profile's system memory does not already reach it (rounded up to a page); nothing below 0x1FFF7800 is
+        mapped or written here."""
+        mapped = any(lo <= UID_ADDR and UID_ADDR + len(UID) - 1 <= hi for lo, hi, _ in self.uc.mem_regions())
+        if not mapped:
+            page = self.uc.query(UC_QUERY_PAGE_SIZE)
+            base = UID_ADDR & ~(page - 1)
+            if base < OTP_BASE or UID_ADDR + len(UID) > base + page:
+                raise Fault(f"a {page}-byte page at {base:#x} would reach below the OTP area into system memory")
+            self.uc.mem_map(base, page, UC_PROT_READ)
+        self.uc.mem_write(OTP_BASE, b"\xff" * OTP_SIZE)
+        self.uc.mem_write(UID_ADDR, UID)
+
+    def uid_hex(self):
+        """The serial number the firmware gives the USB host: the ID's bytes from the lowest address, in hex."""
+        return bytes(self.uc.mem_read(UID_ADDR, len(UID))).hex().upper()
 
     # -- the bus --
     def _find(self, address):

@@ -24,6 +24,9 @@ from unicorn import arm_const as A  # noqa: E402
 
 from defmt_log import DefmtLog  # noqa: E402
 from elf import memory_x  # noqa: E402
+from bootloader_checks import (SystemMemory, bootloader_entry_checks, bootloader_refused_check,  # noqa: E402
+                               flash_check)
+from dfu_bridge import DfuBridge  # noqa: E402
 from board_checks import estop_check, inputs_check, pins_check, priority_check, timing  # noqa: E402
 from hold_up import hold_up_checks  # noqa: E402
 from machine import SYSCLK, Machine  # noqa: E402
@@ -159,7 +162,8 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
-def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, jog_buzz=False):
+def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, jog_buzz=False, rom=None,
+                  elf=None):
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -218,6 +222,8 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
     stream_check(m, plant, cli, port, ringpod)
     if usb is not None:
         usb_stream_checks(CHECKS, m, usb, plant, stream_check)
+    if rom is not None:
+        bootloader_refused_check(CHECKS, m, cli, port, plant, rom)
     # the host gone mid-stream: back within the time on USART1, the cable pulled and plugged again on USB
     silent_check(CHECKS, m, cli, port, plant, bridge, "usart-silent", power_down=False)
     if usb is not None:
@@ -245,6 +251,10 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
     if hold_ups:
         homing_check(m, plant, cli, port, name="serial-home-hold-ups")
         hold_up_checks(CHECKS, m, cli, port)
+    if rom is not None:
+        bootloader_entry_checks(CHECKS, m, cli, port, rom, log, usb)
+        if usb is not None:
+            flash_check(CHECKS, m, cli, port, rom, log, DfuBridge(m, usb.host), elf)
 
 
 SLOT_US = source_constant("STEP_SLOT_NS") / 1000
@@ -416,6 +426,7 @@ def main():
     m.observers.append(log.poll)
     plant = Plant(m)
     usb = None if args.ringpod is None or args.no_usb else UsbLink(m, args.ringpod)  # plugged in from power-on
+    rom = SystemMemory(m, usb.host if usb else None)
     if args.count_instructions:
         m.count_instructions()
 
@@ -579,7 +590,8 @@ def main():
 
     # -- the host link on USART1: the real CLI over a pty --
     if args.ringpod:
-        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, args.jog_buzz)
+        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, args.jog_buzz, rom,
+                      args.elf)
     if not args.ringpod:
         pins_check(c, plant, plant.ignored, plant.dir_undriven)
     log_check(m, log)

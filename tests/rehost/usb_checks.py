@@ -27,7 +27,8 @@ from serial_link import Cli, PtyBridge, cli_env
 from usb_host import UsbHost
 
 VID_PID = (0x1209, 0x0001)
-STRINGS = {"manufacturer": "ringpod", "product": "ringpod motion controller", "serial": "ringpod-f411"}
+# The serial number is the chip's unique ID (RM0383 39.1) as the machine models it: `Machine.uid_hex`.
+STRINGS = {"manufacturer": "ringpod", "product": "ringpod motion controller"}
 ENABLE_N, LOGIC_RELAY, POWER_RELAY = 13, 14, 15  # board::resources::PORT_MAP, pin table
 
 
@@ -69,7 +70,8 @@ def descriptor_check(checks, m, link):
     h = link.host
     dev = h.device or bytes(18)
     vid_pid = struct.unpack_from("<HH", dev, 8)
-    strings = {name: h.strings.get(dev[14 + i]) for i, name in enumerate(STRINGS)}
+    want_strings = {**STRINGS, "serial": m.uid_hex()}
+    strings = {name: h.strings.get(dev[14 + i]) for i, name in enumerate(want_strings)}
     iads, ifaces = _interfaces(h)
     want = {
         "VID:PID 1209:0001": vid_pid == VID_PID,
@@ -83,7 +85,7 @@ def descriptor_check(checks, m, link):
         "interface 1 CDC data": len(ifaces) == 2 and ifaces[1]["desc"][5] == 0x0A,
         "interface 1: bulk OUT and IN, 64 bytes": len(ifaces) == 2
         and sorted((a >> 7, t, s) for a, t, s in ifaces[1]["endpoints"]) == [(0, 2, 64), (1, 2, 64)],
-        "strings": strings == STRINGS,
+        "strings, the serial number the modelled unique ID": strings == want_strings,
         "configured, nothing stalled": h.configured and not h.stalls,
         "OTG_FS interrupt enabled": IRQ in m.nvic.enabled,
     }

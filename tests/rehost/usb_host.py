@@ -139,8 +139,9 @@ class UsbHost:
         self._endpoints()
         yield from self.control(0x00, 9, 1, 0)
         comm = self.comm_interface()
-        yield from self.control(0x21, 0x20, 0, comm, data=LINE_CODING)  # SET_LINE_CODING
-        yield from self.control(0x21, 0x22, 0x0003, comm)  # SET_CONTROL_LINE_STATE: DTR and RTS
+        if comm is not None:  # a CDC-ACM port (not the ROM bootloader's DFU device)
+            yield from self.control(0x21, 0x20, 0, comm, data=LINE_CODING)  # SET_LINE_CODING
+            yield from self.control(0x21, 0x22, 0x0003, comm)  # SET_CONTROL_LINE_STATE: DTR and RTS
         self.configured = True
         self.enumerations += 1
         self.log.append((self.clock(), "configured"))
@@ -200,7 +201,7 @@ class UsbHost:
         for kind, d in self.descriptors():
             if kind == 4 and d[5:7] == b"\x02\x02":  # interface, CDC, ACM
                 return d[2]
-        return 0
+        return None
 
     def _endpoints(self):
         for kind, d in self.descriptors():

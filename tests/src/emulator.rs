@@ -30,16 +30,7 @@ pub fn build(bin: &str) -> Result<PathBuf, String> {
     if !out.status.success() {
         return Err(format!("building {bin} failed"));
     }
-    executable(&out.stdout, bin).ok_or_else(|| format!("cargo built {bin} but named no executable for it"))
-}
-
-/// The executable of binary `bin` in cargo's JSON messages.
-fn executable(messages: &[u8], bin: &str) -> Option<PathBuf> {
-    messages
-        .split(|b| *b == b'\n')
-        .filter_map(|line| serde_json::from_slice::<serde_json::Value>(line).ok())
-        .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == bin)
-        .find_map(|m| m["executable"].as_str().map(PathBuf::from))
+    crate::cli::executable(&out.stdout, bin).ok_or_else(|| format!("cargo built {bin} but named no executable for it"))
 }
 
 /// QEMU's command line for an ELF on mps2-an386 with semihosting; `args` are the program's semihosting command
@@ -67,25 +58,4 @@ pub fn qemu(elf: &Path, icount: Option<&str>, args: &[&str]) -> Command {
     }
     c.arg("-kernel").arg(elf);
     c
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_executable_is_where_cargo_says() {
-        let messages = concat!(
-            "{\"reason\":\"compiler-artifact\",\"target\":{\"name\":\"ringpod-core\"},\"executable\":null}\n",
-            "not json\n",
-            "{\"reason\":\"compiler-artifact\",\"target\":{\"name\":\"suite\"},",
-            "\"executable\":\"/t/thumbv7em-none-eabihf/release/suite\"}\n",
-            "{\"reason\":\"build-finished\",\"success\":true}\n"
-        );
-        assert_eq!(
-            executable(messages.as_bytes(), "suite"),
-            Some(PathBuf::from("/t/thumbv7em-none-eabihf/release/suite"))
-        );
-        assert_eq!(executable(messages.as_bytes(), "other"), None);
-    }
 }

@@ -2,8 +2,10 @@
 //! data-driven scenarios ([`scenario`], files under `tests/scenarios/`).
 
 pub mod busy;
+pub mod cli;
 pub mod emulator;
 pub mod scenario;
+pub mod sections;
 pub mod setup;
 pub mod wine;
 

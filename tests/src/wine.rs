@@ -14,8 +14,9 @@ pub struct Failed {
     pub by_wine: bool,
 }
 
-/// How the standard library prints Wine's failed process creation in a test's panic: `Os { code: 1359, ...`.
-const WINE_SPAWN: &str = "Os { code: 1359,";
+/// How Wine's failed process creation shows in a test's panic: the standard library's `Os { code: 1359, ...` (an
+/// unwrapped error) or its `... (os error 1359)` (an error displayed, as assert_cmd's spawn failure is).
+const WINE_SPAWN: [&str; 2] = ["Os { code: 1359,", "(os error 1359)"];
 
 /// The failed tests in `output` (cargo's stdout and stderr together, in order).
 pub fn failures(output: &str) -> Vec<Failed> {
@@ -27,7 +28,7 @@ pub fn failures(output: &str) -> Vec<Failed> {
         if let Some(running) = line.strip_prefix("Running ") {
             program = program_of(running);
             reading = None;
-        } else if let Some(name) = line.strip_prefix("test ").and_then(|r| r.strip_suffix(" ... FAILED")) {
+        } else if let Some(name) = failed_test(line) {
             failed.push(Failed {
                 program: program.clone(),
                 name: name.to_owned(),
@@ -37,18 +38,26 @@ pub fn failures(output: &str) -> Vec<Failed> {
             reading = failed.iter().rposition(|f| f.name == name && f.program == program);
         } else if line == "failures:" || line.starts_with("test result:") {
             reading = None;
-        } else if let (Some(i), true) = (reading, line.contains(WINE_SPAWN)) {
+        } else if let (Some(i), true) = (reading, WINE_SPAWN.iter().any(|w| line.contains(w))) {
             failed[i].by_wine = true;
         }
     }
     failed
 }
 
+/// The name in a `test NAME ... FAILED` line; Wine's own messages on stderr may come first on the same line
+/// (`wine client error:63c: test NAME ... FAILED`).
+fn failed_test(line: &str) -> Option<&str> {
+    let (before, name) = line.strip_suffix(" ... FAILED")?.rsplit_once(' ')?;
+    (before == "test" || before.ends_with(" test")).then_some(name)
+}
+
 /// The cargo arguments of the program cargo's `Running` line names: `unittests src/main.rs (...)` is the host
-/// binary's own tests, `tests/cli.rs (...)` the integration test `cli`.
+/// binary's own tests, `tests/suite/main.rs (...)` the integration test `suite` (a `tests/cli.rs` would be `cli`).
 fn program_of(running: &str) -> Vec<String> {
     let source = running.split_whitespace().find(|w| w.ends_with(".rs")).unwrap_or("");
-    if let Some(name) = source.strip_prefix("tests/").and_then(|s| s.strip_suffix(".rs")) {
+    let test = source.strip_prefix("tests/");
+    if let Some(name) = test.and_then(|s| s.strip_suffix("/main.rs").or_else(|| s.strip_suffix(".rs"))) {
         vec!["--test".into(), name.into()]
     } else if source == "src/main.rs" {
         vec!["--bin".into(), "ringpod".into()]
@@ -77,20 +86,20 @@ failures:
 
 test result: FAILED. 1 passed; 1 failed; 0 ignored; 0 measured; 0 filtered out; finished in 0.01s
 
-     Running tests/cli.rs (target/x86_64-pc-windows-gnu/debug/deps/cli-ed2dd17e6a106a05.exe)
-test loads_set_the_motion_against_the_drives_of_the_rig ... FAILED
+     Running tests/suite/main.rs (target/x86_64-pc-windows-gnu/debug/deps/suite-ed2dd17e6a106a05.exe)
+test cli::loads_set_the_motion_against_the_drives_of_the_rig ... FAILED
 wine client error:6a0: sendmsg: Bad file descriptor
-test draw_refuses_bad_input_in_one_line ... ok
+test cli::draw_refuses_bad_input_in_one_line ... ok
 
 failures:
 
----- loads_set_the_motion_against_the_drives_of_the_rig stdout ----
+---- cli::loads_set_the_motion_against_the_drives_of_the_rig stdout ----
 
-thread 'loads_set_the_motion_against_the_drives_of_the_rig' (716) panicked at host/tests/cli.rs:835:10:
+thread 'cli::loads_set_the_motion_against_the_drives_of_the_rig' (716) panicked at host/tests/suite/cli.rs:835:10:
 called `Result::unwrap()` on an `Err` value: Os { code: 1359, kind: Uncategorized, message: \"Internal error.\" }
 
 failures:
-    loads_set_the_motion_against_the_drives_of_the_rig
+    cli::loads_set_the_motion_against_the_drives_of_the_rig
 
 test result: FAILED. 39 passed; 1 failed; 0 ignored; 0 measured; 0 filtered out; finished in 17.35s
 ";
@@ -106,12 +115,38 @@ test result: FAILED. 39 passed; 1 failed; 0 ignored; 0 measured; 0 filtered out;
                     by_wine: false,
                 },
                 Failed {
-                    program: vec!["--test".into(), "cli".into()],
-                    name: "loads_set_the_motion_against_the_drives_of_the_rig".into(),
+                    program: vec!["--test".into(), "suite".into()],
+                    name: "cli::loads_set_the_motion_against_the_drives_of_the_rig".into(),
                     by_wine: true,
                 },
             ]
         );
+    }
+
+    #[test]
+    fn a_failure_after_wines_own_message_on_its_line_is_read_and_marked() {
+        let run = "     Running tests/suite/main.rs (target/x86_64-pc-windows-gnu/debug/deps/suite-1.exe)
+wine client error:63c: test cli::a_rig_file_drives_the_kinematics_commands ... FAILED
+test cli::other ... ok
+
+failures:
+
+---- cli::a_rig_file_drives_the_kinematics_commands stdout ----
+
+thread 'cli::a_rig_file_drives_the_kinematics_commands' (1536) panicked at host/tests/suite/cli.rs:634:43:
+Failed to spawn Command { cmd: \"ringpod.exe\" \"rig\" }: Internal error. (os error 1359)
+";
+        assert_eq!(
+            failures(run),
+            [Failed {
+                program: vec!["--test".into(), "suite".into()],
+                name: "cli::a_rig_file_drives_the_kinematics_commands".into(),
+                by_wine: true,
+            }]
+        );
+        assert_eq!(failed_test("test a ... FAILED"), Some("a"));
+        assert_eq!(failed_test("contest a ... FAILED"), None);
+        assert_eq!(failed_test("test a ... ok"), None);
     }
 
     #[test]

@@ -11,7 +11,7 @@ use core::sync::atomic::Ordering;
 
 use embassy_time::{Duration, Instant, Timer};
 use embedded_storage_async::nor_flash::NorFlash;
-use ringpod_core::controller::ControllerConfig;
+use ringpod_core::controller::{ControllerConfig, Restart};
 pub use ringpod_core::store::Restored;
 use ringpod_core::store::{self, store};
 
@@ -21,8 +21,9 @@ use super::Shared;
 pub trait Board {
     /// Lengthens the watchdog over a write that may erase a page (`true`), and back (`false`).
     fn widen_watchdog(&mut self, wide: bool);
-    /// Resets the MCU (the next start restores what was stored).
-    fn restart(&mut self) -> !;
+    /// Resets the MCU into `into`: the controller (the next start restores what was stored), or the MCU's ROM
+    /// bootloader to be flashed.
+    fn restart(&mut self, into: Restart) -> !;
     /// A free-running cycle counter that counts on while an erase stalls the CPU (DWT CYCCNT on a board), and its
     /// cycles per microsecond; `None` where an erase does not stall device time.
     fn stall_clock(&self) -> Option<(u32, u32)> {
@@ -68,10 +69,10 @@ pub async fn run<F: NorFlash>(flash: &mut F, range: Range<u32>, shared: &Shared,
             }
             continue;
         }
-        if shared.with(|c| c.restart_due()) {
-            defmt::info!("restarting, as the host asked");
+        if let Some(into) = shared.with(|c| c.restart_due()) {
+            defmt::info!("restarting into {}, as the host asked", into);
             Timer::after(Duration::from_millis(20)).await; // the Ack on its way out
-            board.restart();
+            board.restart(into);
         }
     }
 }

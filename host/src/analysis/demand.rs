@@ -128,12 +128,26 @@ pub fn profile(ring: &RingPlatform<f64>, input: &Path, payload: &Payload<f64>) -
     let text = crate::input::files::read_text(input, crate::input::files::DATA_LIMIT)
         .map_err(|e| bad(format!("{}: {e}", input.display())))?;
     let columns = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
-    let (rows, errors) = table::read(&text, &columns).map_err(bad)?;
+    let in_file = |e: String| bad(format!("{}: {e}", input.display()));
+    let (rows, errors) = table::read(&text, &columns).map_err(in_file)?;
     let rows: Vec<(usize, f64, Pose<f64>)> = rows
         .into_iter()
         .map(|(line, r)| (line, r[0], Pose::from_array(std::array::from_fn(|k| r[k + 1]))))
         .collect();
-    let mut p = profile_of(ring, &rows, payload).map_err(bad)?;
+    let mut p = profile_of(ring, &rows, payload).map_err(in_file)?;
+    if p.t.is_empty() {
+        // No demand to report: a peak, a margin or "the drives keep up" of no row would say what was not found.
+        let first = p
+            .errors
+            .first()
+            .map(|e| format!(" (line {}: {})", e.line, e.reason))
+            .unwrap_or_default();
+        return Err(bad(format!(
+            "{}: none of its {} rows is a pose the platform reaches{first}: nothing to compute",
+            input.display(),
+            p.rows
+        )));
+    }
     let mut all = errors;
     all.append(&mut p.errors);
     all.sort_by_key(|e| e.line);
@@ -149,16 +163,13 @@ pub fn profile_of(
 ) -> Result<Profile, String> {
     // A pose that is not a number has no demand and would poison the unwrapping and the differences of every row
     // after it: it is reported by its line and left out.
-    let (rows, garbage): (Vec<_>, Vec<_>) = rows.iter().cloned().partition(|r| {
-        r.2.to_array()
-            .iter()
-            .all(|c| c.is_finite() && c.abs() <= crate::input::numbers::MAX_TURNING)
-    });
+    let refused = |r: &(usize, f64, Pose<f64>)| crate::input::numbers::motion_row_refused(&r.2.to_array());
+    let (rows, garbage): (Vec<_>, Vec<_>) = rows.iter().cloned().partition(|r| refused(r).is_none());
     let garbage: Vec<InputError> = garbage
         .into_iter()
         .map(|r| InputError {
             line: r.0,
-            reason: "a coordinate is not a finite number in range: left out".into(),
+            reason: format!("{}: left out", refused(&r).unwrap_or_default()),
         })
         .collect();
     let mut profile = profile_of_finite(ring, &rows, payload)?;

@@ -173,7 +173,7 @@ fn report(
         .map(|(r, (_, d))| (r.kinetic + r.potential - d).abs())
         .fold(0.0, f64::max);
     if let Some(path) = table_to {
-        crate::out::file::write(path, table(rows, drives).as_bytes()).map_err(|e| CliError::Dynamics(e.to_string()))?;
+        crate::out::file::write(path, table(rows, drives).as_bytes()).map_err(|e| CliError::file(path, e))?;
     }
     if let Some(path) = plot {
         draw(name, rows, drives, path).map_err(|e| CliError::Dynamics(e.to_string()))?;
@@ -294,6 +294,12 @@ fn motion_file(path: &Path) -> Result<Vec<(f64, MotionState<f64>)>, CliError> {
     let (rows, errors) = crate::input::table::read(&text, &columns).map_err(bad)?;
     if let Some(e) = errors.first() {
         return Err(bad(format!("line {}: {}", e.line, e.reason)));
+    }
+    // As `loads` and `stream` take a motion: a row of garbage is no motion (1e300 gave forces of thousands).
+    if let Some((line, why)) = rows.iter().find_map(|(line, r)| {
+        crate::input::numbers::motion_row_refused(&std::array::from_fn(|k| r[k + 1])).map(|why| (line, why))
+    }) {
+        return Err(bad(format!("line {line}: {why}")));
     }
     let rows: Vec<(usize, f64, Pose<f64>)> = rows
         .into_iter()

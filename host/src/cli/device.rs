@@ -34,6 +34,9 @@ pub enum DeviceAction {
     Rig,
     /// Restart the controller (supplies off) once it has stored everything: a loaded rig or setting runs.
     Restart,
+    /// Restart into the MCU's ROM bootloader (USB DFU, 0483:df11; supplies off) once everything is stored, to be
+    /// flashed (`ringpod flash` does this itself). Asked without a handshake: a board of any protocol version takes it.
+    Bootloader,
     /// `aux N on|off`: switch auxiliary output N (1 or 2: AUX1 on PC15, AUX2 on PC13). On only while homed and
     /// holding or streaming (Ready, Running); a fault, an e-stop, a disable, homing or a jog switches both off.
     Aux,
@@ -63,6 +66,16 @@ pub struct DeviceArgs {
     pub watch: bool,
 }
 
+/// `--files DIR`: a folder there is, said at the start (a misspelt one would show only when a page asks for a
+/// file). clap names the option and the value; this says what is wrong with it.
+fn existing_dir(text: &str) -> Result<std::path::PathBuf, String> {
+    match std::fs::metadata(text) {
+        Ok(m) if m.is_dir() => Ok(text.into()),
+        Ok(_) => Err("not a folder".into()),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
 #[derive(Debug, clap::Args)]
 pub struct UiArgs {
     /// The controller.
@@ -73,7 +86,7 @@ pub struct UiArgs {
     #[arg(long, default_value = "127.0.0.1:8080")]
     pub listen: std::net::SocketAddr,
     /// Let the page stream pose files under DIR by name. Without it the page streams only the files picked in it.
-    #[arg(long, value_name = "DIR")]
+    #[arg(long, value_name = "DIR", value_parser = existing_dir)]
     pub files: Option<std::path::PathBuf>,
     /// VR motion compensation (Windows): write the pose the seat followed, whenever the device reports it (every
     /// run from the page, and at rest), where OpenXR-MotionCompensation's virtual tracker of this type reads it, as

@@ -111,6 +111,26 @@ pub enum Command {
     /// Lists the serial ports with their USB VID:PID (a board shows up as a USB CDC port, 1209:0001: /dev/ttyACM* on
     /// Linux, COMn on Windows).
     Ports,
+    /// Writes the firmware into the board over its USB cable with the STM32F411's ROM bootloader (USB DFU: no probe
+    /// needed): the running firmware is asked to restart into it (only at rest, supplies off), or a board held in
+    /// it (BOOT0) is found; the sectors the image covers are erased (the settings are kept), the image written, read
+    /// back and compared, and the new firmware must come back naming it. The image: --image FILE (.elf or .bin), or
+    /// the firmware built from this source tree (cargo, `--profile firmware`). Exit codes: 0 flashed, verified and
+    /// answering; 3 the image was refused (nothing was done); 4 no board, or it did not enter its bootloader; 5
+    /// the transfer failed half way, 6 the image read back differs (for both: flash again); 7 the new firmware did
+    /// not come back as flashed.
+    Flash {
+        /// The firmware image (ELF or raw .bin from the start of flash) instead of building it.
+        #[arg(long, value_name = "FILE")]
+        image: Option<std::path::PathBuf>,
+        /// The board's serial port, when more than one board is plugged in (found by its USB id otherwise).
+        #[arg(long)]
+        port: Option<String>,
+        /// The ROM bootloader served over TCP (`tcp://HOST:PORT`) instead of the machine's USB: the emulated board's
+        /// harness serves it so (`tests/rehost`).
+        #[arg(long, value_name = "tcp://HOST:PORT")]
+        dfu: Option<String>,
+    },
     /// Static drive loads for a payload at a pose (ring platforms): carriage torques and actuator forces.
     Loads(LoadsArgs),
     /// Paper 002's matrix method on a ring platform (trainer-ch5, rotopod-ch4, or a rig file of rod and radial

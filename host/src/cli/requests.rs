@@ -356,6 +356,7 @@ impl DeviceArgs {
                 _ => return Err(RequestError::RigUsage),
             },
             A::Restart => Action::Restart,
+            A::Bootloader => Action::Bootloader,
             A::Aux => {
                 let parsed = match words.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
                     [n, level] => n

@@ -62,6 +62,8 @@ pub struct StreamArgs {
     /// yaw, `<N>` the byte N, other characters as they are. Each axis is an offset from the platform's neutral,
     /// its full scale --pose-range. The book's streaming chapter gives each front end's settings.
     #[arg(long, value_name = "TEMPLATE", requires = "udp", conflicts_with = "degrees")]
+    // `requires` alone lets it pass beside another source (clap takes the source group as satisfying it): named.
+    #[arg(conflicts_with_all = ["input", "motion", "telemetry_udp", "telemetry_shm"])]
     #[arg(value_parser = pose_format)]
     pub pose_format: Option<Template>,
     /// With --pose-format: the offset each axis reaches at the end of its range, either way from neutral:

@@ -9,10 +9,11 @@ pub mod settings;
 use std::io::Write;
 use std::path::PathBuf;
 
-use ringpod_core::protocol::RigSource;
+use ringpod_core::protocol::{Firmware, RigSource, PROTOCOL_VERSION};
 use ringpod_core::safety::State;
 
-use crate::link::{self, client::Client, sim, Target};
+use crate::link::client::{Client, ClientError};
+use crate::link::{self, sim, Target};
 use crate::signals::Signals;
 pub use error::DeviceError;
 
@@ -44,6 +45,8 @@ pub enum Action {
     ShowRig,
     /// Restart once everything is stored.
     Restart,
+    /// Restart into the ROM bootloader once everything is stored (no handshake first).
+    Bootloader,
     /// Switch an auxiliary output.
     Aux {
         output: ringpod_core::safety::Aux,
@@ -54,7 +57,10 @@ pub enum Action {
 /// `ringpod device ACTION`: 0 when done; a signal ends `inputs --watch` with 128 + its number.
 pub fn run(target: &Target, action: &Action) -> Result<u8, DeviceError> {
     let mut client = Client::new(link::connect(target, false)?);
-    client.hello()?;
+    // The bootloader is asked without a handshake, so that a board of another protocol version can be updated.
+    if *action != Action::Bootloader {
+        client.hello()?;
+    }
     let text = match action {
         Action::Status => status(&mut client)?,
         Action::Enable => status_after(&mut client, |c| c.enable())?,
@@ -80,6 +86,10 @@ pub fn run(target: &Target, action: &Action) -> Result<u8, DeviceError> {
         Action::LoadRig(file) => rig::load(&mut client, file)?,
         Action::ShowRig => rig::show(&mut client)?,
         Action::Restart => rig::restart(&mut client)?,
+        Action::Bootloader => {
+            client.enter_bootloader()?;
+            "the board restarts into its ROM bootloader (USB DFU, 0483:df11) once everything is stored".into()
+        }
         Action::Config(words) => serde_json::to_string_pretty(&settings::run(&mut client, words)?)?,
     };
     // A failed write decides the exit code in `main`.
@@ -120,7 +130,26 @@ fn status<T: link::client::Transport>(client: &mut Client<T>) -> Result<String, 
     }
     let mut json = serde_json::to_value(status)?;
     json["rig"] = serde_json::json!({ "name": rig.name(), "source": source.to_string(), "pending": pending });
+    if let Some(device) = client.device {
+        json["firmware"] = firmware_json(&device.firmware);
+    }
     Ok(serde_json::to_string_pretty(&json)?)
+}
+
+/// The firmware a device of this host's protocol runs, in a few words (`ports`, the workbench).
+pub fn firmware_text(firmware: &Firmware) -> String {
+    format!("{firmware}, protocol {PROTOCOL_VERSION}")
+}
+
+/// The firmware a device runs, as `device status` gives it: ringpod's version, the protocol (this host's: the
+/// handshake agreed), and the flashed image's length and CRC-32C (`null` for the simulated controller).
+pub fn firmware_json(firmware: &Firmware) -> serde_json::Value {
+    let [major, minor, patch] = firmware.version;
+    serde_json::json!({
+        "version": format!("{major}.{minor}.{patch}"),
+        "protocol": PROTOCOL_VERSION,
+        "image": firmware.image.map(|i| serde_json::json!({ "size": i.size, "crc32c": format!("{:08x}", i.crc) })),
+    })
 }
 
 /// `ringpod monitor`: until `frames` frames are drawn or a signal (then 128 + its number).
@@ -184,20 +213,42 @@ fn serve_pty(_: sim::SimDevice, _: &Signals) -> Result<(), DeviceError> {
     ))
 }
 
-/// `ringpod ports`: the serial ports this machine has, and what each is.
+/// `ringpod ports`: the serial ports this machine has, and what each is; a board is asked which firmware it runs. A
+/// board waiting in its ROM bootloader (USB 0483:df11, no serial port) is named too.
 pub fn ports() -> Result<u8, DeviceError> {
     let ports = serialport::available_ports()?;
-    let mut out = std::io::stdout();
-    let _ = out.write_all(port_list(&ports).as_bytes());
+    let mut text = port_list(&ports, &identify);
+    if crate::flash::usb::bootloader_listed() {
+        text += "USB 0483:df11 STM32 BOOTLOADER  <- a board in its ROM bootloader: `ringpod flash` writes it\n";
+    }
+    let _ = std::io::stdout().write_all(text.as_bytes());
     Ok(0)
 }
 
-/// The USB vendor and product a ringpod board enumerates with (pid.codes' open-source test pair).
-pub const BOARD_USB_ID: (u16, u16) = (0x1209, 0x0001);
+/// What the board on `port` says it runs, in a few words: one handshake, half a second's wait (lengthened by
+/// [`link::PATIENCE_VAR`]). A port another program holds cannot be opened (serial ports are opened exclusively) and
+/// is left alone.
+fn identify(port: &str) -> String {
+    let transport = match link::connect(&Target::Port(port.to_owned()), false) {
+        Ok(t) => t,
+        Err(e) => return format!("not opened: {e}"),
+    };
+    let mut client = Client::new(transport);
+    match client.hello_once(link::patience(std::time::Duration::from_millis(500))) {
+        Ok(device) => firmware_text(&device.firmware),
+        Err(ClientError::VersionMismatch { device, firmware, .. }) => {
+            let runs = firmware.map_or_else(|| "firmware".to_owned(), |f| f.to_string());
+            format!("{runs}, protocol {device}: not this ringpod's (protocol {PROTOCOL_VERSION}), run `ringpod flash`")
+        }
+        Err(e) => format!("no answer: {e}"),
+    }
+}
+
+pub use crate::link::BOARD_USB_ID;
 
 /// One line a port: its name (`/dev/ttyACM0`, `COM5`), its kind with a USB port's VID:PID, and a board marked as
-/// such, so that it is found without the system's device manager.
-fn port_list(ports: &[serialport::SerialPortInfo]) -> String {
+/// such with what `identify` finds it runs, so that it is found without the system's device manager.
+fn port_list(ports: &[serialport::SerialPortInfo], identify: &dyn Fn(&str) -> String) -> String {
     if ports.is_empty() {
         return "no serial ports found\n".into();
     }
@@ -210,7 +261,7 @@ fn port_list(ports: &[serialport::SerialPortInfo]) -> String {
                     kind += &format!(" {product}");
                 }
                 if (u.vid, u.pid) == BOARD_USB_ID {
-                    kind += "  <- a ringpod board";
+                    kind += &format!("  <- a ringpod board: {}", identify(&p.port_name));
                 }
                 kind
             }
@@ -267,13 +318,19 @@ mod tests {
                 port_type: SerialPortType::PciPort,
             },
         ];
-        let text = super::port_list(&ports);
+        let asked = std::cell::RefCell::new(Vec::new());
+        let identify = |port: &str| {
+            asked.borrow_mut().push(port.to_owned());
+            "ringpod 0.1.0".to_owned()
+        };
+        let text = super::port_list(&ports, &identify);
         assert_eq!(
             text,
-            "COM3  USB 0403:6001 FT232R\nCOM5  USB 1209:0001  <- a ringpod board\nCOM1  PCI\n"
+            "COM3  USB 0403:6001 FT232R\nCOM5  USB 1209:0001  <- a ringpod board: ringpod 0.1.0\nCOM1  PCI\n"
         );
+        assert_eq!(*asked.borrow(), ["COM5"], "only the board is asked");
         // Another product of the same vendor is not the board.
-        assert!(!super::port_list(&[usb("/dev/ttyACM0", 0x1209, 0x0002, None)]).contains("board"));
-        assert_eq!(super::port_list(&[]), "no serial ports found\n");
+        assert!(!super::port_list(&[usb("/dev/ttyACM0", 0x1209, 0x0002, None)], &identify).contains("board"));
+        assert_eq!(super::port_list(&[], &identify), "no serial ports found\n");
     }
 }

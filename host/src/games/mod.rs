@@ -322,9 +322,9 @@ fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 /// The games' packets built field by field from the published layouts: one file, also the end-to-end tests'
-/// (`host/tests/common/packets.rs`), so that the decoders and the live stream are tested with the same bytes.
+/// (`host/tests/suite/common/packets.rs`), so that the decoders and the live stream are tested with the same bytes.
 #[cfg(test)]
-#[path = "../../tests/common/packets.rs"]
+#[path = "../../tests/suite/common/packets.rs"]
 pub(crate) mod packets;
 
 #[cfg(test)]

@@ -104,6 +104,24 @@ pub fn pose_in_range(what: &'static str, pose: &[f64; 6], length: f64) -> Result
     Ok(())
 }
 
+/// Why a timed pose read from a motion file (`loads --input`, `dynamics --input`) cannot be one: a coordinate that
+/// is not a finite number, or beyond [`MAX_TURNING`] either way (no translation in metres or angle is; 1e300 gave
+/// 300-digit forces). `None` when it can.
+pub fn motion_row_refused(pose: &[f64; 6]) -> Option<String> {
+    let names = ["x", "y", "z", "alpha", "beta", "gamma"];
+    let i = pose.iter().position(|c| !(c.is_finite() && c.abs() <= MAX_TURNING))?;
+    Some(if pose[i].is_finite() {
+        format!(
+            "{} = {} is out of range (at most {} either way)",
+            names[i],
+            readable(pose[i]),
+            readable(MAX_TURNING)
+        )
+    } else {
+        format!("{} is not a finite number", names[i])
+    })
+}
+
 /// Checks rates given on the command line (SI: m/s, and rad/s where `angular`) against sane ranges for a mechanism
 /// of characteristic length `length`: a hundred times that length a second, and [`MAX_TURNING`] rad/s. The rates
 /// are linear in them, so a larger one says nothing more; it is a mistake (1e300 came back as 300 digits).

@@ -7,11 +7,12 @@ use std::time::Duration;
 use ringpod_core::kinematics::presets::Preset;
 use ringpod_core::motion::{Accepted, RejectReason};
 use ringpod_core::protocol::endpoints::{
-    Do, Endpoint, GetInputs, GetRig, GetSettings, GetStatus, Hello, Restart, SetRig, SetSettings, TelemetryOn,
+    Do, Endpoint, EnterBootloader, GetInputs, GetRig, GetSettings, GetStatus, Hello, Restart, SetRig, SetSettings,
+    TelemetryOn,
 };
 use ringpod_core::protocol::{
-    self, DeviceMessage, FrameReader, HostMessage, InputReport, NackReason, Request, Response, RigRecord, RigSource,
-    Settings, SettingsKind, Status, Telemetry, PROTOCOL_VERSION,
+    self, DeviceMessage, Firmware, FrameReader, HostMessage, InputReport, NackReason, Request, Response, RigRecord,
+    RigSource, Settings, SettingsKind, Status, Telemetry, PROTOCOL_VERSION,
 };
 use ringpod_core::safety::{Command, FaultReason};
 
@@ -38,6 +39,8 @@ pub trait Transport {
 /// What a device says of itself in the handshake.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Device {
+    /// The firmware it runs (its protocol version is this host's).
+    pub firmware: Firmware,
     /// The preset it drives, if its geometry is one.
     pub preset: Option<Preset>,
     /// What each actuator coordinate measures.
@@ -56,13 +59,15 @@ pub enum ClientError {
     /// The device refused the request.
     #[error("device refused: {0}")]
     Device(NackReason),
-    /// Host and device speak different protocol versions.
-    #[error("protocol version mismatch: host {host}, device {device}")]
+    /// Host and device speak different protocol versions: nothing was asked of it but the handshake.
+    #[error("{}", mismatch(.host, .device, .firmware))]
     VersionMismatch {
         /// Ours.
         host: u16,
         /// Theirs.
         device: u16,
+        /// The firmware it runs, when it names it (a board of protocol 9 or older does not).
+        firmware: Option<Firmware>,
     },
     /// An answer of the wrong kind.
     #[error("unexpected answer: {0}")]
@@ -70,6 +75,23 @@ pub enum ClientError {
     /// The user interrupted a wait (Ctrl-C).
     #[error("interrupted")]
     Interrupted,
+}
+
+/// What a version mismatch tells the user: which firmware the board runs and what to do, `ringpod flash` named.
+fn mismatch(host: &u16, device: &u16, firmware: &Option<Firmware>) -> String {
+    let runs = match firmware {
+        Some(f) => format!("{f}, protocol {device}"),
+        None => format!("firmware of protocol {device}"),
+    };
+    if device < host {
+        format!(
+            "the board runs older firmware ({runs}) than this ringpod (protocol {host}): nothing was sent to it; run `ringpod flash` to update the board"
+        )
+    } else {
+        format!(
+            "the board runs newer firmware ({runs}) than this ringpod (protocol {host}): nothing was sent to it; update ringpod, or run `ringpod flash` to put this version's firmware on the board"
+        )
+    }
 }
 
 /// The client.
@@ -94,6 +116,8 @@ pub struct Client<T: Transport> {
     /// The platform and motors the device runs, when known: each telemetry sample's pose becomes the pose of the
     /// steps it counted ([`super::followed`]) before the tap and the caller see it.
     pub followed: Option<super::followed::Followed>,
+    /// What the device said of itself in the last handshake that agreed.
+    pub device: Option<Device>,
 }
 
 impl<T: Transport> Client<T> {
@@ -111,6 +135,7 @@ impl<T: Transport> Client<T> {
             cancel: None,
             tap: None,
             followed: None,
+            device: None,
         }
     }
 
@@ -135,8 +160,9 @@ impl<T: Transport> Client<T> {
             }
             for &b in &buf[..n] {
                 if let Some(frame) = self.reader.push(b) {
-                    // A frame that does not decode is dropped: the request it answered times out and says so.
-                    if let Ok(response) = protocol::decode::<Response>(frame) {
+                    // A frame that does not decode is dropped: the request it answered times out and says so. A
+                    // device of another protocol version is read from the stable head its answer keeps.
+                    if let Some(response) = decode(frame) {
                         match (response.id, response.body) {
                             (0, DeviceMessage::Fault(reason)) => self.faults.push(reason),
                             (0, DeviceMessage::Telemetry(mut sample)) => {
@@ -248,7 +274,8 @@ impl<T: Transport> Client<T> {
         })
     }
 
-    /// Version handshake; returns the geometry the device drives.
+    /// Version handshake; returns the firmware the device runs and the geometry it drives, or the version mismatch
+    /// naming its firmware.
     ///
     /// The first request on a port that was just opened can be lost: a board still enumerating, or a pseudo
     /// terminal whose other side is polled only now and then (QEMU's, about once a second). Hello changes nothing,
@@ -267,21 +294,44 @@ impl<T: Transport> Client<T> {
         };
         self.pump()?;
         self.inbox.retain(|r| !tries.contains(&r.id));
-        let version = match Hello.answer(answer?) {
+        self.greeted(answer?)
+    }
+
+    /// One handshake, waiting `wait` for its answer (`ringpod ports`, which must not wait long for each port).
+    pub fn hello_once(&mut self, wait: Duration) -> Result<Device, ClientError> {
+        let mut tries = Vec::new();
+        let answer = self.try_once(Hello.request(), wait, &mut tries)?;
+        self.greeted(answer)
+    }
+
+    /// The device of a handshake's answer, or the version mismatch it says.
+    fn greeted(&mut self, answer: DeviceMessage) -> Result<Device, ClientError> {
+        let (version, firmware) = match Hello.answer(answer) {
             Ok(hello) if hello.version == PROTOCOL_VERSION => {
-                return Ok(Device {
+                let device = Device {
+                    firmware: hello.firmware,
                     preset: hello.preset,
                     axes: hello.axes,
-                })
+                };
+                self.device = Some(device);
+                return Ok(device);
             }
-            Ok(hello) => hello.version,
-            Err(DeviceMessage::Nack(NackReason::VersionMismatch { device })) => device,
+            Ok(hello) => (hello.version, Some(hello.firmware)),
+            Err(DeviceMessage::Nack(NackReason::VersionMismatch { device, firmware })) => (device, firmware),
             Err(other) => return Err(ClientError::Unexpected(format!("{other:?}"))),
         };
+        self.device = None;
         Err(ClientError::VersionMismatch {
             host: PROTOCOL_VERSION,
             device: version,
+            firmware,
         })
+    }
+
+    /// Asks the device to restart into its ROM bootloader (no handshake needed: any protocol version takes it),
+    /// refused unless `Off`. The link goes with the reset.
+    pub fn enter_bootloader(&mut self) -> Result<(), ClientError> {
+        self.call(EnterBootloader)
     }
 
     /// Power up (logic, then power).
@@ -402,6 +452,20 @@ impl<T: Transport> Client<T> {
             waited += step;
         }
     }
+}
+
+/// A device's message from one frame: this version's, or a version mismatch read from the stable head of another.
+fn decode(frame: &[u8]) -> Option<Response> {
+    if let Ok(response) = protocol::decode::<Response>(frame) {
+        return Some(response);
+    }
+    let mut scratch = [0u8; protocol::MAX_FRAME];
+    let payload = protocol::unframe(frame, &mut scratch).ok()?;
+    let (id, device, firmware) = protocol::firmware::version_mismatch(payload)?;
+    Some(Response {
+        id,
+        body: DeviceMessage::Nack(NackReason::VersionMismatch { device, firmware }),
+    })
 }
 
 /// What a device's answer to a setpoint means: `Ok(Ok(accepted))` as applied or limited, `Ok(Err(reason))` when

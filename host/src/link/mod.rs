@@ -15,6 +15,9 @@ use std::time::Duration;
 
 use ringpod_core::controller::ConfigError;
 
+/// The USB vendor and product a ringpod board enumerates with (pid.codes' open-source test pair).
+pub const BOARD_USB_ID: (u16, u16) = (0x1209, 0x0001);
+
 /// The environment variable whose factor (1 to 1000, default 1) lengthens every wait of the host for a board: a
 /// board run in an emulator many times slower than real time (the rehost harness) answers in the same device time
 /// as a real one but later in wall time.

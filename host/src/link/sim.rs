@@ -98,7 +98,8 @@ impl SimDevice {
             // A RAM flash only fails when full; the device then runs on and the next start finds the old record.
             let _ = block_on(store::store(&mut self.flash, range.clone(), &config));
         }
-        if c.restart_due() {
+        // The simulated controller has no ROM bootloader: a request for it restarts the controller.
+        if c.restart_due().is_some() {
             let (config, restored) = block_on(store::restore(
                 &mut self.flash,
                 range,

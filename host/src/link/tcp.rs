@@ -54,10 +54,22 @@ impl Pacer {
     }
 }
 
+/// What `simulate --tcp` sends a client that connects while another holds the controller, before it closes the
+/// connection: the client's side tells it from a controller's bytes (every frame ends with a 0x00, which the notice
+/// has not, so a whole frame never passes for it) and says why it was closed.
+const BUSY: &[u8] = b"ringpod simulate: busy with another client\n";
+
+/// What a client is told when the simulator closed its connection as busy.
+const BUSY_SAID: &str = "the simulator is busy with another client (one at a time, as a serial port is one program's)";
+
 /// A TCP connection to a controller.
 pub struct Tcp {
     stream: TcpStream,
     pacer: Pacer,
+    /// The first bytes of the connection, held back while they may still be [`BUSY`]; `None` once they are not.
+    held: Option<Vec<u8>>,
+    /// Bytes to hand on before reading more (the first ones, once they were not [`BUSY`]).
+    release: Vec<u8>,
 }
 
 impl Tcp {
@@ -80,7 +92,36 @@ impl Tcp {
         Ok(Self {
             stream,
             pacer: Pacer::new(),
+            held: Some(Vec::new()),
+            release: Vec::new(),
         })
+    }
+
+    /// Reads what has arrived, holding the first bytes back while they may be the busy notice.
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if !self.release.is_empty() {
+            let n = buf.len().min(self.release.len());
+            buf[..n].copy_from_slice(&self.release[..n]);
+            self.release.drain(..n);
+            return Ok(n);
+        }
+        let read = read_ready(&mut self.stream, buf);
+        let Some(held) = self.held.as_mut() else {
+            return read;
+        };
+        match read {
+            Err(_) if held.as_slice() == BUSY => Err(std::io::Error::new(ErrorKind::ConnectionRefused, BUSY_SAID)),
+            Err(e) => Err(e),
+            Ok(n) => {
+                held.extend_from_slice(&buf[..n]);
+                if BUSY.starts_with(held) {
+                    // The notice so far, or nothing yet: wait for the rest, or for the end that follows it.
+                    return Ok(0);
+                }
+                self.release = self.held.take().unwrap_or_default();
+                self.read(buf)
+            }
+        }
     }
 }
 
@@ -126,7 +167,7 @@ impl Transport for Tcp {
         write_within(&mut self.stream, bytes)
     }
     fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        read_ready(&mut self.stream, buf)
+        self.read(buf)
     }
     fn elapse(&mut self, dt: Duration) {
         self.pacer.elapse(dt);
@@ -138,7 +179,8 @@ impl Transport for Tcp {
 /// as a serial port is one program's: another one that connects meanwhile is closed at once. The controller lives
 /// on across clients, as a board does across the host programs that open its port.
 pub fn serve(mut device: SimDevice, addr: SocketAddr, stop: &dyn Fn() -> bool) -> std::io::Result<()> {
-    let listener = TcpListener::bind(addr)?;
+    let listener =
+        TcpListener::bind(addr).map_err(|e| std::io::Error::new(e.kind(), format!("cannot listen on {addr}: {e}")))?;
     listener.set_nonblocking(true)?;
     let mut out = std::io::stdout();
     // A reader that went away (`| head -1`) does not stop the simulator: the address is known to whoever took it.
@@ -202,12 +244,21 @@ fn admit(
 ) -> std::io::Result<()> {
     if let Some(held) = client.as_mut() {
         if drain(held, feed)? {
-            // Dropped: the newcomer reads a closed connection.
+            refuse(new);
             return Ok(());
         }
     }
     *client = Some(new);
     Ok(())
+}
+
+/// Closes a newcomer's connection with the busy notice: the notice, then the end of what it reads, and what it
+/// sent read and dropped first (a socket closed with unread bytes resets the connection, which may overtake the
+/// notice).
+fn refuse(mut new: TcpStream) {
+    let _ = write_within(&mut new, BUSY);
+    let _ = new.shutdown(std::net::Shutdown::Write);
+    let _ = drain(&mut new, &mut |_| Ok(()));
 }
 
 #[cfg(test)]
@@ -285,7 +336,44 @@ mod tests {
         admit(&mut client, refused, &mut |_| Ok(())).unwrap();
         assert_eq!(client.as_ref().unwrap().peer_addr().unwrap(), newcomer_port);
         third.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-        assert_eq!(third.read(&mut [0u8; 4]).unwrap_or(0), 0);
+        let mut told = Vec::new();
+        let _ = third.read_to_end(&mut told);
+        assert_eq!(told, BUSY, "the newcomer is told, then closed");
+    }
+
+    /// The client's side: the busy notice and the end after it are said as busy; a controller's bytes, even ones
+    /// that begin as the notice does, are handed on whole and in order.
+    #[test]
+    fn the_busy_notice_is_said_and_a_controllers_bytes_pass_whole() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        let read_all = |tcp: &mut Tcp| {
+            let (mut got, mut buf, started) = (Vec::new(), [0u8; 4], Instant::now());
+            loop {
+                match tcp.receive(&mut buf) {
+                    Ok(n) if started.elapsed() < Duration::from_secs(5) => got.extend_from_slice(&buf[..n]),
+                    Ok(_) => return (got, None),
+                    Err(e) => return (got, Some(e)),
+                }
+            }
+        };
+        let mut tcp = Tcp::connect(&addr).unwrap();
+        let (peer, _) = listener.accept().unwrap();
+        peer.set_nonblocking(true).unwrap();
+        refuse(peer);
+        let (got, e) = read_all(&mut tcp);
+        assert!(got.is_empty(), "{got:?}");
+        let e = e.expect("closed");
+        assert_eq!(e.kind(), ErrorKind::ConnectionRefused);
+        assert!(e.to_string().contains("busy with another client"), "{e}");
+        let mut tcp = Tcp::connect(&addr).unwrap();
+        let (mut peer, _) = listener.accept().unwrap();
+        let bytes = [&BUSY[..10], b"\x00\x07frame"].concat();
+        peer.write_all(&bytes).unwrap();
+        drop(peer);
+        let (got, e) = read_all(&mut tcp);
+        assert_eq!(got, bytes);
+        assert_eq!(e.expect("closed").kind(), ErrorKind::ConnectionAborted);
     }
 
     #[test]

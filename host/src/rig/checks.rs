@@ -114,6 +114,11 @@ impl RigFile {
             ranges,
             drives,
         } = self.platform()?;
+        // A finite number far beyond any pose (a yaw of 1e300) is out of range, not "NaN or infinite" as the
+        // kinematics, overflowing on it, would say. After the geometry's own checks: its scale is the ring's.
+        if let Err(e) = crate::input::numbers::pose_in_range("home", &self.home, self.ring_radius) {
+            return err("home", e.reason);
+        }
         let m = RingPlatform::<f64>::new(&geometry);
         match m.inverse_checked(&home) {
             Err(e) => return err("home", format!("has no solution: {e}")),

@@ -75,7 +75,7 @@ fn preset_file(name: &str, what: &'static str) -> Result<(Preset, RigFile), Comm
 /// the trainer model, whose configuration is compiled in; for another ring platform, its rig file with the trainer
 /// model's drives and switches, checked as `--geometry` checks a file.
 pub fn preset(name: &str) -> Result<Option<super::Rig>, CommandError> {
-    let (preset, file) = preset_file(name, "--mechanism")?;
+    let (preset, file) = preset_file(name, "mechanism")?;
     if preset == Preset::TrainerModel {
         return Ok(None);
     }

@@ -425,8 +425,8 @@ fn limits_of_chains_the_rig_has_not_are_refused_by_key() {
 }
 
 /// `rig check`'s "drivable" homes the rig in the simulated machine: the trainer model homes within the bound; a
-/// home yaw of 1e6 or 1e10 rad ends in a homing fault, a pose velocity of 1e-30 in a move that never ends. Each is
-/// seen in well under a second of the check's time.
+/// home yaw of 1e6 or 1e10 rad is out of range before it is homed, a pose velocity of 1e-30 ends in a move that
+/// never ends. Each is seen in well under a second of the check's time.
 #[test]
 fn a_rig_that_cannot_home_is_not_drivable() {
     let rig = trainer_file().check().unwrap();
@@ -435,9 +435,9 @@ fn a_rig_that_cannot_home_is_not_drivable() {
     for yaw in [1e6, 1e10] {
         let mut f = trainer_file();
         f.home[5] = yaw;
-        let rig = f.check().unwrap();
-        let e = homing::homing_time(&rig.record).unwrap_err();
-        assert!(e.contains("HomingFailed"), "{yaw}: {e}");
+        let e = f.check().unwrap_err();
+        assert_eq!(e.key, "home", "{yaw}: {e}");
+        assert!(e.why.contains("out of range"), "{yaw}: {e}");
     }
     let mut f = trainer_file().with_sections(&rig.record);
     if let Some(m) = &mut f.motion {
@@ -448,4 +448,23 @@ fn a_rig_that_cannot_home_is_not_drivable() {
     let e = homing::homing_time(&rig.record).unwrap_err();
     assert!(e.contains("stalls"), "{e}");
     assert!(started.elapsed() < std::time::Duration::from_secs(20));
+}
+
+/// A home of finite numbers far beyond any pose is out of range, by key and value, not "NaN or infinite" (which
+/// the kinematics, overflowing on it, would say).
+#[test]
+fn a_home_far_out_of_range_is_said_to_be_out_of_range() {
+    let text = trainer_file().to_toml().unwrap();
+    let home = text.lines().find(|l| l.starts_with("home = ")).unwrap().to_owned();
+    for (bad, says) in [
+        ("home = [0, 0, 0.227, 0, 0, 1e300]", "gamma = 1e300 rad is out of range"),
+        ("home = [1e300, 0, 0.227, 0, 0, 0]", "x = 1e300 m is out of range"),
+        ("home = [0, 0, 0.227, 7, 0, 0]", "alpha = 7 rad is out of range"),
+    ] {
+        let e = parse(&text.replace(&home, bad))
+            .and_then(|f| f.check().map(|_| ()))
+            .unwrap_err();
+        assert_eq!(e.key, "home", "{bad}: {e}");
+        assert!(e.why.contains(says) && !e.why.contains("NaN"), "{bad}: {e}");
+    }
 }

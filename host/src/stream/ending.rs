@@ -88,6 +88,12 @@ pub(super) fn report<T: Transport>(
     capture: Option<CaptureReport>,
 ) -> Report {
     let refused: u32 = s.rejected.values().sum();
+    let unsaid = s.refusal_lines.unsaid();
+    if unsaid > 0 {
+        console::err(&format!(
+            "{unsaid} more setpoints refused by the device since the last said; the report lists each"
+        ));
+    }
     let mut input_errors = input_errors;
     input_errors.sort_by_key(|e| e.line);
     let (outcome, reason, code) = verdict(

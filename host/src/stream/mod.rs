@@ -16,6 +16,7 @@ pub mod live;
 mod loads;
 mod prepare;
 pub mod record;
+mod repeats;
 mod report;
 mod session;
 mod source;
@@ -167,6 +168,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             in_flight: VecDeque::new(),
             refused_in_a_row: 0,
             last_refusal: None,
+            refusal_lines: repeats::Repeats::default(),
             recorder,
             record_error: None,
         }

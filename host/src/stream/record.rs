@@ -228,35 +228,47 @@ pub(crate) fn read(path: &Path) -> Result<Run, RecordError> {
     })
 }
 
-/// A run record's text.
-pub fn parse(text: &str) -> Result<Run, RecordError> {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
-    let col = |name: &'static str| {
-        header
-            .iter()
-            .position(|h| h.trim() == name)
-            .ok_or(RecordError::NoColumn(name))
-    };
-    let index: Vec<usize> = COLUMNS.iter().map(|c| col(c)).collect::<Result<_, _>>()?;
-    let mut run = Run {
-        t: Vec::new(),
-        commanded: Vec::new(),
-        target: Vec::new(),
-        steps: Vec::new(),
-        state: Vec::new(),
-        limited: Vec::new(),
-        refused: Vec::new(),
-    };
-    for (n, line) in lines.enumerate() {
-        if line.trim().is_empty() {
-            continue;
+/// A run record's columns, found by name in its header line.
+pub struct Columns {
+    index: Vec<usize>,
+}
+
+/// One row of a run record, as read (angles as written, not made continuous).
+pub struct Row {
+    pub t: f64,
+    pub commanded: [f64; 6],
+    pub target: [f64; 6],
+    pub steps: [f64; 6],
+    pub state: String,
+    pub limited: bool,
+    pub refused: bool,
+}
+
+impl Columns {
+    /// The columns of a record whose first line is `header`.
+    pub fn of(header: &str) -> Result<Self, RecordError> {
+        let header: Vec<&str> = header.split(',').collect();
+        let col = |name: &'static str| {
+            header
+                .iter()
+                .position(|h| h.trim() == name)
+                .ok_or(RecordError::NoColumn(name))
+        };
+        Ok(Self {
+            index: COLUMNS.iter().map(|c| col(c)).collect::<Result<_, _>>()?,
+        })
+    }
+
+    /// The row on line `line` (from 1), `None` for a blank line.
+    pub fn row(&self, line: usize, text: &str) -> Result<Option<Row>, RecordError> {
+        if text.trim().is_empty() {
+            return Ok(None);
         }
-        let fields: Vec<&str> = line.split(',').collect();
+        let fields: Vec<&str> = text.split(',').collect();
         let number = |k: usize| -> Result<f64, RecordError> {
-            let f = fields.get(index[k]).ok_or(RecordError::TooFewFields(n + 2))?;
+            let f = fields.get(self.index[k]).ok_or(RecordError::TooFewFields(line))?;
             f.trim().parse::<f64>().map_err(|_| RecordError::NotANumber {
-                line: n + 2,
+                line,
                 column: COLUMNS[k],
                 text: (*f).to_owned(),
             })
@@ -268,13 +280,42 @@ pub fn parse(text: &str) -> Result<Run, RecordError> {
             }
             Ok(v)
         };
-        run.t.push(number(1)?);
-        run.commanded.push(six(2)?);
-        run.target.push(six(8)?);
-        run.steps.push(six(14)?);
-        run.state.push(fields.get(index[20]).unwrap_or(&"").trim().to_owned());
-        run.limited.push(number(21)? != 0.0);
-        run.refused.push(number(22)? != 0.0);
+        Ok(Some(Row {
+            t: number(1)?,
+            commanded: six(2)?,
+            target: six(8)?,
+            steps: six(14)?,
+            state: fields.get(self.index[20]).unwrap_or(&"").trim().to_owned(),
+            limited: number(21)? != 0.0,
+            refused: number(22)? != 0.0,
+        }))
+    }
+}
+
+/// A run record's text.
+pub fn parse(text: &str) -> Result<Run, RecordError> {
+    let mut lines = text.lines();
+    let columns = Columns::of(lines.next().unwrap_or(""))?;
+    let mut run = Run {
+        t: Vec::new(),
+        commanded: Vec::new(),
+        target: Vec::new(),
+        steps: Vec::new(),
+        state: Vec::new(),
+        limited: Vec::new(),
+        refused: Vec::new(),
+    };
+    for (n, line) in lines.enumerate() {
+        let Some(row) = columns.row(n + 2, line)? else {
+            continue;
+        };
+        run.t.push(row.t);
+        run.commanded.push(row.commanded);
+        run.target.push(row.target);
+        run.steps.push(row.steps);
+        run.state.push(row.state);
+        run.limited.push(row.limited);
+        run.refused.push(row.refused);
     }
     if run.t.is_empty() {
         return Err(RecordError::NoRows);

@@ -13,6 +13,7 @@ use ringpod_core::safety::{AuxLevels, State};
 /// A setpoint that leaves the auxiliary outputs as they are (every pose but a pose file's rows with aux columns).
 pub const NO_AUX: AuxLevels = [None; 2];
 
+use super::repeats::Say;
 use super::report::{reason_name, LimitedReport};
 use super::InputError;
 use crate::link::client::{setpoint_answer, Client, ClientError, Transport};
@@ -119,6 +120,8 @@ pub(super) struct Streamer<'a, T: Transport> {
     pub(super) in_flight: VecDeque<(u32, Option<usize>, Pose<f64>)>,
     pub(super) refused_in_a_row: u32,
     pub(super) last_refusal: Option<String>,
+    /// The refusals said on stderr: the first each on a line, then counted (a file of bad rows is thousands).
+    pub(super) refusal_lines: super::repeats::Repeats,
     /// `--record`: the open file, and the first write error.
     pub(super) recorder: Option<Recorder>,
     pub(super) record_error: Option<String>,
@@ -292,8 +295,17 @@ impl<'a, T: Transport> Streamer<'a, T> {
                 let name = reason_name(reason);
                 if let Some(number) = number {
                     *self.rejected.entry(name.clone()).or_default() += 1;
-                    self.bar
-                        .suspend(|| console::err(&format!("line {number}: refused by the device: {name}")));
+                    let line = match self.refusal_lines.note(std::time::Instant::now()) {
+                        Say::Line => Some(format!("line {number}: refused by the device: {name}")),
+                        Say::Count(n) => Some(format!(
+                            "{n} more setpoints refused by the device (the last: line {number}, {name}); the \
+                             report lists each"
+                        )),
+                        Say::Nothing => None,
+                    };
+                    if let Some(line) = line {
+                        self.bar.suspend(|| console::err(&line));
+                    }
                     self.refusals.push(InputError {
                         line: number,
                         reason: name.clone(),

@@ -174,12 +174,6 @@ fn section(m: &RingPlatform<f64>, r: f64, z: f64) -> Value {
     json!({ "z": z, "half_width": r, "rows": rows, "checks": checks })
 }
 
-/// A run record's text, as columns.
-pub fn run_record(text: &str) -> Result<Value, String> {
-    let run = crate::stream::record::parse(text).map_err(|e| format!("{e:#}"))?;
-    serde_json::to_value(run).map_err(|e| e.to_string())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -287,15 +281,5 @@ mod tests {
         assert_eq!(bad["analysable"], false);
         let why = bad["errors"][0]["why"].as_str().unwrap();
         assert!(why.contains("ring_raduis"), "{bad}");
-    }
-
-    #[test]
-    fn a_record_is_read_as_columns_and_garbage_is_refused() {
-        let header = crate::stream::record::COLUMNS.join(",");
-        let row = "0.1,0.01,0,0,0.2,0,0,0,0,0,0.2,0,0,0,1,2,3,4,5,6,Ready,0,0,0,1,0,0,1000";
-        let out = run_record(&format!("{header}\n{row}\n")).unwrap();
-        assert_eq!(out["t"][0], 0.01);
-        assert_eq!(out["state"][0], "Ready");
-        assert!(run_record("a,b\n1,2\n").unwrap_err().contains("no column"));
     }
 }

@@ -33,14 +33,16 @@ pub fn under(dir: Option<&Path>, name: &str) -> Result<PathBuf, String> {
 }
 
 /// The text of the file `name` under `dir` (at most `limit` bytes), or why the page may not read it, as
-/// [`under`] says. The name is checked, the file opened, and the name checked again against the file that was
+/// [`under`] says, naming the file. The name is checked, the file opened, and the name checked again against the file that was
 /// opened: someone who can write in the directory and swaps a component for a link between the check and the
 /// open gets the open file refused, whatever it is (the same file by a hard link is the same file).
 pub fn read_under(dir: Option<&Path>, name: &str, limit: u64) -> Result<String, String> {
+    // Every reason names the file once, as [`under`]'s do.
+    let named = |reason: String| format!("{name}: {reason}");
     let path = under(dir, name)?;
-    let file = crate::input::files::open(&path)?;
+    let file = crate::input::files::open(&path).map_err(named)?;
     still_under(&file, dir, name)?;
-    crate::input::files::as_text(crate::input::files::read_open(file, limit)?)
+    crate::input::files::as_text(crate::input::files::read_open(file, limit).map_err(named)?).map_err(named)
 }
 
 /// Whether the open `file` is the one `name` under `dir` resolves to now.

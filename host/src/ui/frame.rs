@@ -25,6 +25,8 @@ pub struct RigView {
     pub inputs: Vec<(u16, String)>,
     /// Where it came from, as the device says.
     pub source: String,
+    /// The firmware the device runs and its protocol version (empty for a rig file shown on its own).
+    pub firmware: String,
 }
 
 impl RigView {
@@ -58,6 +60,7 @@ impl RigView {
                 .map(|(bit, name)| (bit.mask(), name))
                 .collect(),
             source,
+            firmware: String::new(),
         }
     }
 }

@@ -6,7 +6,7 @@
 //! runs now (a stream, its powering up and homing), which ends it at once. The device thread then brings the
 //! platform to rest and powers down.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 use std::net::IpAddr;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -46,7 +46,13 @@ pub struct Hub {
     pub bind: IpAddr,
     /// The directory whose files a page may stream by name (`ringpod ui --files`).
     pub files: Option<PathBuf>,
+    /// What the workbench did on its own (a stream stopped because its page went, a STOP's outcome), newest
+    /// last, at most [`KEPT_NOTICES`]: a page that opens later (a reload) is told in its log.
+    notices: Mutex<VecDeque<serde_json::Value>>,
 }
+
+/// Notices kept for pages that open later.
+pub const KEPT_NOTICES: usize = 16;
 
 impl Hub {
     /// A hub with no page and no STOP yet.
@@ -64,7 +70,40 @@ impl Hub {
             presence: Presence::default(),
             bind,
             files,
+            notices: Mutex::new(VecDeque::new()),
         }
+    }
+
+    /// Keeps a notice for the pages that open later (the pages open now were told otherwise).
+    pub fn keep(&self, text: impl Into<String>) -> serde_json::Value {
+        let at_ms = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_millis() as u64);
+        let notice = json!({ "type": "notice", "text": text.into(), "at_ms": at_ms });
+        let mut kept = self.notices.lock().unwrap_or_else(PoisonError::into_inner);
+        if kept.len() >= KEPT_NOTICES {
+            kept.pop_front();
+        }
+        kept.push_back(notice.clone());
+        notice
+    }
+
+    /// Says a notice to every page now and keeps it for the pages that open later.
+    pub fn notice(&self, text: impl Into<String>) {
+        let notice = self.keep(text);
+        self.publish(&notice);
+    }
+
+    /// The notices kept, for a page that opens now: each marked as from before it.
+    pub fn earlier_notices(&self) -> Vec<String> {
+        let kept = self.notices.lock().unwrap_or_else(PoisonError::into_inner);
+        kept.iter()
+            .map(|n| {
+                let mut n = n.clone();
+                n["earlier"] = json!(true);
+                n.to_string()
+            })
+            .collect()
     }
 
     fn outboxes(&self) -> Vec<Arc<Outbox>> {

@@ -12,6 +12,7 @@ mod hub;
 mod outbox;
 mod presence;
 mod request;
+mod runs;
 mod socket;
 mod worker;
 
@@ -275,6 +276,28 @@ async fn rig_check(Json(body): Json<TextBody>) -> Response {
     )
 }
 
-async fn run_record(Json(body): Json<TextBody>) -> Response {
-    answer(api::run_record(&body.text))
+/// A run record, sent as the file's bytes (the page never holds it as text), read as it arrives (see [`runs`]).
+async fn run_record(mut body: axum::body::Body) -> Response {
+    use axum::body::HttpBody;
+    let mut reader = runs::Reader::default();
+    let read = loop {
+        match std::future::poll_fn(|cx| std::pin::Pin::new(&mut body).poll_frame(cx)).await {
+            None => break reader.finish(),
+            Some(Err(e)) => break Err(runs::RunError::Upload(e.to_string())),
+            Some(Ok(frame)) => {
+                if let Some(bytes) = frame.data_ref() {
+                    if let Err(e) = reader.take(bytes) {
+                        break Err(e);
+                    }
+                }
+            }
+        }
+    };
+    match read {
+        Ok(v) => Json(v).into_response(),
+        Err(e @ runs::RunError::TooLarge) => {
+            (StatusCode::PAYLOAD_TOO_LARGE, Json(json!({ "error": e.to_string() }))).into_response()
+        }
+        Err(e) => answer(Err(e.to_string())),
+    }
 }

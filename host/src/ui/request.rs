@@ -103,13 +103,70 @@ pub struct Unreadable {
     pub why: String,
 }
 
+/// A JSON value whose objects each give a key once. serde_json's `Value` keeps the last of a key given twice, so
+/// that `{"do":"enable","do":"halt"}` would run the halt: a request that says two things is refused instead.
+struct Unique(Value);
+
+impl<'de> Deserialize<'de> for Unique {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(UniqueVisitor)
+    }
+}
+
+struct UniqueVisitor;
+
+impl<'de> serde::de::Visitor<'de> for UniqueVisitor {
+    type Value = Unique;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("a JSON value")
+    }
+    fn visit_bool<E>(self, v: bool) -> Result<Unique, E> {
+        Ok(Unique(Value::Bool(v)))
+    }
+    fn visit_i64<E>(self, v: i64) -> Result<Unique, E> {
+        Ok(Unique(v.into()))
+    }
+    fn visit_u64<E>(self, v: u64) -> Result<Unique, E> {
+        Ok(Unique(v.into()))
+    }
+    fn visit_f64<E>(self, v: f64) -> Result<Unique, E> {
+        Ok(Unique(v.into()))
+    }
+    fn visit_str<E>(self, v: &str) -> Result<Unique, E> {
+        Ok(Unique(Value::String(v.to_owned())))
+    }
+    fn visit_unit<E>(self) -> Result<Unique, E> {
+        Ok(Unique(Value::Null))
+    }
+    fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Unique, A::Error> {
+        let mut all = Vec::new();
+        while let Some(Unique(v)) = seq.next_element()? {
+            all.push(v);
+        }
+        Ok(Unique(Value::Array(all)))
+    }
+    fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Unique, A::Error> {
+        let mut object = serde_json::Map::new();
+        while let Some(key) = map.next_key::<String>()? {
+            if object.contains_key(&key) {
+                return Err(serde::de::Error::custom(format!("the key `{key}` is given twice")));
+            }
+            let Unique(v) = map.next_value()?;
+            object.insert(key, v);
+        }
+        Ok(Unique(Value::Object(object)))
+    }
+}
+
 /// Reads a page's message. Every command refuses a field it does not have, by name (serde's `deny_unknown_fields`
 /// does not reach the commands without fields of an internally tagged enum, so the keys are compared here too).
 pub fn parse(text: &str) -> Result<(u64, Request), Unreadable> {
     let unreadable = |id: u64, why: String| Unreadable { id, why };
-    let mut object = match serde_json::from_str::<Value>(text) {
-        Ok(Value::Object(o)) => o,
+    let mut object = match serde_json::from_str::<Unique>(text) {
+        Ok(Unique(Value::Object(o))) => o,
         Ok(_) => return Err(unreadable(0, "a request is a JSON object".into())),
+        Err(e) if e.is_data() => return Err(unreadable(0, format!("not a request: {e}"))),
         Err(e) => return Err(unreadable(0, format!("not JSON: {e}"))),
     };
     let id = match object.remove("id") {
@@ -191,5 +248,27 @@ mod tests {
             assert!(!e.why.is_empty(), "{text}");
         }
         assert_eq!(parse(r#"{"id":7,"do":"fly"}"#).unwrap_err().id, 7);
+    }
+
+    #[test]
+    fn a_key_given_twice_is_refused_at_any_depth() {
+        for (text, key) in [
+            (r#"{"id":1,"do":"enable","do":"halt"}"#, "do"),
+            (r#"{"id":1,"id":2,"do":"halt"}"#, "id"),
+            (r#"{"id":1,"do":"jog","axis":1,"distance":1,"distance":90}"#, "distance"),
+            (r#"{"id":1,"do":"file","name":"a","text":"x","name":"b"}"#, "name"),
+        ] {
+            let e = parse(text).unwrap_err();
+            assert!(
+                e.why.contains(&format!("the key `{key}` is given twice")),
+                "{text}: {}",
+                e.why
+            );
+        }
+        // Keys in nested values are checked too, and the same key in two objects is not a repeat.
+        let nested = serde_json::from_str::<Unique>(r#"{"a":{"b":1,"b":2}}"#).map(|_| ());
+        assert!(nested.unwrap_err().to_string().contains("`b` is given twice"));
+        let fine = serde_json::from_str::<Unique>(r#"[{"b":1},{"b":2.5,"c":[null,true,-3,"s"]}]"#).unwrap();
+        assert_eq!(fine.0, serde_json::json!([{"b":1},{"b":2.5,"c":[null,true,-3,"s"]}]));
     }
 }

@@ -71,12 +71,22 @@ async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
     if let Some(rig) = app.hub.rig.lock().ok().and_then(|r| r.clone()) {
         outbox.push(rig);
     }
+    for notice in app.hub.earlier_notices() {
+        outbox.push(notice);
+    }
     let end = converse(&app, page, &outbox, &mut ws).await;
     app.hub.close_outbox(page);
     app.hub.presence.leave(page, Instant::now());
     if app.hub.streaming.load(Ordering::SeqCst) == page {
-        // The page that started the stream is gone: nobody watches it any more.
-        app.hub.cancel_current();
+        // The page that started the stream is gone: closed, reloaded, or killed; the workbench cannot tell which,
+        // and a page being loaded has no STOP yet. What STOP does, at once, whatever other pages are open.
+        stop_for_the_operator(
+            &app,
+            format!(
+                "page {page}, which started the stream, went away (closed, reloaded or not answering): the stream \
+                 is stopped and the platform comes to rest and powers down, as STOP does"
+            ),
+        );
     }
     if let End::Close(code, reason) = end {
         let frame = CloseFrame {
@@ -158,16 +168,29 @@ fn queue(app: &App, page: u64, id: u64, epoch: u64, request: Request) -> bool {
     app.jobs.lock().ok().is_some_and(|jobs| jobs.send(job).is_ok())
 }
 
+/// STOP given by the workbench itself (page 0) because its operator has gone: said on stderr, to every page now
+/// and to the pages that open later. Whether the device thread took it.
+fn stop_for_the_operator(app: &App, why: String) -> bool {
+    eprintln!("ringpod ui: {why}");
+    app.hub.notice(why);
+    app.hub.publish(&json!({
+        "type": "stop_pending",
+        "pending": true,
+        "text": "STOP given by the workbench: pending until the device confirms it"
+    }));
+    stop(app, 0, 0)
+}
+
 /// When no page is left for the grace, the operator has gone: STOP.
 pub async fn watch_presence(app: Arc<App>) {
     loop {
         tokio::time::sleep(std::time::Duration::from_millis(100)).await;
         if app.hub.presence.deserted(Instant::now()) {
-            eprintln!(
-                "ringpod ui: no page open for {} s: stopping and powering down",
+            let why = format!(
+                "no page open for {} s: stopping and powering down",
                 super::presence::GRACE.as_secs()
             );
-            if !stop(&app, 0, 0) {
+            if !stop_for_the_operator(&app, why) {
                 return;
             }
         }

@@ -8,12 +8,12 @@ use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
-use ringpod_core::protocol::{RigSource, Telemetry};
+use ringpod_core::protocol::RigSource;
 use ringpod_core::safety::State;
 use serde_json::json;
 
 use super::files;
-use super::frame::{self, LinkCounts, RigView};
+use super::frame::{LinkCounts, RigView};
 use super::hub::Hub;
 use super::request::{Job, Request};
 use crate::link::client::{Client, ClientError, Transport};
@@ -23,7 +23,10 @@ use crate::link::{self, Target};
 use crate::stream::command::{self as job, Datagrams, Input};
 use crate::stream::{self, Motion, Source};
 
+mod publisher;
 mod stop;
+
+use publisher::Publisher;
 
 /// Why the device thread could not start, or a page's request was not done (sent back to the page in words).
 #[derive(Debug, thiserror::Error)]
@@ -69,42 +72,11 @@ pub enum WorkerError {
     Ended(String),
 }
 
+/// The reply to a stream that STOP ended before it sent a setpoint.
+const STOPPED_BEFORE_START: &str = "stopped by STOP before it started: nothing was sent";
+
 /// Frames a page is sent per second at most (a browser draws at 60; telemetry may come at 1 kHz).
 pub const FRAME_HZ: f64 = 50.0;
-
-/// Makes frames of the telemetry the client sees, at most [`FRAME_HZ`] a second.
-struct Publisher {
-    hub: Arc<Hub>,
-    mechanism: Arc<Mutex<RingPlatform<f64>>>,
-    counts: LinkCounts,
-    last_sent: Option<Instant>,
-    window: (Instant, u64),
-}
-
-impl Publisher {
-    fn see(&mut self, sample: &Telemetry) {
-        self.counts.received += 1;
-        let now = Instant::now();
-        let (since, n) = self.window;
-        if now.duration_since(since) >= Duration::from_secs(1) {
-            self.counts.rate_hz = (self.counts.received - n) as f64 / now.duration_since(since).as_secs_f64();
-            self.window = (now, self.counts.received);
-        }
-        if self
-            .last_sent
-            .is_some_and(|t| now.duration_since(t) < Duration::from_secs_f64(1.0 / FRAME_HZ))
-        {
-            return;
-        }
-        self.last_sent = Some(now);
-        let streaming = self.hub.streaming.load(Ordering::SeqCst) != 0;
-        let Ok(m) = self.mechanism.lock() else { return };
-        let frame = frame::frame(&m, sample, self.counts, streaming);
-        let mut message = serde_json::to_value(frame).unwrap_or_default();
-        message["type"] = json!("frame");
-        self.hub.publish_frame(&message);
-    }
-}
 
 /// Opens the device and serves the pages' requests until the hub closes. Errors here mean no device.
 pub fn run(
@@ -176,6 +148,9 @@ fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlat
     // The frames and motion compensation show the pose of the counted steps of the rig the device runs now.
     client.followed = crate::link::followed::Followed::of(&record);
     let mut view = RigView::of(&geometry, record.home, source.to_string());
+    view.firmware = client
+        .device
+        .map_or_else(String::new, |d| crate::device::firmware_text(&d.firmware));
     // The name the user gave the rig (its file's `name`), not the geometry's generic one.
     if !record.name().trim().is_empty() {
         record.name().clone_into(&mut view.name);
@@ -201,26 +176,30 @@ struct Device {
 
 impl Device {
     /// Serves a page's request; a stream's claim ends with it (run, refused or cancelled).
+    /// The claim ends before the reply goes out: a page that asks for the next stream as soon as it reads the
+    /// reply is not refused for the one just answered.
     fn serve(&mut self, job: &Job) {
-        self.serve_job(job);
+        let reply = self.serve_job(job);
         if job.request.is_stream() {
             self.hub.stream_claimed.store(false, Ordering::SeqCst);
         }
+        if let Some((ok, text)) = reply {
+            self.hub.reply(job.page, job.id, ok, text);
+        }
     }
 
-    fn serve_job(&mut self, job: &Job) {
+    /// Runs a request: its reply (none for a STOP run, which says its outcome itself).
+    fn serve_job(&mut self, job: &Job) -> Option<(bool, String)> {
         let cancel = match self.hub.begin(job) {
             Ok(flag) => flag,
-            Err(why) => return self.hub.reply(job.page, job.id, job.request.is_halt(), why),
+            Err(why) => return Some((job.request.is_halt(), why.to_owned())),
         };
         // Nothing moves before the STOP given last is confirmed.
         if self.pending_stop.is_some() && !job.request.is_halt() {
-            return self.hub.reply(
-                job.page,
-                job.id,
+            return Some((
                 false,
-                "refused: a STOP is pending (the device has not confirmed it yet)",
-            );
+                "refused: a STOP is pending (the device has not confirmed it yet)".to_owned(),
+            ));
         }
         self.cancel = cancel;
         let result = match &job.request {
@@ -286,9 +265,9 @@ impl Device {
             Request::LoadRig { text } => self.load_rig(text),
         };
         match result {
-            Ok(_) if job.request.is_halt() => {}
-            Ok(text) => self.hub.reply(job.page, job.id, true, text),
-            Err(e) => self.hub.reply(job.page, job.id, false, format!("{e:#}")),
+            Ok(_) if job.request.is_halt() => None,
+            Ok(text) => Some((true, text)),
+            Err(e) => Some((false, format!("{e:#}"))),
         }
     }
 
@@ -327,7 +306,12 @@ impl Device {
         let (record, _, _) = self.client.rig()?;
         let home = Pose::from_array(record.home);
         let poses = vec![(1, 0.0, home, [None; 2]), (2, 1.0, home, [None; 2])];
-        let report = self.run(page, Source::Poses(poses), Vec::new())?;
+        let report = match self.run(page, Source::Poses(poses), Vec::new()) {
+            Err(WorkerError::NotStarted(ClientError::Interrupted)) => {
+                return Ok(format!("park: {STOPPED_BEFORE_START}"))
+            }
+            r => r?,
+        };
         if report.exit_code != stream::exit::FOLLOWED {
             return Err(WorkerError::Ended(format!(
                 "park: {}",
@@ -346,7 +330,9 @@ impl Device {
             Some(t) => t.to_owned(),
             None => {
                 let limit = crate::input::files::DATA_LIMIT;
-                files::read_under(self.hub.files.as_deref(), name, limit).map_err(refused)?
+                // Its reasons name the file already.
+                files::read_under(self.hub.files.as_deref(), name, limit)
+                    .map_err(|r| WorkerError::File(files::reason_without_content(&r).to_owned()))?
             }
         };
         let (poses, errors) = stream::read_csv(&text, degrees).map_err(refused)?;
@@ -421,7 +407,11 @@ impl Device {
 
     /// Runs a stream and tells the pages its report.
     fn follow(&mut self, page: u64, source: Source, errors: Vec<stream::InputError>) -> Result<String, WorkerError> {
-        let report = self.run(page, source, errors)?;
+        let report = match self.run(page, source, errors) {
+            // STOP while it powered up, homed or waited for its first setpoint: what was asked, not a failure.
+            Err(WorkerError::NotStarted(ClientError::Interrupted)) => return Ok(STOPPED_BEFORE_START.into()),
+            r => r?,
+        };
         let text = format!(
             "{}: {} setpoints sent, {} applied, {} limited, {} refused{}",
             report.outcome,
@@ -434,6 +424,11 @@ impl Device {
         let mut message = serde_json::to_value(&report)?;
         message["type"] = json!("report");
         self.hub.publish(&message);
+        if !self.hub.presence.is_open(page) {
+            // Its page has gone: the page that opens next is told how the stream ended.
+            self.hub
+                .keep(format!("the stream of page {page}, which went away: {text}"));
+        }
         if report.exit_code == stream::exit::FOLLOWED || report.exit_code == stream::exit::INTERRUPTED {
             Ok(text)
         } else {

@@ -289,8 +289,7 @@ impl ControllerConfig {
 /// each carriage at most 7 degrees before its flag ([`crate::sim::parked`]); a search shorter than that is refused
 /// by the plan's own check (the back-off) or fails homing, never moves blind.
 fn carriage_search(q: &[f64; 6], a: usize, carriages: usize, min_spacing: f64) -> f32 {
-    let gap =
-        |from: usize, to: usize| libm::fmod(q[to] - q[from] + 4.0 * core::f64::consts::TAU, core::f64::consts::TAU);
+    let gap = |from: usize, to: usize| crate::real::wrap_turn(q[to] - q[from]);
     let next = (a + 1) % carriages;
     let prev = (a + carriages - 1) % carriages;
     let room = gap(a, next).min(gap(prev, a)) - min_spacing;

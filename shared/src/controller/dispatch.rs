@@ -2,7 +2,7 @@
 //! executed.
 
 use super::homing::Homing;
-use super::Controller;
+use super::{Controller, Restart};
 use crate::kinematics::presets::{Preset, PresetGeometry};
 use crate::kinematics::{AxisKind, Mechanism};
 use crate::motion::jog::Jog;
@@ -23,6 +23,7 @@ impl Controller {
                     self.telemetry.on = false;
                     DeviceMessage::Hello {
                         version: PROTOCOL_VERSION,
+                        firmware: self.firmware,
                         preset: Preset::ALL
                             .into_iter()
                             .find(|p| matches!(p.geometry(), PresetGeometry::Ring(g) if *g == self.config.geometry)),
@@ -32,9 +33,15 @@ impl Controller {
                     self.connected = false;
                     DeviceMessage::Nack(NackReason::VersionMismatch {
                         device: PROTOCOL_VERSION,
+                        firmware: Some(self.firmware),
                     })
                 }
             }
+            // Without a handshake: a host of any version can update the board (the stable head, `firmware`).
+            HostMessage::EnterBootloader => match self.request_restart(Restart::Bootloader) {
+                Ok(()) => DeviceMessage::Ack,
+                Err(r) => DeviceMessage::Nack(r),
+            },
             _ if !self.connected => DeviceMessage::Nack(NackReason::NotConnected),
             HostMessage::Setpoint(sp) => self.submit(&sp),
             HostMessage::GetStatus => DeviceMessage::Status(self.status()),
@@ -56,7 +63,7 @@ impl Controller {
                 Ok(()) => DeviceMessage::Ack,
                 Err(r) => DeviceMessage::Nack(r),
             },
-            HostMessage::Restart => match self.request_restart() {
+            HostMessage::Restart => match self.request_restart(Restart::Controller) {
                 Ok(()) => DeviceMessage::Ack,
                 Err(r) => DeviceMessage::Nack(r),
             },

@@ -14,11 +14,12 @@ mod settings;
 pub use crate::safety::Inputs;
 pub use config::{Checked, ConfigError, ControllerConfig};
 pub use sections::axis_scale;
+pub use settings::Restart;
 
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;
 use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
-use crate::protocol::{DeviceMessage, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
+use crate::protocol::{DeviceMessage, Firmware, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
 use crate::safety::homing::HomingPlan;
 use crate::safety::{Command, Event, HostWatch, Motion, Outputs, State, Supervisor};
 use homing::Homing;
@@ -64,8 +65,10 @@ pub struct Controller {
     jog: Option<(Jog, bool)>,
     /// Where the running rig came from (the board says so at boot).
     rig_source: RigSource,
-    /// The host asked for a restart.
-    restart: bool,
+    /// The host asked for a restart, and into what.
+    restart: Option<Restart>,
+    /// The firmware it runs (the board says so at boot).
+    firmware: Firmware,
     /// A homing since start set every axis's origin: the counted steps say where the axes are (whatever moved them
     /// since, a power-down, a jog or a fault, the motors did it step by step), so homing again can park first.
     origins: bool,
@@ -122,7 +125,8 @@ impl Controller {
             raw_inputs: None,
             jog: None,
             rig_source: RigSource::Compiled,
-            restart: false,
+            restart: None,
+            firmware: Firmware::BUILT,
             origins: false,
             host: HostWatch::default(),
         })

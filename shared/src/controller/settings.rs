@@ -2,7 +2,7 @@
 //! changes the firmware has yet to store.
 
 use super::{ConfigError, Controller, ControllerConfig};
-use crate::protocol::{DeviceMessage, NackReason, RigRecord, RigSource, Settings, SettingsKind};
+use crate::protocol::{DeviceMessage, Firmware, NackReason, RigRecord, RigSource, Settings, SettingsKind};
 use crate::safety::{Motion, Refusal, State};
 
 impl Controller {
@@ -78,6 +78,16 @@ impl Controller {
         self.rig_source = source;
     }
 
+    /// The board says which firmware it runs (at boot, with the image it checksummed in its flash).
+    pub fn set_firmware(&mut self, firmware: Firmware) {
+        self.firmware = firmware;
+    }
+
+    /// The firmware it runs, as the hello says.
+    pub fn firmware(&self) -> Firmware {
+        self.firmware
+    }
+
     /// The running rig, where it came from, and whether another waits for the next start.
     pub fn rig_report(&self) -> DeviceMessage {
         DeviceMessage::Rig {
@@ -108,17 +118,29 @@ impl Controller {
         Ok(())
     }
 
-    /// Asks for a restart (only in `Off`): the firmware restarts once everything is stored.
-    pub(super) fn request_restart(&mut self) -> Result<(), NackReason> {
+    /// Asks for a restart into `into` (only in `Off`: supplies and drivers off, nothing moves): the firmware
+    /// restarts once everything is stored.
+    pub(super) fn request_restart(&mut self, into: Restart) -> Result<(), NackReason> {
         if self.supervisor.state() != State::Off {
             return Err(NackReason::Refused(Refusal::WrongState));
         }
-        self.restart = true;
+        self.restart = Some(into);
         Ok(())
     }
 
-    /// The host asked for a restart and every setting and rig is stored: the board resets now.
-    pub fn restart_due(&self) -> bool {
-        self.restart && !self.unsaved && self.supervisor.state() == State::Off
+    /// The host asked for a restart and every setting and rig is stored: the board resets now, into what it says.
+    pub fn restart_due(&self) -> Option<Restart> {
+        self.restart
+            .filter(|_| !self.unsaved && self.supervisor.state() == State::Off)
     }
+}
+
+/// What a restart the host asked for starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Restart {
+    /// The controller again, the stored settings and rig restored ([`crate::protocol::HostMessage::Restart`]).
+    Controller,
+    /// The MCU's ROM bootloader, to be flashed ([`crate::protocol::HostMessage::EnterBootloader`]).
+    Bootloader,
 }

@@ -7,7 +7,7 @@
 //! | request | answer |
 //! |---|---|
 //! | [`HostMessage::Hello`] | [`Hello`]'s [`DeviceHello`] (any version: the client compares) |
-//! | [`HostMessage::Command`], `SetSettings`, `SetRig`, `Restart`, `Telemetry`, `Jog`, `Buzz` | `Ack`: `()` |
+//! | [`HostMessage::Command`], `SetSettings`, `SetRig`, `Restart`, `EnterBootloader`, `Telemetry`, `Jog`, `Buzz` | `Ack`: `()` |
 //! | [`HostMessage::GetStatus`] | [`Status`] |
 //! | [`HostMessage::GetInputs`] | [`InputReport`] |
 //! | [`HostMessage::GetSettings`] | [`SettingsAnswer`] (the section asked for, and whether one waits) |
@@ -17,7 +17,8 @@
 //! streaming code itself.
 
 use super::{
-    DeviceMessage, HostMessage, InputReport, RigRecord, RigSource, Settings, SettingsKind, Status, PROTOCOL_VERSION,
+    DeviceMessage, Firmware, HostMessage, InputReport, RigRecord, RigSource, Settings, SettingsKind, Status,
+    PROTOCOL_VERSION,
 };
 use crate::kinematics::presets::Preset;
 use crate::kinematics::AxisKind;
@@ -71,6 +72,10 @@ pub struct SetRig(pub RigRecord);
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Restart;
 
+/// Restarts into the MCU's ROM bootloader once everything is stored (taken without a handshake).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EnterBootloader;
+
 /// Turns the telemetry stream on or off.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TelemetryOn(pub bool);
@@ -93,6 +98,7 @@ acked! {
     SetSettings: |e| HostMessage::SetSettings(e.0);
     SetRig: |e| HostMessage::SetRig(e.0);
     Restart: |_e| HostMessage::Restart;
+    EnterBootloader: |_e| HostMessage::EnterBootloader;
     TelemetryOn: |e| HostMessage::Telemetry(e.0);
     Jog: |e| HostMessage::Jog { axis: e.axis, steps: e.steps };
     Buzz: |e| HostMessage::Buzz { axis: e.0 };
@@ -107,6 +113,8 @@ pub struct Hello;
 pub struct DeviceHello {
     /// Its protocol version.
     pub version: u16,
+    /// The firmware it runs.
+    pub firmware: Firmware,
     /// The preset it drives, if its geometry is one.
     pub preset: Option<Preset>,
     /// What each actuator coordinate measures.
@@ -122,7 +130,17 @@ impl Endpoint for Hello {
     }
     fn answer(&self, message: DeviceMessage) -> Result<DeviceHello, DeviceMessage> {
         match message {
-            DeviceMessage::Hello { version, preset, axes } => Ok(DeviceHello { version, preset, axes }),
+            DeviceMessage::Hello {
+                version,
+                firmware,
+                preset,
+                axes,
+            } => Ok(DeviceHello {
+                version,
+                firmware,
+                preset,
+                axes,
+            }),
             other => Err(other),
         }
     }

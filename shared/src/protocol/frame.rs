@@ -7,12 +7,17 @@ use serde::{de::DeserializeOwned, Serialize};
 use super::wire;
 
 /// Largest postcard payload of any message (bytes): a rig record with six chains (`HostMessage::SetRig`,
-/// `DeviceMessage::Rig`) is the largest, about 560 (tested in `tests/rig_record.rs`).
+/// `DeviceMessage::Rig`) is the largest, about 560 (tested in `tests/suite/rig_record.rs`).
 pub const MAX_PAYLOAD: usize = 768;
 /// Largest encoded frame including the delimiter (bytes).
 pub const MAX_FRAME: usize = cobs::max_encoding_length(MAX_PAYLOAD + 4) + 1;
 
 const CRC: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI);
+
+/// The frames' CRC-32C of `bytes` (also the flashed image's, `firmware::image_crc`: one table in the firmware).
+pub(super) fn crc32c(bytes: &[u8]) -> u32 {
+    CRC.checksum(bytes)
+}
 
 /// Why a frame could not be encoded or decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,9 +12,10 @@ use crate::safety::{Command, FaultReason, Refusal, State};
 
 /// Protocol version; host and device must agree exactly. 8: the motion section carries the actuator limits, the
 /// operator's commands switch the auxiliary outputs and setpoints carry their levels. 9: the status counts the
-/// periods the step generator played empty and the control periods passed. 10: the stream section carries the time
-/// after which a host silent since its stream was lost is taken as gone (`host_gone_ms`).
-pub const PROTOCOL_VERSION: u16 = 10;
+/// periods the step generator played empty and the control periods passed. 10: the hello and a version mismatch
+/// name the firmware ([`super::Firmware`]); the bootloader request. 11: the stream section carries the time after
+/// which a host silent since its stream was lost is taken as gone (`host_gone_ms`).
+pub const PROTOCOL_VERSION: u16 = 11;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -78,6 +79,11 @@ pub enum HostMessage {
     SetRig(RigRecord),
     /// Restart the controller once every setting and rig is stored (state `Off` only): a board resets its MCU.
     Restart,
+    /// Restart into the MCU's ROM bootloader (USB DFU) once every setting and rig is stored, to be flashed (state
+    /// `Off` only: supplies and drivers off). Taken without a handshake, at its fixed tag
+    /// ([`super::firmware::BOOTLOADER_TAG`]), so that a host of any protocol version can update the board. The
+    /// simulated controller has no bootloader: it restarts.
+    EnterBootloader,
 }
 
 /// The position of [`HostMessage::Setpoint`] among the variants: its tag on the wire.
@@ -116,6 +122,8 @@ pub enum DeviceMessage {
     Hello {
         /// The device's [`PROTOCOL_VERSION`].
         version: u16,
+        /// The firmware it runs.
+        firmware: super::Firmware,
         /// The preset it drives, if its geometry is one.
         preset: Option<Preset>,
         /// What each of its actuator coordinates measures.
@@ -185,7 +193,7 @@ pub struct Telemetry {
 impl core::fmt::Display for NackReason {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
-            Self::VersionMismatch { device } => write!(f, "the device speaks protocol version {device}"),
+            Self::VersionMismatch { device, .. } => write!(f, "the device speaks protocol version {device}"),
             Self::NotConnected => f.write_str("no handshake yet"),
             Self::Refused(r) => write!(f, "refused: {r}"),
             Self::Rejected(r) => write!(f, "setpoint rejected: {r}"),
@@ -229,10 +237,13 @@ impl TelemetryFlags {
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[non_exhaustive]
 pub enum NackReason {
-    /// The versions differ; the device's is given.
+    /// The versions differ; the device's is given, and its firmware.
     VersionMismatch {
         /// The device's version.
         device: u16,
+        /// The firmware it runs: always there from a device of this version; `None` where a host read the answer
+        /// of a device of protocol 9 or older, which did not name it ([`super::firmware::version_mismatch`]).
+        firmware: Option<super::Firmware>,
     },
     /// No successful hello yet.
     NotConnected,

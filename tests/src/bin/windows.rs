@@ -2,7 +2,7 @@
 //!
 //! 1. The MinGW-w64 cross compiler and Wine (installed with apt-get when missing and allowed, as QEMU is), and the
 //!    `x86_64-pc-windows-gnu` standard library (rustup).
-//! 2. A debug cross-build of `ringpod.exe` and of its test programs and examples (`cargo test --no-run`).
+//! 2. A debug cross-build of the host's test programs, with `ringpod.exe` and the examples (`cargo test --no-run`).
 //! 3. Beside them, a test-only `bcryptprimitives.dll` built from `tests/windows/bcryptprimitives.c`: Rust's standard
 //!    library imports `ProcessPrng` from it, which Wine 8 lacks.
 //! 4. The host's tests under Wine, unit and integration (`cargo test` with Wine as the target's runner): the
@@ -204,8 +204,10 @@ fn main_command() -> Result<(), String> {
         .ok_or_else(|| "the demo was not followed under Wine".into())
 }
 
-/// The games whose shared memory `--telemetry-shm` reads (`ringpod stream --help`).
-const SHM_GAMES: [&str; 7] = ["ac", "acc", "iracing", "rf2", "lmu", "ams2", "ets2"];
+/// The games whose shared memory `--telemetry-shm` reads (`ringpod stream --help`), in two lanes that run side by
+/// side: the games of one lane one after the other, since AC and ACC share their mappings' names, and so do rF2
+/// and LMU.
+const SHM_GAMES: [&[&str]; 2] = [&["ac", "acc", "ets2"], &["rf2", "lmu", "iracing", "ams2"]];
 /// Seconds of each stand-in's drive: one cycle of it (6 s of motion, then its pause of 1.5 s), and a half second.
 const DRIVE_S: &str = "8";
 /// The reader ends this long after its last sample (once the drive is over): longer than the drive's pause.
@@ -217,10 +219,23 @@ const IDLE_S: &str = "3";
 /// (one wineserver holds the named objects). Each game: followed, every setpoint applied, more than a hundred new
 /// samples taken (the drive runs at 50 Hz or more), none refused.
 fn shared_memory_games() -> Result<(), String> {
-    let failed: Vec<&str> = SHM_GAMES
-        .into_iter()
-        .filter(|game| cue_game(game).map_err(|e| println!("{game}: {e}")).is_err())
-        .collect();
+    let failed: Vec<&str> = std::thread::scope(|s| {
+        let lanes: Vec<_> = SHM_GAMES
+            .map(|lane| {
+                s.spawn(move || {
+                    lane.iter()
+                        .copied()
+                        .filter(|game| cue_game(game).map_err(|e| println!("{game}: {e}")).is_err())
+                        .collect::<Vec<_>>()
+                })
+            })
+            .into_iter()
+            .collect();
+        lanes
+            .into_iter()
+            .flat_map(|lane| lane.join().unwrap_or_else(|_| vec!["a lane that panicked"]))
+            .collect()
+    });
     if failed.is_empty() {
         Ok(())
     } else {
@@ -296,8 +311,8 @@ fn main() -> ExitCode {
         .and_then(|()| step("the Windows target", ensure_target))
         .and_then(|()| {
             step("cross-build (debug)", || {
-                status(cargo(&["build", "-p", "ringpod"]), "cargo build")?;
-                // The test programs, and the examples with them: `shm_games.exe`, the games' stand-in.
+                // The test programs, and with them `ringpod.exe` (the integration tests start it) and the examples
+                // (`shm_games.exe`, the games' stand-in): one build, no second one of the host with other features.
                 status(cargo(&["test", "-p", "ringpod", "--no-run"]), "cargo test --no-run")
             })
         })

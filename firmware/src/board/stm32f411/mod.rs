@@ -31,10 +31,12 @@
 //! One file a job: `resources` (the pin map as code: which peripherals each step takes, the interrupt bindings),
 //! `clocks`, `outputs` (relays, enable, auxiliary outputs, STEP/DIR at their idle levels), `switches` (EXTI
 //! inputs), `steps` (TIM1 + DMA2 and its interrupt executor), `usb` and `uart` (the two host links), `settings`
-//! (flash), `watchdog` (IWDG); this file brings them up in order and spawns the tasks.
+//! (flash), `watchdog` (IWDG), `bootloader` (the ROM bootloader entered from the firmware); this file brings them up in
+//! order and spawns the tasks.
 
 #[macro_use]
 mod resources;
+mod bootloader;
 mod clocks;
 mod outputs;
 mod settings;
@@ -46,7 +48,7 @@ mod watchdog;
 
 use embassy_executor::Spawner;
 use ringpod_core::controller::Controller;
-use ringpod_core::protocol::RigSource;
+use ringpod_core::protocol::{Firmware, Image, RigSource};
 use ringpod_firmware::app::inputs::InputPins;
 use ringpod_firmware::app::Shared;
 use static_cell::StaticCell;
@@ -60,6 +62,7 @@ static SHARED: StaticCell<Shared> = StaticCell::new();
 
 /// Brings the board up and spawns the tasks.
 pub async fn start(spawner: Spawner) {
+    bootloader::enter_if_marked();
     let watchdog_reset = watchdog::caused_last_reset();
     let p = embassy_stm32::init(clocks::config());
     let r = split_resources!(p);
@@ -75,6 +78,8 @@ pub async fn start(spawner: Spawner) {
     let restored = settings::restore(settings::read(&mut flash).await);
     let mut switches = switches::new(r.switches);
     let shared = share(restored.controller, &mut switches, restored.rig, watchdog_reset);
+    let firmware = firmware();
+    shared.with(|c| c.set_firmware(firmware));
 
     steps::start(r.step_generator, restored.renderer, shared);
     let (device, usb_link) = usb::new(r.usb);
@@ -89,6 +94,31 @@ pub async fn start(spawner: Spawner) {
     spawner.spawn(defmt::unwrap!(uart::uart_link_task(uart_link, shared)));
     spawner.spawn(defmt::unwrap!(settings::settings_task(flash, shared)));
     defmt::info!("ringpod firmware up: {} Hz control tick", 1_000_000 / restored.tick_us);
+}
+
+/// The firmware this is, with the image as flash holds it: from the start of flash to the end of `.data`'s initial
+/// values (cortex-m-rt's link.x: they start at `__sidata` and are `__edata - __sdata` long), checksummed at boot
+/// (`ringpod_core::protocol::firmware`: why at boot; about 2 M cycles, 20 ms, before the watchdog starts).
+fn firmware() -> Firmware {
+    extern "C" {
+        static __sidata: u8;
+        static __sdata: u8;
+        static __edata: u8;
+    }
+    const FLASH: usize = 0x0800_0000;
+    let (load, start, end) = (
+        core::ptr::addr_of!(__sidata) as usize,
+        core::ptr::addr_of!(__sdata) as usize,
+        core::ptr::addr_of!(__edata) as usize,
+    );
+    let size = load + (end - start) - FLASH;
+    // SAFETY: flash from its start to the end of the image is mapped and never written while the firmware runs
+    // (the settings sectors lie beyond the program's, memory.x).
+    let image = unsafe { core::slice::from_raw_parts(FLASH as *const u8, size) };
+    Firmware {
+        image: Some(Image::of(image)),
+        ..Firmware::BUILT
+    }
 }
 
 /// The cycle counter the control task measures its tick with.

@@ -3,7 +3,7 @@
 
 use embassy_embedded_hal::adapter::BlockingAsync;
 use embassy_stm32::flash::{Blocking, Flash};
-use ringpod_core::controller::{Controller, ControllerConfig};
+use ringpod_core::controller::{Controller, ControllerConfig, Restart};
 use ringpod_core::motion::pulse::PulseRenderer;
 use ringpod_core::protocol::RigSource;
 use ringpod_core::store;
@@ -64,7 +64,7 @@ pub fn restore((config, restored): (ControllerConfig, store::Restored)) -> Resto
     }
 }
 
-/// The watchdog and the reset, for the settings task.
+/// The watchdog and the resets, for the settings task.
 struct SettingsBoard;
 
 impl app::settings::Board for SettingsBoard {
@@ -76,8 +76,11 @@ impl app::settings::Board for SettingsBoard {
         })
     }
 
-    fn restart(&mut self) -> ! {
-        cortex_m::peripheral::SCB::sys_reset()
+    fn restart(&mut self, into: Restart) -> ! {
+        match into {
+            Restart::Controller => cortex_m::peripheral::SCB::sys_reset(),
+            Restart::Bootloader => super::bootloader::restart_into(),
+        }
     }
 
     /// CYCCNT counts core clock cycles, stalled ones included (ARMv7-M ARM C1.8.8), at SYSCLK (`clocks`).

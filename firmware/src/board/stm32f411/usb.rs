@@ -45,6 +45,7 @@ pub fn new(r: UsbParts) -> (Device, UsbLink) {
     static BOS_DESC: StaticCell<[u8; 256]> = StaticCell::new();
     static CONTROL_BUF: StaticCell<[u8; 64]> = StaticCell::new();
     static CDC_STATE: StaticCell<State> = StaticCell::new();
+    static SERIAL: StaticCell<[u8; 24]> = StaticCell::new();
     let mut usb_config = usb::Config::default();
     // The Black Pill does not wire VBUS to PA9 (PA9 is LOGIC_OK here).
     usb_config.vbus_detection = false;
@@ -52,7 +53,10 @@ pub fn new(r: UsbParts) -> (Device, UsbLink) {
     let mut device_config = embassy_usb::Config::new(0x1209, 0x0001);
     device_config.manufacturer = Some("ringpod");
     device_config.product = Some("ringpod motion controller");
-    device_config.serial_number = Some("ringpod-f411");
+    // The chip's 96-bit unique ID (RM0383 39.1, at 0x1FFF7A10) as 24 hexadecimal digits, byte by byte from the
+    // lowest address: two boards on one PC have two serial numbers, so the host (and Windows' COM-port assignment)
+    // tells them apart.
+    device_config.serial_number = Some(serial_number(SERIAL.init([0; 24])));
     let mut builder = Builder::new(
         driver,
         device_config,
@@ -64,6 +68,17 @@ pub fn new(r: UsbParts) -> (Device, UsbLink) {
     let class = CdcAcmClass::new(&mut builder, CDC_STATE.init(State::new()), 64);
     let device = builder.build();
     (device, UsbLink { class })
+}
+
+/// The chip's unique ID as 24 upper-case hexadecimal digits in `hex`, byte by byte from the lowest address.
+fn serial_number(hex: &'static mut [u8; 24]) -> &'static str {
+    const DIGITS: &[u8; 16] = b"0123456789ABCDEF";
+    for (pair, byte) in hex.chunks_exact_mut(2).zip(embassy_stm32::uid::uid()) {
+        pair[0] = DIGITS[usize::from(byte >> 4)];
+        pair[1] = DIGITS[usize::from(byte & 0xF)];
+    }
+    // SAFETY: every byte is one of DIGITS, ASCII.
+    unsafe { core::str::from_utf8_unchecked(hex) }
 }
 
 #[embassy_executor::task]

@@ -101,8 +101,51 @@ struct MotionFile {
     step: f64,
 }
 
+/// The heaviest body a mechanism file may give (kg), and the largest moment of inertia (kg m^2): a thousand
+/// tonnes; beyond that the number is a mistake (1e308 kg came back as a 300-digit force), as `loads --mass` takes it.
+const MOST_MASS: f64 = 1e6;
+
 fn bad(what: String) -> CliError {
-    CliError::Dynamics(what)
+    CliError::Dynamics(shown(&what))
+}
+
+/// Text from the file as it may be printed: a control character (an escape sequence would drive the terminal) is
+/// written as its escape, `\u{1b}`.
+fn shown(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+/// Why a body's mass, centre or inertia cannot be a body's (a mass not positive, not finite or beyond
+/// [`MOST_MASS`]), by its key and link.
+fn body_refused(b: &BodyFile) -> Option<String> {
+    use crate::input::numbers::readable;
+    let said = |what: String| Some(format!("body on `{}`: {what}", b.link));
+    if !(b.mass.is_finite() && b.mass > 0.0 && b.mass <= MOST_MASS) {
+        return said(format!(
+            "mass = {} kg: a body's mass is positive and at most {} kg",
+            readable(b.mass),
+            readable(MOST_MASS)
+        ));
+    }
+    if let Some(v) = b.inertia.iter().find(|v| !(v.is_finite() && v.abs() <= MOST_MASS)) {
+        return said(format!(
+            "inertia {} kg m^2: each a finite number, at most {} either way",
+            readable(*v),
+            readable(MOST_MASS)
+        ));
+    }
+    if let Some(v) = b.centre.iter().find(|v| !v.is_finite()) {
+        return said(format!("centre {}: not a finite number", readable(*v)));
+    }
+    None
 }
 
 /// Why a file's mechanism or model is refused, in words.
@@ -279,6 +322,9 @@ fn build(f: &File) -> Result<Built, CliError> {
         .body
         .iter()
         .map(|b| {
+            if let Some(why) = body_refused(b) {
+                return Err(bad(why));
+            }
             let i = link(&b.link)?;
             let [xx, yy, zz, xy, xz, yz] = b.inertia;
             let tensor = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
@@ -297,7 +343,7 @@ fn build(f: &File) -> Result<Built, CliError> {
         .zip(m.amplitude.iter().zip(&m.frequency))
         .map(|(d, (a, w))| (q[*d], *a, *w))
         .collect();
-    let name = f.name.clone().unwrap_or_else(|| "mechanism".into());
+    let name = f.name.as_deref().map_or_else(|| "mechanism".into(), shown);
     Ok(Built {
         model,
         q,
@@ -310,8 +356,11 @@ fn build(f: &File) -> Result<Built, CliError> {
 
 /// `dynamics --file`: the file's mechanism along its drives' swing, its inverse dynamics, table, plot and energy.
 pub fn run_file(path: &Path, table: Option<&Path>, plot: Option<&Path>) -> Result<Outcome, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| bad(format!("{}: {e}", path.display())))?;
-    let file: File = toml::from_str(&text).map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    // Bounded, and never waiting in open() for a FIFO's writer, as every settings file is read.
+    let text = crate::input::files::read_text(path, crate::input::files::CONFIG_LIMIT)
+        .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+    // TOML's message spans lines (the line quoted, a caret under the fault): kept as it is.
+    let file: File = toml::from_str(&text).map_err(|e| CliError::Dynamics(format!("{}: {e}", path.display())))?;
     let b = build(&file)?;
     let d = b.swing.len();
     let at = |t: f64, k: usize| -> [f64; MAX_DRIVES] {
@@ -401,12 +450,23 @@ mod tests {
             ("[[loop]]\na = \"pin\"\nb = \"ground\"", "", "the mechanism"),
             ("stiffness = 3.0", "stiffness = 3.0\nspring = 1.0", "unknown field"),
             ("gravity = [0.0, -9.81, 0.0]", "gravity = [0.0, nan, 0.0]", "the model"),
+            ("mass = 1.0", "mass = -1.0", "mass = -1 kg: a body's mass is positive"),
+            ("mass = 1.0", "mass = 0.0", "mass = 0 kg"),
+            ("mass = 1.0", "mass = 1e308", "mass = 1e308 kg"),
+            ("mass = 1.0", "mass = nan", "mass = NaN kg"),
+            ("mass = 1.0", "mass = 2e6", "at most 1e6 kg"),
+            ("inertia = [6.250000000e-04", "inertia = [1e300", "inertia 1e300 kg m^2"),
+            // A control character from the file is printed as its escape.
+            ("a = \"pin\"", "a = \"pin\\u001b[2J\"", "`pin\\u{1b}[2J` names no pair"),
         ];
         for (from, to, says) in cases {
             assert!(FOUR_BAR.contains(from), "{from}");
             let text = FOUR_BAR.replacen(from, to, 1);
             let e = built(&text).err().map(|e| e.to_string()).unwrap_or_default();
             assert!(e.contains(says), "{from} -> {to}: {e}");
+            assert!(!e.contains('\u{1b}'), "{e:?}");
         }
+        let named = FOUR_BAR.replacen("name = \"four-bar\"", "name = \"four\\u001b]0;x\\u0007bar\"", 1);
+        assert_eq!(built(&named).unwrap().name, "four\\u{1b}]0;x\\u{7}bar");
     }
 }

@@ -52,6 +52,7 @@ function connect() {
     else if (m.type === "reply") showReply(m);
     else if (m.type === "halted") { state.halted = m; log(m.text); }
     else if (m.type === "stop_pending") showStopPending(m);
+    else if (m.type === "notice") showNotice(m);
     else if (m.type === "report") log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
   };
 }
@@ -70,14 +71,24 @@ function send(request) {
   return id;
 }
 
+// Each line numbered from the page's first (the oldest go past 200 lines; the numbers stay those they were given).
+let logged = 0;
 function log(text, error) {
   const li = document.createElement("li");
+  li.value = ++logged;
   li.textContent = `${new Date().toLocaleTimeString()}  ${text}`;
   if (error) li.className = "error";
   const list = $("log");
   list.appendChild(li);
   while (list.children.length > 200) list.removeChild(list.firstChild);
   list.scrollTop = list.scrollHeight;
+}
+
+// What the workbench did on its own (a stream stopped because its page went away, a STOP's outcome): a page that
+// opens later (a reload) is told what happened before it, at the time it happened.
+function showNotice(m) {
+  if (m.earlier) log(`before this page opened, at ${new Date(m.at_ms).toLocaleTimeString()}: ${m.text}`);
+  else log(m.text, true);
 }
 
 function showReply(m) {
@@ -111,7 +122,7 @@ const liveCharts = [];
 
 function showRig(rig) {
   state.rig = rig;
-  $("rig-name").textContent = `${rig.name} (${rig.source})`;
+  $("rig-name").textContent = `${rig.name} (${rig.source})` + (rig.firmware ? ` · ${rig.firmware}` : "");
   const axis = $("jog-axis");
   axis.innerHTML = "";
   rig.axes.forEach((kind, i) => {
@@ -265,10 +276,18 @@ $("start-help").textContent = "Start lets the device follow setpoints: it waits 
 const cue = { config: null, fields: [], drive: null, charts: [], timer: null };
 
 async function post(path, body) {
-  const r = await fetch(api(path), { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) });
-  const j = await r.json().catch(() => ({ error: `HTTP ${r.status}` }));
-  if (!r.ok) throw new Error(j.error || `HTTP ${r.status}`);
-  return j;
+  return answered(await fetch(api(path), { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) }));
+}
+
+// A response's JSON, or an error in the words the server gave: its JSON's `error`, else its text or the status's
+// name with the status (a proxy's or the server's own refusal in front of the workbench's).
+async function answered(r) {
+  const text = await r.text();
+  let j = null;
+  try { j = JSON.parse(text); } catch (_) { j = null; }
+  if (r.ok && j) return j;
+  if (j && j.error) throw new Error(j.error);
+  throw new Error(`${text.trim() || r.statusText || "no reason given"} (HTTP ${r.status})`);
 }
 
 async function loadCueDefaults() {
@@ -470,25 +489,34 @@ function escapeHtml(s) {
 }
 
 // ---- Runs ----
+// The file goes as its bytes (never held as text here) and comes back drawn at a few thousand points: a record of
+// a whole evening opens. The most the server reads (its `ui::runs::MOST_BYTES`), said before sending.
+const RUN_MOST_BYTES = 1073741824;
 $("run-file").addEventListener("change", async (e) => {
   const file = e.target.files[0];
   if (!file) return;
+  const status = $("run-status");
   try {
-    showRun(await post("/api/run", { text: await file.text() }), file.name);
+    if (file.size > RUN_MOST_BYTES) throw new Error(`${(file.size / 1048576).toFixed(0)} MiB: the Runs panel reads at most ${RUN_MOST_BYTES / 1048576} MiB; plot a part of it with \`ringpod plot\``);
+    status.className = "small"; status.textContent = `${file.name}: reading ${(file.size / 1048576).toFixed(1)} MiB…`;
+    const r = await fetch(api("/api/run"), { method: "POST", headers: { "content-type": "text/csv" }, body: file });
+    showRun(await answered(r), file.name);
   } catch (err) {
-    $("run-status").className = "small msg bad"; $("run-status").textContent = `${file.name}: ${err.message}`;
+    status.className = "small msg bad"; status.textContent = `${file.name}: ${err.message}`;
     $("run-charts").innerHTML = "";
   }
 });
 
 function showRun(run, name) {
-  const events = [];
-  run.state.forEach((s, i) => { if (i > 0 && s !== run.state[i - 1]) events.push({ x: run.t[i], colour: "#9ca3af", label: s }); });
+  const events = run.changes.map((c) => ({ x: c.t, colour: "#9ca3af", label: c.state }));
   run.limited.forEach((l, i) => { if (l && (i === 0 || !run.limited[i - 1])) events.push({ x: run.t[i], colour: "#f59e0b" }); });
   run.refused.forEach((r, i) => { if (r && (i === 0 || !run.refused[i - 1])) events.push({ x: run.t[i], colour: "#dc2626" }); });
+  state.run = { rows: run.rows, points: run.t.length };
+  const drawn = run.rows_per_span > 1 ? `, drawn as ${run.t.length} points (the lowest and highest of each ${run.rows_per_span} rows)` : "";
+  const more = run.more_changes ? `, ${run.more_changes} more state changes not marked` : "";
   $("run-status").className = "small";
-  $("run-status").textContent = `${name}: ${run.t.length} rows over ${(run.t[run.t.length - 1] - run.t[0]).toFixed(2)} s; ` +
-    `grey lines: state changes, amber: limited, red: refused`;
+  $("run-status").textContent = `${name}: ${run.rows} rows over ${(run.t[run.t.length - 1] - run.t[0]).toFixed(2)} s${drawn}; ` +
+    `grey lines: state changes${more}, amber: limited, red: refused`;
   const charts = $("run-charts");
   charts.innerHTML = "";
   AXES.forEach((a, i) => new Chart(charts, a, i < 3 ? " m" : " rad").set([

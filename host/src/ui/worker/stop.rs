@@ -65,6 +65,8 @@ impl Device {
         let text = format!("STOP: the device answered but did not power down: {e:#}");
         self.hub
             .publish(&json!({ "type": "stop_pending", "pending": false, "text": text }));
+        // Also for a page that opens later (a STOP the workbench gave for a page that went away).
+        self.hub.keep(text);
     }
 
     /// The device confirmed the STOP (`page`'s request `id`, 0 for one given again): the pages are told.
@@ -72,6 +74,7 @@ impl Device {
         let confirmed = format!("STOP confirmed: {text}");
         self.hub
             .publish(&json!({ "type": "stop_pending", "pending": false, "text": confirmed }));
+        self.hub.keep(confirmed);
         self.hub
             .publish(&json!({ "type": "halted", "page": page, "id": id, "text": text }));
     }

@@ -19,7 +19,7 @@
 //! Each bound takes only differences of vectors IK and the fast checks compute anyway. While both margins stay
 //! above their bounds (with [`SLACK`] for rounding), the checks pass and report those lower bounds; otherwise they
 //! are evaluated, and the guard starts again from there. Tested against full evaluation on random walks
-//! (`shared/tests/guard.rs`).
+//! (`shared/tests/suite/guard.rs`).
 
 use super::checks::{Configuration, SlowMargins};
 use super::RingPlatform;

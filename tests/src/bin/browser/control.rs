@@ -212,7 +212,22 @@ pub async fn lost_page(c: &Client, url: &str) -> Result<String, String> {
         Duration::from_secs(30),
     )
     .await?;
+    // The new page's log says what happened before it opened, numbered whole (a tenth line reads "10.", not "0.").
+    let told = until(
+        c,
+        "[...document.querySelectorAll('#log li')].map((l) => l.textContent)\
+         .find((t) => t.includes('before this page opened') && t.includes('went away')) || false",
+        Duration::from_secs(10),
+    )
+    .await?;
+    let numbers = js(c, "getComputedStyle(document.getElementById('log')).listStylePosition").await?;
+    if numbers != json!("inside") {
+        return Err(format!(
+            "the log's numbers are outside its lines ({numbers}), where a wide one is cut"
+        ));
+    }
     Ok(format!(
-        "the stream of the page that left ended, and with no page left the platform powered down; device {state}"
+        "the stream of the page that left ended, and with no page left the platform powered down; device {state}; \
+         the new page's log says {told}"
     ))
 }

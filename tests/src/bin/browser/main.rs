@@ -1,8 +1,9 @@
 //! `cargo run -p ringpod-tests --bin browser`: `ringpod ui --sim` in a real browser (Debian's headless Chromium,
 //! driven through ChromeDriver over WebDriver).
 //!
-//! 1. Chromium and ChromeDriver (installed with apt-get when missing and allowed, as QEMU is), and the CLI
-//!    (`cargo build -p ringpod`), and a run record made by `ringpod stream --sim --record`.
+//! 1. Chromium and ChromeDriver (installed with apt-get when missing and allowed, as QEMU is), and the CLI (the
+//!    release build the README's main command makes, `ringpod_tests::cli`), and a run record made by `ringpod
+//!    stream --sim --record`.
 //! 2. `ringpod ui --sim --listen 127.0.0.1:0`, its URL read from its first line; ChromeDriver on a free port.
 //! 3. The checks, each a `PASS`/`FAIL` line: the page connects and draws; Enable and Home through the buttons, a
 //!    disabled button says why; the demo runs and the 3D pose and the counters advance; STOP (the button, and the
@@ -31,7 +32,8 @@ use serde_json::json;
 use control::{connects, demo_runs, enable_and_home, lost_page, space_bar, stop_button, udp_session};
 use origin::other_origin;
 use panels::{cueing, rig_editor, runs};
-use process::{build_cli, chromedriver, record, serve};
+use process::{chromedriver, record, serve};
+use ringpod_tests::cli;
 
 struct Checks {
     passed: u32,
@@ -117,7 +119,7 @@ fn main() -> ExitCode {
         }
     };
     let prepared = setup::ensure_browser()
-        .and_then(|()| build_cli())
+        .and_then(|()| cli::build_release())
         .and_then(|cli| Ok((record(&cli)?, cli)))
         .and_then(|(record, cli)| Ok((record, serve(&cli)?, chromedriver()?)));
     let (record, (_ui, url), (_driver, driver)) = match prepared {

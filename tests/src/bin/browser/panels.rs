@@ -188,13 +188,16 @@ pub async fn runs(c: &Client, record: &Path, shots: Option<&Path>) -> Result<Str
         .map_err(|e| e.to_string())?;
     let status = until(
         c,
-        "document.getElementById('run-status').textContent.includes('rows') && document.getElementById('run-status').textContent",
+        // Drawn, or refused (the file's own name, browser-run.csv, holds "rows": the words of a drawn record are
+        // waited for, not the word).
+        "(document.getElementById('run-status').textContent.includes(' rows over ') \
+         || document.getElementById('run-status').className.includes('bad')) && document.getElementById('run-status').textContent",
         Duration::from_secs(20),
     )
     .await?;
     let charts = js(c, "document.querySelectorAll('#run-charts canvas').length").await?;
     if charts != json!(12) {
-        return Err(format!("{charts} charts instead of 12"));
+        return Err(format!("{charts} charts instead of 12; the panel says {status}"));
     }
     screenshot(c, shots, "runs").await?;
     Ok(format!("{status}"))

@@ -29,19 +29,6 @@ pub fn free_port() -> Result<u16, String> {
     Ok(l.local_addr().map_err(|e| e.to_string())?.port())
 }
 
-pub fn build_cli() -> Result<PathBuf, String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(repo())
-        .args(["build", "-p", "ringpod"])
-        .status()
-        .map_err(|e| format!("cargo build -p ringpod: {e}"))?;
-    if !status.success() {
-        return Err(format!("cargo build -p ringpod failed ({status})"));
-    }
-    Ok(target_dir().join("debug").join("ringpod"))
-}
-
 /// A short run record of the simulated controller, for the Runs panel.
 pub fn record(cli: &Path) -> Result<PathBuf, String> {
     let path = target_dir().join("browser-run.csv");

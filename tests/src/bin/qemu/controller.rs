@@ -1,6 +1,5 @@
 //! The controller's firmware tasks on the emulated MCU, streamed through its UART as a board is over USB.
 
-use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
@@ -8,23 +7,9 @@ use crate::emulator::start_or_fail;
 use crate::host_cli::{ringpod, ringpod_json, send_garbage, write_beyond_envelope, write_input};
 use crate::Tally;
 
-/// Builds the host CLI the runs drive.
-fn build_cli() -> Result<(), String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let cli = Command::new(&cargo)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .args(["build", "--release", "-p", "ringpod"])
-        .status();
-    if cli.is_ok_and(|s| s.success()) {
-        Ok(())
-    } else {
-        Err("the host CLI does not build".into())
-    }
-}
-
 /// Builds everything the suite runs: the host CLI and both Cortex-M4F programs.
 pub(crate) fn build_all() -> Result<(), String> {
-    build_cli()?;
+    ringpod_tests::cli::build_release()?;
     crate::emulator::build("ringpod-qemu")?;
     crate::emulator::build("ringpod-qemu-controller").map(|_| ())
 }
@@ -32,7 +17,7 @@ pub(crate) fn build_all() -> Result<(), String> {
 /// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
 pub(crate) fn controller_on_m4f(t: &mut Tally) {
     println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
-    if build_cli().is_err() {
+    if ringpod_tests::cli::build_release().is_err() {
         t.check(false, "the host CLI builds");
         return;
     }
@@ -265,7 +250,7 @@ fn stream_loss(t: &mut Tally, pty: &str) {
 /// timeout), as a busy test machine gives one: the stream goes on, every setpoint applied, no restart. Under
 /// `-icount` device time stands still while QEMU is stopped, so the device sees no hold-up of its own (the periods it
 /// passed are printed); the firmware's catch-up after a hold-up of device time is the core's and the simulator's
-/// test (`Controller::pass`, `host/tests/link.rs`).
+/// test (`Controller::pass`, `host/tests/suite/link.rs`).
 fn hold_up_mid_stream(t: &mut Tally, emulated: &crate::emulator::Emulated) {
     let pty = emulated.pty.as_str();
     let passed = |s: &serde_json::Value| s["passed_periods"].as_u64().unwrap_or(0);

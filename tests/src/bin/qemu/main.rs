@@ -10,8 +10,10 @@
 //! 3. `watchdog`: a stalled control loop reset by the watchdog. 4. `rig`: a rig of one's own loaded and run, and
 //!    the elbow trainer's and the rotopod's rig files likewise.
 //!
-//! `--busy` builds everything first, then runs the suite beside two spinning threads per core (`ringpod_tests::busy`):
-//! the emulated controller keeps device time under `-icount` and its checks hold on a loaded machine.
+//! Everything is built first; then the sections run as child processes of this runner (`--section NAME` runs one),
+//! one per two cores at once. `--busy` runs the suite beside two spinning threads per core
+//! (`ringpod_tests::busy`): the emulated controller keeps device time under `-icount` and its checks hold on a loaded
+//! machine.
 //!
 //! `setup` installs what the suite needs first (the target's standard library, QEMU) or says how;
 //! `cargo run -p ringpod-tests --bin qemu -- --preflight` runs only that. `emulator` starts QEMU and the programs;
@@ -32,6 +34,7 @@ use crate::rig::{elbow_on_m4f, rig_on_m4f, rotopod_on_m4f};
 use crate::self_check::core_on_m4f;
 use crate::watchdog::watchdog_on_m4f;
 use ringpod_tests::busy::{load_average, Busy};
+use ringpod_tests::sections;
 use ringpod_tests::setup::{self, preflight};
 
 pub(crate) struct Tally {
@@ -48,17 +51,67 @@ impl Tally {
             self.failed += 1;
         }
     }
+
+    /// The runner's last line, and its exit status.
+    fn end(self) -> ExitCode {
+        println!("{} passed, {} failed", self.passed, self.failed);
+        if self.failed == 0 {
+            ExitCode::SUCCESS
+        } else {
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// A section of the suite: its checks, counted in the tally.
+type Section = fn(&mut Tally);
+
+/// The suite's sections, longest first (each starts its own QEMU).
+const SECTIONS: [(&str, Section); 6] = [
+    ("controller", controller_on_m4f),
+    ("watchdog", watchdog_on_m4f),
+    ("core", core_on_m4f),
+    ("rig", rig_on_m4f),
+    ("elbow", elbow_on_m4f),
+    ("rotopod", rotopod_on_m4f),
+];
+
+enum Mode {
+    Suite { busy: bool },
+    Preflight,
+    Section(Section),
+}
+
+fn mode() -> Result<Mode, String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
+        [] => Ok(Mode::Suite { busy: false }),
+        ["--preflight"] => Ok(Mode::Preflight),
+        ["--busy"] => Ok(Mode::Suite { busy: true }),
+        ["--section", name] | ["--busy", "--section", name] => SECTIONS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, run)| Mode::Section(*run))
+            .ok_or_else(|| format!("no section {name:?} (one of {:?})", SECTIONS.map(|(n, _)| n))),
+        _ => Err(format!(
+            "unknown arguments {args:?} (--preflight, --busy, or --section NAME)"
+        )),
+    }
 }
 
 fn main() -> ExitCode {
-    let (only_preflight, busy) = match std::env::args().nth(1).as_deref() {
-        None => (false, false),
-        Some("--preflight") => (true, false),
-        Some("--busy") => (false, true),
-        Some(other) => {
-            eprintln!("qemu: unknown argument {other:?} (--preflight, or --busy)");
+    let busy = match mode() {
+        Err(e) => {
+            eprintln!("qemu: {e}");
             return ExitCode::from(2);
         }
+        Ok(Mode::Section(run)) => {
+            let mut t = Tally { passed: 0, failed: 0 };
+            run(&mut t);
+            return t.end();
+        }
+        Ok(Mode::Preflight) => return preflight_only(),
+        Ok(Mode::Suite { busy }) => busy,
     };
     // Nothing is built before this passes: a missing piece is one line naming its command, not a compiler error.
     if let Err(e) = preflight() {
@@ -66,33 +119,24 @@ fn main() -> ExitCode {
         println!("0 passed, 1 failed");
         return ExitCode::FAILURE;
     }
-    if only_preflight {
-        println!(
-            "preflight: the {} standard library and qemu-system-arm are installed",
-            setup::TARGET
-        );
-        return ExitCode::SUCCESS;
+    // Everything is built first, so that the sections do not wait on one another's cargo.
+    if let Err(e) = controller::build_all() {
+        eprintln!("qemu: {e}");
+        println!("0 passed, 1 failed");
+        return ExitCode::FAILURE;
     }
-    let mut t = Tally { passed: 0, failed: 0 };
-    // `--busy`: everything is built first, then the suite runs beside two spinning threads per core.
-    let load = if busy {
-        if let Err(e) = controller::build_all() {
-            eprintln!("qemu: {e}");
-            println!("0 passed, 1 failed");
-            return ExitCode::FAILURE;
-        }
+    // `--busy`: the suite runs beside two spinning threads per core.
+    let load = busy.then(|| {
         let load = Busy::start(2);
         println!("== beside {} busy threads (a loaded machine)", load.threads());
-        Some(load)
-    } else {
-        None
-    };
-    core_on_m4f(&mut t);
-    controller_on_m4f(&mut t);
-    watchdog_on_m4f(&mut t);
-    rig_on_m4f(&mut t);
-    elbow_on_m4f(&mut t);
-    rotopod_on_m4f(&mut t);
+        load
+    });
+    // A streamed section keeps about a core busy (QEMU's CPU thread counts device time in instructions) and its CLI
+    // answers in real time: one section per two cores, so that a section is never starved into a late answer (on
+    // two cores the sections run one after the other).
+    let jobs = std::thread::available_parallelism().map_or(1, |n| n.get() / 2).max(1);
+    let names = SECTIONS.map(|(n, _)| n);
+    let sections = sections::run(&names, if busy { &["--busy"] } else { &[] }, jobs);
     if let Some(load) = load {
         let average = load_average().map_or("unknown".into(), |l| format!("{l:.1}"));
         println!(
@@ -100,10 +144,26 @@ fn main() -> ExitCode {
             load.threads()
         );
     }
-    println!("{} passed, {} failed", t.passed, t.failed);
-    if t.failed == 0 {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::FAILURE
+    Tally {
+        passed: sections.passed,
+        failed: sections.failed,
+    }
+    .end()
+}
+
+fn preflight_only() -> ExitCode {
+    match preflight() {
+        Ok(()) => {
+            println!(
+                "preflight: the {} standard library and qemu-system-arm are installed",
+                setup::TARGET
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("qemu: {e}");
+            println!("0 passed, 1 failed");
+            ExitCode::FAILURE
+        }
     }
 }

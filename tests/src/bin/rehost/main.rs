@@ -3,8 +3,8 @@
 //!
 //! 1. The `thumbv7em-none-eabihf` standard library (the preflight the QEMU runner uses), then
 //!    `cargo build -p ringpod-firmware --target thumbv7em-none-eabihf --profile firmware`.
-//!    Then the host CLI (`cargo build -p ringpod`), which run.py drives over ptys bridged to the emulated USART1
-//!    and to the USB host on the emulated OTG FS core.
+//!    Then the host CLI, the release build the README's main command makes (`ringpod_tests::cli`), which run.py
+//!    drives over ptys bridged to the emulated USART1 and to the USB host on the emulated OTG FS core.
 //! 2. A Python venv in `target/rehost-venv` with the pinned emulator (`tests/rehost/requirements.txt`), made again
 //!    whenever that file changes.
 //! 3. The firmware's flash against its budget (`size`), counted as one check.
@@ -12,6 +12,7 @@
 //!    print `PASS`/`FAIL` lines. The last line is the sum, `N passed, N failed`; the exit status is 1 when anything
 //!    failed.
 //!
+//! Other arguments go to run.py (`-- --until serial-status` stops after that check; `-- --help` lists them).
 //! `-- --mutants [NAME...]`: instead, the firmware faults of `tests/rehost/mutants.toml`, each built from a copy of
 //! the sources and run up to the check meant to catch it (`mutants`).
 
@@ -23,7 +24,8 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, ExitCode};
 
-use prepare::{build_cli, build_firmware, repo, run_py, venv};
+use prepare::{build_firmware, repo, run_py, venv};
+use ringpod_tests::cli;
 use ringpod_tests::setup;
 
 /// The models' unit tests: Ok(number of tests) when all passed.
@@ -56,8 +58,9 @@ fn tally(line: &str) -> Option<(u32, u32)> {
 }
 
 /// run.py, its lines passed through as they come, except its count, which is returned.
-fn checks(python: &Path, elf: &Path, cli: &Path) -> Result<(u32, u32, bool), String> {
-    let mut child = run_py(python, elf, cli, &[])?;
+fn checks(python: &Path, elf: &Path, cli: &Path, args: &[String]) -> Result<(u32, u32, bool), String> {
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let mut child = run_py(python, elf, cli, &args)?;
     let mut count = None;
     if let Some(out) = child.stdout.take() {
         for line in BufReader::new(out).lines().map_while(Result::ok) {
@@ -75,7 +78,7 @@ fn checks(python: &Path, elf: &Path, cli: &Path) -> Result<(u32, u32, bool), Str
 fn main() -> ExitCode {
     let prepared = setup::ensure_target()
         .and_then(|()| build_firmware())
-        .and_then(|elf| Ok((elf, build_cli()?, venv()?)));
+        .and_then(|elf| Ok((elf, cli::build_release()?, venv()?)));
     let (elf, cli, python) = match prepared {
         Ok(p) => p,
         Err(e) => {
@@ -124,7 +127,7 @@ fn main() -> ExitCode {
         }
     }
     let mut ok = failed == 0;
-    match checks(&python, &elf, &cli) {
+    match checks(&python, &elf, &cli, &args) {
         Ok((p, f, exited_ok)) => {
             passed += p;
             failed += f;

@@ -50,16 +50,6 @@ pub fn build_firmware_at(root: &Path, target: &Path) -> Result<PathBuf, String> 
     Ok(target.join(setup::TARGET).join("firmware").join(FIRMWARE))
 }
 
-/// The host CLI, driven by run.py over a pty on the emulated USART1.
-pub fn build_cli() -> Result<PathBuf, String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    run(
-        Command::new(cargo).current_dir(repo()).args(["build", "-p", "ringpod"]),
-        "cargo build -p ringpod",
-    )?;
-    Ok(target_dir().join("debug").join("ringpod"))
-}
-
 /// The venv's Python, with `requirements.txt` installed exactly.
 pub fn venv() -> Result<PathBuf, String> {
     let dir = target_dir().join("rehost-venv");

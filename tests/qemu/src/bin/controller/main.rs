@@ -112,8 +112,9 @@ impl app::settings::Board for SettingsBoard {
         // No flash erase stalls the emulated CPU: the watchdog needs no widening.
     }
 
-    fn restart(&mut self) -> ! {
-        // SYSRESETREQ: QEMU resets the machine; the retained RAM (settings flash) stays.
+    fn restart(&mut self, _into: ringpod_core::controller::Restart) -> ! {
+        // SYSRESETREQ: QEMU resets the machine; the retained RAM (settings flash) stays. The emulated board has no
+        // ROM bootloader: a request for it restarts the controller.
         cortex_m::peripheral::SCB::sys_reset()
     }
 }

@@ -1,0 +1,59 @@
+//! A jog's end: the drivers stay enabled through the period that plays its last steps.
+
+use crate::common::device;
+
+use ringpod_core::controller::Controller;
+use ringpod_core::protocol::{DeviceMessage, HostMessage, Request};
+use ringpod_core::safety::{Command, Inputs, State};
+
+fn powered() -> Controller {
+    let mut c = device::connected();
+    c.set_inputs(Inputs {
+        logic_ok: true,
+        power_ok: true,
+        ..Inputs::default()
+    });
+    let r = c.handle(&Request {
+        id: 2,
+        body: HostMessage::Command(Command::Enable),
+    });
+    assert_eq!(r.body, DeviceMessage::Ack);
+    for _ in 0..3_000 {
+        c.tick();
+        if c.supervisor().state() == (State::PowerOn { settled: true }) {
+            return c;
+        }
+    }
+    panic!("never powered: {:?}", c.supervisor().state());
+}
+
+#[test]
+fn the_drivers_stay_enabled_for_the_period_after_a_jogs_last_steps() {
+    // A board plays a tick's moves in the period after it, and ticks again before that period ends: the tick
+    // after the last steps must still enable the drivers, or the last steps play into disabled drivers.
+    for steps in [1, 36, -5] {
+        let mut c = powered();
+        let r = c.handle(&Request {
+            id: 3,
+            body: HostMessage::Jog { axis: 0, steps },
+        });
+        assert_eq!(r.body, DeviceMessage::Ack, "{steps}");
+        let mut last_move = None;
+        for period in 0..10_000 {
+            let out = c.tick();
+            if out.moves.iter().any(|m| m.count > 0) {
+                last_move = Some(period);
+            }
+            if !out.outputs.driver_enable {
+                let last = last_move.expect("the jog moved");
+                assert!(
+                    period >= last + 2,
+                    "jog of {steps}: drivers off in period {period}, last steps planned in {last}"
+                );
+                assert_eq!(c.steps()[0], i64::from(steps));
+                break;
+            }
+        }
+        assert_eq!(c.supervisor().state(), State::PowerOn { settled: true }, "{steps}");
+    }
+}

@@ -1,0 +1,159 @@
+//! `cargo run -p ringpod-tests --bin all`: the README's test command. Every test of the project, the emulators'
+//! and the browser's runs and the Windows build under Wine, arranged so that two cores are both at work:
+//!
+//! 1. `cargo test --no-run`: the workspace's test programs, built with both cores.
+//! 2. `cargo test` alone: most of its tests wait on a child `ringpod` in real time, and a build beside them would
+//!    starve their answers.
+//! 3. Then two lanes side by side. Lane one, its output as it comes: the QEMU suite, the rehost run and the browser
+//!    tests, each keeping about one core busy. Lane two: the Windows runner, its cross-build on one job
+//!    (`CARGO_BUILD_JOBS=1`) in a target folder of its own (`target/windows`: a cross-build holds the build folder's
+//!    lock for minutes, and the runners of lane one build in it), then its programs under Wine; its output is
+//!    written to `target/windows-runner.log` as it comes and printed whole once lane one is over.
+//!
+//! Each part runs whatever the others gave. The last lines name each part with its result and time, and the exit
+//! status is 1 when any part failed. On a system other than Linux only `cargo test` runs: the emulators, the
+//! browser tests and Wine are Linux tools (the book's Tests chapter).
+
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitCode, Stdio};
+use std::time::{Duration, Instant};
+
+/// A part of the run: what it was, whether it passed, how long it took.
+struct Part {
+    name: String,
+    passed: bool,
+    took: Duration,
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| repo().join("target"), PathBuf::from)
+}
+
+fn cargo() -> Command {
+    let mut c = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()));
+    c.current_dir(repo());
+    c
+}
+
+/// A runner of this crate, beside this program.
+fn runner(name: &str) -> Command {
+    let exe = std::env::current_exe().map_or_else(|_| PathBuf::from(name), |me| me.with_file_name(name));
+    let mut c = Command::new(exe);
+    c.current_dir(repo());
+    c
+}
+
+/// Runs `c` with its output as it comes.
+fn part(name: &str, mut c: Command) -> Part {
+    println!("== {name}");
+    let start = Instant::now();
+    let passed = c.status().is_ok_and(|s| s.success());
+    Part {
+        name: name.into(),
+        passed,
+        took: start.elapsed(),
+    }
+}
+
+/// The Windows runner in its own target folder, on one job, its output to `log`.
+fn windows_lane(log: &Path) -> Result<Child, String> {
+    let target = target_dir().join("windows");
+    std::fs::create_dir_all(&target).map_err(|e| format!("{}: {e}", target.display()))?;
+    let out = std::fs::File::create(log).map_err(|e| format!("{}: {e}", log.display()))?;
+    let err = out.try_clone().map_err(|e| format!("{}: {e}", log.display()))?;
+    runner("windows")
+        .env("CARGO_TARGET_DIR", &target)
+        .env("CARGO_BUILD_JOBS", "1")
+        .stdin(Stdio::null())
+        .stdout(out)
+        .stderr(err)
+        .spawn()
+        .map_err(|e| format!("the Windows runner: {e}"))
+}
+
+fn main() -> ExitCode {
+    if let Some(other) = std::env::args().nth(1) {
+        eprintln!("all: unknown argument {other:?} (it takes none)");
+        return ExitCode::from(2);
+    }
+    let mut parts = Vec::new();
+    if !cfg!(target_os = "linux") {
+        let mut test = cargo();
+        test.args(["test", "--no-fail-fast"]);
+        parts.push(part("cargo test", test));
+        println!("the QEMU suite, the rehost run, the browser tests and the Windows build under Wine run on Linux");
+        return summary(&parts);
+    }
+    let mut build = cargo();
+    build.args(["test", "--no-run"]);
+    let built = part("the test programs (cargo test --no-run)", build);
+    let mut runners = cargo();
+    runners.args(["build", "-p", "ringpod-tests", "--bins"]);
+    let runners = part("the runners (cargo build -p ringpod-tests --bins)", runners);
+    let ready = built.passed && runners.passed;
+    parts.extend([built, runners]);
+    if !ready {
+        return summary(&parts);
+    }
+    // cargo test alone: most of its tests wait on a child `ringpod` in real time, and a build beside them starves
+    // their answers.
+    let mut test = cargo();
+    test.args(["test", "--no-fail-fast"]);
+    parts.push(part("cargo test", test));
+    let log = target_dir().join("windows-runner.log");
+    let started = Instant::now();
+    let mut windows = windows_lane(&log);
+    match &windows {
+        Ok(_) => println!(
+            "== the Windows runner, beside the rest: its output at the end ({})",
+            log.display()
+        ),
+        Err(e) => println!("FAIL {e}"),
+    }
+    for name in ["qemu", "rehost", "browser"] {
+        parts.push(part(&format!("the {name} runner"), runner(name)));
+    }
+    let passed = windows
+        .as_mut()
+        .map_err(|e| e.clone())
+        .and_then(|child| child.wait().map_err(|e| format!("the Windows runner: {e}")))
+        .is_ok_and(|s| s.success());
+    println!("== the Windows runner's output");
+    match std::fs::File::open(&log) {
+        Ok(f) => BufReader::new(f)
+            .lines()
+            .map_while(Result::ok)
+            .for_each(|l| println!("{l}")),
+        Err(e) => println!("{}: {e}", log.display()),
+    }
+    parts.push(Part {
+        name: "the windows runner (beside)".into(),
+        passed,
+        took: started.elapsed(),
+    });
+    summary(&parts)
+}
+
+/// The parts with their results and times; the exit status.
+fn summary(parts: &[Part]) -> ExitCode {
+    println!("== the test command");
+    for p in parts {
+        println!(
+            "{:<52} {} in {:.0} s",
+            p.name,
+            if p.passed { "passed" } else { "FAILED" },
+            p.took.as_secs_f64()
+        );
+    }
+    let _ = std::io::stdout().flush();
+    if parts.iter().all(|p| p.passed) {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}
