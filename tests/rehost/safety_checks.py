@@ -26,6 +26,7 @@ STEP edges and its switches) and in the device's own status:
 """
 
 import json
+from collections import Counter
 import os
 import re
 import subprocess
@@ -287,7 +288,7 @@ def _opened_while(m, cli, port, plant, args, motion_needed):
 
 
 def estop_states_check(checks, m, cli, port, plant):
-    """Off (after the power-down): the e-stop chain opened in Off, PowerOn, Jogging and Homing."""
+    """Off (after the power-down): the e-stop chain opened in Off, PowerOn, Jogging, Homing and Ready."""
     said, ok = [], True
     # Off: nothing to stop; enable is refused while the chain is open
     plant.open_estop(True)
@@ -324,7 +325,33 @@ def estop_states_check(checks, m, cli, port, plant):
         m.run(m.now + SYSCLK // 50)
         cli.run("device", "clear", *port)  # logic alone kept: back to Off
         m.run(m.now + SYSCLK // 50)
+    ok &= _estop_ready(m, cli, port, plant, said)
     checks.check("estop-states", ok, "; ".join(said))
+
+
+def _estop_ready(m, cli, port, plant, said):
+    """Ready: homed to the end and holding, the chain opened: no STEP edge after it, the drivers and the motor
+    supply off, the logic kept, the homing lost (a fault's rule); then closed and cleared back to Off."""
+    en = _enable(m, cli, port)
+    home = cli.run("device", "home", *port)
+    m.run(m.now + SYSCLK // 20)  # the steps still in the ring
+    ready = _status(cli, port)
+    plant.reset_counts()
+    plant.open_estop(True)
+    m.run(m.now + SYSCLK // 20)
+    outputs, edges = _odr(m), list(plant.steps)
+    status = _status(cli, port)
+    fault = _fault_state(status)
+    good = (en.code == 0 and home.code == 0 and ready.get("state") == "Ready" and ready.get("homed") is True
+            and "EStop" in fault and outputs == (1, 1, 0) and edges == [0] * 6 and status.get("homed") is False)
+    said.append(f"Ready: `device home` exit {home.code}, state {ready.get('state')}, homed {ready.get('homed')}; "
+                f"opened: STEP edges after {edges}, state {fault}, homed {status.get('homed')}, ENABLE, LOGIC, POWER "
+                f"{outputs} (want 1, 1, 0)")
+    plant.open_estop(False)
+    m.run(m.now + SYSCLK // 50)
+    cli.run("device", "clear", *port)
+    m.run(m.now + SYSCLK // 50)
+    return good
 
 
 def limit_check(checks, m, cli, port, plant):
@@ -405,6 +432,7 @@ def jog_buzz_check(checks, m, cli, port, plant):
     for axis in range(6):
         before = _status(cli, port).get("steps")
         plant.reset_counts()
+        ignored0, undriven0, at0 = Counter(plant.ignored), plant.dir_undriven, len(plant.ignored_at)
         jog = cli.run("device", "jog", str(axis + 1), "0.5" if axis < 4 else "0.1", *port)
         _until_still(m, plant)
         jogged = list(plant.net)
@@ -419,7 +447,9 @@ def jog_buzz_check(checks, m, cli, port, plant):
         ok &= good
         said.append(f"axis {axis + 1}: jogged {jogged[axis]} steps, then {plant.steps[axis] - abs(jogged[axis])} "
                     f"buzz edges; device moved {moved}, STEP edges {plant.net}, other axes' edges {others}"
-                    + ("" if good else f"; {jog}; {buzz}; state {after.get('state')}"))
+                    + ("" if good else f"; {jog}; {buzz}; state {after.get('state')}; STEP rises no driver saw "
+                       f"{dict(plant.ignored - ignored0)} (first at {plant.ignored_at[at0:]}), steps with DIR undriven "
+                       f"{plant.dir_undriven - undriven0}"))
     cli.run("device", "disable", *port)
     m.run(m.now + int(0.6 * SYSCLK))
     checks.check("jog-buzz-axes", ok, "; ".join(said))
