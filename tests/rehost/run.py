@@ -162,7 +162,7 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
-def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, jog_buzz=False, rom=None,
+def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, rom=None,
                   elf=None):
     c = CHECKS
     u = m.usart1
@@ -243,11 +243,7 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
         silent_check(CHECKS, m, cli, port, plant, bridge, "usart-silent-gone", power_down=True)
     estop_states_check(CHECKS, m, cli, port, plant)
     limit_check(CHECKS, m, cli, port, plant)
-    if jog_buzz:
-        jog_buzz_check(CHECKS, m, cli, port, plant)
-    else:
-        cli.run("device", "disable", *port)
-        m.run(m.now + int(0.6 * SYSCLK))
+    jog_buzz_check(CHECKS, m, cli, port, plant)
     if hold_ups:
         homing_check(m, plant, cli, port, name="serial-home-hold-ups")
         hold_up_checks(CHECKS, m, cli, port)
@@ -407,8 +403,6 @@ def main():
     ap.add_argument("--no-usb", action="store_true", help="no USB host: every link check over USART1")
     ap.add_argument("--usb-full", action="store_true",
                     help="also homing over USB, and the cable pulled mid-stream and plugged again (usb_checks.py)")
-    ap.add_argument("--jog-buzz", action="store_true",
-                    help="also jog and buzz every axis (safety_checks.py; a buzz of a linear actuator is 32,000 steps)")
     ap.add_argument("--until", help="stop after this check (the mutants' runs)")
     ap.add_argument("--max-sim-s", type=float, default=90.0, help="stop the run past this many simulated seconds")
     ap.add_argument("--max-wall-s", type=float, default=2400.0, help="stop the run past this many wall seconds")
@@ -590,7 +584,7 @@ def main():
 
     # -- the host link on USART1: the real CLI over a pty --
     if args.ringpod:
-        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, args.jog_buzz, rom,
+        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, rom,
                       args.elf)
     if not args.ringpod:
         pins_check(c, plant, plant.ignored, plant.dir_undriven)
