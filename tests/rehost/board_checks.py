@@ -11,7 +11,8 @@ the STEP edges the drivers could see, the step signals' timing, and the e-stop c
   one), and no read so far found one floating.
 - `pins-electrical`: every STEP rise of the run reached a driver (STEP driven as an output, the drivers enabled,
   the motor supply on) and every step had its DIR driven, until the e-stop check opens the chain (a stop by design
-  cuts the drivers' enable under the period that is playing).
+  cuts the drivers' enable under the period that is playing); no edge on a pin of the step port that nothing is
+  wired to (PB11: a STEP bit there is a step no driver sees).
 - `estop`: the e-stop chain opened once the platform moves in `stream --motion demo`: the last STEP edge within
   the debounce (3 ms), the inputs task's sampling and the step ring's two periods; the supervisor latches
   `Fault(EStop)` and keeps only what that fault keeps (drivers disabled, motor power off, logic on); the CLI ends
@@ -84,9 +85,11 @@ def pins_check(checks, plant, ignored, undriven):
         return f"ENABLE changes around it {last + nxt}"
 
     at = [(round(t * 1000 / SYSCLK, 3), f"axis {a + 1}", why, enable_before(t)) for t, a, why in plant.ignored_at]
-    checks.check("pins-electrical", not ignored and not undriven,
+    stray = {f"PB{pin}": n for pin, n in sorted(plant.stray_edges.items())}
+    checks.check("pins-electrical", not ignored and not undriven and not stray,
                  f"STEP rises that reached no driver: {dict(ignored) or 'none'}{f' (ms, axis, why: {at})' if at else ''}; "
-                 f"steps with DIR undriven: {undriven} (until the e-stop check)")
+                 f"steps with DIR undriven: {undriven} (until the e-stop check); edges on the step port's unwired "
+                 f"pins (none of STEP, DIR, ENABLE, the relays): {stray or 'none'}")
 
 
 def timing(plant, slot_us, both_ways):

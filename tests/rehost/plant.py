@@ -16,6 +16,11 @@ electrically (the pins as `models.gpio.Gpio` says the chip drives them, not its 
   (`BOUNCE_US` after the first edge; 1.6 ms in all, within the 1-5 ms such switches are specified for), so that the
   firmware's debounce, not the plant, decides where it latched. The e-stop chain (PA0, normally closed, an
   external pull-up on the board) reads high when opened (`open_estop`).
+- Every pin of the step port (GPIOB) is watched: an edge on a pin that is none of the STEP, DIR, ENABLE and relay
+  pins above is counted in `stray_edges` by pin (nothing is wired there: a pulse on it is a step lost). Every change
+  of ENABLE and the relays is kept with its time (`output_changes`), for the supplies' order and delays.
+- Each linear actuator's far-end switch sits at `far_limit[a]` (240,000 steps), which a check may move near the
+  axis (as an end stop is set on a shorter stroke) to close it with a short move; `home_end` likewise.
 - Supply sense follows the relays at once: LOGIC_OK (PA9) is driven high while LOGIC_EN (PB14) is, POWER_OK (PC14)
   while POWER_EN (PB15) is; otherwise they are left to their pull-downs.
 - A pin whose level changes is an edge for the EXTI model (its line, if the firmware routed it there).
@@ -36,6 +41,9 @@ STEP = [0, 1, 2, 3, 4, 5]
 DIR = [6, 7, 8, 9, 10, 12]
 ENABLE_N, LOGIC_EN, POWER_EN = 13, 14, 15
 FLAG_WIDTH, FAR_LIMIT = 60, 240_000
+# board::resources::PORT_MAP: the pins of GPIOB something is wired to; an edge on another is a fault
+UNWIRED_B = 0xFFFF & ~sum(1 << p for p in {*STEP, *DIR, ENABLE_N, LOGIC_EN, POWER_EN})
+OUTPUTS_B = 1 << ENABLE_N | 1 << LOGIC_EN | 1 << POWER_EN
 BOUNCE_US = (150, 400, 900, 1_600)  # a contact's changes after its first edge: old, new, old, new level
 CYCLES_PER_US = SYSCLK // 1_000_000
 PORT_A, PORT_C = 0, 2
@@ -60,6 +68,10 @@ class Plant:
         self.dir_undriven = 0  # steps taken while the chip did not drive that axis's DIR
         self.ignored_at = []  # (time, axis, why) of the first ignored rises
         self.enable_changes = []  # (time, ENABLE's ODR bit) of every change
+        self.output_changes = []  # (time, pin, level) of every change of ENABLE, LOGIC_EN and POWER_EN
+        self.stray_edges = Counter()  # GPIOB pin -> edges on it, for the pins nothing is wired to
+        self.far_limit = [FAR_LIMIT] * 6  # where each linear actuator's far-end switch closes (steps)
+        self.home_end = [0] * 6  # where each linear actuator's home-end switch closes (steps, at and below)
         self.high_at = [None] * 6
         self.rise_at = [None] * 6  # the slot of each axis's last STEP rise
         self.dir_at = [None] * 6  # the slot of each axis's last DIR change
@@ -150,6 +162,14 @@ class Plant:
                 self.high_at[a] = None
         if changed >> ENABLE_N & 1:
             self.enable_changes.append((self.m.now, new >> ENABLE_N & 1))
+        if changed & OUTPUTS_B:
+            for pin in (ENABLE_N, LOGIC_EN, POWER_EN):
+                if changed >> pin & 1:
+                    self.output_changes.append((self.m.now, pin, new >> pin & 1))
+        if changed & UNWIRED_B:
+            for pin in range(16):
+                if (changed & UNWIRED_B) >> pin & 1:
+                    self.stray_edges[pin] += 1
         if changed & ((1 << 6) - 1 | 1 << LOGIC_EN | 1 << POWER_EN):
             self._update(new)
 
@@ -172,7 +192,7 @@ class Plant:
         b = self.gpio["b"]
         for a in range(6):
             p = self.position[a]
-            home = 0 <= p < FLAG_WIDTH if a < 4 else p <= 0
+            home = 0 <= p < FLAG_WIDTH if a < 4 else p <= self.home_end[a]
             level, old = (0 if home else None), (None if home else 0)
             if home == self.contact[a]:
                 if not self.bouncing[a]:  # driven again (a reset or a pull set since), unless it is bouncing
@@ -186,10 +206,16 @@ class Plant:
             self.contact[a] = home
             self._drive("a", 1 + a, level)
         for a, pin in ((4, 7), (5, 8)):
-            self._drive("a", pin, 0 if self.position[a] >= FAR_LIMIT else None)
+            self._drive("a", pin, 0 if self.position[a] >= self.far_limit[a] else None)
         self._drive("a", ESTOP, 1 if self.estop_open else 0)
         self._drive("a", LOGIC_OK, 1 if b.driven(LOGIC_EN, odr) == 1 else None)
         self._drive("c", POWER_OK, 1 if b.driven(POWER_EN, odr) == 1 else None)
+
+    def set_switches(self, far_limit=None, home_end=None):
+        """Moves the linear actuators' end switches (None: back where the trainer model has them)."""
+        self.far_limit = list(far_limit or [FAR_LIMIT] * 6)
+        self.home_end = list(home_end or [0] * 6)
+        self._update()
 
     def refresh(self):
         """The pins' levels again after the firmware configured them (a pull set makes an edge of its own)."""

@@ -37,7 +37,9 @@ from models.rcc import IWDGRSTF  # noqa: E402
 from plant import FLAG_WIDTH, HOME_POSITION, SLOW_RATE, TOWARD, Plant  # noqa: E402
 from seqstore import used_up_page  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
-from usb_checks import UsbLink, usb_full_checks, usb_link_checks, usb_stream_checks  # noqa: E402
+from usb_checks import UsbLink, cable_check, usb_full_checks, usb_link_checks, usb_stream_checks  # noqa: E402
+from safety_checks import (estop_states_check, jog_buzz_check, limit_check, silent_check,  # noqa: E402
+                           supply_order_check)
 
 CLI_BAUD = 921_600  # host/src/link: the serial ports' rate (USART_BAUD in firmware/src/board/stm32f411/uart.rs)
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7 (firmware/src/board/stm32f411/settings.rs, SETTINGS)
@@ -160,7 +162,8 @@ def source_constant(name):
     raise KeyError(f"const {name} not found under shared/src")
 
 
-def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, rom=None, elf=None):
+def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, rom=None,
+                  elf=None):
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -197,6 +200,7 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
     before = steps()
     plant.reset_counts()
     plant.clear_timing()
+    enabled_at = m.now
     en = cli.run("device", "enable", *port)
     m.run(m.now + int(0.6 * SYSCLK))  # logic, then power, each with its settling time
     jog = cli.run("device", "jog", "1", "0.5", *port)
@@ -207,8 +211,10 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
             and dev == plant.net and timed,
             f"{clear}; {en}; {jog}; device steps moved {dev}, STEP edges on PB0-PB5 (signed by DIR) {plant.net}; "
             f"{timing_said}")
+    disabled_at = m.now
     cli.run("device", "disable", *port)
-    m.run(m.now + int(0.5 * SYSCLK))  # drivers, power, logic off
+    m.run(m.now + int(0.6 * SYSCLK))  # drivers, power, logic off
+    supply_order_check(CHECKS, plant, enabled_at, disabled_at)
     settings_check(m, p, log, cli, port)
     if usb is not None:
         usb_link_checks(CHECKS, m, usb, port)
@@ -218,13 +224,28 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
         usb_stream_checks(CHECKS, m, usb, plant, stream_check)
     if rom is not None:
         bootloader_refused_check(CHECKS, m, cli, port, plant, rom)
+    # the host gone mid-stream: back within the time on USART1, the cable pulled and plugged again on USB
+    silent_check(CHECKS, m, cli, port, plant, bridge, "usart-silent", power_down=False)
+    if usb is not None:
+        cable_check(CHECKS, m, usb, plant)
     pins_check(CHECKS, plant, Counter(plant.ignored), plant.dir_undriven)
     estop_check(CHECKS, m, cli, port, plant)
     if usb is not None and usb_full:
         usb_full_checks(CHECKS, m, usb, plant, homing_check)
+    else:
+        homing_check(m, plant, cli, port, name="serial-home-again")
+    # the host gone for good (on USB with the cable in, when the host is plugged): the power-down, then the e-stop
+    # in the states that need no homing and the end switches
+    if usb is not None:
+        silent_check(CHECKS, m, usb.cli, ["--port", usb.bridge.path], plant, usb.bridge, "usb-silent",
+                     power_down=True)
+    else:
+        silent_check(CHECKS, m, cli, port, plant, bridge, "usart-silent-gone", power_down=True)
+    estop_states_check(CHECKS, m, cli, port, plant)
+    limit_check(CHECKS, m, cli, port, plant)
+    jog_buzz_check(CHECKS, m, cli, port, plant)
     if hold_ups:
-        if not usb_full:
-            homing_check(m, plant, cli, port, name="serial-home-again")
+        homing_check(m, plant, cli, port, name="serial-home-hold-ups")
         hold_up_checks(CHECKS, m, cli, port)
     if rom is not None:
         bootloader_entry_checks(CHECKS, m, cli, port, rom, log, usb)
@@ -383,8 +404,8 @@ def main():
     ap.add_argument("--usb-full", action="store_true",
                     help="also homing over USB, and the cable pulled mid-stream and plugged again (usb_checks.py)")
     ap.add_argument("--until", help="stop after this check (the mutants' runs)")
-    ap.add_argument("--max-sim-s", type=float, default=60.0, help="stop the run past this many simulated seconds")
-    ap.add_argument("--max-wall-s", type=float, default=1200.0, help="stop the run past this many wall seconds")
+    ap.add_argument("--max-sim-s", type=float, default=90.0, help="stop the run past this many simulated seconds")
+    ap.add_argument("--max-wall-s", type=float, default=2400.0, help="stop the run past this many wall seconds")
     ap.add_argument("--count-instructions", action="store_true", help="count instructions (slow): for the book's Emulation chapter")
     args = ap.parse_args()
 
@@ -504,13 +525,19 @@ def main():
     periods = p.periods_between(before.t, after.t)
     gaps = [b - a for a, b in zip(feeds, feeds[1:])]
     timeout = iw.rlr_act * iw.tick(iw.pr_act)
-    # each control period (ticked or passed: `Controller::advance_clock`) ends with one feed; the window's edges
-    # may split one period from its feed
+    # each control period (ticked or passed: `Controller::advance_clock`) ends with one feed, so periods and feeds
+    # alternate (a period's clock comes before its feed at the same time); a feed of a timer of its own drifts
+    # against the control loop's schedule and breaks the alternation where the two cross. The window's edges may
+    # split one period from its feed.
+    marks = sorted([(t, 0) for t in p.periods if before.t <= t < after.t] + [(t, 1) for t in feeds])
+    doubled = [round(ms(a[0]), 3) for a, b in zip(marks, marks[1:]) if a[1] == b[1]]
     c.check("watchdog-fed", iw.started and gaps and max(gaps) < timeout and not m.resets and periods > 0
-            and abs(len(feeds) - periods) <= 1 and not config_feeds,
+            and abs(len(feeds) - periods) <= 1 and not config_feeds and not doubled,
             f"IWDG PR {iw.pr_act} (/{4 << iw.pr_act}) RLR {iw.rlr_act}: timeout {ms(timeout):.0f} ms at LSI 32 kHz; "
             f"fed {len(feeds)} times in {ms(dt):.0f} ms ({len(config_feeds)} by a change of its configuration), "
-            f"{periods} control periods ticked or passed; longest gap {ms(max(gaps or [0])):.2f} ms")
+            f"{periods} control periods ticked or passed, each followed by its feed before the next"
+            + (f" but at {doubled[:4]} ms ({len(doubled)} times: two periods or two feeds in a row)" if doubled else "")
+            + f"; longest gap {ms(max(gaps or [0])):.2f} ms")
     priority_check(c, m)
     inputs_check(c, m, plant)
 
@@ -557,7 +584,8 @@ def main():
 
     # -- the host link on USART1: the real CLI over a pty --
     if args.ringpod:
-        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, rom, args.elf)
+        serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, rom,
+                      args.elf)
     if not args.ringpod:
         pins_check(c, plant, plant.ignored, plant.dir_undriven)
     log_check(m, log)

@@ -11,7 +11,7 @@ driving it through a pty bridged to the bulk endpoints, as a PC's /dev/ttyACM0.
   12,000 status polls 10 wall ms apart, and over USB a status (722 bytes, twelve packets) comes back in a fraction
   of the 7.8 ms it takes on USART1 at 921,600 baud, so the CLI polls several times as often per simulated second;
   with the machine loaded (about 30 wall s per simulated s) the polls ran out 4 of the 7.7 simulated s into homing.
-- `usb-cable` (`--usb-full`): the cable pulled mid-stream (VBUS low, no SOF: the core suspends, the host's port
+- `usb-cable`: the cable pulled mid-stream (VBUS low, no SOF: the core suspends, the host's port
   is gone): the motion stops within the stream timeout and its braking, the supplies stay as the supervisor keeps
   them after a stop (a lost stream is no fault); plugged again, the host enumerates the device again and streams.
 """
@@ -133,10 +133,9 @@ def usb_stream_checks(checks, m, link, plant, stream_check):
 
 
 def usb_full_checks(checks, m, link, plant, homing_check):
-    """`--usb-full`: homing over USB, then the cable pulled and plugged again."""
+    """`--usb-full`: homing over USB (the cable pulled and plugged again is in the default run)."""
     port = ["--port", link.bridge.path]
     homing_check(m, plant, link.cli, port, name="usb-home")
-    cable_check(checks, m, link, plant)
 
 
 def both_links_check(checks, m, link, port, serial_port):

@@ -56,6 +56,7 @@ fn random_request(rng: &mut Rng, seq: &mut u32) -> Request {
             follow: FollowMode::Interpolate,
             margins: [rng.f32(); 6],
             telemetry_hz: rng.below(4_000) as u16,
+            host_gone_ms: rng.below(70_000) as u16,
         })),
         _ => {
             *seq = seq.wrapping_add(if rng.below(10) == 0 { rng.next() as u32 } else { 1 });

@@ -48,11 +48,11 @@ pub struct DeviceArgs {
     #[arg(value_enum)]
     pub action: DeviceAction,
     /// For `config`: nothing (every section), `get SECTION[.PATH]` or `set SECTION.PATH VALUE` (VALUE in JSON).
-    /// Sections: stream (timeout_ms, gross_jump_ms, follow, margins.N, telemetry_hz), control (tick_hz), motion
-    /// (pose_velocity.N, pose_acceleration.N, actuator_velocity.N, actuator_acceleration.N), inputs (active_low,
-    /// debounce_ms), axes.N (steps_per_unit, reverse),
-    /// homing, supervisor; N counts from 0, e.g. `set axes.4.reverse true`, `set stream.timeout_ms 200`. For
-    /// `jog`: AXIS DISTANCE; for `buzz`: AXIS; for `rig`: `load RIG.toml` or `show`; for `aux`: N on|off.
+    /// Sections: stream (timeout_ms, gross_jump_ms, follow, margins.N, telemetry_hz, host_gone_ms), control
+    /// (tick_hz), motion (pose_velocity.N, pose_acceleration.N, actuator_velocity.N, actuator_acceleration.N),
+    /// inputs (active_low, debounce_ms), axes.N (steps_per_unit, reverse), homing, supervisor; N counts from 0,
+    /// e.g. `set axes.4.reverse true`, `set stream.timeout_ms 200`. For `jog`: AXIS DISTANCE; for `buzz`: AXIS;
+    /// for `rig`: `load RIG.toml` or `show`; for `aux`: N on|off.
     #[arg(allow_negative_numbers = true)]
     pub config: Vec<String>,
     /// Serial port of the board (USB CDC).

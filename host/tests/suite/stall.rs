@@ -12,7 +12,47 @@ use crate::common::proxy::{Proxy, Served};
 /// again until the link returns, and reports the platform at rest (exit 130, state Ready) instead of a lost link.
 #[test]
 fn ctrl_c_in_a_stalled_link_is_confirmed_when_the_link_returns() {
+    // Longer than the answers in flight are waited for (5 s): the stop itself goes unanswered and is given again.
+    let (code, report, said) = ctrl_c_in_a_stall(None, 8000);
+    assert_eq!(code, Some(130), "{report}\n{said}");
+    assert_eq!(report["state"], "Ready", "{report}\n{said}");
+    assert!(said.contains("the link is stalled"), "{said}");
+    assert!(said.contains("STOP pending"), "{said}");
+    assert!(said.contains("the stop was confirmed after"), "{said}");
+}
+
+/// A stall longer than the device's time for a host gone (set to 2 s): the device brakes when its stream is lost
+/// and powers down on its own before the link returns; the pending stop is then confirmed by a device that is Off,
+/// supplies off, and the CLI says so (exit 130, state Off).
+#[test]
+fn a_stall_longer_than_the_host_gone_time_ends_with_the_device_off() {
+    let (code, report, said) = ctrl_c_in_a_stall(Some(2000), 8000);
+    assert_eq!(code, Some(130), "{report}\n{said}");
+    assert_eq!(report["state"], "Off", "{report}\n{said}");
+    assert!(said.contains("STOP pending"), "{said}");
+    assert!(said.contains("the stop was confirmed after"), "{said}");
+}
+
+/// `stream --motion demo` through a proxy to `simulate --tcp` (its `stream.host_gone_ms` set first when given), the
+/// link stalled once the motion runs, SIGINT 1.5 s into the stall, the link back `stalled_ms` later: the exit code,
+/// the JSON report and what the CLI said.
+fn ctrl_c_in_a_stall(host_gone_ms: Option<u32>, stalled_ms: u64) -> (Option<i32>, serde_json::Value, String) {
     let server = Served::start();
+    if let Some(ms) = host_gone_ms {
+        let set = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
+            .args([
+                "device",
+                "config",
+                "set",
+                "stream.host_gone_ms",
+                &ms.to_string(),
+                "--port",
+                &server.addr,
+            ])
+            .output()
+            .unwrap();
+        assert!(set.status.success(), "{}", String::from_utf8_lossy(&set.stderr));
+    }
     let proxy = Proxy::to(&server.addr);
     let mut child = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
         .args(["stream", "--port", &proxy.addr, "--motion", "demo", "--duration", "60"])
@@ -30,24 +70,16 @@ fn ctrl_c_in_a_stalled_link_is_confirmed_when_the_link_returns() {
         .status()
         .unwrap()
         .success());
-    // Longer than the answers in flight are waited for (5 s): the stop itself goes unanswered and is given again.
-    std::thread::sleep(Duration::from_millis(8000));
+    std::thread::sleep(Duration::from_millis(stalled_ms));
     proxy.stall(false);
     let mut said = String::new();
     let mut stderr = child.stderr.take().unwrap();
-    let out = {
-        let status = child.wait().unwrap();
-        std::io::Read::read_to_string(&mut stderr, &mut said).unwrap();
-        let mut stdout = String::new();
-        std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
-        (status, stdout)
-    };
-    let report: serde_json::Value = serde_json::from_str(&out.1).unwrap_or_else(|e| panic!("{e}: {said}"));
-    assert_eq!(out.0.code(), Some(130), "{report}\n{said}");
-    assert_eq!(report["state"], "Ready", "{report}\n{said}");
-    assert!(said.contains("the link is stalled"), "{said}");
-    assert!(said.contains("STOP pending"), "{said}");
-    assert!(said.contains("the stop was confirmed after"), "{said}");
+    let status = child.wait().unwrap();
+    std::io::Read::read_to_string(&mut stderr, &mut said).unwrap();
+    let mut stdout = String::new();
+    std::io::Read::read_to_string(&mut child.stdout.take().unwrap(), &mut stdout).unwrap();
+    let report = serde_json::from_str(&stdout).unwrap_or_else(|e| panic!("{e}: {said}"));
+    (status.code(), report, said)
 }
 
 /// SIGINT while the CLI greets a port that never answers (a listening socket nobody serves): it ends at once with

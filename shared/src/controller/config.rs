@@ -38,6 +38,8 @@ pub struct ControllerConfig {
     pub inputs: InputConfig,
     /// Telemetry samples per second while a host is connected (0: none).
     pub telemetry_hz: u16,
+    /// After a lost stream, how long without a frame from any host before the device powers down (ms).
+    pub host_gone_ms: u16,
     /// The rig's name (UTF-8, zero-padded), as `device rig show` reports it.
     pub rig_name: [u8; RIG_NAME_LEN],
 }
@@ -173,6 +175,7 @@ impl ControllerConfig {
             switches: model::HOMING,
             inputs: InputConfig::default(),
             telemetry_hz: model::TELEMETRY_HZ,
+            host_gone_ms: crate::safety::HOST_GONE_MS,
             rig_name: [0; RIG_NAME_LEN],
         };
         config.rig_name = RigRecord::new(
@@ -286,8 +289,7 @@ impl ControllerConfig {
 /// each carriage at most 7 degrees before its flag ([`crate::sim::parked`]); a search shorter than that is refused
 /// by the plan's own check (the back-off) or fails homing, never moves blind.
 fn carriage_search(q: &[f64; 6], a: usize, carriages: usize, min_spacing: f64) -> f32 {
-    let gap =
-        |from: usize, to: usize| libm::fmod(q[to] - q[from] + 4.0 * core::f64::consts::TAU, core::f64::consts::TAU);
+    let gap = |from: usize, to: usize| crate::real::wrap_turn(q[to] - q[from]);
     let next = (a + 1) % carriages;
     let prev = (a + carriages - 1) % carriages;
     let room = gap(a, next).min(gap(prev, a)) - min_spacing;

@@ -13,6 +13,8 @@ use crate::safety::{Aux, Command, Event, HomingSequencer, State};
 impl Controller {
     /// Handles one request; always exactly one response.
     pub fn handle(&mut self, request: &Request) -> Response {
+        // Any request says a host is there (a lost stream's silence starts again).
+        self.host.heard();
         let body = match request.body {
             HostMessage::Hello { version } => {
                 if version == PROTOCOL_VERSION {

@@ -57,6 +57,7 @@ impl Controller {
                 targets[a] = p;
                 targets
             }
+            None if jog.settle() => position,
             None => {
                 self.jog = None;
                 position

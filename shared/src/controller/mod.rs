@@ -21,7 +21,7 @@ use crate::motion::jog::Jog;
 use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
 use crate::protocol::{DeviceMessage, Firmware, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
 use crate::safety::homing::HomingPlan;
-use crate::safety::{Event, Motion, Outputs, State, Supervisor};
+use crate::safety::{Command, Event, HostWatch, Motion, Outputs, State, Supervisor};
 use homing::Homing;
 
 /// What the firmware does in one control period.
@@ -72,6 +72,8 @@ pub struct Controller {
     /// A homing since start set every axis's origin: the counted steps say where the axes are (whatever moved them
     /// since, a power-down, a jog or a fault, the motors did it step by step), so homing again can park first.
     origins: bool,
+    /// The silence since a lost stream: a host gone that long powers the machine down (`safety::HostWatch`).
+    host: HostWatch,
 }
 
 /// When the next telemetry sample is due, and what the previous one counted (for its flags).
@@ -126,6 +128,7 @@ impl Controller {
             restart: None,
             firmware: Firmware::BUILT,
             origins: false,
+            host: HostWatch::default(),
         })
     }
 
@@ -332,7 +335,7 @@ impl Controller {
             Motion::Stream => {
                 let (targets, event) = self.pipeline.tick();
                 match event {
-                    Some(PipelineEvent::StreamLost) => self.event(Event::StreamLost),
+                    Some(PipelineEvent::StreamLost) => self.stream_lost(),
                     Some(PipelineEvent::AtRest) => self.event(Event::AtRest),
                     Some(PipelineEvent::MotionFault) => self.event(Event::MotionFault),
                     None => {}
@@ -371,7 +374,7 @@ impl Controller {
         self.advance_clock();
         // A stream's setpoints bound its hold-ups too (`Pipeline::pass`): a loop that stays behind still loses it.
         if self.supervisor.outputs().motion == Motion::Stream && self.pipeline.pass().is_some() {
-            self.event(Event::StreamLost);
+            self.stream_lost();
         }
         self.supervisor.outputs()
     }
@@ -385,8 +388,27 @@ impl Controller {
             let ms = self.elapsed_us / 1000;
             self.elapsed_us %= 1000;
             self.event(Event::Elapsed(ms));
+            if self.host.elapse(ms, self.supervisor.state(), self.config.host_gone_ms) {
+                // The host's STOP, given by the device: the drivers, the motor supply and the logic supply off in
+                // the supervisor's order and delays.
+                self.event(Event::Command(Command::Disable));
+            }
         }
         tick_us
+    }
+
+    /// The stream's setpoints stopped: the platform brakes to rest, and a host silent from now on for the stream
+    /// section's `host_gone_ms` is taken as gone.
+    fn stream_lost(&mut self) {
+        self.event(Event::StreamLost);
+        if self.supervisor.state() == State::Stopping {
+            self.host.lost();
+        }
+    }
+
+    /// Milliseconds since a lost stream with no request from a host, while the device watches for one.
+    pub fn host_silent_ms(&self) -> Option<u32> {
+        self.host.silent_ms()
     }
 
     /// Advances device time; a telemetry sample falls due every `tick rate / telemetry rate` ticks while the

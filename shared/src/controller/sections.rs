@@ -39,6 +39,7 @@ impl ControllerConfig {
             follow: c.follow,
             margins: c.margins.0,
             telemetry_hz: self.telemetry_hz,
+            host_gone_ms: self.host_gone_ms,
         }
     }
 
@@ -85,36 +86,45 @@ impl ControllerConfig {
         }
     }
 
+    /// The stream section after checking its values' ranges (`StreamSettings` documents them).
+    fn apply_stream(&mut self, s: &StreamSettings) -> Result<(), ConfigError> {
+        let field = |name| ConfigError::Value(Field::of(SettingsKind::Stream, name));
+        if !(1..=10_000).contains(&s.timeout_ms) {
+            return Err(field(FieldName::TimeoutMs));
+        }
+        if !(10..=10_000).contains(&s.gross_jump_ms) {
+            return Err(field(FieldName::GrossJumpMs));
+        }
+        if let Some(i) = s.margins.iter().position(|m| !(0.0..=0.1).contains(m)) {
+            return Err(ConfigError::Value(Field::at(
+                SettingsKind::Stream,
+                i,
+                FieldName::Margins,
+            )));
+        }
+        if s.telemetry_hz > 2_000 {
+            return Err(field(FieldName::TelemetryHz));
+        }
+        if !(1_000..=60_000).contains(&s.host_gone_ms) {
+            return Err(field(FieldName::HostGoneMs));
+        }
+        let c = &mut self.pipeline;
+        c.stream_timeout_us = u32::from(s.timeout_ms) * 1000;
+        c.gross_jump_us = u32::from(s.gross_jump_ms) * 1000;
+        c.follow = s.follow;
+        c.margins.0 = s.margins;
+        self.telemetry_hz = s.telemetry_hz;
+        self.host_gone_ms = s.host_gone_ms;
+        Ok(())
+    }
+
     /// Changes a section after checking its values' ranges (each section documents them); the configuration as a
     /// whole is checked by [`Self::validate`]. On an error nothing has changed.
     pub fn apply(&mut self, settings: &Settings) -> Result<(), ConfigError> {
         let mut next = *self;
         let c = &mut next.pipeline;
         match *settings {
-            Settings::Stream(s) => {
-                let field = |name| ConfigError::Value(Field::of(SettingsKind::Stream, name));
-                if !(1..=10_000).contains(&s.timeout_ms) {
-                    return Err(field(FieldName::TimeoutMs));
-                }
-                if !(10..=10_000).contains(&s.gross_jump_ms) {
-                    return Err(field(FieldName::GrossJumpMs));
-                }
-                if let Some(i) = s.margins.iter().position(|m| !(0.0..=0.1).contains(m)) {
-                    return Err(ConfigError::Value(Field::at(
-                        SettingsKind::Stream,
-                        i,
-                        FieldName::Margins,
-                    )));
-                }
-                if s.telemetry_hz > 2_000 {
-                    return Err(field(FieldName::TelemetryHz));
-                }
-                c.stream_timeout_us = u32::from(s.timeout_ms) * 1000;
-                c.gross_jump_us = u32::from(s.gross_jump_ms) * 1000;
-                c.follow = s.follow;
-                c.margins.0 = s.margins;
-                next.telemetry_hz = s.telemetry_hz;
-            }
+            Settings::Stream(s) => next.apply_stream(&s)?,
             Settings::Control(s) => {
                 if !matches!(s.tick_hz, 500 | 1_000 | 2_000) {
                     return Err(ConfigError::Value(Field::of(SettingsKind::Control, FieldName::TickHz)));

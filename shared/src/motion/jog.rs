@@ -20,7 +20,14 @@ pub struct Jog {
     rate: u32,
     /// Step-time carried between ticks (steps x us).
     carry: u64,
+    /// Periods held since the last leg ended.
+    settled: u8,
 }
+
+/// Periods a jog holds, drivers enabled, after its last steps were planned, beyond the period that plays them: a
+/// board takes a tick's moves at the next period boundary and plays them in the ring's half after it, so the last
+/// steps may still be at the pins when the tick after next writes the outputs.
+pub const SETTLE_PERIODS: u8 = 1;
 
 impl Jog {
     /// One leg of `steps` from `from`.
@@ -36,6 +43,13 @@ impl Jog {
         Self::with_legs(axis, from, legs, MAX_LEGS, rate)
     }
 
+    /// Once every leg is done: `true` for each of the [`SETTLE_PERIODS`] periods the jog still holds.
+    pub fn settle(&mut self) -> bool {
+        let holding = self.settled < SETTLE_PERIODS;
+        self.settled = self.settled.saturating_add(1);
+        holding
+    }
+
     fn with_legs(axis: usize, from: i64, legs: [i32; MAX_LEGS], count: usize, rate: u32) -> Self {
         Self {
             axis,
@@ -45,6 +59,7 @@ impl Jog {
             target: from.saturating_add(i64::from(legs[0])),
             rate,
             carry: 0,
+            settled: 0,
         }
     }
 

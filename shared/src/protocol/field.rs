@@ -44,6 +44,7 @@ pub enum FieldName {
     SupplyTimeoutMs,
     DriverOffMs,
     DischargeMs,
+    HostGoneMs,
 }
 
 impl FieldName {
@@ -72,6 +73,7 @@ impl FieldName {
             Self::SupplyTimeoutMs => "supply_timeout_ms",
             Self::DriverOffMs => "driver_off_ms",
             Self::DischargeMs => "discharge_ms",
+            Self::HostGoneMs => "host_gone_ms",
         }
     }
 }
@@ -103,6 +105,7 @@ impl Field {
             FieldName::GrossJumpMs => "10 to 10,000 ms",
             FieldName::Margins => "0 to 0.1, in its check's unit",
             FieldName::TelemetryHz => "0 to 2,000 samples a second",
+            FieldName::HostGoneMs => "1,000 to 60,000 ms",
             FieldName::TickHz => "500, 1,000 or 2,000 ticks a second",
             FieldName::PoseVelocity | FieldName::PoseAcceleration | FieldName::ActuatorAcceleration => {
                 "a positive number"

@@ -13,8 +13,9 @@ use crate::safety::{Command, FaultReason, Refusal, State};
 /// Protocol version; host and device must agree exactly. 8: the motion section carries the actuator limits, the
 /// operator's commands switch the auxiliary outputs and setpoints carry their levels. 9: the status counts the
 /// periods the step generator played empty and the control periods passed. 10: the hello and a version mismatch
-/// name the firmware ([`super::Firmware`]); the bootloader request.
-pub const PROTOCOL_VERSION: u16 = 10;
+/// name the firmware ([`super::Firmware`]); the bootloader request. 11: the stream section carries the time after
+/// which a host silent since its stream was lost is taken as gone (`host_gone_ms`).
+pub const PROTOCOL_VERSION: u16 = 11;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;

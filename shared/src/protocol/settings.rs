@@ -26,6 +26,9 @@ pub struct StreamSettings {
     pub margins: [f32; 6],
     /// Telemetry samples per second while a host asks for them (0: none; at most the control rate).
     pub telemetry_hz: u16,
+    /// After a stream is lost, no frame from any host for this long powers the machine down (ms, 1,000-60,000):
+    /// the host is gone, not late.
+    pub host_gone_ms: u16,
 }
 
 /// The control rate (next start).

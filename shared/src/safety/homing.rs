@@ -119,10 +119,7 @@ impl HomingPlan {
                     } else {
                         (neighbour, axis)
                     };
-                    let gap = libm::fmod(
-                        ring.home_angles[b] - ring.home_angles[a] + 4.0 * core::f64::consts::TAU,
-                        core::f64::consts::TAU,
-                    );
+                    let gap = crate::real::wrap_turn(ring.home_angles[b] - ring.home_angles[a]);
                     let other = if homed[neighbour] { 0.0 } else { travel(neighbour) };
                     if n > 1 && gap - travel(axis) - other < ring.min_spacing {
                         return Err(HomingError::Spacing(axis as u8));

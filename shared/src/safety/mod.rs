@@ -1,13 +1,16 @@
-//! Safety: the interlock supervisor (FIRMWARE.md "Safety supervisor") and the homing sequence.
+//! Safety: the interlock supervisor (FIRMWARE.md "Safety supervisor"), the homing sequence and the rule for a host
+//! gone long after its stream was lost.
 
 pub mod debounce;
 mod events;
 pub mod homing;
+mod host_gone;
 pub mod pins;
 pub mod supervisor;
 
 pub use events::{Aux, AuxLevels, Command, Event, Refusal};
 pub use homing::{HomingConfig, HomingPlan, HomingSequencer, HomingStep};
+pub use host_gone::{HostWatch, HOST_GONE_MS};
 pub use supervisor::{FaultReason, Motion, Outputs, State, Supervisor, SupervisorConfig, Supplies};
 
 /// Switch and supply levels, as read from the pins (after debouncing and polarity). The supervisor keeps the

@@ -19,20 +19,23 @@ use crate::controller::ControllerConfig;
 use crate::protocol::{wire, ControlSettings, RigRecord, RigSource, Settings, StreamSettings};
 
 mod v2;
+mod v3;
 
 /// The record's key in flash. (Keys 1-53 held the single `f32` settings of protocol versions up to 5: never read.)
 pub const CONFIG_KEY: u8 = 0xf0;
 /// Layout of the stored record. Version 1 held the rig alone; 2 adds the machine's settings sections (homing among
-/// them) and the stream and control sections; 3 adds the actuator limits to the motion section. A record of
-/// version 2 is read and migrated (its actuators get their kinds' limits, what a version-2 device drove them with);
-/// one of another version is not read (the compiled-in defaults run and the host sees [`RigSource::Unreadable`]).
-pub const RECORD_VERSION: u16 = 3;
+/// them) and the stream and control sections; 3 adds the actuator limits to the motion section; 4 the time for a
+/// host gone (`host_gone_ms`) to the stream section. Records of versions 2 and 3 are read and migrated (version 2's
+/// actuators get their kinds' limits, what a version-2 device drove them with; both get the default time for a host
+/// gone); one of another version is not read (the compiled-in defaults run and the host sees
+/// [`RigSource::Unreadable`]).
+pub const RECORD_VERSION: u16 = 4;
 /// Room for the record's postcard bytes (about 690 with elbow chains) and the crate's header; every item read or moved passes through
 /// a buffer of this size.
 const RECORD_BUFFER: usize = 768;
 
-/// The record as flash holds it.
-#[derive(serde::Serialize, serde::Deserialize)]
+/// The record as flash holds it (read back field by field: `read`).
+#[derive(serde::Serialize)]
 struct Record {
     version: u16,
     rig: RigRecord,
@@ -101,22 +104,31 @@ pub async fn restore<F: NorFlash>(
     (config, report)
 }
 
-/// The record in `bytes`, of this version or migrated from version 2. The version is the first field of every
-/// version, so it is read first and decides the layout.
+/// The record in `bytes`, of this version or migrated from version 2 or 3, read field by field: the version first,
+/// which decides the layout of the rig (version 2's has no actuator limits) and of the stream section (versions 2
+/// and 3 have no `host_gone_ms`); one reading of each type serves every version (the firmware has room for one).
 fn read(bytes: &[u8]) -> Option<Record> {
-    match wire::take_from_bytes::<u16>(bytes).ok()?.0 {
-        RECORD_VERSION => wire::take_from_bytes::<Record>(bytes).ok().map(|(record, _)| record),
+    let (version, rest) = wire::take_from_bytes::<u16>(bytes).ok()?;
+    let (rig, rest) = match version {
         2 => {
-            let (old, _) = wire::take_from_bytes::<v2::Record>(bytes).ok()?;
-            Some(Record {
-                version: RECORD_VERSION,
-                rig: old.rig(),
-                stream: old.stream,
-                control: old.control,
-            })
+            let (old, rest) = wire::take_from_bytes::<v2::Rig>(rest).ok()?;
+            (old.rig(), rest)
         }
-        _ => None,
-    }
+        3 | RECORD_VERSION => wire::take_from_bytes::<RigRecord>(rest).ok()?,
+        _ => return None,
+    };
+    let (stream, rest) = if version == RECORD_VERSION {
+        wire::take_from_bytes::<StreamSettings>(rest).ok()?
+    } else {
+        v3::stream(rest)?
+    };
+    let (control, _) = wire::take_from_bytes::<ControlSettings>(rest).ok()?;
+    Some(Record {
+        version: RECORD_VERSION,
+        rig,
+        stream,
+        control,
+    })
 }
 
 /// Stores `config` (what the next start is to run) as the record. On an error the previously stored record (or

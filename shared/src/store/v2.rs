@@ -6,25 +6,13 @@
 
 use crate::kinematics::{Chain, RingLimits};
 use crate::model;
-use crate::protocol::{
-    AxisSettings, ControlSettings, HomingSettings, MachineSettings, MotionSettings, RigRecord, StreamSettings,
-    RIG_NAME_LEN,
-};
+use crate::protocol::{AxisSettings, HomingSettings, MachineSettings, MotionSettings, RigRecord, RIG_NAME_LEN};
 use crate::safety::debounce::InputConfig;
 use crate::safety::SupervisorConfig;
 
-/// The record as version 2 stored it.
+/// The rig as version 2 stored it (after the version; the stream and control sections follow it).
 #[derive(serde::Deserialize)]
-pub(super) struct Record {
-    /// 2; read before this layout is chosen.
-    _version: u16,
-    rig: Rig,
-    pub stream: StreamSettings,
-    pub control: ControlSettings,
-}
-
-#[derive(serde::Deserialize)]
-struct Rig {
+pub(super) struct Rig {
     name: [u8; RIG_NAME_LEN],
     ring_radius: f64,
     rod_length: f64,
@@ -50,12 +38,12 @@ struct Motion {
     pose_acceleration: [f32; 6],
 }
 
-impl Record {
-    /// The rig of this record as today's record, its actuators given their kinds' limits. A geometry that is not
+impl Rig {
+    /// This rig as today's record, its actuators given their kinds' limits. A geometry that is not
     /// valid leaves them at zero: the restore refuses such a rig by its geometry, as it refuses any stored rig
     /// that cannot run.
     pub fn rig(&self) -> RigRecord {
-        let r = &self.rig;
+        let r = self;
         let m = &r.machine;
         let mut record = RigRecord {
             name: r.name,

@@ -22,6 +22,7 @@ mod elbow_drive;
 mod forward;
 mod guard;
 mod homing;
+mod host_gone;
 mod jog;
 mod latency;
 mod pass;

@@ -309,7 +309,7 @@ fn a_version_2_record_is_migrated_with_its_actuators_kinds_limits() {
         ..defaults.stream()
     };
     let mut raw = [0u8; 1024];
-    let bytes = postcard::to_slice(&(2u16, old_rig, stream, defaults.control()), &mut raw).unwrap();
+    let bytes = postcard::to_slice(&(2u16, old_rig, old_stream(&stream), defaults.control()), &mut raw).unwrap();
     let mut f = flash();
     store_raw(&mut f, bytes);
     let (config, report) = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
@@ -330,4 +330,43 @@ fn a_version_2_record_is_migrated_with_its_actuators_kinds_limits() {
     block_on(store(&mut f, Flash::FULL_FLASH_RANGE, &config)).unwrap();
     let again = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
     assert_eq!((again.0, again.1.rig), (config, RigSource::Stored));
+}
+
+/// The stream section as versions 2 and 3 stored it (postcard writes a struct as its fields in order): without
+/// `host_gone_ms`.
+fn old_stream(s: &StreamSettings) -> (u16, u16, ringpod_core::motion::FollowMode, [f32; 6], u16) {
+    (s.timeout_ms, s.gross_jump_ms, s.follow, s.margins, s.telemetry_hz)
+}
+
+#[test]
+fn a_version_3_record_is_migrated_with_the_default_time_for_a_host_gone() {
+    let defaults = ControllerConfig::trainer_model();
+    let rig = wider(0.3, 0.325);
+    let stream = StreamSettings {
+        timeout_ms: 250,
+        telemetry_hz: 50,
+        host_gone_ms: ringpod_core::safety::HOST_GONE_MS,
+        ..defaults.stream()
+    };
+    let mut raw = [0u8; 1024];
+    let bytes = postcard::to_slice(&(3u16, &rig, old_stream(&stream), defaults.control()), &mut raw).unwrap();
+    let mut f = flash();
+    store_raw(&mut f, bytes);
+    let (config, report) = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
+    assert_eq!((report.rig, report.applied, report.refused), (RigSource::Stored, 2, 0));
+    assert_eq!(config.rig(), rig);
+    assert_eq!(config.stream(), stream, "the stored values, and the default time");
+    // A record of this version keeps a time of its own.
+    let mut changed = config;
+    changed
+        .apply(&Settings::Stream(StreamSettings {
+            host_gone_ms: 2_500,
+            ..stream
+        }))
+        .unwrap();
+    let mut f = flash();
+    block_on(store(&mut f, Flash::FULL_FLASH_RANGE, &changed)).unwrap();
+    let again = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
+    assert_eq!(again.0.stream().host_gone_ms, 2_500);
+    assert_eq!(again.1.rig, RigSource::Stored);
 }

@@ -709,20 +709,24 @@ fn any_settings() -> impl Strategy<Value = Settings> {
         any::<bool>(),
         prop::array::uniform6(real()),
         0u16..3_000,
+        0u16..=u16::MAX,
     )
-        .prop_map(|(timeout_ms, gross_jump_ms, direct, margins, telemetry_hz)| {
-            Settings::Stream(StreamSettings {
-                timeout_ms,
-                gross_jump_ms,
-                follow: if direct {
-                    FollowMode::Direct
-                } else {
-                    FollowMode::Interpolate
-                },
-                margins: margins.map(|m| m * 0.25),
-                telemetry_hz,
-            })
-        });
+        .prop_map(
+            |(timeout_ms, gross_jump_ms, direct, margins, telemetry_hz, host_gone_ms)| {
+                Settings::Stream(StreamSettings {
+                    timeout_ms,
+                    gross_jump_ms,
+                    follow: if direct {
+                        FollowMode::Direct
+                    } else {
+                        FollowMode::Interpolate
+                    },
+                    margins: margins.map(|m| m * 0.25),
+                    telemetry_hz,
+                    host_gone_ms,
+                })
+            },
+        );
     let control = prop::sample::select(vec![0u16, 500, 999, 1_000, 1_500, 2_000, 4_000])
         .prop_map(|tick_hz| Settings::Control(ControlSettings { tick_hz }));
     // Actuator velocities up to 4 rad/s or m/s: a carriage takes any of them, a linear actuator only up to the
