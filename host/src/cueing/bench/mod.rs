@@ -6,6 +6,7 @@
 //! so that both are measured against what the rig allows, not only against each other.
 
 mod floors;
+pub mod laps;
 mod picture;
 pub mod score;
 pub mod tune;
