@@ -7,6 +7,7 @@
 pub mod bench;
 pub mod capture;
 pub mod engine;
+pub mod error;
 pub mod lap;
 pub mod live;
 pub mod offline;

@@ -18,6 +18,22 @@
 use ringpod_core::cueing::{Telemetry, G};
 use serde::Serialize;
 
+/// What the optimal cueing's reference over its horizon is made of.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Preview {
+    /// The last sample held (a live game gives nothing ahead).
+    #[default]
+    None,
+    /// A recorded drive's own next samples (the future known: a yardstick, not a live cueing).
+    Drive,
+    /// The laps driven before, aligned by the lap distance (the drive's `lap_distance` column).
+    Lap,
+}
+
+/// The telemetry CSV's optional column: the lap distance (any unit that grows along the lap and wraps).
+pub const LAP_DISTANCE: &str = "lap_distance";
+
 /// The preview's parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Settings {
@@ -69,6 +85,8 @@ pub struct Counts {
     pub previewed_s: f64,
     /// Time spent departed (s).
     pub departed_s: f64,
+    /// The state at the last sample.
+    pub state: Option<State>,
 }
 
 /// The preview's present state, for a report or a panel.
@@ -141,7 +159,7 @@ impl Lap {
 
 /// The lap preview of one stream or drive.
 #[derive(Debug, Clone)]
-pub struct Preview {
+pub struct LapPreview {
     settings: Settings,
     /// The lap's length (in the distance's unit), learned at the first wrap.
     length: Option<f64>,
@@ -164,7 +182,7 @@ pub struct Preview {
     counts: Counts,
 }
 
-impl Preview {
+impl LapPreview {
     /// A preview with no lap yet.
     pub fn new(settings: Settings) -> Self {
         Self {
@@ -189,7 +207,10 @@ impl Preview {
 
     /// What it did so far.
     pub fn counts(&self) -> Counts {
-        self.counts
+        Counts {
+            state: Some(self.state()),
+            ..self.counts
+        }
     }
 
     /// Its present state.

@@ -19,7 +19,7 @@ fn sample(ax: f64) -> Telemetry<f64> {
 /// Drives `laps` laps at constant speed from time `t0`: lap `n`'s force at distance `s` is `force(n, s)`; each
 /// sample's preview ahead (8 steps of 0.15 s) and state returned.
 fn drive(
-    p: &mut Preview,
+    p: &mut LapPreview,
     laps: usize,
     force: impl Fn(usize, f64) -> f64,
 ) -> Vec<(Vec<Telemetry<f64>>, State, Telemetry<f64>)> {
@@ -39,7 +39,7 @@ fn drive(
 
 #[test]
 fn a_lap_shifted_in_distance_is_matched_at_its_shift_and_previews_what_comes() {
-    let mut p = Preview::new(Settings::default());
+    let mut p = LapPreview::new(Settings::default());
     // The second lap's features come 6 m later: its distance s sees the first lap's s - 6.
     let out = drive(&mut p, 2, |n, s| lap_force(if n == 0 { s } else { s - 6.0 }));
     assert_eq!(p.counts().laps, 1);
@@ -63,7 +63,7 @@ fn a_lap_shifted_in_distance_is_matched_at_its_shift_and_previews_what_comes() {
 
 #[test]
 fn a_departure_is_detected_within_a_fraction_of_a_second_and_the_preview_fades_without_a_jump() {
-    let mut p = Preview::new(Settings::default());
+    let mut p = LapPreview::new(Settings::default());
     // On the third lap the car leaves the track at 600 m: a steady 10 m/s^2 it never had, for 4 s.
     let off = |s: f64| (600.0..700.0).contains(&s);
     let out = drive(&mut p, 4, |n, s| if n == 2 && off(s) { 10.0 } else { lap_force(s) });
@@ -99,7 +99,7 @@ fn a_departure_is_detected_within_a_fraction_of_a_second_and_the_preview_fades_w
 #[test]
 fn two_runs_give_the_same_preview_bit_for_bit() {
     let run = || {
-        let mut p = Preview::new(Settings::default());
+        let mut p = LapPreview::new(Settings::default());
         let out = drive(&mut p, 3, |n, s| {
             lap_force(s + n as f64 * 2.0) * (1.0 + 0.03 * n as f64)
         });
@@ -118,19 +118,20 @@ fn two_runs_give_the_same_preview_bit_for_bit() {
     let (b, cb) = run();
     assert!(a == b);
     assert_eq!(ca, cb);
+    assert!(ca.state.unwrap().matched.is_some(), "{ca:?}");
     assert!(ca.previewed_s > 30.0, "{ca:?}");
 }
 
 #[test]
 fn bad_lap_distances_are_counted_and_fade_the_preview_without_a_panic() {
-    let mut p = Preview::new(Settings::default());
+    let mut p = LapPreview::new(Settings::default());
     drive(&mut p, 2, |_, s| lap_force(s));
     assert_eq!(p.state().confidence, 1.0);
     let t0 = 80.0;
     let mut t = t0;
     let mut s = 100.0;
     let mut confidence = vec![p.state().confidence];
-    let mut feed = |p: &mut Preview, t: f64, s: f64, ax: f64| {
+    let mut feed = |p: &mut LapPreview, t: f64, s: f64, ax: f64| {
         p.observe(t, s, &sample(ax));
         let _ = p.ahead(&sample(ax), 8, 0.15);
         confidence.push(p.state().confidence);
