@@ -1,6 +1,6 @@
 //! A multi-lap drive for the bench, made from the one lap of `docs/drives/lap-mix.csv`: the laps a driver
 //! repeats, each a little different (its braking points earlier or later, its forces larger or smaller, its pace,
-//! noise, and on one lap an excursion off the track), with the lap distance as a column: what a game's telemetry
+//! noise in proportion to each channel, and on one lap an excursion off the track), with the lap distance as a column: what a game's telemetry
 //! gives and a lap preview aligns by. Deterministic: the noise is a seeded generator of its own, so the shipped
 //! file is this code's output, byte for byte (the test below holds it so).
 //!
@@ -73,9 +73,10 @@ pub const SHIPPED: [LapSpec; 5] = [
 /// The shipped drive's noise seed.
 pub const SEED: u64 = 0x6c61_7073;
 
-/// Noise: standard deviation on the forces (m/s^2) and the rates (rad/s).
-const FORCE_NOISE: f64 = 0.15;
-const RATE_NOISE: f64 = 0.01;
+/// Noise: a share of each channel (of the force less g on z), standard deviation. In proportion, so that a
+/// channel at rest stays at rest: noise added to a zero channel flips its sign sample by sample, and the bench
+/// would count every platform cue above threshold against that sign as a false cue the cueing did not make.
+const NOISE: f64 = 0.05;
 
 /// The base lap's speed (m/s) at its time `p` (s): the segments' speeds, ramped linearly over a second.
 fn base_speed(p: f64) -> f64 {
@@ -194,12 +195,11 @@ pub fn generate(base: &[[f64; 7]], laps: &[LapSpec], seed: u64) -> Vec<[f64; 8]>
                     v[j + 1] += off * (off_track[j] - v[j + 1]);
                 }
             }
-            for j in 1..4 {
-                v[j] += FORCE_NOISE * noise.normal();
+            v[3] -= g;
+            for x in &mut v[1..7] {
+                *x *= 1.0 + NOISE * noise.normal().clamp(-3.0, 3.0);
             }
-            for j in 4..7 {
-                v[j] += RATE_NOISE * noise.normal();
-            }
+            v[3] += g;
             rows.push([t, v[1], v[2], v[3], v[4], v[5], v[6], distance(p)]);
             // The progress over the next sample: the pace, and slower off the track.
             let rate = lap.pace * (1.0 - 0.4 * off);
@@ -287,10 +287,11 @@ mod tests {
         for (lap, spec) in laps.iter().zip(&SHIPPED) {
             let moved = onset(lap) - first;
             assert!((moved - spec.brake_shift * 25.0).abs() < 1.0, "{moved} for {spec:?}");
-            // The hard braking's plateau, past its onset: -12 m/s^2 times the scale, within the noise.
+            // The hard braking's plateau, past its onset: -12 m/s^2 times the scale, within the noise (5 %: its
+            // mean over 50 samples within 0.3 m/s^2).
             let at = lap.iter().position(|r| r[1] < -6.0).unwrap() + 100;
             let plateau: f64 = lap[at..at + 50].iter().map(|r| r[1]).sum::<f64>() / 50.0;
-            assert!((plateau + 12.0 * spec.scale).abs() < 0.15, "{plateau} for {spec:?}");
+            assert!((plateau + 12.0 * spec.scale).abs() < 0.3, "{plateau} for {spec:?}");
         }
         let longest = (0..laps.len()).max_by_key(|&i| laps[i].len()).unwrap();
         assert!(SHIPPED[longest].excursion.is_some());

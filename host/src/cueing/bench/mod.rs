@@ -397,3 +397,6 @@ fn table(r: &Report) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests;
