@@ -10,9 +10,9 @@ use ringpod_core::kinematics::{Pose, RingPlatform};
 use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
+use super::engine::Pause;
 pub use super::error::CueError;
 pub use super::lap::{Preview, LAP_DISTANCE};
-use super::engine::Pause;
 use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
@@ -75,7 +75,6 @@ pub struct Replay {
     /// The lap preview's counts, with [`Preview::Lap`].
     pub lap: Option<super::lap::Counts>,
 }
-
 
 /// What `cue` is asked to do.
 pub struct Options<'a> {
@@ -172,20 +171,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
             );
         }
         if let Some(c) = &summary.lap {
-            s += &format!(
-                "lap preview: {} laps ({} kept as references), {} departures ({:.1} s departed), previewed \
-                 {:.1} s, {} samples without a usable lap distance\n",
-                c.laps, c.kept, c.departures, c.departed_s, c.previewed_s, c.bad_distance
-            );
-            if let Some(last) = c.state {
-                s += &format!(
-                    "lap preview at the end: lap {}, matched to lap {}, share {:.2}, alignment error {:.2} m/s^2\n",
-                    last.lap + 1,
-                    last.matched.map_or("none".into(), |m| (m + 1).to_string()),
-                    last.confidence,
-                    last.error
-                );
-            }
+            s += &c.describe();
         }
         if let Some(c) = &summary.capture {
             s += &format!(

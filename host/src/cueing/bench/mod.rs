@@ -213,7 +213,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         neutral,
     };
     let drives: Vec<Rows> = args.inputs.iter().map(|p| read_drive(p)).collect::<Result<_, _>>()?;
-    let from: Vec<usize> = drives.iter().map(|d| second_lap(d)).collect();
+    let from: Vec<usize> = drives.iter().map(second_lap).collect();
     let name = |p: &Path| {
         p.file_name()
             .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into())
@@ -355,6 +355,12 @@ fn table(r: &Report) -> String {
                 .map_or("-".into(), |c| format!("{:.1}, {:.1}", c.previewed_s, c.departed_s))
         });
     }
+    s + &floors_and_ratios(r)
+}
+
+/// The table's last lines: the floors, and each entry's force error against the first's and the floor's.
+fn floors_and_ratios(r: &Report) -> String {
+    let mut s = String::new();
     if let Some(f) = &r.floor {
         let [x, y, z] = f.figures.force_rms;
         s += &format!(

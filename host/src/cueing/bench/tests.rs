@@ -73,11 +73,10 @@ fn the_lap_preview_cues_the_laps_after_the_first_and_repeats_bit_for_bit() {
     )
     .unwrap();
     config.optimal.budget_ms = 1000.0;
-    let run = |preview| {
-        replay(&drives[0], config, &rig.mechanism, &rig.neutral, &rig.envelope, preview).unwrap()
-    };
+    let run = |preview| replay(&drives[0], config, &rig.mechanism, &rig.neutral, &rig.envelope, preview).unwrap();
     let (a, b, live) = (run(Preview::Lap), run(Preview::Lap), run(Preview::None));
-    let poses = |r: &super::super::offline::Replay| -> Vec<[f64; 6]> { r.cued.iter().map(|c| c.pose.to_array()).collect() };
+    let poses =
+        |r: &super::super::offline::Replay| -> Vec<[f64; 6]> { r.cued.iter().map(|c| c.pose.to_array()).collect() };
     assert!(poses(&a) == poses(&b), "two runs differ");
     assert!(poses(&a) != poses(&live), "the preview changed nothing");
     // The first lap is the same motion: nothing to preview from.

@@ -89,6 +89,27 @@ pub struct Counts {
     pub state: Option<State>,
 }
 
+impl Counts {
+    /// The counts as lines of text (`cue`'s summary).
+    pub fn describe(&self) -> String {
+        let mut s = format!(
+            "lap preview: {} laps ({} kept as references), {} departures ({:.1} s departed), previewed {:.1} s, {} \
+             samples without a usable lap distance\n",
+            self.laps, self.kept, self.departures, self.departed_s, self.previewed_s, self.bad_distance
+        );
+        if let Some(last) = self.state {
+            s += &format!(
+                "lap preview at the end: lap {}, matched to lap {}, share {:.2}, alignment error {:.2} m/s^2\n",
+                last.lap + 1,
+                last.matched.map_or("none".into(), |m| (m + 1).to_string()),
+                last.confidence,
+                last.error
+            );
+        }
+        s
+    }
+}
+
 /// The preview's present state, for a report or a panel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct State {
