@@ -96,17 +96,20 @@ fn one_sample_with_the_lap_preview(c: &mut Criterion) {
     let (mut p, mut t) = previewing();
     let (n, h) = (config.optimal.horizon as usize, config.optimal.step_s);
     let mut k = 0usize;
-    c.bench_function("optimal cueing with the lap preview: one sample (eight laps kept)", |b| {
-        b.iter(|| {
-            let s = (k % 6000) as f64 * 0.3;
-            let x = on_lap(s);
-            p.observe(t, s, &x);
-            let ahead = p.ahead(&x, n, h);
-            t += 0.01;
-            k += 1;
-            o.step(&x, 0.01, &ahead).expect("finite")
-        })
-    });
+    c.bench_function(
+        "optimal cueing with the lap preview: one sample (eight laps kept)",
+        |b| {
+            b.iter(|| {
+                let s = (k % 6000) as f64 * 0.3;
+                let x = on_lap(s);
+                p.observe(t, s, &x);
+                let ahead = p.ahead(&x, n, h);
+                t += 0.01;
+                k += 1;
+                o.step(&x, 0.01, &ahead).expect("finite")
+            })
+        },
+    );
     let (mut p, mut t) = previewing();
     let mut k = 0usize;
     c.bench_function("lap preview alone: one sample (eight laps kept)", |b| {

@@ -207,7 +207,11 @@ impl LapPreview {
     /// A preview with no lap yet.
     pub fn new(settings: Settings) -> Self {
         Self {
-            settings,
+            // A grid of two points at least: a lap's lookups interpolate between neighbours.
+            settings: Settings {
+                bins: settings.bins.max(2),
+                ..settings
+            },
             length: None,
             laps: Vec::new(),
             current: Vec::new(),
