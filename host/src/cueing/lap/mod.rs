@@ -18,6 +18,9 @@
 use ringpod_core::cueing::{Telemetry, G};
 use serde::Serialize;
 
+mod report;
+pub use report::{Counts, State};
+
 /// What the optimal cueing's reference over its horizon is made of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -68,59 +71,6 @@ impl Default for Settings {
             max_laps: 8,
         }
     }
-}
-
-/// What the preview did.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
-pub struct Counts {
-    /// Laps completed (lap distance wrapped).
-    pub laps: usize,
-    /// Of them, kept as references (whole, without a departure).
-    pub kept: usize,
-    /// Departures from the matched lap (each fades the preview out).
-    pub departures: usize,
-    /// Samples whose lap distance was not finite, went backwards or jumped.
-    pub bad_distance: usize,
-    /// Time the preview had a share of the reference (s).
-    pub previewed_s: f64,
-    /// Time spent departed (s).
-    pub departed_s: f64,
-    /// The state at the last sample.
-    pub state: Option<State>,
-}
-
-impl Counts {
-    /// The counts as lines of text (`cue`'s summary).
-    pub fn describe(&self) -> String {
-        let mut s = format!(
-            "lap preview: {} laps ({} kept as references), {} departures ({:.1} s departed), previewed {:.1} s, {} \
-             samples without a usable lap distance\n",
-            self.laps, self.kept, self.departures, self.departed_s, self.previewed_s, self.bad_distance
-        );
-        if let Some(last) = self.state {
-            s += &format!(
-                "lap preview at the end: lap {}, matched to lap {}, share {:.2}, alignment error {:.2} m/s^2\n",
-                last.lap + 1,
-                last.matched.map_or("none".into(), |m| (m + 1).to_string()),
-                last.confidence,
-                last.error
-            );
-        }
-        s
-    }
-}
-
-/// The preview's present state, for a report or a panel.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct State {
-    /// The lap being driven (0: the first).
-    pub lap: usize,
-    /// The earlier lap it is matched to.
-    pub matched: Option<usize>,
-    /// The preview's share of the reference (0 to 1).
-    pub confidence: f64,
-    /// The alignment's RMS specific-force error (m/s^2).
-    pub error: f64,
 }
 
 /// One sample of the vehicle's input: specific force (less g on z) and rates.
