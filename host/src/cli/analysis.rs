@@ -339,10 +339,13 @@ pub struct CueArgs {
     /// of seconds on a few minutes of drive).
     #[arg(long, requires = "floor")]
     pub envelope_floor: bool,
-    /// With `algorithm = "optimal"`: the reference over the horizon is the drive's own next samples (a recorded
-    /// drive's preview) rather than the last sample held, as a live game gives it.
-    #[arg(long)]
-    pub preview: bool,
+    /// With `algorithm = "optimal"`: the reference over the horizon is the drive's own next samples (`--preview`
+    /// or `--preview drive`: a recorded drive's future, a yardstick) or the laps driven before, aligned by the
+    /// drive's `lap_distance` column (`--preview lap`: what a live game allows), rather than the last sample held.
+    /// With --compare and `lap`, the second file is cued both live and with the lap preview, and drives with a lap
+    /// distance are scored from their second lap.
+    #[arg(long, value_enum, num_args = 0..=1, default_missing_value = "drive", value_name = "drive|lap")]
+    pub preview: Option<crate::cueing::offline::Preview>,
     /// Washout parameters (TOML; every key optional, see the book's Motion cueing chapter).
     #[arg(long)]
     pub config: Option<std::path::PathBuf>,

@@ -11,6 +11,8 @@ use ringpod_core::motion::{envelope, EnvelopeMargins};
 use serde::Serialize;
 
 use super::engine::Pause;
+pub use super::error::CueError;
+pub use super::lap::{Preview, LAP_DISTANCE};
 use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
@@ -43,6 +45,9 @@ pub struct Summary {
     /// The optimal cueing's samples planned and its fallbacks.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal: Option<super::optimal::Counts>,
+    /// The lap preview's counts, with `--preview lap`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lap: Option<super::lap::Counts>,
 }
 
 /// One cued sample, for the output and the plot.
@@ -67,6 +72,8 @@ pub struct Replay {
     pub pauses: Vec<Pause>,
     /// The optimal cueing's counts (solves, fallbacks, solve times); none for the classical washout.
     pub counts: Option<super::optimal::Counts>,
+    /// The lap preview's counts, with [`Preview::Lap`].
+    pub lap: Option<super::lap::Counts>,
 }
 
 /// What `cue` is asked to do.
@@ -89,8 +96,8 @@ pub struct Options<'a> {
     pub plot: Option<&'a Path>,
     /// The summary as JSON.
     pub json: bool,
-    /// The optimal cueing sees the drive's next samples (a recorded drive's preview).
-    pub preview: bool,
+    /// What the optimal cueing sees ahead: the sample held, the drive's next samples, or the laps before.
+    pub preview: Preview,
     /// The platform: a preset by name...
     pub mechanism: &'a str,
     /// ...or a rig file.
@@ -123,6 +130,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         errors: mut cue_errors,
         counts,
         pauses,
+        lap,
     } = replay(&rows, config, &mechanism, &neutral, &envelope, args.preview)?;
     errors.append(&mut cue_errors);
     errors.sort_by_key(|e| e.line);
@@ -138,6 +146,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         pauses,
         capture,
         optimal: counts,
+        lap,
     };
     let code = if summary.input_errors.is_empty() && summary.rows > 0 {
         0
@@ -161,6 +170,9 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
                 o.samples, o.fallbacks, o.followed_plan, o.took_classical, o.late
             );
         }
+        if let Some(c) = &summary.lap {
+            s += &c.describe();
+        }
         if let Some(c) = &summary.capture {
             s += &format!(
                 "{}: {} packets, {} UDP datagrams read as {}; skipped: {:?}\n",
@@ -182,52 +194,26 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     Ok((text, code))
 }
 
-/// Why a drive could not be cued.
-#[derive(Debug, thiserror::Error)]
-pub enum CueError {
-    /// The washout refused its configuration.
-    #[error("{0}")]
-    Washout(cueing::ConfigError),
-    /// The input could not be read, or is not telemetry (a CSV or a packet capture).
-    #[error("{}: {reason}", path.display())]
-    Input {
-        /// The file.
-        path: std::path::PathBuf,
-        /// Why.
-        reason: String,
-    },
-    /// The poses could not be written.
-    #[error("{}: {reason}", path.display())]
-    Output {
-        /// The file.
-        path: std::path::PathBuf,
-        /// Why.
-        reason: std::io::Error,
-    },
-    /// The bench's floor could not be found.
-    #[error("the floor: {0}")]
-    Floor(super::optimal::floor::FloorError),
-    /// The command's other errors: the mechanism, the cueing file, the picture, the JSON.
-    #[error(transparent)]
-    Cli(#[from] CliError),
-}
-
 /// Cues telemetry rows (`t, ax, ay, az, wx, wy, wz`) by the washout of `config` on `mechanism` around `neutral`
 /// (whose envelope about home is `envelope`, [`super::engine::envelope`]: scanned once by the caller, however
-/// many configurations it replays), every pose limited into the envelope; with `preview`, the optimal cueing sees the drive's next samples (the
-/// reference over its horizon) rather than the last sample held.
+/// many configurations it replays), every pose limited into the envelope; `preview` says what the optimal
+/// cueing's reference over its horizon is made of (a row's lap distance is its eighth value, when it has one).
 pub fn replay(
     rows: &[(usize, Vec<f64>)],
     config: cueing::CueConfig,
     mechanism: &RingPlatform<f64>,
     neutral: &Pose<f64>,
     envelope: &super::optimal::Envelope,
-    preview: bool,
+    preview: Preview,
 ) -> Result<Replay, CueError> {
     let margins = EnvelopeMargins::default();
     let mut washout = super::engine::Engine::new(config, envelope).map_err(CueError::Washout)?;
-    // A recorded drive's next samples, for the optimal cueing's preview.
-    let preview = washout.horizon().filter(|_| preview);
+    // A recorded drive's next samples, or the laps before, for the optimal cueing's preview.
+    let horizon = washout.horizon();
+    let drive_preview = horizon.filter(|_| preview == Preview::Drive);
+    let mut laps = horizon
+        .filter(|_| preview == Preview::Lap)
+        .map(|_| super::lap::LapPreview::new(super::lap::Settings::default()));
     let (mut errors, mut pauses) = (Vec::new(), Vec::new());
     let mut cued: Vec<Cued> = Vec::with_capacity(rows.len());
     let mut limited = 0;
@@ -236,11 +222,18 @@ pub fn replay(
     for (line, v) in rows {
         let t = v[0];
         let sample = super::engine::row_sample(v);
+        if let Some(laps) = laps.as_mut() {
+            laps.observe(t, v.get(7).copied().unwrap_or(f64::NAN), &sample);
+        }
         let offset = match last_t {
             // The first row (and the first after a gap) starts the washout at neutral and is its first input.
             None => washout.begin(&sample),
             Some(l) => {
-                let ahead = preview.map_or_else(Vec::new, |(n, h)| super::engine::ahead(rows, t, n, h));
+                let ahead = match (drive_preview, horizon, &laps) {
+                    (Some((n, h)), _, _) => super::engine::ahead(rows, t, n, h),
+                    (None, Some((n, h)), Some(laps)) => laps.ahead(&sample, n, h),
+                    _ => Vec::new(),
+                };
                 washout.step(&sample, t - l, &ahead)
             }
         };
@@ -288,6 +281,7 @@ pub fn replay(
         errors,
         pauses,
         counts: washout.counts().cloned(),
+        lap: laps.map(|l| l.counts()),
     })
 }
 
@@ -304,7 +298,7 @@ pub fn read_drive(path: &Path) -> Result<Vec<(usize, Vec<f64>)>, CueError> {
         profile: None,
         plot: None,
         json: false,
-        preview: false,
+        preview: Preview::None,
         mechanism: "",
         geometry: None,
     };
@@ -373,7 +367,8 @@ fn read_input(
         ));
     }
     let text = crate::input::files::read_text(args.input, crate::input::files::DATA_LIMIT).map_err(bad)?;
-    let (rows, errors) = table::read(&text, &TELEMETRY_COLUMNS).map_err(|e| bad(e.to_string()))?;
+    let (rows, errors, _) =
+        table::read_with_optional(&text, &TELEMETRY_COLUMNS, &[LAP_DISTANCE]).map_err(|e| bad(e.to_string()))?;
     Ok((rows, errors, None))
 }
 
@@ -588,7 +583,7 @@ mod tests {
             profile: None,
             plot: None,
             json: true,
-            preview: false,
+            preview: Preview::None,
             mechanism: "trainer-model",
             geometry: None,
         };

@@ -148,6 +148,7 @@ mod tests {
         assert_eq!(
             names,
             [
+                "classical-tuned.toml",
                 "classical.toml",
                 "optimal-tilt.toml",
                 "optimal-unbounded.toml",
@@ -156,6 +157,11 @@ mod tests {
             ]
         );
         assert_eq!(load("classical.toml"), CueConfig::default());
+        // The tuned washout the laps are compared with: the tilt of the book's table, little translation.
+        let tuned = load("classical-tuned.toml");
+        assert_eq!(tuned.algorithm, Algorithm::Classical);
+        assert_eq!((tuned.tilt_limit_deg, tuned.tilt_rate_deg), ([18.75; 2], [18.75; 2]));
+        assert!(tuned.translation_scale.iter().all(|s| *s < 0.02), "{tuned:?}");
         let tilt = load("optimal-tilt.toml");
         assert_eq!(tilt.algorithm, Algorithm::Optimal);
         assert_eq!((tilt.optimal.envelope_share, tilt.optimal.tilt_share), (0.2, 0.95));

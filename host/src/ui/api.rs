@@ -11,6 +11,7 @@ use super::frame::RigView;
 use crate::analysis::placement::place;
 use crate::analysis::workspace::{classify, Cell};
 use crate::cueing::bench::score::score;
+use crate::cueing::offline::Preview;
 use crate::cueing::offline::{delivered_forces, replay, Replay, TELEMETRY_COLUMNS};
 
 /// The example drive the Cueing panel replays until the user gives one (a braking, a lane change, a bump).
@@ -62,7 +63,7 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
         )
     })?;
     let scored = |config: CueConfig| -> Result<(Replay, Value), String> {
-        let run = replay(&rows, config, &m, &neutral, &envelope, false).map_err(|e| format!("{e:#}"))?;
+        let run = replay(&rows, config, &m, &neutral, &envelope, Preview::None).map_err(|e| format!("{e:#}"))?;
         let (s, _) = score(&run.cued, &neutral, &envelope.ranges, config.forward);
         let summary = json!({
             "algorithm": config.algorithm,

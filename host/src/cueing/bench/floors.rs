@@ -53,22 +53,32 @@ pub struct EnvelopeFloor {
 /// bounded by the ranges alone, it swings the tilt at any rate and reaches corners of the ranges' box outside the
 /// coupled envelope, so the bench would score the limiter and the finite differences of a motion no cueing
 /// makes, not the floor.
-pub(super) fn floor_of(drives: &[Rows], rig: &Rig, forward: Forward, coupled: bool) -> Result<FloorReport, CueError> {
+pub(super) fn floor_of(
+    drives: &[Rows],
+    from: &[usize],
+    rig: &Rig,
+    forward: Forward,
+    coupled: bool,
+) -> Result<FloorReport, CueError> {
     let ranges = &rig.envelope.ranges;
     let outer = coupled.then(|| Polytope::of(&rig.mechanism, &rig.neutral, ranges, &polytope::directions(3), RAYS));
     let (mut within_ranges, mut within_envelope) = (Sums::default(), Sums::default());
     let mut envelope_share = [0.0f64; 5];
-    for rows in drives {
+    for (d, rows) in drives.iter().enumerate() {
         for piece in pieces(rows) {
             let t: Vec<f64> = piece.iter().map(|(_, v)| v[0]).collect();
             let samples: Vec<Telemetry<f64>> = piece.iter().map(|(_, v)| row_sample(v)).collect();
-            let f = floor::floor(&t, &samples, Room::Ranges(ranges), forward).map_err(CueError::Floor)?;
+            // The piece's own index of the drive's first sample scored (lines are unique).
+            let start = rows.iter().position(|r| r.0 == piece[0].0).unwrap_or(0);
+            let from = from.get(d).map_or(0, |f| f.saturating_sub(start));
+            let f = floor::floor_from(&t, &samples, Room::Ranges(ranges), forward, from).map_err(CueError::Floor)?;
             within_ranges.add(&f);
             for offset in &f.offsets {
                 score::widen_shares(&mut envelope_share, offset, ranges);
             }
             if let Some(outer) = &outer {
-                let f = floor::floor(&t, &samples, Room::Envelope(outer), forward).map_err(CueError::Floor)?;
+                let f =
+                    floor::floor_from(&t, &samples, Room::Envelope(outer), forward, from).map_err(CueError::Floor)?;
                 within_envelope.add(&f);
             }
         }
@@ -111,7 +121,7 @@ struct Sums {
 impl Sums {
     /// Adds a piece of the present drive.
     fn add(&mut self, f: &floor::Floor) {
-        let m = f.offsets.len().saturating_sub(1);
+        let m = f.scored;
         for i in 0..3 {
             let square = f.force_rms[i].powi(2) * m as f64;
             self.sum[i] += square;
@@ -157,7 +167,7 @@ mod tests {
             plot: None,
             tune: false,
             json: false,
-            preview: false,
+            preview: crate::cueing::offline::Preview::None,
             floor: true,
             envelope_floor: envelope,
             mechanism: "trainer-model",

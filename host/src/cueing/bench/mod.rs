@@ -6,6 +6,8 @@
 //! so that both are measured against what the rig allows, not only against each other.
 
 mod floors;
+#[cfg(test)]
+pub mod laps;
 mod picture;
 pub mod score;
 pub mod tune;
@@ -16,13 +18,13 @@ use ringpod_core::cueing::{Algorithm, CueConfig};
 use ringpod_core::kinematics::{Pose, RingPlatform};
 use serde::Serialize;
 
-use super::offline::{read_drive, replay, CueError};
+use super::offline::{read_drive, replay, CueError, Preview};
 use super::optimal::{Counts, Envelope, Ranges};
 use crate::analysis::mechanism::{AnyMechanism, Selected};
 use crate::error::CliError;
 use crate::input::cueing::load_config;
 use floors::{floor_of, FloorReport};
-use score::{score, Score, Trace};
+use score::{score_from, Score, Trace};
 
 /// What the bench is asked to do.
 pub struct Options<'a> {
@@ -38,8 +40,9 @@ pub struct Options<'a> {
     pub tune: bool,
     /// Print the report as JSON rather than a table.
     pub json: bool,
-    /// The optimal cueing sees each drive's next samples.
-    pub preview: bool,
+    /// What the optimal cueing sees ahead: with [`Preview::Lap`] the second file is cued both live and with the
+    /// lap preview.
+    pub preview: Preview,
     /// Add the floor: the least error any motion inside the ranges can give, the whole drive known.
     pub floor: bool,
     /// With the floor: also the floor inside the outer polytope of the rig's whole envelope.
@@ -68,6 +71,8 @@ pub struct Entry {
     pub fallbacks: Option<[usize; 3]>,
     /// The optimal cueing's solve time per sample, all axes: p50, p99, max (ms).
     pub solve_ms: Option<[f64; 3]>,
+    /// The lap preview's counts, every drive together.
+    pub lap: Option<LapCounts>,
 }
 
 /// The bench's report.
@@ -85,6 +90,9 @@ pub struct Report {
     pub entries: Vec<Entry>,
     /// With `--floor`: the least error any motion inside the ranges can give.
     pub floor: Option<FloorReport>,
+    /// Each drive's first sample scored: a drive with a lap distance is scored from its second lap on (the
+    /// first has no lap before it to preview from), every other from its start.
+    pub scored_from: Vec<usize>,
 }
 
 /// A drive's rows.
@@ -100,23 +108,38 @@ pub struct Rig {
     pub envelope: Envelope,
 }
 
-/// Cues every drive by `config` and scores it; with each drive's perceived forces.
+/// The lap preview's counts of every drive.
+pub type LapCounts = super::lap::Counts;
+
+/// Cues every drive by `config` and scores it from its sample `from[i]` on; with each drive's perceived forces.
 pub fn evaluate(
     name: &str,
     config: CueConfig,
     drives: &[Rows],
+    from: &[usize],
     rig: &Rig,
-    preview: bool,
+    preview: Preview,
 ) -> Result<(Entry, Vec<Vec<Trace>>), CueError> {
     let mut scores = Vec::new();
     let mut traces = Vec::new();
     let (mut limited, mut counts) = (0, Counts::default());
-    for rows in drives {
+    let mut lap: Option<LapCounts> = None;
+    for (d, rows) in drives.iter().enumerate() {
         let r = replay(rows, config, &rig.mechanism, &rig.neutral, &rig.envelope, preview)?;
-        let (s, t) = score(&r.cued, &rig.neutral, &rig.envelope.ranges, config.forward);
+        let first = from.get(d).copied().unwrap_or(0);
+        let (s, t) = score_from(&r.cued, first, &rig.neutral, &rig.envelope.ranges, config.forward);
         limited += r.limited;
         if let Some(c) = &r.counts {
             counts.add(c);
+        }
+        if let Some(c) = r.lap {
+            let sum = lap.get_or_insert_with(LapCounts::default);
+            sum.laps += c.laps;
+            sum.kept += c.kept;
+            sum.departures += c.departures;
+            sum.bad_distance += c.bad_distance;
+            sum.previewed_s += c.previewed_s;
+            sum.departed_s += c.departed_s;
         }
         scores.push(s);
         traces.push(t);
@@ -131,6 +154,7 @@ pub fn evaluate(
             limited,
             fallbacks: optimal.then_some([counts.fallbacks, counts.followed_plan, counts.took_classical]),
             solve_ms: optimal.then(|| counts.solve_ms()),
+            lap,
         },
         traces,
     ))
@@ -189,6 +213,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         neutral,
     };
     let drives: Vec<Rows> = args.inputs.iter().map(|p| read_drive(p)).collect::<Result<_, _>>()?;
+    let from: Vec<usize> = drives.iter().map(second_lap).collect();
     let name = |p: &Path| {
         p.file_name()
             .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into())
@@ -197,7 +222,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     let mut traces = Vec::new();
     let mut tuned = None;
     let first = if args.tune && a.algorithm == Algorithm::Classical {
-        let best = tune::tune(a, &drives, &rig)?;
+        let best = tune::tune(a, &drives, &from, &rig)?;
         tuned = Some(toml::to_string(&best).map_err(|e| CueError::Input {
             path: args.configs[0].to_path_buf(),
             reason: e.to_string(),
@@ -206,14 +231,23 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     } else {
         (name(args.configs[0]), a)
     };
-    for (n, c) in [first, (name(args.configs[1]), b)] {
-        let (e, t) = evaluate(&n, c, &drives, &rig, args.preview)?;
+    let second = name(args.configs[1]);
+    let mut runs = vec![(first.0, first.1, Preview::None)];
+    match args.preview {
+        Preview::Lap => {
+            runs.push((second.clone(), b, Preview::None));
+            runs.push((format!("{second} (lap preview)"), b, Preview::Lap));
+        }
+        p => runs.push((second, b, p)),
+    }
+    for (n, c, p) in runs {
+        let (e, t) = evaluate(&n, c, &drives, &from, &rig, p)?;
         entries.push(e);
         traces.push(t);
     }
     let floor = args
         .floor
-        .then(|| floor_of(&drives, &rig, a.forward, args.envelope_floor))
+        .then(|| floor_of(&drives, &from, &rig, a.forward, args.envelope_floor))
         .transpose()?;
     let report = Report {
         drives: args.inputs.iter().map(|p| p.display().to_string()).collect(),
@@ -222,6 +256,7 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
         tuned,
         entries,
         floor,
+        scored_from: from,
     };
     let json = serde_json::to_string_pretty(&report).map_err(CliError::from)? + "\n";
     crate::out::file::write(args.out, json.as_bytes()).map_err(|reason| CueError::Output {
@@ -235,6 +270,22 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
     Ok((text, 0))
 }
 
+/// The index of a drive's second lap's first sample: where its lap distance (a row's eighth value) first wraps
+/// (falls by more than half of the largest distance before it); 0 for a drive without one.
+pub fn second_lap(rows: &Rows) -> usize {
+    let mut top = f64::NEG_INFINITY;
+    for (k, (_, v)) in rows.iter().enumerate() {
+        let Some(&s) = v.get(7).filter(|s| s.is_finite()) else {
+            continue;
+        };
+        if top > 0.0 && s < top - 0.5 * top {
+            return k;
+        }
+        top = top.max(s);
+    }
+    0
+}
+
 /// The report as a table: one column per algorithm.
 fn table(r: &Report) -> String {
     let mut s = format!(
@@ -243,6 +294,12 @@ fn table(r: &Report) -> String {
         r.mechanism,
         r.drives.join(", ")
     );
+    if r.scored_from.iter().any(|&k| k > 0) {
+        s += &format!(
+            "scored from each drive's second lap (its first sample scored: {:?})\n",
+            r.scored_from
+        );
+    }
     let row = |label: &str, f: &dyn Fn(&Entry) -> String| {
         let mut line = format!("{label:<44}");
         for e in &r.entries {
@@ -288,6 +345,22 @@ fn table(r: &Report) -> String {
         e.solve_ms
             .map_or("-".into(), |t| format!("{:.3} {:.3} {:.3}", t[0], t[1], t[2]))
     });
+    if r.entries.iter().any(|e| e.lap.is_some()) {
+        s += &row("lap preview: laps (kept), departures", &|e| {
+            e.lap
+                .map_or("-".into(), |c| format!("{} ({}), {}", c.laps, c.kept, c.departures))
+        });
+        s += &row("lap preview: previewed, departed (s)", &|e| {
+            e.lap
+                .map_or("-".into(), |c| format!("{:.1}, {:.1}", c.previewed_s, c.departed_s))
+        });
+    }
+    s + &floors_and_ratios(r)
+}
+
+/// The table's last lines: the floors, and each entry's force error against the first's and the floor's.
+fn floors_and_ratios(r: &Report) -> String {
+    let mut s = String::new();
     if let Some(f) = &r.floor {
         let [x, y, z] = f.figures.force_rms;
         s += &format!(
@@ -315,6 +388,10 @@ fn table(r: &Report) -> String {
         if let Some(f) = &r.floor {
             let ratio = f.figures.force_total / a.total.force_total().max(1e-12);
             s += &format!("floor / {} perceived force error (RMS, all axes): {ratio:.3}\n", a.name);
+            for b in rest {
+                let ratio = b.total.force_total() / f.figures.force_total.max(1e-12);
+                s += &format!("{} / floor perceived force error (RMS, all axes): {ratio:.3}\n", b.name);
+            }
             if let Some(e) = &f.envelope {
                 let ratio = e.figures.force_total / a.total.force_total().max(1e-12);
                 s += &format!(
@@ -326,3 +403,6 @@ fn table(r: &Report) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests;

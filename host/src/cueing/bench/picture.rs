@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use plotters::style::colors::{BLACK, BLUE, RED};
+use plotters::style::colors::{BLACK, BLUE, GREEN, RED};
 
 use super::score::Trace;
 use super::Report;
@@ -11,7 +11,7 @@ use crate::out::plot::{self, Panel, PlotError, Series, TimePlot};
 
 /// Draws `traces` (per entry, per drive) of `report` to `path` (SVG or PNG).
 pub fn draw(path: &Path, report: &Report, traces: &[Vec<Vec<Trace>>]) -> Result<(), PlotError> {
-    let colours = [BLUE, RED];
+    let colours = [BLUE, RED, GREEN];
     let mut panels = Vec::new();
     for (d, drive) in report.drives.iter().enumerate() {
         for (axis, what) in ["longitudinal (x)", "lateral (y)"].iter().enumerate() {

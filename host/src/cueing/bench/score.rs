@@ -113,8 +113,20 @@ pub fn widen_shares(shares: &mut [f64; 5], offset: &[f64], ranges: &Ranges) {
 /// Scores a cued drive about `neutral` in `ranges`, the platform facing `forward`; with each sample's perceived
 /// forces.
 pub fn score(cued: &[Cued], neutral: &Pose<f64>, ranges: &Ranges, forward: Forward) -> (Score, Vec<Trace>) {
+    score_from(cued, 0, neutral, ranges, forward)
+}
+
+/// [`score`] of the samples from index `from` on (a multi-lap drive scored on the laps after the first: the
+/// perception runs from the start, the errors, false cues and shares count from `from`).
+pub fn score_from(
+    cued: &[Cued],
+    from: usize,
+    neutral: &Pose<f64>,
+    ranges: &Ranges,
+    forward: Forward,
+) -> (Score, Vec<Trace>) {
     let mut s = Score {
-        samples: cued.len(),
+        samples: cued.len().saturating_sub(from),
         ..Score::default()
     };
     let mut traces = Vec::with_capacity(cued.len());
@@ -151,6 +163,9 @@ pub fn score(cued: &[Cued], neutral: &Pose<f64>, ranges: &Ranges, forward: Forwa
             vehicle: pv.force,
             platform: pp.force,
         });
+        if k < from {
+            continue;
+        }
         for i in 0..3 {
             let e = pp.force[i] - pv.force[i];
             sum_f[i] += e * e;
@@ -165,7 +180,8 @@ pub fn score(cued: &[Cued], neutral: &Pose<f64>, ranges: &Ranges, forward: Forwa
         let offset: [f64; 5] = core::array::from_fn(|i| pb[i] - n[i]);
         widen_shares(&mut s.envelope_share, &offset, ranges);
     }
-    let m = (cued.len() - 1) as f64;
+    // Every interval from `from` on (those skipped over a pause included, as ever).
+    let m = cued.len().saturating_sub(from.max(1)).max(1) as f64;
     s.force_rms = sum_f.map(|v| (v / m).sqrt());
     s.rotation_rms = sum_w.map(|v| (v / m).sqrt());
     s.false_force = force_runs.map(|r| r.cues);

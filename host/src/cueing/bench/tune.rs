@@ -9,7 +9,7 @@
 use ringpod_core::cueing::CueConfig;
 
 use super::{evaluate, Rig, Rows};
-use crate::cueing::offline::CueError;
+use crate::cueing::offline::{CueError, Preview};
 
 /// The factors tried on each parameter.
 pub const FACTORS: [f64; 6] = [0.4, 0.6, 0.8, 1.25, 1.6, 2.5];
@@ -46,15 +46,15 @@ pub const KNOBS: [Knob; 8] = [
 ];
 
 /// The score of a configuration on the drives (lower is better).
-pub fn cost(config: CueConfig, drives: &[Rows], rig: &Rig) -> Result<f64, CueError> {
-    let (e, _) = evaluate("", config, drives, rig, false)?;
+pub fn cost(config: CueConfig, drives: &[Rows], from: &[usize], rig: &Rig) -> Result<f64, CueError> {
+    let (e, _) = evaluate("", config, drives, from, rig, Preview::None)?;
     Ok(e.total.force_total() + FALSE_CUE_COST * e.total.false_total() as f64)
 }
 
 /// The best configuration found from `start`.
-pub fn tune(start: CueConfig, drives: &[Rows], rig: &Rig) -> Result<CueConfig, CueError> {
+pub fn tune(start: CueConfig, drives: &[Rows], from: &[usize], rig: &Rig) -> Result<CueConfig, CueError> {
     let mut best = start;
-    let mut best_cost = cost(best, drives, rig)?;
+    let mut best_cost = cost(best, drives, from, rig)?;
     for _ in 0..PASSES {
         for (_, turn) in KNOBS {
             let mut pass_best = (best, best_cost);
@@ -65,7 +65,7 @@ pub fn tune(start: CueConfig, drives: &[Rows], rig: &Rig) -> Result<CueConfig, C
                 if c.validate().is_err() {
                     continue;
                 }
-                let k = cost(c, drives, rig)?;
+                let k = cost(c, drives, from, rig)?;
                 if k < pass_best.1 {
                     pass_best = (c, k);
                 }

@@ -45,6 +45,8 @@ pub struct Floor {
     pub force_rms: [f64; 3],
     /// The motion that reaches it: each sample's offset from neutral in platform axes (yaw none).
     pub offsets: Vec<[f64; 6]>,
+    /// The intervals its figures count.
+    pub scored: usize,
 }
 
 /// What bounds the floor's motion.
@@ -57,7 +59,20 @@ pub enum Room<'a> {
 }
 
 /// The floor of a drive (`samples` at times `t`) in `room`, the platform facing `forward`.
+#[cfg(test)]
 pub fn floor(t: &[f64], samples: &[Telemetry<f64>], room: Room, forward: Forward) -> Result<Floor, FloorError> {
+    floor_from(t, samples, room, forward, 0)
+}
+
+/// [`floor`] of the samples from index `from` on: the error before it is not priced (the motion is free to
+/// prepare), nor counted.
+pub fn floor_from(
+    t: &[f64],
+    samples: &[Telemetry<f64>],
+    room: Room,
+    forward: Forward,
+    from: usize,
+) -> Result<Floor, FloorError> {
     if t.len() < 2 || samples.len() != t.len() {
         return Err(FloorError::TooShort(t.len().min(samples.len())));
     }
@@ -74,7 +89,7 @@ pub fn floor(t: &[f64], samples: &[Telemetry<f64>], room: Room, forward: Forward
     let variables = base;
     let mut qp = Sparse::default();
     for part in &parts {
-        part.dynamics(&mut qp, t, samples);
+        part.dynamics(&mut qp, t, samples, from);
     }
     qp.equalities = qp.b.len();
     match room {
@@ -88,8 +103,10 @@ pub fn floor(t: &[f64], samples: &[Telemetry<f64>], room: Room, forward: Forward
     let x = solve(&qp, variables)?;
     let mut force_rms = [0.0; 3];
     for part in &parts {
-        let sum: f64 = (0..n).map(|k| x[part.error(k)].powi(2)).sum();
-        force_rms[part.i] = (sum / n.max(1) as f64).sqrt();
+        // Error k is sample k + 1's.
+        let first = from.saturating_sub(1).min(n);
+        let sum: f64 = (first..n).map(|k| x[part.error(k)].powi(2)).sum();
+        force_rms[part.i] = (sum / (n - first).max(1) as f64).sqrt();
     }
     let offsets = std::iter::once([0.0; 6])
         .chain((0..n).map(|k| {
@@ -97,7 +114,11 @@ pub fn floor(t: &[f64], samples: &[Telemetry<f64>], room: Room, forward: Forward
             cueing::to_platform(forward, [px, py, pz], roll, pitch, 0.0)
         }))
         .collect();
-    Ok(Floor { force_rms, offsets })
+    Ok(Floor {
+        force_rms,
+        offsets,
+        scored: n - from.saturating_sub(1).min(n),
+    })
 }
 
 /// Bounds the programme by every face of the polytope at every sample. (Adding only the faces a solution
@@ -202,7 +223,7 @@ impl Part {
     }
 
     /// The dynamics and the error's definition, as equalities; the error's square and the effort as the cost.
-    fn dynamics(&self, qp: &mut Sparse, t: &[f64], samples: &[Telemetry<f64>]) {
+    fn dynamics(&self, qp: &mut Sparse, t: &[f64], samples: &[Telemetry<f64>], from: usize) {
         let (nx, nu, _) = self.model.dims();
         let model = &self.model;
         let reference = vehicle_perceived(&self.perception, t, samples, self.i);
@@ -233,7 +254,9 @@ impl Part {
                 qp.a.push(row, self.input(k) + c, -model.d[(0, c)]);
             }
             qp.b.push(-reference[k + 1]);
-            qp.p.push(self.error(k), self.error(k), 2.0);
+            if k + 1 >= from {
+                qp.p.push(self.error(k), self.error(k), 2.0);
+            }
             for c in 0..nu {
                 qp.p.push(self.input(k) + c, self.input(k) + c, 2.0 * EFFORT);
             }
