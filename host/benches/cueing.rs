@@ -23,7 +23,9 @@ fn sample(t: f64) -> Telemetry<f64> {
     }
 }
 
-fn one_sample(c: &mut Criterion) {
+/// The optimal cueing at its defaults on the trainer model, with the rig: each sample also searches the tilt's
+/// shared room.
+fn optimiser() -> (CueConfig, optimal::Optimal) {
     let config = CueConfig {
         algorithm: Algorithm::Optimal,
         ..CueConfig::default()
@@ -36,7 +38,6 @@ fn one_sample(c: &mut Criterion) {
         (-0.454, 0.384),
         (-0.358, 0.358),
     ];
-    // With the rig: each sample also searches the tilt's shared room.
     let envelope = optimal::Envelope {
         ranges,
         rig: Some((
@@ -44,7 +45,12 @@ fn one_sample(c: &mut Criterion) {
             Pose::from_array(Preset::TrainerModel.home()),
         )),
     };
-    let mut o = optimal::Optimal::new(config, &envelope).expect("the defaults are valid");
+    let o = optimal::Optimal::new(config, &envelope).expect("the defaults are valid");
+    (config, o)
+}
+
+fn one_sample(c: &mut Criterion) {
+    let (_, mut o) = optimiser();
     o.begin(&sample(0.0)).expect("finite");
     let mut t = 0.0;
     c.bench_function("optimal cueing: one sample (three axes)", |b| {
@@ -73,25 +79,7 @@ fn previewing() -> (lap::LapPreview, f64) {
 }
 
 fn one_sample_with_the_lap_preview(c: &mut Criterion) {
-    let config = CueConfig {
-        algorithm: Algorithm::Optimal,
-        ..CueConfig::default()
-    };
-    let ranges = [
-        (-0.129, 0.129),
-        (-0.055, 0.095),
-        (-0.067, 0.059),
-        (-0.454, 0.384),
-        (-0.358, 0.358),
-    ];
-    let envelope = optimal::Envelope {
-        ranges,
-        rig: Some((
-            RingPlatform::new(&TRAINER_MODEL),
-            Pose::from_array(Preset::TrainerModel.home()),
-        )),
-    };
-    let mut o = optimal::Optimal::new(config, &envelope).expect("the defaults are valid");
+    let (config, mut o) = optimiser();
     o.begin(&on_lap(0.0)).expect("finite");
     let (mut p, mut t) = previewing();
     let (n, h) = (config.optimal.horizon as usize, config.optimal.step_s);
