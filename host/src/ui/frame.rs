@@ -27,6 +27,11 @@ pub struct RigView {
     pub source: String,
     /// The firmware the device runs and its protocol version (empty for a rig file shown on its own).
     pub firmware: String,
+    /// Each axis's reach about home (surge, sway, heave m; roll, pitch rad), as the cueing's envelope scans it:
+    /// the Live view's share of the envelope used. None when the home is outside the workspace.
+    pub envelope: Option<[(f64, f64); 5]>,
+    /// The unit of a frame's tick cost: `cycles` on a board's MCU, `ns` in the simulator.
+    pub tick_unit: &'static str,
 }
 
 impl RigView {
@@ -61,6 +66,10 @@ impl RigView {
                 .collect(),
             source,
             firmware: String::new(),
+            envelope: crate::cueing::engine::envelope(&m, &Pose::from_array(home))
+                .ok()
+                .map(|e| e.ranges),
+            tick_unit: "cycles",
         }
     }
 }
@@ -142,6 +151,27 @@ pub struct Frame {
     pub ghost: Option<Placed>,
     pub gates: Gates,
     pub streaming: bool,
+    /// What the game asked of the cueing in the last half second (a telemetry session's newest sample).
+    pub cue_input: Option<CueInput>,
+}
+
+/// A telemetry sample as the Live view shows it: specific force in g (x forward, y left, z up) and angular rate
+/// in deg/s (roll, pitch, yaw).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct CueInput {
+    pub force_g: [f64; 3],
+    pub rate_deg_s: [f64; 3],
+}
+
+impl CueInput {
+    /// The newest sample a telemetry session cued, if it came within the last half second.
+    pub fn newest() -> Option<Self> {
+        let (at, t) = crate::stream::datagram::newest_input()?;
+        (at.elapsed() < std::time::Duration::from_millis(500)).then(|| Self {
+            force_g: t.force.map(|f| f / ringpod_core::cueing::G),
+            rate_deg_s: t.rate.map(f64::to_degrees),
+        })
+    }
 }
 
 /// Counts of the telemetry link, kept by whoever taps it.
@@ -173,6 +203,7 @@ pub fn frame(m: &RingPlatform<f64>, t: &Telemetry, link: LinkCounts, streaming: 
         ghost: place(m, &target),
         gates: Gates::of(t, streaming),
         streaming,
+        cue_input: CueInput::newest(),
     }
 }
 

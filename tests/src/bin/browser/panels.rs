@@ -88,7 +88,8 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
          !!q('smoothing.window')]; })()",
     )
     .await?;
-    if layout != json!(["surge", "tilt coordination", "m/s²", "SELECT", false]) {
+    // The pitch's and roll's tilt with the force each cues (surge, sway); the optimal cueing's fields hidden.
+    if layout != json!(["surge", "sway", "m/s²", "SELECT", false]) {
         return Err(format!(
             "the controls are not grouped by channel with units and selects: {layout}"
         ));
@@ -132,6 +133,11 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
     .await?;
     if seen != json!([true, true]) {
         return Err(format!("the refusal is out of view or the value not marked: {seen}"));
+    }
+    // Named as on screen (its group and label), with the range shown, not the file's key.
+    let said = refused.as_str().unwrap_or("");
+    if !said.starts_with("surge: ") || said.contains("translation_scale") {
+        return Err(format!("the refusal does not name the field as shown: {said}"));
     }
     let runs = js(c, "window.ringpod.cueRuns").await?.as_u64().unwrap_or(0);
     js(
