@@ -32,6 +32,9 @@ pub struct RigView {
     pub envelope: Option<[(f64, f64); 5]>,
     /// The unit of a frame's tick cost: `cycles` on a board's MCU, `ns` in the simulator.
     pub tick_unit: &'static str,
+    /// The longest jog of each actuator the device takes (deg of ring or shoulder, mm of a linear actuator): a
+    /// carriage its homing back-off, a linear actuator or a shoulder its homing search travel. Empty when unknown.
+    pub jog_most: Vec<f64>,
 }
 
 impl RigView {
@@ -70,6 +73,7 @@ impl RigView {
                 .ok()
                 .map(|e| e.ranges),
             tick_unit: "cycles",
+            jog_most: Vec::new(),
         }
     }
 }

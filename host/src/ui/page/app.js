@@ -52,7 +52,7 @@ function connect() {
   };
   ws.onmessage = (e) => {
     const m = JSON.parse(e.data);
-    if (m.type === "hello") state.page = m.page;
+    if (m.type === "hello") { state.page = m.page; $("file-name-row").hidden = !m.files; }
     else if (m.type === "rig") showRig(m);
     else if (m.type === "frame") showFrame(m);
     else if (m.type === "reply") showReply(m);
@@ -152,7 +152,13 @@ function showRig(rig) {
     axis.appendChild(o);
   });
   // Degrees of ring for a carriage and of a shoulder's angle, mm for a linear actuator (as `device jog`).
-  axis.onchange = () => { $("jog-unit").textContent = rig.axes[axis.value - 1] === "linear" ? "mm" : "deg"; };
+  // The longest jog the device takes, said before it is refused (a carriage its homing back-off).
+  axis.onchange = () => {
+    const unit = rig.axes[axis.value - 1] === "linear" ? "mm" : "deg", most = (rig.jog_most || [])[axis.value - 1];
+    $("jog-unit").textContent = unit;
+    $("jog-most").textContent = most ? `at most ${most.toPrecision(3)} ${unit} (${rig.axes[axis.value - 1] === "ring" ? "the carriage's homing back-off" : "its homing search travel"})` : "";
+    if (most) $("jog-distance").max = most;
+  };
   axis.onchange();
   const charts = $("live-charts");
   charts.innerHTML = "";
@@ -160,6 +166,9 @@ function showRig(rig) {
   AXIS_NAMES.forEach((a, i) => {
     const c = new Chart(charts, `${a} (${MOTION_UNIT[i]})`, "");
     c.rightUnit = " " + CUE_UNIT[i];
+    // At rest: 2 mm or 1 deg of scale, 0.2 g or 10 deg/s of cue.
+    c.minSpan = i < 3 ? 2 : 1;
+    c.rightMinSpan = i < 3 ? 0.2 : 10;
     c.canvas.id = `live-${a}`;
     liveCharts.push(c);
   });
@@ -275,13 +284,13 @@ function drawLive(f) {
       const [lo, hi] = env[i];
       const reach = shown(followed >= 0 ? hi : lo, i);
       const used = reach ? Math.min(Math.abs(followed / reach), 1) : 0;
-      share = `<span class="share"><meter min="0" max="1" low="0.7" high="0.9" optimum="0" value="${used.toFixed(3)}"></meter> ${(used * 100).toFixed(0)} % of reach</span>`;
-    } else if (i === 5) share = `<span class="share muted">no limit</span>`;
+      share = `<span class="share" title="the share of the platform's reach on this side of home the followed pose uses">reach ${(used * 100).toFixed(0)} % <meter min="0" max="1" low="0.7" high="0.9" optimum="0" value="${used.toFixed(3)}"></meter></span>`;
+    } else if (i === 5) share = `<span class="share muted">turns freely</span>`;
     const q = history.cue[last];
-    const cueText = q ? `cue <b>${q[i].toFixed(i < 3 ? 2 : 1)}</b> ${CUE_UNIT[i]}` : `<span class="muted">no game cue</span>`;
-    const limited = events.length ? ` <span class="limited">limited ${events.length}× in 10 s</span>` : "";
-    c.caption.innerHTML = `<b>${AXIS_NAMES[i]}</b> followed <b>${followed.toFixed(1)}</b> ${MOTION_UNIT[i]}` +
-      ` <span class="muted">commanded ${commanded.toFixed(1)}</span> ${cueText} ${share}${limited}`;
+    const cueText = q ? `cue <b>${q[i].toFixed(i < 3 ? 2 : 1)}</b> ${CUE_UNIT[i]}` : `<span class="muted">no cue</span>`;
+    const limited = events.length ? ` <span class="limited">limited ${events.length}×</span>` : "";
+    c.caption.innerHTML = `<b>${AXIS_NAMES[i]}</b> <b>${followed.toFixed(1)}</b> ${MOTION_UNIT[i]}` +
+      ` <span class="muted">(commanded ${commanded.toFixed(1)})</span> ${cueText} ${share}${limited}`;
   });
   if (costChart) {
     costChart.set([{ x: history.t, y: history.cost, colour: "#374151" }]);
@@ -448,4 +457,3 @@ function showRun(run, name) {
 }
 
 connect();
-loadProfiles();

@@ -26,6 +26,8 @@ class Chart {
     this.title = title;
     this.unit = unit || "";
     this.rightUnit = "";
+    this.minSpan = 0; // the least span of the y scale (left), and of the right one
+    this.rightMinSpan = 0;
     this.series = [];
     this.events = [];
     this.view = null; // [x0, x1] when zoomed
@@ -64,6 +66,7 @@ class Chart {
 
   // The y range of the series on one side (`right` or not) within [x0, x1], padded; none when nothing is there.
   range(x0, x1, right) {
+    right = !!right;
     let y0 = Infinity, y1 = -Infinity;
     for (const s of this.series) {
       if (!!s.right !== right) continue;
@@ -73,6 +76,12 @@ class Chart {
       }
     }
     if (!isFinite(y0)) return null;
+    // A span of at least `minSpan` (a platform at rest drawn as a line at its value, not its noise magnified).
+    const least = right ? this.rightMinSpan : this.minSpan;
+    if (least && y1 - y0 < least) {
+      const mid = (y0 + y1) / 2;
+      y0 = mid - least / 2; y1 = mid + least / 2;
+    }
     if (y1 - y0 < 1e-9) {
       // A flat series: a band around it, scaled to its value (not a whole metre around a millimetre).
       const h = Math.max(Math.abs(y0) * 0.05, 1e-3);
@@ -94,13 +103,13 @@ class Chart {
     const g = c.getContext("2d");
     g.setTransform(dpr, 0, 0, dpr, 0, 0);
     const W = box.width, H = box.height;
-    const hasRight = this.series.some((s) => s.right);
-    const L = 62, R = hasRight ? 62 : 8, T = 6, B = 20;
     g.clearRect(0, 0, W, H);
     const [x0, x1] = this.view || this.extent();
     if (!isFinite(x0) || x1 <= x0) return;
-    const left = this.range(x0, x1, false), right = hasRight ? this.range(x0, x1, true) : null;
+    const left = this.range(x0, x1, false), right = this.range(x0, x1, true);
     if (!left && !right) return;
+    // The right-hand scale takes room only while it has something to show (a game's cue).
+    const L = 62, R = right ? 62 : 8, T = 6, B = 20;
     const X = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
     const Yof = ([y0, y1]) => (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
     g.strokeStyle = "#e5e7eb"; g.lineWidth = 1; g.fillStyle = "#4b5563"; g.font = "12px system-ui";
@@ -119,11 +128,23 @@ class Chart {
     }
     g.textAlign = "center"; g.fillStyle = "#4b5563";
     const xt = ticks(x0, x1, Math.max(2, Math.floor((W - L - R) / 90)));
-    for (const x of xt.at) g.fillText(x.toFixed(xt.decimals) + " s", X(x), H - 5);
+    for (const x of xt.at) {
+      // Kept whole inside the canvas at either end.
+      const label = x.toFixed(xt.decimals) + " s", half = g.measureText(label).width / 2;
+      g.fillText(label, Math.min(Math.max(X(x), half + 2), W - half - 2), H - 5);
+    }
     g.textAlign = "left";
+    // Each event's line, and its label (a state change's new state) beside its top, unless the last label is
+    // still there.
+    let freeFrom = -Infinity;
     for (const e of this.events) {
       if (e.x < x0 || e.x > x1) continue;
       g.strokeStyle = e.colour; g.beginPath(); g.moveTo(X(e.x), T); g.lineTo(X(e.x), H - B); g.stroke();
+      if (e.label && X(e.x) >= freeFrom) {
+        g.fillStyle = "#374151";
+        g.fillText(e.label, X(e.x) + 3, T + 12);
+        freeFrom = X(e.x) + g.measureText(e.label).width + 8;
+      }
     }
     g.save();
     g.beginPath(); g.rect(L, T, W - L - R, H - T - B); g.clip();

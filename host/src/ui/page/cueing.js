@@ -115,7 +115,8 @@ function cueControl(f) {
   row.className = "cue-row";
   const value = getPath(cue.config, f.path);
   const first = f.key.split(".")[0];
-  const meaning = MEANING[first] ? (first === "optimal" ? `${MEANING.optimal} ${f.label.replace("optimal: ", "")}` : MEANING[first]) : "";
+  const meaning = f.key.endsWith(".zeta") ? "its damping: 1 settles without overshoot, lower overshoots, higher is slower"
+    : MEANING[first] ? (first === "optimal" ? `${MEANING.optimal} ${f.label.replace("optimal: ", "")}` : MEANING[first]) : "";
   const name = document.createElement("label");
   name.className = "cue-name";
   name.textContent = f.label.replace(/^optimal: /, "");
@@ -185,7 +186,7 @@ function checkShown() {
     const v = parseFloat(i.value), lo = +i.dataset.shownMin, hi = +i.dataset.shownMax;
     i.classList.toggle("bad", !(isFinite(v) && v >= lo && v <= hi));
     if (i.classList.contains("bad")) {
-      cueStatus(`${i.dataset.name} must be ${lo} to ${hi} ${i.dataset.unit}, not ${i.value || "empty"}`, true);
+      cueStatus(`${i.dataset.name} must be ${lo} to ${hi}${i.dataset.unit ? " " + i.dataset.unit : ""}, not ${i.value || "empty"}`, true);
       return false;
     }
   }
@@ -406,3 +407,6 @@ function placeLiveCharts() {
   $("cue-charts").hidden = !!tuning;
   $("cue-live-note").hidden = !tuning;
 }
+
+// The games and profiles from the start: the Control panel's game list needs them.
+loadProfiles();

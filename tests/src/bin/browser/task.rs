@@ -189,8 +189,9 @@ async fn live_view(c: &Client, w: u32, h: u32) -> Result<String, String> {
            document.getElementById('live-' + a).getBoundingClientRect()); \
          const text = [...document.querySelectorAll('#panel-live figcaption, #counters td')] \
            .map((e) => parseFloat(getComputedStyle(e).fontSize)); \
-         return cap.textContent.includes('cue') && { css: [Math.round(r.width), Math.round(r.height)], \
+         return cap.textContent.includes('deg/s') && { css: [Math.round(r.width), Math.round(r.height)], \
            drawn: [c.width, c.height], dpr, caption: cap.textContent.trim(), \
+           whole: [...document.querySelectorAll('#live-charts figcaption')].every((e) => e.scrollWidth <= e.clientWidth + 1), \
            beside: v.right <= r.left || v.right <= Math.min(...all.map((a) => a.left)), \
            onScreen: all.every((a) => a.top >= 0 && a.bottom <= window.innerHeight && a.width >= 300), \
            smallestText: Math.min(...text), inner: [window.innerWidth, window.innerHeight], \
@@ -217,9 +218,12 @@ async fn live_view(c: &Client, w: u32, h: u32) -> Result<String, String> {
     if !caption.starts_with("roll")
         || !caption.contains("deg")
         || !caption.contains("deg/s")
-        || !caption.contains("% of reach")
+        || !caption.contains("reach")
     {
         wrong.push("the roll caption does not say roll in deg, the cue in deg/s and the reach used");
+    }
+    if roll["whole"] != json!(true) {
+        wrong.push("a caption cut off");
     }
     if roll["beside"] != json!(true) || roll["onScreen"] != json!(true) {
         wrong.push("the charts are not beside the platform, on screen and 300 px wide");
