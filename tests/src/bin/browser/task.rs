@@ -121,6 +121,8 @@ pub async fn at_size(
     click(c, "#run-udp").await?;
     let stop = Arc::new(AtomicBool::new(false));
     let sender = game(port, stop.clone());
+    // Beside the panels' pictures at each size (the book's).
+    let sizes = shots.map(|d| d.join("sizes"));
     let ran = async {
         until(
             c,
@@ -138,9 +140,9 @@ pub async fn at_size(
             return Err(format!("the session did not take the F1 profile: {session}"));
         }
         let live = live_view(c, w, h).await?;
-        screenshot(c, shots, &format!("task-live-{w}x{h}")).await?;
+        screenshot(c, sizes.as_deref(), &format!("task-live-{w}x{h}")).await?;
         let tuned = tune(c, raise).await?;
-        screenshot(c, shots, &format!("task-cueing-{w}x{h}")).await?;
+        screenshot(c, sizes.as_deref(), &format!("task-cueing-{w}x{h}")).await?;
         Ok::<_, String>(format!("{live}; {tuned}"))
     }
     .await;
