@@ -78,6 +78,23 @@ impl RigView {
     }
 }
 
+impl RigView {
+    /// The longest jog of each actuator, as the device checks it (`commission::begin_move`'s "further than a jog
+    /// goes"): a carriage its homing back-off, a linear actuator or a shoulder its homing search travel.
+    pub fn jog_the_device_takes(&mut self, homing: &[ringpod_core::protocol::SwitchSettings; 6]) {
+        self.jog_most = self
+            .axes
+            .iter()
+            .zip(homing)
+            .map(|(kind, h)| match *kind {
+                "ring" => f64::from(h.backoff).to_degrees(),
+                "linear" => f64::from(h.search) * 1000.0,
+                _ => f64::from(h.search).to_degrees(),
+            })
+            .collect();
+    }
+}
+
 /// Whether each command would be taken now (`None`) or why not: the supervisor's own decision, asked of one
 /// rebuilt from the reported state and inputs; while a stream runs from this workbench, only its STOP.
 #[derive(Debug, Clone, Serialize, PartialEq)]
@@ -214,7 +231,7 @@ pub fn frame(m: &RingPlatform<f64>, t: &Telemetry, link: LinkCounts, streaming: 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ringpod_core::kinematics::presets::Preset;
+    use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
     use ringpod_core::safety::debounce::InputBit;
     use ringpod_core::safety::State;
 
@@ -234,6 +251,40 @@ mod tests {
             inputs,
             outputs: 0,
         }
+    }
+
+    /// The jog the page says is the one the device takes: a carriage's homing back-off in degrees of ring, a
+    /// linear actuator's search travel in mm; the trainer's simulator counts its tick in ns.
+    #[test]
+    fn the_longest_jog_is_the_homing_back_off_or_search() {
+        use ringpod_core::protocol::{SwitchSettings, Toward};
+        let PresetGeometry::Ring(g) = Preset::TrainerModel.geometry() else {
+            unreachable!("the trainer model is a ring platform")
+        };
+        let mut view = RigView::of(g, Preset::TrainerModel.home(), "test".into());
+        assert_eq!(view.tick_unit, "cycles", "a board's until the worker says it simulates");
+        let envelope = view.envelope.expect("the trainer's home is inside its workspace");
+        assert!(envelope.iter().all(|(lo, hi)| *lo < 0.0 && *hi > 0.0), "{envelope:?}");
+        let switch = |backoff: f32, search: f32| SwitchSettings {
+            toward: Toward::Plus,
+            switch: 0.0,
+            search,
+            backoff,
+            fast: 1.0,
+            slow: 0.1,
+        };
+        view.axes = vec!["ring", "linear", "angle", "ring", "ring", "ring"];
+        let homing = [
+            switch(0.0349, 7.0),
+            switch(0.01, 0.05),
+            switch(0.01, 0.5),
+            switch(0.1, 7.0),
+            switch(0.1, 7.0),
+            switch(0.1, 7.0),
+        ];
+        view.jog_the_device_takes(&homing);
+        let most: Vec<f64> = view.jog_most.iter().map(|v| (v * 100.0).round() / 100.0).collect();
+        assert_eq!(most, [2.0, 50.0, 28.65, 5.73, 5.73, 5.73]);
     }
 
     #[test]

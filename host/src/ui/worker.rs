@@ -151,18 +151,7 @@ fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlat
     view.firmware = client
         .device
         .map_or_else(String::new, |d| crate::device::firmware_text(&d.firmware));
-    // What a jog may cover, as the device's check of it (`commission::begin_move`'s "further than a jog goes").
-    let homing = record.machine.homing.axes;
-    view.jog_most = view
-        .axes
-        .iter()
-        .zip(homing)
-        .map(|(kind, h)| match *kind {
-            "ring" => f64::from(h.backoff).to_degrees(),
-            "linear" => f64::from(h.search) * 1000.0,
-            _ => f64::from(h.search).to_degrees(),
-        })
-        .collect();
+    view.jog_the_device_takes(&record.machine.homing.axes);
     // The simulator counts a tick's cost in ns of the host's time, a board in its MCU's cycles.
     if matches!(client.transport(), crate::link::transport::AnyTransport::Sim(_)) {
         view.tick_unit = "ns";

@@ -406,6 +406,7 @@ function placeLiveCharts() {
   if (charts.parentElement !== home) home.appendChild(charts);
   $("cue-charts").hidden = !!tuning;
   $("cue-live-note").hidden = !tuning;
+  $("cue-heading").hidden = !!tuning;
 }
 
 // The games and profiles from the start: the Control panel's game list needs them.

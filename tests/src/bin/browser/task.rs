@@ -79,33 +79,7 @@ pub async fn at_size(
     )
     .await?;
     until(c, &format!("{STATE} === 'Off'"), Duration::from_secs(30)).await?;
-    // 1. The F1 session from the Control panel: the game's name, its default port and what to set in the game.
-    tab(c, "control").await?;
-    until(
-        c,
-        "document.getElementById('udp-game').options.length > 1",
-        Duration::from_secs(10),
-    )
-    .await?;
-    let chosen = js(
-        c,
-        "(() => { const s = document.getElementById('udp-game'); \
-         s.value = [...s.options].find((o) => o.textContent.startsWith('F1 23')).value; \
-         s.dispatchEvent(new Event('change')); \
-         return [s.selectedOptions[0].textContent, document.getElementById('udp-port').value, \
-         document.getElementById('udp-format').value, document.getElementById('udp-game-help').textContent]; })()",
-    )
-    .await?;
-    let help = chosen[3].as_str().unwrap_or("");
-    if chosen[1] != json!("20777")
-        || chosen[2] != json!("f1")
-        || !help.contains("UDP Telemetry On")
-        || !help.contains("profile f1")
-    {
-        return Err(format!(
-            "the F1 game is not offered with its port, settings and profile: {chosen}"
-        ));
-    }
+    f1_offered(c).await?;
     let port = free_port()?;
     js(
         c,
@@ -178,7 +152,39 @@ pub async fn at_size(
     Ok(format!("{ran}; after a reload profile f1 has pitch tilt {found}"))
 }
 
-/// 2. The Live view: the platform beside the six charts, none below the fold; the roll chart wide enough, drawn
+/// Step 1: the F1 session from the Control panel, offered by the game's name with its default port, what to set
+/// in the game and the profile it takes.
+async fn f1_offered(c: &Client) -> Result<(), String> {
+    tab(c, "control").await?;
+    until(
+        c,
+        "document.getElementById('udp-game').options.length > 1",
+        Duration::from_secs(10),
+    )
+    .await?;
+    let chosen = js(
+        c,
+        "(() => { const s = document.getElementById('udp-game'); \
+         s.value = [...s.options].find((o) => o.textContent.startsWith('F1 23')).value; \
+         s.dispatchEvent(new Event('change')); \
+         return [s.selectedOptions[0].textContent, document.getElementById('udp-port').value, \
+         document.getElementById('udp-format').value, document.getElementById('udp-game-help').textContent]; })()",
+    )
+    .await?;
+    let help = chosen[3].as_str().unwrap_or("");
+    if chosen[1] != json!("20777")
+        || chosen[2] != json!("f1")
+        || !help.contains("UDP Telemetry On")
+        || !help.contains("profile f1")
+    {
+        return Err(format!(
+            "the F1 game is not offered with its port, settings and profile: {chosen}"
+        ));
+    }
+    Ok(())
+}
+
+/// Step 2, the Live view: the platform beside the six charts, none below the fold; the roll chart wide enough, drawn
 /// at its size times the pixel ratio, its caption readable, in degrees, with the game's cue.
 async fn live_view(c: &Client, w: u32, h: u32) -> Result<String, String> {
     tab(c, "live").await?;
@@ -243,7 +249,7 @@ async fn live_view(c: &Client, w: u32, h: u32) -> Result<String, String> {
     }
 }
 
-/// 3. The F1 profile chosen, the pitch tilt raised: applied live, the live pitch grows on the Cueing panel's
+/// Step 3: the F1 profile chosen, the pitch tilt raised: applied live, the live pitch grows on the Cueing panel's
 /// charts; the profile saved.
 async fn tune(c: &Client, raise: f64) -> Result<String, String> {
     tab(c, "cueing").await?;
