@@ -208,3 +208,65 @@ fn raw(addr: &str, path: &str, host: &str, origin: Option<&str>, body: &str) -> 
     .unwrap();
     super::workbench::answer(&mut s).0
 }
+
+/// While a telemetry session runs, each frame carries what the game asks, in the units the Live view shows:
+/// a braking of 2 m/s^2 and a yaw rate of 0.5 rad/s arrive as -0.204 g (surge), 1 g (heave) and 28.6 deg/s; none
+/// before the session, none half a second after its last datagram.
+#[test]
+fn frames_carry_the_games_cue_in_g_and_deg_per_s() {
+    let bench = Workbench::start(&[]);
+    let mut a = bench.page();
+    let before = a
+        .until(std::time::Duration::from_secs(10), |m| m["type"] == "frame")
+        .unwrap();
+    assert_eq!(before["cue_input"], Value::Null, "{before}");
+    let port = std::net::UdpSocket::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    a.send(json!({ "do": "udp", "port": port, "holds": "telemetry", "format": "text", "idle": 60 }));
+    a.until(std::time::Duration::from_secs(60), |m| {
+        m["type"] == "frame" && m["streaming"] == true && (m["state"] == "Ready" || m["state"] == "Running")
+    })
+    .unwrap();
+    let s = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+    let mut cued = None;
+    for i in 0..150 {
+        let datagram = format!("{} -2 0 9.80665 0 0 0.5", f64::from(i) * 0.02);
+        s.send_to(datagram.as_bytes(), ("127.0.0.1", port)).unwrap();
+        for m in a.watch(std::time::Duration::from_millis(20)) {
+            if m["type"] == "frame" && !m["cue_input"].is_null() {
+                cued = Some(m["cue_input"].clone());
+            }
+        }
+    }
+    let cued = cued.expect("no frame carried the game's cue");
+    let g = |i: usize| cued["force_g"][i].as_f64().unwrap();
+    let rate = |i: usize| cued["rate_deg_s"][i].as_f64().unwrap();
+    assert!(
+        (g(0) + 2.0 / 9.80665).abs() < 1e-6 && g(1).abs() < 1e-9 && (g(2) - 1.0).abs() < 1e-6,
+        "{cued}"
+    );
+    assert!(
+        rate(0).abs() < 1e-9 && (rate(2) - 0.5f64.to_degrees()).abs() < 1e-6,
+        "{cued}"
+    );
+    // The frames of the next second and a half: the newest, sent after the cue went stale, carries none.
+    let frames: Vec<Value> = a
+        .watch(std::time::Duration::from_millis(1500))
+        .into_iter()
+        .filter(|m| m["type"] == "frame")
+        .collect();
+    let last = frames.last().expect("frames after the last datagram");
+    assert_eq!(
+        last["cue_input"],
+        Value::Null,
+        "a cue over half a second old is not shown as the game's: {last}"
+    );
+    let stop = a.send(json!({ "do": "halt" }));
+    a.until(std::time::Duration::from_secs(20), |m| {
+        m["type"] == "halted" && m["id"] == stop
+    })
+    .unwrap();
+}
