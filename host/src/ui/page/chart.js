@@ -141,9 +141,12 @@ class Chart {
       if (e.x < x0 || e.x > x1) continue;
       g.strokeStyle = e.colour; g.beginPath(); g.moveTo(X(e.x), T); g.lineTo(X(e.x), H - B); g.stroke();
       if (e.label && X(e.x) >= freeFrom) {
+        // Right of its line, or left of it where the plot ends first.
+        const w = g.measureText(e.label).width;
+        const at = X(e.x) + 3 + w <= W - R ? X(e.x) + 3 : X(e.x) - 3 - w;
         g.fillStyle = "#374151";
-        g.fillText(e.label, X(e.x) + 3, T + 12);
-        freeFrom = X(e.x) + g.measureText(e.label).width + 8;
+        g.fillText(e.label, at, T + 12);
+        freeFrom = X(e.x) + w + 8;
       }
     }
     g.save();

@@ -104,14 +104,15 @@ async fn checks(driver: &str, url: &str, record: &Path, shots: Option<&Path>) ->
         "at 1366x768 the Control panel's buttons are on screen above its log",
         page::control_fits(&c).await,
     );
+    if let Some(dir) = shots {
+        k.report("every panel at 1366x768 and 1920x1080", page::sizes(&c, dir).await);
+    }
+    // Last: it reloads the page, and the pictures above are of the panels as the checks before left them.
     for (size, raise) in [((1366, 768), 1.2), ((1920, 1080), 2.5)] {
         k.report(
             &format!("a rig builder's task at {}x{}: an F1 session, the Live view, the F1 profile tuned live, saved and found again", size.0, size.1),
             task::at_size(&c, url, size, raise, shots).await,
         );
-    }
-    if let Some(dir) = shots {
-        k.report("every panel at 1366x768 and 1920x1080", page::sizes(&c, dir).await);
     }
     let _ = c.close().await;
     Ok(k)

@@ -131,14 +131,7 @@ pub async fn at_size(
         Duration::from_secs(20),
     )
     .await?;
-    tab(c, "cueing").await?;
-    until(
-        c,
-        "document.querySelector('#profile option[value=f1]')",
-        Duration::from_secs(20),
-    )
-    .await?;
-    js(c, "(() => { const s = document.getElementById('profile'); s.value = 'f1'; s.dispatchEvent(new Event('change')); return true; })()").await?;
+    choose_f1(c).await?;
     let found = until(
         c,
         &format!(
@@ -195,7 +188,7 @@ async fn live_view(c: &Client, w: u32, h: u32) -> Result<String, String> {
          const cap = c.parentElement.querySelector('figcaption'); const dpr = window.devicePixelRatio; \
          const all = ['surge', 'sway', 'heave', 'roll', 'pitch', 'yaw'].map((a) => \
            document.getElementById('live-' + a).getBoundingClientRect()); \
-         const text = [...document.querySelectorAll('#panel-live figcaption, #counters td')] \
+         const text = [...document.querySelectorAll('#panel-live figcaption, #panel-live .lamp, #live-session, #panel-live h2 .small, #counters td')] \
            .map((e) => parseFloat(getComputedStyle(e).fontSize)); \
          return cap.textContent.includes('deg/s') && { css: [Math.round(r.width), Math.round(r.height)], \
            drawn: [c.width, c.height], dpr, caption: cap.textContent.trim(), \
@@ -249,9 +242,8 @@ async fn live_view(c: &Client, w: u32, h: u32) -> Result<String, String> {
     }
 }
 
-/// Step 3: the F1 profile chosen, the pitch tilt raised: applied live, the live pitch grows on the Cueing panel's
-/// charts; the profile saved.
-async fn tune(c: &Client, raise: f64) -> Result<String, String> {
+/// The Cueing panel, its F1 profile chosen from the list as a person chooses it.
+async fn choose_f1(c: &Client) -> Result<(), String> {
     tab(c, "cueing").await?;
     until(
         c,
@@ -260,6 +252,13 @@ async fn tune(c: &Client, raise: f64) -> Result<String, String> {
     )
     .await?;
     js(c, "(() => { const s = document.getElementById('profile'); s.value = 'f1'; s.dispatchEvent(new Event('change')); return true; })()").await?;
+    Ok(())
+}
+
+/// Step 3: the F1 profile chosen, the pitch tilt raised: applied live, the live pitch grows on the Cueing panel's
+/// charts; the profile saved.
+async fn tune(c: &Client, raise: f64) -> Result<String, String> {
+    choose_f1(c).await?;
     let before_tilt = until(
         c,
         "(() => { const i = document.querySelector('[data-path=\"tilt_scale.0\"]'); return i && document.getElementById('profile').value === 'f1' && i.value; })()",
