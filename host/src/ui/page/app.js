@@ -239,6 +239,8 @@ function showFrame(f) {
     ["device time", f.t.toFixed(2) + " s"], ["streaming", f.streaming ? "yes" : "no"]];
   $("counters").innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td id="count-${k.replace(" ", "-")}">${v}</td></tr>`).join("");
   remember(f);
+  // A session of this page begins or ends streaming: the live charts go where the user tunes, or back.
+  if (f.streaming !== state.wasStreaming) { state.wasStreaming = f.streaming; placeLiveCharts(); }
   // Drawn where the charts are on screen (the Live panel, or the Cueing panel while a session runs).
   if (state.frames % 5 === 0 && $("live-charts").offsetParent !== null) drawLive(f);
   showGates(f.gates);
