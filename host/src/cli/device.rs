@@ -93,6 +93,11 @@ pub struct UiArgs {
     /// `stream --motion-compensation` does.
     #[arg(long, value_enum, value_name = "TRACKER")]
     pub motion_compensation: Option<crate::vr::Tracker>,
+    /// The cueing file whose profiles (`[profiles.NAME]`, one per game) the page chooses, loads, saves and
+    /// duplicates, as `stream --cue-config FILE --profile NAME` reads them; made by the first save. Without it
+    /// the page's profiles last until the workbench ends.
+    #[arg(long, value_name = "FILE")]
+    pub cue_config: Option<std::path::PathBuf>,
 }
 
 /// Which controller a command drives: a board on a serial port, or the simulated controller in this process (of the

@@ -405,6 +405,7 @@ impl super::UiArgs {
             listen: self.listen,
             files: self.files.clone(),
             motion_compensation: self.motion_compensation,
+            cue_config: self.cue_config.clone(),
         })
     }
 }

@@ -50,6 +50,7 @@ pub mod forza;
 pub mod outsim;
 pub mod outsim2;
 pub mod reader;
+pub mod setup;
 pub mod shm;
 mod telemetry;
 pub mod xplane;

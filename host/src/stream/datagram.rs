@@ -50,6 +50,15 @@ pub enum Decoder {
 /// A sample this much older than the last (s) is not out of order: the game's clock started again.
 const RESTARTED_S: f64 = 1.0;
 
+/// The newest telemetry sample a session cued and when it came: the workbench's Live view shows what the game
+/// asks beside what the platform does. One process runs one stream at a time, so one slot.
+static NEWEST_INPUT: std::sync::Mutex<Option<(Instant, Telemetry<f64>)>> = std::sync::Mutex::new(None);
+
+/// The newest telemetry sample any session cued, and when it came.
+pub fn newest_input() -> Option<(Instant, Telemetry<f64>)> {
+    *NEWEST_INPUT.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 /// How often the cueing file is looked at while streaming.
 pub const WATCH_EVERY: Duration = Duration::from_millis(500);
 
@@ -205,6 +214,7 @@ impl Decoder {
             time: t,
             telemetry: sample,
         } = read?;
+        *NEWEST_INPUT.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some((now, sample));
         let dt = match *last {
             None => None,
             Some((Some(t0), _)) if t.is_some() => t.map(|t| t - t0),

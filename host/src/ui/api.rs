@@ -38,9 +38,20 @@ pub struct CueRequest {
     pub compare: bool,
 }
 
-/// The panel's parameters, checked as a cueing file's are: each error names its key.
+/// The panel's parameters, checked as a cueing file's are: each error names its key. With the classical washout
+/// the optimal cueing's values are not read (the panel hides them): kept when they are valid, else its defaults.
 pub fn cue_config(config: &Value) -> Result<CueConfig, String> {
-    let config: CueConfig = serde_json::from_value(config.clone()).map_err(|e| e.to_string())?;
+    let mut config: CueConfig = serde_json::from_value(config.clone()).map_err(|e| e.to_string())?;
+    if config.algorithm == Algorithm::Classical {
+        let plain = CueConfig {
+            optimal: Default::default(),
+            ..config
+        };
+        plain.validate().map_err(|e| e.to_string())?;
+        if config.validate().is_err() {
+            config = plain;
+        }
+    }
     config.validate().map_err(|e| e.to_string())?;
     Ok(config)
 }

@@ -35,7 +35,10 @@ fn controls(p: &Param) -> Vec<((usize, usize), Value)> {
             } else {
                 format!("{axis}: {}", p.name)
             };
-            ((at(channel), i), field(p, path(p.key, Some(i)), channel, label))
+            let mut f = field(p, path(p.key, Some(i)), channel, label);
+            // The axis as the core's check names it in an error (`tilt_scale (x)`), for the page to say which.
+            f["axis"] = json!(axis.split(' ').next().unwrap_or(axis));
+            ((at(channel), i), f)
         })
         .collect()
 }

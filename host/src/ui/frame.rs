@@ -27,6 +27,14 @@ pub struct RigView {
     pub source: String,
     /// The firmware the device runs and its protocol version (empty for a rig file shown on its own).
     pub firmware: String,
+    /// Each axis's reach about home (surge, sway, heave m; roll, pitch rad), as the cueing's envelope scans it:
+    /// the Live view's share of the envelope used. None when the home is outside the workspace.
+    pub envelope: Option<[(f64, f64); 5]>,
+    /// The unit of a frame's tick cost: `cycles` on a board's MCU, `ns` in the simulator.
+    pub tick_unit: &'static str,
+    /// The longest jog of each actuator the device takes (deg of ring or shoulder, mm of a linear actuator): a
+    /// carriage its homing back-off, a linear actuator or a shoulder its homing search travel. Empty when unknown.
+    pub jog_most: Vec<f64>,
 }
 
 impl RigView {
@@ -61,7 +69,29 @@ impl RigView {
                 .collect(),
             source,
             firmware: String::new(),
+            envelope: crate::cueing::engine::envelope(&m, &Pose::from_array(home))
+                .ok()
+                .map(|e| e.ranges),
+            tick_unit: "cycles",
+            jog_most: Vec::new(),
         }
+    }
+}
+
+impl RigView {
+    /// The longest jog of each actuator, as the device checks it (`commission::begin_move`'s "further than a jog
+    /// goes"): a carriage its homing back-off, a linear actuator or a shoulder its homing search travel.
+    pub fn jog_the_device_takes(&mut self, homing: &[ringpod_core::protocol::SwitchSettings; 6]) {
+        self.jog_most = self
+            .axes
+            .iter()
+            .zip(homing)
+            .map(|(kind, h)| match *kind {
+                "ring" => f64::from(h.backoff).to_degrees(),
+                "linear" => f64::from(h.search) * 1000.0,
+                _ => f64::from(h.search).to_degrees(),
+            })
+            .collect();
     }
 }
 
@@ -142,6 +172,27 @@ pub struct Frame {
     pub ghost: Option<Placed>,
     pub gates: Gates,
     pub streaming: bool,
+    /// What the game asked of the cueing in the last half second (a telemetry session's newest sample).
+    pub cue_input: Option<CueInput>,
+}
+
+/// A telemetry sample as the Live view shows it: specific force in g (x forward, y left, z up) and angular rate
+/// in deg/s (roll, pitch, yaw).
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct CueInput {
+    pub force_g: [f64; 3],
+    pub rate_deg_s: [f64; 3],
+}
+
+impl CueInput {
+    /// The newest sample a telemetry session cued, if it came within the last half second.
+    pub fn newest() -> Option<Self> {
+        let (at, t) = crate::stream::datagram::newest_input()?;
+        (at.elapsed() < std::time::Duration::from_millis(500)).then(|| Self {
+            force_g: t.force.map(|f| f / ringpod_core::cueing::G),
+            rate_deg_s: t.rate.map(f64::to_degrees),
+        })
+    }
 }
 
 /// Counts of the telemetry link, kept by whoever taps it.
@@ -173,13 +224,14 @@ pub fn frame(m: &RingPlatform<f64>, t: &Telemetry, link: LinkCounts, streaming: 
         ghost: place(m, &target),
         gates: Gates::of(t, streaming),
         streaming,
+        cue_input: CueInput::newest(),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ringpod_core::kinematics::presets::Preset;
+    use ringpod_core::kinematics::presets::{Preset, PresetGeometry};
     use ringpod_core::safety::debounce::InputBit;
     use ringpod_core::safety::State;
 
@@ -199,6 +251,40 @@ mod tests {
             inputs,
             outputs: 0,
         }
+    }
+
+    /// The jog the page says is the one the device takes: a carriage's homing back-off in degrees of ring, a
+    /// linear actuator's search travel in mm; the trainer's simulator counts its tick in ns.
+    #[test]
+    fn the_longest_jog_is_the_homing_back_off_or_search() {
+        use ringpod_core::protocol::{SwitchSettings, Toward};
+        let PresetGeometry::Ring(g) = Preset::TrainerModel.geometry() else {
+            unreachable!("the trainer model is a ring platform")
+        };
+        let mut view = RigView::of(g, Preset::TrainerModel.home(), "test".into());
+        assert_eq!(view.tick_unit, "cycles", "a board's until the worker says it simulates");
+        let envelope = view.envelope.expect("the trainer's home is inside its workspace");
+        assert!(envelope.iter().all(|(lo, hi)| *lo < 0.0 && *hi > 0.0), "{envelope:?}");
+        let switch = |backoff: f32, search: f32| SwitchSettings {
+            toward: Toward::Plus,
+            switch: 0.0,
+            search,
+            backoff,
+            fast: 1.0,
+            slow: 0.1,
+        };
+        view.axes = vec!["ring", "linear", "angle", "ring", "ring", "ring"];
+        let homing = [
+            switch(0.0349, 7.0),
+            switch(0.01, 0.05),
+            switch(0.01, 0.5),
+            switch(0.1, 7.0),
+            switch(0.1, 7.0),
+            switch(0.1, 7.0),
+        ];
+        view.jog_the_device_takes(&homing);
+        let most: Vec<f64> = view.jog_most.iter().map(|v| (v * 100.0).round() / 100.0).collect();
+        assert_eq!(most, [2.0, 50.0, 28.65, 5.73, 5.73, 5.73]);
     }
 
     #[test]

@@ -11,6 +11,7 @@ pub mod guard;
 mod hub;
 mod outbox;
 mod presence;
+pub(crate) mod profiles;
 mod request;
 mod runs;
 mod socket;
@@ -48,12 +49,15 @@ pub struct Options {
     pub files: Option<std::path::PathBuf>,
     /// Write the followed pose for VR motion compensation.
     pub motion_compensation: Option<crate::vr::Tracker>,
+    /// The cueing file whose `[profiles.NAME]` the page chooses, loads and saves (made by the first save).
+    pub cue_config: Option<std::path::PathBuf>,
 }
 
 /// The page, its scripts and its style, compiled in.
 const PAGE: &str = include_str!("page/index.html");
 const SCRIPT: &str = include_str!("page/app.js");
 const CHART: &str = include_str!("page/chart.js");
+const CUEING: &str = include_str!("page/cueing.js");
 const VIEW3D: &str = include_str!("page/view3d.js");
 const STYLE: &str = include_str!("page/style.css");
 
@@ -63,6 +67,7 @@ struct App {
     hub: Arc<Hub>,
     jobs: Mutex<mpsc::Sender<Job>>,
     pages: AtomicU64,
+    profiles: profiles::Profiles,
 }
 
 #[derive(Deserialize)]
@@ -135,6 +140,11 @@ pub fn run(options: Options) -> Result<u8, UiError> {
         hub: hub.clone(),
         jobs: Mutex::new(jobs),
         pages: AtomicU64::new(0),
+        // Without --cue-config the profiles live as long as the workbench, beside the live cueing file.
+        profiles: match options.cue_config {
+            Some(path) => profiles::Profiles::new(path, true),
+            None => profiles::Profiles::new(private.path().join("profiles.toml"), false),
+        },
     });
     let served = runtime.block_on(async {
         println!("ringpod ui: open http://{local}/?token={}", app.token.as_str());
@@ -188,6 +198,8 @@ fn routes(app: &Arc<App>) -> Router {
         .route("/api/cue/defaults", get(cue_defaults))
         .route("/api/cue", post(cue))
         .route("/api/cue/apply", post(cue_apply))
+        .route("/api/profiles", get(profiles::list))
+        .route("/api/profile", get(profiles::get).post(profiles::put))
         .route("/api/rig/check", post(rig_check))
         .route("/api/rig/current", get(rig_current))
         .route("/api/run", post(run_record))
@@ -198,6 +210,7 @@ fn routes(app: &Arc<App>) -> Router {
         .merge(checked)
         .route("/app.js", asset("text/javascript", SCRIPT))
         .route("/chart.js", asset("text/javascript", CHART))
+        .route("/cueing.js", asset("text/javascript", CUEING))
         .route("/view3d.js", asset("text/javascript", VIEW3D))
         .route("/style.css", asset("text/css", STYLE))
         .with_state(app.clone())

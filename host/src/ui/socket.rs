@@ -67,7 +67,9 @@ fn close_for(error: axum::Error) -> End {
 async fn serve_page(app: Arc<App>, page: u64, mut ws: WebSocket) {
     let outbox = app.hub.open_outbox(page);
     app.hub.presence.arrive(page);
-    outbox.push(json!({ "type": "hello", "page": page }).to_string());
+    // Whether pose files may be named (`ui --files`): the page shows the field only then.
+    let files = app.hub.files.is_some();
+    outbox.push(json!({ "type": "hello", "page": page, "files": files }).to_string());
     if let Some(rig) = app.hub.rig.lock().ok().and_then(|r| r.clone()) {
         outbox.push(rig);
     }

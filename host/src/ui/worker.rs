@@ -151,6 +151,11 @@ fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlat
     view.firmware = client
         .device
         .map_or_else(String::new, |d| crate::device::firmware_text(&d.firmware));
+    view.jog_the_device_takes(&record.machine.homing.axes);
+    // The simulator counts a tick's cost in ns of the host's time, a board in its MCU's cycles.
+    if matches!(client.transport(), crate::link::transport::AnyTransport::Sim(_)) {
+        view.tick_unit = "ns";
+    }
     // The name the user gave the rig (its file's `name`), not the geometry's generic one.
     if !record.name().trim().is_empty() {
         record.name().clone_into(&mut view.name);

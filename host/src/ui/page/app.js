@@ -22,7 +22,13 @@ document.querySelectorAll(".tab").forEach((b) => b.addEventListener("click", () 
   window.scrollTo(0, scrolled[b.dataset.panel] || 0);
   if (b.dataset.panel === "rig" && !$("rig-text").value) loadDeviceRig();
   if (b.dataset.panel === "cueing" && !cue.config) loadCueDefaults();
+  placeLiveCharts();
 }));
+
+// A stream's report ends this page's session: the live charts go back to the Live panel.
+function endSession(m) {
+  if (state.session) { state.session = null; showSession(); }
+}
 
 // ---- the WebSocket ----
 let ws = null;
@@ -46,14 +52,14 @@ function connect() {
   };
   ws.onmessage = (e) => {
     const m = JSON.parse(e.data);
-    if (m.type === "hello") state.page = m.page;
+    if (m.type === "hello") { state.page = m.page; $("file-name-row").hidden = !m.files; }
     else if (m.type === "rig") showRig(m);
     else if (m.type === "frame") showFrame(m);
     else if (m.type === "reply") showReply(m);
     else if (m.type === "halted") { state.halted = m; log(m.text); }
     else if (m.type === "stop_pending") showStopPending(m);
     else if (m.type === "notice") showNotice(m);
-    else if (m.type === "report") log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
+    else if (m.type === "report") endSession(m), log(`report: ${m.outcome}, ${m.setpoints_applied}/${m.setpoints_sent} applied, limited ${m.limited.host} on the host and ${m.limited.device} on the device`, m.exit_code !== 0 && m.exit_code !== 130);
   };
 }
 
@@ -117,8 +123,22 @@ document.addEventListener("keyup", (e) => {
 
 // ---- Live ----
 const view = new View3d($("view3d"));
-const history = { t: [], pose: [], target: [], cost: [] };
+const history = { t: [], pose: [], target: [], cost: [], cue: [], limits: [] };
 const liveCharts = [];
+state.history = history;
+let costChart = null;
+// The axes as people say them, each with the unit its motion is shown in and the unit of the game's cue beside it.
+const AXIS_NAMES = ["surge", "sway", "heave", "roll", "pitch", "yaw"];
+const MOTION_UNIT = ["mm", "mm", "mm", "deg", "deg", "deg"];
+const CUE_UNIT = ["g", "g", "g", "deg/s", "deg/s", "deg/s"];
+// A pose about home in the shown units (mm, deg).
+const shown = (v, i) => (i < 3 ? v * 1000 : v * 180 / Math.PI);
+// Yaw as one continuous angle: each new value is taken nearest the last one, so a turn past 180 deg goes on
+// to 181 rather than jumping to -179.
+function unwrap(v, last) {
+  if (last === undefined) return v;
+  return v + 2 * Math.PI * Math.round((last - v) / (2 * Math.PI));
+}
 
 function showRig(rig) {
   state.rig = rig;
@@ -132,13 +152,29 @@ function showRig(rig) {
     axis.appendChild(o);
   });
   // Degrees of ring for a carriage and of a shoulder's angle, mm for a linear actuator (as `device jog`).
-  axis.onchange = () => { $("jog-unit").textContent = rig.axes[axis.value - 1] === "linear" ? "mm" : "deg"; };
+  // The longest jog the device takes, said before it is refused (a carriage its homing back-off).
+  axis.onchange = () => {
+    const unit = rig.axes[axis.value - 1] === "linear" ? "mm" : "deg", most = (rig.jog_most || [])[axis.value - 1];
+    $("jog-unit").textContent = unit;
+    $("jog-most").textContent = most ? `at most ${most.toPrecision(3)} ${unit} (${rig.axes[axis.value - 1] === "ring" ? "the carriage's homing back-off" : "its homing search travel"})` : "";
+    if (most) $("jog-distance").max = most;
+  };
   axis.onchange();
   const charts = $("live-charts");
   charts.innerHTML = "";
   liveCharts.length = 0;
-  AXES.forEach((a, i) => liveCharts.push(new Chart(charts, a, i < 3 ? " m" : " rad")));
-  liveCharts.push(new Chart(charts, "tick cost", ""));
+  AXIS_NAMES.forEach((a, i) => {
+    const c = new Chart(charts, `${a} (${MOTION_UNIT[i]})`, "");
+    c.rightUnit = " " + CUE_UNIT[i];
+    // At rest: 2 mm or 1 deg of scale, 0.2 g or 10 deg/s of cue.
+    c.minSpan = i < 3 ? 2 : 1;
+    c.rightMinSpan = i < 3 ? 0.2 : 10;
+    c.canvas.id = `live-${a}`;
+    liveCharts.push(c);
+  });
+  $("live-cost").innerHTML = "";
+  costChart = new Chart($("live-cost"), `tick cost (${rig.tick_unit})`, "");
+  costChart.canvas.id = "live-tick-cost";
   view.show(rig, null, null);
 }
 
@@ -146,8 +182,6 @@ function lamp(on, label, alarm) {
   return `<span class="lamp ${on ? (alarm ? "alarm" : "on") : ""}">${label}</span>`;
 }
 
-// A pose value as the table shows it: mm for a position, degrees for an angle.
-const show = (v, i) => (i < 3 ? v * 1000 : v * 180 / Math.PI).toFixed(2);
 
 // ---- the link's health: what is shown is as old as the newest frame ----
 // Telemetry comes at 50 frames a second: none for half a second is a stalled link, none for five a lost one. The
@@ -200,29 +234,70 @@ function showFrame(f) {
       return lamp(on, name, alarm);
     }).join("");
   }
-  const rows = [["applied", f.applied], ["limited", f.limited], ["refused", f.refused], ["tick cost", f.tick_cost],
+  const unit = state.rig ? state.rig.tick_unit : "";
+  const rows = [["applied", f.applied], ["limited", f.limited], ["refused", f.refused], ["tick cost", `${f.tick_cost} ${unit}`],
     ["device time", f.t.toFixed(2) + " s"], ["streaming", f.streaming ? "yes" : "no"]];
   $("counters").innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td id="count-${k.replace(" ", "-")}">${v}</td></tr>`).join("");
-  $("pose").innerHTML = `<tr><th>axis</th><th>followed</th><th>commanded</th></tr>` +
-    AXES.map((a, i) => `<tr><td>${a} (${i < 3 ? "mm" : "deg"})</td><td>${show(f.pose[i], i)}</td><td class="muted">${show(f.target[i], i)}</td></tr>`).join("");
-  // The rolling history.
-  history.t.push(f.t); history.pose.push(f.pose); history.target.push(f.target); history.cost.push(f.tick_cost);
-  while (history.t.length && history.t[0] < f.t - HISTORY_S) {
-    history.t.shift(); history.pose.shift(); history.target.shift(); history.cost.shift();
-  }
-  if (document.querySelector("#panel-live.active") && state.frames % 5 === 0) {
-    liveCharts.forEach((c, i) => {
-      if (i < 6) {
-        c.set([
-          { x: history.t, y: history.target.map((p) => p[i]), colour: pale(COLOURS[i]), width: 4 },
-          { x: history.t, y: history.pose.map((p) => p[i]), colour: COLOURS[i] },
-        ]);
-      } else {
-        c.set([{ x: history.t, y: history.cost, colour: "#374151" }]);
-      }
-    });
-  }
+  remember(f);
+  // A session of this page begins or ends streaming: the live charts go where the user tunes, or back.
+  if (f.streaming !== state.wasStreaming) { state.wasStreaming = f.streaming; placeLiveCharts(); }
+  // Drawn where the charts are on screen (the Live panel, or the Cueing panel while a session runs).
+  if (state.frames % 5 === 0 && $("live-charts").offsetParent !== null) drawLive(f);
   showGates(f.gates);
+}
+
+// The rolling history: the motion about home in mm and deg (yaw unwrapped), the game's cue in g and deg/s, and
+// where the device limited a setpoint (its count grew).
+function remember(f) {
+  const home = state.rig ? state.rig.home : [0, 0, 0, 0, 0, 0];
+  const n = history.t.length;
+  const about = (p, last) => p.map((v, i) => {
+    const d = v - home[i];
+    return shown(i === 5 ? unwrap(d, last && last[5] * Math.PI / 180) : d, i);
+  });
+  history.pose.push(about(f.pose, n ? history.pose[n - 1] : null));
+  history.target.push(about(f.target, n ? history.target[n - 1] : null));
+  history.cue.push(f.cue_input ? [...f.cue_input.force_g, ...f.cue_input.rate_deg_s] : null);
+  if (n && f.limited > history.limitedCount) history.limits.push(f.t);
+  history.limitedCount = f.limited;
+  history.t.push(f.t); history.cost.push(f.tick_cost);
+  while (history.t.length && history.t[0] < f.t - HISTORY_S) {
+    history.t.shift(); history.pose.shift(); history.target.shift(); history.cost.shift(); history.cue.shift();
+  }
+  while (history.limits.length && history.limits[0] < f.t - HISTORY_S) history.limits.shift();
+}
+
+// Each axis's chart and caption: the followed and commanded motion now, the game's cue now, and the share of
+// the platform's reach on that side of home the followed pose uses (the envelope the cueing scans).
+function drawLive(f) {
+  const env = state.rig && state.rig.envelope;
+  const last = history.t.length - 1;
+  const events = history.limits.map((x) => ({ x, colour: "#f59e0b" }));
+  liveCharts.forEach((c, i) => {
+    const cue = history.cue.map((q) => (q ? q[i] : NaN));
+    c.set([
+      { x: history.t, y: history.target.map((p) => p[i]), colour: pale(COLOURS[i]), width: 4 },
+      { x: history.t, y: history.pose.map((p) => p[i]), colour: COLOURS[i], width: 2 },
+      { x: history.t, y: cue, colour: "#6b7280", width: 1.5, dash: [5, 3], right: true },
+    ], events);
+    const followed = history.pose[last][i], commanded = history.target[last][i];
+    let share = "";
+    if (env && i < 5) {
+      const [lo, hi] = env[i];
+      const reach = shown(followed >= 0 ? hi : lo, i);
+      const used = reach ? Math.min(Math.abs(followed / reach), 1) : 0;
+      share = `<span class="share" title="the share of the platform's reach on this side of home the followed pose uses">reach ${(used * 100).toFixed(0)} % <meter min="0" max="1" low="0.7" high="0.9" optimum="0" value="${used.toFixed(3)}"></meter></span>`;
+    } else if (i === 5) share = `<span class="share muted">turns freely</span>`;
+    const q = history.cue[last];
+    const cueText = q ? `cue <b>${q[i].toFixed(i < 3 ? 2 : 1)}</b> ${CUE_UNIT[i]}` : `<span class="muted">no cue</span>`;
+    const limited = events.length ? ` <span class="limited">limited ${events.length}×</span>` : "";
+    c.caption.innerHTML = `<b>${AXIS_NAMES[i]}</b> <b>${followed.toFixed(1)}</b> ${MOTION_UNIT[i]}` +
+      ` <span class="muted">(commanded ${commanded.toFixed(1)})</span> ${cueText} ${share}${limited}`;
+  });
+  if (costChart) {
+    costChart.set([{ x: history.t, y: history.cost, colour: "#374151" }]);
+    costChart.caption.textContent = `tick cost (${state.rig ? state.rig.tick_unit : ""}): ${history.cost[last]}`;
+  }
 }
 
 // ---- Control ----
@@ -267,14 +342,12 @@ $("run-udp").addEventListener("click", () => {
   const request = { do: "udp", port: +$("udp-port").value, holds, format, idle: +$("udp-idle").value };
   if ($("udp-from").value.trim()) request.from = $("udp-from").value.trim();
   if ($("udp-outsim-opts").value.trim()) request.outsim_opts = $("udp-outsim-opts").value.trim();
-  send(request);
+  startSession(request);
 });
 $("park").addEventListener("click", () => send({ do: "park" }));
 $("start-help").textContent = "Start lets the device follow setpoints: it waits for a stream (Run motion, Stream file, Start session), which starts by itself.";
 
-// ---- Cueing ----
-const cue = { config: null, fields: [], drive: null, charts: [], timer: null };
-
+// ---- the API ----
 async function post(path, body) {
   return answered(await fetch(api(path), { method: "POST", headers: { "content-type": "application/json" }, body: JSON.stringify(body) }));
 }
@@ -289,149 +362,6 @@ async function answered(r) {
   if (j && j.error) throw new Error(j.error);
   throw new Error(`${text.trim() || r.statusText || "no reason given"} (HTTP ${r.status})`);
 }
-
-async function loadCueDefaults() {
-  const r = await fetch(api("/api/cue/defaults"));
-  const j = await r.json();
-  cue.config = j.config;
-  cue.fields = j.fields;
-  buildCueControls();
-  const charts = $("cue-charts");
-  charts.innerHTML = "";
-  cue.charts = ["surge (x)", "sway (y)", "heave (z)"].map((n) => new Chart(charts, n, " m/s²"));
-  recue();
-}
-
-// The controls, from the server's list of them (the core's parameter list, each per-axis key spread over its
-// axes): a fieldset per channel in the list's order, each value labelled with its unit and range, a select where
-// it takes one of a few values. A value read only with a choice of another (a median's window) shows with it.
-function buildCueControls() {
-  const parent = $("cue-controls");
-  parent.innerHTML = "";
-  const groups = new Map();
-  for (const f of cue.fields) {
-    if (f.only_with && getPath(cue.config, f.only_with.path) !== f.only_with.value) continue;
-    if (!groups.has(f.channel)) {
-      const fs = document.createElement("fieldset");
-      const lg = document.createElement("legend");
-      lg.textContent = f.channel;
-      fs.appendChild(lg);
-      parent.appendChild(fs);
-      groups.set(f.channel, fs);
-    }
-    groups.get(f.channel).appendChild(cueControl(f));
-  }
-}
-
-function cueControl(f) {
-  const label = document.createElement("label");
-  const name = document.createElement("span");
-  name.textContent = f.label;
-  label.appendChild(name);
-  const value = getPath(cue.config, f.path);
-  let input;
-  if (f.choices) {
-    input = document.createElement("select");
-    f.choices.forEach((c, i) => {
-      const o = document.createElement("option");
-      o.value = String(i); o.textContent = String(c); o.selected = c === value;
-      input.appendChild(o);
-    });
-    input.addEventListener("change", () => cueChoose(f, f.choices[+input.value]));
-  } else {
-    input = document.createElement("input");
-    input.type = "number"; input.step = "any"; input.min = f.min; input.max = f.max; input.value = value;
-    input.title = `${f.min} to ${f.max}${f.unit ? " " + f.unit : ""}`;
-    input.addEventListener("input", () => {
-      setPath(cue.config, f.path, parseFloat(input.value));
-      cue.edited = input;
-      clearTimeout(cue.timer);
-      cue.timer = setTimeout(recue, 200);
-    });
-  }
-  input.dataset.path = f.path.join(".");
-  const unit = document.createElement("span");
-  unit.className = "unit";
-  unit.textContent = f.unit;
-  const box = document.createElement("span");
-  box.appendChild(input); box.appendChild(unit);
-  label.appendChild(box);
-  return label;
-}
-
-// A choice: the values read only with another choice of it go, the ones read with this one come with their
-// starting value, and the controls follow.
-function cueChoose(f, v) {
-  setPath(cue.config, f.path, v);
-  const key = f.path.join(".");
-  for (const g of cue.fields) {
-    if (!g.only_with || g.only_with.path.join(".") !== key) continue;
-    const table = getPath(cue.config, g.path.slice(0, -1));
-    const leaf = g.path[g.path.length - 1];
-    if (g.only_with.value === v) { if (!(leaf in table)) table[leaf] = g.only_with.initial; }
-    else delete table[leaf];
-  }
-  buildCueControls();
-  clearTimeout(cue.timer);
-  cue.timer = setTimeout(recue, 300);
-}
-
-function getPath(obj, path) {
-  return path.reduce((o, k) => (o === undefined || o === null ? undefined : o[k]), obj);
-}
-
-function setPath(obj, path, v) {
-  let o = obj;
-  for (const k of path.slice(0, -1)) o = o[k];
-  o[path[path.length - 1]] = v;
-}
-
-async function recue() {
-  const status = $("cue-status");
-  try {
-    const j = await post("/api/cue", { config: cue.config, drive: cue.drive, compare: $("cue-compare").checked });
-    // What the rider perceives, scored as the bench scores it, for this cueing and (compared) the other one.
-    const scored = (s) => `${s.algorithm}: perceived force error ${s.force_rms.toFixed(2)} m/s² RMS, ${s.false_cues} false cues, ${s.limited} limited` + (s.fallbacks == null ? "" : `, ${s.fallbacks} fallbacks`);
-    status.className = "small"; status.textContent = `${j.t.length} samples cued. ${scored(j.score)}` + (j.other ? `. ${scored(j.other.score)} (grey)` : "") + (j.errors.length ? `; ${j.errors.length} rows unusable` : "");
-    $("cue-summary").textContent = cue.drive ? "(your drive)" : "(the example drive)";
-    cue.toml = j.toml;
-    // For tests and the curious: how many replays, and the largest surge delivered in the last.
-    state.cueRuns = (state.cueRuns || 0) + 1;
-    state.cuePeak = Math.max(...j.delivered.map((f) => Math.abs(f[0])));
-    state.cueScores = [j.score, j.other && j.other.score];
-    cue.charts.forEach((c, i) => c.set([
-      { x: j.t, y: j.asked.map((f) => f[i]), colour: pale(COLOURS[i]), width: 4 },
-      ...(j.other ? [{ x: j.t, y: j.other.delivered.map((f) => f[i]), colour: "#888888", width: 1 }] : []),
-      { x: j.t, y: j.delivered.map((f) => f[i]), colour: COLOURS[i] },
-    ]));
-    document.querySelectorAll("#cue-controls input, #cue-controls select").forEach((i) => i.classList.remove("bad"));
-  } catch (e) {
-    status.className = "small msg bad"; status.textContent = e.message;
-    // The value just typed is the one refused (the others were taken before it): marked where the eye is.
-    if (cue.edited) cue.edited.classList.add("bad");
-    // The plots were of other parameters: not shown as if they were of these.
-    cue.charts.forEach((c) => c.set([]));
-  }
-}
-
-$("cue-save").addEventListener("click", () => {
-  if (!cue.toml) return;
-  const a = document.createElement("a");
-  a.href = URL.createObjectURL(new Blob([cue.toml], { type: "application/toml" }));
-  a.download = "cueing.toml";
-  a.click();
-});
-$("cue-apply").addEventListener("click", async () => {
-  try {
-    const j = await post("/api/cue/apply", { config: cue.config });
-    $("cue-status").textContent = `applied: ${j.applied} (a running telemetry session blends them in)`;
-  } catch (e) { $("cue-status").textContent = e.message; }
-});
-$("cue-compare").addEventListener("change", () => recue());
-$("cue-drive").addEventListener("change", async (e) => {
-  const file = e.target.files[0];
-  if (file) { cue.drive = await file.text(); recue(); }
-});
 
 // ---- Rig ----
 let rigTimer = null;

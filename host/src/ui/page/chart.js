@@ -11,20 +11,30 @@ function pale(hex) {
 }
 
 class Chart {
-  // title: shown top left; unit: after the y labels.
+  // title: the caption above the plot (text of the page, readable and found by tests); unit: after the y labels.
+  // The canvas is drawn at its CSS size times the screen's pixel ratio, never stretched.
   constructor(parent, title, unit) {
+    this.figure = document.createElement("figure");
+    this.figure.className = "chart";
+    this.caption = document.createElement("figcaption");
+    this.caption.textContent = title;
     this.canvas = document.createElement("canvas");
-    this.canvas.width = 660;
-    this.canvas.height = 300;
     this.canvas.title = title;
-    parent.appendChild(this.canvas);
+    this.figure.appendChild(this.caption);
+    this.figure.appendChild(this.canvas);
+    parent.appendChild(this.figure);
     this.title = title;
     this.unit = unit || "";
+    this.rightUnit = "";
+    this.minSpan = 0; // the least span of the y scale (left), and of the right one
+    this.rightMinSpan = 0;
     this.series = [];
     this.events = [];
     this.view = null; // [x0, x1] when zoomed
     this.canvas.addEventListener("wheel", (e) => this.zoom(e), { passive: false });
     this.canvas.addEventListener("dblclick", () => { this.view = null; this.draw(); });
+    // Shown, hidden or resized (a tab, the window): drawn again at the new size.
+    if (window.ResizeObserver) new ResizeObserver(() => this.draw()).observe(this.canvas);
   }
 
   // series: [{x: [], y: [], colour, width}]; events: [{x, colour, label}]
@@ -54,23 +64,24 @@ class Chart {
     this.draw();
   }
 
-  draw() {
-    const c = this.canvas, g = c.getContext("2d");
-    const W = c.width, H = c.height, L = 70, R = 10, T = 28, B = 30;
-    g.clearRect(0, 0, W, H);
-    g.font = "20px system-ui";
-    g.fillStyle = "#374151";
-    g.fillText(this.title, L, 20);
-    const [x0, x1] = this.view || this.extent();
-    if (!isFinite(x0) || x1 <= x0) return;
+  // The y range of the series on one side (`right` or not) within [x0, x1], padded; none when nothing is there.
+  range(x0, x1, right) {
+    right = !!right;
     let y0 = Infinity, y1 = -Infinity;
     for (const s of this.series) {
+      if (!!s.right !== right) continue;
       for (let i = 0; i < s.x.length; i++) {
         if (s.x[i] < x0 || s.x[i] > x1 || !isFinite(s.y[i])) continue;
         y0 = Math.min(y0, s.y[i]); y1 = Math.max(y1, s.y[i]);
       }
     }
-    if (!isFinite(y0)) return;
+    if (!isFinite(y0)) return null;
+    // A span of at least `minSpan` (a platform at rest drawn as a line at its value, not its noise magnified).
+    const least = right ? this.rightMinSpan : this.minSpan;
+    if (least && y1 - y0 < least) {
+      const mid = (y0 + y1) / 2;
+      y0 = mid - least / 2; y1 = mid + least / 2;
+    }
     if (y1 - y0 < 1e-9) {
       // A flat series: a band around it, scaled to its value (not a whole metre around a millimetre).
       const h = Math.max(Math.abs(y0) * 0.05, 1e-3);
@@ -79,24 +90,73 @@ class Chart {
     const pad = (y1 - y0) * 0.08;
     // A quantity that is never negative (a cost, a count) keeps its axis at zero and above.
     y0 = y0 >= 0 ? Math.max(0, y0 - pad) : y0 - pad; y1 += pad;
+    return [y0, y1];
+  }
+
+  draw() {
+    const c = this.canvas, box = c.getBoundingClientRect();
+    // Hidden (another tab): drawn when shown.
+    if (box.width < 1 || box.height < 1) return;
+    const dpr = window.devicePixelRatio || 1;
+    const pw = Math.round(box.width * dpr), ph = Math.round(box.height * dpr);
+    if (c.width !== pw || c.height !== ph) { c.width = pw; c.height = ph; }
+    const g = c.getContext("2d");
+    g.setTransform(dpr, 0, 0, dpr, 0, 0);
+    const W = box.width, H = box.height;
+    g.clearRect(0, 0, W, H);
+    const [x0, x1] = this.view || this.extent();
+    if (!isFinite(x0) || x1 <= x0) return;
+    const left = this.range(x0, x1, false), right = this.range(x0, x1, true);
+    if (!left && !right) return;
+    // The right-hand scale takes room only while it has something to show (a game's cue).
+    const L = 62, R = right ? 62 : 8, T = 6, B = 20;
     const X = (x) => L + (x - x0) / (x1 - x0) * (W - L - R);
-    const Y = (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
-    g.strokeStyle = "#e5e7eb"; g.lineWidth = 1; g.fillStyle = "#6b7280"; g.font = "17px system-ui";
-    const yt = ticks(y0, y1, 4);
-    for (const y of yt.at) {
-      g.beginPath(); g.moveTo(L, Y(y)); g.lineTo(W - R, Y(y)); g.stroke();
-      g.fillText(y.toFixed(yt.decimals) + this.unit, 2, Y(y) + 5);
+    const Yof = ([y0, y1]) => (y) => H - B - (y - y0) / (y1 - y0) * (H - T - B);
+    g.strokeStyle = "#e5e7eb"; g.lineWidth = 1; g.fillStyle = "#4b5563"; g.font = "12px system-ui";
+    if (left) {
+      const Y = Yof(left), yt = ticks(left[0], left[1], 4);
+      g.textAlign = "right";
+      for (const y of yt.at) {
+        g.beginPath(); g.moveTo(L, Y(y)); g.lineTo(W - R, Y(y)); g.stroke();
+        g.fillText(y.toFixed(yt.decimals) + this.unit, L - 4, Y(y) + 4);
+      }
     }
-    const xt = ticks(x0, x1, 5);
-    for (const x of xt.at) g.fillText(x.toFixed(xt.decimals) + " s", X(x) - 16, H - 8);
+    if (right) {
+      const Y = Yof(right), yt = ticks(right[0], right[1], 4);
+      g.textAlign = "left"; g.fillStyle = "#6b7280";
+      for (const y of yt.at) g.fillText(y.toFixed(yt.decimals) + this.rightUnit, W - R + 4, Y(y) + 4);
+    }
+    g.textAlign = "center"; g.fillStyle = "#4b5563";
+    const xt = ticks(x0, x1, Math.max(2, Math.floor((W - L - R) / 90)));
+    for (const x of xt.at) {
+      // Kept whole inside the canvas at either end.
+      const label = x.toFixed(xt.decimals) + " s", half = g.measureText(label).width / 2;
+      g.fillText(label, Math.min(Math.max(X(x), half + 2), W - half - 2), H - 5);
+    }
+    g.textAlign = "left";
+    // Each event's line, and its label (a state change's new state) beside its top, unless the last label is
+    // still there.
+    let freeFrom = -Infinity;
     for (const e of this.events) {
       if (e.x < x0 || e.x > x1) continue;
       g.strokeStyle = e.colour; g.beginPath(); g.moveTo(X(e.x), T); g.lineTo(X(e.x), H - B); g.stroke();
+      if (e.label && X(e.x) >= freeFrom) {
+        // Right of its line, or left of it where the plot ends first.
+        const w = g.measureText(e.label).width;
+        const at = X(e.x) + 3 + w <= W - R ? X(e.x) + 3 : X(e.x) - 3 - w;
+        g.fillStyle = "#374151";
+        g.fillText(e.label, at, T + 12);
+        freeFrom = X(e.x) + w + 8;
+      }
     }
     g.save();
     g.beginPath(); g.rect(L, T, W - L - R, H - T - B); g.clip();
     for (const s of this.series) {
-      g.strokeStyle = s.colour; g.lineWidth = s.width || 2;
+      const r = s.right ? right : left;
+      if (!r) continue;
+      const Y = Yof(r);
+      g.strokeStyle = s.colour; g.lineWidth = s.width || 1.5;
+      g.setLineDash(s.dash || []);
       g.beginPath();
       let started = false;
       for (let i = 0; i < s.x.length; i++) {

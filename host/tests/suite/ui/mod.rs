@@ -1,5 +1,6 @@
 //! `ringpod ui --sim` driven over its WebSocket and HTTP as a page (or a hostile client) drives it.
 
+mod profiles;
 mod requests;
 mod runs;
 mod stall;

@@ -9,7 +9,9 @@
 //!    disabled button says why; the demo runs and the 3D pose and the counters advance; STOP (the button, and the
 //!    space bar) stops and powers down; a UDP session is followed; a page of another origin cannot open the WebSocket, nor can a request
 //!    without the token; the rig editor names a bad key; cueing redraws when a parameter changes; a run record
-//!    opens; a page that goes away stops the stream it started, and with no page left the platform powers down.
+//!    opens; a page that goes away stops the stream it started, and with no page left the platform powers down;
+//!    a rig builder's task at 1366x768 and 1920x1080 (an F1 session, the Live view read, its profile tuned live,
+//!    saved and found again after a reload; `task`).
 //!
 //! `--screenshots DIR` saves a picture of each panel there (the book's are in `docs/book/src/images/ui/`), and of
 //! every panel at 1366x768 and 1920x1080 at the end, in `DIR/sizes/`. The last line is the
@@ -20,6 +22,7 @@ mod origin;
 mod page;
 mod panels;
 mod process;
+mod task;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -104,6 +107,13 @@ async fn checks(driver: &str, url: &str, record: &Path, shots: Option<&Path>) ->
     if let Some(dir) = shots {
         k.report("every panel at 1366x768 and 1920x1080", page::sizes(&c, dir).await);
     }
+    // Last: it reloads the page, and the pictures above are of the panels as the checks before left them.
+    for (size, raise) in [((1366, 768), 1.2), ((1920, 1080), 2.5)] {
+        k.report(
+            &format!("a rig builder's task at {}x{}: an F1 session, the Live view, the F1 profile tuned live, saved and found again", size.0, size.1),
+            task::at_size(&c, url, size, raise, shots).await,
+        );
+    }
     let _ = c.close().await;
     Ok(k)
 }
@@ -121,7 +131,12 @@ fn main() -> ExitCode {
     let prepared = setup::ensure_browser()
         .and_then(|()| cli::build_release())
         .and_then(|cli| Ok((record(&cli)?, cli)))
-        .and_then(|(record, cli)| Ok((record, serve(&cli)?, chromedriver()?)));
+        .and_then(|(record, cli)| {
+            // The rig builder's cueing file, with an F1 profile (the task's), written afresh for each run.
+            let profiles = process::target_dir().join("browser-cueing.toml");
+            std::fs::write(&profiles, task::PROFILES).map_err(|e| format!("{}: {e}", profiles.display()))?;
+            Ok((record, serve(&cli, &profiles)?, chromedriver()?))
+        });
     let (record, (_ui, url), (_driver, driver)) = match prepared {
         Ok(p) => p,
         Err(e) => {

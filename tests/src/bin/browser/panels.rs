@@ -4,7 +4,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use fantoccini::{Client, Locator};
-use serde_json::json;
+use serde_json::{json, Value};
 
 use crate::page::{js, screenshot, tab, until};
 
@@ -88,7 +88,8 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
          !!q('smoothing.window')]; })()",
     )
     .await?;
-    if layout != json!(["surge", "tilt coordination", "m/s²", "SELECT", false]) {
+    // The pitch's and roll's tilt with the force each cues (surge, sway); the optimal cueing's fields hidden.
+    if layout != json!(["surge", "sway", "m/s²", "SELECT", false]) {
         return Err(format!(
             "the controls are not grouped by channel with units and selects: {layout}"
         ));
@@ -133,6 +134,7 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
     if seen != json!([true, true]) {
         return Err(format!("the refusal is out of view or the value not marked: {seen}"));
     }
+    named_as_shown(&refused)?;
     let runs = js(c, "window.ringpod.cueRuns").await?.as_u64().unwrap_or(0);
     js(
         c,
@@ -151,6 +153,15 @@ pub async fn cueing(c: &Client, shots: Option<&Path>) -> Result<String, String> 
         "largest surge delivered {p1:.3} -> {p2:.3} m/s^2; controls by channel with units, selects, the median's \
          window shown with it: {layout}; -5 refused in view and marked: {refused}; both: {both}"
     ))
+}
+
+/// A refusal names the field as on screen (its group and label), with the range shown, not the file's key.
+fn named_as_shown(refused: &Value) -> Result<(), String> {
+    let said = refused.as_str().unwrap_or("");
+    if !said.starts_with("surge: ") || said.contains("translation_scale") {
+        return Err(format!("the refusal does not name the field as shown: {said}"));
+    }
+    Ok(())
 }
 
 /// Both algorithms on the same drive: the optimal cueing beside the classical one, each scored.

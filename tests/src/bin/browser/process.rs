@@ -55,9 +55,10 @@ pub fn record(cli: &Path) -> Result<PathBuf, String> {
 }
 
 /// `ringpod ui --sim` on a free port, and the URL it printed.
-pub fn serve(cli: &Path) -> Result<(Running, String), String> {
+pub fn serve(cli: &Path, cue_config: &Path) -> Result<(Running, String), String> {
     let mut child = Command::new(cli)
-        .args(["ui", "--sim", "--listen", "127.0.0.1:0"])
+        .args(["ui", "--sim", "--listen", "127.0.0.1:0", "--cue-config"])
+        .arg(cue_config)
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
