@@ -82,6 +82,12 @@ pub fn write_whole(path: &Path, text: &str) -> std::io::Result<()> {
     let mut file = tempfile::NamedTempFile::new_in(dir)?;
     file.write_all(text.as_bytes())?;
     file.as_file().sync_all()?;
+    // An existing file keeps its mode (a temporary file is made 0600); a link's is not taken (never followed).
+    if let Ok(m) = std::fs::symlink_metadata(path) {
+        if m.is_file() {
+            file.as_file().set_permissions(m.permissions())?;
+        }
+    }
     file.persist(path).map_err(|e| e.error)?;
     Ok(())
 }
@@ -89,6 +95,19 @@ pub fn write_whole(path: &Path, text: &str) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[cfg(unix)]
+    #[test]
+    fn a_file_written_whole_keeps_its_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = private_dir().unwrap();
+        let path = dir.path().join("cueing.toml");
+        std::fs::write(&path, "old").unwrap();
+        std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o644)).unwrap();
+        write_whole(&path, "new").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");
+        assert_eq!(std::fs::metadata(&path).unwrap().permissions().mode() & 0o777, 0o644);
+    }
 
     #[cfg(unix)]
     #[test]
