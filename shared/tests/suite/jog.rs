@@ -64,13 +64,9 @@ fn the_drivers_stay_enabled_for_the_periods_that_play_a_jogs_last_steps() {
 /// does (a reversal inside a period must not lose or add a step at the pins).
 #[test]
 fn a_buzz_ends_at_the_pins_where_the_count_does() {
-    use ringpod_core::motion::pulse::{PortMap, PulseRenderer, MAX_STEP_SLOTS, STEP_SLOT_NS};
+    use crate::pulse::MAP;
+    use ringpod_core::motion::pulse::{PulseRenderer, MAX_STEP_SLOTS, STEP_SLOT_NS};
     use ringpod_core::sim::drivers::DriverInputs;
-    const MAP: PortMap = PortMap {
-        step: [0, 1, 2, 3, 4, 5],
-        dir: [6, 7, 8, 9, 10, 12],
-        dir_forward_low: 0,
-    };
     for axis in 0..6u8 {
         let mut c = powered();
         let sched = ringpod_core::controller::ControllerConfig::trainer_model().scheduler;

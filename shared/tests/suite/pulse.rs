@@ -16,7 +16,7 @@ use ringpod_core::sim::drivers::{DriverInputs, TimingRule, TimingViolation};
 use ringpod_core::sim::Plant;
 
 /// The Black Pill's map: STEP on PB0-PB5, DIR on PB6-PB10 and PB12; axis 2 wired the other way round.
-const MAP: PortMap = PortMap {
+pub(crate) const MAP: PortMap = PortMap {
     step: [0, 1, 2, 3, 4, 5],
     dir: [6, 7, 8, 9, 10, 12],
     dir_forward_low: 0b000100,
