@@ -222,6 +222,18 @@ impl<T: Transport> Client<T> {
             .map(|r| r.body))
     }
 
+    /// Whether the answer to a request sent after `id` has arrived while `id`'s has not: the device answers its
+    /// link's requests in order, so `id`'s request or its answer was lost on the way (a frame cut by noise or an
+    /// overrun, dropped as undecodable) and will never come.
+    pub fn answered_after(&mut self, id: u32) -> Result<bool, ClientError> {
+        self.pump()?;
+        // Ids count up and wrap: a later one is less than half the id space ahead.
+        Ok(self
+            .inbox
+            .iter()
+            .any(|r| r.id != id && r.id.wrapping_sub(id) < u32::MAX / 2))
+    }
+
     /// Waits for the response to request `id`, up to the timeout; a raised cancel flag (Ctrl-C) ends the wait at
     /// once, so that a device that does not answer (a silent port, a stalled link) does not hold a signal back.
     pub fn wait_response(&mut self, id: u32) -> Result<DeviceMessage, ClientError> {
@@ -535,6 +547,39 @@ mod tests {
         // The link works normally afterwards, and no stale answer is left behind.
         assert!(client.hello().is_ok());
         assert!(client.inbox.is_empty());
+    }
+
+    #[test]
+    fn a_later_answer_tells_that_an_earlier_request_was_lost() {
+        let mut client = Client::new(Lossy {
+            device: SimDevice::new(false),
+            pass: 1,
+            lose: 1,
+            elapsed: Duration::ZERO,
+        });
+        let answered = client.send(HostMessage::GetStatus).unwrap();
+        let lost = client.send(HostMessage::GetStatus).unwrap();
+        let after = client.send(HostMessage::GetStatus).unwrap();
+        client.transport().elapse(Duration::from_millis(10));
+        // Only the first has its answer so far: nothing after it is known lost yet.
+        assert!(!client.answered_after(after).unwrap());
+        assert!(client.take_response(answered).unwrap().is_some());
+        assert!(client.answered_after(lost).unwrap());
+        assert!(client.take_response(lost).unwrap().is_none());
+        assert!(client.take_response(after).unwrap().is_some());
+        assert!(!client.answered_after(lost).unwrap());
+    }
+
+    #[test]
+    fn ids_that_wrap_are_still_later() {
+        let mut client = lossy(0);
+        client.inbox.push_back(Response {
+            id: 2,
+            body: DeviceMessage::Ack,
+        });
+        assert!(client.answered_after(u32::MAX - 1).unwrap());
+        assert!(!client.answered_after(2).unwrap());
+        assert!(!client.answered_after(3).unwrap());
     }
 
     #[test]

@@ -135,6 +135,7 @@ pub(super) fn report<T: Transport>(
         input_errors,
         datagrams,
         last_applied_pose: s.last_applied.map(|p| p.to_array()),
+        setpoints_unanswered: s.unanswered,
         counts_agree,
         record: ending.record,
         capture,

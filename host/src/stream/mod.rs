@@ -149,6 +149,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             sent_all: 0,
             applied_all: 0,
             rejected_all: 0,
+            unanswered: 0,
             device_limited: 0,
             input_sent: 0,
             input_applied: 0,

@@ -115,6 +115,9 @@ pub struct Report {
     pub datagrams: Option<DatagramReport>,
     /// The last input pose the device accepted, as sent (after host limiting).
     pub last_applied_pose: Option<[f64; 6]>,
+    /// Setpoints (of every kind) whose answer never came while a later request's did: the device answers in order,
+    /// so the request or its answer was lost on the link. Not waited for; `counts_agree` is false when any was.
+    pub setpoints_unanswered: u32,
     /// The device's counters for this run agree with the host's, and every setpoint sent was answered.
     pub counts_agree: bool,
     /// `--record`: rows written (a row per telemetry sample), or why the record failed.

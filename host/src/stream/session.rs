@@ -98,6 +98,8 @@ pub(super) struct Streamer<'a, T: Transport> {
     pub(super) sent_all: u32,
     pub(super) applied_all: u32,
     pub(super) rejected_all: u32,
+    /// Setpoints whose answer was lost on the link (see `collect`).
+    pub(super) unanswered: u32,
     pub(super) device_limited: u32,
     pub(super) input_sent: u32,
     pub(super) input_applied: u32,
@@ -230,6 +232,20 @@ impl<'a, T: Transport> Streamer<'a, T> {
         let stall = crate::link::patience(STALLED);
         while let Some(&(id, number, pose)) = self.in_flight.front() {
             let Some(answer) = self.client.take_response(id)? else {
+                if self.client.answered_after(id)? {
+                    // Lost on the link: waiting would stall the stream for good. Counted and reported.
+                    self.in_flight.pop_front();
+                    self.unanswered += 1;
+                    if self.unanswered == 1 {
+                        self.bar.suspend(|| {
+                            console::err(
+                                "a setpoint's answer was lost on the link (the device answered a later request): \
+                                 counted in the report, the stream goes on",
+                            )
+                        });
+                    }
+                    continue;
+                }
                 if !stalled && waited >= stall {
                     stalled = true;
                     self.bar.suspend(|| {

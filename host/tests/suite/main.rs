@@ -19,6 +19,7 @@ mod inputs;
 mod line_endings;
 mod link;
 mod live_motion;
+mod lost;
 mod motion_compensation;
 mod outputs;
 mod safety;
