@@ -148,4 +148,5 @@ def estop_check(checks, m, cli, port, plant):
                  f"the last STEP edge {stop_ms:.1f} ms after (at most {ESTOP_STOP_MS}); `stream` exit {r.code} "
                  f"(5: the device stopped); ENABLE, LOGIC, POWER {supplies} (want 1, 1, 0: drivers disabled, logic "
                  f"kept, motor power off); state {status.get('state')}; closed again, `device clear` exit "
-                 f"{clear.code}: state {cleared.get('state')}" + ("" if r.code == 5 else f"; {r}"))
+                 f"{clear.code}: state {cleared.get('state')}" + ("" if r.code == 5 else f"; {r}; the device's bad frames {status.get('bad_frames')}, "
+                                              f"refusals {status.get('rejected')}"))

@@ -68,12 +68,6 @@ class Elf:
         return [self.text_addr + i for i in range(0, len(self.text) - 1, 2)
                 if self.text[i] == opcode & 0xFF and self.text[i + 1] == opcode >> 8]
 
-    def msr_primask_sites(self):
-        """(address, n) of every `MSR PRIMASK, Rn` (T1 encoding F38n 8810, ARM DDI 0403E B5.2.3), as `hint_sites`."""
-        t = self.text
-        return [(self.text_addr + i, t[i] & 0xF) for i in range(0, len(t) - 3, 2)
-                if t[i + 1] == 0xF3 and t[i] & 0xF0 == 0x80 and t[i + 2] == 0x10 and t[i + 3] == 0x88]
-
 
 def memory_x(path):
     """ORIGIN and LENGTH of each region of a linker script's MEMORY block."""
