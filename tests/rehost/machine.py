@@ -247,7 +247,9 @@ class Machine:
         self.uc.hook_add(UC_HOOK_CODE, count)
 
     def add_breakpoint(self, addr, callback):
-        self.uc.hook_add(UC_HOOK_CODE, lambda uc, a, size, ud: callback(self), None, addr & ~1, addr & ~1)
+        """Calls `callback(self)` before the instruction at `addr` runs; returns the hook (for `uc.hook_del`). Each
+        code hook costs every instruction while Unicorn counts them: remove one whose work is done."""
+        return self.uc.hook_add(UC_HOOK_CODE, lambda uc, a, size, ud: callback(self), None, addr & ~1, addr & ~1)
 
     def _scb_write(self, scb, access, offset, size, value):
         # PM0214 4.4.4 AIRCR: SYSRESETREQ with the key 0x05FA requests a system reset

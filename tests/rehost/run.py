@@ -83,8 +83,8 @@ class Probes:
         elf = m.elf
         self.pools = {name.split("::")[-2]: (addr, size) for name, addr, size in elf.find(r"::POOL$")}
         self.polled = {}  # task -> set of IPSR values it was polled in
-        for _name, addr, _size in elf.find(r"TaskStorage<F>::poll$"):
-            m.add_breakpoint(addr, self._poll)
+        self.task_hooks = [m.add_breakpoint(addr, self._poll) for _name, addr, _size in
+                           elf.find(r"TaskStorage<F>::poll$")]
         self.reached = {}
         self.inlined = []  # labels with no symbol of their own: LTO inlined them into their caller
         for label, pattern in (("Executor::run", r"thread::Executor::run$"),
@@ -93,7 +93,8 @@ class Probes:
             if not found:
                 self.inlined.append(label)
             for _name, addr, _size in found:
-                m.add_breakpoint(addr, lambda mm, label=label: self.reached.setdefault(label, mm.now))
+                self.task_hooks.append(
+                    m.add_breakpoint(addr, lambda mm, label=label: self.reached.setdefault(label, mm.now)))
         self.faults = []
         for pattern in (r"^HardFault_?$", r"^DefaultHandler_?$", r"rust_begin_unwind", r"^_defmt_panic$"):
             for name, addr, _size in elf.find(pattern):
@@ -125,6 +126,13 @@ class Probes:
                 self.polled.setdefault(task, set()).add(m.reg(A.UC_ARM_REG_IPSR) & 0x1FF)
                 if self.stalled == (task, len(m.resets)):
                     m.uc.reg_write(A.UC_ARM_REG_PC, m.reg(A.UC_ARM_REG_LR) | 1)  # the poll returns at once
+
+    def drop_task_probes(self):
+        """The tasks' polls and the start's breakpoints no longer watched (`tasks-reached` and `stall` are done):
+        every code hook slows every instruction."""
+        for h in self.task_hooks:
+            self.m.uc.hook_del(h)
+        self.task_hooks = []
 
     def stall(self, task):
         """Stops polling `task` (the others run on) until the chip resets."""
@@ -581,6 +589,8 @@ def main():
              f"and cleared it (RMVF), logged {said[0].split(' ms ', 1)[-1] if said else 'no error'!r}, fed the watchdog {len(refeeds)} times in the "
              f"{ms(since_reset):.0f} ms after the reset"
              if reset else f"no reset within 200 ms of stalling the control task (fault: {m.fault})"))
+
+    p.drop_task_probes()
 
     # -- the host link on USART1: the real CLI over a pty --
     if args.ringpod:
