@@ -5,8 +5,9 @@
 //! 2. `cargo test` alone: most of its tests wait on a child `ringpod` in real time, and a build beside them would
 //!    starve their answers.
 //! 3. Then two lanes side by side. Lane one, its output as it comes: the QEMU suite, the rehost run and the browser
-//!    tests, each keeping about one core busy. Lane two: the Windows runner, its cross-build on one job
-//!    (`CARGO_BUILD_JOBS=1`) in a target folder of its own (`target/windows`: a cross-build holds the build folder's
+//!    tests, each keeping about one core busy and waiting on real time. Lane two: the Windows runner, its
+//!    cross-build on both cores at the lowest CPU priority (`nice -n 19`: it takes what lane one leaves, and never
+//!    starves its answers) in a target folder of its own (`target/windows`: a cross-build holds the build folder's
 //!    lock for minutes, and the runners of lane one build in it), then its programs under Wine; its output is
 //!    written to `target/windows-runner.log` as it comes and printed whole once lane one is over.
 //!
@@ -60,7 +61,7 @@ fn part(name: &str, mut c: Command) -> Part {
     }
 }
 
-/// The Windows runner in its own target folder, on one job, its output to `log`.
+/// The Windows runner in its own target folder, its output to `log` (its cross-build yields the CPU to lane one).
 fn windows_lane(log: &Path) -> Result<Child, String> {
     let target = target_dir().join("windows");
     std::fs::create_dir_all(&target).map_err(|e| format!("{}: {e}", target.display()))?;
@@ -68,7 +69,6 @@ fn windows_lane(log: &Path) -> Result<Child, String> {
     let err = out.try_clone().map_err(|e| format!("{}: {e}", log.display()))?;
     runner("windows")
         .env("CARGO_TARGET_DIR", &target)
-        .env("CARGO_BUILD_JOBS", "1")
         .stdin(Stdio::null())
         .stdout(out)
         .stderr(err)

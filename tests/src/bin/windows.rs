@@ -2,7 +2,8 @@
 //!
 //! 1. The MinGW-w64 cross compiler and Wine (installed with apt-get when missing and allowed, as QEMU is), and the
 //!    `x86_64-pc-windows-gnu` standard library (rustup).
-//! 2. A debug cross-build of the host's test programs, with `ringpod.exe` and the examples (`cargo test --no-run`).
+//! 2. A debug cross-build of the host's test programs, with `ringpod.exe` and the examples (`cargo test --no-run`),
+//!    at the lowest CPU priority (`nice -n 19`): it uses what the machine's other work leaves.
 //! 3. Beside them, a test-only `bcryptprimitives.dll` built from `tests/windows/bcryptprimitives.c`: Rust's standard
 //!    library imports `ProcessPrng` from it, which Wine 8 lacks.
 //! 4. The host's tests under Wine, unit and integration (`cargo test` with Wine as the target's runner): the
@@ -121,6 +122,23 @@ fn step(name: &str, run: impl FnOnce() -> Result<(), String>) -> Result<(), Stri
     let result = run();
     println!("== {name}: {:.0} s", started.elapsed().as_secs_f64());
     result
+}
+
+/// `c` at the lowest CPU priority (`nice -n 19`): the cross-build takes only what the machine's other work leaves,
+/// so that it can run beside timing-sensitive tests (the test command's lanes) without starving them.
+fn yielding(c: Command) -> Command {
+    let mut niced = Command::new("nice");
+    niced.args(["-n", "19"]).arg(c.get_program()).args(c.get_args());
+    if let Some(dir) = c.get_current_dir() {
+        niced.current_dir(dir);
+    }
+    for (key, value) in c.get_envs() {
+        match value {
+            Some(v) => niced.env(key, v),
+            None => niced.env_remove(key),
+        };
+    }
+    niced
 }
 
 fn status(mut c: Command, what: &str) -> Result<(), String> {
@@ -313,7 +331,10 @@ fn main() -> ExitCode {
             step("cross-build (debug)", || {
                 // The test programs, and with them `ringpod.exe` (the integration tests start it) and the examples
                 // (`shm_games.exe`, the games' stand-in): one build, no second one of the host with other features.
-                status(cargo(&["test", "-p", "ringpod", "--no-run"]), "cargo test --no-run")
+                status(
+                    yielding(cargo(&["test", "-p", "ringpod", "--no-run"])),
+                    "cargo test --no-run",
+                )
             })
         })
         .and_then(|()| step("the ProcessPrng DLL", shim));
@@ -360,6 +381,23 @@ fn main() -> ExitCode {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_yielding_command_is_the_same_command_under_nice() {
+        let mut c = Command::new("cargo");
+        c.args(["test", "--no-run"])
+            .current_dir("/tmp")
+            .env("A", "1")
+            .env_remove("B");
+        let n = yielding(c);
+        assert_eq!(n.get_program(), "nice");
+        let args: Vec<_> = n.get_args().collect();
+        assert_eq!(args, ["-n", "19", "cargo", "test", "--no-run"]);
+        assert_eq!(n.get_current_dir(), Some(Path::new("/tmp")));
+        let envs: Vec<_> = n.get_envs().collect();
+        assert!(envs.contains(&(std::ffi::OsStr::new("A"), Some(std::ffi::OsStr::new("1")))));
+        assert!(envs.contains(&(std::ffi::OsStr::new("B"), None)));
+    }
 
     #[test]
     fn tee_keeps_output_and_errors_in_order_and_the_status() {
