@@ -232,7 +232,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
         let stall = crate::link::patience(STALLED);
         while let Some(&(id, number, pose)) = self.in_flight.front() {
             let Some(answer) = self.client.take_response(id)? else {
-                if self.client.answered_after(id)? {
+                if self.client.answered_after(id) {
                     // Lost on the link: waiting would stall the stream for good. Counted and reported.
                     self.in_flight.pop_front();
                     self.unanswered += 1;
