@@ -61,6 +61,7 @@ const SCRIPT: &str = include_str!("page/app.js");
 const CHART: &str = include_str!("page/chart.js");
 const CUEING: &str = include_str!("page/cueing.js");
 const VIEW3D: &str = include_str!("page/view3d.js");
+const RIG: &str = include_str!("page/rig.js");
 const STYLE: &str = include_str!("page/style.css");
 
 struct App {
@@ -222,6 +223,7 @@ fn routes(app: &Arc<App>) -> Router {
         .route("/chart.js", asset("text/javascript", CHART))
         .route("/cueing.js", asset("text/javascript", CUEING))
         .route("/view3d.js", asset("text/javascript", VIEW3D))
+        .route("/rig.js", asset("text/javascript", RIG))
         .route("/style.css", asset("text/css", STYLE))
         .with_state(app.clone())
 }

@@ -51,14 +51,22 @@ pub struct RigBody {
 }
 
 impl RigBody {
-    /// The file, read: the form's values by [`rig_form::read`], a text as `rig check` reads one.
-    fn file(&self) -> Result<RigFile, RigError> {
+    /// The file, read: the form's values by [`rig_form::read`], a text as `rig check` reads one; a refusal with
+    /// the form's fields, when the values were of the file's types.
+    fn file(&self) -> Result<RigFile, (RigError, Vec<Field>)> {
         match (&self.text, &self.rig) {
-            (Some(text), None) => crate::rig::parse(text),
-            (None, Some(rig)) => rig_form::read(rig),
-            _ => Err(RigError::new(
-                "",
-                "send the rig file as `text` (TOML) or as `rig` (the form's values)",
+            (Some(text), None) => crate::rig::parse(text).map_err(|e| (e, Vec::new())),
+            (None, Some(rig)) => {
+                let file = rig_form::typed(rig).map_err(|e| (e, Vec::new()))?;
+                let fields = rig_form::fields(&file);
+                match rig_form::in_range(&fields, rig) {
+                    Ok(()) => Ok(file),
+                    Err(e) => Err((e, fields)),
+                }
+            }
+            _ => Err((
+                RigError::new("", "send the rig file as `text` (TOML) or as `rig` (the form's values)"),
+                Vec::new(),
             )),
         }
     }
@@ -81,7 +89,11 @@ fn said(e: &RigError, fields: &[Field]) -> Value {
 pub fn check(body: &RigBody) -> Value {
     let file = match body.file() {
         Ok(f) => f,
-        Err(e) => return Value::Object(refused(&e, &[])),
+        Err((e, fields)) => {
+            let mut v = refused(&e, &fields);
+            v.insert("fields".into(), json!(fields));
+            return Value::Object(v);
+        }
     };
     let fields = rig_form::fields(&file);
     let platform = match file.platform() {
@@ -94,7 +106,7 @@ pub fn check(body: &RigBody) -> Value {
             return Value::Object(v);
         }
     };
-    let drivable = file.check().map(|_| ()).map_err(|e| {
+    let drivable = file.drivable().map(|_| ()).map_err(|e| {
         let s = said(&e, &fields);
         format!("{}: {}", s["field"].as_str().unwrap_or(""), e.why)
     });
@@ -205,8 +217,9 @@ pub(super) async fn current(State(app): State<Arc<App>>) -> Response {
     answer(text.map(|text| json!({ "text": text, "file": path })))
 }
 
-/// Saves the panel's rig to the file the workbench was started with: only a file `--geometry` loads (a mechanism
-/// whose home is inside every check, its sections the controller's), written whole with its mode kept; it must
+/// Saves the panel's rig to the file the workbench was started with: only a file `rig check` calls drivable (a
+/// mechanism whose home is inside every check, its sections the controller's, homing in the simulated machine),
+/// written whole with its mode kept; it must
 /// read back as the same file. Nothing is written otherwise.
 pub fn save(target: &RigTarget, body: &RigBody) -> Result<Value, String> {
     let Some(path) = &target.path else {
@@ -216,16 +229,19 @@ pub fn save(target: &RigTarget, body: &RigBody) -> Result<Value, String> {
                 .into(),
         );
     };
-    let file = body.file().map_err(|e| e.to_string())?;
+    let file = body.file().map_err(|(e, fields)| {
+        let s = said(&e, &fields);
+        format!("{}: {} (not saved)", s["field"].as_str().unwrap_or(""), e.why)
+    })?;
     let fields = rig_form::fields(&file);
     let refusal = |e: RigError| {
         let s = said(&e, &fields);
         format!("{}: {} (not saved)", s["field"].as_str().unwrap_or(""), e.why)
     };
-    file.check().map_err(refusal)?;
+    file.drivable().map_err(refusal)?;
     let text = file.to_toml().map_err(|e| e.to_string())?;
     let again = crate::rig::parse(&text).map_err(refusal)?;
-    again.check().map_err(refusal)?;
+    again.drivable().map_err(refusal)?;
     let _one = target.writing.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     files::write_whole(path, &text).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(json!({ "saved": path.display().to_string(), "toml": text }))

@@ -182,21 +182,6 @@ fn describe(generic: &str, at: &[usize], motions: &[Motion]) -> Option<Field> {
     let j = at.get(1).copied().unwrap_or(0);
     let g = |s: &str| s.to_owned();
     let chain = || format!("Chain {}", i + 1);
-    let axis = || format!("Axis {}", i + 1);
-    let motion = |k: usize| motions.get(k).copied().unwrap_or(Motion::Turns);
-    let pose = |k: usize, per_s: u8| {
-        if k < 3 {
-            Motion::Slides.unit(per_s)
-        } else {
-            Motion::Turns.unit(per_s)
-        }
-    };
-    let ms = |label| {
-        ranged(
-            of_kind("integer", number(g("Supervisor"), label, None, ("ms", 1.0))),
-            within(0.0, 60000.0),
-        )
-    };
     Some(match generic {
         "name" => ranged(
             of_kind("text", number(g("Rig"), "name", None, ("", 1.0))),
@@ -204,7 +189,12 @@ fn describe(generic: &str, at: &[usize], motions: &[Motion]) -> Option<Field> {
         ),
         "ring_radius" => ranged(number(g("Geometry"), "ring radius", None, MM), POSITIVE),
         "rod_length" => ranged(number(g("Geometry"), "rod length", None, MM), POSITIVE),
-        "home[]" => number(g("Home pose"), "home", Some(POSE[i % 6]), pose(i, 0)),
+        "home[]" => number(
+            g("Home pose"),
+            if i < 3 { "position" } else { "angle" },
+            Some(POSE[i % 6]),
+            pose(i, 0),
+        ),
         "chains[].kind" => choice(chain(), "kind", &["rod", "radial", "elbow"]),
         "chains[].branch" => choice(chain(), "branch", &["plus", "minus"]),
         "chains[].elbow" => choice(chain(), "elbow", &["up", "down"]),
@@ -253,6 +243,32 @@ fn describe(generic: &str, at: &[usize], motions: &[Motion]) -> Option<Field> {
             number(g("Spec ranges (±)"), spec_label(generic), None, DEG_),
             within(0.0, 360.0),
         ),
+        _ => return machine(generic, i, motions),
+    })
+}
+
+/// The unit of pose axis `k` (x, y, z slide; roll, pitch, yaw turn).
+fn pose(k: usize, per_s: u8) -> (&'static str, f64) {
+    if k < 3 {
+        Motion::Slides.unit(per_s)
+    } else {
+        Motion::Turns.unit(per_s)
+    }
+}
+
+/// [`describe`] of the controller's sections: each axis's steps, speeds and homing in its own unit, the pose
+/// limits, the inputs and the supervisor.
+fn machine(generic: &str, i: usize, motions: &[Motion]) -> Option<Field> {
+    let g = |s: &str| s.to_owned();
+    let axis = || format!("Axis {}", i + 1);
+    let motion = |k: usize| motions.get(k).copied().unwrap_or(Motion::Turns);
+    let ms = |label| {
+        ranged(
+            of_kind("integer", number(g("Supervisor"), label, None, ("ms", 1.0))),
+            within(0.0, 60000.0),
+        )
+    };
+    Some(match generic {
         "axes[].steps_per_unit" => {
             let (unit, scale) = match motion(i) {
                 Motion::Turns => ("steps/deg", 1.0 / DEG),
@@ -361,13 +377,26 @@ fn walk(
 }
 
 /// The form's values as a rig file: each of a type the file does not take, each key the file does not have, each
-/// number outside its range, refused with the field named as shown (its unit and range with it). What the rig
-/// module's checks say beyond that (the home pose outside a check, a chain too few) is theirs: [`shown`] names it.
+/// number outside its range, refused by its key with the value and range in the unit shown ([`shown`] names the
+/// field). What the rig module's checks say beyond that (the home pose outside a check, a chain too few) is theirs.
+#[cfg(test)]
 pub fn read(value: &Value) -> Result<RigFile, RigError> {
-    let file: RigFile = serde_path_to_error::deserialize(value).map_err(|e| {
+    let file = typed(value)?;
+    in_range(&fields(&file), value)?;
+    Ok(file)
+}
+
+/// The form's values as a rig file, each of a type the file does not take and each key it does not have refused
+/// by its key.
+pub fn typed(value: &Value) -> Result<RigFile, RigError> {
+    serde_path_to_error::deserialize(value).map_err(|e| {
         let key = e.path().to_string();
         RigError::new(if key == "." { String::new() } else { key }, e.into_inner().to_string())
-    })?;
+    })
+}
+
+/// Every shown value of `value` inside its field's range.
+pub fn in_range(fields: &[Field], value: &Value) -> Result<(), RigError> {
     let at = |path: &str| {
         path.split(['.', '[', ']'])
             .filter(|s| !s.is_empty())
@@ -376,7 +405,7 @@ pub fn read(value: &Value) -> Result<RigFile, RigError> {
                 Err(_) => v.get(k),
             })
     };
-    for f in fields(&file) {
+    for f in fields {
         let (Some(range), Some(v)) = (f.range, at(&f.path)) else {
             continue;
         };
@@ -392,12 +421,12 @@ pub fn read(value: &Value) -> Result<RigFile, RigError> {
                 format!("{shown} {unit}")
             };
             return Err(RigError::new(
-                f.shown(),
+                f.path.clone(),
                 format!("{} is out of range: {}", said.trim_end(), range.text(unit)),
             ));
         }
     }
-    Ok(file)
+    Ok(())
 }
 
 /// A shown number without the noise of its conversion (120, not 119.99999999999999).
@@ -489,7 +518,10 @@ mod tests {
         let mut v = trainer();
         v["ring_radius"] = json!(-0.005);
         let e = read(&v).unwrap_err();
-        assert_eq!(e.key, "Geometry · ring radius (mm)");
+        assert_eq!(
+            shown(&e.key, &fields(&read(&trainer()).unwrap())),
+            "Geometry · ring radius (mm)"
+        );
         assert_eq!(e.why, "-5 mm is out of range: more than 0 mm");
         let mut v = trainer();
         v["limits"]["base_cone_deg"] = json!(90);
