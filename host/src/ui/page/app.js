@@ -398,10 +398,15 @@ function showRun(run, name) {
     `grey lines: state changes${more}, amber: limited, red: refused`;
   const charts = $("run-charts");
   charts.innerHTML = "";
-  AXES.forEach((a, i) => new Chart(charts, a, i < 3 ? " m" : " rad").set([
-    { x: run.t, y: run.commanded.map((p) => p[i]), colour: pale(COLOURS[i]), width: 4 },
-    { x: run.t, y: run.target.map((p) => p[i]), colour: COLOURS[i] },
-  ], events));
+  // The record keeps m and rad; the charts say mm and deg, as the Live view and the rig editor do.
+  const NAMES = ["surge x", "sway y", "heave z", "roll", "pitch", "yaw"];
+  AXES.forEach((a, i) => {
+    const k = i < 3 ? 1000 : 180 / Math.PI, unit = i < 3 ? "mm" : "deg";
+    new Chart(charts, `${NAMES[i]} (${unit})`, " " + unit).set([
+      { x: run.t, y: run.commanded.map((p) => p[i] * k), colour: pale(COLOURS[i]), width: 4 },
+      { x: run.t, y: run.target.map((p) => p[i] * k), colour: COLOURS[i] },
+    ], events);
+  });
   for (let k = 0; k < 6; k++) {
     new Chart(charts, `steps ${k + 1}`, "").set([{ x: run.t, y: run.steps.map((s) => s[k]), colour: COLOURS[k] }], events);
   }

@@ -124,6 +124,19 @@ async fn steps(
         return Err(format!("the ring radius is not shown as 286 mm: {shown}"));
     }
     let before = js(c, PICTURE).await?;
+    // The mechanism is drawn at its CSS size x devicePixelRatio: one drawn pixel per screen pixel.
+    let drawn = js(
+        c,
+        "(() => { const v = document.getElementById('rig-view'), r = v.getBoundingClientRect(), d = devicePixelRatio; \
+         return [v.width, v.height, r.width, r.height, d]; })()",
+    )
+    .await?;
+    let at = |i: usize| drawn[i].as_f64().unwrap_or(f64::NAN);
+    if (at(0) - (at(2) * at(4)).round()).abs() > 0.5 || (at(1) - (at(3) * at(4)).round()).abs() > 0.5 {
+        return Err(format!(
+            "the mechanism is not drawn 1:1 ([width, height] drawn, CSS, ratio): {drawn}"
+        ));
+    }
     let sizes = (
         rect(c, "rig-form").await?,
         rect(c, "rig-section").await?,
@@ -159,11 +172,12 @@ async fn steps(
     if js(c, &format!("{RADIUS}.classList.contains('bad')")).await? != Value::Bool(true) {
         return Err("the bad field is not marked".into());
     }
-    screenshot(c, shots, &format!("rig-refused-{w}x{h}")).await?;
+    // Beside the panels' pictures at each size (the book's).
+    let sizes_dir = shots.map(|d| d.join("sizes"));
+    screenshot(c, sizes_dir.as_deref(), &format!("rig-refused-{w}x{h}")).await?;
     let (saved, again) = save_and_reload(c, url, rig_file, cli).await?;
-    screenshot(c, shots, &format!("rig-{w}x{h}")).await?;
     Ok(format!(
-        "286 -> 306 mm redrawn ({}); -5 mm refused: {said}; {saved}, `rig check` reads it as 306 mm and drivable; {again} after a reload; \
+        "mechanism drawn {drawn} ([width, height] drawn, CSS, ratio); 286 -> 306 mm redrawn ({}); -5 mm refused: {said}; {saved}, `rig check` reads it as 306 mm and drivable; {again} after a reload; \
          form {}, map {}, Save {} ([left, top, width, height] CSS px)",
         after[0].as_str().unwrap_or(""),
         sizes.0,
