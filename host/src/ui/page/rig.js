@@ -144,6 +144,13 @@ function kindChanged(path, kind) {
     Object.assign(chain, { shoulder_radius: 0.9 * rig.file.ring_radius, shoulder_height: 0.02, upper_arm: 0.1,
       forearm: 0.19, elbow: "up" });
   }
+  // The limits only some kinds have follow too (`rig check` refuses a stroke without radial chains): a start
+  // from the export's presets where one is needed, gone where none is.
+  const has = (k) => rig.file.chains.some((c) => c.kind === k), limits = rig.file.limits;
+  if (!has("radial")) delete limits.stroke;
+  else if (!limits.stroke) limits.stroke = [0.16, 0.31];
+  if (!has("elbow")) { delete limits.shoulder_angle_deg; delete limits.elbow_angle_deg; }
+  else if (!limits.shoulder_angle_deg) limits.shoulder_angle_deg = [100, 190];
 }
 
 function edited(f, el) {

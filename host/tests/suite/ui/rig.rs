@@ -35,13 +35,21 @@ fn trainer(dir: &Path) -> std::path::PathBuf {
 
 /// The form's values of the rig the panel starts from (the file, every section written out).
 fn form(bench: &Workbench) -> Value {
-    let (status, current) = http(
-        &bench.addr,
-        "GET",
-        &format!("/api/rig/current?token={}", bench.token),
-        &bench.addr,
-        None,
-    );
+    // Without a rig file the panel starts from the device's rig, known once the device thread has asked for it.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    let (status, current) = loop {
+        let (status, current) = http(
+            &bench.addr,
+            "GET",
+            &format!("/api/rig/current?token={}", bench.token),
+            &bench.addr,
+            None,
+        );
+        if status == 200 || !current.contains("not known yet") || std::time::Instant::now() > deadline {
+            break (status, current);
+        }
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    };
     assert_eq!(status, 200, "{current}");
     let current: Value = serde_json::from_str(&current).unwrap();
     let (status, checked) = post(bench, "/api/rig/check", &json!({ "text": current["text"] }));

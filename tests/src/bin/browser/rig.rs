@@ -123,6 +123,18 @@ async fn steps(
     if shown[0] != "286" || shown[1] != "Geometry · ring radius (mm)" {
         return Err(format!("the ring radius is not shown as 286 mm: {shown}"));
     }
+    // The axes and their homing in the form, each in its own unit: a carriage turns (deg), a radial length slides
+    // (mm).
+    let units = js(
+        c,
+        "['axes-0-steps-per-unit', 'axes-4-steps-per-unit', 'homing-axes-4-search', 'homing-axes-0-fast'] \
+         .map((k) => { const i = document.getElementById('rig-f-' + k); \
+         return i && i.closest('.rig-row').querySelector('.unit').textContent; })",
+    )
+    .await?;
+    if units != serde_json::json!(["steps/deg", "steps/mm", "mm", "deg/s"]) {
+        return Err(format!("the axes' units are not the axes' own: {units}"));
+    }
     let before = js(c, PICTURE).await?;
     // The mechanism is drawn at its CSS size x devicePixelRatio: one drawn pixel per screen pixel.
     let drawn = js(
@@ -177,7 +189,7 @@ async fn steps(
     screenshot(c, sizes_dir.as_deref(), &format!("rig-refused-{w}x{h}")).await?;
     let (saved, again) = save_and_reload(c, url, rig_file, cli).await?;
     Ok(format!(
-        "mechanism drawn {drawn} ([width, height] drawn, CSS, ratio); 286 -> 306 mm redrawn ({}); -5 mm refused: {said}; {saved}, `rig check` reads it as 306 mm and drivable; {again} after a reload; \
+        "axes {units}; mechanism drawn {drawn} ([width, height] drawn, CSS, ratio); 286 -> 306 mm redrawn ({}); -5 mm refused: {said}; {saved}, `rig check` reads it as 306 mm and drivable; {again} after a reload; \
          form {}, map {}, Save {} ([left, top, width, height] CSS px)",
         after[0].as_str().unwrap_or(""),
         sizes.0,
