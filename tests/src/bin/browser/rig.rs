@@ -104,6 +104,27 @@ async fn save_and_reload(c: &Client, url: &str, rig_file: &Path, cli: &Path) -> 
     Ok((saved, again))
 }
 
+/// Far down the form (the last axis's homing), the workspace map is still on screen; the page scrolled back.
+async fn map_stays(c: &Client) -> Result<Value, String> {
+    // Far down the form (the last axis's homing), the workspace map is still on screen.
+    let map = js(
+        c,
+        "(() => { document.getElementById('rig-f-homing-axes-5-slow').closest('details').open = true; \
+         document.getElementById('rig-f-homing-axes-5-slow').scrollIntoView({block: 'center'}); \
+         const r = document.getElementById('rig-section').getBoundingClientRect(); \
+         const out = [Math.round(window.scrollY), Math.round(r.top), Math.round(r.bottom), innerHeight]; \
+         window.scrollTo(0, 0); return out; })()",
+    )
+    .await?;
+    let at = |i: usize| map[i].as_f64().unwrap_or(f64::NAN);
+    if !(at(0) > 0.0 && at(1) >= 0.0 && at(2) <= at(3)) {
+        return Err(format!(
+            "scrolled down the form, the map is off screen ([scrollY, top, bottom, inner height]): {map}"
+        ));
+    }
+    Ok(map)
+}
+
 async fn steps(
     c: &Client,
     url: &str,
@@ -135,6 +156,7 @@ async fn steps(
     if units != serde_json::json!(["steps/deg", "steps/mm", "mm", "deg/s"]) {
         return Err(format!("the axes' units are not the axes' own: {units}"));
     }
+    let map = map_stays(c).await?;
     let before = js(c, PICTURE).await?;
     // The mechanism is drawn at its CSS size x devicePixelRatio: one drawn pixel per screen pixel.
     let drawn = js(
@@ -189,7 +211,7 @@ async fn steps(
     screenshot(c, sizes_dir.as_deref(), &format!("rig-refused-{w}x{h}")).await?;
     let (saved, again) = save_and_reload(c, url, rig_file, cli).await?;
     Ok(format!(
-        "axes {units}; mechanism drawn {drawn} ([width, height] drawn, CSS, ratio); 286 -> 306 mm redrawn ({}); -5 mm refused: {said}; {saved}, `rig check` reads it as 306 mm and drivable; {again} after a reload; \
+        "axes {units}; the map on screen with the form scrolled {map}; mechanism drawn {drawn} ([width, height] drawn, CSS, ratio); 286 -> 306 mm redrawn ({}); -5 mm refused: {said}; {saved}, `rig check` reads it as 306 mm and drivable; {again} after a reload; \
          form {}, map {}, Save {} ([left, top, width, height] CSS px)",
         after[0].as_str().unwrap_or(""),
         sizes.0,
