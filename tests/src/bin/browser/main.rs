@@ -118,13 +118,19 @@ async fn checks(driver: &str, given: &Given<'_>, shots: Option<&Path>) -> Result
     if let Some(dir) = shots {
         k.report("every panel at 1366x768 and 1920x1080", page::sizes(&c, dir).await);
     }
+    let rig_given = rig::Given {
+        url,
+        rig_file: given.rig,
+        cli: given.cli,
+        shots,
+    };
     for size in [(1366, 768), (1920, 1080)] {
         k.report(
             &format!(
                 "the rig form at {}x{}: the ring radius in mm redrawn, a bad value named, saved, found again",
                 size.0, size.1
             ),
-            rig::rig_form(&c, url, size, given.rig, given.cli, shots).await,
+            rig::rig_form(&c, &rig_given, size).await,
         );
     }
     // Last: it reloads the page, and the pictures above are of the panels as the checks before left them.

@@ -43,16 +43,18 @@ async fn rect(c: &Client, id: &str) -> Result<Value, String> {
     .await
 }
 
-pub async fn rig_form(
-    c: &Client,
-    url: &str,
-    (w, h): (u32, u32),
-    rig_file: &Path,
-    cli: &Path,
-    shots: Option<&Path>,
-) -> Result<String, String> {
+/// What the check is given: the page's URL, the rig file the server was started with, the CLI, where pictures go.
+pub struct Given<'a> {
+    pub url: &'a str,
+    pub rig_file: &'a Path,
+    pub cli: &'a Path,
+    pub shots: Option<&'a Path>,
+}
+
+pub async fn rig_form(c: &Client, given: &Given<'_>, size: (u32, u32)) -> Result<String, String> {
+    let rig_file = given.rig_file;
     let original = std::fs::read(rig_file).map_err(|e| format!("{}: {e}", rig_file.display()))?;
-    let result = steps(c, url, (w, h), rig_file, cli, shots).await;
+    let result = steps(c, given, size).await;
     // The next check starts from the same file.
     std::fs::write(rig_file, original).map_err(|e| format!("{}: {e}", rig_file.display()))?;
     result
@@ -125,14 +127,13 @@ async fn map_stays(c: &Client) -> Result<Value, String> {
     Ok(map)
 }
 
-async fn steps(
-    c: &Client,
-    url: &str,
-    (w, h): (u32, u32),
-    rig_file: &Path,
-    cli: &Path,
-    shots: Option<&Path>,
-) -> Result<String, String> {
+async fn steps(c: &Client, given: &Given<'_>, (w, h): (u32, u32)) -> Result<String, String> {
+    let Given {
+        url,
+        rig_file,
+        cli,
+        shots,
+    } = *given;
     c.set_window_size(w, h)
         .await
         .map_err(|e| format!("window {w}x{h}: {e}"))?;
