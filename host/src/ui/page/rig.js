@@ -198,6 +198,12 @@ async function checkRig(body, rebuild) {
   $("rig-messages").innerHTML = m.join("");
   rig.toml = j.analysable ? j.toml : null;
   rig.drivable = !!j.drivable;
+  // Save writes only a rig `rig check` calls drivable (the server checks again): said on the button until then.
+  if (rig.target) {
+    $("rig-save").disabled = !rig.drivable;
+    $("rig-save").title = rig.drivable ? `writes ${rig.target} whole (its mode kept; comments not kept)` :
+      "only a drivable rig is saved: mend what the checks name first";
+  }
   $("rig-download").disabled = !rig.toml;
   $("rig-download").title = rig.toml ? "the form's values as a rig file (m and rad, as rig files are)" : "the file has an error (named above)";
   if (rig.toml && document.activeElement !== $("rig-text")) $("rig-text").value = rig.toml;

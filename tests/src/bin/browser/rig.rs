@@ -204,8 +204,15 @@ async fn steps(c: &Client, given: &Given<'_>, (w, h): (u32, u32)) -> Result<Stri
             "the refusal does not name the field, unit and range: {refusal}"
         ));
     }
-    if js(c, &format!("{RADIUS}.classList.contains('bad')")).await? != Value::Bool(true) {
-        return Err("the bad field is not marked".into());
+    let marked = js(
+        c,
+        &format!("[{RADIUS}.classList.contains('bad'), document.getElementById('rig-save').disabled]"),
+    )
+    .await?;
+    if marked != serde_json::json!([true, true]) {
+        return Err(format!(
+            "the bad field is not marked, or Save is not off ([marked, Save disabled]): {marked}"
+        ));
     }
     // Beside the panels' pictures at each size (the book's).
     let sizes_dir = shots.map(|d| d.join("sizes"));
