@@ -110,11 +110,7 @@ pub fn check_command(path: &Path, json: bool) -> Result<Outcome, CommandError> {
     // Not a mechanism at all: an error, as for every command. A mechanism that cannot be driven is a verdict.
     let rig = file.platform().map_err(|e| e.in_file(path))?;
     // Drivable: the controller accepts the rig and homes it, in the simulated machine, within a bounded time.
-    let drivable = file.check().map_err(|e| e.to_string()).and_then(|rig| {
-        super::homing::homing_time(&rig.record)
-            .map(|_| ())
-            .map_err(|why| format!("it does not home: {why}"))
-    });
+    let drivable = file.drivable().map(|_| ()).map_err(|e| e.to_string());
     let m = RingPlatform::<f64>::new(&rig.geometry);
     let cover = rig.ranges.map(|r| (r, coverage(&m, &rig.home, &r)));
     let covered = cover

@@ -106,6 +106,16 @@ pub fn load_platform(path: &Path) -> Result<Platform, RigError> {
     read(path)?.platform().map_err(|e| e.in_file(path))
 }
 
+impl RigFile {
+    /// What `rig check` calls drivable: every rule of [`RigFile::check`], and homing that ends in `Ready` in the
+    /// simulated machine.
+    pub fn drivable(&self) -> Result<Rig, RigError> {
+        let rig = self.check()?;
+        homing::homing_time(&rig.record).map_err(|why| RigError::new("", format!("it does not home: {why}")))?;
+        Ok(rig)
+    }
+}
+
 fn err<T>(key: impl Into<String>, why: impl Into<String>) -> Result<T, RigError> {
     Err(RigError::new(key, why))
 }

@@ -1,24 +1,18 @@
-//! The workbench's computations that move nothing: cueing a drive with the panel's parameters, checking a rig
-//! file as it is typed, reading a run record. Each takes the page's JSON and gives JSON, through the same code as
-//! `ringpod cue`, `ringpod rig check` and `ringpod plot`.
+//! The workbench's computations that move nothing: cueing a drive with the panel's parameters (the rig file is
+//! checked in [`super::rig_edit`], run records read in [`super::runs`]). Each takes the page's JSON and gives JSON,
+//! through the same code as `ringpod cue`.
 
 use ringpod_core::cueing::{Algorithm, CueConfig};
-use ringpod_core::kinematics::{Check, Pose, RingGeometry, RingPlatform};
+use ringpod_core::kinematics::{Pose, RingGeometry, RingPlatform};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
-use super::frame::RigView;
-use crate::analysis::placement::place;
-use crate::analysis::workspace::{classify, Cell};
 use crate::cueing::bench::score::score;
 use crate::cueing::offline::Preview;
 use crate::cueing::offline::{delivered_forces, replay, Replay, TELEMETRY_COLUMNS};
 
 /// The example drive the Cueing panel replays until the user gives one (a braking, a lane change, a bump).
 pub const EXAMPLE_DRIVE: &str = include_str!("../../../docs/drive-telemetry.csv");
-
-/// Cells per side of the Rig panel's workspace section.
-const SECTION_CELLS: usize = 48;
 
 /// The cueing parameters as the panel starts them: the defaults, the example drive's name, and the controls the
 /// panel builds for them (channel, unit, range or choices of each value, from the core's list).
@@ -119,73 +113,6 @@ pub fn cue(request: &CueRequest, geometry: &RingGeometry, home: [f64; 6]) -> Res
     }))
 }
 
-/// A rig file's text checked as `rig check` checks it: whether it is a mechanism at all (the error names its
-/// key), whether it can be driven (and why not), the mechanism at home, an xy workspace section at the home
-/// height, and the spec coverage when the file gives ranges.
-pub fn rig_check(text: &str) -> Value {
-    let file = match crate::rig::parse(text) {
-        Ok(f) => f,
-        Err(e) => return refused(&e),
-    };
-    let platform = match file.platform() {
-        Ok(p) => p,
-        Err(e) => return refused(&e),
-    };
-    let drivable = file.check().map(|_| ()).map_err(|e| e.to_string());
-    let g = &platform.geometry;
-    let m = RingPlatform::<f64>::new(g);
-    let home = platform.home;
-    let coverage = platform.ranges.map(|r| {
-        let c = crate::rig::coverage(&m, &home, &r);
-        let per_axis: Vec<Value> = ["surge", "sway", "heave", "roll", "pitch"]
-            .iter()
-            .zip(c.per_axis)
-            .map(|(name, (inside, tried))| json!({ "axis": name, "inside": inside, "tried": tried }))
-            .collect();
-        json!({ "per_axis": per_axis, "combined": c.combined })
-    });
-    json!({
-        "analysable": true,
-        "drivable": drivable.is_ok(),
-        "why": drivable.err(),
-        "errors": [],
-        "rig": RigView::of(g, home.to_array(), "this file".into()),
-        "at_home": place(&m, &home),
-        "section": section(&m, g.ring_radius, home.to_array()[2]),
-        "coverage": coverage,
-    })
-}
-
-fn refused(e: &crate::rig::error::RigError) -> Value {
-    json!({ "analysable": false, "drivable": false, "errors": [{ "key": e.key, "why": e.why }] })
-}
-
-/// The xy section at height `z` over the ring's square: a character per cell, rows from -y up: `.` no solution,
-/// a digit the first failing check (1-6, KINEMATICS.md 4's order), `#` inside every check.
-fn section(m: &RingPlatform<f64>, r: f64, z: f64) -> Value {
-    let n = SECTION_CELLS;
-    let d = 2.0 * r / n as f64;
-    let rows: Vec<String> = (0..n)
-        .map(|j| {
-            (0..n)
-                .map(|i| {
-                    let (x, y) = (-r + (i as f64 + 0.5) * d, -r + (j as f64 + 0.5) * d);
-                    match classify(m, &Pose::new(x, y, z, 0.0, 0.0, 0.0)) {
-                        Cell::Unreachable => '.',
-                        Cell::Inside(_) => '#',
-                        Cell::Fails(c) => {
-                            let k = Check::ALL.iter().position(|a| *a == c).unwrap_or(0);
-                            char::from(b'1' + k as u8)
-                        }
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    let checks: Vec<String> = Check::ALL.iter().map(|c| format!("{c:?}")).collect();
-    json!({ "z": z, "half_width": r, "rows": rows, "checks": checks })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -273,25 +200,5 @@ mod tests {
         .unwrap();
         assert_eq!(out["t"].as_array().unwrap().len(), 2);
         assert_eq!(out["errors"].as_array().unwrap().len(), 1, "{out}");
-    }
-
-    #[test]
-    fn a_rig_file_is_checked_by_key_and_drawn() {
-        let text = crate::rig::export("trainer-model").unwrap().text;
-        let ok = rig_check(&text);
-        assert_eq!(ok["analysable"], true, "{ok}");
-        assert_eq!(ok["drivable"], true, "{ok}");
-        let rows = ok["section"]["rows"].as_array().unwrap();
-        assert_eq!(rows.len(), SECTION_CELLS);
-        assert!(
-            rows.iter().any(|r| r.as_str().unwrap().contains('#')),
-            "some of the section is inside"
-        );
-        assert_eq!(ok["at_home"]["carriages"].as_array().unwrap().len(), 4);
-        let typo = text.replacen("ring_radius", "ring_raduis", 1);
-        let bad = rig_check(&typo);
-        assert_eq!(bad["analysable"], false);
-        let why = bad["errors"][0]["why"].as_str().unwrap();
-        assert!(why.contains("ring_raduis"), "{bad}");
     }
 }

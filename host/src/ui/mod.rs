@@ -13,6 +13,8 @@ mod outbox;
 mod presence;
 pub(crate) mod profiles;
 mod request;
+mod rig_edit;
+mod rig_form;
 mod runs;
 mod socket;
 mod worker;
@@ -59,6 +61,7 @@ const SCRIPT: &str = include_str!("page/app.js");
 const CHART: &str = include_str!("page/chart.js");
 const CUEING: &str = include_str!("page/cueing.js");
 const VIEW3D: &str = include_str!("page/view3d.js");
+const RIG: &str = include_str!("page/rig.js");
 const STYLE: &str = include_str!("page/style.css");
 
 struct App {
@@ -68,6 +71,7 @@ struct App {
     jobs: Mutex<mpsc::Sender<Job>>,
     pages: AtomicU64,
     profiles: profiles::Profiles,
+    rig_target: rig_edit::RigTarget,
 }
 
 #[derive(Deserialize)]
@@ -99,6 +103,11 @@ pub fn run(options: Options) -> Result<u8, UiError> {
     let signals = Signals::install()?;
     let token = Token::random().map_err(UiError::Random)?;
     let rig = Platform::rig(options.platform.as_ref())?;
+    // The Rig panel saves to the rig file the simulator was started with, and to no other.
+    let rig_file = match &options.platform {
+        Some(Platform::File(path)) => Some(path.clone()),
+        _ => None,
+    };
     // The mapping is opened before anything is served: a tracker that cannot be written is said at the start.
     let compensation = match options.motion_compensation {
         Some(tracker) => Some(crate::vr::tap(
@@ -145,6 +154,7 @@ pub fn run(options: Options) -> Result<u8, UiError> {
             Some(path) => profiles::Profiles::new(path, true),
             None => profiles::Profiles::new(private.path().join("profiles.toml"), false),
         },
+        rig_target: rig_edit::RigTarget::new(rig_file),
     });
     let served = runtime.block_on(async {
         println!("ringpod ui: open http://{local}/?token={}", app.token.as_str());
@@ -200,8 +210,9 @@ fn routes(app: &Arc<App>) -> Router {
         .route("/api/cue/apply", post(cue_apply))
         .route("/api/profiles", get(profiles::list))
         .route("/api/profile", get(profiles::get).post(profiles::put))
-        .route("/api/rig/check", post(rig_check))
-        .route("/api/rig/current", get(rig_current))
+        .route("/api/rig/check", post(rig_edit::check_route))
+        .route("/api/rig/current", get(rig_edit::current))
+        .route("/api/rig/save", post(rig_edit::save_route))
         .route("/api/run", post(run_record))
         .route_layer(axum::middleware::from_fn_with_state(app.clone(), admitted));
     let asset =
@@ -212,6 +223,7 @@ fn routes(app: &Arc<App>) -> Router {
         .route("/chart.js", asset("text/javascript", CHART))
         .route("/cueing.js", asset("text/javascript", CUEING))
         .route("/view3d.js", asset("text/javascript", VIEW3D))
+        .route("/rig.js", asset("text/javascript", RIG))
         .route("/style.css", asset("text/css", STYLE))
         .with_state(app.clone())
 }
@@ -262,31 +274,6 @@ async fn cue_apply(State(app): State<Arc<App>>, Json(request): Json<api::CueRequ
         files::write_whole(&app.hub.cue_file, &text).map_err(|e| format!("{}: {e}", app.hub.cue_file.display()))
     });
     answer(written.map(|()| json!({ "applied": app.hub.cue_file.display().to_string() })))
-}
-
-/// The rig the device runs, as a rig file (what `device rig show` prints), for the Rig panel's editor.
-async fn rig_current(State(app): State<Arc<App>>) -> Response {
-    let record = app.hub.record.lock().ok().and_then(|r| *r);
-    answer(
-        record
-            .ok_or_else(|| "the device's rig is not known yet".to_owned())
-            .and_then(|r| crate::device::rig::as_file(&r).map_err(|e| format!("{e:#}")))
-            .map(|text| json!({ "text": text })),
-    )
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TextBody {
-    text: String,
-}
-
-async fn rig_check(Json(body): Json<TextBody>) -> Response {
-    answer(
-        tokio::task::spawn_blocking(move || Ok(api::rig_check(&body.text)))
-            .await
-            .unwrap_or_else(|e| Err(e.to_string())),
-    )
 }
 
 /// A run record, sent as the file's bytes (the page never holds it as text), read as it arrives (see [`runs`]).

@@ -1,5 +1,5 @@
 // The workbench page: one WebSocket for the live data and every command, the panels, and the computations
-// (cueing, rig checks, run records) over the token-checked API.
+// (cueing, run records; the rig editor in rig.js) over the token-checked API.
 "use strict";
 
 const token = new URLSearchParams(location.search).get("token") || "";
@@ -20,7 +20,7 @@ document.querySelectorAll(".tab").forEach((b) => b.addEventListener("click", () 
   document.querySelectorAll(".tab").forEach((t) => t.classList.toggle("active", t === b));
   document.querySelectorAll(".panel").forEach((p) => p.classList.toggle("active", p.id === "panel-" + b.dataset.panel));
   window.scrollTo(0, scrolled[b.dataset.panel] || 0);
-  if (b.dataset.panel === "rig" && !$("rig-text").value) loadDeviceRig();
+  if (b.dataset.panel === "rig" && !state.rigEditor.file) loadDeviceRig();
   if (b.dataset.panel === "cueing" && !cue.config) loadCueDefaults();
   placeLiveCharts();
 }));
@@ -363,57 +363,6 @@ async function answered(r) {
   throw new Error(`${text.trim() || r.statusText || "no reason given"} (HTTP ${r.status})`);
 }
 
-// ---- Rig ----
-let rigTimer = null;
-async function loadDeviceRig() {
-  const r = await fetch(api("/api/rig/current"));
-  const j = await r.json();
-  if (j.text) { $("rig-text").value = j.text; checkRig(); }
-}
-$("rig-text").addEventListener("input", () => { clearTimeout(rigTimer); rigTimer = setTimeout(checkRig, 300); });
-$("rig-reset").addEventListener("click", loadDeviceRig);
-$("rig-load").addEventListener("click", () => send({ do: "load_rig", text: $("rig-text").value }));
-
-async function checkRig() {
-  let j;
-  try { j = await post("/api/rig/check", { text: $("rig-text").value }); }
-  catch (e) { $("rig-messages").innerHTML = `<div class="msg bad">${escapeHtml(e.message)}</div>`; return; }
-  const m = [];
-  for (const e of j.errors) m.push(`<div class="msg bad rig-error"><code>${escapeHtml(e.key || "file")}</code>: ${escapeHtml(e.why)}</div>`);
-  if (j.analysable) m.push(`<div class="msg ok">analysable: yes</div>`);
-  if (j.analysable) m.push(j.drivable ? `<div class="msg ok">drivable: yes</div>` : `<div class="msg warn">drivable: no, because ${escapeHtml(j.why)}</div>`);
-  $("rig-messages").innerHTML = m.join("");
-  if (!j.analysable) {
-    // The drawings were of the last file that read: cleared, not left as if they were of this one.
-    ["rig-view", "rig-section"].forEach((id) => $(id).getContext("2d").clearRect(0, 0, $(id).width, $(id).height));
-    $("rig-legend").textContent = ""; $("rig-coverage").innerHTML = "";
-    return;
-  }
-  const v = new View3d($("rig-view"));
-  v.pitch = 0.35;
-  v.show(j.rig, j.at_home, null);
-  drawSection(j.section);
-  const cov = j.coverage;
-  $("rig-coverage").innerHTML = cov
-    ? cov.per_axis.map((a) => `<tr><td>${a.axis}</td><td>${a.inside} of ${a.tried}</td></tr>`).join("") +
-      `<tr><td>all at once</td><td>${cov.combined[0]} of ${cov.combined[1]}</td></tr>`
-    : `<tr><td class="muted">no [spec] ranges in the file</td></tr>`;
-}
-
-const CHECK_COLOURS = ["#f97316", "#a855f7", "#ec4899", "#eab308", "#ef4444", "#14b8a6"];
-function drawSection(s) {
-  const c = $("rig-section"), g = c.getContext("2d");
-  const n = s.rows.length, w = c.width / n;
-  g.clearRect(0, 0, c.width, c.height);
-  s.rows.forEach((row, j) => [...row].forEach((ch, i) => {
-    g.fillStyle = ch === "#" ? "#16a34a" : ch === "." ? "#e5e7eb" : CHECK_COLOURS[+ch - 1];
-    g.fillRect(i * w, c.height - (j + 1) * w, w + 0.5, w + 0.5);
-  }));
-  $("rig-legend").innerHTML = `xy at z = ${s.z.toFixed(3)} m over ±${s.half_width} m: <span style="color:#16a34a">■</span> inside every check, ` +
-    `<span style="color:#9ca3af">■</span> no solution, ` +
-    s.checks.map((n, i) => `<span style="color:${CHECK_COLOURS[i]}">■</span> ${n}`).join(", ");
-}
-
 function escapeHtml(s) {
   return String(s).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
 }
@@ -449,10 +398,15 @@ function showRun(run, name) {
     `grey lines: state changes${more}, amber: limited, red: refused`;
   const charts = $("run-charts");
   charts.innerHTML = "";
-  AXES.forEach((a, i) => new Chart(charts, a, i < 3 ? " m" : " rad").set([
-    { x: run.t, y: run.commanded.map((p) => p[i]), colour: pale(COLOURS[i]), width: 4 },
-    { x: run.t, y: run.target.map((p) => p[i]), colour: COLOURS[i] },
-  ], events));
+  // The record keeps m and rad; the charts say mm and deg, as the Live view and the rig editor do.
+  const NAMES = ["surge x", "sway y", "heave z", "roll", "pitch", "yaw"];
+  AXES.forEach((a, i) => {
+    const k = i < 3 ? 1000 : 180 / Math.PI, unit = i < 3 ? "mm" : "deg";
+    new Chart(charts, `${NAMES[i]} (${unit})`, " " + unit).set([
+      { x: run.t, y: run.commanded.map((p) => p[i] * k), colour: pale(COLOURS[i]), width: 4 },
+      { x: run.t, y: run.target.map((p) => p[i] * k), colour: COLOURS[i] },
+    ], events);
+  });
   for (let k = 0; k < 6; k++) {
     new Chart(charts, `steps ${k + 1}`, "").set([{ x: run.t, y: run.steps.map((s) => s[k]), colour: COLOURS[k] }], events);
   }

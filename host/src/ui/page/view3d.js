@@ -5,6 +5,10 @@
 class View3d {
   constructor(canvas) {
     this.canvas = canvas;
+    // The box keeps the shape the page gave it; the drawing is made at its CSS size x devicePixelRatio (sharp on
+    // a high-density screen, never stretched), so the attributes' size is only the shape.
+    canvas.style.aspectRatio = `${canvas.width} / ${canvas.height}`;
+    this.W = canvas.width; this.H = canvas.height;
     this.yaw = -0.6;
     this.pitch = 0.45;
     this.zoom = 1;
@@ -38,7 +42,7 @@ class View3d {
 
   project(p) {
     const r = this.rig ? this.rig.ring_radius : 0.3;
-    const W = this.canvas.width, H = this.canvas.height;
+    const W = this.W, H = this.H;
     const s = Math.min(W, H) * 0.42 / r * this.zoom;
     const cy = Math.cos(this.yaw), sy = Math.sin(this.yaw);
     const x = p[0] * cy - p[1] * sy, y = p[0] * sy + p[1] * cy;
@@ -100,8 +104,16 @@ class View3d {
   }
 
   draw() {
-    const g = this.canvas.getContext("2d");
-    const W = this.canvas.width, H = this.canvas.height;
+    const c = this.canvas, box = c.getBoundingClientRect(), dpr = window.devicePixelRatio || 1;
+    // Hidden (another tab): drawn at the attributes' size until shown.
+    if (box.width >= 1 && box.height >= 1) {
+      const pw = Math.round(box.width * dpr), ph = Math.round(box.height * dpr);
+      if (c.width !== pw || c.height !== ph) { c.width = pw; c.height = ph; }
+    }
+    const g = c.getContext("2d");
+    const k = box.width >= 1 ? c.width / box.width : 1;
+    g.setTransform(k, 0, 0, k, 0, 0);
+    const W = this.W = c.width / k, H = this.H = c.height / k;
     g.fillStyle = "#0f1420"; g.fillRect(0, 0, W, H);
     if (!this.rig) return;
     const r = this.rig.ring_radius;

@@ -2,6 +2,7 @@
 
 mod profiles;
 mod requests;
+mod rig;
 mod runs;
 mod stall;
 mod workbench;

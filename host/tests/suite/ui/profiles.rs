@@ -195,7 +195,7 @@ fn urlencode(s: &str) -> String {
 }
 
 /// A POST with an Origin of the caller's choosing; the status.
-fn raw(addr: &str, path: &str, host: &str, origin: Option<&str>, body: &str) -> u16 {
+pub(super) fn raw(addr: &str, path: &str, host: &str, origin: Option<&str>, body: &str) -> u16 {
     use std::io::Write;
     let mut s = std::net::TcpStream::connect(addr).unwrap();
     let origin = origin.map(|o| format!("Origin: {o}\r\n")).unwrap_or_default();

@@ -4,13 +4,14 @@
 //! 1. Chromium and ChromeDriver (installed with apt-get when missing and allowed, as QEMU is), and the CLI (the
 //!    release build the README's main command makes, `ringpod_tests::cli`), and a run record made by `ringpod
 //!    stream --sim --record`.
-//! 2. `ringpod ui --sim --listen 127.0.0.1:0`, its URL read from its first line; ChromeDriver on a free port.
+//! 2. `ringpod ui --sim --listen 127.0.0.1:0 --geometry RIG` (the trainer model's rig file), its URL read from its first line; ChromeDriver on a free port.
 //! 3. The checks, each a `PASS`/`FAIL` line: the page connects and draws; Enable and Home through the buttons, a
 //!    disabled button says why; the demo runs and the 3D pose and the counters advance; STOP (the button, and the
 //!    space bar) stops and powers down; a UDP session is followed; a page of another origin cannot open the WebSocket, nor can a request
 //!    without the token; the rig editor names a bad key; cueing redraws when a parameter changes; a run record
 //!    opens; a page that goes away stops the stream it started, and with no page left the platform powers down;
-//!    a rig builder's task at 1366x768 and 1920x1080 (an F1 session, the Live view read, its profile tuned live,
+//!    the rig form at both sizes (a value in mm redrawn, a bad one named, saved to the `--geometry` file, found
+//!    again; `rig`); a rig builder's task at 1366x768 and 1920x1080 (an F1 session, the Live view read, its profile tuned live,
 //!    saved and found again after a reload; `task`).
 //!
 //! `--screenshots DIR` saves a picture of each panel there (the book's are in `docs/book/src/images/ui/`), and of
@@ -22,6 +23,7 @@ mod origin;
 mod page;
 mod panels;
 mod process;
+mod rig;
 mod task;
 
 use std::path::{Path, PathBuf};
@@ -58,7 +60,16 @@ impl Checks {
     }
 }
 
-async fn checks(driver: &str, url: &str, record: &Path, shots: Option<&Path>) -> Result<Checks, String> {
+/// What the checks are given: the CLI, its server's URL, a run record and the rig file the server was started with.
+struct Given<'a> {
+    cli: &'a Path,
+    url: &'a str,
+    record: &'a Path,
+    rig: &'a Path,
+}
+
+async fn checks(driver: &str, given: &Given<'_>, shots: Option<&Path>) -> Result<Checks, String> {
+    let (url, record) = (given.url, given.record);
     let mut caps = serde_json::Map::new();
     caps.insert(
         "goog:chromeOptions".into(),
@@ -107,6 +118,21 @@ async fn checks(driver: &str, url: &str, record: &Path, shots: Option<&Path>) ->
     if let Some(dir) = shots {
         k.report("every panel at 1366x768 and 1920x1080", page::sizes(&c, dir).await);
     }
+    let rig_given = rig::Given {
+        url,
+        rig_file: given.rig,
+        cli: given.cli,
+        shots,
+    };
+    for size in [(1366, 768), (1920, 1080)] {
+        k.report(
+            &format!(
+                "the rig form at {}x{}: the ring radius in mm redrawn, a bad value named, saved, found again",
+                size.0, size.1
+            ),
+            rig::rig_form(&c, &rig_given, size).await,
+        );
+    }
     // Last: it reloads the page, and the pictures above are of the panels as the checks before left them.
     for (size, raise) in [((1366, 768), 1.2), ((1920, 1080), 2.5)] {
         k.report(
@@ -135,9 +161,10 @@ fn main() -> ExitCode {
             // The rig builder's cueing file, with an F1 profile (the task's), written afresh for each run.
             let profiles = process::target_dir().join("browser-cueing.toml");
             std::fs::write(&profiles, task::PROFILES).map_err(|e| format!("{}: {e}", profiles.display()))?;
-            Ok((record, serve(&cli, &profiles)?, chromedriver()?))
+            let rig = process::rig_file(&cli)?;
+            Ok((record, serve(&cli, &profiles, &rig)?, chromedriver()?, rig, cli))
         });
-    let (record, (_ui, url), (_driver, driver)) = match prepared {
+    let (record, (_ui, url), (_driver, driver), rig, cli) = match prepared {
         Ok(p) => p,
         Err(e) => {
             eprintln!("browser: {e}");
@@ -152,7 +179,13 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    match runtime.block_on(checks(&driver, &url, &record, shots.as_deref())) {
+    let given = Given {
+        cli: &cli,
+        url: &url,
+        record: &record,
+        rig: &rig,
+    };
+    match runtime.block_on(checks(&driver, &given, shots.as_deref())) {
         Ok(k) => {
             println!("{} passed, {} failed", k.passed, k.failed);
             if k.failed == 0 {

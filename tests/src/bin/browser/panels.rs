@@ -210,6 +210,21 @@ pub async fn runs(c: &Client, record: &Path, shots: Option<&Path>) -> Result<Str
     if charts != json!(12) {
         return Err(format!("{charts} charts instead of 12; the panel says {status}"));
     }
+    // The pose in the units people read: mm for the translations, deg for the rotations.
+    let captions = js(
+        c,
+        "[...document.querySelectorAll('#run-charts figcaption')].slice(0, 6).map((f) => f.textContent)",
+    )
+    .await?;
+    let units: Vec<bool> = (0..6)
+        .map(|i| {
+            let caption = captions[i].as_str().unwrap_or("");
+            caption.contains(if i < 3 { "(mm)" } else { "(deg)" })
+        })
+        .collect();
+    if units.iter().any(|u| !u) {
+        return Err(format!("the pose charts are not in mm and deg: {captions}"));
+    }
     screenshot(c, shots, "runs").await?;
-    Ok(format!("{status}"))
+    Ok(format!("{status}; {captions}"))
 }

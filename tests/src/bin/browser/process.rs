@@ -55,10 +55,12 @@ pub fn record(cli: &Path) -> Result<PathBuf, String> {
 }
 
 /// `ringpod ui --sim` on a free port, and the URL it printed.
-pub fn serve(cli: &Path, cue_config: &Path) -> Result<(Running, String), String> {
+pub fn serve(cli: &Path, cue_config: &Path, rig: &Path) -> Result<(Running, String), String> {
     let mut child = Command::new(cli)
         .args(["ui", "--sim", "--listen", "127.0.0.1:0", "--cue-config"])
         .arg(cue_config)
+        .arg("--geometry")
+        .arg(rig)
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
@@ -75,6 +77,20 @@ pub fn serve(cli: &Path, cue_config: &Path) -> Result<(Running, String), String>
         .ok_or_else(|| format!("ringpod ui printed no URL: {line:?}"))?
         .to_owned();
     Ok((running, url))
+}
+
+/// The trainer model as a rig file (what the simulator runs without one), for the Rig panel to save to.
+pub fn rig_file(cli: &Path) -> Result<PathBuf, String> {
+    let path = target_dir().join("browser-rig.toml");
+    let out = Command::new(cli)
+        .args(["presets", "--export", "trainer-model"])
+        .output()
+        .map_err(|e| format!("presets --export: {e}"))?;
+    if !out.status.success() {
+        return Err(format!("presets --export: {}", String::from_utf8_lossy(&out.stderr)));
+    }
+    std::fs::write(&path, out.stdout).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(path)
 }
 
 pub fn chromedriver() -> Result<(Running, String), String> {
