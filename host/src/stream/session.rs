@@ -209,6 +209,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
             time_us: self.clock_us,
             pose: pose.cast(),
             aux,
+            spare: [None; 2],
         }))?;
         if pose.to_array().iter().all(|c| c.is_finite()) {
             self.last_sent = pose;

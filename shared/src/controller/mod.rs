@@ -18,7 +18,7 @@ pub use settings::Restart;
 
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;
-use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
+use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler, SPARE_AXES};
 use crate::protocol::{DeviceMessage, Firmware, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
 use crate::safety::homing::HomingPlan;
 use crate::safety::{Command, Event, HostWatch, Motion, Outputs, State, Supervisor};
@@ -29,6 +29,8 @@ use homing::Homing;
 pub struct TickOutput {
     /// Pulses of each axis for this period.
     pub moves: [AxisMove; 6],
+    /// Pulses of the spare axes 7 and 8, when either is fitted.
+    pub spare: Option<[AxisMove; SPARE_AXES]>,
     /// Relays, driver enable.
     pub outputs: Outputs,
 }
@@ -45,6 +47,8 @@ pub struct Controller {
     supervisor: Supervisor,
     pipeline: Pipeline<RingPlatform<f32>>,
     scheduler: StepScheduler,
+    /// The spare axes' steps, on the same timing as the platform's.
+    spare_scheduler: StepScheduler<SPARE_AXES>,
     plan: HomingPlan,
     homing: Homing,
     connected: bool,
@@ -109,6 +113,7 @@ impl Controller {
             supervisor: Supervisor::new(config.supervisor),
             pipeline,
             scheduler: StepScheduler::new(config.scheduler, [0; 6]),
+            spare_scheduler: StepScheduler::new(config.scheduler, [0; SPARE_AXES]),
             plan,
             homing: Homing::Idle,
             connected: false,
@@ -358,8 +363,31 @@ impl Controller {
         };
         TickOutput {
             moves: self.scheduler.plan(&targets),
+            spare: self.spare_tick(&outputs),
             outputs,
         }
+    }
+
+    /// The spare axes' period: a stream's positions while the drivers are enabled; otherwise they stay at their
+    /// counted steps, and the pipeline takes those as where they are (a fault or a disable stops them where the
+    /// steps did, and the next stream starts there). Nothing when neither is fitted.
+    fn spare_tick(&mut self, outputs: &Outputs) -> Option<[AxisMove; SPARE_AXES]> {
+        if !self.pipeline.spare().any() {
+            return None;
+        }
+        let targets = if outputs.driver_enable && outputs.motion == Motion::Stream {
+            self.pipeline.spare_steps()
+        } else {
+            let at = self.spare_scheduler.position();
+            self.pipeline.spare_at_steps(at);
+            at
+        };
+        Some(self.spare_scheduler.plan(&targets))
+    }
+
+    /// The spare axes' counted steps.
+    pub fn spare_steps(&self) -> [i64; SPARE_AXES] {
+        self.spare_scheduler.position()
     }
 
     /// A control period that plans no motion, for a firmware whose step generator is already far enough ahead:

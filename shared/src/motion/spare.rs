@@ -110,6 +110,14 @@ impl SpareAxes {
         }
     }
 
+    /// New settings, the positions kept (an axis's counted steps stay where they are), every axis held.
+    pub fn configure(&mut self, settings: [SpareAxisSettings; SPARE_AXES]) {
+        let position = self.position;
+        *self = Self::new(settings);
+        self.position = position;
+        self.hold();
+    }
+
     /// The settings.
     pub fn settings(&self) -> &[SpareAxisSettings; SPARE_AXES] {
         &self.settings
@@ -200,6 +208,14 @@ impl SpareAxes {
                 done: 1,
             };
         }
+    }
+
+    /// The axes are at `steps` (counted by the step scheduler), at rest there.
+    pub fn at_steps(&mut self, steps: [i64; SPARE_AXES]) {
+        for (i, s) in steps.iter().enumerate() {
+            self.position[i] = *s as f32 / self.settings[i].steps_per_unit;
+        }
+        self.hold();
     }
 
     /// Motor step targets of the commanded positions (round to nearest; saturating far outside any travel).

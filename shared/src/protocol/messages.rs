@@ -14,8 +14,9 @@ use crate::safety::{Command, FaultReason, Refusal, State};
 /// operator's commands switch the auxiliary outputs and setpoints carry their levels. 9: the status counts the
 /// periods the step generator played empty and the control periods passed. 10: the hello and a version mismatch
 /// name the firmware ([`super::Firmware`]); the bootloader request. 11: the stream section carries the time after
-/// which a host silent since its stream was lost is taken as gone (`host_gone_ms`).
-pub const PROTOCOL_VERSION: u16 = 11;
+/// which a host silent since its stream was lost is taken as gone (`host_gone_ms`). 12: setpoints carry the spare
+/// axes' targets (`axis7`, `axis8`) and the settings their section.
+pub const PROTOCOL_VERSION: u16 = 12;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;

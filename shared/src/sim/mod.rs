@@ -70,6 +70,8 @@ pub struct Plant {
     /// The auxiliary outputs as the controller last set them (bit 0 AUX1, bit 1 AUX2): what the equipment on them
     /// (a spindle, a pump, a valve) is doing.
     pub aux: u8,
+    /// Position of the spare axes 7 and 8 (steps from where they stood at the start).
+    pub spare: [i64; 2],
 }
 
 impl Plant {
@@ -97,6 +99,7 @@ impl Plant {
             steps_received: [0; 6],
             reversed: 0,
             aux: 0,
+            spare: [0; 2],
         }
     }
 
@@ -177,6 +180,12 @@ impl Plant {
             }
             self.position[a] += self.direction(a) * m.signed();
             self.steps_received[a] += u64::from(m.count);
+        }
+        for (a, m) in out.spare.iter().flatten().enumerate() {
+            if m.count > 0 && !out.outputs.driver_enable {
+                self.steps_while_disabled += u64::from(m.count);
+            }
+            self.spare[a] += m.signed();
         }
     }
 

@@ -266,6 +266,7 @@ fn stream_costs(config: ControllerConfig, rate_hz: u32) -> (u32, u32, u32) {
                 time_us: u64::from(k * period_us),
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             }),
         };
         let len = protocol::encode(&request, &mut frame).unwrap_or(1);
