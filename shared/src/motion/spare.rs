@@ -380,8 +380,8 @@ mod tests {
             for t in 0..most[0].max(most[1]) {
                 s.tick(DT, true);
                 check(&s, &mut prev_v)?;
-                for i in 0..2 {
-                    if t >= most[i] {
+                for (i, &last) in most.iter().enumerate() {
+                    if t >= last {
                         prop_assert_eq!(s.velocity()[i], 0.0, "axis {} still moving", i);
                     }
                 }
