@@ -29,8 +29,6 @@ use homing::Homing;
 pub struct TickOutput {
     /// Pulses of each axis for this period.
     pub moves: [AxisMove; 6],
-    /// Pulses of the spare axes 7 and 8, when either is fitted.
-    pub spare: Option<[AxisMove; SPARE_AXES]>,
     /// Relays, driver enable.
     pub outputs: Outputs,
 }
@@ -78,6 +76,11 @@ pub struct Controller {
     origins: bool,
     /// The silence since a lost stream: a host gone that long powers the machine down (`safety::HostWatch`).
     host: HostWatch,
+    /// The board drives the spare axes' STEP/DIR (see [`Controller::no_spare_outputs`]).
+    spare_outputs: bool,
+    /// The spare axes' pulses of the last tick, when either is fitted: kept here rather than in [`TickOutput`],
+    /// whose every byte is copied on each tick's way out (a tick without spare axes pays nothing for them).
+    spare_moves: Option<[AxisMove; SPARE_AXES]>,
 }
 
 /// When the next telemetry sample is due, and what the previous one counted (for its flags).
@@ -134,6 +137,8 @@ impl Controller {
             firmware: Firmware::BUILT,
             origins: false,
             host: HostWatch::default(),
+            spare_outputs: true,
+            spare_moves: None,
         })
     }
 
@@ -361,9 +366,9 @@ impl Controller {
         } else {
             self.scheduler.position()
         };
+        self.spare_moves = self.spare_tick(&outputs);
         TickOutput {
             moves: self.scheduler.plan(&targets),
-            spare: self.spare_tick(&outputs),
             outputs,
         }
     }
@@ -383,6 +388,11 @@ impl Controller {
             at
         };
         Some(self.spare_scheduler.plan(&targets))
+    }
+
+    /// The spare axes' pulses for the period the last [`Controller::tick`] planned (`None` when neither is fitted).
+    pub fn spare_moves(&self) -> Option<[AxisMove; SPARE_AXES]> {
+        self.spare_moves
     }
 
     /// The spare axes' counted steps.

@@ -177,6 +177,8 @@ pub enum ConfigRefusal {
     PulseSlots,
     /// The geometry is not a valid ring platform (lengths, chains, joint limits).
     Geometry,
+    /// It fits a spare axis, and this board drives none.
+    NoSpareOutputs,
 }
 
 impl core::fmt::Display for ConfigRefusal {
@@ -188,6 +190,7 @@ impl core::fmt::Display for ConfigRefusal {
             Self::StepTiming => "the step timing would be inconsistent",
             Self::PulseSlots => "the step generator could not render the pulses faithfully",
             Self::Geometry => "the geometry is not a valid ring platform",
+            Self::NoSpareOutputs => "it fits a spare axis, and this board's firmware drives none",
         })
     }
 }

@@ -181,8 +181,12 @@ impl Plant {
             self.position[a] += self.direction(a) * m.signed();
             self.steps_received[a] += u64::from(m.count);
         }
-        for (a, m) in out.spare.iter().flatten().enumerate() {
-            if m.count > 0 && !out.outputs.driver_enable {
+    }
+
+    /// Applies one period's pulses of the spare axes ([`Controller::spare_moves`](crate::controller::Controller::spare_moves)).
+    pub fn apply_spare(&mut self, moves: Option<[crate::motion::AxisMove; 2]>, driver_enable: bool) {
+        for (a, m) in moves.iter().flatten().enumerate() {
+            if m.count > 0 && !driver_enable {
                 self.steps_while_disabled += u64::from(m.count);
             }
             self.spare[a] += m.signed();
@@ -233,6 +237,8 @@ impl Rig {
             .set_inputs(self.plant.inputs(o.logic_relay, o.power_relay));
         let out = self.controller.tick();
         self.plant.apply(&out);
+        self.plant
+            .apply_spare(self.controller.spare_moves(), out.outputs.driver_enable);
         self.ticks += 1;
         out
     }

@@ -236,3 +236,39 @@ fn the_section_names_the_field_out_of_range_and_the_pins_it_takes() {
     assert!(Controller::new(sensing).is_ok());
     assert!(Controller::new(base).is_ok());
 }
+
+/// A board that drives no spare axes refuses a section that fits one, takes one that fits none, and runs a stored
+/// one with none fitted.
+#[test]
+fn a_board_without_spare_outputs_refuses_a_fitted_axis() {
+    let connected = || {
+        let mut c = Controller::new(fitted()).unwrap();
+        let version = ringpod_core::protocol::PROTOCOL_VERSION;
+        let hello = c
+            .handle(&Request {
+                id: 1,
+                body: HostMessage::Hello { version },
+            })
+            .body;
+        assert!(matches!(hello, DeviceMessage::Hello { .. }), "{hello:?}");
+        c
+    };
+    let mut c = connected();
+    assert!(c.pipeline().spare().any());
+    c.no_spare_outputs();
+    assert!(!c.pipeline().spare().any(), "the stored axes are not run");
+    let set = |c: &mut Controller, axes| {
+        c.handle(&Request {
+            id: 1,
+            body: HostMessage::SetSettings(Settings::Spare(axes)),
+        })
+        .body
+    };
+    assert_eq!(
+        set(&mut c, [SpareAxisSettings::NONE, AXIS8]),
+        DeviceMessage::Nack(NackReason::BadConfig(ConfigRefusal::NoSpareOutputs))
+    );
+    assert_eq!(set(&mut c, [SpareAxisSettings::NONE; 2]), DeviceMessage::Ack);
+    let mut driven = connected();
+    assert_eq!(set(&mut driven, [SpareAxisSettings::NONE, AXIS8]), DeviceMessage::Ack);
+}
