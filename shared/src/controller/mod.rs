@@ -333,6 +333,7 @@ impl Controller {
             queue_depth: self.queue_depth,
             idle_periods: self.idle_periods,
             passed_periods: self.passed_periods,
+            spare_steps: self.spare_scheduler.position(),
         }
     }
 

@@ -91,6 +91,11 @@ fn a_stream_steps_the_spare_axes_to_their_columns_within_their_limits_and_holds_
     }
     assert_eq!(rig.plant.spare, [20_000, 3_000], "100 x 200 and 3 x 1,000 steps");
     assert_eq!(rig.controller.spare_steps(), rig.plant.spare);
+    assert_eq!(
+        rig.controller.status().spare_steps,
+        rig.plant.spare,
+        "the status says them"
+    );
     // The speed limits, in steps a period (1 ms): 40 x 200 / 1000 = 8 and 5 x 1000 / 1000 = 5, reached, and
     // exceeded by no more than the rounding of a position to whole steps.
     assert!((8..=9).contains(&most[0]) && (5..=6).contains(&most[1]), "{most:?}");
