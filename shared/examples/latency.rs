@@ -46,6 +46,7 @@ pub fn measure(follow: FollowMode, rate_hz: u32) -> Latency {
                 time_us: t_us,
                 pose: goal,
                 aux: [None; 2],
+                spare: [None; 2],
             })
             .unwrap();
         }
@@ -71,6 +72,7 @@ pub fn measure(follow: FollowMode, rate_hz: u32) -> Latency {
                 time_us: u64::from(tick) * 1000,
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             })
             .unwrap();
         }

@@ -236,6 +236,7 @@ fn frames(d: &mut Digest) -> bool {
             time_us: 123_456,
             pose: home(),
             aux: [None; 2],
+            spare: [None; 2],
         }),
     };
     let mut buf = [0u8; protocol::MAX_FRAME];
@@ -337,6 +338,7 @@ fn stream(d: &mut Digest) -> bool {
             time_us: u64::from(k) * 16_667,
             pose: last,
             aux: [None; 2],
+            spare: [None; 2],
         };
         let reply = rig
             .controller

@@ -35,6 +35,7 @@ fn setpoint(k: u64) -> HostMessage {
         time_us: k * 1000,
         pose: pose_at(k),
         aux: [None; 2],
+        spare: [None; 2],
     })
 }
 

@@ -335,6 +335,7 @@ fn apply_step(
             time_us: now * 1000,
             pose,
             aux: [None; 2],
+            spare: [None; 2],
         };
         let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
         let text = format!("{:?}", response.body);
@@ -373,6 +374,7 @@ fn feed_streams(now: u64, streams: &mut [ActiveStream], rig: &mut Rig, host: &mu
                 time_us: (s.next_ms * 1000.0) as u64,
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             };
             let response = host.send(&mut rig.controller, HostMessage::Setpoint(sp));
             host.accepted(&rig.controller, &response.body, pose);

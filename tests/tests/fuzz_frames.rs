@@ -73,6 +73,7 @@ fn random_request(rng: &mut Rng, seq: &mut u32) -> Request {
                 time_us: u64::from(*seq) * 1000,
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             })
         }
     };

@@ -40,6 +40,7 @@ pub fn load<T: Transport>(client: &mut Client<T>, path: &Path) -> Result<String,
 /// Checks a rig file here, then stores it on the device for its next start. Returns what to print.
 pub fn store<T: Transport>(client: &mut Client<T>, file: &RigFile) -> Result<String, DeviceRigError> {
     let record = file.check()?.record;
+    let spare = file.spare_section(&record)?;
     if record.name() != file.name {
         eprintln!(
             "note: the device keeps the name's first {} bytes: {}",
@@ -48,6 +49,8 @@ pub fn store<T: Transport>(client: &mut Client<T>, file: &RigFile) -> Result<Str
         );
     }
     client.set_rig(record)?;
+    // Beside the rig, not in it: a file without `[[spare]]` fits none, whatever the device had.
+    client.set_settings(spare)?;
     Ok(format!(
         "{}: stored on the device for its next start; `ringpod device restart` runs it",
         record.name()

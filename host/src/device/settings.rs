@@ -76,6 +76,7 @@ fn to_json(settings: &Settings) -> Result<Value, serde_json::Error> {
         Settings::Axes(s) => serde_json::to_value(s)?,
         Settings::Homing(s) => serde_json::to_value(s)?,
         Settings::Supervisor(s) => serde_json::to_value(s)?,
+        Settings::Spare(s) => serde_json::to_value(s)?,
     };
     tidy(&mut value);
     Ok(value)
@@ -99,6 +100,7 @@ fn from_json(kind: SettingsKind, value: Value) -> Result<Settings, ConfigCommand
         SettingsKind::Axes => Settings::Axes(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Homing => Settings::Homing(serde_json::from_value(value).map_err(bad)?),
         SettingsKind::Supervisor => Settings::Supervisor(serde_json::from_value(value).map_err(bad)?),
+        SettingsKind::Spare => Settings::Spare(serde_json::from_value(value).map_err(bad)?),
     })
 }
 

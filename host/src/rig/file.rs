@@ -4,7 +4,7 @@ use std::path::Path;
 
 use ringpod_core::controller::{ConfigError, ControllerConfig};
 use ringpod_core::kinematics::geometry::{Branch, Chain, ChainKind, ElbowBranch, RingGeometry, DEG};
-use ringpod_core::protocol::{AxisSettings, HomingSettings, RigRecord};
+use ringpod_core::protocol::{AxisSettings, HomingSettings, RigRecord, Settings};
 use serde::{Deserialize, Serialize};
 
 use super::{err, settings, DriveSpec, RigError};
@@ -51,6 +51,10 @@ pub struct RigFile {
     /// stroke).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub homing: Option<HomingSettings>,
+    /// The spare stepper axes 7 and 8 (`[[spare]]`, at most two; optional: none fitted). A fitted axis takes the
+    /// Black Pill's LOGIC_OK, POWER_OK and USART1 pins for its STEP and DIR, so `[supervisor]` must sense no supply.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub spare: Vec<ringpod_core::motion::SpareAxisSettings>,
     /// VR motion compensation: the rig's centre of rotation (`stream --motion-compensation`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub motion_compensation: Option<crate::vr::CompensationSpec>,
@@ -323,6 +327,7 @@ impl RigFile {
             inputs: None,
             supervisor: None,
             homing: None,
+            spare: Vec::new(),
             motion_compensation: None,
         }
     }
@@ -376,6 +381,25 @@ impl RigFile {
             other => RigError::new("rig", format!("the controller cannot drive it: {other}")),
         })?;
         Ok(record)
+    }
+
+    /// The spare axes' section of the file (none fitted without `[[spare]]`), checked with the rig it comes with:
+    /// each fitted axis's ranges and the pins it takes (the error names the key).
+    pub fn spare_section(&self, record: &RigRecord) -> Result<Settings, RigError> {
+        use ringpod_core::motion::{SpareAxisSettings, SPARE_AXES};
+        if self.spare.len() > SPARE_AXES {
+            return Err(RigError::new("spare", "at most two axes (7 and 8)"));
+        }
+        let mut axes = [SpareAxisSettings::NONE; SPARE_AXES];
+        axes[..self.spare.len()].copy_from_slice(&self.spare);
+        let section = Settings::Spare(axes);
+        let named = |e: ConfigError| match e {
+            ConfigError::Value(field) => RigError::new(field.to_string(), format!("must be {}", field.must())),
+            other => RigError::new("spare", format!("the controller cannot drive it: {other}")),
+        };
+        let mut config = ControllerConfig::from_record(record).map_err(named)?;
+        config.apply(&section).and_then(|()| config.validate()).map_err(named)?;
+        Ok(section)
     }
 
     /// This file with the sections of `record` written out (what `device rig show` prints).

@@ -468,3 +468,49 @@ fn a_home_far_out_of_range_is_said_to_be_out_of_range() {
         assert!(e.why.contains(says) && !e.why.contains("NaN"), "{bad}: {e}");
     }
 }
+
+/// `[[spare]]` in a rig file: the spare axes' section, none fitted without it; a fitted axis with the supply senses
+/// on, a third axis and a value out of range are refused by their keys.
+#[test]
+fn spare_axes_in_a_rig_file_are_checked_with_the_pins_they_take() {
+    use ringpod_core::motion::SpareAxisSettings;
+    use ringpod_core::protocol::Settings;
+    let file = trainer_file();
+    let record = file.check().unwrap().record;
+    assert_eq!(
+        file.spare_section(&record).unwrap(),
+        Settings::Spare([SpareAxisSettings::NONE; 2])
+    );
+    let spare = "\n[[spare]]\nenabled = true\nsteps_per_unit = 400.0\nvelocity = 20.0\nacceleration = 200.0\n\
+                 travel = [-5.0, 120.0]\n";
+    let text = file.to_toml().unwrap() + spare;
+    let with = parse(&text).unwrap();
+    let e = with.spare_section(&record).unwrap_err().to_string();
+    assert!(e.contains("spare[0].enabled") && e.contains("senses"), "{e}");
+    let mut unsensed = with.clone();
+    let mut supervisor = unsensed.supervisor.unwrap_or_default();
+    supervisor.logic_sense = false;
+    supervisor.power_sense = false;
+    unsensed.supervisor = Some(supervisor);
+    let record = unsensed.check().unwrap().record;
+    let Settings::Spare(axes) = unsensed.spare_section(&record).unwrap() else {
+        panic!("the spare section")
+    };
+    assert_eq!(
+        (axes[0].steps_per_unit, axes[0].travel, axes[1]),
+        (400.0, [-5.0, 120.0], SpareAxisSettings::NONE)
+    );
+    let back: RigFile = toml::from_str(&unsensed.to_toml().unwrap()).unwrap();
+    assert_eq!(back, unsensed, "round trips");
+    let mut fast = unsensed.clone();
+    fast.spare[0].velocity = 1_000.0;
+    let e = fast.spare_section(&record).unwrap_err().to_string();
+    assert!(e.contains("spare[0].velocity"), "{e}");
+    let mut three = unsensed;
+    three.spare = vec![three.spare[0]; 3];
+    assert!(three
+        .spare_section(&record)
+        .unwrap_err()
+        .to_string()
+        .contains("at most two"));
+}

@@ -5,13 +5,12 @@ use std::time::{Duration, Instant};
 
 use indicatif::ProgressBar;
 use ringpod_core::kinematics::Pose;
-use ringpod_core::safety::AuxLevels;
 
 use ringpod_core::protocol::MotionSettings;
 
 use super::live::{Arrival, LiveSource};
 use super::report::{CaptureReport, DatagramReport};
-use super::session::{Kind, Stop, StreamError, Streamer, KEEP_ALIVE, NO_AUX};
+use super::session::{Columns, Kind, Stop, StreamError, Streamer, KEEP_ALIVE, NO_AUX};
 use super::{motion_pose, InputError, Source};
 use crate::link::client::{ClientError, Transport};
 use crate::out::console;
@@ -43,7 +42,7 @@ impl<T: Transport> Streamer<'_, T> {
     /// in to must be one it can.
     pub(super) fn timed(
         &mut self,
-        poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>, AuxLevels)>,
+        poses: &mut dyn Iterator<Item = (Option<usize>, f64, Pose<f64>, Columns)>,
         fast: bool,
         errors: &mut Vec<InputError>,
     ) -> Result<(), StreamError> {

@@ -33,6 +33,7 @@ pub use loads::{check_loads, platform as loads_platform};
 use prepare::{greet, prepare};
 pub use report::{LimitedReport, Report};
 use session::Streamer;
+pub use session::NO_AUX;
 pub use source::{motion_pose, read_csv, Amplitude, Axis, Motion, Sine, Source};
 
 pub use crate::input::table::InputError;

@@ -6,12 +6,26 @@ use std::time::Duration;
 
 use indicatif::ProgressBar;
 use ringpod_core::kinematics::{Check, Pose, RingPlatform};
-use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, RejectReason, Setpoint};
+use ringpod_core::motion::{envelope, Accepted, EnvelopeMargins, RejectReason, Setpoint, SpareTargets};
 use ringpod_core::protocol::{HostMessage, MotionSettings, Status};
 use ringpod_core::safety::{AuxLevels, State};
 
-/// A setpoint that leaves the auxiliary outputs as they are (every pose but a pose file's rows with aux columns).
-pub const NO_AUX: AuxLevels = [None; 2];
+/// What a setpoint carries beside its pose: the auxiliary outputs it switches and the spare axes' targets (a pose
+/// file's `aux1`, `aux2`, `axis7`, `axis8` columns); `None` leaves each as it is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Columns {
+    /// The auxiliary outputs.
+    pub aux: AuxLevels,
+    /// The spare axes 7 and 8, in each axis's unit.
+    pub spare: SpareTargets,
+}
+
+/// A setpoint that leaves the auxiliary outputs and the spare axes as they are (every pose but a pose file's rows
+/// with those columns).
+pub const NO_AUX: Columns = Columns {
+    aux: [None; 2],
+    spare: [None; 2],
+};
 
 use super::repeats::Say;
 use super::report::{reason_name, LimitedReport};
@@ -200,7 +214,7 @@ impl<'a, T: Transport> Streamer<'a, T> {
     /// Sends one setpoint without waiting for its answer (a round trip per setpoint would cap the rate at one
     /// per round trip: 1 kHz needs them in flight), then counts the answers that have arrived, waiting while more
     /// than [`IN_FLIGHT`] are outstanding. A device that stops streaming ends the run.
-    pub(super) fn send(&mut self, pose: Pose<f64>, kind: Kind, aux: AuxLevels) -> Result<(), StreamError> {
+    pub(super) fn send(&mut self, pose: Pose<f64>, kind: Kind, columns: Columns) -> Result<(), StreamError> {
         self.seq = self.seq.wrapping_add(1);
         self.sent_all += 1;
         if let Kind::Input(_) = kind {
@@ -210,7 +224,8 @@ impl<'a, T: Transport> Streamer<'a, T> {
             seq: self.seq,
             time_us: self.clock_us,
             pose: pose.cast(),
-            aux,
+            aux: columns.aux,
+            spare: columns.spare,
         }))?;
         if pose.to_array().iter().all(|c| c.is_finite()) {
             self.last_sent = pose;

@@ -1,10 +1,10 @@
 //! Where a stream's poses come from: a built-in motion, a pose file, or a live source (UDP datagrams from simulator
 //! software, a game's shared memory: [`super::live`]).
 
+use super::session::Columns;
 use ringpod_core::kinematics::presets::TRAINER_MODEL_RANGES;
 use ringpod_core::kinematics::Pose;
 use ringpod_core::protocol::MotionSettings;
-use ringpod_core::safety::AuxLevels;
 
 use super::InputError;
 
@@ -165,8 +165,9 @@ impl Sine {
     }
 }
 
-/// A pose of an input file: its line number, its time (s), the pose, and the auxiliary outputs it switches.
-pub type TimedPose = (usize, f64, Pose<f64>, AuxLevels);
+/// A pose of an input file: its line number, its time (s), the pose, and the auxiliary outputs it switches and the
+/// spare axes' targets.
+pub type TimedPose = (usize, f64, Pose<f64>, Columns);
 
 /// Where poses come from.
 pub enum Source {
@@ -190,14 +191,16 @@ pub enum Source {
 /// The columns of a pose file.
 pub const POSE_COLUMNS: [&str; 7] = ["t", "x", "y", "z", "alpha", "beta", "gamma"];
 
-/// The optional columns of a pose file: the auxiliary outputs, 0 (off) or 1 (on) in each row.
-pub const AUX_COLUMNS: [&str; 2] = ["aux1", "aux2"];
+/// The optional columns of a pose file: the auxiliary outputs, 0 (off) or 1 (on) in each row, and the spare axes'
+/// targets in each axis's unit.
+pub const AUX_COLUMNS: [&str; 4] = ["aux1", "aux2", "axis7", "axis8"];
 
 /// Reads a pose file: `t,x,y,z,alpha,beta,gamma` named in its header in any order (seconds, metres, radians or
 /// degrees; [`crate::input::table::read`]), and optionally `aux1`, `aux2` (0 or 1: the auxiliary outputs, switched
-/// when the row's setpoint is taken; a file without the column leaves that output as it is). NaN and infinity in a
-/// pose are passed on: the device refuses them with a reason, which is the point; an aux value other than 0 or 1
-/// makes the row an error.
+/// when the row's setpoint is taken; a file without the column leaves that output as it is) and `axis7`, `axis8`
+/// (the spare axes' targets in their own units, interpolated by the device like the pose; a file without the column
+/// leaves that axis where it is). NaN and infinity in a pose or an axis column are passed on: the device refuses
+/// them with a reason, which is the point; an aux value other than 0 or 1 makes the row an error.
 pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputError>), String> {
     let (rows, mut errors, present) = crate::input::table::read_with_optional(text, &POSE_COLUMNS, &AUX_COLUMNS)?;
     let a = |x: f64| if degrees { x.to_radians() } else { x };
@@ -209,12 +212,16 @@ pub fn read_csv(text: &str, degrees: bool) -> Result<(Vec<TimedPose>, Vec<InputE
             1.0 => Ok(Some(true)),
             _ => Err(x),
         };
+        let spare = |k: usize| present[k].then_some(v[7 + k] as f32);
         match (level(0, v[7]), level(1, v[8])) {
             (Ok(a1), Ok(a2)) => poses.push((
                 line,
                 v[0],
                 Pose::new(v[1], v[2], v[3], a(v[4]), a(v[5]), a(v[6])),
-                [a1, a2],
+                Columns {
+                    aux: [a1, a2],
+                    spare: [spare(2), spare(3)],
+                },
             )),
             (Err(x), _) | (_, Err(x)) => errors.push(InputError {
                 line,
@@ -269,6 +276,7 @@ pub fn motion_pose(motion: Motion, sine: Option<&Sine>, t: f64, home: [f64; 6], 
 
 #[cfg(test)]
 mod tests {
+    use super::super::session::NO_AUX;
     use super::*;
 
     #[test]
@@ -276,14 +284,13 @@ mod tests {
         let (poses, errors) = read_csv("t,x,y,z,alpha,beta,gamma\n0,0,0,0.2,0,0,0\n", false).unwrap();
         assert!(errors.is_empty());
         assert_eq!(
-            poses[0].3,
-            [None, None],
-            "without the columns the outputs are left as they are"
+            poses[0].3, NO_AUX,
+            "without the columns the outputs and the spare axes are left as they are"
         );
         let text = "aux2,t,x,y,z,alpha,beta,gamma\n1,0,0,0,0.2,0,0,0\n0,1,0,0,0.2,0,0,0\n0.5,2,0,0,0.2,0,0,0\n";
         let (poses, errors) = read_csv(text, false).unwrap();
         assert_eq!(
-            poses.iter().map(|p| p.3).collect::<Vec<_>>(),
+            poses.iter().map(|p| p.3.aux).collect::<Vec<_>>(),
             [[None, Some(true)], [None, Some(false)]]
         );
         assert_eq!(poses[1].2.z, 0.2, "the pose columns read in the header's order");
@@ -297,6 +304,20 @@ mod tests {
         let short = read_csv("t,x,y,z,alpha,beta,gamma,aux1,aux2\n0,0,0,0.2,0,0,0,1\n", false).unwrap();
         assert!(short.0.is_empty() && short.1[0].reason.contains("expected 9 fields, got 8"));
         let unknown = read_csv("t,x,y,z,alpha,beta,gamma,aux3\n", false).unwrap_err();
-        assert!(unknown.contains("may name aux1,aux2"), "{unknown}");
+        assert!(unknown.contains("may name aux1,aux2,axis7,axis8"), "{unknown}");
+    }
+
+    #[test]
+    fn spare_axis_columns_are_optional_targets() {
+        let text = "t,x,y,z,alpha,beta,gamma,axis8\n0,0,0,0.2,0,0,0,12.5\n1,0,0,0.2,0,0,0,-3\n2,0,0,0.2,0,0,0,nan\n";
+        let (poses, errors) = read_csv(text, false).unwrap();
+        assert!(errors.is_empty(), "{errors:?}");
+        let spare: Vec<_> = poses.iter().map(|p| p.3.spare).collect();
+        assert_eq!(spare[..2], [[None, Some(12.5)], [None, Some(-3.0)]]);
+        assert!(
+            spare[2][1].is_some_and(f32::is_nan),
+            "passed on for the device to refuse"
+        );
+        assert_eq!(poses[0].3.aux, [None, None]);
     }
 }

@@ -310,7 +310,10 @@ impl Device {
     fn park(&mut self, page: u64) -> Result<String, WorkerError> {
         let (record, _, _) = self.client.rig()?;
         let home = Pose::from_array(record.home);
-        let poses = vec![(1, 0.0, home, [None; 2]), (2, 1.0, home, [None; 2])];
+        let poses = vec![
+            (1, 0.0, home, crate::stream::NO_AUX),
+            (2, 1.0, home, crate::stream::NO_AUX),
+        ];
         let report = match self.run(page, Source::Poses(poses), Vec::new()) {
             Err(WorkerError::NotStarted(ClientError::Interrupted)) => {
                 return Ok(format!("park: {STOPPED_BEFORE_START}"))

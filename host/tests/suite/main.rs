@@ -24,6 +24,7 @@ mod motion_compensation;
 mod outputs;
 mod safety;
 mod signals;
+mod spare;
 mod stability;
 mod stall;
 mod stream;

@@ -112,7 +112,7 @@ impl ControllerConfig {
     /// Every actuator's velocity limit within the step generator's rate at its steps per unit: the tracker never
     /// asks an axis for more steps a second than one per minimum step spacing.
     fn step_rates(&self) -> Result<(), ConfigError> {
-        let most = 1e9 / self.scheduler.min_spacing_ns.max(1) as f32;
+        let most = self.top_step_rate();
         let limits = &self.pipeline.limits;
         match (0..6).find(|&a| limits.actuator_velocity[a] * self.scales[a].steps_per_unit > most) {
             Some(a) => Err(ConfigError::Value(Field::at(
@@ -121,6 +121,23 @@ impl ControllerConfig {
                 FieldName::ActuatorVelocity,
             ))),
             None => Ok(()),
+        }
+    }
+
+    /// The step generator's top rate (steps/s): one step per minimum step spacing.
+    pub(super) fn top_step_rate(&self) -> f32 {
+        1e9 / self.scheduler.min_spacing_ns.max(1) as f32
+    }
+
+    /// A fitted spare axis takes the pins of the supply senses and the USART1 link (the board has no other free
+    /// pin): the supervisor must then sequence by timing alone.
+    fn spare_pins(&self) -> Result<(), ConfigError> {
+        let fitted = self.pipeline.spare.iter().position(|a| a.enabled);
+        match fitted {
+            Some(i) if self.supervisor.logic_sense || self.supervisor.power_sense => Err(ConfigError::Value(
+                Field::at(SettingsKind::Spare, i, FieldName::Enabled),
+            )),
+            _ => Ok(()),
         }
     }
 
@@ -140,6 +157,7 @@ impl ControllerConfig {
         self.pulse_timing().map_err(ConfigError::StepTiming)?;
         self.step_rates()?;
         supervisor_fields(&self.supervisor)?;
+        self.spare_pins()?;
         let mechanism = RingPlatform::<f32>::new(geometry);
         let home_pose = Pose::from_array(self.home).cast::<f32>();
         let home_q = mechanism.inverse(&home_pose).map_err(ConfigError::HomePose)?;

@@ -18,7 +18,7 @@ pub use settings::Restart;
 
 use crate::kinematics::{AxisKind, Mechanism, Pose, RingPlatform};
 use crate::motion::jog::Jog;
-use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler};
+use crate::motion::{AxisMove, Pipeline, PipelineEvent, StepConverter, StepScheduler, SPARE_AXES};
 use crate::protocol::{DeviceMessage, Firmware, InputReport, Response, RigSource, Status, Telemetry, TelemetryFlags};
 use crate::safety::homing::HomingPlan;
 use crate::safety::{Command, Event, HostWatch, Motion, Outputs, State, Supervisor};
@@ -45,6 +45,8 @@ pub struct Controller {
     supervisor: Supervisor,
     pipeline: Pipeline<RingPlatform<f32>>,
     scheduler: StepScheduler,
+    /// The spare axes' steps, on the same timing as the platform's.
+    spare_scheduler: StepScheduler<SPARE_AXES>,
     plan: HomingPlan,
     homing: Homing,
     connected: bool,
@@ -74,6 +76,11 @@ pub struct Controller {
     origins: bool,
     /// The silence since a lost stream: a host gone that long powers the machine down (`safety::HostWatch`).
     host: HostWatch,
+    /// The board drives the spare axes' STEP/DIR (see [`Controller::no_spare_outputs`]).
+    spare_outputs: bool,
+    /// The spare axes' pulses of the last tick, when either is fitted: kept here rather than in [`TickOutput`],
+    /// whose every byte is copied on each tick's way out (a tick without spare axes pays nothing for them).
+    spare_moves: Option<[AxisMove; SPARE_AXES]>,
 }
 
 /// When the next telemetry sample is due, and what the previous one counted (for its flags).
@@ -109,6 +116,7 @@ impl Controller {
             supervisor: Supervisor::new(config.supervisor),
             pipeline,
             scheduler: StepScheduler::new(config.scheduler, [0; 6]),
+            spare_scheduler: StepScheduler::new(config.scheduler, [0; SPARE_AXES]),
             plan,
             homing: Homing::Idle,
             connected: false,
@@ -129,6 +137,8 @@ impl Controller {
             firmware: Firmware::BUILT,
             origins: false,
             host: HostWatch::default(),
+            spare_outputs: true,
+            spare_moves: None,
         })
     }
 
@@ -323,6 +333,7 @@ impl Controller {
             queue_depth: self.queue_depth,
             idle_periods: self.idle_periods,
             passed_periods: self.passed_periods,
+            spare_steps: self.spare_scheduler.position(),
         }
     }
 
@@ -356,10 +367,38 @@ impl Controller {
         } else {
             self.scheduler.position()
         };
+        self.spare_moves = self.spare_tick(&outputs);
         TickOutput {
             moves: self.scheduler.plan(&targets),
             outputs,
         }
+    }
+
+    /// The spare axes' period: a stream's positions while the drivers are enabled; otherwise they stay at their
+    /// counted steps, and the pipeline takes those as where they are (a fault or a disable stops them where the
+    /// steps did, and the next stream starts there). Nothing when neither is fitted.
+    fn spare_tick(&mut self, outputs: &Outputs) -> Option<[AxisMove; SPARE_AXES]> {
+        if !self.pipeline.spare().any() {
+            return None;
+        }
+        let targets = if outputs.driver_enable && outputs.motion == Motion::Stream {
+            self.pipeline.spare_steps()
+        } else {
+            let at = self.spare_scheduler.position();
+            self.pipeline.spare_at_steps(at);
+            at
+        };
+        Some(self.spare_scheduler.plan(&targets))
+    }
+
+    /// The spare axes' pulses for the period the last [`Controller::tick`] planned (`None` when neither is fitted).
+    pub fn spare_moves(&self) -> Option<[AxisMove; SPARE_AXES]> {
+        self.spare_moves
+    }
+
+    /// The spare axes' counted steps.
+    pub fn spare_steps(&self) -> [i64; SPARE_AXES] {
+        self.spare_scheduler.position()
     }
 
     /// A control period that plans no motion, for a firmware whose step generator is already far enough ahead:

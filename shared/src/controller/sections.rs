@@ -6,7 +6,7 @@
 use super::config::supervisor_fields;
 use super::{ConfigError, ControllerConfig};
 use crate::kinematics::{AxisKind, Mechanism, RingPlatform};
-use crate::motion::{AxisScale, MotionLimits};
+use crate::motion::{AxisScale, MotionLimits, SpareAxisSettings, SPARE_AXES};
 use crate::protocol::{
     AxisSettings, ControlSettings, Field, FieldName, MachineSettings, MotionSettings, Settings, SettingsKind,
     StreamSettings, SwitchSettings, Toward,
@@ -27,6 +27,7 @@ impl ControllerConfig {
             SettingsKind::Axes => Settings::Axes(self.axes()),
             SettingsKind::Homing => Settings::Homing(self.switches),
             SettingsKind::Supervisor => Settings::Supervisor(self.supervisor),
+            SettingsKind::Spare => Settings::Spare(self.pipeline.spare),
         }
     }
 
@@ -189,6 +190,10 @@ impl ControllerConfig {
                 supervisor_fields(&s)?;
                 next.supervisor = s;
             }
+            Settings::Spare(axes) => {
+                spare_fields(&axes, next.top_step_rate())?;
+                next.pipeline.spare = axes;
+            }
         }
         if matches!(settings.kind(), SettingsKind::Axes | SettingsKind::Homing) {
             // A step count out of range is a value out of range.
@@ -286,4 +291,24 @@ pub fn axis_scale(axis: &AxisSettings, kind: AxisKind) -> Option<AxisScale> {
             invert: axis.reverse,
         },
     })
+}
+
+/// Each fitted spare axis's ranges (an axis not fitted is not checked: its values are never used).
+fn spare_fields(axes: &[SpareAxisSettings; SPARE_AXES], top_rate: f32) -> Result<(), ConfigError> {
+    for (i, a) in axes.iter().enumerate().filter(|(_, a)| a.enabled) {
+        let [least, most] = a.travel;
+        let name = if !(1.0..=16_777_216.0).contains(&a.steps_per_unit) {
+            FieldName::StepsPerUnit
+        } else if !(a.velocity > 0.0 && a.velocity * a.steps_per_unit <= top_rate) {
+            FieldName::Velocity
+        } else if !(a.acceleration > 0.0 && a.acceleration.is_finite()) {
+            FieldName::Acceleration
+        } else if !(least <= 0.0 && most >= 0.0 && least.is_finite() && most.is_finite()) {
+            FieldName::Travel
+        } else {
+            continue;
+        };
+        return Err(ConfigError::Value(Field::at(SettingsKind::Spare, i, name)));
+    }
+    Ok(())
 }

@@ -2,7 +2,10 @@
 //! changes the firmware has yet to store.
 
 use super::{ConfigError, Controller, ControllerConfig};
-use crate::protocol::{DeviceMessage, Firmware, NackReason, RigRecord, RigSource, Settings, SettingsKind};
+use crate::motion::{SpareAxisSettings, SPARE_AXES};
+use crate::protocol::{
+    ConfigRefusal, DeviceMessage, Firmware, NackReason, RigRecord, RigSource, Settings, SettingsKind,
+};
 use crate::safety::{Motion, Refusal, State};
 
 impl Controller {
@@ -57,6 +60,11 @@ impl Controller {
             return Err(NackReason::Refused(Refusal::WrongState));
         }
         let refused = |e: ConfigError| NackReason::BadConfig(e.refusal());
+        if let Settings::Spare(axes) = settings {
+            if !self.spare_outputs && axes.iter().any(|a| a.enabled) {
+                return Err(NackReason::BadConfig(ConfigRefusal::NoSpareOutputs));
+            }
+        }
         let mut saved = self.saved;
         saved.apply(settings).map_err(refused)?;
         saved.validate().map_err(refused)?;
@@ -76,6 +84,17 @@ impl Controller {
     /// The board says where the running rig came from (at boot, from what its settings store restored).
     pub fn set_rig_source(&mut self, source: RigSource) {
         self.rig_source = source;
+    }
+
+    /// The board says it drives no spare axes (at boot): a section that fits one is refused
+    /// ([`ConfigRefusal::NoSpareOutputs`]), and a stored one that fits one runs with none fitted, so that no step
+    /// is counted that no motor makes.
+    pub fn no_spare_outputs(&mut self) {
+        self.spare_outputs = false;
+        let none = [SpareAxisSettings::NONE; SPARE_AXES];
+        self.config.pipeline.spare = none;
+        self.saved.pipeline.spare = none;
+        self.pipeline.set_config(self.config.pipeline);
     }
 
     /// The board says which firmware it runs (at boot, with the image it checksummed in its flash).

@@ -10,6 +10,7 @@ pub mod pipeline;
 pub mod pulse;
 pub mod scheduler;
 pub mod setpoint;
+pub mod spare;
 pub mod steps;
 
 pub use envelope::{EnvelopeMargins, Limited};
@@ -17,4 +18,5 @@ pub use limits::{AxisTracker, MotionLimits};
 pub use pipeline::{FollowMode, Pipeline, PipelineConfig, PipelineEvent};
 pub use scheduler::{AxisMove, Direction, SchedulerConfig, StepScheduler, StepTimes};
 pub use setpoint::{Accepted, LimitCounters, LimitReport, RejectCounters, RejectReason, Setpoint};
+pub use spare::{SpareAxes, SpareAxisSettings, SpareTargets, SPARE_AXES};
 pub use steps::{actuators_at_steps, AxisScale, StepConverter};

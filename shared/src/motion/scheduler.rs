@@ -182,37 +182,38 @@ impl Iterator for StepTimes {
     }
 }
 
-/// Turns per-period step targets of six axes into timed pulses.
+/// Turns per-period step targets of `N` axes into timed pulses: the platform's six, and the two spare axes with a
+/// scheduler of their own.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct StepScheduler {
+pub struct StepScheduler<const N: usize = 6> {
     config: SchedulerConfig,
-    position: [i64; 6],
-    direction: [Direction; 6],
+    position: [i64; N],
+    direction: [Direction; N],
     /// Time of each axis's last step relative to the start of the next period (ns, negative = in the past; never
     /// before [`LONG_AGO`]).
-    last_step: [i32; 6],
+    last_step: [i32; N],
     carried: u32,
 }
 
-impl StepScheduler {
+impl<const N: usize> StepScheduler<N> {
     /// A scheduler whose axes are at `position` (steps).
-    pub fn new(config: SchedulerConfig, position: [i64; 6]) -> Self {
+    pub fn new(config: SchedulerConfig, position: [i64; N]) -> Self {
         Self {
             config,
             position,
-            direction: [Direction::Forward; 6],
-            last_step: [LONG_AGO; 6],
+            direction: [Direction::Forward; N],
+            last_step: [LONG_AGO; N],
             carried: 0,
         }
     }
 
     /// Scheduled position of every axis at the end of the last planned period.
-    pub fn position(&self) -> [i64; 6] {
+    pub fn position(&self) -> [i64; N] {
         self.position
     }
 
     /// Redefines the positions (homing sets an axis's origin); no pulses.
-    pub fn set_position(&mut self, position: [i64; 6]) {
+    pub fn set_position(&mut self, position: [i64; N]) {
         self.position = position;
     }
 
@@ -226,26 +227,16 @@ impl StepScheduler {
         &self.config
     }
 
-    /// Plans one period toward `targets` (steps at the end of the period).
-    ///
-    /// Never inlined, and the moves made as the array it returns: the caller's result is then its own return
-    /// slot, where moves built apart (`array::from_fn`, or an array filled in a loop) would be copied out (a 144-byte
-    /// `memcpy`, 134 instructions on the M4F a period).
-    #[inline(never)]
-    pub fn plan(&mut self, targets: &[i64; 6]) -> [AxisMove; 6] {
-        let timing = Timing::of(&self.config);
-        let mut counted = false;
-        let mut axis = |i: usize| {
-            let (m, short) = self.plan_axis(&timing, i, targets[i]);
-            if short && !counted {
-                self.carried = self.carried.saturating_add(1);
-                counted = true;
-            }
-            m
-        };
-        [axis(0), axis(1), axis(2), axis(3), axis(4), axis(5)]
+    /// Plans one axis of a period and counts a period whose targets some axis could not reach (once a period).
+    #[inline(always)]
+    fn plan_counted(&mut self, timing: &Timing, i: usize, target: i64, counted: &mut bool) -> AxisMove {
+        let (m, short) = self.plan_axis(timing, i, target);
+        if short && !*counted {
+            self.carried = self.carried.saturating_add(1);
+            *counted = true;
+        }
+        m
     }
-
     #[inline(always)]
     fn plan_axis(&mut self, t: &Timing, i: usize, target: i64) -> (AxisMove, bool) {
         let want = target.saturating_sub(self.position[i]);
@@ -303,6 +294,32 @@ impl StepScheduler {
         self.position[i] = self.position[i].wrapping_add(m.signed());
         self.last_step[i] = forget(m.step_ns(count - 1) as i32);
         (m, short)
+    }
+}
+
+impl StepScheduler<6> {
+    /// Plans one period toward `targets` (steps at the end of the period).
+    ///
+    /// Never inlined, and the moves made as the array it returns: the caller's result is then its own return
+    /// slot, where moves built apart (`array::from_fn`, or an array filled in a loop) would be copied out (a 144-byte
+    /// `memcpy`, 134 instructions on the M4F a period).
+    #[inline(never)]
+    pub fn plan(&mut self, targets: &[i64; 6]) -> [AxisMove; 6] {
+        let timing = Timing::of(&self.config);
+        let mut counted = false;
+        let mut axis = |i: usize| self.plan_counted(&timing, i, targets[i], &mut counted);
+        [axis(0), axis(1), axis(2), axis(3), axis(4), axis(5)]
+    }
+}
+
+impl StepScheduler<2> {
+    /// Plans one period of the spare axes toward `targets`, as [`StepScheduler::plan`] the platform's.
+    #[inline(never)]
+    pub fn plan(&mut self, targets: &[i64; 2]) -> [AxisMove; 2] {
+        let timing = Timing::of(&self.config);
+        let mut counted = false;
+        let mut axis = |i: usize| self.plan_counted(&timing, i, targets[i], &mut counted);
+        [axis(0), axis(1)]
     }
 }
 

@@ -4,6 +4,8 @@
 use crate::kinematics::{Check, Pose};
 use crate::safety::AuxLevels;
 
+use super::spare::SpareTargets;
+
 /// A pose setpoint from the host.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Setpoint {
@@ -16,6 +18,9 @@ pub struct Setpoint {
     /// The auxiliary outputs this setpoint switches when it is taken (a pose file's `aux1`, `aux2` columns); `None`
     /// leaves an output as it is. Two bytes on the wire without them.
     pub aux: AuxLevels,
+    /// Targets of the spare axes 7 and 8 (a pose file's `axis7`, `axis8` columns, in each axis's unit); `None`
+    /// keeps an axis's target. Two bytes on the wire without them.
+    pub spare: SpareTargets,
 }
 
 /// Why a setpoint was rejected.

@@ -45,6 +45,10 @@ pub enum FieldName {
     DriverOffMs,
     DischargeMs,
     HostGoneMs,
+    Velocity,
+    Acceleration,
+    Travel,
+    Enabled,
 }
 
 impl FieldName {
@@ -74,6 +78,10 @@ impl FieldName {
             Self::DriverOffMs => "driver_off_ms",
             Self::DischargeMs => "discharge_ms",
             Self::HostGoneMs => "host_gone_ms",
+            Self::Velocity => "velocity",
+            Self::Acceleration => "acceleration",
+            Self::Travel => "travel",
+            Self::Enabled => "enabled",
         }
     }
 }
@@ -125,6 +133,16 @@ impl Field {
             FieldName::LogicSettleMs | FieldName::PowerSettleMs | FieldName::DriverOffMs | FieldName::DischargeMs => {
                 "at most 60,000 ms"
             }
+            FieldName::Velocity => {
+                "a positive number, and no more steps a second at the axis's steps per unit than the step generator \
+                 makes"
+            }
+            FieldName::Acceleration => "a positive number",
+            FieldName::Travel => "[least, most] with least <= 0 <= most, both finite",
+            FieldName::Enabled => {
+                "off while the supervisor senses a supply: a fitted spare axis takes the pins of LOGIC_OK, POWER_OK \
+                 and the USART1 link"
+            }
         }
     }
 }
@@ -136,6 +154,7 @@ impl core::fmt::Display for Field {
             (SettingsKind::Homing, FieldName::Order, _) | (_, _, None) => write!(f, "{section}.{name}"),
             (SettingsKind::Axes, _, Some(i)) => write!(f, "axes[{i}].{name}"),
             (SettingsKind::Homing, _, Some(i)) => write!(f, "homing.axes[{i}].{name}"),
+            (SettingsKind::Spare, _, Some(i)) => write!(f, "spare[{i}].{name}"),
             (_, _, Some(i)) => write!(f, "{section}.{name}[{i}]"),
         }
     }
@@ -158,6 +177,8 @@ pub enum ConfigRefusal {
     PulseSlots,
     /// The geometry is not a valid ring platform (lengths, chains, joint limits).
     Geometry,
+    /// It fits a spare axis, and this board drives none.
+    NoSpareOutputs,
 }
 
 impl core::fmt::Display for ConfigRefusal {
@@ -169,6 +190,7 @@ impl core::fmt::Display for ConfigRefusal {
             Self::StepTiming => "the step timing would be inconsistent",
             Self::PulseSlots => "the step generator could not render the pulses faithfully",
             Self::Geometry => "the geometry is not a valid ring platform",
+            Self::NoSpareOutputs => "it fits a spare axis, and this board's firmware drives none",
         })
     }
 }

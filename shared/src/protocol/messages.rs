@@ -14,8 +14,9 @@ use crate::safety::{Command, FaultReason, Refusal, State};
 /// operator's commands switch the auxiliary outputs and setpoints carry their levels. 9: the status counts the
 /// periods the step generator played empty and the control periods passed. 10: the hello and a version mismatch
 /// name the firmware ([`super::Firmware`]); the bootloader request. 11: the stream section carries the time after
-/// which a host silent since its stream was lost is taken as gone (`host_gone_ms`).
-pub const PROTOCOL_VERSION: u16 = 11;
+/// which a host silent since its stream was lost is taken as gone (`host_gone_ms`). 12: setpoints carry the spare
+/// axes' targets (`axis7`, `axis8`), the settings their section and the status their steps.
+pub const PROTOCOL_VERSION: u16 = 12;
 
 /// The supervisor state, as reported.
 pub type StateCode = State;
@@ -297,4 +298,6 @@ pub struct Status {
     /// Control periods passed rather than ticked because a period was still queued: the catch-up after a hold-up
     /// of the control loop (the clocks ran on, the motion resumed a period later).
     pub passed_periods: u32,
+    /// Step position of the spare axes 7 and 8 (0 when not fitted).
+    pub spare_steps: [i64; 2],
 }

@@ -6,7 +6,7 @@
 //! the board). Sections that describe the machine ([`SettingsKind::in_rig`]) are part of the [`super::RigRecord`];
 //! a device stores the rig and the other sections together, as one record.
 
-use crate::motion::FollowMode;
+use crate::motion::{FollowMode, SpareAxisSettings, SPARE_AXES};
 use crate::safety::debounce::InputConfig;
 use crate::safety::SupervisorConfig;
 
@@ -126,6 +126,8 @@ pub enum Settings {
     Homing(HomingSettings),
     /// Supply sensing and sequencing delays (next start).
     Supervisor(SupervisorConfig),
+    /// The spare axes 7 and 8 (next start: a board gives them the pins of its optional link and supply senses).
+    Spare([SpareAxisSettings; SPARE_AXES]),
 }
 
 /// Which section.
@@ -146,11 +148,13 @@ pub enum SettingsKind {
     Homing,
     /// [`Settings::Supervisor`].
     Supervisor,
+    /// [`Settings::Spare`].
+    Spare,
 }
 
 impl SettingsKind {
     /// Every section.
-    pub const ALL: [SettingsKind; 7] = [
+    pub const ALL: [SettingsKind; 8] = [
         Self::Stream,
         Self::Control,
         Self::Motion,
@@ -158,6 +162,7 @@ impl SettingsKind {
         Self::Axes,
         Self::Homing,
         Self::Supervisor,
+        Self::Spare,
     ];
 
     /// Whether a new value takes effect at once (otherwise at the next start).
@@ -165,9 +170,10 @@ impl SettingsKind {
         matches!(self, Self::Stream | Self::Motion | Self::Inputs)
     }
 
-    /// Whether the section describes the machine, and so is part of its rig record.
+    /// Whether the section is part of the rig record. The spare axes are stored beside it, with the stream and
+    /// control sections (a rig file's `[[spare]]` entries are sent as this section after the rig).
     pub const fn in_rig(self) -> bool {
-        !matches!(self, Self::Stream | Self::Control)
+        !matches!(self, Self::Stream | Self::Control | Self::Spare)
     }
 
     /// The section's name: its table in a rig file and on the command line.
@@ -180,6 +186,7 @@ impl SettingsKind {
             Self::Axes => "axes",
             Self::Homing => "homing",
             Self::Supervisor => "supervisor",
+            Self::Spare => "spare",
         }
     }
 }
@@ -195,6 +202,7 @@ impl Settings {
             Self::Axes(_) => SettingsKind::Axes,
             Self::Homing(_) => SettingsKind::Homing,
             Self::Supervisor(_) => SettingsKind::Supervisor,
+            Self::Spare(_) => SettingsKind::Spare,
         }
     }
 }

@@ -70,6 +70,8 @@ pub struct Plant {
     /// The auxiliary outputs as the controller last set them (bit 0 AUX1, bit 1 AUX2): what the equipment on them
     /// (a spindle, a pump, a valve) is doing.
     pub aux: u8,
+    /// Position of the spare axes 7 and 8 (steps from where they stood at the start).
+    pub spare: [i64; 2],
 }
 
 impl Plant {
@@ -97,6 +99,7 @@ impl Plant {
             steps_received: [0; 6],
             reversed: 0,
             aux: 0,
+            spare: [0; 2],
         }
     }
 
@@ -180,6 +183,16 @@ impl Plant {
         }
     }
 
+    /// Applies one period's pulses of the spare axes ([`Controller::spare_moves`](crate::controller::Controller::spare_moves)).
+    pub fn apply_spare(&mut self, moves: Option<[crate::motion::AxisMove; 2]>, driver_enable: bool) {
+        for (a, m) in moves.iter().flatten().enumerate() {
+            if m.count > 0 && !driver_enable {
+                self.steps_while_disabled += u64::from(m.count);
+            }
+            self.spare[a] += m.signed();
+        }
+    }
+
     /// +1, or -1 for a reversed motor.
     fn direction(&self, axis: usize) -> i64 {
         if self.reversed & (1 << axis) != 0 {
@@ -224,6 +237,8 @@ impl Rig {
             .set_inputs(self.plant.inputs(o.logic_relay, o.power_relay));
         let out = self.controller.tick();
         self.plant.apply(&out);
+        self.plant
+            .apply_spare(self.controller.spare_moves(), out.outputs.driver_enable);
         self.ticks += 1;
         out
     }

@@ -16,6 +16,7 @@ use sequential_storage::cache::NoCache;
 use sequential_storage::map::{fetch_item, store_item};
 
 use crate::controller::ControllerConfig;
+use crate::motion::{SpareAxisSettings, SPARE_AXES};
 use crate::protocol::{wire, ControlSettings, RigRecord, RigSource, Settings, StreamSettings};
 
 mod v2;
@@ -25,14 +26,14 @@ mod v3;
 pub const CONFIG_KEY: u8 = 0xf0;
 /// Layout of the stored record. Version 1 held the rig alone; 2 adds the machine's settings sections (homing among
 /// them) and the stream and control sections; 3 adds the actuator limits to the motion section; 4 the time for a
-/// host gone (`host_gone_ms`) to the stream section. Records of versions 2 and 3 are read and migrated (version 2's
+/// host gone (`host_gone_ms`) to the stream section; 5 the spare axes' section after the control section. Records of versions 2 and 3 are read and migrated (version 2's
 /// actuators get their kinds' limits, what a version-2 device drove them with; both get the default time for a host
 /// gone); one of another version is not read (the compiled-in defaults run and the host sees
-/// [`RigSource::Unreadable`]).
-pub const RECORD_VERSION: u16 = 4;
-/// Room for the record's postcard bytes (about 690 with elbow chains) and the crate's header; every item read or moved passes through
-/// a buffer of this size.
-const RECORD_BUFFER: usize = 768;
+/// [`RigSource::Unreadable`]). A record of version 4 is version 5 without the spare axes: it is read as none fitted.
+pub const RECORD_VERSION: u16 = 5;
+/// Room for the record's postcard bytes (about 690 with elbow chains, and 52 for the spare axes) and the crate's
+/// header; every item read or moved passes through a buffer of this size.
+const RECORD_BUFFER: usize = 832;
 
 /// The record as flash holds it (read back field by field: `read`).
 #[derive(serde::Serialize)]
@@ -41,6 +42,7 @@ struct Record {
     rig: RigRecord,
     stream: StreamSettings,
     control: ControlSettings,
+    spare: [SpareAxisSettings; SPARE_AXES],
 }
 
 /// What boot found in flash.
@@ -91,7 +93,11 @@ pub async fn restore<F: NorFlash>(
     };
     report.rig = RigSource::Stored;
     let mut config = base;
-    for section in [Settings::Stream(record.stream), Settings::Control(record.control)] {
+    for section in [
+        Settings::Stream(record.stream),
+        Settings::Control(record.control),
+        Settings::Spare(record.spare),
+    ] {
         match config.apply(&section) {
             Ok(()) => report.applied += 1,
             Err(_) => report.refused += 1,
@@ -114,20 +120,26 @@ fn read(bytes: &[u8]) -> Option<Record> {
             let (old, rest) = wire::take_from_bytes::<v2::Rig>(rest).ok()?;
             (old.rig(), rest)
         }
-        3 | RECORD_VERSION => wire::take_from_bytes::<RigRecord>(rest).ok()?,
+        3 | 4 | RECORD_VERSION => wire::take_from_bytes::<RigRecord>(rest).ok()?,
         _ => return None,
     };
-    let (stream, rest) = if version == RECORD_VERSION {
+    let (stream, rest) = if version >= 4 {
         wire::take_from_bytes::<StreamSettings>(rest).ok()?
     } else {
         v3::stream(rest)?
     };
-    let (control, _) = wire::take_from_bytes::<ControlSettings>(rest).ok()?;
+    let (control, rest) = wire::take_from_bytes::<ControlSettings>(rest).ok()?;
+    let spare = if version == RECORD_VERSION {
+        wire::take_from_bytes::<[SpareAxisSettings; SPARE_AXES]>(rest).ok()?.0
+    } else {
+        [SpareAxisSettings::NONE; SPARE_AXES]
+    };
     Some(Record {
         version: RECORD_VERSION,
         rig,
         stream,
         control,
+        spare,
     })
 }
 
@@ -143,6 +155,7 @@ pub async fn store<F: NorFlash>(
         rig: config.rig(),
         stream: config.stream(),
         control: config.control(),
+        spare: config.pipeline.spare,
     };
     let mut bytes = [0u8; RECORD_BUFFER];
     let Ok(len) = wire::to_slice(&record, &mut bytes) else {

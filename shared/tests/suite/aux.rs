@@ -27,6 +27,7 @@ fn setpoint_frame(rig: &mut Rig, seq: u32, levels: AuxLevels) -> DeviceMessage {
             time_us: u64::from(seq) * 10_000,
             pose: rig.controller.pipeline().pose(),
             aux: levels,
+            spare: [None; 2],
         }),
     };
     let mut frame = [0u8; MAX_FRAME];
@@ -142,6 +143,7 @@ fn the_messages_round_trip() {
             time_us: 90_000,
             pose: ringpod_core::kinematics::Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.1),
             aux: levels,
+            spare: [None; 2],
         };
         let request = Request {
             id: 4,
@@ -151,8 +153,8 @@ fn the_messages_round_trip() {
         let bytes = postcard::to_slice(&request, &mut payload).unwrap();
         // The stream's hot path reads the aux levels too.
         assert_eq!(setpoint_request(bytes), Some((4, setpoint)));
-        // Two bytes without levels, one more per level given.
-        let given = levels.iter().filter(|l| l.is_some()).count();
+        // Two bytes without levels, one more per level given; two more for the spare axes' absent targets.
+        let given = levels.iter().filter(|l| l.is_some()).count() + 2;
         let bare = postcard::to_slice(&(4u32, 2u32, 9u32, 90_000u64, setpoint.pose), &mut [0u8; 64])
             .unwrap()
             .len();

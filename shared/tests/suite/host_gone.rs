@@ -25,6 +25,7 @@ fn stream(rig: &mut Rig, seq: &mut u32, ms: u32) {
                 time_us: u64::from(*seq) * 10_000,
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             };
             assert!(matches!(
                 ask(rig, HostMessage::Setpoint(sp)),

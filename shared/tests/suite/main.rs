@@ -37,6 +37,7 @@ mod screws;
 mod selfcheck;
 mod settings;
 mod source_numbers;
+mod spare;
 mod stability;
 mod store;
 mod structure;

@@ -130,7 +130,7 @@ proptest! {
             // Stay inside the spec range of the axis.
             let next = (target + s * frac * per_setpoint_max).clamp(-presets::TRAINER_MODEL_RANGES[axis] as f32 * 0.9, presets::TRAINER_MODEL_RANGES[axis] as f32 * 0.9);
             t_us += 16_667;
-            if p.submit(&Setpoint { seq: k as u32 + 1, time_us: t_us, pose: pose_with(axis, next), aux: [None; 2] }).is_ok() {
+            if p.submit(&Setpoint { seq: k as u32 + 1, time_us: t_us, pose: pose_with(axis, next), aux: [None; 2], spare: [None; 2] }).is_ok() {
                 target = next;
                 accepted += 1;
             }
@@ -160,7 +160,7 @@ proptest! {
             if ms <= cut_ms && ms % 10 == 0 {
                 let v = rate * ms as f32 * 1e-3;
                 let v = if axis == 5 { v.rem_euclid(std::f32::consts::TAU) } else { v.min(presets::TRAINER_MODEL_RANGES[axis.min(4)] as f32 * 0.8) };
-                p.submit(&Setpoint { seq: ms, time_us: u64::from(ms) * 1000, pose: pose_with(axis, v), aux: [None; 2] }).unwrap();
+                p.submit(&Setpoint { seq: ms, time_us: u64::from(ms) * 1000, pose: pose_with(axis, v), aux: [None; 2], spare: [None; 2] }).unwrap();
             }
             let (_, e) = p.tick();
             trace.record(&p, &limits, 1e-3)?;
@@ -176,7 +176,7 @@ proptest! {
         prop_assert_eq!(events[1].1, PipelineEvent::AtRest);
         prop_assert!(p.at_rest(), "not at rest: {:?} vs {:?}", p.pose(), p.target());
         // After a loss the stream stays closed until started again.
-        let next = Setpoint { seq: 5000, time_us: 5_000_000, pose: p.pose(), aux: [None; 2] };
+        let next = Setpoint { seq: 5000, time_us: 5_000_000, pose: p.pose(), aux: [None; 2], spare: [None; 2] };
         prop_assert_eq!(p.submit(&next), Err(RejectReason::NotStreaming));
         p.start();
         prop_assert_eq!(p.submit(&next), Ok(Accepted::Applied));
@@ -194,7 +194,7 @@ proptest! {
         for ms in 1..=total_ms {
             if ms % 10 == 0 {
                 let yaw = (rate * f64::from(ms) * 1e-3).rem_euclid(std::f64::consts::TAU) as f32;
-                p.submit(&Setpoint { seq: ms, time_us: u64::from(ms) * 1000, pose: pose_with(5, yaw), aux: [None; 2] }).unwrap();
+                p.submit(&Setpoint { seq: ms, time_us: u64::from(ms) * 1000, pose: pose_with(5, yaw), aux: [None; 2], spare: [None; 2] }).unwrap();
             }
             p.tick();
             trace.record(&p, &limits, 1e-3)?;
@@ -230,6 +230,7 @@ fn rejected_setpoints_never_move() {
                 time_us: 10_000,
                 pose: Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0),
                 aux: [None; 2],
+                spare: [None; 2],
             })
             .unwrap();
         }
@@ -239,6 +240,7 @@ fn rejected_setpoints_never_move() {
                 time_us: 20_000 + k as u64,
                 pose: *pose,
                 aux: [None; 2],
+                spare: [None; 2],
             }),
             Err(*reason)
         );
@@ -266,6 +268,7 @@ fn a_stream_out_of_the_workspace_is_limited_not_refused() {
             time_us: u64::from(k) * 20_000,
             pose: pose_with(2, z - HOME[2]),
             aux: [None; 2],
+            spare: [None; 2],
         });
         match answer {
             Ok(Accepted::Applied) => assert_eq!(limited, 0, "inside again after the edge"),
@@ -303,6 +306,7 @@ fn steps_follow_the_actuators() {
             time_us: u64::from(k) * 10_000,
             pose: pose_with(2, k as f32 * 4e-4),
             aux: [None; 2],
+            spare: [None; 2],
         })
         .unwrap();
         for _ in 0..10 {
@@ -412,7 +416,7 @@ proptest! {
                     last = source(t);
                 }
                 seq += 1;
-                let answer = p.submit(&Setpoint { seq, time_us: next_us as u64 + 1, pose: last, aux: [None; 2] });
+                let answer = p.submit(&Setpoint { seq, time_us: next_us as u64 + 1, pose: last, aux: [None; 2], spare: [None; 2] });
                 prop_assert!(answer.is_ok(), "setpoint {seq} at {t} s: {answer:?}");
                 next_us += 1e6 / rate_hz;
             }

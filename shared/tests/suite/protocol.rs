@@ -38,6 +38,7 @@ fn the_largest_status_fits_a_frame() {
         queue_depth: u16::MAX,
         idle_periods: u32::MAX,
         passed_periods: u32::MAX,
+        spare_steps: [i64::MIN, i64::MAX],
     };
     let response = Response {
         id: u32::MAX,

@@ -8,6 +8,7 @@ use embassy_futures::block_on;
 use ringpod_core::controller::{Controller, ControllerConfig, Inputs};
 use ringpod_core::kinematics::presets::{Preset, TRAINER_MODEL};
 use ringpod_core::kinematics::RingGeometry;
+use ringpod_core::motion::{SpareAxisSettings, SPARE_AXES};
 use ringpod_core::protocol::{
     self, ConfigRefusal, ControlSettings, DeviceMessage, HostMessage, NackReason, Request, RigRecord, RigSource,
     Settings, SettingsKind, StreamSettings, MAX_PAYLOAD,
@@ -76,7 +77,7 @@ fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
     assert_eq!(report.rig, RigSource::Stored);
     assert_eq!(
         (report.applied, report.refused, report.unreadable, report.fell_back),
-        (2, 0, false, false)
+        (3, 0, false, false)
     );
     assert_eq!(config.rig(), rig);
     assert_eq!(config.rig().name(), "wider-ring");
@@ -89,8 +90,15 @@ fn a_rig_round_trips_through_the_wire_and_flash_exactly() {
 fn raw_record(version: u16, rig: &RigRecord) -> Vec<u8> {
     let defaults = ControllerConfig::trainer_model();
     let mut raw = [0u8; 1024];
-    let bytes = postcard::to_slice(&(version, rig, defaults.stream(), defaults.control()), &mut raw).unwrap();
-    bytes.to_vec()
+    let mut bytes = postcard::to_slice(&(version, rig, defaults.stream(), defaults.control()), &mut raw)
+        .unwrap()
+        .to_vec();
+    if version >= 5 {
+        // The spare axes' section (none fitted), after the control section.
+        let spare = [SpareAxisSettings::NONE; SPARE_AXES];
+        bytes.extend_from_slice(postcard::to_slice(&spare, &mut raw).unwrap());
+    }
+    bytes
 }
 
 fn store_raw(f: &mut Flash, bytes: &[u8]) {
@@ -246,6 +254,7 @@ fn a_setpoint_request_read_on_its_own_is_the_request_decoded_whole() {
         time_us: 987_654_321,
         pose: Pose::from_array([0.01, -0.02, 0.23, 0.1, -0.2, 3.0]),
         aux: [None; 2],
+        spare: [None; 2],
     };
     for id in [0, 1, 300, u32::MAX] {
         let mut raw = [0u8; 128];
@@ -314,7 +323,11 @@ fn a_version_2_record_is_migrated_with_its_actuators_kinds_limits() {
     store_raw(&mut f, bytes);
     let (config, report) = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
     assert_eq!(report.rig, RigSource::Stored);
-    assert_eq!(report.applied, 1 + 1);
+    assert_eq!(
+        report.applied,
+        1 + 1 + 1,
+        "stream, control and (none fitted) the spare axes"
+    );
     let limits = config.pipeline.limits;
     assert_eq!(limits.pose_velocity[5], 1.5);
     assert_eq!(limits.actuator_velocity, [2.4, 2.4, 2.4, 2.4, 3.0, 3.0]);
@@ -353,7 +366,7 @@ fn a_version_3_record_is_migrated_with_the_default_time_for_a_host_gone() {
     let mut f = flash();
     store_raw(&mut f, bytes);
     let (config, report) = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
-    assert_eq!((report.rig, report.applied, report.refused), (RigSource::Stored, 2, 0));
+    assert_eq!((report.rig, report.applied, report.refused), (RigSource::Stored, 3, 0));
     assert_eq!(config.rig(), rig);
     assert_eq!(config.stream(), stream, "the stored values, and the default time");
     // A record of this version keeps a time of its own.
@@ -369,4 +382,36 @@ fn a_version_3_record_is_migrated_with_the_default_time_for_a_host_gone() {
     let again = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
     assert_eq!(again.0.stream().host_gone_ms, 2_500);
     assert_eq!(again.1.rig, RigSource::Stored);
+}
+
+/// A version-4 record (no spare axes' section) restores with none fitted; a version-5 record keeps fitted spare
+/// axes through flash exactly.
+#[test]
+fn the_spare_axes_are_stored_and_a_version_4_record_has_none() {
+    let defaults = ControllerConfig::trainer_model();
+    let rig = wider(0.3, 0.325);
+    let mut f = flash();
+    store_raw(&mut f, &raw_record(4, &rig));
+    let (config, report) = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
+    assert_eq!((report.rig, report.applied, report.refused), (RigSource::Stored, 3, 0));
+    assert_eq!(config.pipeline.spare, [SpareAxisSettings::NONE; SPARE_AXES]);
+
+    let mut fitted = ControllerConfig::from_record(&rig).unwrap();
+    fitted.supervisor.logic_sense = false;
+    fitted.supervisor.power_sense = false;
+    let axis7 = SpareAxisSettings {
+        enabled: true,
+        steps_per_unit: 3_200.0,
+        velocity: 25.0,
+        acceleration: 400.0,
+        travel: [-10.0, 350.0],
+    };
+    fitted
+        .apply(&Settings::Spare([axis7, SpareAxisSettings::NONE]))
+        .unwrap();
+    let mut f = flash();
+    block_on(store(&mut f, Flash::FULL_FLASH_RANGE, &fitted)).unwrap();
+    let (config, report) = block_on(restore(&mut f, Flash::FULL_FLASH_RANGE, defaults));
+    assert_eq!((report.applied, report.refused, report.fell_back), (3, 0, false));
+    assert_eq!(config.pipeline.spare, [axis7, SpareAxisSettings::NONE]);
 }

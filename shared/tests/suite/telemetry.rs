@@ -98,6 +98,7 @@ fn a_refusal_is_flagged_in_the_next_sample_only() {
             time_us: 0,
             pose: Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0),
             aux: [None; 2],
+            spare: [None; 2],
         }),
     });
     assert!(matches!(r.body, DeviceMessage::Nack(_)), "{r:?}");

@@ -188,6 +188,30 @@ fn controller_costs(report: &dyn Fn(&str, u32, u32)) {
     }
     let (tick, _, n) = stream_costs(fast, 2_000);
     report("control tick at 2 kHz (the same work, half the period)", tick, n);
+    let (tick, _, n) = stream_costs_with(spare_fitted(), 1_000, true);
+    report(
+        "control tick with the spare axes 7 and 8 fitted and streaming (their trackers and step plan)",
+        tick,
+        n,
+    );
+}
+
+/// The trainer model with both spare axes fitted (and so no supply senses: their pins are STEP/DIR 7-8).
+fn spare_fitted() -> ControllerConfig {
+    let mut c = ControllerConfig::trainer_model();
+    c.supervisor.logic_sense = false;
+    c.supervisor.power_sense = false;
+    let axis = ringpod_core::motion::SpareAxisSettings {
+        enabled: true,
+        steps_per_unit: 400.0,
+        velocity: 50.0,
+        acceleration: 500.0,
+        travel: [-10.0, 10.0],
+    };
+    if c.apply(&Settings::Spare([axis; 2])).is_err() || c.validate().is_err() {
+        fail("the spare axes' section");
+    }
+    c
 }
 
 /// The step generator's CPU work for one period of step buffers, idle, at typical rates, at the trainer model's
@@ -247,6 +271,12 @@ fn render_cost(per_period: [i64; 6]) -> (u32, u32) {
 /// SysTick counts of the control ticks and of the setpoint frames of 500 ticks of a stream moving
 /// surge and yaw, for a controller brought to `Running` with `config` ticking at `rate_hz`.
 fn stream_costs(config: ControllerConfig, rate_hz: u32) -> (u32, u32, u32) {
+    stream_costs_with(config, rate_hz, false)
+}
+
+/// [`stream_costs`], the setpoints carrying targets for the spare axes when `spare` (a sine on each, in the units of
+/// [`spare_fitted`]).
+fn stream_costs_with(config: ControllerConfig, rate_hz: u32, spare: bool) -> (u32, u32, u32) {
     let mut d = Digest::default();
     let mut rig =
         selfcheck::running_rig_with(&mut d, config).unwrap_or_else(|| fail("controller did not reach Running"));
@@ -266,6 +296,11 @@ fn stream_costs(config: ControllerConfig, rate_hz: u32) -> (u32, u32, u32) {
                 time_us: u64::from(k * period_us),
                 pose,
                 aux: [None; 2],
+                spare: if spare {
+                    [Some(5.0 * libm_sin(3.0 * t)), Some(-2.0 * libm_sin(5.0 * t))]
+                } else {
+                    [None; 2]
+                },
             }),
         };
         let len = protocol::encode(&request, &mut frame).unwrap_or(1);

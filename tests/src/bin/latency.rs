@@ -91,6 +91,7 @@ fn host_us(n: usize) -> (f64, f64) {
                 time_us: k as u64 * 10_000,
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             }),
         };
         let len = protocol::encode(&request, &mut frame).unwrap();
@@ -118,6 +119,7 @@ fn device_us(follow: FollowMode, offset: [f32; 6]) -> Option<(f64, u32)> {
                 time_us,
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             }),
         });
     };

@@ -79,7 +79,12 @@ pub async fn start(spawner: Spawner) {
     let mut switches = switches::new(r.switches);
     let shared = share(restored.controller, &mut switches, restored.rig, watchdog_reset);
     let firmware = firmware();
-    shared.with(|c| c.set_firmware(firmware));
+    shared.with(|c| {
+        c.set_firmware(firmware);
+        // STEP/DIR 7-8 (PA9, PA10, PA15, PC14) need DMA streams of their own from TIM1, which this board does not
+        // start yet: a fitted spare axis is refused rather than counted without pulses.
+        c.no_spare_outputs();
+    });
 
     steps::start(r.step_generator, restored.renderer, shared);
     let (device, usb_link) = usb::new(r.usb);

@@ -6,6 +6,7 @@ use crate::kinematics::{Check, Mechanism, Pose};
 
 use super::super::envelope;
 use super::super::setpoint::{Accepted, LimitReport, RejectReason, Setpoint};
+use super::super::spare::SpareAxes;
 use super::segment::{self, Segment};
 use super::{delta, Mode, Pipeline};
 
@@ -63,6 +64,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         };
         let ticks = segment::setpoint_ticks(config.follow, interval_us, config.tick_us);
         self.segment = Segment::new(self.segment.reference(), limited.pose, ticks);
+        self.spare.take(&sp.spare, ticks);
         self.last = Some((sp.seq, sp.time_us, sp.pose));
         self.since_setpoint_us = 0;
         self.passed_us = 0;
@@ -76,6 +78,9 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             return Err(RejectReason::NotStreaming);
         }
         let pose = sp.pose.validated().map_err(|_| RejectReason::NonFinite)?;
+        if !SpareAxes::finite(&sp.spare) {
+            return Err(RejectReason::NonFinite);
+        }
         let (from, interval) = match self.last {
             Some((seq, time, last_pose)) => {
                 // Sequence numbers wrap: newer means a forward distance of less than half the range.
@@ -124,6 +129,7 @@ mod tests {
             time_us,
             pose,
             aux: [None; 2],
+            spare: [None; 2],
         }
     }
 

@@ -2,6 +2,7 @@
 
 use super::super::envelope::EnvelopeMargins;
 use super::super::limits::MotionLimits;
+use super::super::spare::{SpareAxisSettings, SPARE_AXES};
 
 /// How the reference moves toward a new setpoint.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -35,6 +36,13 @@ pub struct PipelineConfig {
     pub follow: FollowMode,
     /// Velocity and acceleration limits.
     pub limits: MotionLimits,
+    /// The spare axes 7 and 8 (none fitted by default).
+    #[serde(default = "no_spare_axes")]
+    pub spare: [SpareAxisSettings; SPARE_AXES],
+}
+
+fn no_spare_axes() -> [SpareAxisSettings; SPARE_AXES] {
+    [SpareAxisSettings::NONE; SPARE_AXES]
 }
 
 impl Default for PipelineConfig {
@@ -48,6 +56,7 @@ impl Default for PipelineConfig {
             limit_evaluations: 8,
             follow: FollowMode::Interpolate,
             limits: MotionLimits::TRAINER_MODEL,
+            spare: no_spare_axes(),
         }
     }
 }

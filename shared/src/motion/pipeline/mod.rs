@@ -44,6 +44,7 @@ use crate::real::wrap_pi;
 
 use super::limits::AxisTracker;
 use super::setpoint::{LimitCounters, RejectCounters};
+use super::spare::{SpareAxes, SPARE_AXES};
 use super::steps::StepConverter;
 
 pub use config::{FollowMode, PipelineConfig};
@@ -108,6 +109,8 @@ pub struct Pipeline<M: Mechanism<f32>> {
     limited: LimitCounters,
     applied: u32,
     held: u32,
+    /// The spare axes 7 and 8: outside the mechanism, stopped and held with it.
+    spare: SpareAxes,
 }
 
 /// `to - from` on one pose axis; the yaw (axis 5) the short way round, so that no path turns the long way.
@@ -152,6 +155,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             limited: LimitCounters::default(),
             applied: 0,
             held: 0,
+            spare: SpareAxes::new(config.spare),
         })
     }
 
@@ -190,6 +194,21 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         self.converter.to_steps(&self.actuators)
     }
 
+    /// The spare axes.
+    pub fn spare(&self) -> &SpareAxes {
+        &self.spare
+    }
+
+    /// The spare axes are at `steps` (their counted steps, while they do not follow a stream), at rest.
+    pub fn spare_at_steps(&mut self, steps: [i64; SPARE_AXES]) {
+        self.spare.at_steps(steps);
+    }
+
+    /// Motor step targets of the spare axes' commanded positions.
+    pub fn spare_steps(&self) -> [i64; SPARE_AXES] {
+        self.spare.steps()
+    }
+
     /// Rejected setpoints per reason.
     pub fn rejected(&self) -> &RejectCounters {
         &self.rejected
@@ -215,14 +234,15 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         &self.config
     }
 
-    /// Replaces the configuration (the controller allows it only at rest).
+    /// Replaces the configuration (the controller allows it only at rest). The spare axes keep their positions.
     pub fn set_config(&mut self, config: PipelineConfig) {
         self.config = config;
+        self.spare.configure(config.spare);
     }
 
-    /// Whether every axis is at rest.
+    /// Whether every axis, the spare ones included, is at rest.
     pub fn at_rest(&self) -> bool {
-        self.trackers.iter().all(|t| t.velocity == 0.0)
+        self.trackers.iter().all(|t| t.velocity == 0.0) && self.spare.at_rest()
     }
 
     /// Restarts at a known pose with zero speed (after homing). The pose must be reachable.
@@ -233,6 +253,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         self.trackers = [AxisTracker::default(); 6];
         self.actuator_velocity = [0.0; 6];
         self.segment.rest_at(pose);
+        self.spare.hold();
         self.last = None;
         self.mode = Mode::Hold;
         Ok(())
@@ -248,6 +269,7 @@ impl<M: Mechanism<f32>> Pipeline<M> {
     pub fn start(&mut self) {
         self.mode = Mode::Streaming;
         self.segment.rest_at(self.pose);
+        self.spare.hold();
         self.last = None;
         self.since_setpoint_us = 0;
         self.passed_us = 0;
@@ -266,5 +288,6 @@ impl<M: Mechanism<f32>> Pipeline<M> {
         self.trackers = [AxisTracker::default(); 6];
         self.actuator_velocity = [0.0; 6];
         self.segment.collapse_to(self.pose);
+        self.spare.hold();
     }
 }

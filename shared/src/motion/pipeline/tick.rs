@@ -35,6 +35,11 @@ impl<M: Mechanism<f32>> Pipeline<M> {
             }
             self.halt_in_place();
         }
+        // The spare axes follow their own references (no IK, no workspace): braking with the platform, resting
+        // when it holds.
+        if self.spare.any() && self.mode != Mode::Hold {
+            self.spare.tick(dt, self.mode == Mode::Stopping);
+        }
         let arrived = self.mode == Mode::Moving && self.segment.finished() && self.settled(dt);
         if arrived {
             self.trackers = [AxisTracker::default(); 6];
@@ -87,6 +92,7 @@ mod tests {
             time_us: u64::from(seq) * 10_000,
             pose: home_plus(0, 0.002 * seq as f32),
             aux: [None; 2],
+            spare: [None; 2],
         };
         p.submit(&sp(1)).unwrap();
         let mut events = [None; 2];
@@ -121,6 +127,7 @@ mod tests {
             time_us: u64::from(seq) * 10_000,
             pose: home_plus(0, 0.002),
             aux: [None; 2],
+            spare: [None; 2],
         };
         p.submit(&sp(1)).unwrap();
         let steps = p.steps();
@@ -157,6 +164,7 @@ mod tests {
             time_us: 10_000,
             pose: home_plus(1, 0.01),
             aux: [None; 2],
+            spare: [None; 2],
         })
         .unwrap();
         for _ in 0..100 {

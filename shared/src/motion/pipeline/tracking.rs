@@ -190,6 +190,7 @@ mod tests {
             time_us: 1_000,
             pose,
             aux: [None; 2],
+            spare: [None; 2],
         })
         .unwrap();
         let target = p.target().to_array();
@@ -248,6 +249,7 @@ mod tests {
             time_us: 1_000,
             pose: home_plus(1, 0.02),
             aux: [None; 2],
+            spare: [None; 2],
         })
         .unwrap();
         for _ in 0..200 {

@@ -38,6 +38,7 @@ fn main() -> ! {
                 time_us: u64::from(k) * 1_000,
                 pose,
                 aux: [None; 2],
+                spare: [None; 2],
             }),
         };
         let len = protocol::encode(&request, &mut frame).unwrap_or(1);

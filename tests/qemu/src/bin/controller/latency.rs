@@ -132,6 +132,7 @@ impl Host {
             time_us: u64::from(self.seq) * 10_000,
             pose,
             aux: [None; 2],
+            spare: [None; 2],
         });
         self.send(body)
     }
