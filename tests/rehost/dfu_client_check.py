@@ -5,8 +5,8 @@ run.
 line (`dfu_client.py`) against `models/dfuse_rom.py` over USB/IP (`usbip.py`), on the wall clock, outside the
 emulated chip: it lists the device (0483:df11, each alternate setting's memory layout string), writes the image
 (`-s 0x08000000 -D`: the sectors it covers erased as the layout string says, the blocks written), and reads it back
-(`-U`). The flash it leaves is kept: `flash-usb` compares what `ringpod flash` writes into the emulated board with
-it, byte for byte.
+(`-U`), then leaves DFU (`:leave`). The flash it leaves is kept: `flash-usb` compares what `ringpod flash` writes
+into the emulated board with it, byte for byte.
 
 The image is the release ELF with its USB product string changed at the same length (`renamed_elf`): every address
 stays, so that the harness's probes, which follow the ELF's symbols, still hold after it is flashed, while the
@@ -84,8 +84,9 @@ class ModelOnWire:
 
     def __init__(self):
         self.flash = bytearray(random.Random(411).randbytes(512 * 1024))
+        self.left = []  # the addresses DFU was left for
         self.rom = D.DfuseRom(lambda: int(time.monotonic() * 96_000_000), 96_000_000, self._read, self._write,
-                              leave=lambda address: None)
+                              leave=self.left.append)
         self.control(struct.pack("<BBHHH", 0, 5, 7, 0, 0), b"")  # SET_ADDRESS, as the exporting host did
 
     def _read(self, at, n):
@@ -139,7 +140,9 @@ def client_check(checks, image, scratch):
     wrote, t_write = _client(server.port, "-a", "0", "-s", "0x08000000", "-D", path)
     written = bytes(model.flash)
     erased = list(model.rom.erased)
-    read, t_read = _client(server.port, "-a", "0", "-s", f"0x08000000:{len(image)}", "-U", back)
+    # read back, then leave DFU (UM0424 6.1.4: the address pointer set to the program, a zero-length download, the
+    # status request that starts the manifestation)
+    read, t_read = _client(server.port, "-a", "0", "-s", f"0x08000000:leave:{len(image)}", "-U", back)
     got = open(back, "rb").read() if os.path.exists(back) else b""
     server.close()
     end = sectors_end(image) - D.FLASH
@@ -150,15 +153,18 @@ def client_check(checks, image, scratch):
     checks.check("dfu-client", listed.returncode == 0 and len(found) == 4 and any(layout in f for f in found)
                  and wrote.returncode == 0 and erased == want and written[:len(image)] == image
                  and blank and kept and read.returncode == 0 and got == image
-                 and not server.errors,
+                 and model.left == [D.FLASH] and not model.rom.attached() and not server.errors,
                  f"pydfuutil over USB/IP: `-l` exit {listed.returncode} ({t_list:.1f} s), {len(found)} alternate "
                  f"settings of 0483:df11 found, alt 0 named {F411_LAYOUT!r}: {any(layout in f for f in found)}; "
                  f"`-s 0x08000000 -D` of {len(image):,} B exit {wrote.returncode} ({t_write:.1f} s): sectors erased "
                  f"{[hex(a) for a in erased]} (want {[hex(a) for a in want]}), the image in flash: "
                  f"{written[:len(image)] == image}, the rest of its last sector erased: "
                  f"{blank}, sectors 6-7 untouched: {kept}; `-U` exit {read.returncode} "
-                 f"({t_read:.1f} s): {len(got):,} B read back, the same: {got == image}; {server.urbs} URBs, "
-                 f"{server.stalls} stalled, {model.rom.early_polls} status polls before their timeout"
+                 f"({t_read:.1f} s): {len(got):,} B read back, the same: {got == image}, then DFU left for "
+                 f"{[hex(a) for a in model.left]} (want 0x8000000), the device off the bus: "
+                 f"{not model.rom.attached()}; {server.urbs} URBs, {server.stalls} stalled, "
+                 f"{model.rom.early_polls} status polls before their timeout"
                  + "".join(f"; {r.stderr.strip().splitlines()[-1]}" for r in (listed, wrote, read)
-                           if r.returncode and r.stderr.strip()) + (f"; server: {server.errors}" if server.errors else ""))
+                           if r.returncode and r.stderr.strip())
+                 + (f"; server: {server.errors}" if server.errors else ""))
     return written

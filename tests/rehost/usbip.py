@@ -223,7 +223,8 @@ class UsbipBackend(usb.backend.IBackend):
     def get_configuration_descriptor(self, dev, config):
         if config != 0:
             raise IndexError("one configuration")
-        names = "bLength bDescriptorType wTotalLength bNumInterfaces bConfigurationValue iConfiguration bmAttributes bMaxPower"
+        names = ("bLength bDescriptorType wTotalLength bNumInterfaces bConfigurationValue iConfiguration bmAttributes "
+                 "bMaxPower")
         extra, _ = _split(dev.config)
         return _Descriptor(**dict(zip(names.split(), struct.unpack_from("<BBHBBBBB", dev.config))),
                            extra_descriptors=list(extra))
