@@ -19,7 +19,7 @@ import struct
 from unicorn import UC_HOOK_CODE
 from unicorn import arm_const as A
 
-from dfu_client_check import RENAMED, elf_image, sectors_end
+from dfu_client_check import RENAMED, crc32c, elf_image, sectors_end
 from models.dfuse_rom import DfuseRom
 from plant import ENABLE_N, LOGIC_EN, POWER_EN
 
@@ -161,17 +161,17 @@ def bootloader_entry_checks(checks, m, cli, port, rom, log, usb=None):
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7
 
 
-def flash_check(checks, m, cli, port, rom, log, bridge, elf, client=None):
+def flash_check(checks, m, cli, port, rom, log, bridge, elf, clients=()):
     """`ringpod flash --image ELF` from the running firmware (Off): the board asked over its link to enter its
     bootloader, the image written into the ROM model over the bridge (only sectors 0-5 erased), read back, DFU left;
     the firmware back, answering with the image's CRC-32C, the setting stored before still there. The image is the
-    run's program renamed (`dfu_client_check.renamed_elf`): the program that comes back enumerates with the new
-    product string and names another CRC than before; the sectors it covers hold byte for byte what the published
-    client (`dfu-client`, `client`: the flash it left) wrote from the same image."""
+    run's program renamed (`dfu_client_check.renamed_elf`), which `dfu-client-board` wrote before with the published
+    client: the program that comes back enumerates with the new product string and names the image's CRC-32C; the
+    sectors the image covers, erased and written again, hold byte for byte what that client wrote (`clients`: the
+    flash it left on the board and in the model alone)."""
     from machine import SYSCLK
 
     settings = bytes(m.uc.mem_read(SETTINGS[0], SETTINGS[1] - SETTINGS[0]))
-    before = _image(cli.run("device", "status", *port))
     lines, entries = len(log.lines), len(rom.entries)
     roms = []
     grab = lambda: roms.append(rom.dfu) if rom.dfu is not None and rom.dfu not in roms else None  # noqa: E731
@@ -197,21 +197,23 @@ def flash_check(checks, m, cli, port, rom, log, bridge, elf, client=None):
     flashed = elf_image(elf)
     end = sectors_end(flashed) - 0x0800_0000
     ours = bytes(m.uc.mem_read(0x0800_0000, end))
-    differ = [i for i in range(end) if client is not None and ours[i] != client[i]]
-    same = client is not None and not differ
+    differ = {name: [i for i in range(end) if ours[i] != flash[i]] for name, flash in clients}
+    same = bool(clients) and not any(differ.values())
+    crc = f"{crc32c(flashed):08x}"
     checks.check("flash-usb", r.code == 0 and "verified" in r.stdout and len(rom.entries) == entries + 1
                  and erased == want and dfu.early_polls == 0 and kept and value == 250 and len(starts) == 1
-                 and image is not None and image.get("crc32c", "") in r.stdout and image.get("size") == len(flashed)
-                 and before is not None and before.get("crc32c") != image.get("crc32c")
-                 and product == RENAMED.decode() and same,
+                 and image is not None and image.get("crc32c") == crc and crc in r.stdout
+                 and image.get("size") == len(flashed) and product == RENAMED.decode() and same,
                  f"{r} after {r.sim_s:.1f} simulated s; the ROM model: erased {erased} (want sectors 0-5), "
                  f"{dfu.written if dfu else 0} B programmed, {dfu.early_polls if dfu else '-'} polls before their "
                  f"timeout, {bridge.served} bridge requests; sectors 6-7 unchanged: {kept}; firmware starts since: "
-                 f"{len(starts)}; {got}; the image the firmware names: {image} (before: {before}), its USB product "
-                 f"string {product!r} (want {RENAMED.decode()!r}); flash 0x08000000..{0x0800_0000 + end:#010x} (the "
-                 f"sectors the {len(flashed):,} B image covers) the same as the published client wrote: {same}"
-                 + (f" ({len(differ)} bytes differ, the first at {0x0800_0000 + differ[0]:#010x})" if differ else "")
-                 + ("" if client is not None else " (`dfu-client` did not run)"))
+                 f"{len(starts)}; {got}; the image the firmware names: {image} (the image's CRC-32C {crc}), its USB "
+                 f"product string {product!r} (want {RENAMED.decode()!r}); flash 0x08000000..{0x0800_0000 + end:#010x} "
+                 f"(the sectors the {len(flashed):,} B image covers) the same as the published client wrote: {same} ("
+                 + ", ".join(f"{name}: {len(d)} bytes differ"
+                             + (f", the first at {0x0800_0000 + d[0]:#010x}" if d else "")
+                             for name, d in differ.items())
+                 + ")")
 
 
 def _image(status):

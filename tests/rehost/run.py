@@ -29,7 +29,7 @@ from elf import memory_x  # noqa: E402
 from bootloader_checks import (SystemMemory, bootloader_entry_checks, bootloader_refused_check,  # noqa: E402
                                flash_check)
 from dfu_bridge import DfuBridge  # noqa: E402
-from dfu_client_check import client_check, elf_image, renamed_elf  # noqa: E402
+from dfu_client_check import board_client_check, client_check, elf_image, renamed_elf  # noqa: E402
 from board_checks import estop_check, inputs_check, pins_check, priority_check, timing  # noqa: E402
 from hold_up import hold_up_checks  # noqa: E402
 from machine import SYSCLK, Machine  # noqa: E402
@@ -166,7 +166,7 @@ def source_constant(name):
 
 
 def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, rom=None,
-                  elf=None, client=None):
+                  elf=None, client=None, scratch=None):
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -253,7 +253,10 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
     if rom is not None:
         bootloader_entry_checks(CHECKS, m, cli, port, rom, log, usb)
         if usb is not None:
-            flash_check(CHECKS, m, cli, port, rom, log, DfuBridge(m, usb.host), elf, client)
+            clients = [("dfu-client", client)] if client is not None else []
+            board = board_client_check(CHECKS, m, cli, port, rom, usb.host, elf_image(elf), scratch, client)
+            clients.append(("dfu-client-board", board))
+            flash_check(CHECKS, m, cli, port, rom, log, DfuBridge(m, usb.host), elf, clients)
 
 
 SLOT_US = source_constant("STEP_SLOT_NS") / 1000
@@ -597,7 +600,7 @@ def main():
     # -- the host link on USART1: the real CLI over a pty --
     if args.ringpod:
         serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, rom,
-                      renamed, client)
+                      renamed, client, scratch)
     if not args.ringpod:
         pins_check(c, plant, plant.ignored, plant.dir_undriven)
     log_check(m, log)

@@ -50,8 +50,8 @@ def _device_record(device, config):
 
 
 class UsbipServer:
-    """Exports one device: `descriptors()` gives its (device, configuration) descriptors, `control(setup, data)` carries
-    out a control transfer and returns the IN data (b"" for an OUT transfer) or None when the device stalls it."""
+    """Exports one device: `descriptors()` gives its (device, configuration) descriptors (None while there is none),
+    `control(setup, data)` carries out a control transfer and returns the IN data (b"" for an OUT transfer) or None when the device stalls it."""
 
     def __init__(self, descriptors, control):
         self.descriptors, self.control = descriptors, control
@@ -88,7 +88,10 @@ class UsbipServer:
 
     def _session(self, conn):
         version, code, _status = struct.unpack(">HHI", _exact(conn, 8))
-        device, config = self.descriptors()
+        device, config = self.descriptors() or (None, None)
+        if code == OP_REQ_DEVLIST and device is None:  # nothing on the bus now
+            conn.sendall(struct.pack(">HHII", VERSION, OP_REP_DEVLIST, 0, 0))
+            return
         if code == OP_REQ_DEVLIST:
             # one device, then its interfaces: class, subclass, protocol, padding (of alternate setting 0)
             intf = _split(config)[1][0][0]
@@ -98,7 +101,7 @@ class UsbipServer:
         if code != OP_REQ_IMPORT:
             return
         busid = _exact(conn, 32).rstrip(b"\0").decode()
-        if busid != BUSID:
+        if busid != BUSID or device is None:
             conn.sendall(struct.pack(">HHI", VERSION, OP_REP_IMPORT, 1))
             return
         conn.sendall(struct.pack(">HHI", VERSION, OP_REP_IMPORT, 0) + _device_record(device, config))
