@@ -19,6 +19,7 @@ import struct
 from unicorn import UC_HOOK_CODE
 from unicorn import arm_const as A
 
+from dfu_client_check import RENAMED, crc32c, elf_image, sectors_end
 from models.dfuse_rom import DfuseRom
 from plant import ENABLE_N, LOGIC_EN, POWER_EN
 
@@ -160,10 +161,14 @@ def bootloader_entry_checks(checks, m, cli, port, rom, log, usb=None):
 SETTINGS = (0x0804_0000, 0x0808_0000)  # sectors 6-7
 
 
-def flash_check(checks, m, cli, port, rom, log, bridge, elf):
+def flash_check(checks, m, cli, port, rom, log, bridge, elf, clients=()):
     """`ringpod flash --image ELF` from the running firmware (Off): the board asked over its link to enter its
     bootloader, the image written into the ROM model over the bridge (only sectors 0-5 erased), read back, DFU left;
-    the firmware back, answering with the image's CRC-32C, the setting stored before still there."""
+    the firmware back, answering with the image's CRC-32C, the setting stored before still there. The image is the
+    run's program renamed (`dfu_client_check.renamed_elf`), which `dfu-client-board` wrote before with the published
+    client: the program that comes back enumerates with the new product string and names the image's CRC-32C; the
+    sectors the image covers, erased and written again, hold byte for byte what that client wrote (`clients`: the
+    flash it left on the board and in the model alone)."""
     from machine import SYSCLK
 
     settings = bytes(m.uc.mem_read(SETTINGS[0], SETTINGS[1] - SETTINGS[0]))
@@ -179,18 +184,40 @@ def flash_check(checks, m, cli, port, rom, log, bridge, elf):
     log.poll()
     try:
         value = json.loads(got.stdout)["value"]
-        image = json.loads(status.stdout)["firmware"]["image"]
     except (ValueError, KeyError, TypeError):
-        value, image = None, None
+        value = None
+    image = _image(status)
+    host = bridge.host
+    product = host.strings.get(host.device[15]) if host.device and len(host.device) > 15 else None
     dfu = roms[0] if roms else None
     erased = [hex(a) for a in dfu.erased] if dfu else []
     want = [hex(0x0800_0000 + a) for a in (0, 0x4000, 0x8000, 0xC000, 0x1_0000, 0x2_0000)]
     starts = [t for _, _, t in log.lines[lines:] if "firmware up" in t]
     kept = bytes(m.uc.mem_read(SETTINGS[0], SETTINGS[1] - SETTINGS[0])) == settings
+    flashed = elf_image(elf)
+    end = sectors_end(flashed) - 0x0800_0000
+    ours = bytes(m.uc.mem_read(0x0800_0000, end))
+    differ = {name: [i for i in range(end) if ours[i] != flash[i]] for name, flash in clients}
+    same = bool(clients) and not any(differ.values())
+    crc = f"{crc32c(flashed):08x}"
     checks.check("flash-usb", r.code == 0 and "verified" in r.stdout and len(rom.entries) == entries + 1
                  and erased == want and dfu.early_polls == 0 and kept and value == 250 and len(starts) == 1
-                 and image is not None and image.get("crc32c", "") in r.stdout,
+                 and image is not None and image.get("crc32c") == crc and crc in r.stdout
+                 and image.get("size") == len(flashed) and product == RENAMED.decode() and same,
                  f"{r} after {r.sim_s:.1f} simulated s; the ROM model: erased {erased} (want sectors 0-5), "
                  f"{dfu.written if dfu else 0} B programmed, {dfu.early_polls if dfu else '-'} polls before their "
                  f"timeout, {bridge.served} bridge requests; sectors 6-7 unchanged: {kept}; firmware starts since: "
-                 f"{len(starts)}; {got}; the image the firmware names: {image}")
+                 f"{len(starts)}; {got}; the image the firmware names: {image} (the image's CRC-32C {crc}), its USB "
+                 f"product string {product!r} (want {RENAMED.decode()!r}); flash 0x08000000..{0x0800_0000 + end:#010x} "
+                 f"(the sectors the {len(flashed):,} B image covers) the same as the published client wrote: {same} ("
+                 + ", ".join(f"{name}: {len(d)} bytes differ"
+                             + (f", the first at {0x0800_0000 + d[0]:#010x}" if d else "")
+                             for name, d in differ.items())
+                 + ")")
+
+
+def _image(status):
+    try:
+        return json.loads(status.stdout)["firmware"]["image"]
+    except (ValueError, KeyError, TypeError):
+        return None

@@ -6,9 +6,11 @@ models, and checks what it does. Prints `PASS name: detail` / `FAIL name: detail
 """
 
 import argparse
+import atexit
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -27,6 +29,7 @@ from elf import memory_x  # noqa: E402
 from bootloader_checks import (SystemMemory, bootloader_entry_checks, bootloader_refused_check,  # noqa: E402
                                flash_check)
 from dfu_bridge import DfuBridge  # noqa: E402
+from dfu_client_check import board_client_check, client_check, elf_image, renamed_elf  # noqa: E402
 from board_checks import estop_check, inputs_check, pins_check, priority_check, timing  # noqa: E402
 from hold_up import hold_up_checks  # noqa: E402
 from machine import SYSCLK, Machine  # noqa: E402
@@ -171,7 +174,7 @@ def source_constant(name):
 
 
 def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=False, rom=None,
-                  elf=None):
+                  elf=None, client=None, scratch=None):
     c = CHECKS
     u = m.usart1
     bridge = PtyBridge(u)
@@ -258,7 +261,10 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
     if rom is not None:
         bootloader_entry_checks(CHECKS, m, cli, port, rom, log, usb)
         if usb is not None:
-            flash_check(CHECKS, m, cli, port, rom, log, DfuBridge(m, usb.host), elf)
+            clients = [("dfu-client", client)] if client is not None else []
+            board = board_client_check(CHECKS, m, cli, port, rom, usb.host, elf_image(elf), scratch, client)
+            clients.append(("dfu-client-board", board))
+            flash_check(CHECKS, m, cli, port, rom, log, DfuBridge(m, usb.host), elf, clients)
 
 
 SLOT_US = source_constant("STEP_SLOT_NS") / 1000
@@ -421,6 +427,15 @@ def main():
     c.until = args.until
     ram = memory_x(args.memory_x)["RAM"]
     wall0 = time.time()
+    # the image `flash-usb` writes, first written by the published DfuSe client into the ROM model alone
+    scratch = tempfile.mkdtemp(prefix="rehost-dfu-")
+    atexit.register(shutil.rmtree, scratch, True)
+    try:
+        renamed = renamed_elf(args.elf, os.path.join(scratch, "renamed.elf"))
+        client = client_check(c, elf_image(renamed), scratch)
+    except (ValueError, OSError, subprocess.SubprocessError) as e:  # `flash-usb` then writes the ELF as it is: fails
+        renamed, client = args.elf, None
+        c.check("dfu-client", False, f"{type(e).__name__}: {e}")
     m = Machine(args.elf, ram)
     m.limit(int(args.max_sim_s * SYSCLK), wall0 + args.max_wall_s)
     p = Probes(m)
@@ -595,7 +610,7 @@ def main():
     # -- the host link on USART1: the real CLI over a pty --
     if args.ringpod:
         serial_checks(m, p, log, plant, args.ringpod, args.hold_ups, usb, args.usb_full, rom,
-                      args.elf)
+                      renamed, client, scratch)
     if not args.ringpod:
         pins_check(c, plant, plant.ignored, plant.dir_undriven)
     log_check(m, log)

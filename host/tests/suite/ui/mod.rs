@@ -337,3 +337,19 @@ fn a_stop_before_the_first_datagram_is_answered_as_stopped_not_failed() {
         "{answer}"
     );
 }
+
+#[test]
+fn the_rig_message_names_the_firmware_the_device_runs_and_its_protocol() {
+    use ringpod_core::protocol::firmware::BUILT_VERSION;
+    use ringpod_core::protocol::PROTOCOL_VERSION;
+    // The simulated controller runs this build's core, with no flashed image; the page shows the line beside the
+    // rig's name (app.js, `rig-name`).
+    let wb = Workbench::start(&[]);
+    let mut page = wb.page();
+    let rig = page.until(Duration::from_secs(20), |m| m["type"] == "rig").unwrap();
+    let [major, minor, patch] = BUILT_VERSION;
+    assert_eq!(
+        rig["firmware"],
+        format!("ringpod {major}.{minor}.{patch} (no image: simulated), protocol {PROTOCOL_VERSION}")
+    );
+}
