@@ -49,7 +49,7 @@ struct Record {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Restored {
-    /// Stored sections besides the rig applied (stream, control).
+    /// Stored sections besides the rig applied (stream, control, spare).
     pub applied: u8,
     /// Stored sections refused by the checks (left at their defaults).
     pub refused: u8,

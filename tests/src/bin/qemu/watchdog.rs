@@ -50,7 +50,7 @@ pub(crate) fn watchdog_on_m4f(t: &mut Tally) {
     );
     let setting = ringpod_json(&[&["device", "config", "get", "stream.telemetry_hz"][..], &port].concat());
     t.check(
-        setting.is_ok_and(|s| s["value"] == 50) && lines.iter().any(|l| l.starts_with("SETTINGS 2 restored")),
+        setting.is_ok_and(|s| s["value"] == 50) && lines.iter().any(|l| l.starts_with("SETTINGS 3 restored")),
         "the setting stored before the reset is restored from flash by the settings task",
     );
     let cleared = ringpod_text(&[&["device", "clear"][..], &port].concat()).0
