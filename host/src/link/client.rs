@@ -230,11 +230,7 @@ impl<T: Transport> Client<T> {
     /// bring the rest of it together with later answers.
     pub fn answered_after(&self, id: u32) -> bool {
         // Ids count up and wrap: a later one is less than half the id space ahead.
-        !self.inbox.iter().any(|r| r.id == id)
-            && self
-                .inbox
-                .iter()
-                .any(|r| r.id != id && r.id.wrapping_sub(id) < u32::MAX / 2)
+        !self.inbox.iter().any(|r| r.id == id) && self.inbox.iter().any(|r| r.id.wrapping_sub(id) < u32::MAX / 2)
     }
 
     /// Waits for the response to request `id`, up to the timeout; a raised cancel flag (Ctrl-C) ends the wait at
