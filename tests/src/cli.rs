@@ -1,10 +1,31 @@
-//! The host CLI the runners drive: one optimised build of `ringpod`, shared by the QEMU suite, the rehost run and the
-//! browser tests. It is the build the README's main command makes (`cargo run --release -p ringpod`), so after that
-//! command no runner compiles the host again; a debug build of its own would recompile the host and the
-//! dependencies whose features differ under `cargo test`, minutes on two cores.
+//! The host CLI the runners drive, one optimised build of `ringpod` shared by the QEMU suite, the rehost run and the
+//! browser tests. Run alone, a runner uses the build the README's main command makes (`cargo run --release -p
+//! ringpod`), so after that command no runner compiles the host again. Under the test command, `all` names the
+//! `ringpod` its `cargo test --no-run` built (the test profile: optimised, with debug assertions) in
+//! [`CLI_VAR`]: a release build beside it would compile the host and its dependencies a second time, minutes on two
+//! cores.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
+use std::sync::OnceLock;
+
+/// The variable in which `all` names the CLI it built with the test programs.
+pub const CLI_VAR: &str = "RINGPOD_CLI";
+
+/// The CLI the runners drive: the one [`CLI_VAR`] names, or else the release build (built once per process).
+pub fn host() -> Result<PathBuf, String> {
+    static CLI: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    CLI.get_or_init(|| match std::env::var_os(CLI_VAR) {
+        Some(named) => {
+            let path = PathBuf::from(named);
+            path.is_file()
+                .then_some(path)
+                .ok_or_else(|| format!("{CLI_VAR} names no file"))
+        }
+        None => build_release(),
+    })
+    .clone()
+}
 
 /// Builds `ringpod` with the release profile and returns its executable, where cargo says it wrote it.
 pub fn build_release() -> Result<PathBuf, String> {
@@ -30,12 +51,13 @@ pub fn build_release() -> Result<PathBuf, String> {
 }
 
 /// The executable of binary `bin` in cargo's JSON messages (a `CARGO_TARGET_DIR` or a configured target directory
-/// moves it: a guessed path would run a stale build or none).
+/// moves it: a guessed path would run a stale build or none); under `cargo test`, the program and not its unit tests'.
 pub fn executable(messages: &[u8], bin: &str) -> Option<PathBuf> {
     messages
         .split(|b| *b == b'\n')
         .filter_map(|line| serde_json::from_slice::<serde_json::Value>(line).ok())
         .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == bin)
+        .filter(|m| m["profile"]["test"] != true)
         .find_map(|m| m["executable"].as_str().map(PathBuf::from))
 }
 
@@ -51,6 +73,17 @@ mod tests {
             "{\"reason\":\"compiler-artifact\",\"target\":{\"name\":\"suite\"},",
             "\"executable\":\"/t/thumbv7em-none-eabihf/release/suite\"}\n",
             "{\"reason\":\"build-finished\",\"success\":true}\n"
+        );
+        // Under `cargo test` the binary's unit tests come as an artifact of the same name.
+        let tested = concat!(
+            "{\"reason\":\"compiler-artifact\",\"target\":{\"name\":\"ringpod\"},\"profile\":{\"test\":true},",
+            "\"executable\":\"/t/debug/deps/ringpod-0123\"}\n",
+            "{\"reason\":\"compiler-artifact\",\"target\":{\"name\":\"ringpod\"},\"profile\":{\"test\":false},",
+            "\"executable\":\"/t/debug/ringpod\"}\n",
+        );
+        assert_eq!(
+            executable(tested.as_bytes(), "ringpod"),
+            Some(PathBuf::from("/t/debug/ringpod"))
         );
         assert_eq!(
             executable(messages.as_bytes(), "suite"),

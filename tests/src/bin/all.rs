@@ -1,15 +1,18 @@
 //! `cargo run -p ringpod-tests --bin all`: the README's test command. Every test of the project, the emulators'
 //! and the browser's runs and the Windows build under Wine, arranged so that two cores are both at work:
 //!
-//! 1. `cargo test --no-run`: the workspace's test programs, built with both cores.
-//! 2. `cargo test` alone: most of its tests wait on a child `ringpod` in real time, and a build beside them would
-//!    starve their answers.
-//! 3. Then two lanes side by side. Lane one, its output as it comes: the QEMU suite, the rehost run and the browser
-//!    tests, each keeping about one core busy and waiting on real time. Lane two: the Windows runner, its
-//!    cross-build on both cores at the lowest CPU priority (`nice -n 19`: it takes what lane one leaves, and never
-//!    starves its answers) in a target folder of its own (`target/windows`: a cross-build holds the build folder's
-//!    lock for minutes, and the runners of lane one build in it), then its programs under Wine; its output is
-//!    written to `target/windows-runner.log` as it comes and printed whole once lane one is over.
+//! 1. The Windows runner first, in a target folder of its own (`target/windows`: a cross-build holds the build
+//!    folder's lock for minutes, and the other runners build in it), its cross-build at the lowest CPU priority
+//!    (`nice -n 19`: it takes only what the rest leaves, and never starves an answer the rest waits for) from the
+//!    start to the end of its build; its programs under Wine are held until `cargo test` is over. Its output is
+//!    written to `target/windows-runner.log` as it comes and printed whole at the end.
+//! 2. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
+//!    optimised, with debug assertions) is the CLI the QEMU suite, the rehost run and the browser tests drive, named
+//!    to them in `RINGPOD_CLI`: no second, release, build of the host.
+//! 3. `cargo test`, with only the Windows cross-build beside it: most of its tests wait on a child `ringpod` in real
+//!    time, and a build at normal priority beside them would starve their answers.
+//! 4. The QEMU suite, the rehost run and the browser tests, one after the other, their output as it comes, each
+//!    keeping about one core busy and waiting on real time; the Windows runner's programs under Wine beside them.
 //!
 //! Each part runs whatever the others gave. The last lines name each part with its result and time, and the exit
 //! status is 1 when any part failed. On a system other than Linux only `cargo test` runs: the emulators, the
@@ -61,15 +64,17 @@ fn part(name: &str, mut c: Command) -> Part {
     }
 }
 
-/// The Windows runner in its own target folder, its output to `log` (its cross-build yields the CPU to lane one).
+/// The Windows runner in its own target folder, its output to `log` (its cross-build yields the CPU to the rest), its
+/// programs under Wine held until a line on its standard input.
 fn windows_lane(log: &Path) -> Result<Child, String> {
     let target = target_dir().join("windows");
     std::fs::create_dir_all(&target).map_err(|e| format!("{}: {e}", target.display()))?;
     let out = std::fs::File::create(log).map_err(|e| format!("{}: {e}", log.display()))?;
     let err = out.try_clone().map_err(|e| format!("{}: {e}", log.display()))?;
     runner("windows")
+        .arg("--hold-wine")
         .env("CARGO_TARGET_DIR", &target)
-        .stdin(Stdio::null())
+        .stdin(Stdio::piped())
         .stdout(out)
         .stderr(err)
         .spawn()
@@ -89,34 +94,40 @@ fn main() -> ExitCode {
         println!("the QEMU suite, the rehost run, the browser tests and the Windows build under Wine run on Linux");
         return summary(&parts);
     }
-    let mut build = cargo();
-    build.args(["test", "--no-run"]);
-    let built = part("the test programs (cargo test --no-run)", build);
-    let mut runners = cargo();
-    runners.args(["build", "-p", "ringpod-tests", "--bins"]);
-    let runners = part("the runners (cargo build -p ringpod-tests --bins)", runners);
-    let ready = built.passed && runners.passed;
-    parts.extend([built, runners]);
-    if !ready {
-        return summary(&parts);
-    }
-    // cargo test alone: most of its tests wait on a child `ringpod` in real time, and a build beside them starves
-    // their answers.
-    let mut test = cargo();
-    test.args(["test", "--no-fail-fast"]);
-    parts.push(part("cargo test", test));
     let log = target_dir().join("windows-runner.log");
     let started = Instant::now();
     let mut windows = windows_lane(&log);
     match &windows {
         Ok(_) => println!(
-            "== the Windows runner, beside the rest: its output at the end ({})",
+            "== the Windows runner, from the start beside the rest: its output at the end ({})",
             log.display()
         ),
         Err(e) => println!("FAIL {e}"),
     }
-    for name in ["qemu", "rehost", "browser"] {
-        parts.push(part(&format!("the {name} runner"), runner(name)));
+    let (built, cli) = test_programs();
+    let mut runners = cargo();
+    runners.args(["build", "-p", "ringpod-tests", "--bins"]);
+    let runners = part("the runners (cargo build -p ringpod-tests --bins)", runners);
+    let ready = built.passed && runners.passed;
+    parts.extend([built, runners]);
+    if ready {
+        let mut test = cargo();
+        test.args(["test", "--no-fail-fast"]);
+        parts.push(part("cargo test", test));
+    }
+    // `cargo test` is over: the Windows runner's programs may run under Wine.
+    if let Some(mut go) = windows.as_mut().ok().and_then(|child| child.stdin.take()) {
+        // A runner that has ended already needs no signal; the pipe's end when `go` drops is one too.
+        let _ = go.write_all(b"go\n");
+    }
+    if ready {
+        for name in ["qemu", "rehost", "browser"] {
+            let mut c = runner(name);
+            if let Some(cli) = &cli {
+                c.env(ringpod_tests::cli::CLI_VAR, cli);
+            }
+            parts.push(part(&format!("the {name} runner"), c));
+        }
     }
     let passed = windows
         .as_mut()
@@ -132,11 +143,39 @@ fn main() -> ExitCode {
         Err(e) => println!("{}: {e}", log.display()),
     }
     parts.push(Part {
-        name: "the windows runner (beside)".into(),
+        name: "the windows runner (beside, from the start)".into(),
         passed,
         took: started.elapsed(),
     });
     summary(&parts)
+}
+
+/// `cargo test --no-run`, its messages read for the `ringpod` it built (the runners' CLI), its diagnostics and
+/// progress printed as they come.
+fn test_programs() -> (Part, Option<PathBuf>) {
+    let name = "the test programs (cargo test --no-run)";
+    println!("== {name}");
+    let start = Instant::now();
+    let out = cargo()
+        .args(["test", "--no-run", "--message-format=json-render-diagnostics"])
+        .stderr(Stdio::inherit())
+        .output();
+    let (passed, cli) = match out {
+        Ok(out) => (
+            out.status.success(),
+            ringpod_tests::cli::executable(&out.stdout, "ringpod"),
+        ),
+        Err(e) => {
+            println!("cargo test --no-run: {e}");
+            (false, None)
+        }
+    };
+    let part = Part {
+        name: name.into(),
+        passed,
+        took: start.elapsed(),
+    };
+    (part, cli)
 }
 
 /// The parts with their results and times; the exit status.

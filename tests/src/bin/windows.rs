@@ -13,6 +13,10 @@
 //! 5. Each game of `--telemetry-shm` cued end to end: the example `shm_games.exe GAME` writes a drive into the
 //!    game's named mappings in its publisher's layout while `ringpod.exe stream --sim --telemetry-shm GAME` reads it.
 //!
+//! With `--hold-wine` it builds at once and waits for a line on its standard input (or its end) before step 4: the
+//! test command starts it first, so that the cross-build uses what its own builds and `cargo test` leave, and lets
+//! its programs run once `cargo test`, whose tests wait on child processes in real time, is over.
+//!
 //! Wine runs in its own prefix under the target folder, so that a developer's `~/.wine` is not touched. Cargo's own
 //! `test result:` lines are passed through; the last line is the sum, `N passed, N failed`, and the exit status is 1
 //! when anything failed.
@@ -318,11 +322,24 @@ fn cue_game(game: &str) -> Result<(), String> {
     ok.then_some(()).ok_or_else(|| "not cued end to end".into())
 }
 
+/// Waits for a line on standard input or its end: the test command's signal that `cargo test` is over.
+fn held() {
+    println!("== held until the test command's `cargo test` is over");
+    let started = Instant::now();
+    let mut line = String::new();
+    let _ = std::io::stdin().read_line(&mut line);
+    println!("== held for {:.0} s", started.elapsed().as_secs_f64());
+}
+
 fn main() -> ExitCode {
-    if let Some(other) = std::env::args().nth(1) {
-        eprintln!("windows: unknown argument {other:?} (it takes none)");
-        return ExitCode::from(2);
-    }
+    let hold = match std::env::args().nth(1).as_deref() {
+        None => false,
+        Some("--hold-wine") => true,
+        Some(other) => {
+            eprintln!("windows: unknown argument {other:?} (it takes only --hold-wine)");
+            return ExitCode::from(2);
+        }
+    };
     let mut failed = 0u32;
     let mut passed = 0u32;
     let prepared = step("MinGW-w64 and Wine", setup::ensure_windows)
@@ -338,6 +355,9 @@ fn main() -> ExitCode {
             })
         })
         .and_then(|()| step("the ProcessPrng DLL", shim));
+    if hold {
+        held();
+    }
     if let Err(e) = prepared {
         println!("FAIL {e}");
         println!("0 passed, 1 failed");

@@ -155,7 +155,7 @@ fn main() -> ExitCode {
         }
     };
     let prepared = setup::ensure_browser()
-        .and_then(|()| cli::build_release())
+        .and_then(|()| cli::host())
         .and_then(|cli| Ok((record(&cli)?, cli)))
         .and_then(|(record, cli)| {
             // The rig builder's cueing file, with an F1 profile (the task's), written afresh for each run.

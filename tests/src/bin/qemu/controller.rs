@@ -9,7 +9,7 @@ use crate::Tally;
 
 /// Builds everything the suite runs: the host CLI and both Cortex-M4F programs.
 pub(crate) fn build_all() -> Result<(), String> {
-    ringpod_tests::cli::build_release()?;
+    ringpod_tests::cli::host()?;
     crate::emulator::build("ringpod-qemu")?;
     crate::emulator::build("ringpod-qemu-controller").map(|_| ())
 }
@@ -17,7 +17,7 @@ pub(crate) fn build_all() -> Result<(), String> {
 /// The firmware's tasks on the emulated MCU, driven by the host CLI over the UART.
 pub(crate) fn controller_on_m4f(t: &mut Tally) {
     println!("== the controller's firmware tasks on the emulated Cortex-M4F, over its UART");
-    if ringpod_tests::cli::build_release().is_err() {
+    if ringpod_tests::cli::host().is_err() {
         t.check(false, "the host CLI builds");
         return;
     }

@@ -5,11 +5,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
+/// The CLI the suite drives ([`ringpod_tests::cli::host`], built or named before the first section that needs it).
 pub(crate) fn ringpod() -> PathBuf {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"));
-    target.join("release/ringpod")
+    ringpod_tests::cli::host().unwrap_or_else(|e| PathBuf::from(format!("<no CLI: {e}>")))
 }
 
 /// Runs the CLI and parses the JSON it prints.

@@ -78,7 +78,7 @@ fn checks(python: &Path, elf: &Path, cli: &Path, args: &[String]) -> Result<(u32
 fn main() -> ExitCode {
     let prepared = setup::ensure_target()
         .and_then(|()| build_firmware())
-        .and_then(|elf| Ok((elf, cli::build_release()?, venv()?)));
+        .and_then(|elf| Ok((elf, cli::host()?, venv()?)));
     let (elf, cli, python) = match prepared {
         Ok(p) => p,
         Err(e) => {
