@@ -1,10 +1,10 @@
 //! `cargo run -p ringpod-tests --bin all`: the README's test command. Every test of the project, the emulators'
 //! and the browser's runs and the Windows build under Wine, arranged so that two cores are both at work:
 //!
-//! 1. The Windows runner first, in a target folder of its own (`target/windows`: a cross-build holds the build
-//!    folder's lock for minutes, and the other runners build in it), its cross-build at the lowest CPU priority
-//!    (`nice -n 19`: it takes only what the rest leaves, and never starves an answer the rest waits for) from the
-//!    start to the end of its build; its programs under Wine are held until `cargo test` is over. Its output is
+//! 1. The runners' build (seconds), then the Windows runner, in a target folder of its own (`target/windows`: a
+//!    cross-build holds the build folder's lock for minutes, and the other runners build in it), its cross-build at
+//!    the lowest CPU priority (`nice -n 19`: it takes only what the rest leaves, and never starves an answer the
+//!    rest waits for) from the start; its programs under Wine are held until `cargo test` is over. Its output is
 //!    written to `target/windows-runner.log` as it comes and printed whole at the end.
 //! 2. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
 //!    optimised, with debug assertions) is the CLI the QEMU suite, the rehost run and the browser tests drive, named
@@ -94,9 +94,17 @@ fn main() -> ExitCode {
         println!("the QEMU suite, the rehost run, the browser tests and the Windows build under Wine run on Linux");
         return summary(&parts);
     }
+    // The runners first (seconds: `cargo run` built their crate's library for this one), the Windows runner with them.
+    let mut runners = cargo();
+    runners.args(["build", "-p", "ringpod-tests", "--bins"]);
+    let runners = part("the runners (cargo build -p ringpod-tests --bins)", runners);
     let log = target_dir().join("windows-runner.log");
     let started = Instant::now();
-    let mut windows = windows_lane(&log);
+    let mut windows = if runners.passed {
+        windows_lane(&log)
+    } else {
+        Err("the runners did not build".into())
+    };
     match &windows {
         Ok(_) => println!(
             "== the Windows runner, from the start beside the rest: its output at the end ({})",
@@ -105,11 +113,8 @@ fn main() -> ExitCode {
         Err(e) => println!("FAIL {e}"),
     }
     let (built, cli) = test_programs();
-    let mut runners = cargo();
-    runners.args(["build", "-p", "ringpod-tests", "--bins"]);
-    let runners = part("the runners (cargo build -p ringpod-tests --bins)", runners);
     let ready = built.passed && runners.passed;
-    parts.extend([built, runners]);
+    parts.extend([runners, built]);
     if ready {
         let mut test = cargo();
         test.args(["test", "--no-fail-fast"]);
