@@ -13,7 +13,10 @@
 //! | POWER_EN relay | PB15 | | USB D-/D+ | PA11/PA12 |
 //! | AUX1, AUX2 outputs | PC15, PC13 | | USART1 TX, RX (AF7) | PA15, PA10 |
 //!
-//! All STEP and DIR pins are on port B so that one 32-bit write to `GPIOB.BSRR` sets and clears all of them at
+//! With a spare axis fitted in the restored settings, PA9, PA10, PA15 and PC14 are STEP 7, DIR 7, STEP 8 and DIR 8
+//! instead (no supply senses, no USART1 link): `steps` explains their DMA rings.
+//!
+//! All STEP and DIR pins of the platform are on port B so that one 32-bit write to `GPIOB.BSRR` sets and clears all of them at
 //! once: the step generator is TIM1 updating every 2.5 us and DMA2 stream 5 (channel 6, TIM1_UP) copying one word
 //! per update from a ring of rendered periods into `BSRR`. The CPU renders a period per millisecond; it never
 //! touches a pin per step. Inputs are on PA0-PA9 and PC14, each on its own EXTI line (0-9, 14).

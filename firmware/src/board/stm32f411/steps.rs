@@ -132,34 +132,34 @@ pub fn start(
     // Every ring is started (playing zeros: no pin changes) before the timer, so that all count their words from
     // the same first slot.
     let ring = {
-        static BUF: StaticCell<[u32; RING]> = StaticCell::new();
+        static RING_BUF: StaticCell<[u32; RING]> = StaticCell::new();
         let request = r.dma.request();
         start_ring(
             r.dma,
             request,
             pac::GPIOB.bsrr().as_ptr() as *mut u32,
-            BUF.init([0; RING]),
+            RING_BUF.init([0; RING]),
             words,
         )
     };
     let (spare_rings, spare_renderer) = match spare {
         Some((d, spare_renderer)) => {
-            static BUF_A: StaticCell<[u32; RING]> = StaticCell::new();
-            static BUF_C: StaticCell<[u32; RING]> = StaticCell::new();
+            static RING_BUF_A: StaticCell<[u32; RING]> = StaticCell::new();
+            static RING_BUF_C: StaticCell<[u32; RING]> = StaticCell::new();
             let req_a = Dma::<TIM1, Ch1>::request(&*d.port_a);
             let req_c = Dma::<TIM1, Ch2>::request(&*d.port_c);
             let a = start_ring(
                 d.port_a,
                 req_a,
                 pac::GPIOA.bsrr().as_ptr() as *mut u32,
-                BUF_A.init([0; RING]),
+                RING_BUF_A.init([0; RING]),
                 words,
             );
             let c = start_ring(
                 d.port_c,
                 req_c,
                 pac::GPIOC.bsrr().as_ptr() as *mut u32,
-                BUF_C.init([0; RING]),
+                RING_BUF_C.init([0; RING]),
                 words,
             );
             (Some([a, c]), Some(spare_renderer))
