@@ -146,57 +146,49 @@ def _ms(cycles):
     return cycles * 1000 / SYSCLK
 
 
-def spare_check(checks, m, cli, port, link, plant, slot_us):
-    """After `links-both`: both links up, nothing homed. Ends with the board as it found it (restarted, USART1 up)."""
-    # refused while the supervisor senses a supply (the compiled-in default)
-    refused = cli.run("device", "config", "set", "spare.0", json.dumps(AXIS), *port, expect=(1,))
-    sets = [cli.run("device", "config", "set", f"supervisor.{k}", "false", *port) for k in ("logic_sense", "power_sense")]
-    sets += [cli.run("device", "config", "set", f"spare.{i}", json.dumps(AXIS), *port) for i in (0, 1)]
-    restarts = len(m.resets)
-    plant.senses = False  # the senses' pins become outputs: the plant no longer drives them
-    r, usb = _restart_usb(m, link)  # over USB: the board comes back without USART1
-    plant.refresh()
+def _taken(m):
+    """What a start with the spare axes fitted must leave: the pins as outputs, USART1 and the senses' EXTI lines
+    off, and the spare rings beside the platform's. Each item's name, and the names of those not so."""
     a, c = m.gpio["a"], m.gpio["c"]
-    released = {
+    tim1, dma2 = m.tim["tim1"], m.dma["dma2"]
+    main = dma2.streams[5]
+    want = {
         "PA9/PA10/PA15 outputs": all(a.mode(p) == OUTPUT for p in (STEP7, DIR7, STEP8)),
         "PC14 output": c.mode(DIR8) == OUTPUT,
         "USART1 off (CR1.UE 0)": not m.usart1.cr1 & USART_UE,
         "EXTI 9, 14 masked": not m.exti.imr & (1 << 9 | 1 << 14),
+        "TIM1 CCR1 = CCR2 = ARR, CC1DE+CC2DE": tim1.ccr[0] == tim1.ccr[1] == tim1.arr
+        and tim1.dier & T.CCDE[0] and tim1.dier & T.CCDE[1],
     }
-    tim1, dma2 = m.tim["tim1"], m.dma["dma2"]
-    main = dma2.streams[5]
-    rings = {}
     for s, par in ((1, GPIOA_BSRR), (2, GPIOC_BSRR)):
         st = dma2.streams[s]
-        rings[f"S{s} CHSEL 6, PAR {par:#x}, circular, NDTR {main.reload}"] = (
+        want[f"DMA2 S{s} CHSEL 6, PAR {par:#x}, circular, NDTR {main.reload}"] = (
             st.cr & D.EN and st.channel == 6 and st.par == par and st.cr & D.CIRC and st.reload == main.reload)
-    rings["TIM1 CCR1 = CCR2 = ARR, CC1DE+CC2DE"] = (tim1.ccr[0] == tim1.ccr[1] == tim1.arr
-                                                   and tim1.dier & T.CCDE[0] and tim1.dier & T.CCDE[1])
-    bad = [k for k, ok in {**released, **rings}.items() if not ok]
+    return list(want), [k for k, ok in want.items() if not ok]
 
-    pins = SparePins(m)
-    words0 = (a.dma_words, m.gpio["b"].dma_words, c.dma_words)
-    en = link.cli.run("device", "enable", *usb)
-    m.run(m.now + int(0.6 * SYSCLK))
-    home = link.cli.run("device", "home", *usb, sim_limit_s=30)
-    m.run(m.now + SYSCLK // 20)
-    before = _status(link.cli, usb)
 
-    # -- a stream with both columns, the platform heaving 4 mm and back --
+def _both_columns(m, cli, usb, plant, pins, slot_us):
+    """A pose file with both columns: axis 7 to 10 on the smoothstep the platform rises 4 mm on, axis 8 out to about
+    2.5 and back to -2. (ok, what was seen)."""
     rows = []
     for i in range(76):
         t = min(i / 50, 1.0)
         s = t * t * (3 - 2 * t)  # at rest at both ends
         rows.append((i / 50, 0.004 * s, 10 * s, 4 * math.sin(math.pi * t) - 2 * s))
     path = _pose_file(rows)
+    def words():
+        return [m.gpio[port].dma_words for port in "abc"]
+
+    words0 = words()
+    before = _status(cli, usb)
     pins.net, pins.rises, pins.times = [0, 0], [0, 0], [[], []]
     start_position = list(plant.position)
     moves, watch = _platform_moves(m, plant)
-    st = link.cli.run("stream", *usb, "--input", path, "--report-json", "--quiet", sim_limit_s=30)
+    st = cli.run("stream", *usb, "--input", path, "--report-json", "--quiet", sim_limit_s=30)
     m.run(m.now + SYSCLK // 10)
     m.observers.remove(watch)
     os.unlink(path)
-    after = _status(link.cli, usb)
+    after = _status(cli, usb)
     moved = [x - y for x, y in zip(after.get("spare_steps", [0, 0]), before.get("spare_steps", [0, 0]))]
     want = [round(10 * STEPS_PER_UNIT), round(-2 * STEPS_PER_UNIT)]
     # axis 7 and the platform's heave follow the same smoothstep: each is half way at the stream's middle row
@@ -205,28 +197,31 @@ def spare_check(checks, m, cli, port, link, plant, slot_us):
     ax = deltas.index(max(deltas))  # the platform axis that moved most
     platform_half = _half_way([(t, p[ax]) for t, p in moves], start_position[ax], plant.position[ax])
     lag_ms = _ms(spare_half - platform_half) if spare_half and platform_half else None
-    in_time = lag_ms is not None and abs(lag_ms) <= 10
-    dw = [w - w0 for w, w0 in zip((a.dma_words, m.gpio["b"].dma_words, c.dma_words), words0)]
+    dw = [w - w0 for w, w0 in zip(words(), words0)]
     width = min(pins.widths, default=0) * slot_us
     setup = min(pins.setups, default=0) * slot_us
     hold = min(pins.holds, default=0) * slot_us
-    timed = width >= 2.5 and setup >= 5.0 and hold >= 5.0 and pins.reversals[1] >= 1 and not pins.undriven
-    followed = st.code == 0 and pins.net == want == moved and pins.rises[1] > abs(want[1])
-    stream_said = (f"`stream` of axis7/axis8 exit {st.code} ({st.sim_s:.2f} simulated s): STEP rises on PA9/PA15 signed "
-                   f"by PA10/PC14 {pins.net} ({pins.rises} rises), the device's spare steps moved {moved}, the "
-                   f"columns' last values x 400 {want}; platform steps {before.get('steps')} -> {after.get('steps')}; "
-                   f"shortest STEP high {width} us, DIR set-up {setup} us, hold {hold} us, DIR reversals "
-                   f"{pins.reversals}, {pins.undriven} steps with DIR undriven; DMA words GPIOA/GPIOB/GPIOC {dw}; axis 7 "
-                   f"half way (its 2,000th step) {lag_ms if lag_ms is None else round(lag_ms, 2)} ms after platform "
-                   f"axis {ax + 1} (at most 10 ms apart)")
+    ok = (st.code == 0 and pins.net == want == moved and pins.rises[1] > abs(want[1])
+          and width >= 2.5 and setup >= 5.0 and hold >= 5.0 and pins.reversals[1] >= 1 and not pins.undriven
+          and lag_ms is not None and abs(lag_ms) <= 10 and max(dw) - min(dw) <= 2)
+    return ok, (f"`stream` of axis7/axis8 exit {st.code} ({st.sim_s:.2f} simulated s): STEP rises on PA9/PA15 signed "
+                f"by PA10/PC14 {pins.net} ({pins.rises} rises), the device's spare steps moved {moved}, the "
+                f"columns' last values x 400 {want}; platform steps {before.get('steps')} -> {after.get('steps')}; "
+                f"shortest STEP high {width} us, DIR set-up {setup} us, hold {hold} us, DIR reversals "
+                f"{pins.reversals}, {pins.undriven} steps with DIR undriven; DMA words GPIOA/GPIOB/GPIOC {dw}; axis 7 "
+                f"half way (its 2,000th step) {lag_ms if lag_ms is None else round(lag_ms, 2)} ms after platform "
+                f"axis {ax + 1} (at most 10 ms apart)")
 
-    # -- STOP mid-stream --
+
+def _stopped(m, ringpod, cli, usb, plant, pins):
+    """A stream toward axis 7 = 30 over 4 s interrupted by SIGINT (the CLI sends STOP) once axis 7 moved 400 steps.
+    (ok, what was seen)."""
     rows = [(i / 50, 0.004 + 0.002 * min(i / 50, 1.0), 10 + 20 * i / 200, 0.0) for i in range(201)]
     path = _pose_file(rows)
     pins.net, pins.rises, pins.times = [0, 0], [0, 0], [[], []]
-    moves, watch = _platform_moves(m, plant)
-    before_stop = _status(link.cli, usb)  # (moves: the platform's steps, none of which may come after the brake)
-    proc = subprocess.Popen([link.ringpod, "stream", *usb, "--input", path, "--quiet"], stdout=subprocess.DEVNULL,
+    before = _status(cli, usb)
+    moves, watch = _platform_moves(m, plant)  # the platform's steps: none may come after the brake either
+    proc = subprocess.Popen([ringpod, "stream", *usb, "--input", path, "--quiet"], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=cli_env())
     t0, interrupted = m.now, None
     while proc.poll() is None and m.now - t0 < 30 * SYSCLK and m.fault is None:
@@ -245,20 +240,41 @@ def spare_check(checks, m, cli, port, link, plant, slot_us):
     m.run(m.now + SYSCLK // 2)
     m.observers.remove(watch)
     quiet = pins.rises == rises_then and len(moves) == platform_then
-    stopped = _status(link.cli, usb)
-    stop_moved = [x - y for x, y in zip(stopped.get("spare_steps", [0, 0]), before_stop.get("spare_steps", [0, 0]))]
+    stopped = _status(cli, usb)
+    moved = [x - y for x, y in zip(stopped.get("spare_steps", [0, 0]), before.get("spare_steps", [0, 0]))]
     last = max((ts[-1] for ts in pins.times if ts), default=None)
-    stop_ok = (interrupted is not None and code == 130 and quiet and pins.net == stop_moved
-               and 400 <= stop_moved[0] < 20 * STEPS_PER_UNIT and stopped.get("state") == "Ready")
-    stop_said = (f"a stream toward axis7 = 30 interrupted (SIGINT) {_ms(interrupted - t0) if interrupted else '-'} ms "
-                 f"in, after {rises_then[0]} rises: exit {code} (130), exited {_ms(exited - (interrupted or t0)):.0f} ms "
-                 f"after the signal, the last spare STEP rise {_ms(last - (interrupted or t0)) if last else '-'} ms "
-                 f"after it; no STEP edge on PA9/PA15 nor a platform step in the 0.5 s after the brake: {quiet}; "
-                 f"STEP rises signed {pins.net}, the device's spare steps moved {stop_moved} (short of 8,000); state "
-                 f"{stopped.get('state')}")
+    ok = (interrupted is not None and code == 130 and quiet and pins.net == moved
+          and 400 <= moved[0] < 20 * STEPS_PER_UNIT and stopped.get("state") == "Ready")
+    since = interrupted or t0
+    return ok, (f"a stream toward axis7 = 30 interrupted (SIGINT) {_ms(since - t0):.0f} ms in, after "
+                f"{rises_then[0]} rises: exit {code} (130), exited {_ms(exited - since):.0f} ms after the signal, the "
+                f"last spare STEP rise {_ms(last - since) if last else '-'} ms after it; no STEP edge on PA9/PA15 "
+                f"nor a platform step in the 0.5 s after the brake: {quiet}; STEP rises signed {pins.net}, the "
+                f"device's spare steps moved {moved} (short of 8,000); state {stopped.get('state')}")
+
+
+def spare_check(checks, m, cli, port, link, plant, slot_us):
+    """After `links-both`: both links up, nothing homed. Ends with the board as it found it (restarted, USART1 up)."""
+    # refused while the supervisor senses a supply (the compiled-in default)
+    refused = cli.run("device", "config", "set", "spare.0", json.dumps(AXIS), *port, expect=(1,))
+    sets = [cli.run("device", "config", "set", f"supervisor.{k}", "false", *port) for k in ("logic_sense", "power_sense")]
+    sets += [cli.run("device", "config", "set", f"spare.{i}", json.dumps(AXIS), *port) for i in (0, 1)]
+    restarts = len(m.resets)
+    plant.senses = False  # the senses' pins become outputs: the plant no longer drives them
+    r, usb = _restart_usb(m, link)  # over USB: the board comes back without USART1
+    plant.refresh()
+    taken, bad = _taken(m)
+
+    pins = SparePins(m)
+    en = link.cli.run("device", "enable", *usb)
+    m.run(m.now + int(0.6 * SYSCLK))
+    home = link.cli.run("device", "home", *usb, sim_limit_s=30)
+    m.run(m.now + SYSCLK // 20)
+    followed, stream_said = _both_columns(m, link.cli, usb, plant, pins, slot_us)
+    stop_ok, stop_said = _stopped(m, link.ringpod, link.cli, usb, plant, pins)
     pins.close()
 
-    # -- put back: no spare axes, the senses on, USART1 up (a restart only with the supplies off) --
+    # put back: no spare axes, the senses on, USART1 up (a restart only with the supplies off)
     off = link.cli.run("device", "disable", *usb)
     m.run(m.now + int(0.6 * SYSCLK))
     back = [link.cli.run("device", "config", "set", f"spare.{i}", json.dumps(NONE), *usb) for i in (0, 1)]
@@ -270,13 +286,12 @@ def spare_check(checks, m, cli, port, link, plant, slot_us):
     serial = _status(cli, port)
     checks.check("spare-axes",
                  refused.code == 1 and "spare[0].enabled" in refused.stderr and "LOGIC_OK" in refused.stderr
-                 and all(x.code == 0 for x in sets + back) and r.code == 0 and off.code == 0 and len(m.resets) >= restarts + 2
-                 and not bad and en.code == 0 and home.code == 0 and followed and timed and in_time
-                 and max(dw) - min(dw) <= 2 and stop_ok and "state" in serial and m.usart1.cr1 & USART_UE,
+                 and all(x.code == 0 for x in [r, rs, off, en, home, *sets, *back])
+                 and len(m.resets) == restarts + 2 and not bad and followed and stop_ok
+                 and "state" in serial and m.usart1.cr1 & USART_UE,
                  f"fitting axis 7 beside a sensed supply: exit {refused.code}, {refused.stderr.strip()[:160]!r}; "
-                 f"senses off and both fitted, restarted: {', '.join(k for k in released)}"
-                 + (f"; wrong: {', '.join(bad)}" if bad else "; the spare rings as set")
+                 f"senses off and both fitted, restarted: {', '.join(taken)}"
+                 + (f"; wrong: {', '.join(bad)}" if bad else "")
                  + f"; homed over USB exit {home.code} ({home.sim_s:.1f} simulated s); {stream_said}; {stop_said}; "
-                 f"put back ({off.code}, {[x.code for x in back]}) and restarted ({rs.code}; "
-                 f"{len(m.resets) - restarts} resets in the check): USART1 answers (state {serial.get('state')})"
-                 + "".join(f"; {x}" for x in [r, rs, off, *sets, *back] if x.code != 0))
+                 f"put back and restarted ({len(m.resets) - restarts} resets in the check): USART1 answers (state "
+                 f"{serial.get('state')})" + "".join(f"; {x}" for x in [r, rs, off, en, home, *sets, *back] if x.code != 0))
