@@ -72,9 +72,14 @@ pub const SPARE_MAP: PortMap = PortMap {
     dir_forward_low: 0,
 };
 /// The set and reset bits of STEP7 (PA9), DIR7 (PA10) and STEP8 (PA15) in [`SPARE_MAP`]'s words.
-pub const SPARE_PORT_A: u32 = 0x8600_8600;
+pub const SPARE_PORT_A: u32 = set_reset(SPARE_MAP.step[0]) | set_reset(SPARE_MAP.dir[0]) | set_reset(SPARE_MAP.step[1]);
 /// The set and reset bits of DIR8 (PC14) in [`SPARE_MAP`]'s words.
-pub const SPARE_PORT_C: u32 = 0x4000_4000;
+pub const SPARE_PORT_C: u32 = set_reset(SPARE_MAP.dir[1]);
+
+/// A pin's set (BSy) and reset (BRy) bits in a BSRR word (RM0383 8.4.7).
+const fn set_reset(pin: u8) -> u32 {
+    (1 << pin) | (1 << (pin + 16))
+}
 
 assign_resources! {
     /// Driver enable (active low), the two supply relays and the auxiliary outputs.

@@ -26,7 +26,7 @@ use embassy_time::Instant;
 use ringpod_core::motion::pulse::{PulseRenderer, MAX_STEP_SLOTS};
 use ringpod_firmware::app::steps::{Overrun, PortOutput};
 use ringpod_firmware::app::{self, Shared};
-use static_cell::StaticCell;
+use static_cell::ConstStaticCell;
 
 use super::resources::{Irqs, SpareDmaParts, StepGeneratorParts, SPARE_PORT_A, SPARE_PORT_C, STEP_EXECUTOR_PRIORITY};
 
@@ -130,36 +130,37 @@ pub fn start(
 ) {
     let words = 2 * renderer.timing().slots;
     // Every ring is started (playing zeros: no pin changes) before the timer, so that all count their words from
-    // the same first slot.
+    // the same first slot. The rings are zeroed statics taken in place: built as values they would pass through the
+    // stack (6.4 KB each, measured 13 KB deeper at boot).
     let ring = {
-        static RING_BUF: StaticCell<[u32; RING]> = StaticCell::new();
+        static RING_BUF: ConstStaticCell<[u32; RING]> = ConstStaticCell::new([0; RING]);
         let request = r.dma.request();
         start_ring(
             r.dma,
             request,
             pac::GPIOB.bsrr().as_ptr() as *mut u32,
-            RING_BUF.init([0; RING]),
+            RING_BUF.take(),
             words,
         )
     };
     let (spare_rings, spare_renderer) = match spare {
         Some((d, spare_renderer)) => {
-            static RING_BUF_A: StaticCell<[u32; RING]> = StaticCell::new();
-            static RING_BUF_C: StaticCell<[u32; RING]> = StaticCell::new();
+            static RING_BUF_A: ConstStaticCell<[u32; RING]> = ConstStaticCell::new([0; RING]);
+            static RING_BUF_C: ConstStaticCell<[u32; RING]> = ConstStaticCell::new([0; RING]);
             let req_a = Dma::<TIM1, Ch1>::request(&*d.port_a);
             let req_c = Dma::<TIM1, Ch2>::request(&*d.port_c);
             let a = start_ring(
                 d.port_a,
                 req_a,
                 pac::GPIOA.bsrr().as_ptr() as *mut u32,
-                RING_BUF_A.init([0; RING]),
+                RING_BUF_A.take(),
                 words,
             );
             let c = start_ring(
                 d.port_c,
                 req_c,
                 pac::GPIOC.bsrr().as_ptr() as *mut u32,
-                RING_BUF_C.init([0; RING]),
+                RING_BUF_C.take(),
                 words,
             );
             (Some([a, c]), Some(spare_renderer))
