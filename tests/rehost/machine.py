@@ -68,6 +68,12 @@ UPDATE_REQUESTS = {
     "tim4": [("dma1", 6, 2)],
     "tim5": [("dma1", 0, 6), ("dma1", 6, 6)],
 }
+# RM0383 9.3.3, table 28 (DMA2): where TIM1's compare requests go (channel 0-3 -> (controller, stream, channel)).
+# The step generator's spare axes use CH1 on stream 1 and CH2 on stream 2; the other timers' are not wired.
+COMPARE_REQUESTS = {
+    "tim1": {0: [("dma2", 1, 6), ("dma2", 3, 6), ("dma2", 6, 0)], 1: [("dma2", 2, 6), ("dma2", 6, 0)],
+             2: [("dma2", 6, 6), ("dma2", 6, 0)], 3: [("dma2", 4, 6)]},
+}
 QILING_PERIPHERALS = ["pwr", "syscfg", "dbgmcu", "usart2", "usart6"]
 # RM0383 39.1: the 96-bit unique device ID at 0x1FFF7A10 (X and Y on the wafer, 16 bits each; the wafer number;
 # the lot number, seven ASCII characters), in the page after system memory that also holds the OTP area (RM0383
@@ -182,6 +188,8 @@ class Machine:
             tim = self.install(label, base, Tim(label, self.clock, self.pend, up, cc, bits))
             for dma, stream, channel in UPDATE_REQUESTS[label]:
                 tim.update_dma.append(_Request(self.dma[dma], stream, channel))
+            for ch, lines in COMPARE_REQUESTS.get(label, {}).items():
+                tim.cc_dma[ch] += [_Request(self.dma[dma], stream, channel) for dma, stream, channel in lines]
             self.tim[label] = tim
         self.iwdg = self.install("iwdg", 0x4000_3000, Iwdg(self.clock, self._watchdog_timeout, SYSCLK))
         # RM0383 6.3.10 RCC_AHB2ENR.OTGFSEN (bit 7) clocks the OTG FS core
@@ -529,7 +537,7 @@ class Machine:
 
 
 class _Request:
-    """A timer's update request line into one DMA stream (RM0383 9.3.3)."""
+    """A timer's update or compare request line into one DMA stream (RM0383 9.3.3)."""
 
     def __init__(self, dma, stream, channel):
         self.dma, self.stream, self.channel = dma, stream, channel

@@ -22,7 +22,8 @@ electrically (the pins as `models.gpio.Gpio` says the chip drives them, not its 
 - Each linear actuator's far-end switch sits at `far_limit[a]` (240,000 steps), which a check may move near the
   axis (as an end stop is set on a shorter stroke) to close it with a short move; `home_end` likewise.
 - Supply sense follows the relays at once: LOGIC_OK (PA9) is driven high while LOGIC_EN (PB14) is, POWER_OK (PC14)
-  while POWER_EN (PB15) is; otherwise they are left to their pull-downs.
+  while POWER_EN (PB15) is; otherwise they are left to their pull-downs. With `senses` off (a board whose spare
+  axes take those pins) nothing drives them.
 - A pin whose level changes is an edge for the EXTI model (its line, if the firmware routed it there).
 """
 
@@ -61,6 +62,7 @@ class Plant:
         self.gpio["a"].wired |= WIRED_A
         self.gpio["c"].wired |= WIRED_C
         self.position = list(start)
+        self.senses = True  # the supply senses wired; False: their pins are spare axes' STEP/DIR (spare_check.py)
         self.estop_open = False
         self.steps = [0] * 6  # STEP rising edges per axis that moved it
         self.net = [0] * 6  # signed steps per axis
@@ -208,8 +210,8 @@ class Plant:
         for a, pin in ((4, 7), (5, 8)):
             self._drive("a", pin, 0 if self.position[a] >= self.far_limit[a] else None)
         self._drive("a", ESTOP, 1 if self.estop_open else 0)
-        self._drive("a", LOGIC_OK, 1 if b.driven(LOGIC_EN, odr) == 1 else None)
-        self._drive("c", POWER_OK, 1 if b.driven(POWER_EN, odr) == 1 else None)
+        self._drive("a", LOGIC_OK, 1 if self.senses and b.driven(LOGIC_EN, odr) == 1 else None)
+        self._drive("c", POWER_OK, 1 if self.senses and b.driven(POWER_EN, odr) == 1 else None)
 
     def set_switches(self, far_limit=None, home_end=None):
         """Moves the linear actuators' end switches (None: back where the trainer model has them)."""

@@ -39,6 +39,7 @@ from models.flash import sector_of  # noqa: E402
 from models.rcc import IWDGRSTF  # noqa: E402
 from plant import FLAG_WIDTH, HOME_POSITION, SLOW_RATE, TOWARD, Plant  # noqa: E402
 from seqstore import used_up_page  # noqa: E402
+from spare_check import spare_check  # noqa: E402
 from serial_link import Cli, PtyBridge  # noqa: E402
 from usb_checks import UsbLink, cable_check, usb_full_checks, usb_link_checks, usb_stream_checks  # noqa: E402
 from safety_checks import (estop_states_check, jog_buzz_check, limit_check, silent_check,  # noqa: E402
@@ -229,6 +230,7 @@ def serial_checks(m, p, log, plant, ringpod, hold_ups=False, usb=None, usb_full=
     settings_check(m, p, log, cli, port)
     if usb is not None:
         usb_link_checks(CHECKS, m, usb, port)
+        spare_check(CHECKS, m, cli, port, usb, plant, SLOT_US)
     homing_check(m, plant, cli, port)
     stream_check(m, plant, cli, port, ringpod)
     if usb is not None:

@@ -86,7 +86,11 @@ pub async fn run(machine: &mut impl Machine, shared: &Shared) -> ! {
                 (c.pass(), None)
             } else {
                 let out = c.tick();
-                (out.outputs, Some(out.moves))
+                let period = super::StepPeriod {
+                    moves: out.moves,
+                    spare: c.spare_moves(),
+                };
+                (out.outputs, Some(period))
             };
             (outputs, moves, c.unsolicited())
         });

@@ -19,7 +19,7 @@ use embassy_sync::blocking_mutex::raw::{CriticalSectionRawMutex, ThreadModeRawMu
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::channel::Channel;
 use ringpod_core::controller::Controller;
-use ringpod_core::motion::AxisMove;
+use ringpod_core::motion::{AxisMove, SPARE_AXES};
 use ringpod_core::protocol::Response;
 use ringpod_core::safety::debounce::Debouncer;
 
@@ -35,6 +35,15 @@ pub const STEP_QUEUE: usize = 4;
 /// the one period a phase correction gives two ticks, finds a period queued.
 pub const AHEAD: usize = 1;
 
+/// One control period's step moves, from the control tick to the step generator.
+#[derive(Debug, Clone, Copy)]
+pub struct StepPeriod {
+    /// The platform's six axes.
+    pub moves: [AxisMove; 6],
+    /// The spare axes 7 and 8 (`None` when neither is fitted).
+    pub spare: Option<[AxisMove; SPARE_AXES]>,
+}
+
 /// What the tasks share. The controller is only touched from thread mode (link, control, inputs, settings),
 /// briefly and never across an `.await`; the step queue crosses to the step generator's interrupt priority.
 pub struct Shared {
@@ -46,7 +55,7 @@ pub struct Shared {
     /// messages go there. Every link's requests are answered on that link.
     pub host_link: AtomicU8,
     /// One period's step moves per entry, from the control tick to the step generator.
-    pub steps: Channel<CriticalSectionRawMutex, [AxisMove; 6], STEP_QUEUE>,
+    pub steps: Channel<CriticalSectionRawMutex, StepPeriod, STEP_QUEUE>,
     /// Debounced logical input levels (`safety::debounce` layout), written by the inputs task.
     pub inputs: AtomicU16,
     /// Periods the step generator had to fill with no steps because the queue was empty.

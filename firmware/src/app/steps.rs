@@ -7,7 +7,7 @@ use core::sync::atomic::Ordering;
 use embassy_time::Instant;
 use ringpod_core::motion::pulse::PulseRenderer;
 use ringpod_core::motion::pulse::MAX_STEP_SLOTS;
-use ringpod_core::motion::{AxisMove, Direction};
+use ringpod_core::motion::{AxisMove, Direction, SPARE_AXES};
 
 use super::Shared;
 
@@ -23,11 +23,21 @@ pub trait PortOutput {
     async fn room(&mut self, words: usize) -> Result<Instant, Overrun>;
     /// Writes one period into the room [`PortOutput::room`] found; does not wait.
     fn write(&mut self, words: &[u32]) -> Result<(), Overrun>;
+    /// Writes the spare axes' words of the same period (rendered on the board's spare pin map), to play in the
+    /// same slots as [`PortOutput::write`]'s. Only called when [`run`] was given a spare renderer.
+    fn write_spare(&mut self, words: &[u32]) -> Result<(), Overrun>;
 }
 
 /// Feeds the port forever. An empty queue becomes a period without steps (counted, never a lost step: the
-/// controller's positions only advance with moves, and the moves are played later).
-pub async fn run(port: &mut impl PortOutput, mut renderer: PulseRenderer, shared: &Shared) -> ! {
+/// controller's positions only advance with moves, and the moves are played later). With `spare` (a renderer on the
+/// board's spare pin map: the spare axes as its axes 0 and 1) the spare axes' words are written every period too,
+/// idle when the period has none: their ring would otherwise play its old words again.
+pub async fn run(
+    port: &mut impl PortOutput,
+    mut renderer: PulseRenderer,
+    mut spare: Option<PulseRenderer>,
+    shared: &Shared,
+) -> ! {
     let slots = renderer.timing().slots;
     let period_ns = renderer.timing().slot_ns * slots as u32;
     let idle = [AxisMove {
@@ -51,14 +61,25 @@ pub async fn run(port: &mut impl PortOutput, mut renderer: PulseRenderer, shared
         shared
             .boundary_us
             .store(super::control::micros(boundary), Ordering::Relaxed);
-        let moves = match shared.steps.try_receive() {
-            Ok(m) => m,
+        let period = match shared.steps.try_receive() {
+            Ok(p) => p,
             Err(_) => {
                 shared.step_underruns.fetch_add(1, Ordering::Relaxed);
-                idle
+                super::StepPeriod {
+                    moves: idle,
+                    spare: None,
+                }
             }
         };
-        if renderer.render(&moves, &mut words).is_none() || port.write(&words[..slots]).is_err() {
+        let mut fault = renderer.render(&period.moves, &mut words).is_none() || port.write(&words[..slots]).is_err();
+        if let Some(spare) = spare.as_mut() {
+            let mut moves = idle;
+            if let Some(m) = period.spare {
+                moves[..SPARE_AXES].copy_from_slice(&m);
+            }
+            fault |= spare.render(&moves, &mut words).is_none() || port.write_spare(&words[..slots]).is_err();
+        }
+        if fault {
             shared.step_fault.store(true, Ordering::Relaxed);
         }
     }

@@ -1,5 +1,5 @@
 """TIM1 (advanced-control, RM0383 section 12) and TIM2-TIM5 / TIM9-TIM11 (general-purpose, sections 13-14):
-the up-counting time base, update and compare events with their interrupts, and update DMA requests.
+the up-counting time base, update and compare events with their interrupts, and update and compare DMA requests.
 
 Qiling's STM32F4xxTim has no compare flags (embassy's time driver on TIM5 waits on CC1IF/CC2IF and never ticks),
 stores SR writes instead of clearing on write 0, ignores EGR.UG and makes no DMA requests.
@@ -7,7 +7,7 @@ stores SR writes instead of clearing on write 0, ignores EGR.UG and makes no DMA
 The counter is computed from the clock rather than stepped: at time `t_a` it held `c_a`, and it counts once per
 `PSC + 1` cycles of the timer clock (here the CPU clock: on this board both APB timer clocks equal SYSCLK, 96 MHz,
 RM0383 6.2, clock tree). Not modelled: down and centre-aligned counting (CR1.DIR/CMS), slave modes (SMCR), input
-capture, output pins, break (BDTR), DMA burst (DCR/DMAR), CCxDE requests.
+capture, output pins, break (BDTR), DMA burst (DCR/DMAR), CR2.CCDS = 1 (a compare's DMA request at the update).
 """
 
 from .base import NEVER, Block
@@ -17,6 +17,7 @@ CEN, UDIS, URS, ARPE = 1 << 0, 1 << 1, 1 << 2, 1 << 7
 # RM0383 12.4.4 / 13.4.4 TIMx_DIER
 UIE, UDE = 1 << 0, 1 << 8
 CCIE = [1 << 1, 1 << 2, 1 << 3, 1 << 4]
+CCDE = [1 << 9, 1 << 10, 1 << 11, 1 << 12]
 # RM0383 12.4.5 / 13.4.5 TIMx_SR
 UIF = 1 << 0
 CCIF = [1 << 1, 1 << 2, 1 << 3, 1 << 4]
@@ -40,6 +41,8 @@ class Tim(Block):
         # DMA channels this timer's update request is wired to: callables request(n) -> None and
         # horizon() -> requests until the DMA next raises an enabled interrupt (or None).
         self.update_dma = []
+        # The same for each compare channel's request (CCxDE, RM0383 12.4.4: a request at each CCx event).
+        self.cc_dma = [[], [], [], []]
         self.reset()
 
     def reset(self):
@@ -53,6 +56,7 @@ class Tim(Block):
         self.c_a = 0
         self.updates = 0  # update events since reset
         self.dma_requests = 0
+        self.cc_requests = [0, 0, 0, 0]  # compare DMA requests since reset, per channel
 
     # -- the counter --
     def _per(self):
@@ -82,6 +86,15 @@ class Tim(Block):
                 request(n)
         self._load_shadows()
 
+    def _compare_events(self, ch, n):
+        """n compare matches of channel `ch` (RM0383 12.3.8, output compare mode: CCxIF set, and a DMA request
+        when CCxDE, whatever the output mode, the frozen one included)."""
+        self.sr |= CCIF[ch]
+        if self.dier & CCDE[ch]:
+            self.cc_requests[ch] += n
+            for request in self.cc_dma[ch]:
+                request(n)
+
     def advance(self, now):
         if now <= self.last:
             return
@@ -98,7 +111,7 @@ class Tim(Block):
                 for ch in range(4):
                     ccr = self.ccr[ch]
                     if c0 < ccr <= min(c1, top) or (ccr == 0 and end == t_wrap):
-                        self.sr |= CCIF[ch]
+                        self._compare_events(ch, 1)
             if t_wrap > now:
                 break
             # overflow at t_wrap: RM0383 12.3.3 repetition counter (RCR = 0 on TIM2-5: a UEV at every overflow)
@@ -118,7 +131,7 @@ class Tim(Block):
                 self._update_events(k)
                 for ch in range(4):
                     if self.ccr[ch] <= self.arr_act:
-                        self.sr |= CCIF[ch]
+                        self._compare_events(ch, k)  # one match in each whole period
         self.last = now
         self._irq()
 
@@ -145,12 +158,22 @@ class Tim(Block):
                 ccr = self.ccr[ch]
                 t = self.t_a + (ccr - self.c_a) * per if c < ccr <= top else t_wrap + ccr * per
                 best = min(best, t)
+        period = (self.arr + 1) * (self.psc + 1)
         if self.dier & UDE:
-            period = (self.arr + 1) * (self.psc + 1)
             for request in self.update_dma:
                 h = request.horizon()
                 if h is not None:
                     best = min(best, t_wrap + (max(h, 1) - 1) * period)
+        for ch in range(4):
+            ccr = self.ccr[ch]
+            if not self.dier & CCDE[ch] or ccr > top:
+                continue
+            # the next match: in this period if the counter is below CCRx, else in the next
+            first = self.t_a + (ccr - self.c_a) * per if c < ccr else t_wrap + ccr * per
+            for request in self.cc_dma[ch]:
+                h = request.horizon()
+                if h is not None:
+                    best = min(best, first + (max(h, 1) - 1) * period)
         return max(best, now + 1)
 
     # -- registers --

@@ -95,6 +95,58 @@ class TimTest(unittest.TestCase):
         self.assertEqual(sum(got), 500)
         self.assertEqual(t.dma_requests, 500)
 
+    def test_compare_requests_keep_step_with_the_updates(self):
+        # the step generator's spare rings: CCR1 = CCR2 = ARR, one request per slot each, in the slot of the update's
+        t, clock, _ = timer()
+        got = {"up": 0, 0: 0, 1: 0}
+
+        class Req:
+            def __init__(self, key, horizon):
+                self.key, self.h = key, horizon
+
+            def __call__(self, n):
+                got[self.key] += n
+
+            def horizon(self):
+                return self.h
+
+        t.update_dma.append(Req("up", None))
+        t.cc_dma[0].append(Req(0, 1200))
+        t.cc_dma[1].append(Req(1, None))
+        t.write(T.Tim.ARR, 4, 239)
+        t.write(T.Tim.CCR[0], 4, 239)
+        t.write(T.Tim.CCR[1], 4, 239)
+        t.write(T.Tim.DIER, 4, T.UDE | T.CCDE[0] | T.CCDE[1])
+        t.write(T.Tim.CR1, 4, T.CEN)
+        # the 1200th compare 1 match: one timer clock before the 1200th update
+        self.assertEqual(t.next_event(0), 240 * 1199 + 239)
+        for now in (239, 240, 240 * 7 + 100, 240 * 500 + 239, 240 * 1000 + 5):
+            clock.now = now
+            t.advance(now)
+            self.assertEqual((got[0], got[1]), (now // 240 + (now % 240 >= 239),) * 2, now)
+            self.assertEqual(got["up"], now // 240)
+        self.assertEqual(t.cc_requests[:2], [1000, 1000])
+
+    def test_compare_without_ccde_makes_no_request(self):
+        t, clock, _ = timer()
+        got = []
+
+        class Req:
+            def __call__(self, n):
+                got.append(n)
+
+            def horizon(self):
+                return None
+
+        t.cc_dma[0].append(Req())
+        t.write(T.Tim.ARR, 4, 239)
+        t.write(T.Tim.CCR[0], 4, 239)
+        t.write(T.Tim.CR1, 4, T.CEN)
+        clock.now = 240 * 100
+        t.advance(clock.now)
+        self.assertEqual(got, [])
+        self.assertTrue(t.read(T.Tim.SR, 4) & T.CCIF[0])
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -13,7 +13,10 @@
 //! | POWER_EN relay | PB15 | | USB D-/D+ | PA11/PA12 |
 //! | AUX1, AUX2 outputs | PC15, PC13 | | USART1 TX, RX (AF7) | PA15, PA10 |
 //!
-//! All STEP and DIR pins are on port B so that one 32-bit write to `GPIOB.BSRR` sets and clears all of them at
+//! With a spare axis fitted in the restored settings, PA9, PA10, PA15 and PC14 are STEP 7, DIR 7, STEP 8 and DIR 8
+//! instead (no supply senses, no USART1 link): `steps` explains their DMA rings.
+//!
+//! All STEP and DIR pins of the platform are on port B so that one 32-bit write to `GPIOB.BSRR` sets and clears all of them at
 //! once: the step generator is TIM1 updating every 2.5 us and DMA2 stream 5 (channel 6, TIM1_UP) copying one word
 //! per update from a ring of rendered periods into `BSRR`. The CPU renders a period per millisecond; it never
 //! touches a pin per step. Inputs are on PA0-PA9 and PC14, each on its own EXTI line (0-9, 14).
@@ -48,6 +51,7 @@ mod watchdog;
 
 use embassy_executor::Spawner;
 use ringpod_core::controller::Controller;
+use ringpod_core::motion::pulse::PulseRenderer;
 use ringpod_core::protocol::{Firmware, Image, RigSource};
 use ringpod_firmware::app::inputs::InputPins;
 use ringpod_firmware::app::Shared;
@@ -55,7 +59,8 @@ use static_cell::StaticCell;
 use {defmt_rtt as _, panic_probe as _};
 
 use resources::{
-    AssignedResources, OutputPins, SettingsParts, StepDirPins, StepGeneratorParts, SwitchPins, UartParts, UsbParts,
+    AssignedResources, OutputPins, SensePins, SettingsParts, SpareDmaParts, StepDirPins, StepGeneratorParts,
+    SwitchPins, UartParts, UsbParts,
 };
 
 static SHARED: StaticCell<Shared> = StaticCell::new();
@@ -76,19 +81,29 @@ pub async fn start(spawner: Spawner) {
     // Settings: the compiled-in defaults with what flash holds replayed over them.
     let mut flash = settings::flash(r.settings);
     let restored = settings::restore(settings::read(&mut flash).await);
-    let mut switches = switches::new(r.switches);
+    // A spare axis fitted in the restored settings takes the supply senses' and USART1's pins for STEP/DIR 7-8
+    // (a settings choice, applied at this start: the configuration refuses sensed supplies beside it).
+    let spare = spare_renderer(&restored);
+    let (senses, uart) = match spare {
+        Some(_) => {
+            outputs::hold_spare(r.senses, r.uart);
+            (None, None)
+        }
+        None => (Some(r.senses), Some(r.uart)),
+    };
+    let mut switches = switches::new(r.switches, senses);
     let shared = share(restored.controller, &mut switches, restored.rig, watchdog_reset);
     let firmware = firmware();
-    shared.with(|c| {
-        c.set_firmware(firmware);
-        // STEP/DIR 7-8 (PA9, PA10, PA15, PC14) need DMA streams of their own from TIM1, which this board does not
-        // start yet: a fitted spare axis is refused rather than counted without pulses.
-        c.no_spare_outputs();
-    });
+    shared.with(|c| c.set_firmware(firmware));
 
-    steps::start(r.step_generator, restored.renderer, shared);
+    steps::start(
+        r.step_generator,
+        restored.renderer,
+        spare.map(|s| (r.spare_dma, s)),
+        shared,
+    );
     let (device, usb_link) = usb::new(r.usb);
-    let uart_link = uart::new(r.uart);
+    let uart_link = uart.map(uart::new);
 
     resources::set_priorities();
     watchdog::start(watchdog::NORMAL_US);
@@ -96,9 +111,23 @@ pub async fn start(spawner: Spawner) {
     spawner.spawn(defmt::unwrap!(switches::inputs_task(switches, shared)));
     spawner.spawn(defmt::unwrap!(usb::usb_task(device)));
     spawner.spawn(defmt::unwrap!(usb::link_task(usb_link, shared)));
-    spawner.spawn(defmt::unwrap!(uart::uart_link_task(uart_link, shared)));
+    if let Some(link) = uart_link {
+        spawner.spawn(defmt::unwrap!(uart::uart_link_task(link, shared)));
+    }
     spawner.spawn(defmt::unwrap!(settings::settings_task(flash, shared)));
     defmt::info!("ringpod firmware up: {} Hz control tick", 1_000_000 / restored.tick_us);
+}
+
+/// The spare axes' renderer (their pin map on the platform's slot grid) when the restored settings fit either.
+fn spare_renderer(restored: &settings::Restored) -> Option<PulseRenderer> {
+    if !restored.controller.config().pipeline.spare.iter().any(|a| a.enabled) {
+        return None;
+    }
+    // The map is a valid constant and the grid the platform's renderer accepted: this cannot fail.
+    match PulseRenderer::new(resources::SPARE_MAP, *restored.renderer.timing()) {
+        Ok(renderer) => Some(renderer),
+        Err(e) => defmt::panic!("the spare pin map: {}", e),
+    }
 }
 
 /// The firmware this is, with the image as flash holds it: from the start of flash to the end of `.data`'s initial

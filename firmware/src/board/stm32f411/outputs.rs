@@ -5,7 +5,7 @@ use embassy_stm32::gpio::{Level, Output, Speed};
 use ringpod_core::safety::pins::OutputPin;
 use ringpod_firmware::app::{self, control::Machine, Shared};
 
-use super::resources::{OutputPins, StepDirPins, PORT_MAP};
+use super::resources::{OutputPins, SensePins, StepDirPins, UartParts, PORT_MAP, SPARE_MAP};
 use super::watchdog;
 
 /// Relays, driver enable, cycle counter, watchdog: the control loop's hardware.
@@ -75,6 +75,22 @@ pub fn hold_step_dir(r: StepDirPins) {
     ];
     // Dropping an `Output` would make the pin an input again.
     core::mem::forget(step_dir);
+}
+
+/// STEP7 (PA9) and STEP8 (PA15) low, DIR7 (PA10) and DIR8 (PC14) at their idle level, as outputs for the life of the
+/// program, from the pins of the supply senses and the USART1 link. PC14 is in the backup domain: low speed only
+/// (the F411 datasheet's pin table: at most 2 MHz through the power switch), enough for a DIR level, which is set
+/// up microseconds before its step.
+pub fn hold_spare(senses: SensePins, uart: UartParts) {
+    let idle = SPARE_MAP.idle_word();
+    let level = |pin: u8| Level::from(idle & (1 << pin) != 0);
+    let spare = (
+        Output::new(senses.logic_ok, level(9), Speed::VeryHigh),
+        Output::new(uart.rx, level(10), Speed::VeryHigh),
+        Output::new(uart.tx, level(15), Speed::VeryHigh),
+        Output::new(senses.power_ok, level(14), Speed::Low),
+    );
+    core::mem::forget(spare);
 }
 
 #[embassy_executor::task]

@@ -9,6 +9,8 @@ use ringpod_core::motion::pulse::PortMap;
 bind_interrupts!(pub struct Irqs {
     OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
     USART1 => usart::BufferedInterruptHandler<peripherals::USART1>;
+    DMA2_STREAM1 => dma::InterruptHandler<peripherals::DMA2_CH1>;
+    DMA2_STREAM2 => dma::InterruptHandler<peripherals::DMA2_CH2>;
     DMA2_STREAM5 => dma::InterruptHandler<peripherals::DMA2_CH5>;
     EXTI0 => exti::InterruptHandler<interrupt::typelevel::EXTI0>;
     EXTI1 => exti::InterruptHandler<interrupt::typelevel::EXTI1>;
@@ -60,6 +62,25 @@ pub const PORT_MAP: PortMap = PortMap {
     dir_forward_low: 0,
 };
 
+/// The spare axes 7 and 8 as a renderer's axes 0 and 1 (STEP7 PA9, DIR7 PA10, STEP8 PA15, DIR8 PC14), on one
+/// word of bit positions shared by ports A and C: its [`SPARE_PORT_A`] bits go to `GPIOA.BSRR`, its
+/// [`SPARE_PORT_C`] bits to `GPIOC.BSRR` (PC14 is bit 14, a bit no port A pin of the map uses). Axes 2-5 are never
+/// given steps; their pins are only there to make a valid map and are masked off.
+pub const SPARE_MAP: PortMap = PortMap {
+    step: [9, 15, 0, 1, 2, 3],
+    dir: [10, 14, 4, 5, 6, 7],
+    dir_forward_low: 0,
+};
+/// The set and reset bits of STEP7 (PA9), DIR7 (PA10) and STEP8 (PA15) in [`SPARE_MAP`]'s words.
+pub const SPARE_PORT_A: u32 = set_reset(SPARE_MAP.step[0]) | set_reset(SPARE_MAP.dir[0]) | set_reset(SPARE_MAP.step[1]);
+/// The set and reset bits of DIR8 (PC14) in [`SPARE_MAP`]'s words.
+pub const SPARE_PORT_C: u32 = set_reset(SPARE_MAP.dir[1]);
+
+/// A pin's set (BSy) and reset (BRy) bits in a BSRR word (RM0383 8.4.7).
+const fn set_reset(pin: u8) -> u32 {
+    (1 << pin) | (1 << (pin + 16))
+}
+
 assign_resources! {
     /// Driver enable (active low), the two supply relays and the auxiliary outputs.
     outputs: OutputPins {
@@ -84,7 +105,7 @@ assign_resources! {
         dir5: PB10,
         dir6: PB12,
     }
-    /// The switches and supply senses, each with its EXTI line (the order of `switches::SWITCH_BITS`).
+    /// The switches, each with its EXTI line (the order of `switches::SWITCH_BITS`).
     switches: SwitchPins {
         estop: PA0,
         estop_line: EXTI0,
@@ -104,6 +125,10 @@ assign_resources! {
         limit5_line: EXTI7,
         limit6: PA8,
         limit6_line: EXTI8,
+    }
+    /// The supply senses LOGIC_OK (PA9) and POWER_OK (PC14) with their EXTI lines; with a spare axis fitted, the
+    /// pins are STEP7 and DIR8.
+    senses: SensePins {
         logic_ok: PA9,
         logic_ok_line: EXTI9,
         power_ok: PC14,
@@ -114,13 +139,19 @@ assign_resources! {
         dma: DMA2_CH5,
         timer: TIM1,
     }
+    /// The spare axes' rings: TIM1's compare 1 paces DMA2 stream 1 into GPIOA's BSRR, compare 2 stream 2 into
+    /// GPIOC's (channel 6 both, RM0383 9.3.3, table 28).
+    spare_dma: SpareDmaParts {
+        port_a: DMA2_CH1,
+        port_c: DMA2_CH2,
+    }
     /// USB OTG FS on PA12 (D+) and PA11 (D-).
     usb: UsbParts {
         otg: USB_OTG_FS,
         dp: PA12,
         dm: PA11,
     }
-    /// USART1 on RX PA10 and TX PA15.
+    /// USART1 on RX PA10 and TX PA15; with a spare axis fitted, the pins are DIR7 and STEP8.
     uart: UartParts {
         usart: USART1,
         rx: PA10,

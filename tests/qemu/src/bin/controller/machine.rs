@@ -184,6 +184,12 @@ impl PortOutput for Port {
         self.pending_len = words.len();
         Ok(())
     }
+
+    /// Never called: this program's step generator is given no spare renderer (its plant has no spare axes), so
+    /// a call would be a fault, not steps dropped unseen.
+    fn write_spare(&mut self, _words: &[u32]) -> Result<(), Overrun> {
+        Err(Overrun)
+    }
 }
 
 impl Port {

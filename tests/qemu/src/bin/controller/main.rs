@@ -96,7 +96,7 @@ async fn inputs_task(mut pins: Pins, shared: &'static Shared) -> ! {
 
 #[embassy_executor::task]
 async fn steps_task(mut port: Port, renderer: PulseRenderer, shared: &'static Shared) -> ! {
-    app::steps::run(&mut port, renderer, shared).await
+    app::steps::run(&mut port, renderer, None, shared).await
 }
 
 #[embassy_executor::task]
