@@ -2,10 +2,10 @@
 //! and the browser's runs and the Windows build under Wine, arranged so that two cores are both at work:
 //!
 //! 1. The runners' build (seconds), then the Windows runner, in a target folder of its own (`target/windows`: a
-//!    cross-build holds the build folder's lock for minutes, and the other runners build in it), its cross-build at
-//!    the lowest CPU priority (`nice -n 19`: it takes only what the rest leaves, and never starves an answer the
-//!    rest waits for) from the start; its programs under Wine are held until `cargo test` is over. Its output is
-//!    written to `target/windows-runner.log` as it comes and printed whole at the end.
+//!    cross-build holds the build folder's lock for minutes, and the other runners build in it), its cross-build in
+//!    Linux's idle scheduling class (`chrt --idle 0`: it takes only what the rest leaves, and never starves an
+//!    answer the rest waits for) from the start; its programs under Wine are held until `cargo test` is over. Its
+//!    output is written to `target/windows-runner.log` as it comes and printed whole at the end.
 //! 2. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
 //!    optimised, with debug assertions) is the CLI the QEMU suite, the rehost run and the browser tests drive, named
 //!    to them in `RINGPOD_CLI`: no second, release, build of the host.

@@ -3,7 +3,7 @@
 //! 1. The MinGW-w64 cross compiler and Wine (installed with apt-get when missing and allowed, as QEMU is), and the
 //!    `x86_64-pc-windows-gnu` standard library (rustup).
 //! 2. A debug cross-build of the host's test programs, with `ringpod.exe` and the examples (`cargo test --no-run`),
-//!    at the lowest CPU priority (`nice -n 19`): it uses what the machine's other work leaves.
+//!    in Linux's idle scheduling class (`chrt --idle 0`): it uses only what the machine's other work leaves.
 //! 3. Beside them, a test-only `bcryptprimitives.dll` built from `tests/windows/bcryptprimitives.c`: Rust's standard
 //!    library imports `ProcessPrng` from it, which Wine 8 lacks.
 //! 4. The host's tests under Wine, unit and integration (`cargo test` with Wine as the target's runner): the
@@ -128,21 +128,23 @@ fn step(name: &str, run: impl FnOnce() -> Result<(), String>) -> Result<(), Stri
     result
 }
 
-/// `c` at the lowest CPU priority (`nice -n 19`): the cross-build takes only what the machine's other work leaves,
-/// so that it can run beside timing-sensitive tests (the test command's lanes) without starving them.
+/// `c` in Linux's idle scheduling class (`chrt --idle 0`, SCHED_IDLE, sched(7)): the cross-build runs only on what
+/// the machine's other work leaves, and a waking process of that work takes the core at once, so that it can run
+/// beside timing-sensitive tests (the test command's) without starving them; a task at `nice -n 19` still has a share
+/// of its own and the ordinary wake-up rules.
 fn yielding(c: Command) -> Command {
-    let mut niced = Command::new("nice");
-    niced.args(["-n", "19"]).arg(c.get_program()).args(c.get_args());
+    let mut idle = Command::new("chrt");
+    idle.args(["--idle", "0"]).arg(c.get_program()).args(c.get_args());
     if let Some(dir) = c.get_current_dir() {
-        niced.current_dir(dir);
+        idle.current_dir(dir);
     }
     for (key, value) in c.get_envs() {
         match value {
-            Some(v) => niced.env(key, v),
-            None => niced.env_remove(key),
+            Some(v) => idle.env(key, v),
+            None => idle.env_remove(key),
         };
     }
-    niced
+    idle
 }
 
 fn status(mut c: Command, what: &str) -> Result<(), String> {
@@ -403,16 +405,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_yielding_command_is_the_same_command_under_nice() {
+    fn a_yielding_command_is_the_same_command_in_the_idle_class() {
         let mut c = Command::new("cargo");
         c.args(["test", "--no-run"])
             .current_dir("/tmp")
             .env("A", "1")
             .env_remove("B");
         let n = yielding(c);
-        assert_eq!(n.get_program(), "nice");
+        assert_eq!(n.get_program(), "chrt");
         let args: Vec<_> = n.get_args().collect();
-        assert_eq!(args, ["-n", "19", "cargo", "test", "--no-run"]);
+        assert_eq!(args, ["--idle", "0", "cargo", "test", "--no-run"]);
         assert_eq!(n.get_current_dir(), Some(Path::new("/tmp")));
         let envs: Vec<_> = n.get_envs().collect();
         assert!(envs.contains(&(std::ffi::OsStr::new("A"), Some(std::ffi::OsStr::new("1")))));
