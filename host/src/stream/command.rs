@@ -45,6 +45,8 @@ pub enum Input {
         profile: Option<String>,
         /// Seconds without a new sample after which the stream ends.
         idle: f64,
+        /// The lap preview on, where the game's layout carries a lap position.
+        lap_preview: bool,
     },
 }
 
@@ -62,6 +64,8 @@ pub enum Datagrams {
         profile: Option<String>,
         /// Live for Speed's `OutSim Opts`, when given.
         outsim_opts: Option<crate::games::outsim2::Opts>,
+        /// The lap preview on, where the format carries a lap position.
+        lap_preview: bool,
     },
 }
 
@@ -187,7 +191,8 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
                     cue_config,
                     profile,
                     outsim_opts,
-                } => telemetry_decoder(*format, *outsim_opts, cue_config, profile)?,
+                    lap_preview,
+                } => telemetry_decoder(*format, *outsim_opts, cue_config, profile, *lap_preview)?,
             };
             let idle = positive("udp-idle", *idle, 1e6)?;
             let socket = std::net::UdpSocket::bind(addr).map_err(|reason| SourceError::Bind { addr: *addr, reason })?;
@@ -205,8 +210,15 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
             cue_config,
             profile,
             idle,
+            lap_preview,
         } => {
-            let decoder = telemetry_decoder(crate::games::TelemetryFormat::Text, None, cue_config, profile)?;
+            let decoder = telemetry_decoder(
+                crate::games::TelemetryFormat::Text,
+                None,
+                cue_config,
+                profile,
+                *lap_preview,
+            )?;
             let idle = positive("udp-idle", *idle, 1e6)?;
             let source = LiveSource {
                 receiver: shared_memory(*game)?,
@@ -267,9 +279,12 @@ pub(crate) fn telemetry_decoder(
     outsim_opts: Option<crate::games::outsim2::Opts>,
     cue_config: &Option<PathBuf>,
     profile: &Option<String>,
+    lap_preview: bool,
 ) -> Result<datagram::Decoder, SourceError> {
     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
-    let washout = crate::cueing::live::LiveCueing::new(config).map_err(SourceError::Washout)?;
+    let washout = crate::cueing::live::LiveCueing::new(config)
+        .map_err(SourceError::Washout)?
+        .with_lap_preview(lap_preview);
     let outsim_opts =
         crate::games::outsim2::Opts::chosen(format, outsim_opts, cue_config.as_deref(), profile.as_deref())?;
     Ok(datagram::Decoder::Telemetry {

@@ -30,7 +30,7 @@ fn telemetry_shm_becomes_a_shared_memory_job() {
     let job = args.job().unwrap();
     assert!(matches!(
         &job.input,
-        Input::Shm { game: Game::Rf2, cue_config: Some(c), profile: None, idle } if c.as_os_str() == "c.toml" && *idle == 9.0
+        Input::Shm { game: Game::Rf2, cue_config: Some(c), profile: None, idle, lap_preview: true } if c.as_os_str() == "c.toml" && *idle == 9.0
     ));
     assert!(job.capture.is_some());
     for other in [
