@@ -104,7 +104,8 @@ pub struct StreamArgs {
     /// format carries the car's lap position (the book's games table), the laps driven are kept and the optimal
     /// cueing's reference over its horizon is the best matching earlier lap's next seconds; a lap that departs from
     /// it fades the preview out. The classical washout has no horizon and is not changed.
-    #[arg(long, value_name = "ON|OFF", default_value = "on", value_parser = on_off, requires = "telemetry")]
+    #[arg(long, value_name = "ON|OFF", default_value = "on", value_parser = on_off, action = clap::ArgAction::Set)]
+    #[arg(requires = "telemetry")]
     #[arg(conflicts_with_all = NOT_TELEMETRY)]
     pub lap_preview: bool,
     /// With --cue-config: a profile of the cueing file (its `[profiles.NAME]` table overrides the base keys).

@@ -103,3 +103,26 @@ fn outsim_options_need_a_format_that_reads_outsim2() {
         }
     }
 }
+
+/// `--lap-preview` is on unless `off`, reaches the telemetry job, and goes only with a telemetry source.
+#[test]
+fn the_lap_preview_is_on_unless_off_and_only_for_telemetry() {
+    use crate::stream::command::Datagrams;
+    let preview = |extra: &[&str]| {
+        let args = parse(&[&["--telemetry-udp", "127.0.0.1:0"][..], extra].concat()).unwrap();
+        match args.job().unwrap().input {
+            Input::Udp {
+                holds: Datagrams::Telemetry { lap_preview, .. },
+                ..
+            } => lap_preview,
+            _ => panic!("a telemetry job"),
+        }
+    };
+    assert!(preview(&[]));
+    assert!(preview(&["--lap-preview", "on"]));
+    assert!(!preview(&["--lap-preview", "off"]));
+    assert!(parse(&["--telemetry-udp", "127.0.0.1:0", "--lap-preview", "maybe"]).is_err());
+    assert!(parse(&["--udp", "127.0.0.1:0", "--lap-preview", "off"]).is_err());
+    assert!(parse(&["--motion", "sine", "--lap-preview", "on"]).is_err());
+    assert!(parse(&["--motion", "sine"]).is_ok(), "the default needs no telemetry");
+}
