@@ -7,7 +7,8 @@
 use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout, HANDOVER_S};
 
 use crate::cueing::engine::Engine;
-use crate::cueing::lap::{self, LapPreview, LapTrack};
+use crate::cueing::lap::{self, LapPreview};
+use crate::cueing::lap_track::LapTrack;
 use crate::cueing::optimal::{Counts, Envelope};
 use crate::games::LapPosition;
 
@@ -200,6 +201,7 @@ impl LiveCueing {
     }
 
     /// The first sample of a stream.
+    #[cfg(test)]
     pub fn begin(&mut self, sample: &Telemetry<f64>) -> Result<[f64; 6], SampleError> {
         self.begin_at(sample, None)
     }

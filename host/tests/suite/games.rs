@@ -374,18 +374,32 @@ fn a_multi_lap_f1_drive_engages_the_lap_preview_live() {
     });
     for (code, report, said) in [&on, &off] {
         assert_eq!(*code, Some(0), "{report} {said}");
-        assert_eq!(report["setpoints_applied"].as_u64(), Some(450), "one pose per motion packet: {report}");
+        assert_eq!(
+            report["setpoints_applied"].as_u64(),
+            Some(450),
+            "one pose per motion packet: {report}"
+        );
     }
     let lap = &on.1["datagrams"]["lap_preview"];
     let n = |k: &str| lap[k].as_u64().unwrap_or_else(|| panic!("{k} in {lap}"));
-    assert_eq!((n("laps"), n("kept"), n("departures"), n("bad_distance")), (2, 2, 0, 0), "{lap}");
-    assert!(lap["previewed_s"].as_f64().unwrap() > 8.0, "previewed most of laps 2 and 3: {lap}");
+    assert_eq!(
+        (n("laps"), n("kept"), n("departures"), n("bad_distance")),
+        (2, 2, 0, 0),
+        "{lap}"
+    );
+    assert!(
+        lap["previewed_s"].as_f64().unwrap() > 8.0,
+        "previewed most of laps 2 and 3: {lap}"
+    );
     assert_eq!(lap["state"]["lap"], 2, "{lap}");
     assert!(lap["state"]["matched"].is_u64(), "{lap}");
     assert_eq!(lap["state"]["confidence"], 1.0, "{lap}");
     assert!(on.2.contains("lap preview: 2 laps (2 kept as references)"), "{}", on.2);
     assert!(off.1["datagrams"].get("lap_preview").is_none(), "{}", off.1);
-    let (a, b) = (numbers(&on.1["last_applied_pose"]), numbers(&off.1["last_applied_pose"]));
+    let (a, b) = (
+        numbers(&on.1["last_applied_pose"]),
+        numbers(&off.1["last_applied_pose"]),
+    );
     assert!(
         a.iter().zip(&b).any(|(x, y)| (x - y).abs() > 1e-4),
         "the preview moves the platform otherwise: {a:?} against {b:?}"

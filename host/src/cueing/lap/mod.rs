@@ -19,9 +19,7 @@ use ringpod_core::cueing::{Telemetry, G};
 use serde::Serialize;
 
 mod report;
-mod track;
 pub use report::{Counts, State};
-pub use track::LapTrack;
 
 /// What the optimal cueing's reference over its horizon is made of.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum, Serialize)]
