@@ -432,4 +432,40 @@ mod tests {
             .optimal_counts()
             .is_none());
     }
+
+    /// The laps driven are the stream's, not the tuning's: a reload of the cueing file keeps them, the match
+    /// and the preview's share, and the new engine plans on the preview at once.
+    #[test]
+    fn a_retune_keeps_the_lap_preview() {
+        let optimal = CueConfig {
+            algorithm: Algorithm::Optimal,
+            ..CueConfig::default()
+        };
+        let mut c = LiveCueing::new(optimal).unwrap().with_lap_preview(true);
+        c.place(ranges().into());
+        // Laps of 4 s: braking over the first second, at rest after.
+        let at = |k: usize| {
+            let s = (k % 400) as f64 / 400.0;
+            let force = if s < 0.25 { [-6.0, 0.0, G] } else { [1.0, 0.0, G] };
+            (Telemetry { force, rate: [0.0; 3] }, Some(LapPosition::Along(s)))
+        };
+        let (first, lap) = at(0);
+        c.begin_at(&first, lap).unwrap();
+        for k in 1..1000 {
+            let (s, lap) = at(k);
+            c.step_at(&s, 0.01, lap).unwrap();
+        }
+        let before = c.lap_counts().unwrap();
+        assert_eq!((before.laps, before.kept), (2, 2), "{before:?}");
+        assert_eq!(before.state.unwrap().confidence, 1.0);
+        let mut heavier = optimal;
+        heavier.optimal.force_weight = [2.0; 3];
+        assert!(c.retune(heavier).unwrap());
+        let (s, lap) = at(1000);
+        assert_eq!(c.ahead(&s, 0.01, lap).len(), 8, "the new engine's horizon previewed");
+        let after = c.lap_counts().unwrap();
+        assert_eq!((after.laps, after.kept), (before.laps, before.kept));
+        assert_eq!(after.state.unwrap().matched, before.state.unwrap().matched);
+        assert_eq!(after.state.unwrap().confidence, 1.0);
+    }
 }
