@@ -148,10 +148,11 @@ pub struct Sample {
 /// | `ac`, `acc` (shared memory) | `normalizedCarPosition` of the graphics page | along, fraction |
 /// | `iracing` (shared memory) | `LapDistPct` | along, fraction |
 /// | `rf2`, `lmu` (shared memory) | the player's `mLapDist` over `mScoringInfo.mLapDist` | along, fraction |
+/// | `ams2` (shared memory) | the viewed participant's `mCurrentLapDistance` over `mTrackLength` | along, fraction |
 ///
 /// None: `outsim` and `outsim2` (LFS's OutSim has no lap distance; its `OSO_DISTANCE` is not read), `beamng`
 /// (MotionSim carries motion only), `xplane` (an aircraft has no lap), Forza's Sled size (232 bytes: motion only),
-/// `ams2` (not read yet: its participant array's `mCurrentLapDistance`), `ets2` (a truck's route has no lap).
+/// `ets2` (a truck's route has no lap).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LapPosition {
     /// The distance along the lap, growing from the line and wrapping to 0 there: metres, or a fraction of the lap.
