@@ -289,6 +289,7 @@ impl StreamArgs {
                     cue_config: self.cue_config.clone(),
                     profile: self.profile.clone(),
                     outsim_opts: self.outsim_opts,
+                    lap_preview: self.lap_preview,
                 },
             ),
             (None, None, Some(game), _) => Input::Shm {
@@ -296,6 +297,7 @@ impl StreamArgs {
                 cue_config: self.cue_config.clone(),
                 profile: self.profile.clone(),
                 idle: self.udp_idle,
+                lap_preview: self.lap_preview,
             },
             (None, None, None, Some(path)) => Input::File {
                 path: path.clone(),

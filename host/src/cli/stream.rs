@@ -100,6 +100,14 @@ pub struct StreamArgs {
     /// is refused.
     #[arg(long, requires = "telemetry", conflicts_with_all = NOT_TELEMETRY)]
     pub cue_config: Option<std::path::PathBuf>,
+    /// With --telemetry-udp or --telemetry-shm: the lap preview (`on`, the default, or `off`). Where the game's
+    /// format carries the car's lap position (the book's games table), the laps driven are kept and the optimal
+    /// cueing's reference over its horizon is the best matching earlier lap's next seconds; a lap that departs from
+    /// it fades the preview out. The classical washout has no horizon and is not changed.
+    #[arg(long, value_name = "ON|OFF", default_value = "on", value_parser = on_off, action = clap::ArgAction::Set)]
+    #[arg(requires = "telemetry")]
+    #[arg(conflicts_with_all = NOT_TELEMETRY)]
+    pub lap_preview: bool,
     /// With --cue-config: a profile of the cueing file (its `[profiles.NAME]` table overrides the base keys).
     #[arg(long, requires = "cue_config", conflicts_with_all = NOT_TELEMETRY)]
     pub profile: Option<String>,
@@ -183,3 +191,12 @@ fn refuse_shm(_: &str) -> Result<crate::games::shm::Game, String> {
 
 #[cfg(test)]
 mod tests;
+
+/// `on` or `off`.
+fn on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        other => Err(format!("`{other}`: on or off")),
+    }
+}

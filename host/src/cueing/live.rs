@@ -7,7 +7,23 @@
 use ringpod_core::cueing::{Algorithm, ConfigError, CueConfig, SampleError, Telemetry, Washout, HANDOVER_S};
 
 use crate::cueing::engine::Engine;
+use crate::cueing::lap::{self, LapPreview};
+use crate::cueing::lap_track::LapTrack;
 use crate::cueing::optimal::{Counts, Envelope};
+use crate::games::LapPosition;
+
+/// The lap preview of a stream: the laps driven, and the stream's own clock (the sum of its samples' intervals:
+/// no wall clock, so that the same stream gives the same preview).
+#[derive(Debug, Clone)]
+struct Laps {
+    preview: LapPreview,
+    track: LapTrack,
+    clock: f64,
+}
+
+/// What the stream's clock skips at a restart (s): more than the preview's longest interval, so that it takes the
+/// restart as a pause and does not follow the lap across it.
+const RESTART_SKIP_S: f64 = 2.0;
 
 /// A stream's cueing.
 pub struct LiveCueing {
@@ -29,6 +45,8 @@ pub struct LiveCueing {
     retired: Counts,
     /// Whether an optimal cueing has run.
     optimal_ran: bool,
+    /// The lap preview, when on: kept across retunes (the laps driven do not depend on the tuning).
+    laps: Option<Laps>,
 }
 
 /// The handover's weight of the new engine after `elapsed` seconds: smooth from 0 to 1 over [`HANDOVER_S`].
@@ -55,7 +73,42 @@ impl LiveCueing {
             restarted_from: None,
             retired: Counts::default(),
             optimal_ran: false,
+            laps: None,
         })
+    }
+
+    /// With the lap preview on or off: on, the optimal cueing's reference over its horizon is the best matching
+    /// earlier lap's next seconds wherever the samples carry a lap position ([`LiveCueing::step_at`]); the
+    /// classical washout has no horizon and is not changed.
+    pub fn with_lap_preview(mut self, on: bool) -> Self {
+        self.laps = on.then(|| Laps {
+            preview: LapPreview::new(lap::Settings::default()),
+            track: LapTrack::default(),
+            clock: 0.0,
+        });
+        self
+    }
+
+    /// What the lap preview did and its state, when it is on.
+    pub fn lap_counts(&self) -> Option<lap::Counts> {
+        self.laps.as_ref().map(|l| l.preview.counts())
+    }
+
+    /// The lap preview's reference for the running engine after `dt` more seconds at `sample`, on `lap`: empty
+    /// without a preview, a lap position or a horizon.
+    fn ahead(&mut self, sample: &Telemetry<f64>, dt: f64, lap: Option<LapPosition>) -> Vec<Telemetry<f64>> {
+        let Some(laps) = &mut self.laps else {
+            return Vec::new();
+        };
+        laps.clock += dt.max(0.0);
+        if let Some(position) = lap {
+            let d = laps.track.distance(laps.clock, position);
+            laps.preview.observe(laps.clock, d, sample);
+        }
+        match self.engine.as_ref().and_then(Engine::horizon) {
+            Some((n, h)) => laps.preview.ahead(sample, n, h),
+            None => Vec::new(),
+        }
     }
 
     /// The platform's envelope about home: the optimal cueing plans in it.
@@ -148,7 +201,15 @@ impl LiveCueing {
     }
 
     /// The first sample of a stream.
+    #[cfg(test)]
     pub fn begin(&mut self, sample: &Telemetry<f64>) -> Result<[f64; 6], SampleError> {
+        self.begin_at(sample, None)
+    }
+
+    /// The first sample of a stream, on `lap` when the source says where the vehicle is on its lap.
+    pub fn begin_at(&mut self, sample: &Telemetry<f64>, lap: Option<LapPosition>) -> Result<[f64; 6], SampleError> {
+        // Observed only: a first sample has no interval to plan over.
+        let _ = self.ahead(sample, 0.0, lap);
         if let Some((old, _)) = &mut self.fading {
             old.begin(sample)?;
         }
@@ -161,16 +222,30 @@ impl LiveCueing {
 
     /// One sample after `dt` seconds.
     pub fn step(&mut self, sample: &Telemetry<f64>, dt: f64) -> Result<[f64; 6], SampleError> {
+        self.step_at(sample, dt, None)
+    }
+
+    /// One sample after `dt` seconds, on `lap` when the source says where the vehicle is on its lap.
+    pub fn step_at(
+        &mut self,
+        sample: &Telemetry<f64>,
+        dt: f64,
+        lap: Option<LapPosition>,
+    ) -> Result<[f64; 6], SampleError> {
+        let ahead = self.ahead(sample, dt, lap);
+        let horizon = self.engine.as_ref().and_then(Engine::horizon);
         if let Some(e) = &mut self.engine {
             if self.fresh {
                 e.begin(sample)?;
                 self.fresh = false;
             } else {
-                e.step(sample, dt, &[])?;
+                e.step(sample, dt, &ahead)?;
             }
         }
         if let Some((old, elapsed)) = &mut self.fading {
-            old.step(sample, dt, &[])?;
+            // The reference is made for the running engine's horizon: an old engine of another takes none.
+            let old_ahead = if old.horizon() == horizon { &ahead[..] } else { &[] };
+            old.step(sample, dt, old_ahead)?;
             *elapsed += dt;
         }
         if let Some((_, elapsed)) = &mut self.restarted_from {
@@ -213,6 +288,9 @@ impl LiveCueing {
     /// Back to neutral (a gap, a restarted game): the handover ends, a pending change is taken, and the offset the
     /// cueing had is blended out over [`HANDOVER_S`] rather than left in one step.
     pub fn reset(&mut self) {
+        if let Some(laps) = &mut self.laps {
+            laps.clock += RESTART_SKIP_S;
+        }
         self.restarted_from = Some((self.offset(), 0.0));
         self.fade_out();
         if let Some(config) = self.pending.take() {
@@ -353,5 +431,41 @@ mod tests {
             .unwrap()
             .optimal_counts()
             .is_none());
+    }
+
+    /// The laps driven are the stream's, not the tuning's: a reload of the cueing file keeps them, the match
+    /// and the preview's share, and the new engine plans on the preview at once.
+    #[test]
+    fn a_retune_keeps_the_lap_preview() {
+        let optimal = CueConfig {
+            algorithm: Algorithm::Optimal,
+            ..CueConfig::default()
+        };
+        let mut c = LiveCueing::new(optimal).unwrap().with_lap_preview(true);
+        c.place(ranges().into());
+        // Laps of 4 s: braking over the first second, at rest after.
+        let at = |k: usize| {
+            let s = (k % 400) as f64 / 400.0;
+            let force = if s < 0.25 { [-6.0, 0.0, G] } else { [1.0, 0.0, G] };
+            (Telemetry { force, rate: [0.0; 3] }, Some(LapPosition::Along(s)))
+        };
+        let (first, lap) = at(0);
+        c.begin_at(&first, lap).unwrap();
+        for k in 1..1000 {
+            let (s, lap) = at(k);
+            c.step_at(&s, 0.01, lap).unwrap();
+        }
+        let before = c.lap_counts().unwrap();
+        assert_eq!((before.laps, before.kept), (2, 2), "{before:?}");
+        assert_eq!(before.state.unwrap().confidence, 1.0);
+        let mut heavier = optimal;
+        heavier.optimal.force_weight = [2.0; 3];
+        assert!(c.retune(heavier).unwrap());
+        let (s, lap) = at(1000);
+        assert_eq!(c.ahead(&s, 0.01, lap).len(), 8, "the new engine's horizon previewed");
+        let after = c.lap_counts().unwrap();
+        assert_eq!((after.laps, after.kept), (before.laps, before.kept));
+        assert_eq!(after.state.unwrap().matched, before.state.unwrap().matched);
+        assert_eq!(after.state.unwrap().confidence, 1.0);
     }
 }

@@ -77,6 +77,8 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
             force: [ay + gravity[0], -ax + gravity[1], -az + G * up_z],
             rate: [roll_rate, -pitch_rate, yaw_rate],
         },
+        // MotionSim carries motion only.
+        lap: None,
     })
 }
 

@@ -42,8 +42,9 @@
 //! | force z | `g * sqrt(1 - forward.y^2 - right.y^2)`: no heave beyond the attitude's |
 //! | rate | 0: none published |
 //! | time | total time |
+//! | lap | float 2, lap distance (m, from the line; a rally stage's distance never wraps, and gives no preview) |
 
-use super::{add, gravity_from_axes, Format, Le, Sample, Telemetry, Unreadable, G};
+use super::{add, gravity_from_axes, Format, LapPosition, Le, Sample, Telemetry, Unreadable, G};
 
 /// The packet's size: 66 floats.
 pub const SIZE: usize = 66 * 4;
@@ -69,6 +70,7 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
             force: add([G * longitudinal, G * lateral, 0.0], gravity),
             rate: [0.0; 3],
         },
+        lap: Some(LapPosition::Along(float(2))),
     })
 }
 
@@ -129,5 +131,17 @@ mod tests {
         let mut nan = good;
         nan[34 * 4..35 * 4].copy_from_slice(&f32::NAN.to_le_bytes());
         assert!(super::super::decode(Format::Codemasters, &nan).is_err());
+    }
+
+    /// Float 2, the lap distance, written channel by channel.
+    #[test]
+    fn extradata_3_carries_the_lap_distance() {
+        for d in [0.0, 1234.5, 4999.0] {
+            let p = super::super::packets::codemasters::on_lap(10.0, d, RIGHT, FORWARD, 0.0, 0.0);
+            assert_eq!(
+                decoded(Format::Codemasters, &p).lap,
+                Some(LapPosition::Along(f64::from(d)))
+            );
+        }
     }
 }

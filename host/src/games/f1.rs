@@ -52,8 +52,25 @@
 //! | force z | `g * m_gForceVertical + g * sqrt(1 - forward.y^2 - right.y^2)` |
 //! | rate | 0: the motion packet has no angular rates (the cue comes from the forces alone) |
 //! | time | `m_sessionTime` |
+//! | lap | `m_lapDistance` of the player's car in the latest lap data packet (below) |
+//!
+//! ## Lap distance
+//!
+//! The motion packet has no lap distance: the lap data packet (id 2, "Frequency: Rate as specified in menus", as
+//! the motion packet's) has it for every car, `LapData m_lapData[22]` after the header, then two bytes
+//! (`m_timeTrialPBCarIdx`, `m_timeTrialRivalCarIdx`). The player's car is the header's `m_playerCarIndex`.
+//! `m_lapDistance` is an f32 in metres, "Distance vehicle is around current lap in metres – could be negative if
+//! line hasn't been crossed yet"; where it lies in `LapData` differs by year:
+//!
+//! | format | `LapData` | packet | `m_lapDistance` at | why |
+//! |---|---|---|---|---|
+//! | 2023 | 50 bytes | 1131 | 18 | after `m_deltaToCarInFrontInMS`, `m_deltaToRaceLeaderInMS` (u16 each) |
+//! | 2024, 2025 | 57 bytes | 1285 | 20 | those deltas split into `..MSPart` (u16) and `..MinutesPart` (u8) |
+//!
+//! [`Reader`](super::Reader) keeps the player's last lap distance and gives it with each motion sample, so that a
+//! motion sample's lap is at most one of the game's frames old.
 
-use super::{add, gravity_from_axes, Format, Le, Sample, Telemetry, Unreadable, G};
+use super::{add, gravity_from_axes, Format, LapPosition, Le, Sample, Telemetry, Unreadable, G};
 
 /// The header's size.
 pub const HEADER: usize = 29;
@@ -133,7 +150,29 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
             force: add([G * longitudinal, G * lateral, G * vertical], gravity),
             rate: [0.0; 3],
         },
+        // In the lap data packet: the reader adds it.
+        lap: None,
     })
+}
+
+/// The lap data packet's id.
+pub const LAP_DATA: u8 = 2;
+
+/// The player's lap distance (m) from a lap data packet (id 2) of F1 23, 24 or 25, or `None` for any other
+/// datagram (another packet, another size, spectating).
+pub fn lap(bytes: &[u8]) -> Option<LapPosition> {
+    if !header_fits(bytes) || bytes[6] != LAP_DATA {
+        return None;
+    }
+    let (car, at) = match Le(bytes).u16(0) {
+        2023 => (50, 18),
+        _ => (57, 20),
+    };
+    if bytes.len() != HEADER + CARS * car + 2 {
+        return None;
+    }
+    let player = usize::from(bytes[27]);
+    (player < CARS).then(|| LapPosition::Along(Le(bytes).f32(HEADER + car * player + at)))
 }
 
 #[cfg(test)]
@@ -239,5 +278,39 @@ mod tests {
         let at = HEADER + 2 * CAR + 36;
         p[at..at + 4].copy_from_slice(&f32::INFINITY.to_le_bytes());
         assert!(super::super::decode(Format::F1, &p).is_err());
+    }
+
+    /// The lap data packet of each year, every car's `LapData` written field by field: the player's
+    /// `m_lapDistance` (not another car's), and the reader gives it with the next motion packets.
+    #[test]
+    fn the_players_lap_distance_comes_from_the_lap_data_packet() {
+        use super::super::packets::f1::lap_data;
+        use super::super::{Reader, TelemetryFormat};
+        for format in [2023u16, 2024, 2025] {
+            for player in [0u8, 5, 21] {
+                let p = lap_data(format, player, 10.0, 2345.5);
+                assert_eq!(lap(&p), Some(LapPosition::Along(2345.5)), "{format} slot {player}");
+                assert!(matches!(decode(&p), Err(Unreadable::Skipped { .. })), "no motion in it");
+            }
+            let p = lap_data(format, 5, 10.0, -12.0);
+            assert_eq!(lap(&p), Some(LapPosition::Along(-12.0)), "before the line: negative");
+            assert_eq!(lap(&p[..p.len() - 1]), None, "{format}: another size");
+            let mut spectating = p.clone();
+            spectating[27] = SPECTATING;
+            assert_eq!(lap(&spectating), None);
+            let motion = packet(format, 0, 5, LEVEL_F, LEVEL_R, [0.0; 3]);
+            assert_eq!(lap(&motion), None, "the motion packet has none");
+            for asked in [TelemetryFormat::Game(Format::F1), TelemetryFormat::Auto] {
+                let mut r = Reader::new(asked, None);
+                assert_eq!(r.read(&motion).unwrap().unwrap().lap, None, "no lap data yet");
+                assert_eq!(r.read(&p).unwrap(), None, "the lap data packet is no sample");
+                assert_eq!(r.read(&motion).unwrap().unwrap().lap, Some(LapPosition::Along(-12.0)));
+                r.read(&lap_data(format, 5, 10.1, 3.5)).unwrap();
+                assert_eq!(r.read(&motion).unwrap().unwrap().lap, Some(LapPosition::Along(3.5)));
+            }
+            // A text reader takes nothing from F1's packets.
+            let mut text = Reader::new(TelemetryFormat::Text, None);
+            assert!(text.read(&p).is_err());
+        }
     }
 }

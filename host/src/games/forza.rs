@@ -44,6 +44,7 @@
 //! | rate pitch | `AngularVelocityX` |
 //! | rate yaw | `-AngularVelocityY` |
 //! | time | `TimestampMS / 1000` |
+//! | lap | Dash: `DistanceTraveled` (m) and `LapNumber` (u16) at 280 and 300 (Horizon: 292 and 312); Sled: none |
 //!
 //! The documentation gives the axes, not the sense of the rotations nor whether the acceleration holds gravity.
 //! Two real Forza Motorsport 7 laps (forza-telemetry, `austinbaccus/forza-telemetry`, `data/laguna-seca.csv` and
@@ -55,7 +56,7 @@
 //! assumed (body roll and road banking confound it; the roll rate agrees with the angle's derivative): check it
 //! with a capture (at rest on a camber sloping down to the right, force y > 0).
 
-use super::{add, gravity_from_attitude, Format, Le, Sample, Telemetry, Unreadable};
+use super::{add, gravity_from_attitude, Format, LapPosition, Le, Sample, Telemetry, Unreadable};
 
 /// Sled.
 pub const SLED: usize = 232;
@@ -102,6 +103,24 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
             force: add([az, -ax, ay], gravity_from_attitude(-pitch, -roll)),
             rate: [-wz, wx, -wy],
         },
+        lap: lap(bytes),
+    })
+}
+
+/// `DistanceTraveled` (f32, m) and `LapNumber` (u16) of a Dash packet: 48 and 68 bytes into the Dash fields (after
+/// position, speed, power, torque, four tyre temperatures, boost and fuel; and after the three lap times and
+/// `CurrentRaceTime`), which start at 232 (FM7, FM 2023) or 244 (Horizon's 12 bytes of its own first). Sled has
+/// neither.
+fn lap(bytes: &[u8]) -> Option<LapPosition> {
+    let dash = match bytes.len() {
+        DASH_FM7 | DASH_FM2023 => SLED,
+        HORIZON => SLED + 12,
+        _ => return None,
+    };
+    let le = Le(bytes);
+    Some(LapPosition::Travelled {
+        distance: le.f32(dash + 48),
+        lap: u32::from(le.u16(dash + 68)),
     })
 }
 
@@ -164,5 +183,24 @@ mod tests {
         let mut nan = good;
         nan[24..28].copy_from_slice(&f32::NAN.to_le_bytes());
         assert!(super::super::decode(Format::Forza, &nan).is_err());
+    }
+
+    /// Dash (each size) carries `DistanceTraveled` and `LapNumber`, written field by field; Sled neither.
+    #[test]
+    fn dash_carries_the_distance_travelled_and_the_lap_number() {
+        use super::super::packets::forza::on_lap;
+        for size in [DASH_FM7, HORIZON, DASH_FM2023] {
+            let p = on_lap(size, 1, 5, [0.0; 3], [0.0; 3], [0.0; 3], (4321.5, 7));
+            assert_eq!(
+                decoded(Format::Forza, &p).lap,
+                Some(LapPosition::Travelled {
+                    distance: 4321.5,
+                    lap: 7
+                }),
+                "{size}"
+            );
+        }
+        let sled = on_lap(SLED, 1, 5, [0.0; 3], [0.0; 3], [0.0; 3], (4321.5, 7));
+        assert_eq!(decoded(Format::Forza, &sled).lap, None);
     }
 }

@@ -134,6 +134,37 @@ pub struct Sample {
     pub time: Option<f64>,
     /// Specific force and angular rates in ringpod's vehicle axes.
     pub telemetry: Telemetry<f64>,
+    /// Where the vehicle is on its lap, when the format carries it (the lap preview aligns laps by it).
+    pub lap: Option<LapPosition>,
+}
+
+/// Where the vehicle is on its lap, as the game's layout says it. Which formats carry it:
+///
+/// | format | field | kind |
+/// |---|---|---|
+/// | `f1` | `m_lapDistance` of the player's car in the lap data packet (id 2) | along, m |
+/// | `forza` (Dash and Horizon sizes) | `DistanceTraveled` and `LapNumber` | travelled, m |
+/// | `codemasters` | float 2, lap distance | along, m |
+/// | `ac`, `acc` (shared memory) | `normalizedCarPosition` of the graphics page | along, fraction |
+/// | `iracing` (shared memory) | `LapDistPct` | along, fraction |
+/// | `rf2`, `lmu` (shared memory) | the player's `mLapDist` over `mScoringInfo.mLapDist` | along, fraction |
+/// | `ams2` (shared memory) | the viewed participant's `mCurrentLapDistance` over `mTrackLength` | along, fraction |
+///
+/// None: `outsim` and `outsim2` (LFS's OutSim has no lap distance; its `OSO_DISTANCE` is not read), `beamng`
+/// (MotionSim carries motion only), `xplane` (an aircraft has no lap), Forza's Sled size (232 bytes: motion only),
+/// `ets2` (a truck's route has no lap).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LapPosition {
+    /// The distance along the lap, growing from the line and wrapping to 0 there: metres, or a fraction of the lap.
+    Along(f64),
+    /// The distance travelled in the session (m) and the lap's number: the lap's distance is what was travelled
+    /// since the number last changed.
+    Travelled {
+        /// Distance since the session's start (m).
+        distance: f64,
+        /// The lap's number.
+        lap: u32,
+    },
 }
 
 /// Why a datagram was not used.

@@ -62,6 +62,7 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
     Ok(Sample {
         time: Some(f64::from(le.u32(0)) / 1000.0),
         telemetry: main(le, 4),
+        lap: None,
     })
 }
 

@@ -275,6 +275,7 @@ pub fn decode(bytes: &[u8], opts: Option<Opts>) -> Result<Sample, Unreadable> {
     Ok(Sample {
         time: packet.time,
         telemetry,
+        lap: None,
     })
 }
 

@@ -13,7 +13,7 @@
 //! `auto`'s run, nor counts against a lock.
 
 use super::outsim2::Opts;
-use super::{decode_with, parse_telemetry, recognise, Format, Sample, TelemetryFormat, Unreadable};
+use super::{decode_with, parse_telemetry, recognise, Format, LapPosition, Sample, TelemetryFormat, Unreadable};
 
 /// Datagrams in a row of one format before `auto` locks onto it: at a game's 60 Hz or more, under a tenth of a
 /// second; more than a stray or two.
@@ -49,6 +49,8 @@ pub struct Reader {
     /// Changes of format past the kept ones.
     pub locks_dropped: u64,
     news: Option<String>,
+    /// F1's last lap distance of the player's car: its lap data packet, given with the next motion samples.
+    f1_lap: Option<LapPosition>,
 }
 
 impl Reader {
@@ -65,6 +67,7 @@ impl Reader {
             locks: Vec::new(),
             locks_dropped: 0,
             news: None,
+            f1_lap: None,
         }
     }
 
@@ -102,8 +105,31 @@ impl Reader {
     /// One datagram: its sample, `None` for another of the game's packets (skipped), or why it is not used.
     pub fn read(&mut self, bytes: &[u8]) -> Result<Option<Sample>, String> {
         self.datagrams += 1;
+        let f1 = matches!(self.asked, TelemetryFormat::Game(Format::F1) | TelemetryFormat::Auto);
+        if f1 {
+            if let Some(lap) = super::f1::lap(bytes) {
+                self.f1_lap = Some(lap);
+            }
+        }
+        let mut read = self.read_one(bytes);
+        // F1's motion packet has no lap distance: the lap data packet's, at most a frame old.
+        if let Ok(Some(sample)) = &mut read {
+            if f1 && sample.lap.is_none() && super::f1::header_fits(bytes) {
+                sample.lap = self.f1_lap;
+            }
+        }
+        read
+    }
+
+    fn read_one(&mut self, bytes: &[u8]) -> Result<Option<Sample>, String> {
         match self.asked {
-            TelemetryFormat::Text => parse_telemetry(bytes).map(|(time, telemetry)| Some(Sample { time, telemetry })),
+            TelemetryFormat::Text => parse_telemetry(bytes).map(|(time, telemetry)| {
+                Some(Sample {
+                    time,
+                    telemetry,
+                    lap: None,
+                })
+            }),
             TelemetryFormat::Game(f) => skipping(decode_with(f, bytes, self.outsim_opts)),
             TelemetryFormat::Auto => match self.locked {
                 Some(f) => self.locked_read(f, bytes),

@@ -93,6 +93,7 @@ pub fn decode(bytes: &[u8]) -> Result<Sample, Unreadable> {
             force: [G * axial, -G * side, G * normal],
             rate: [p, -q, -r],
         },
+        lap: None,
     })
 }
 

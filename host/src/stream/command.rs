@@ -7,7 +7,9 @@ use std::path::PathBuf;
 
 use super::live::{LiveSource, Receiver};
 use super::{datagram, exit, Motion, Options, Report, Source};
+use crate::cueing::live::LiveCueing;
 use crate::error::CliError;
+use crate::games::TelemetryFormat;
 use crate::input::{files, numbers};
 use crate::link::{self, client};
 use crate::out::console;
@@ -36,7 +38,7 @@ pub enum Input {
         /// Seconds without a readable datagram after which the stream ends.
         idle: f64,
     },
-    /// A game's shared memory (Windows), its telemetry cued by the washout.
+    /// A game's shared memory (Windows), its telemetry cued by the washout (`lap_preview`: the lap preview on).
     Shm {
         /// The game.
         game: crate::games::shm::Game,
@@ -45,6 +47,7 @@ pub enum Input {
         profile: Option<String>,
         /// Seconds without a new sample after which the stream ends.
         idle: f64,
+        lap_preview: bool,
     },
 }
 
@@ -54,14 +57,15 @@ pub enum Datagrams {
     Poses { degrees: bool },
     /// A motion front end's pose strings.
     Strings(Box<datagram::template::Template>),
-    /// Vehicle telemetry in a format, cued by the washout of a cueing file (or the defaults).
+    /// Vehicle telemetry in a format, cued by the washout of a cueing file (or the defaults), with a lap preview.
     Telemetry {
-        format: crate::games::TelemetryFormat,
+        format: TelemetryFormat,
         cue_config: Option<PathBuf>,
         /// A profile of the cueing file.
         profile: Option<String>,
         /// Live for Speed's `OutSim Opts`, when given.
         outsim_opts: Option<crate::games::outsim2::Opts>,
+        lap_preview: bool,
     },
 }
 
@@ -187,7 +191,8 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
                     cue_config,
                     profile,
                     outsim_opts,
-                } => telemetry_decoder(*format, *outsim_opts, cue_config, profile)?,
+                    lap_preview,
+                } => telemetry_decoder(*format, *outsim_opts, cue_config, profile, *lap_preview)?,
             };
             let idle = positive("udp-idle", *idle, 1e6)?;
             let socket = std::net::UdpSocket::bind(addr).map_err(|reason| SourceError::Bind { addr: *addr, reason })?;
@@ -205,8 +210,9 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
             cue_config,
             profile,
             idle,
+            lap_preview,
         } => {
-            let decoder = telemetry_decoder(crate::games::TelemetryFormat::Text, None, cue_config, profile)?;
+            let decoder = telemetry_decoder(TelemetryFormat::Text, None, cue_config, profile, *lap_preview)?;
             let idle = positive("udp-idle", *idle, 1e6)?;
             let source = LiveSource {
                 receiver: shared_memory(*game)?,
@@ -263,13 +269,16 @@ pub(crate) fn open(input: &Input) -> Result<(Source, Vec<super::InputError>), So
 
 /// A decoder of vehicle telemetry through the washout of the cueing file (or the defaults), watched for changes.
 pub(crate) fn telemetry_decoder(
-    format: crate::games::TelemetryFormat,
+    format: TelemetryFormat,
     outsim_opts: Option<crate::games::outsim2::Opts>,
     cue_config: &Option<PathBuf>,
     profile: &Option<String>,
+    lap_preview: bool,
 ) -> Result<datagram::Decoder, SourceError> {
     let config = crate::input::cueing::load_config(cue_config.as_deref(), profile.as_deref())?;
-    let washout = crate::cueing::live::LiveCueing::new(config).map_err(SourceError::Washout)?;
+    let washout = LiveCueing::new(config)
+        .map_err(SourceError::Washout)?
+        .with_lap_preview(lap_preview);
     let outsim_opts =
         crate::games::outsim2::Opts::chosen(format, outsim_opts, cue_config.as_deref(), profile.as_deref())?;
     Ok(datagram::Decoder::Telemetry {

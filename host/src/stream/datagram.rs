@@ -59,6 +59,15 @@ pub fn newest_input() -> Option<(Instant, Telemetry<f64>)> {
     *NEWEST_INPUT.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
+/// The lap preview of the session that cued the newest sample (its counts and state), and when: the workbench's
+/// Live view shows it.
+static NEWEST_LAP: std::sync::Mutex<Option<(Instant, crate::cueing::lap::Counts)>> = std::sync::Mutex::new(None);
+
+/// The newest lap preview's counts and state, and when they were taken.
+pub fn newest_lap() -> Option<(Instant, crate::cueing::lap::Counts)> {
+    *NEWEST_LAP.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 /// How often the cueing file is looked at while streaming.
 pub const WATCH_EVERY: Duration = Duration::from_millis(500);
 
@@ -213,6 +222,7 @@ impl Decoder {
         let games::Sample {
             time: t,
             telemetry: sample,
+            lap,
         } = read?;
         *NEWEST_INPUT.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some((now, sample));
         let dt = match *last {
@@ -220,9 +230,9 @@ impl Decoder {
             Some((Some(t0), _)) if t.is_some() => t.map(|t| t - t0),
             Some((_, arrived)) => Some(now.duration_since(arrived).as_secs_f64()),
         };
-        let offset = match dt.map(|dt| washout.step(&sample, dt)) {
+        let offset = match dt.map(|dt| washout.step_at(&sample, dt, lap)) {
             // The first sample: the washout's first input, at neutral.
-            None => washout.begin(&sample).map_err(|e| e.to_string()),
+            None => washout.begin_at(&sample, lap).map_err(|e| e.to_string()),
             Some(Ok(offset)) => Ok(offset),
             Some(Err(e @ (SampleError::NonFinite | SampleError::Implausible))) => Err(e.to_string()),
             Some(Err(SampleError::Interval)) if dt.is_some_and(|dt| !(-RESTARTED_S..=0.0).contains(&dt)) => {
@@ -230,12 +240,13 @@ impl Decoder {
                 // a replay): wash out to neutral and start again from here, this sample the first input.
                 *gaps += 1;
                 washout.reset();
-                washout.begin(&sample).map_err(|e| e.to_string())
+                washout.begin_at(&sample, lap).map_err(|e| e.to_string())
             }
             Some(Err(SampleError::Interval)) => Err("its time is not after the last one's".to_string()),
         };
         let offset = offset?;
         *last = Some((t, now));
+        *NEWEST_LAP.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = washout.lap_counts().map(|c| (now, c));
         Ok(cueing::pose(&neutral, &offset))
     }
 
@@ -314,6 +325,14 @@ impl Decoder {
         match self {
             Decoder::Poses { .. } | Decoder::Template { .. } => 0,
             Decoder::Telemetry { gaps, .. } => *gaps,
+        }
+    }
+
+    /// What the lap preview did (telemetry with the preview on only).
+    pub fn lap_counts(&self) -> Option<crate::cueing::lap::Counts> {
+        match self {
+            Decoder::Telemetry { washout, .. } => washout.lap_counts(),
+            _ => None,
         }
     }
 

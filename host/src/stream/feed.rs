@@ -327,6 +327,10 @@ pub(super) fn feed<T: Transport>(
             d.shared_memory = udp.receiver.shm_report();
             d.telemetry_gaps = udp.decoder.gaps();
             d.optimal = udp.decoder.optimal_counts().map(Into::into);
+            d.lap_preview = udp.decoder.lap_counts();
+            if let Some(c) = d.lap_preview.filter(|c| c.laps > 0 || c.bad_distance > 0) {
+                console::err(c.describe().trim_end());
+            }
             d.telemetry_format_locks = udp.decoder.locks();
             // Some were counted and not printed: the counts, once.
             if d.unreadable_by_kind

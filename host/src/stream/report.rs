@@ -56,6 +56,11 @@ pub struct DatagramReport {
     /// only), solve time p50/p99/max.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub optimal: Option<crate::cueing::optimal::CountsReport>,
+    /// Telemetry with the lap preview on: laps completed and kept, departures (each a fade of the preview),
+    /// samples without a usable lap distance, time previewed and departed, and the state at the end (the lap,
+    /// the lap it was matched to, the preview's share).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lap_preview: Option<crate::cueing::lap::Counts>,
     /// `--telemetry-shm`: the game, its mappings, and its samples, repeats, torn reads and stalls.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shared_memory: Option<super::live::ShmReport>,

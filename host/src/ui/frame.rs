@@ -174,6 +174,38 @@ pub struct Frame {
     pub streaming: bool,
     /// What the game asked of the cueing in the last half second (a telemetry session's newest sample).
     pub cue_input: Option<CueInput>,
+    /// The lap preview of a telemetry session that has it on, as of its newest sample in the last half second.
+    pub lap_preview: Option<LapPreview>,
+}
+
+/// The lap preview's state as the Live view shows it: the lap being driven, the earlier lap it is matched to (1
+/// the first), the preview's share of the reference, the alignment's error, and what it counted.
+#[derive(Debug, Clone, Copy, Serialize, PartialEq)]
+pub struct LapPreview {
+    pub lap: usize,
+    pub matched: Option<usize>,
+    pub confidence: f64,
+    pub error: f64,
+    pub laps: usize,
+    pub kept: usize,
+    pub departures: usize,
+}
+
+impl LapPreview {
+    /// The newest session's lap preview, if its last sample came within the last half second.
+    pub fn newest() -> Option<Self> {
+        let (at, c) = crate::stream::datagram::newest_lap()?;
+        let s = c.state?;
+        (at.elapsed() < std::time::Duration::from_millis(500)).then_some(Self {
+            lap: s.lap + 1,
+            matched: s.matched.map(|m| m + 1),
+            confidence: s.confidence,
+            error: s.error,
+            laps: c.laps,
+            kept: c.kept,
+            departures: c.departures,
+        })
+    }
 }
 
 /// A telemetry sample as the Live view shows it: specific force in g (x forward, y left, z up) and angular rate
@@ -225,6 +257,7 @@ pub fn frame(m: &RingPlatform<f64>, t: &Telemetry, link: LinkCounts, streaming: 
         gates: Gates::of(t, streaming),
         streaming,
         cue_input: CueInput::newest(),
+        lap_preview: LapPreview::newest(),
     }
 }
 

@@ -61,6 +61,10 @@ pub enum Request {
         /// `--outsim-opts`).
         #[serde(default)]
         outsim_opts: Option<String>,
+        /// The lap preview for telemetry that carries a lap position (as the CLI's `--lap-preview`; on unless
+        /// `false`).
+        #[serde(default = "default_lap_preview")]
+        lap_preview: bool,
     },
     /// A rig file's text, stored on the device (it must be `Off`), then the device restarted to run it.
     LoadRig {
@@ -70,6 +74,10 @@ pub enum Request {
 
 fn default_idle() -> f64 {
     30.0
+}
+
+fn default_lap_preview() -> bool {
+    true
 }
 
 impl Request {
@@ -211,6 +219,7 @@ mod tests {
                 idle: 30.0,
                 from: None,
                 outsim_opts: None,
+                lap_preview: true,
             }
         );
     }

@@ -257,12 +257,13 @@ impl Device {
                 idle,
                 from,
                 outsim_opts,
+                lap_preview,
             } => self.udp(
                 job.page,
                 *port,
                 holds,
                 format.as_deref(),
-                outsim_opts.as_deref(),
+                (outsim_opts.as_deref(), *lap_preview),
                 *degrees,
                 *idle,
                 *from,
@@ -356,7 +357,7 @@ impl Device {
         port: u16,
         holds: &str,
         format: Option<&str>,
-        outsim_opts: Option<&str>,
+        (outsim_opts, lap_preview): (Option<&str>, bool),
         degrees: bool,
         idle: f64,
         from: Option<std::net::IpAddr>,
@@ -381,6 +382,7 @@ impl Device {
                     cue_config: Some(self.hub.cue_file.clone()),
                     profile: None,
                     outsim_opts,
+                    lap_preview,
                 }
             }
             "strings" if outsim_opts.is_none() => {

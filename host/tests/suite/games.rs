@@ -307,3 +307,103 @@ fn shared_memory_is_refused_by_name_off_windows_and_with_other_sources() {
             .code(2);
     }
 }
+
+/// A lap of 200 m at 40 m/s (5 s) as F1 sends it at 30 Hz: each frame's motion packet, then its lap data packet
+/// (the player in slot 4 at the lap distance); braking at 8 m/s^2 from 30 m to 60 m, a left corner at 10 m/s^2
+/// from 80 m to 120 m, a right one at 8 from 150 m to 170 m, accelerating at 3 elsewhere.
+fn f1_lap_frame(k: u32) -> [Vec<u8>; 2] {
+    let t = k as f32 / 30.0;
+    let s = (40.0 * t) % 200.0;
+    let (long, lat) = match s {
+        s if (30.0..60.0).contains(&s) => (-8.0, 0.0),
+        s if (80.0..120.0).contains(&s) => (0.0, 10.0),
+        s if (150.0..170.0).contains(&s) => (0.0, -8.0),
+        _ => (3.0, 0.0),
+    };
+    let level = ([0.0, 0.0, 1.0], [1.0, 0.0, 0.0]);
+    [
+        packets::f1::packet(2024, 0, 4, t, level.0, level.1, [lat / G, long / G, 0.0]),
+        packets::f1::lap_data(2024, 4, t, s),
+    ]
+}
+
+/// Three laps of F1 packets over UDP to `stream --sim --telemetry-udp --telemetry-format f1` with the optimal
+/// cueing, the lap preview on (the default) and off, side by side, each frame at its own time: with it, the report
+/// counts two laps completed and kept, the third matched to an earlier one with the preview's whole share, and
+/// the last pose differs from the one without (the stream times the samples by the game's session time, so each
+/// run's motion does not depend on when the datagrams arrive); without it there is no preview in the report.
+#[test]
+fn a_multi_lap_f1_drive_engages_the_lap_preview_live() {
+    let config = concat!(env!("CARGO_MANIFEST_DIR"), "/../docs/drives/optimal.toml");
+    let run = |preview: &'static str| {
+        use std::io::Read;
+        let args = [
+            "--fast",
+            "--telemetry-udp",
+            "127.0.0.1:0",
+            "--telemetry-format",
+            "f1",
+            // Long enough that a stream starved of the processor for a moment on a busy machine (the optimal
+            // cueing of a debug build, two sessions side by side) does not take it for the end of the drive.
+            "--udp-idle",
+            "3",
+            "--cue-config",
+            config,
+            "--lap-preview",
+            preview,
+        ];
+        let (child, mut stderr, addr) = crate::common::spawn_live_stream(&args);
+        let socket = std::net::UdpSocket::bind("127.0.0.1:0").unwrap();
+        let start = Instant::now();
+        for k in 0..450u32 {
+            let due = start + Duration::from_micros(33_333 * u64::from(k));
+            std::thread::sleep(due.saturating_duration_since(Instant::now()));
+            for bytes in f1_lap_frame(k) {
+                socket.send_to(&bytes, &addr).unwrap();
+            }
+        }
+        let out = child.wait_with_output().unwrap();
+        let mut said = String::new();
+        stderr.read_to_string(&mut said).unwrap();
+        let report: serde_json::Value =
+            serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{preview}: {e}: {said}"));
+        (out.status.code(), report, said)
+    };
+    let (on, off) = std::thread::scope(|s| {
+        let on = s.spawn(|| run("on"));
+        let off = s.spawn(|| run("off"));
+        (on.join().unwrap(), off.join().unwrap())
+    });
+    for (code, report, said) in [&on, &off] {
+        assert_eq!(*code, Some(0), "{report} {said}");
+        assert_eq!(
+            report["setpoints_applied"].as_u64(),
+            Some(450),
+            "one pose per motion packet: {report}"
+        );
+    }
+    let lap = &on.1["datagrams"]["lap_preview"];
+    let n = |k: &str| lap[k].as_u64().unwrap_or_else(|| panic!("{k} in {lap}"));
+    assert_eq!(
+        (n("laps"), n("kept"), n("departures"), n("bad_distance")),
+        (2, 2, 0, 0),
+        "{lap}"
+    );
+    assert!(
+        lap["previewed_s"].as_f64().unwrap() > 8.0,
+        "previewed most of laps 2 and 3: {lap}"
+    );
+    assert_eq!(lap["state"]["lap"], 2, "{lap}");
+    assert!(lap["state"]["matched"].is_u64(), "{lap}");
+    assert_eq!(lap["state"]["confidence"], 1.0, "{lap}");
+    assert!(on.2.contains("lap preview: 2 laps (2 kept as references)"), "{}", on.2);
+    assert!(off.1["datagrams"].get("lap_preview").is_none(), "{}", off.1);
+    let (a, b) = (
+        numbers(&on.1["last_applied_pose"]),
+        numbers(&off.1["last_applied_pose"]),
+    );
+    assert!(
+        a.iter().zip(&b).any(|(x, y)| (x - y).abs() > 1e-4),
+        "the preview moves the platform otherwise: {a:?} against {b:?}"
+    );
+}

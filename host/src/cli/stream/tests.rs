@@ -30,7 +30,7 @@ fn telemetry_shm_becomes_a_shared_memory_job() {
     let job = args.job().unwrap();
     assert!(matches!(
         &job.input,
-        Input::Shm { game: Game::Rf2, cue_config: Some(c), profile: None, idle } if c.as_os_str() == "c.toml" && *idle == 9.0
+        Input::Shm { game: Game::Rf2, cue_config: Some(c), profile: None, idle, lap_preview: true } if c.as_os_str() == "c.toml" && *idle == 9.0
     ));
     assert!(job.capture.is_some());
     for other in [
@@ -102,4 +102,27 @@ fn outsim_options_need_a_format_that_reads_outsim2() {
             Err(e) => panic!("{format}: {e}"),
         }
     }
+}
+
+/// `--lap-preview` is on unless `off`, reaches the telemetry job, and goes only with a telemetry source.
+#[test]
+fn the_lap_preview_is_on_unless_off_and_only_for_telemetry() {
+    use crate::stream::command::Datagrams;
+    let preview = |extra: &[&str]| {
+        let args = parse(&[&["--telemetry-udp", "127.0.0.1:0"][..], extra].concat()).unwrap();
+        match args.job().unwrap().input {
+            Input::Udp {
+                holds: Datagrams::Telemetry { lap_preview, .. },
+                ..
+            } => lap_preview,
+            _ => panic!("a telemetry job"),
+        }
+    };
+    assert!(preview(&[]));
+    assert!(preview(&["--lap-preview", "on"]));
+    assert!(!preview(&["--lap-preview", "off"]));
+    assert!(parse(&["--telemetry-udp", "127.0.0.1:0", "--lap-preview", "maybe"]).is_err());
+    assert!(parse(&["--udp", "127.0.0.1:0", "--lap-preview", "off"]).is_err());
+    assert!(parse(&["--motion", "sine", "--lap-preview", "on"]).is_err());
+    assert!(parse(&["--motion", "sine"]).is_ok(), "the default needs no telemetry");
 }

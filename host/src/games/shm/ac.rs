@@ -41,6 +41,18 @@
 //! | rate pitch | `localAngularVel[0]` | assumed (about left) |
 //! | rate yaw | `localAngularVel[1]` | assumed (about up) |
 //! | time | none: the arrival time is used | the page has no time |
+//! | lap | `normalizedCarPosition` of the graphics page | a fraction of the lap, "Car position on the track's spline" |
+//!
+//! ## Lap position
+//!
+//! The graphics page (`SPageFileGraphic`, mapping `Local\acpmf_graphics`, the same header and pack) carries where
+//! the car is on the lap; its start is the same in both games (ACC's document lists the same members up to
+//! `normalizedCarPosition`): `packetId`, `status`, `session` (i32 at 0, 4, 8), `currentTime`, `lastTime`,
+//! `bestTime`, `split` (`wchar_t[15]` each, 12 to 131), `completedLaps` .. `iBestTime` (i32, 132 to 151),
+//! `sessionTimeLeft`, `distanceTraveled` (f32, 152, 156), `isInPit`, `currentSectorIndex`, `lastSectorTime`,
+//! `numberOfLaps` (i32, 160 to 175), `tyreCompound` (`wchar_t[33]`, 176 to 241, padded to 244),
+//! `replayTimeMultiplier` (f32, 244), `normalizedCarPosition` (f32 at 248). The page is read when it is there;
+//! without it the sample has no lap position (the preview stays off), never an error.
 //!
 //! A real lap of AC settles `accG`'s senses: AC's UDP remote telemetry sends the same vector in the same order
 //! (its document names the three floats vertical, horizontal and frontal, but they are x, y, z), and a recording
@@ -53,7 +65,7 @@
 //! check: accelerating must give force x > 0, a left turn force y > 0 and a positive yaw rate.
 
 use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
-use crate::games::{add, gravity_from_attitude, Telemetry, G};
+use crate::games::{add, gravity_from_attitude, LapPosition, Telemetry, G};
 
 /// The mapping of both games' physics page.
 pub const MAPPING: &str = r"Local\acpmf_physics";
@@ -61,6 +73,10 @@ pub const MAPPING: &str = r"Local\acpmf_physics";
 pub const AC_SIZE: usize = 568;
 /// ACC's `SPageFilePhysics` (through `waterTemp`, v1.8.12).
 pub const ACC_SIZE: usize = 716;
+/// The mapping of both games' graphics page.
+pub const GRAPHICS: &str = r"Local\acpmf_graphics";
+/// The graphics page's bytes read: through `normalizedCarPosition`.
+pub const GRAPHICS_SIZE: usize = 252;
 /// Assumed: the physics step.
 pub const RATE_HZ: f64 = 333.0;
 
@@ -76,6 +92,8 @@ pub mod at {
     pub const ROLL: usize = 216;
     /// `localAngularVel[3]`.
     pub const LOCAL_ANGULAR_VEL: usize = 296;
+    /// `normalizedCarPosition`, in the graphics page.
+    pub const NORMALIZED_CAR_POSITION: usize = 248;
 }
 
 /// The page's size in `game`.
@@ -87,8 +105,8 @@ pub fn size(game: Game) -> usize {
     }
 }
 
-/// Reads one physics page of `game` (AC or ACC).
-pub fn decode(game: Game, page: &[u8]) -> Result<Read, Unreadable> {
+/// Reads one physics page of `game` (AC or ACC), and the lap position from its graphics page when that is there.
+pub fn decode(game: Game, page: &[u8], graphics: &[u8]) -> Result<Read, Unreadable> {
     let size = size(game);
     if page.len() < size {
         return Err(Unreadable::size(game, MAPPING, page.len(), format!("{size} bytes")));
@@ -107,6 +125,8 @@ pub fn decode(game: Game, page: &[u8]) -> Result<Read, Unreadable> {
                 force,
                 rate: [wz, wx, wy],
             },
+            lap: (graphics.len() >= GRAPHICS_SIZE)
+                .then(|| LapPosition::Along(Bytes(graphics).f32(at::NORMALIZED_CAR_POSITION))),
         },
     })
 }

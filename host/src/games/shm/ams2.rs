@@ -10,7 +10,9 @@
 //! |---|---|---|
 //! | 0 | `mVersion` | u32, `SHARED_MEMORY_VERSION`: 8 or above has `mSequenceNumber` |
 //! | 8 | `mGameState` | u32: not used (AMS2 is reported to write 3, paused, while driving) |
-//! | 28-6427 | `mParticipantInfo[64]` | 100 bytes each: not read |
+//! | 20 | `mViewedParticipantIndex` | i32: the participant viewed (the player's car while driving) |
+//! | 28-6427 | `mParticipantInfo[64]` | 100 bytes each: `mIsActive` (bool), `mName` (char[64]), `mWorldPosition` (3 f32 at 68), `mCurrentLapDistance` (f32 at 80, "Metres"), then race position, laps, lap, sector |
+//! | 6704 | `mTrackLength` | f32, m, after the unfiltered inputs, car and class names, `mLapsInEvent`, track location and variation |
 //! | 6908-6919 | `mOrientation[3]` | f32, "Euler Angles" |
 //! | 6944-6955 | `mAngularVelocity[3]` | f32, "Radians per-second" |
 //! | 6956-6967 | `mLocalAcceleration[3]` | f32, "Metres per-second" (per second squared: an acceleration) |
@@ -50,6 +52,7 @@
 //! | rate pitch | `mAngularVelocity[0]` | a real recording |
 //! | rate yaw | `mAngularVelocity[1]` | a real recording |
 //! | time | none: the arrival time is used | the structure has no simulation clock |
+//! | lap | the viewed participant's `mCurrentLapDistance` over `mTrackLength` | a fraction of the lap; none without a positive length or a participant in range |
 //!
 //! Two real snapshots of AMS2 itself with cars at rest (sim-to-motec's `stm/ams2/test/ams2_inrace.bin` and
 //! `ams2_mp4_inpits.bin`, versions 13 and 14, `github.com/GeekyDeaks/sim-to-motec`) read `mLocalAcceleration` below
@@ -58,7 +61,7 @@
 //! y > 0 and a positive yaw rate) is the last check.
 
 use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
-use crate::games::{add, gravity_from_attitude, Telemetry};
+use crate::games::{add, gravity_from_attitude, LapPosition, Telemetry};
 
 /// The mapping.
 pub const MAPPING: &str = "$pcars2$";
@@ -81,6 +84,29 @@ pub mod at {
     pub const LOCAL_ACCELERATION: usize = 6956;
     /// `mSequenceNumber`.
     pub const SEQUENCE_NUMBER: usize = 7320;
+    /// `mViewedParticipantIndex`.
+    pub const VIEWED_PARTICIPANT: usize = 20;
+    /// `mParticipantInfo[0]`, and one participant's size.
+    pub const PARTICIPANTS: usize = 28;
+    /// `sizeof(ParticipantInfo)`.
+    pub const PARTICIPANT: usize = 100;
+    /// In a participant: `mCurrentLapDistance`.
+    pub const CURRENT_LAP_DISTANCE: usize = 80;
+    /// `mTrackLength`.
+    pub const TRACK_LENGTH: usize = 6704;
+}
+
+/// `STORED_PARTICIPANTS_MAX`.
+pub const PARTICIPANTS_MAX: usize = 64;
+
+/// The viewed participant's lap position: its lap distance over the track's length.
+fn lap(b: Bytes<'_>) -> Option<LapPosition> {
+    let i = usize::try_from(b.i32(at::VIEWED_PARTICIPANT)?)
+        .ok()
+        .filter(|i| *i < PARTICIPANTS_MAX)?;
+    let length = b.f32(at::TRACK_LENGTH);
+    let d = b.f32(at::PARTICIPANTS + i * at::PARTICIPANT + at::CURRENT_LAP_DISTANCE);
+    (length.is_finite() && length > 0.0).then(|| LapPosition::Along(d / length))
 }
 
 /// Reads one snapshot of `$pcars2$` (at least its first [`SIZE`] bytes).
@@ -115,6 +141,7 @@ pub fn decode(page: &[u8]) -> Result<Read, Unreadable> {
                 force: add([-az, ax, ay], gravity_from_attitude(pitch, roll)),
                 rate: [-wz, wx, wy],
             },
+            lap: lap(b),
         },
     })
 }

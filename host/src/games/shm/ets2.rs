@@ -110,6 +110,7 @@ pub fn decode(page: &[u8]) -> Result<Read, Unreadable> {
                 force: add([-az, -ax, ay], gravity_from_attitude(pitch, -roll)),
                 rate: [-wz, -wx, wy],
             },
+            lap: None,
         },
     })
 }

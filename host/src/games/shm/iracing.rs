@@ -35,13 +35,14 @@
 //! | rate pitch | `PitchRate` (float, rad/s) | assumed about left, nose down |
 //! | rate yaw | `YawRate` (float, rad/s) | assumed about up, turning left |
 //! | time | `SessionTime` (double, s, "Seconds since session start") | published |
+//! | lap | `LapDistPct` (float, %, "Percentage distance around lap"; a fraction 0 to 1 as the sim writes it) | read when there, else none |
 //!
 //! "Including gravity" makes the three accelerations the specific force ringpod wants, with nothing added. The
 //! descriptions do not give the senses: ringpod assumes iRacing's car axes are x forward, y left, z up
 //! (right-handed), as ringpod's own; a capture settles it. The sim publishes at `tickRate`, 60 Hz.
 
 use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
-use crate::games::Telemetry;
+use crate::games::{LapPosition, Telemetry};
 
 /// The SDK's mapping.
 pub const MAPPING: &str = r"Local\IRSDKMemMapFileName";
@@ -67,6 +68,8 @@ const DOUBLE: i32 = 5;
 pub const FLOATS: [&str; 6] = ["LongAccel", "LatAccel", "VertAccel", "RollRate", "PitchRate", "YawRate"];
 /// The double variable of the time.
 pub const TIME: &str = "SessionTime";
+/// The float variable of the lap position.
+pub const LAP: &str = "LapDistPct";
 
 /// Where the header says things are: variable headers and the latest buffer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -214,6 +217,8 @@ pub fn decode(map: &[u8]) -> Result<Read, Unreadable> {
         *slot = value(map, &at, name, FLOAT)?;
     }
     let time = value(map, &at, TIME, DOUBLE)?;
+    // The lap position is for the preview alone: without it the motion is whole.
+    let lap = value(map, &at, LAP, FLOAT).ok().map(LapPosition::Along);
     Ok(Read {
         tick: u64::from(at.tick),
         guard: Guard::of(map, 0, 48 + 16 * at.buf, 4),
@@ -223,6 +228,7 @@ pub fn decode(map: &[u8]) -> Result<Read, Unreadable> {
                 force: [v[0], v[1], v[2]],
                 rate: [v[3], v[4], v[5]],
             },
+            lap,
         },
     })
 }

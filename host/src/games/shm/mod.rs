@@ -6,8 +6,8 @@
 //!
 //! | game | module | mappings read |
 //! |---|---|---|
-//! | `ac` | [`ac`] | Assetto Corsa: `Local\acpmf_physics` (`SPageFilePhysics`) |
-//! | `acc` | [`ac`] | Assetto Corsa Competizione: `Local\acpmf_physics` (ACC's `SPageFilePhysics`) |
+//! | `ac` | [`ac`] | Assetto Corsa: `Local\acpmf_physics` (`SPageFilePhysics`), `Local\acpmf_graphics` (its start) |
+//! | `acc` | [`ac`] | Assetto Corsa Competizione: the same two, ACC's layouts |
 //! | `iracing` | [`iracing`] | iRacing: `Local\IRSDKMemMapFileName` (`irsdk_header`, variable headers, buffers) |
 //! | `rf2`, `lmu` | [`rf2`] | rFactor 2, Le Mans Ultimate: `$rFactor2SMMP_Telemetry$` and `$rFactor2SMMP_Scoring$` |
 //! | `ams2` | [`ams2`] | Automobilista 2, Project CARS 2: `$pcars2$` (`SharedMemory`) |
@@ -96,7 +96,7 @@ impl Game {
     /// The named mappings read, the first holding the sample's counter.
     pub fn mappings(self) -> &'static [&'static str] {
         match self {
-            Game::Ac | Game::Acc => &[ac::MAPPING],
+            Game::Ac | Game::Acc => &[ac::MAPPING, ac::GRAPHICS],
             Game::Iracing => &[iracing::MAPPING],
             Game::Rf2 | Game::Lmu => &[rf2::TELEMETRY, rf2::SCORING],
             Game::Ams2 => &[ams2::MAPPING],
@@ -251,7 +251,7 @@ impl Unreadable {
 pub fn decode(game: Game, snapshot: &Snapshot) -> Result<Read, Unreadable> {
     let page = |i: usize| snapshot.get(i).map_or(&[][..], Vec::as_slice);
     let read = match game {
-        Game::Ac | Game::Acc => ac::decode(game, page(0)),
+        Game::Ac | Game::Acc => ac::decode(game, page(0), page(1)),
         Game::Iracing => iracing::decode(page(0)),
         Game::Rf2 | Game::Lmu => rf2::decode(game, page(0), page(1)),
         Game::Ams2 => ams2::decode(page(0)),

@@ -45,9 +45,10 @@
 //! | rate pitch | `-mLocalRot.x` | published: +x pitches up (ringpod's positive pitch rate is nose down) |
 //! | rate yaw | `-mLocalRot.y` | published: +y yaws right |
 //! | time | `mElapsedTime` | published |
+//! | lap | the player's `mLapDist` over `mScoringInfo.mLapDist` (a fraction of the lap) | none while the length is not positive |
 
 use super::{Bytes, Game, Guard, Read, Sample, Unreadable};
-use crate::games::{add, gravity_from_axes, Telemetry};
+use crate::games::{add, gravity_from_axes, LapPosition, Telemetry};
 
 /// The telemetry buffer's mapping.
 pub const TELEMETRY: &str = "$rFactor2SMMP_Telemetry$";
@@ -90,6 +91,12 @@ pub mod scoring {
     pub const ID: usize = 0;
     /// `mIsPlayer`.
     pub const IS_PLAYER: usize = 196;
+    /// `mLapDist` (f64, m, "current distance around track"): after `mID`, `mDriverName[32]`, `mVehicleName[64]`,
+    /// `mTotalLaps` (i16), `mSector`, `mFinishStatus` (i8).
+    pub const LAP_DIST: usize = 104;
+    /// `mScoringInfo.mLapDist` (f64, m, "distance around track": the lap's length), after `mTrackName[64]`,
+    /// `mSession` (i32), `mCurrentET`, `mEndET` (f64), `mMaxLaps` (i32).
+    pub const TRACK_LENGTH: usize = 12 + 88;
 }
 
 /// The vehicles a buffer announces (its `mNumVehicles` at `at`, at most [`MAX_VEHICLES`]), and the bytes that
@@ -135,6 +142,18 @@ pub fn player(game: Game, page: &[u8]) -> Result<i32, Unreadable> {
         })
 }
 
+/// The player's lap position in a scoring snapshot [`player`] has found whole: `mLapDist` over the track's length
+/// (the scoring is written at 5 Hz, so the value moves in steps; the preview takes it as it comes).
+fn lap(page: &[u8]) -> Option<LapPosition> {
+    let b = Bytes(page);
+    let (n, _) = extent(page, scoring::NUM_VEHICLES, scoring::VEHICLES, scoring::VEHICLE)?;
+    let v = (0..n)
+        .map(|i| scoring::VEHICLES + i * scoring::VEHICLE)
+        .find(|v| b.u8(v + scoring::IS_PLAYER).is_some_and(|p| p != 0))?;
+    let length = b.f64(scoring::TRACK_LENGTH);
+    (length.is_finite() && length > 0.0).then(|| LapPosition::Along(b.f64(v + scoring::LAP_DIST) / length))
+}
+
 /// Reads the player's vehicle from snapshots of the telemetry and scoring mappings.
 pub fn decode(game: Game, page: &[u8], scoring: &[u8]) -> Result<Read, Unreadable> {
     let (n, need) = extent(page, telemetry::NUM_VEHICLES, telemetry::VEHICLES, telemetry::VEHICLE)
@@ -164,6 +183,7 @@ pub fn decode(game: Game, page: &[u8], scoring: &[u8]) -> Result<Read, Unreadabl
                 force: add([-az, ax, ay], gravity),
                 rate: [rz, -rx, -ry],
             },
+            lap: lap(scoring),
         },
     })
 }

@@ -66,7 +66,11 @@ pub fn now(game: Game, mem: &mut dyn Memory) -> Result<Now, Absent> {
 /// A snapshot of what the game's decoder reads, each mapping from its start.
 pub fn copy(game: Game, mem: &mut dyn Memory) -> Result<Vec<Vec<u8>>, Absent> {
     Ok(match game {
-        Game::Ac | Game::Acc => vec![bytes(mem, 0, 0, ac::size(game))?],
+        Game::Ac | Game::Acc => vec![
+            bytes(mem, 0, 0, ac::size(game))?,
+            // The lap position only: without the graphics page the sample has none.
+            bytes(mem, 1, 0, ac::GRAPHICS_SIZE).unwrap_or_default(),
+        ],
         Game::Iracing => vec![iracing_copy(mem)?],
         Game::Rf2 | Game::Lmu => {
             let t = rf2::telemetry::VEHICLES;

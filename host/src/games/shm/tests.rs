@@ -42,9 +42,17 @@ fn a_sample_is_written_as_a_text_line_that_reads_back_exactly() {
             force: [0.1 + 0.2, -3.0e-7, crate::games::G],
             rate: [1.0 / 3.0, 0.0, -2.5],
         },
+        lap: None,
     };
     let (t, telemetry) = crate::games::parse_telemetry(text_line(&sample).as_bytes()).unwrap();
-    assert_eq!(Sample { time: t, telemetry }, sample);
+    assert_eq!(
+        Sample {
+            time: t,
+            telemetry,
+            lap: None
+        },
+        sample
+    );
     let untimed = Sample { time: None, ..sample };
     assert_eq!(text_line(&untimed).split(' ').count(), 6);
 }

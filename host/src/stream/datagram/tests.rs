@@ -270,3 +270,94 @@ fn a_game_clock_that_starts_again_starts_the_cueing_again() {
     }
     assert_eq!(d.gaps(), 1);
 }
+
+/// A lap of 600 m at 40 m/s as F1 sends it: the motion packet (id 0) and then the lap data packet (id 2) of each
+/// frame at 30 Hz, the car braking at 8 m/s^2 from 100 m to 160 m, cornering at 10 m/s^2 to the left from 200 m to
+/// 300 m and at 8 to the right from 400 m to 460 m, accelerating at 3 elsewhere; the frame at `k`, its lap distance
+/// wrapping at the line.
+fn f1_frame(k: u32) -> [Vec<u8>; 2] {
+    use crate::games::packets::f1;
+    let t = k as f32 / 30.0;
+    let s = (40.0 * t) % 600.0;
+    let (long, lat) = match s {
+        s if (100.0..160.0).contains(&s) => (-8.0, 0.0),
+        s if (200.0..300.0).contains(&s) => (0.0, 10.0),
+        s if (400.0..460.0).contains(&s) => (0.0, -8.0),
+        _ => (3.0, 0.0),
+    };
+    let g = G as f32;
+    let motion = f1::packet(
+        2024,
+        0,
+        4,
+        t,
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 0.0],
+        [lat / g, long / g, 0.0],
+    );
+    [motion, f1::lap_data(2024, 4, t, s)]
+}
+
+/// Three laps of F1 packets through the stream's decoder with the optimal cueing, the lap preview `on` or off:
+/// the poses, and the preview's share after each motion sample.
+fn f1_laps(on: bool) -> (Vec<Pose<f64>>, Vec<f64>, Decoder) {
+    let config = ringpod_core::cueing::CueConfig {
+        algorithm: ringpod_core::cueing::Algorithm::Optimal,
+        ..Default::default()
+    };
+    let mut d = Decoder::Telemetry {
+        reader: Box::new(games::Reader::new(TelemetryFormat::Game(Format::F1), None)),
+        washout: Box::new(LiveCueing::new(config).unwrap().with_lap_preview(on)),
+        neutral: None,
+        last: None,
+        gaps: 0,
+        watch: None,
+    };
+    let ranges: crate::cueing::optimal::Ranges =
+        [(-0.05, 0.05), (-0.05, 0.05), (-0.03, 0.03), (-0.3, 0.3), (-0.3, 0.3)];
+    d.centre_on(Pose::new(0.0, 0.0, 0.227, 0.0, 0.0, 0.0), Some(ranges.into()));
+    let now = Instant::now();
+    let (mut poses, mut shares) = (Vec::new(), Vec::new());
+    for k in 0..3 * 450 {
+        let [motion, lap] = f1_frame(k);
+        poses.push(d.decode(&motion, now).unwrap().unwrap());
+        assert_eq!(d.decode(&lap, now).unwrap(), None, "the lap data packet is no pose");
+        shares.push(d.lap_counts().and_then(|c| c.state).map_or(0.0, |s| s.confidence));
+    }
+    (poses, shares, d)
+}
+
+/// A multi-lap F1 drive live: the preview engages after the first lap (it has no lap to match before), matches
+/// the second lap to the first, and moves the platform otherwise than without it from then on; identical before.
+#[test]
+fn the_lap_preview_engages_after_the_first_lap_and_changes_the_motion() {
+    let (with, shares, d) = f1_laps(true);
+    let (without, none, plain) = f1_laps(false);
+    assert!(plain.lap_counts().is_none() && none.iter().all(|s| *s == 0.0));
+    // Lap 1 (450 frames): nothing to match, the same motion to the bit.
+    assert!(shares[..450].iter().all(|s| *s == 0.0), "no preview on the first lap");
+    assert_eq!(with[..450], without[..450]);
+    let first = shares.iter().position(|s| *s > 0.0).expect("the preview engages");
+    assert!(
+        (450..540).contains(&first),
+        "engaged within 3 s of lap 2's start: frame {first}"
+    );
+    assert_eq!(shares[900..], vec![1.0; 450][..], "the whole third lap previewed");
+    let c = d.lap_counts().unwrap();
+    assert_eq!((c.laps, c.kept, c.departures, c.bad_distance), (2, 2, 0, 0), "{c:?}");
+    let s = c.state.unwrap();
+    assert_eq!((s.lap, s.matched.is_some()), (2, true), "{s:?}");
+    // The motion differs where the preview plans on what comes: by more than a millimetre or a milliradian.
+    let most = with[450..]
+        .iter()
+        .zip(&without[450..])
+        .map(|(a, b)| {
+            let (a, b) = (a.to_array(), b.to_array());
+            (0..3)
+                .map(|i| (a[i] - b[i]).abs() * 1000.0)
+                .chain((3..5).map(|i| (a[i] - b[i]).abs() * 1000.0))
+                .fold(0.0, f64::max)
+        })
+        .fold(0.0, f64::max);
+    assert!(most > 1.0, "the preview changes the motion: at most {most} mm or mrad");
+}

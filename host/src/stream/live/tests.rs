@@ -37,7 +37,8 @@ fn game(drive: Duration) -> Fake {
 /// after the last sample.
 fn stream(fake: Fake, capture: Option<(Box<crate::input::capture::CaptureWriter>, String)>) -> crate::stream::Report {
     let decoder =
-        crate::stream::command::telemetry_decoder(crate::games::TelemetryFormat::Text, None, &None, &None).unwrap();
+        crate::stream::command::telemetry_decoder(crate::games::TelemetryFormat::Text, None, &None, &None, true)
+            .unwrap();
     let source = Source::Live(LiveSource {
         receiver: Receiver::Shm(Box::new(ShmSource::new(Game::Ams2, Box::new(fake)))),
         decoder,

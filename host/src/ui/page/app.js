@@ -237,6 +237,9 @@ function showFrame(f) {
   const unit = state.rig ? state.rig.tick_unit : "";
   const rows = [["applied", f.applied], ["limited", f.limited], ["refused", f.refused], ["tick cost", `${f.tick_cost} ${unit}`],
     ["device time", f.t.toFixed(2) + " s"], ["streaming", f.streaming ? "yes" : "no"]];
+  // The lap preview of a telemetry session: the lap matched, the preview's share, and its departures (fades).
+  const lp = f.lap_preview;
+  if (lp) rows.push(["lap preview", `lap ${lp.lap}, ${lp.matched ? "matched to lap " + lp.matched : "no match"}, share ${lp.confidence.toFixed(2)}, ${lp.kept}/${lp.laps} laps kept, ${lp.departures} departures`]);
   $("counters").innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td id="count-${k.replace(" ", "-")}">${v}</td></tr>`).join("");
   remember(f);
   // A session of this page begins or ends streaming: the live charts go where the user tunes, or back.
@@ -342,6 +345,7 @@ $("run-udp").addEventListener("click", () => {
   const request = { do: "udp", port: +$("udp-port").value, holds, format, idle: +$("udp-idle").value };
   if ($("udp-from").value.trim()) request.from = $("udp-from").value.trim();
   if ($("udp-outsim-opts").value.trim()) request.outsim_opts = $("udp-outsim-opts").value.trim();
+  if (holds === "telemetry") request.lap_preview = $("udp-lap-preview").checked;
   startSession(request);
 });
 $("park").addEventListener("click", () => send({ do: "park" }));

@@ -134,8 +134,21 @@ pub mod codemasters {
     /// A packet written channel by channel as extradata 3 lists them: total time (s), the car's right and forward
     /// unit vectors (world, y up) and its g-forces, everything else plausible.
     pub fn packet(time: f32, right: [f32; 3], forward: [f32; 3], g_lat: f32, g_long: f32) -> Vec<u8> {
+        on_lap(time, 800.0, right, forward, g_lat, g_long)
+    }
+
+    /// A packet as [`packet`]'s, `lap_distance` metres into the lap (and as far into the session).
+    pub fn on_lap(
+        time: f32,
+        lap_distance: f32,
+        right: [f32; 3],
+        forward: [f32; 3],
+        g_lat: f32,
+        g_long: f32,
+    ) -> Vec<u8> {
         let mut w = Writer::default();
-        w.f32s(&[time, 35.0, 800.0, 800.0]); // total time, lap time, lap distance, total distance
+        // Total time, lap time, lap distance, total distance.
+        w.f32s(&[time, 35.0, lap_distance, lap_distance]);
         w.f32s(&[10.0, 1.0, 20.0]).f32(25.0).f32s(&[0.0, 0.0, 25.0]); // position, speed, velocity
         w.f32s(&right).f32s(&forward);
         w.f32s(&[0.0; 4]).f32s(&[0.0; 4]).f32s(&[25.0; 4]); // suspension position, velocity, wheel speed
@@ -201,6 +214,36 @@ pub mod f1 {
             }
         }
         assert_eq!(w.0.len(), 1349);
+        w.0
+    }
+
+    /// The lap data packet (id 2) of `format` at session time `time`, every car's `LapData` field by field as the
+    /// specification lists them (F1 23: 50 bytes, the time deltas in ms; F1 24 and 25: 57 bytes, each delta split
+    /// into its ms and minutes parts, and the speed trap's fastest speed and lap at the end): the player in slot
+    /// `player` at `lap_distance` m, every other car at 1234.5 m (so that reading the wrong car shows).
+    pub fn lap_data(format: u16, player: u8, time: f32, lap_distance: f32) -> Vec<u8> {
+        let mut w = header(format, 2, player, time);
+        for i in 0..22u8 {
+            let d = if i == player { lap_distance } else { 1234.5 };
+            // Last and current lap time (ms), sector 1 and 2 (ms and minutes parts).
+            w.u32(90_000).u32(30_000).u16(25_000).u8(0).u16(28_000).u8(0);
+            if format == 2023 {
+                w.u16(500).u16(1500); // to the car in front, to the leader (ms)
+            } else {
+                w.u16(500).u8(0).u16(1500).u8(0);
+            }
+            w.f32(d).f32(d + 10_000.0).f32(0.0); // lap distance, total distance, safety car delta
+            w.u8(i + 1).u8(3); // car position, current lap number
+                               // Pit status, pit stops, sector, lap invalid, penalties, warnings, corner cutting warnings, unserved
+                               // drive through and stop go penalties, grid position, driver status, result status, pit lane timer.
+            w.bytes(&[0, 0, 1, 0, 0, 0, 0, 0, 0, i + 1, 4, 2, 0]);
+            w.u16(0).u16(0).u8(0); // pit lane time, pit stop time, should serve penalty
+            if format != 2023 {
+                w.f32(310.0).u8(2); // speed trap fastest speed (km/h) and lap
+            }
+        }
+        w.u8(255).u8(255); // time trial PB and rival car
+        assert_eq!(w.0.len(), if format == 2023 { 1131 } else { 1285 });
         w.0
     }
 
@@ -313,11 +356,13 @@ pub mod forza {
         assert_eq!(w.0.len(), SLED);
     }
 
-    /// The Dash fields of FM7 (79 bytes).
-    fn dash(w: &mut Writer) {
+    /// The Dash fields of FM7 (79 bytes): position, speed, power, torque, tyre temperatures, then boost, fuel,
+    /// `DistanceTraveled` (`distance`), best, last and current lap, race time, `LapNumber` (`lap`), race position,
+    /// the inputs, gear, steer and driving line.
+    fn dash(w: &mut Writer, distance: f32, lap: u16) {
         w.f32s(&[1.0, 2.0, 3.0]).f32s(&[20.0, 1e5, 300.0]).f32s(&[80.0; 4]);
-        w.f32s(&[0.0, 40.0, 1500.0, 90.0, 91.0, 30.0, 300.0]);
-        w.u16(3).u8(1).u8(255).u8(0).u8(0).u8(0).u8(4).bytes(&[0, 0, 0]);
+        w.f32s(&[0.0, 40.0, distance, 90.0, 91.0, 30.0, 300.0]);
+        w.u16(lap).u8(1).u8(255).u8(0).u8(0).u8(0).u8(4).bytes(&[0, 0, 0]);
     }
 
     /// A packet of `size` (one of the four) with the given motion.
@@ -329,18 +374,31 @@ pub mod forza {
         ang_vel: [f32; 3],
         ypr: [f32; 3],
     ) -> Vec<u8> {
+        on_lap(size, race_on, time_ms, accel, ang_vel, ypr, (1500.0, 3))
+    }
+
+    /// A packet as [`packet`]'s, its Dash fields at `DistanceTraveled` and `LapNumber` `(distance, lap)`.
+    pub fn on_lap(
+        size: usize,
+        race_on: i32,
+        time_ms: u32,
+        accel: [f32; 3],
+        ang_vel: [f32; 3],
+        ypr: [f32; 3],
+        (distance, lap): (f32, u16),
+    ) -> Vec<u8> {
         let mut w = Writer::default();
         sled(&mut w, race_on, time_ms, accel, ang_vel, ypr);
         match size {
             SLED => {}
-            DASH_FM7 => dash(&mut w),
+            DASH_FM7 => dash(&mut w, distance, lap),
             HORIZON => {
                 w.zeros(12);
-                dash(&mut w);
+                dash(&mut w, distance, lap);
                 w.zeros(1);
             }
             DASH_FM2023 => {
-                dash(&mut w);
+                dash(&mut w, distance, lap);
                 w.f32s(&[0.1; 4]).i32(110);
             }
             _ => panic!("Forza sends no packet of {size} bytes"),

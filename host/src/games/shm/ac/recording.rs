@@ -79,7 +79,7 @@ fn real_corners_sway_towards_them() {
         let centripetal = speed * turn.abs() / dt;
         let braking = f64::from(last[1] - first[1]) / (f64::from(last[0] - first[0]) / 1000.0);
         let decoded = corner.iter().fold([0.0; 3], |sum, d| {
-            let f = decode(Game::Ac, &page(d)).unwrap().sample.telemetry.force;
+            let f = decode(Game::Ac, &page(d), &[]).unwrap().sample.telemetry.force;
             [sum[0] + f[0] / n, sum[1] + f[1] / n, sum[2] + f[2] / n]
         });
         let name = if left { "left" } else { "right" };

@@ -117,15 +117,63 @@ fn a_drive_decodes_in_ringpods_axes() {
 fn short_pages_and_garbage_are_refused() {
     let acc = page(Game::Acc, 1, [0.0; 3], [0.0; 3], 0.0, 0.0);
     assert!(matches!(
-        decode(Game::Acc, &acc[..AC_SIZE]),
+        decode(Game::Acc, &acc[..AC_SIZE], &[]),
         Err(Unreadable::Size { .. })
     ));
-    assert!(decode(Game::Ac, &acc[..AC_SIZE]).is_ok(), "AC's page is the shorter");
-    assert!(matches!(decode(Game::Ac, &[]), Err(Unreadable::Size { .. })));
+    assert!(
+        decode(Game::Ac, &acc[..AC_SIZE], &[]).is_ok(),
+        "AC's page is the shorter"
+    );
+    assert!(matches!(decode(Game::Ac, &[], &[]), Err(Unreadable::Size { .. })));
     let mut nan = acc.clone();
     nan[at::ACC_G..at::ACC_G + 4].copy_from_slice(&f32::NAN.to_le_bytes());
     assert!(matches!(
         decode_game(Game::Acc, &[nan]),
         Err(Unreadable::NotFinite { .. })
     ));
+}
+
+/// `SPageFileGraphic` as `SharedFileOut.h` declares it, through `normalizedCarPosition` (`wchar_t` is 2 bytes).
+fn graphics() -> Layout {
+    use C::{F32, I16, I32};
+    layout(
+        4,
+        &[
+            ("packetId, status, session", I32, 3),
+            ("currentTime, lastTime, bestTime, split", I16, 4 * 15),
+            ("completedLaps, position, iCurrentTime, iLastTime, iBestTime", I32, 5),
+            ("sessionTimeLeft, distanceTraveled", F32, 2),
+            ("isInPit, currentSectorIndex, lastSectorTime, numberOfLaps", I32, 4),
+            ("tyreCompound", I16, 33),
+            ("replayTimeMultiplier", F32, 1),
+            ("normalizedCarPosition", F32, 1),
+        ],
+    )
+}
+
+/// The graphics page gives the lap position when it is there; without it (or short) the sample has none and
+/// the motion is read all the same.
+#[test]
+fn the_graphics_page_gives_the_lap_position() {
+    let g = graphics();
+    assert_eq!(g.at("normalizedCarPosition"), at::NORMALIZED_CAR_POSITION);
+    assert_eq!(g.size, GRAPHICS_SIZE);
+    for game in [Game::Ac, Game::Acc] {
+        let physics = page(game, 3, [1.0, 2.0, 0.0], [0.0; 3], 0.0, 0.0);
+        for x in [0.0, 0.25, 0.999] {
+            let mut p = Page::zeros(g.size);
+            p.f32s(g.at("normalizedCarPosition"), &[x])
+                .f32s(g.at("sessionTimeLeft, distanceTraveled") + 4, &[9999.0]);
+            let read = decode_game(game, &[physics.clone(), p.0]).unwrap();
+            assert_eq!(
+                read.sample.lap,
+                Some(crate::games::LapPosition::Along(f64::from(x as f32)))
+            );
+        }
+        let read = decode_game(game, std::slice::from_ref(&physics)).unwrap();
+        assert_eq!(read.sample.lap, None, "no graphics page");
+        let short = decode_game(game, &[physics.clone(), vec![0; GRAPHICS_SIZE - 1]]).unwrap();
+        assert_eq!(short.sample.lap, None, "a short graphics page");
+        assert!(close(short.sample.telemetry.force, read.sample.telemetry.force));
+    }
 }

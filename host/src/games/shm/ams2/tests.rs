@@ -79,3 +79,46 @@ fn a_drive_decodes_and_an_odd_sequence_is_torn() {
     assert!(matches!(decode(&old), Err(Unreadable::Header { .. })));
     assert!(matches!(decode(&old[..SIZE - 1]), Err(Unreadable::Size { .. })));
 }
+
+/// The viewed participant's `mCurrentLapDistance` over `mTrackLength`, at the offsets the declared structure
+/// gives; none without a track length or with an index out of the participants.
+#[test]
+fn the_lap_position_is_the_viewed_participants_lap_distance_over_the_tracks() {
+    let l = shared_memory();
+    assert_eq!(l.at("mTrackLength"), at::TRACK_LENGTH);
+    assert_eq!(
+        l.at("mViewedParticipantIndex, mNumParticipants"),
+        at::VIEWED_PARTICIPANT
+    );
+    assert_eq!(l.at("mParticipantInfo"), at::PARTICIPANTS);
+    // ParticipantInfo as declared: bool, char[64], float[3], then mCurrentLapDistance.
+    let p = layout(
+        4,
+        &[
+            ("mIsActive", C::I8, 1),
+            ("mName", C::I8, 64),
+            ("mWorldPosition", C::F32, 3),
+            ("mCurrentLapDistance", C::F32, 1),
+            ("mRacePosition .. mCurrentSector", C::I32, 4),
+        ],
+    );
+    assert_eq!(
+        (p.size, p.at("mCurrentLapDistance")),
+        (at::PARTICIPANT, at::CURRENT_LAP_DISTANCE)
+    );
+    let with = |viewed: i32, length: f64| {
+        let mut page = Page(page(4, &DRIVE[0]));
+        page.i32(l.at("mViewedParticipantIndex, mNumParticipants"), viewed)
+            .f32s(l.at("mTrackLength"), &[length]);
+        for i in 0..64 {
+            let at = l.at("mParticipantInfo") + i * p.size + p.at("mCurrentLapDistance");
+            page.f32s(at, &[100.0 * i as f64]);
+        }
+        decode(&page.0).unwrap().sample.lap
+    };
+    assert_eq!(with(3, 1000.0), Some(crate::games::LapPosition::Along(0.3)));
+    assert_eq!(with(63, 10_000.0), Some(crate::games::LapPosition::Along(0.63)));
+    assert_eq!(with(3, 0.0), None, "no track length");
+    assert_eq!(with(64, 1000.0), None, "no such participant");
+    assert_eq!(with(-1, 1000.0), None);
+}

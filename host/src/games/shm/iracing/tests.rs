@@ -179,3 +179,21 @@ fn a_disconnected_sim_or_a_garbage_header_is_refused() {
     assert!(decode(&last).is_ok());
     assert!(matches!(decode(&last[..last.len() - 1]), Err(Unreadable::Size { .. })));
 }
+
+/// `LapDistPct` gives the lap position; a sim without it still gives the motion, without a lap position.
+#[test]
+fn lap_dist_pct_is_the_lap_position_when_the_sim_has_it() {
+    let with: Vec<Var> = VARS.iter().copied().chain([("LapDistPct", 4, 1)]).collect();
+    for x in [0.0, 0.5, 0.875] {
+        let read = decode(&mapping(&with, [3, 2, 1], &[("LapDistPct", x)], true)).unwrap();
+        assert_eq!(read.sample.lap, Some(crate::games::LapPosition::Along(x)));
+    }
+    assert_eq!(decode(&mapping(&VARS, [3, 2, 1], &[], true)).unwrap().sample.lap, None);
+    let mut doubled = with.clone();
+    doubled[10].1 = 5;
+    assert_eq!(
+        decode(&mapping(&doubled, [3, 2, 1], &[], true)).unwrap().sample.lap,
+        None,
+        "of another type: not read"
+    );
+}

@@ -237,3 +237,26 @@ fn torn_buffers_and_no_player_are_refused() {
         Err(Unreadable::Size { .. })
     ));
 }
+
+/// The player's `mLapDist` over the track's (`mScoringInfo.mLapDist`): a fraction of the lap; none while the
+/// track's length is not positive.
+#[test]
+fn the_lap_position_is_the_players_lap_distance_over_the_tracks() {
+    let (info, veh) = (scoring_info(), vehicle_scoring());
+    assert_eq!(12 + info.at("mLapDist"), scoring::TRACK_LENGTH);
+    assert_eq!(veh.at("mLapDist .. mCurSector2"), scoring::LAP_DIST);
+    let at = |i: usize| 12 + info.size + i * veh.size + veh.at("mLapDist .. mCurSector2");
+    let mut p = Page(scoring_page(2));
+    p.f64s(12 + info.at("mLapDist"), &[4000.0]);
+    for (i, d) in [100.0, 1000.0, 3900.0].iter().enumerate() {
+        // The player is the second vehicle; the others elsewhere on the lap.
+        p.f64s(at(0), &[d + 50.0])
+            .f64s(at(1), &[*d])
+            .f64s(at(2), &[10.0 * i as f64]);
+        let read = decode(Game::Rf2, &telemetry_page(5, 5, 1.0, &DRIVE[0]), &p.0).unwrap();
+        assert_eq!(read.sample.lap, Some(crate::games::LapPosition::Along(d / 4000.0)));
+    }
+    p.f64s(12 + info.at("mLapDist"), &[0.0]);
+    let read = decode(Game::Lmu, &telemetry_page(5, 5, 1.0, &DRIVE[0]), &p.0).unwrap();
+    assert_eq!(read.sample.lap, None, "no track length yet");
+}
