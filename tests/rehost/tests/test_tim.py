@@ -4,6 +4,19 @@ from models import tim as T
 from tests.helpers import Clock, Lines
 
 
+class Requests:
+    """A DMA stream's request line as the timer sees it: the requests it took, in `got[key]`, and its horizon."""
+
+    def __init__(self, got, key, horizon=None):
+        self.got, self.key, self.h = got, key, horizon
+
+    def __call__(self, n):
+        self.got[self.key] = self.got.get(self.key, 0) + n
+
+    def horizon(self):
+        return self.h
+
+
 def timer(bits=16):
     clock, lines = Clock(), Lines()
     return T.Tim("tim", clock, lines, irq_up=25, irq_cc=27, bits=bits), clock, lines
@@ -76,43 +89,24 @@ class TimTest(unittest.TestCase):
 
     def test_update_requests_go_to_the_dma_in_bulk(self):
         t, clock, _ = timer()
-        got = []
-
-        class Req:
-            def __call__(self, n):
-                got.append(n)
-
-            def horizon(self):
-                return 1200
-
-        t.update_dma.append(Req())
+        got = {}
+        t.update_dma.append(Requests(got, "up", 1200))
         t.write(T.Tim.ARR, 4, 239)
         t.write(T.Tim.DIER, 4, T.UDE)
         t.write(T.Tim.CR1, 4, T.CEN)
         self.assertEqual(t.next_event(0), 240 * 1200)  # the DMA's next interrupt, not every update
         clock.now = 240 * 500
         t.advance(clock.now)
-        self.assertEqual(sum(got), 500)
+        self.assertEqual(got["up"], 500)
         self.assertEqual(t.dma_requests, 500)
 
     def test_compare_requests_keep_step_with_the_updates(self):
         # the step generator's spare rings: CCR1 = CCR2 = ARR, one request per slot each, in the slot of the update's
         t, clock, _ = timer()
         got = {"up": 0, 0: 0, 1: 0}
-
-        class Req:
-            def __init__(self, key, horizon):
-                self.key, self.h = key, horizon
-
-            def __call__(self, n):
-                got[self.key] += n
-
-            def horizon(self):
-                return self.h
-
-        t.update_dma.append(Req("up", None))
-        t.cc_dma[0].append(Req(0, 1200))
-        t.cc_dma[1].append(Req(1, None))
+        t.update_dma.append(Requests(got, "up"))
+        t.cc_dma[0].append(Requests(got, 0, 1200))
+        t.cc_dma[1].append(Requests(got, 1))
         t.write(T.Tim.ARR, 4, 239)
         t.write(T.Tim.CCR[0], 4, 239)
         t.write(T.Tim.CCR[1], 4, 239)
@@ -129,22 +123,14 @@ class TimTest(unittest.TestCase):
 
     def test_compare_without_ccde_makes_no_request(self):
         t, clock, _ = timer()
-        got = []
-
-        class Req:
-            def __call__(self, n):
-                got.append(n)
-
-            def horizon(self):
-                return None
-
-        t.cc_dma[0].append(Req())
+        got = {}
+        t.cc_dma[0].append(Requests(got, 0))
         t.write(T.Tim.ARR, 4, 239)
         t.write(T.Tim.CCR[0], 4, 239)
         t.write(T.Tim.CR1, 4, T.CEN)
         clock.now = 240 * 100
         t.advance(clock.now)
-        self.assertEqual(got, [])
+        self.assertEqual(got, {})
         self.assertTrue(t.read(T.Tim.SR, 4) & T.CCIF[0])
 
 
