@@ -3,14 +3,15 @@
 //!
 //! 1. The runners' build (seconds), then the Windows runner, in a target folder of its own (`target/windows`: a
 //!    cross-build holds the build folder's lock for minutes, and the other runners build in it), its cross-build in
-//!    Linux's idle scheduling class (`chrt --idle 0`: it takes only what the rest leaves, and never starves an
-//!    answer the rest waits for) from the start; its programs under Wine are held until `cargo test` is over. Its
-//!    output is written to `target/windows-runner.log` as it comes and printed whole at the end.
+//!    Linux's idle scheduling class (`chrt --idle 0`: it takes only what the rest leaves) from the start, stopped
+//!    while `cargo test` runs; its programs under Wine are held until `cargo test` is over. Its output is written
+//!    to `target/windows-runner.log` as it comes and printed whole at the end.
 //! 2. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
 //!    optimised, with debug assertions) is the CLI the QEMU suite, the rehost run and the browser tests drive, named
 //!    to them in `RINGPOD_CLI`: no second, release, build of the host.
-//! 3. `cargo test`, with only the Windows cross-build beside it: most of its tests wait on a child `ringpod` in real
-//!    time, and a build at normal priority beside them would starve their answers.
+//! 3. `cargo test`, alone: the Windows cross-build is stopped meanwhile (`pause`, `go` on its standard input): most
+//!    of its tests wait on a child `ringpod` in real time, and any process keeping both cores busy, even in the idle
+//!    scheduling class, delays their answers past the CLI's 2 s. Eight test threads: they wait more than they work.
 //! 4. The QEMU suite, the rehost run and the browser tests, one after the other, their output as it comes, each
 //!    keeping about one core busy and waiting on real time; the Windows runner's programs under Wine beside them.
 //!
@@ -115,16 +116,19 @@ fn main() -> ExitCode {
     let (built, cli) = test_programs();
     let ready = built.passed && runners.passed;
     parts.extend([runners, built]);
+    let mut word = windows.as_mut().ok().and_then(|child| child.stdin.take());
     if ready {
+        // The Windows cross-build stopped while `cargo test` runs (see `ringpod_tests::gate`); the host's suite
+        // with eight test threads: its tests wait on child processes, 14 s of CPU in 256 s on two threads.
+        say(&mut word, "pause");
         let mut test = cargo();
-        test.args(["test", "--no-fail-fast"]);
+        test.args(["test", "--no-fail-fast"])
+            .env("RUST_TEST_THREADS", TEST_THREADS);
         parts.push(part("cargo test", test));
     }
-    // `cargo test` is over: the Windows runner's programs may run under Wine.
-    if let Some(mut go) = windows.as_mut().ok().and_then(|child| child.stdin.take()) {
-        // A runner that has ended already needs no signal; the pipe's end when `go` drops is one too.
-        let _ = go.write_all(b"go\n");
-    }
+    // `cargo test` is over: the cross-build goes on and the Windows runner's programs may run under Wine.
+    say(&mut word, "go");
+    drop(word);
     if ready {
         for name in ["qemu", "rehost", "browser"] {
             let mut c = runner(name);
@@ -153,6 +157,17 @@ fn main() -> ExitCode {
         took: started.elapsed(),
     });
     summary(&parts)
+}
+
+/// Test threads of `cargo test`: most of the host's tests wait on a child `ringpod` in real time, so that more of
+/// them side by side than cores shorten the run (256 s to 72 s for the host's suite) without starving any.
+const TEST_THREADS: &str = "8";
+
+/// A word to the Windows runner; one that has ended already needs none.
+fn say(to: &mut Option<std::process::ChildStdin>, word: &str) {
+    if let Some(w) = to {
+        let _ = writeln!(w, "{word}").and_then(|()| w.flush());
+    }
 }
 
 /// `cargo test --no-run`, its messages read for the `ringpod` it built (the runners' CLI), its diagnostics and

@@ -13,9 +13,10 @@
 //! 5. Each game of `--telemetry-shm` cued end to end: the example `shm_games.exe GAME` writes a drive into the
 //!    game's named mappings in its publisher's layout while `ringpod.exe stream --sim --telemetry-shm GAME` reads it.
 //!
-//! With `--hold-wine` it builds at once and waits for a line on its standard input (or its end) before step 4: the
-//! test command starts it first, so that the cross-build uses what its own builds and `cargo test` leave, and lets
-//! its programs run once `cargo test`, whose tests wait on child processes in real time, is over.
+//! With `--hold-wine` it follows the test command's word on its standard input ([`ringpod_tests::gate`]): the test
+//! command starts it first, so that the cross-build uses what its own build leaves; `pause` stops the cross-build
+//! while `cargo test`, whose tests wait on child processes in real time, runs; `go` (or the end of the input)
+//! continues it and lets step 4 begin.
 //!
 //! Wine runs in its own prefix under the target folder, so that a developer's `~/.wine` is not touched. Cargo's own
 //! `test result:` lines are passed through; the last line is the sum, `N passed, N failed`, and the exit status is 1
@@ -25,7 +26,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::Instant;
 
-use ringpod_tests::{setup, wine};
+use ringpod_tests::{gate, setup, wine};
 
 /// The Windows target the host is cross-built for.
 const TARGET: &str = "x86_64-pc-windows-gnu";
@@ -145,6 +146,14 @@ fn yielding(c: Command) -> Command {
         };
     }
     idle
+}
+
+/// The cross-build under the test command's gate: stopped while its `cargo test` runs.
+fn gated(gate: &gate::Gate, mut c: Command) -> Result<(), String> {
+    let s = gate.run(&mut c).map_err(|e| format!("cargo test --no-run: {e}"))?;
+    s.success()
+        .then_some(())
+        .ok_or_else(|| format!("cargo test --no-run failed ({s})"))
 }
 
 fn status(mut c: Command, what: &str) -> Result<(), String> {
@@ -324,15 +333,6 @@ fn cue_game(game: &str) -> Result<(), String> {
     ok.then_some(()).ok_or_else(|| "not cued end to end".into())
 }
 
-/// Waits for a line on standard input or its end: the test command's signal that `cargo test` is over.
-fn held() {
-    println!("== held until the test command's `cargo test` is over");
-    let started = Instant::now();
-    let mut line = String::new();
-    let _ = std::io::stdin().read_line(&mut line);
-    println!("== held for {:.0} s", started.elapsed().as_secs_f64());
-}
-
 fn main() -> ExitCode {
     let hold = match std::env::args().nth(1).as_deref() {
         None => false,
@@ -342,6 +342,8 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    // Held: the test command's word on standard input pauses the cross-build and lets the tests run.
+    let gate = hold.then(|| gate::Gate::following(std::io::BufReader::new(std::io::stdin())));
     let mut failed = 0u32;
     let mut passed = 0u32;
     let prepared = step("MinGW-w64 and Wine", setup::ensure_windows)
@@ -350,15 +352,17 @@ fn main() -> ExitCode {
             step("cross-build (debug)", || {
                 // The test programs, and with them `ringpod.exe` (the integration tests start it) and the examples
                 // (`shm_games.exe`, the games' stand-in): one build, no second one of the host with other features.
-                status(
-                    yielding(cargo(&["test", "-p", "ringpod", "--no-run"])),
-                    "cargo test --no-run",
-                )
+                let build = yielding(cargo(&["test", "-p", "ringpod", "--no-run"]));
+                match &gate {
+                    Some(gate) => gated(gate, build),
+                    None => status(build, "cargo test --no-run"),
+                }
             })
         })
         .and_then(|()| step("the ProcessPrng DLL", shim));
-    if hold {
-        held();
+    if let Some(gate) = &gate {
+        println!("== held until the test command's `cargo test` is over");
+        println!("== held for {:.0} s", gate.wait_open().as_secs_f64());
     }
     if let Err(e) = prepared {
         println!("FAIL {e}");
