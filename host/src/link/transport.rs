@@ -22,7 +22,9 @@ impl Serial {
         let builder = serialport::new(path, 921_600).timeout(Duration::from_millis(1));
         #[cfg(unix)]
         let port: Box<dyn serialport::SerialPort> = {
-            let port = builder.open_native()?;
+            // No wait in a read or a write: each polls the port (poll(2) with no timeout) and returns at once; see
+            // `receive` for why a read is not preceded by `bytes_to_read`.
+            let port = builder.timeout(Duration::ZERO).open_native()?;
             // Non-blocking: the bytes `bytes_to_read` counted can be taken by another process that opened the same
             // port before this one reads them, and a blocking read would then wait for the next byte, for good
             // and deaf to signals. A read that finds nothing now returns at once.
@@ -88,13 +90,22 @@ impl Transport for Serial {
         Ok(())
     }
     fn receive(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        // Never block: a read with nothing to read would wait out the port's timeout (1 ms) on every poll, and a
-        // 1 kHz stream has no millisecond to spare.
-        let ready = self.port.bytes_to_read().map_err(std::io::Error::from)? as usize;
-        if ready == 0 {
-            return Ok(0);
-        }
-        let want = ready.min(buf.len());
+        // Never block: a read with nothing to read would wait out the port's timeout on every poll, and a 1 kHz
+        // stream has no millisecond to spare. On Unix the port's timeout is zero and a read that finds nothing
+        // returns at once. Not `bytes_to_read` there: Linux answers FIONREAD on a terminal under the lock its input
+        // is delivered under, and polled every 200 us it held a pseudo-terminal's answers back for seconds while
+        // other processes kept both cores busy (a `stream` to `simulate --pty` beside two busy loops, even at
+        // nice 19, failed with no answer within 2 s; `poll(2)` takes no such lock).
+        #[cfg(unix)]
+        let want = buf.len();
+        #[cfg(not(unix))]
+        let want = {
+            let ready = self.port.bytes_to_read().map_err(std::io::Error::from)? as usize;
+            if ready == 0 {
+                return Ok(0);
+            }
+            ready.min(buf.len())
+        };
         match self.port.read(&mut buf[..want]) {
             Ok(n) => Ok(n),
             Err(e)
