@@ -306,7 +306,12 @@ impl<const N: usize> StepScheduler<N> {
         // target (a target beyond i64's reach saturated `want` toward it). A saturating i64 addition is a dozen
         // instructions on the M4F.
         self.position[i] = self.position[i].wrapping_add(m.signed());
-        self.last_step[i] = forget(m.last_step_ns() as i32);
+        // The last step's time as [`AxisMove::last_step_ns`], in wrapping arithmetic that never wraps here: the span is
+        // at most 1e9 ns and the count at most the span over the spacing, so `span + 2 count - 1 < 2^32`.
+        let span = (t.period - start) as u32;
+        let den = count.wrapping_mul(2);
+        let last_step = (start as u32).wrapping_add(span.wrapping_sub(span.wrapping_add(den - 1) / den));
+        self.last_step[i] = forget(last_step as i32);
         (m, short)
     }
 }
@@ -320,9 +325,18 @@ impl StepScheduler<6> {
     #[inline(never)]
     pub fn plan(&mut self, targets: &[i64; 6]) -> [AxisMove; 6] {
         let timing = self.timing;
-        let mut counted = false;
-        let mut axis = |i: usize| self.plan_counted(&timing, i, targets[i], &mut counted);
-        [axis(0), axis(1), axis(2), axis(3), axis(4), axis(5)]
+        let mut c = false;
+        let counted = &mut c;
+        // Each axis in line (the per-axis planner is always inlined): a call an axis, saving and restoring the
+        // registers and reloading the timing, costs about 20 instructions an axis.
+        [
+            self.plan_counted(&timing, 0, targets[0], counted),
+            self.plan_counted(&timing, 1, targets[1], counted),
+            self.plan_counted(&timing, 2, targets[2], counted),
+            self.plan_counted(&timing, 3, targets[3], counted),
+            self.plan_counted(&timing, 4, targets[4], counted),
+            self.plan_counted(&timing, 5, targets[5], counted),
+        ]
     }
 }
 

@@ -88,10 +88,11 @@ pub(crate) fn core_on_m4f(t: &mut Tally) {
 /// under `-icount` are exact and repeatable for a given build, so these hold or fail deterministically; they keep
 /// the control path from growing back unnoticed.
 pub(crate) const BUDGETS: [(&str, u64); 12] = [
-    ("control tick: pipeline", 5_000),
-    // The same tick with both spare axes fitted and following a stream: 5,384 measured.
-    ("control tick with the spare axes", 5_650),
-    ("control tick at 2 kHz", 4_790),
+    ("control tick: pipeline", 4_730),
+    // The same tick with both spare axes fitted and following a stream: 4,952 measured, held at the goal (5,000)
+    // rather than 5 % over it.
+    ("control tick with the spare axes", 5_000),
+    ("control tick at 2 kHz", 4_570),
     ("trainer IK (f32)", 815),
     ("IK + all", 2_080),
     ("setpoint frame", 4_540),
