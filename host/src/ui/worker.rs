@@ -24,6 +24,7 @@ use crate::stream::command::{self as job, Datagrams, Input};
 use crate::stream::{self, Motion, Source};
 
 mod publisher;
+mod spare;
 mod stop;
 
 use publisher::Publisher;
@@ -110,19 +111,23 @@ pub fn run(
         }
     }));
     client.telemetry(true)?;
+    let fitted = spare::fitted(&mut client)?;
     let mut device = Device {
         client,
         hub: hub.clone(),
         mechanism,
         cancel: Arc::new(AtomicBool::new(false)),
         pending_stop: None,
+        spare: fitted,
     };
     let mut last_sample = Instant::now();
+    let mut last_spare = Instant::now();
     while !hub.closing.load(Ordering::SeqCst) {
         while let Ok(job) = jobs.try_recv() {
             device.serve(&job);
         }
         device.resend_stop();
+        device.publish_spare(&mut last_spare);
         // The samples were published by the tap; none is kept. A device that stopped sending (a restart, a
         // hello by another program on a shared link) is asked again once a second.
         if device.client.take_telemetry().is_ok_and(|s| !s.is_empty()) {
@@ -177,6 +182,8 @@ struct Device {
     cancel: Arc<AtomicBool>,
     /// A STOP the device has not confirmed (its link stalled or cut): kept, and given again until it is.
     pending_stop: Option<stop::PendingStop>,
+    /// The spare axes the device runs (their positions go to the pages while one is fitted).
+    spare: [ringpod_core::motion::SpareAxisSettings; ringpod_core::motion::SPARE_AXES],
 }
 
 impl Device {
@@ -226,6 +233,8 @@ impl Device {
             Request::Jog { axis, distance } => self.commission(*axis, Some(*distance)),
             Request::Buzz { axis } => self.commission(*axis, None),
             Request::Park => self.park(job.page),
+            Request::SpareJog { axis, distance } => self.spare(job.page, *axis, spare::Goal::By(*distance)),
+            Request::SpareTo { axis, value } => self.spare(job.page, *axis, spare::Goal::To(*value)),
             Request::Motion {
                 motion,
                 seconds,
@@ -492,6 +501,7 @@ impl Device {
         if let Ok(mut mechanism) = self.mechanism.lock() {
             *mechanism = m;
         }
+        self.spare = spare::fitted(&mut self.client)?;
         Ok(format!("{} stored; {restarted}", file.name))
     }
 }
