@@ -11,17 +11,11 @@ use super::{homed, is_reply};
 
 /// The trainer model with the supply senses off (axis 7 takes their pins) and axis 7 fitted, 400 steps per unit.
 fn rig_file(dir: &std::path::Path) -> std::path::PathBuf {
-    let out = assert_cmd::Command::cargo_bin("ringpod")
-        .unwrap()
-        .args(["presets", "--export", "trainer-model"])
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap()
+    let path = super::rig::trainer(dir);
+    let text = std::fs::read_to_string(&path).unwrap()
         + "\n[supervisor]\nlogic_sense = false\npower_sense = false\nlogic_settle_ms = 100\npower_settle_ms = 200\n\
            supply_timeout_ms = 1000\ndriver_off_ms = 20\ndischarge_ms = 500\n\n[[spare]]\nenabled = true\n\
            steps_per_unit = 400.0\nvelocity = 50.0\nacceleration = 500.0\ntravel = [-5.0, 120.0]\n";
-    let path = dir.join("rig.toml");
     std::fs::write(&path, text).unwrap();
     path
 }
