@@ -111,7 +111,9 @@ pub fn run(
         }
     }));
     client.telemetry(true)?;
-    let fitted = spare::fitted(&mut client)?;
+    // The spare axes' card waits for a section the device answers; the workbench runs without it.
+    let fitted = spare::fitted(&mut client)
+        .unwrap_or([ringpod_core::motion::SpareAxisSettings::NONE; ringpod_core::motion::SPARE_AXES]);
     let mut device = Device {
         client,
         hub: hub.clone(),

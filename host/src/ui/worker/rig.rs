@@ -56,7 +56,9 @@ impl Device {
         if let Ok(mut mechanism) = self.mechanism.lock() {
             *mechanism = m;
         }
-        self.spare = spare::fitted(&mut self.client)?;
+        if let Ok(axes) = spare::fitted(&mut self.client) {
+            self.spare = axes;
+        }
         Ok(format!("{} stored; {restarted}", file.name))
     }
 }
