@@ -60,7 +60,12 @@ impl SimDevice {
             rig: rig.record.name().to_owned(),
             reason,
         };
-        let config = ControllerConfig::from_record(&rig.record).map_err(undrivable)?;
+        let mut config = ControllerConfig::from_record(&rig.record).map_err(undrivable)?;
+        // The spare axes are a section beside the record, as a board stores them.
+        config
+            .apply(&ringpod_core::protocol::Settings::Spare(rig.spare))
+            .and_then(|()| config.validate())
+            .map_err(undrivable)?;
         let controller = Controller::new(config).map_err(undrivable)?;
         Ok(Self::with(realtime, controller, Plant::for_config(&config)))
     }

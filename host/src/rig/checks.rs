@@ -143,6 +143,10 @@ impl RigFile {
                 .map_err(|why| super::RigError::new("motion_compensation.centre_of_rotation", why))?,
             None => [0.0; 3],
         };
+        let spare = match self.spare_section(&record)? {
+            ringpod_core::protocol::Settings::Spare(axes) => axes,
+            _ => [ringpod_core::motion::SpareAxisSettings::NONE; ringpod_core::motion::SPARE_AXES],
+        };
         Ok(Rig {
             geometry,
             home,
@@ -150,6 +154,7 @@ impl RigFile {
             drives,
             record,
             centre_of_rotation,
+            spare,
         })
     }
 

@@ -94,6 +94,9 @@ pub struct Rig {
     /// The point VR motion compensation reports the pose of (platform coordinates, m; the platform origin unless
     /// the file's `[motion_compensation]` says otherwise).
     pub centre_of_rotation: [f64; 3],
+    /// The spare axes 7 and 8 (`[[spare]]`; none fitted without it), checked with the rig: a device takes them as
+    /// a settings section beside the record, the simulator at its start.
+    pub spare: [ringpod_core::motion::SpareAxisSettings; ringpod_core::motion::SPARE_AXES],
 }
 
 /// Reads and checks a rig file to drive it.

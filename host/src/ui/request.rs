@@ -26,6 +26,16 @@ pub enum Request {
     },
     /// To the home pose, then power down.
     Park,
+    /// Spare axis 7 or 8 moved by `distance` in its own unit from where its counted steps are, the platform held.
+    SpareJog {
+        axis: u8,
+        distance: f64,
+    },
+    /// Spare axis 7 or 8 to `value` in its own unit, the platform held.
+    SpareTo {
+        axis: u8,
+        value: f64,
+    },
     /// A built-in motion (`demo`, `heave`, `yaw`, `vibration`).
     Motion {
         motion: String,
@@ -90,7 +100,12 @@ impl Request {
     pub fn is_stream(&self) -> bool {
         matches!(
             self,
-            Self::Motion { .. } | Self::File { .. } | Self::Udp { .. } | Self::Park
+            Self::Motion { .. }
+                | Self::File { .. }
+                | Self::Udp { .. }
+                | Self::Park
+                | Self::SpareJog { .. }
+                | Self::SpareTo { .. }
         )
     }
 }

@@ -8,12 +8,11 @@ use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use ringpod_core::kinematics::{Mechanism, Pose, RingPlatform};
-use ringpod_core::protocol::RigSource;
 use ringpod_core::safety::State;
 use serde_json::json;
 
 use super::files;
-use super::frame::{LinkCounts, RigView};
+use super::frame::LinkCounts;
 use super::hub::Hub;
 use super::request::{Job, Request};
 use crate::link::client::{Client, ClientError, Transport};
@@ -24,6 +23,8 @@ use crate::stream::command::{self as job, Datagrams, Input};
 use crate::stream::{self, Motion, Source};
 
 mod publisher;
+mod rig;
+mod spare;
 mod stop;
 
 use publisher::Publisher;
@@ -92,7 +93,7 @@ pub fn run(
     };
     let mut client = Client::new(transport);
     client.hello()?;
-    let mechanism = Arc::new(Mutex::new(announce_rig(&mut client, &hub)?));
+    let mechanism = Arc::new(Mutex::new(rig::announce_rig(&mut client, &hub)?));
     let publisher = Arc::new(Mutex::new(Publisher {
         hub: hub.clone(),
         mechanism: mechanism.clone(),
@@ -110,19 +111,25 @@ pub fn run(
         }
     }));
     client.telemetry(true)?;
+    // The spare axes' card waits for a section the device answers; the workbench runs without it.
+    let fitted = spare::fitted(&mut client)
+        .unwrap_or([ringpod_core::motion::SpareAxisSettings::NONE; ringpod_core::motion::SPARE_AXES]);
     let mut device = Device {
         client,
         hub: hub.clone(),
         mechanism,
         cancel: Arc::new(AtomicBool::new(false)),
         pending_stop: None,
+        spare: fitted,
     };
     let mut last_sample = Instant::now();
+    let mut last_spare = Instant::now();
     while !hub.closing.load(Ordering::SeqCst) {
         while let Ok(job) = jobs.try_recv() {
             device.serve(&job);
         }
         device.resend_stop();
+        device.publish_spare(&mut last_spare);
         // The samples were published by the tap; none is kept. A device that stopped sending (a restart, a
         // hello by another program on a shared link) is asked again once a second.
         if device.client.take_telemetry().is_ok_and(|s| !s.is_empty()) {
@@ -138,37 +145,6 @@ pub fn run(
     Ok(())
 }
 
-/// Reads the rig the device runs, tells the pages, and gives its mechanism.
-fn announce_rig(client: &mut Client<AnyTransport>, hub: &Hub) -> Result<RingPlatform<f64>, WorkerError> {
-    let (record, source, _) = client.rig()?;
-    if let RigSource::Refused(_) | RigSource::Unreadable = source {
-        eprintln!("warning: {source}");
-    }
-    let geometry = record.geometry().map_err(WorkerError::DeviceGeometry)?;
-    // The frames and motion compensation show the pose of the counted steps of the rig the device runs now.
-    client.followed = crate::link::followed::Followed::of(&record);
-    let mut view = RigView::of(&geometry, record.home, source.to_string());
-    view.firmware = client
-        .device
-        .map_or_else(String::new, |d| crate::device::firmware_text(&d.firmware));
-    view.jog_the_device_takes(&record.machine.homing.axes);
-    // The simulator counts a tick's cost in ns of the host's time, a board in its MCU's cycles.
-    if matches!(client.transport(), crate::link::transport::AnyTransport::Sim(_)) {
-        view.tick_unit = "ns";
-    }
-    // The name the user gave the rig (its file's `name`), not the geometry's generic one.
-    if !record.name().trim().is_empty() {
-        record.name().clone_into(&mut view.name);
-    }
-    let mut message = serde_json::to_value(view)?;
-    message["type"] = json!("rig");
-    // A poisoned lock only means a page's thread panicked while holding it: the value is still the rig's.
-    *hub.rig.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(message.to_string());
-    *hub.record.lock().unwrap_or_else(std::sync::PoisonError::into_inner) = Some(record);
-    hub.publish(&message);
-    Ok(RingPlatform::new(&geometry))
-}
-
 struct Device {
     client: Client<AnyTransport>,
     hub: Arc<Hub>,
@@ -177,6 +153,8 @@ struct Device {
     cancel: Arc<AtomicBool>,
     /// A STOP the device has not confirmed (its link stalled or cut): kept, and given again until it is.
     pending_stop: Option<stop::PendingStop>,
+    /// The spare axes the device runs (their positions go to the pages while one is fitted).
+    spare: [ringpod_core::motion::SpareAxisSettings; ringpod_core::motion::SPARE_AXES],
 }
 
 impl Device {
@@ -226,6 +204,8 @@ impl Device {
             Request::Jog { axis, distance } => self.commission(*axis, Some(*distance)),
             Request::Buzz { axis } => self.commission(*axis, None),
             Request::Park => self.park(job.page),
+            Request::SpareJog { axis, distance } => self.spare(job.page, *axis, spare::Goal::By(*distance)),
+            Request::SpareTo { axis, value } => self.spare(job.page, *axis, spare::Goal::To(*value)),
             Request::Motion {
                 motion,
                 seconds,
@@ -480,20 +460,5 @@ impl Device {
         // Telemetry stays on for the pages whatever the stream did with it.
         self.client.telemetry(true)?;
         report.map_err(WorkerError::NotStarted)
-    }
-
-    fn load_rig(&mut self, text: &str) -> Result<String, WorkerError> {
-        let file = crate::rig::parse(text)?;
-        if self.client.status()?.state != State::Off {
-            return Err(WorkerError::NotOff);
-        }
-        crate::device::rig::store(&mut self.client, &file)?;
-        let restarted = crate::device::rig::restart(&mut self.client)?;
-        self.client.telemetry(true)?;
-        let m = announce_rig(&mut self.client, &self.hub)?;
-        if let Ok(mut mechanism) = self.mechanism.lock() {
-            *mechanism = m;
-        }
-        Ok(format!("{} stored; {restarted}", file.name))
     }
 }

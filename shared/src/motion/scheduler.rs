@@ -103,6 +103,17 @@ impl AxisMove {
         self.start_ns.saturating_add(offset)
     }
 
+    /// Time of the last step (ns from the period start), `step_ns(count - 1)` for a count of at least 1 by one
+    /// division and no overflow tests: with `c = count`, `floor((2c - 1) span / 2c) = span - ceil(span / 2c)`, and
+    /// `span + 2c - 1` fits in `u32` for any count a valid period holds (the span is at most 1e9 ns and the count at
+    /// most the period over the step spacing). The scheduler works it out for every axis that steps, every period.
+    pub fn last_step_ns(&self) -> u32 {
+        let span = self.period_ns.saturating_sub(self.start_ns);
+        let den = self.count.max(1).saturating_mul(2);
+        let up = span.saturating_add(den - 1) / den;
+        self.start_ns.saturating_add(span - up)
+    }
+
     /// The least time between two consecutive steps (ns): `span / count`, since the times of
     /// [`AxisMove::step_ns`] are `floor` of points exactly `span / count` apart and
     /// `floor(x + d) - floor(x) >= floor(d)`. 0 when the window is empty (a start at or past the period's end puts
@@ -187,6 +198,8 @@ impl Iterator for StepTimes {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StepScheduler<const N: usize = 6> {
     config: SchedulerConfig,
+    /// The configuration's times in `i32`, worked out once rather than each period.
+    timing: Timing,
     position: [i64; N],
     direction: [Direction; N],
     /// Time of each axis's last step relative to the start of the next period (ns, negative = in the past; never
@@ -200,6 +213,7 @@ impl<const N: usize> StepScheduler<N> {
     pub fn new(config: SchedulerConfig, position: [i64; N]) -> Self {
         Self {
             config,
+            timing: Timing::of(&config),
             position,
             direction: [Direction::Forward; N],
             last_step: [LONG_AGO; N],
@@ -292,7 +306,12 @@ impl<const N: usize> StepScheduler<N> {
         // target (a target beyond i64's reach saturated `want` toward it). A saturating i64 addition is a dozen
         // instructions on the M4F.
         self.position[i] = self.position[i].wrapping_add(m.signed());
-        self.last_step[i] = forget(m.step_ns(count - 1) as i32);
+        // The last step's time as [`AxisMove::last_step_ns`], in wrapping arithmetic that never wraps here: the span is
+        // at most 1e9 ns and the count at most the span over the spacing, so `span + 2 count - 1 < 2^32`.
+        let span = (t.period - start) as u32;
+        let den = count.wrapping_mul(2);
+        let last_step = (start as u32).wrapping_add(span.wrapping_sub(span.wrapping_add(den - 1) / den));
+        self.last_step[i] = forget(last_step as i32);
         (m, short)
     }
 }
@@ -305,26 +324,39 @@ impl StepScheduler<6> {
     /// `memcpy`, 134 instructions on the M4F a period).
     #[inline(never)]
     pub fn plan(&mut self, targets: &[i64; 6]) -> [AxisMove; 6] {
-        let timing = Timing::of(&self.config);
-        let mut counted = false;
-        let mut axis = |i: usize| self.plan_counted(&timing, i, targets[i], &mut counted);
-        [axis(0), axis(1), axis(2), axis(3), axis(4), axis(5)]
+        let timing = self.timing;
+        let mut c = false;
+        let counted = &mut c;
+        // Each axis in line (the per-axis planner is always inlined): a call an axis, saving and restoring the
+        // registers and reloading the timing, costs about 20 instructions an axis.
+        [
+            self.plan_counted(&timing, 0, targets[0], counted),
+            self.plan_counted(&timing, 1, targets[1], counted),
+            self.plan_counted(&timing, 2, targets[2], counted),
+            self.plan_counted(&timing, 3, targets[3], counted),
+            self.plan_counted(&timing, 4, targets[4], counted),
+            self.plan_counted(&timing, 5, targets[5], counted),
+        ]
     }
 }
 
 impl StepScheduler<2> {
-    /// Plans one period of the spare axes toward `targets`, as [`StepScheduler::plan`] the platform's.
+    /// Plans one period of the spare axes toward `targets`, as [`StepScheduler::plan`] the platform's. The two
+    /// axes are planned in line, not through a call each as the six are: a call's saving and restoring of registers
+    /// costs more than the second copy of the code (flash) for two axes.
     #[inline(never)]
     pub fn plan(&mut self, targets: &[i64; 2]) -> [AxisMove; 2] {
-        let timing = Timing::of(&self.config);
+        let timing = self.timing;
         let mut counted = false;
-        let mut axis = |i: usize| self.plan_counted(&timing, i, targets[i], &mut counted);
-        [axis(0), axis(1)]
+        let first = self.plan_counted(&timing, 0, targets[0], &mut counted);
+        let second = self.plan_counted(&timing, 1, targets[1], &mut counted);
+        [first, second]
     }
 }
 
-/// The timing of a period in `i32` ns (the M4F's own width), worked out once per period for all six axes. A valid
+/// The timing of a period in `i32` ns (the M4F's own width), worked out once with the scheduler. A valid
 /// configuration has a period of at most 1e9 ns and every other time shorter; out-of-range values are capped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Timing {
     period: i32,
     spacing: i32,

@@ -187,6 +187,21 @@ proptest! {
             prop_assert_eq!(m.times().count(), count as usize);
         }
     }
+
+    /// The last step's time by one division is the closed form's, for every window and count a valid period holds
+    /// (up to a second, at least 2.5 ns a step as the shortest valid spacing allows), the ends included.
+    #[test]
+    fn the_last_step_time_is_the_closed_forms(
+        period in prop_oneof![1u32..=2_000, 1u32..=1_000_000_000, Just(1_000_000_000u32)],
+        start_fraction in prop_oneof![0.0..1.0f64, Just(0.0), Just(1.0)],
+        count_fraction in prop_oneof![0.0..1.0f64, Just(1.0)],
+    ) {
+        let start = ((f64::from(period) * start_fraction) as u32).min(period - 1);
+        let room = ((period - start) / 2).max(1);
+        let count = ((f64::from(room) * count_fraction) as u32).clamp(1, room);
+        let m = AxisMove { direction: Direction::Backward, dir_change_ns: None, start_ns: start, count, period_ns: period };
+        prop_assert_eq!(m.last_step_ns(), m.step_ns(count - 1), "start {} count {}", start, count);
+    }
 }
 
 /// Positions at the ends of `i64` and targets beyond their reach: the new position is never past the target (the

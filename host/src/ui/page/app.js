@@ -55,6 +55,7 @@ function connect() {
     if (m.type === "hello") { state.page = m.page; $("file-name-row").hidden = !m.files; }
     else if (m.type === "rig") showRig(m);
     else if (m.type === "frame") showFrame(m);
+    else if (m.type === "spare") showSpare(m);
     else if (m.type === "reply") showReply(m);
     else if (m.type === "halted") { state.halted = m; log(m.text); }
     else if (m.type === "stop_pending") showStopPending(m);
@@ -323,6 +324,16 @@ function showGates(gates) {
 document.querySelectorAll("[data-do]").forEach((b) => b.addEventListener("click", () => send({ do: b.dataset.do })));
 $("jog").addEventListener("click", () => send({ do: "jog", axis: +$("jog-axis").value, distance: +$("jog-distance").value }));
 $("buzz").addEventListener("click", () => send({ do: "buzz", axis: +$("jog-axis").value }));
+// The spare axes: shown while one is fitted, their positions from the device's counted steps.
+function showSpare(m) {
+  const fitted = [7, 8].filter((_, i) => m.fitted[i]);
+  $("spare-card").hidden = fitted.length === 0;
+  const select = $("spare-axis");
+  if (select.options.length !== fitted.length) select.innerHTML = fitted.map((a) => `<option>${a}</option>`).join("");
+  $("spare-positions").textContent = fitted.map((a) => `axis ${a}: ${m.position[a - 7].toFixed(4)} (${m.steps[a - 7]} steps)`).join(", ");
+}
+$("spare-jog").addEventListener("click", () => send({ do: "spare_jog", axis: +$("spare-axis").value, distance: +$("spare-amount").value }));
+$("spare-to").addEventListener("click", () => send({ do: "spare_to", axis: +$("spare-axis").value, value: +$("spare-amount").value }));
 $("run-motion").addEventListener("click", () => send({
   do: "motion", motion: $("motion").value, seconds: +$("motion-seconds").value, rate_hz: +$("motion-rate").value,
 }));

@@ -4,6 +4,7 @@ mod profiles;
 mod requests;
 mod rig;
 mod runs;
+mod spare;
 mod stall;
 mod workbench;
 

@@ -21,7 +21,7 @@ fn post(bench: &Workbench, path: &str, body: &Value) -> (u16, Value) {
 }
 
 /// The trainer model's rig file in `dir`.
-fn trainer(dir: &Path) -> std::path::PathBuf {
+pub(super) fn trainer(dir: &Path) -> std::path::PathBuf {
     let out = assert_cmd::Command::cargo_bin("ringpod")
         .unwrap()
         .args(["presets", "--export", "trainer-model"])

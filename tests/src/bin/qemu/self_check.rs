@@ -87,17 +87,20 @@ pub(crate) fn core_on_m4f(t: &mut Tally) {
 /// builds of unchanged source (the renderer is never inlined, so its code is the same in every program). Counts
 /// under `-icount` are exact and repeatable for a given build, so these hold or fail deterministically; they keep
 /// the control path from growing back unnoticed.
-pub(crate) const BUDGETS: [(&str, u64); 12] = [
-    ("control tick: pipeline", 5_000),
-    // The same tick with both spare axes fitted and following a stream: 5,384 measured.
-    ("control tick with the spare axes", 5_650),
-    ("control tick at 2 kHz", 4_790),
+pub(crate) const BUDGETS: [(&str, u64); 13] = [
+    ("control tick: pipeline", 4_730),
+    // The same tick with both spare axes fitted and following a stream: 4,950 measured, held at the goal (5,000)
+    // rather than 5 % over it.
+    ("control tick with the spare axes", 5_000),
+    ("control tick at 2 kHz", 4_570),
     ("trainer IK (f32)", 815),
     ("IK + all", 2_080),
     ("setpoint frame", 4_540),
     ("FK", 11_460),
     ("limited into the envelope", 10_330),
     ("step buffers, idle", 900),
+    // The step generator's second render while a spare axis is fitted (its words then split by port on the board).
+    ("the spare axes' period", 1_410),
     ("step buffers, typical", 2_700),
     ("step buffers, the trainer's fastest", 6_100),
     ("step buffers (6 axes x 100 k", 13_500),

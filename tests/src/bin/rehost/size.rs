@@ -5,7 +5,7 @@ use std::path::Path;
 use std::process::Command;
 
 /// Most flash the firmware may take: the goal, 196,608 B, three quarters of the program area (the firmware takes
-/// 190,092 B).
+/// 194,420 B).
 pub const FLASH_BUDGET: u64 = 196_608;
 
 /// What the ELF takes of each memory (bytes).
