@@ -1,8 +1,8 @@
 //! A background build its parent pauses while timing-sensitive tests run. The test command starts the Windows
-//! cross-build at once, beside its own build, but the host's tests wait on child processes in real time, and any
-//! process keeping both cores busy (even in the idle scheduling class) delays their answers past the CLI's 2 s: so
-//! the parent says `pause` before `cargo test` and `go` after it, and the build's process group is stopped
-//! (SIGSTOP) and continued (SIGCONT) in between. The gate also holds the runner's own tests until `go`.
+//! cross-build at once, beside its own build, but the host's tests wait on child processes in real time and measure
+//! them, and a build beside them (even in the idle scheduling class) takes the cores they wake on: so the parent
+//! says `pause` before `cargo test` and `go` after it, and the build's process group is stopped (SIGSTOP) and
+//! continued (SIGCONT) in between. The gate also holds the runner's own tests until `go`.
 
 use std::io::BufRead;
 use std::process::{Child, Command};
