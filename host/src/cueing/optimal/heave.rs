@@ -9,7 +9,7 @@ use nalgebra::{DMatrix, DVector};
 use ringpod_core::cueing::G;
 
 use super::model::{vertical, Discrete, Linear};
-use super::Axis;
+use super::{tilt, Axis, Optimal, X, Y, Z};
 
 /// The vertical force a platform tilted by `x` and `y` (rad) loses (m/s^2).
 pub fn loss(x: f64, y: f64) -> f64 {
@@ -70,6 +70,41 @@ impl Loss {
         if let Some((_, b)) = &self.at_dt {
             *x += b * l;
         }
+    }
+}
+
+impl Optimal {
+    /// Gives the heave the tilts' loss of vertical force `g (1 - cos x cos y)` to make up (this module), within
+    /// the room the tilts leave it, or not (the default). Measured on the laps (the book's Optimal cueing): the
+    /// heave's perceived error and false cues fall, the tilts' force error rises by more (the heave's motion
+    /// takes room from the tilt in the shared envelope).
+    pub fn give_heave_the_tilt_loss(&mut self, on: bool) {
+        self.loss = on.then(|| Loss::new(self.config.optimal.step_s));
+    }
+
+    /// The tilts' loss of vertical force as the heave perceives it over its horizon (from rest, each step's loss
+    /// at the middle of both tilts' planned angles from `before`, their angles as the sample began), and over
+    /// this sample (at the middle of its angles); none where the heave is not given it.
+    pub(super) fn tilt_loss(&self, before: [f64; 2], h: f64) -> Option<(Vec<f64>, f64)> {
+        let loss = self.loss.as_ref()?;
+        let n = self.axes[Z].qp.steps();
+        let [ax, ay] = [X, Y].map(|i| self.axes[i].planned_angles(before[i], h, n));
+        let losses: Vec<f64> = ax.iter().zip(&ay).map(|(x, y)| self::loss(*x, *y)).collect();
+        let [x, y] = [X, Y].map(|i| 0.5 * (before[i] + self.axes[i].x[2] + self.axes[i].x[3]));
+
+        Some((loss.perceived(&losses), self::loss(x, y)))
+    }
+
+    /// The heave's room beside the tilts' planned angles, where it is given their loss and the rig is known (a
+    /// heave that makes up the loss at its range's edge beside a full tilt is cut by the limiter, the tilt with it).
+    pub(super) fn heave_room(&mut self, h: f64, yaw: f64, dt: f64) {
+        let (Some(t), Some(_)) = (self.tilt.as_mut(), &self.loss) else {
+            return;
+        };
+        let share = self.config.optimal.envelope_share;
+        let base = (self.ranges[Z].0 * share, self.ranges[Z].1 * share);
+        let (lo, hi) = t.heave_bound_over(&self.axes, base, h, yaw, dt);
+        self.axes[Z].qp.set_state_bound(tilt::HEAVE_BOUND, lo, hi);
     }
 }
 

@@ -142,9 +142,8 @@ pub struct Optimal {
     axes: [Axis; 3],
     /// The roll and pitch's shared room, where the rig is known.
     tilt: Option<tilt::Sharing>,
-    /// The tilts' loss of vertical force, given to the heave, and the heave's room beside the tilts (none: the
-    /// heave plans without either, the default: on the laps it made up a part of the loss, 11.6 % less heave
-    /// error and 10 s less false cue, but cost the tilts' force more than that, [`Optimal::give_heave_the_tilt_loss`]).
+    /// The tilts' loss of vertical force given to the heave, within its room beside the tilts; none (the default):
+    /// [`Optimal::give_heave_the_tilt_loss`].
     loss: Option<heave::Loss>,
     ranges: Ranges,
     counts: Counts,
@@ -169,14 +168,6 @@ impl Optimal {
             ranges: *ranges,
             counts: Counts::default(),
         })
-    }
-
-    /// Gives the heave the tilts' loss of vertical force `g (1 - cos x cos y)` to make up ([`heave`]), within
-    /// the room the tilts leave it, or not (the default). Measured on the laps (the book's Optimal cueing): the
-    /// heave's perceived error and false cues fall, the tilts' force error rises by more (the heave's motion
-    /// takes room from the tilt in the shared envelope).
-    pub fn give_heave_the_tilt_loss(&mut self, on: bool) {
-        self.loss = on.then(|| heave::Loss::new(self.config.optimal.step_s));
     }
 
     /// The configuration.
@@ -227,17 +218,11 @@ impl Optimal {
             // z plans last, with the loss of vertical force of both tilts as they move now and as planned.
             let loss = if i == Z { self.tilt_loss(before, h) } else { None };
             let yaw = self.classical.channels().yaw;
-            if let Some(t) = self.tilt.as_mut() {
-                if i == Z && self.loss.is_some() {
-                    // The heave's room beside the tilts, as its loss's compensation would leave it otherwise.
-                    let share = self.config.optimal.envelope_share;
-                    let base = (self.ranges[Z].0 * share, self.ranges[Z].1 * share);
-                    let (lo, hi) = t.heave_bound_over(&self.axes, base, h, yaw, dt);
-                    self.axes[i].qp.set_state_bound(tilt::HEAVE_BOUND, lo, hi);
-                } else if i != Z {
-                    let (lo, hi) = t.bound_over(i, i == order[0], &self.axes, h, yaw, dt);
-                    self.axes[i].qp.set_state_bound(tilt::ANGLE_BOUND, lo, hi);
-                }
+            if i == Z {
+                self.heave_room(h, yaw, dt);
+            } else if let Some(t) = self.tilt.as_mut() {
+                let (lo, hi) = t.bound_over(i, i == order[0], &self.axes, h, yaw, dt);
+                self.axes[i].qp.set_state_bound(tilt::ANGLE_BOUND, lo, hi);
             }
             let classical = self.classical_channels(i);
             let axis = &mut self.axes[i];
@@ -282,19 +267,6 @@ impl Optimal {
         self.counts.late += usize::from(late);
         self.counts.solve_s.push(started.elapsed().as_secs_f64());
         Ok(self.offset())
-    }
-
-    /// The tilts' loss of vertical force as the heave perceives it over its horizon (from rest, each step's loss
-    /// at the middle of both tilts' planned angles from `before`, their angles as the sample began), and over
-    /// this sample (at the middle of its angles); none where the heave is not given it.
-    fn tilt_loss(&self, before: [f64; 2], h: f64) -> Option<(Vec<f64>, f64)> {
-        let loss = self.loss.as_ref()?;
-        let n = self.axes[Z].qp.steps();
-        let [ax, ay] = [X, Y].map(|i| self.axes[i].planned_angles(before[i], h, n));
-        let losses: Vec<f64> = ax.iter().zip(&ay).map(|(x, y)| heave::loss(*x, *y)).collect();
-        let [x, y] = [X, Y].map(|i| 0.5 * (before[i] + self.axes[i].x[2] + self.axes[i].x[3]));
-
-        Some((loss.perceived(&losses), heave::loss(x, y)))
     }
 
     /// The classical washout's channels of axis `i` at its last sample: position and the angle's two parts.
