@@ -3,7 +3,8 @@
 //! vertical threshold), but each axis plans on its own, so neither the tilt's programmes nor the heave's price it.
 //! The heave plans last, after both tilts: it is given their plans' loss over its horizon as a known disturbance
 //! of its perceived force (the reference raised by the loss's perceived response), and its own state carries the
-//! loss the platform has, so that the heave makes up what its range allows of it.
+//! loss the platform has. A heave cannot hold a sustained force (the otoliths' gain at rest is 1), so what it
+//! does is move the loss in time: it falls while the tilt comes in and is caught as the loss grows.
 
 use nalgebra::{DMatrix, DVector};
 use ringpod_core::cueing::G;
@@ -91,7 +92,6 @@ impl Optimal {
         let [ax, ay] = [X, Y].map(|i| self.axes[i].planned_angles(before[i], h, n));
         let losses: Vec<f64> = ax.iter().zip(&ay).map(|(x, y)| self::loss(*x, *y)).collect();
         let [x, y] = [X, Y].map(|i| 0.5 * (before[i] + self.axes[i].x[2] + self.axes[i].x[3]));
-
         Some((loss.perceived(&losses), self::loss(x, y)))
     }
 
