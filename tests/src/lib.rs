@@ -4,7 +4,6 @@
 pub mod busy;
 pub mod cli;
 pub mod emulator;
-pub mod gate;
 pub mod scenario;
 pub mod sections;
 pub mod setup;

@@ -1,21 +1,17 @@
 //! `cargo run -p ringpod-tests --bin all`: the README's test command. Every test of the project, the emulators'
 //! and the browser's runs and the Windows build under Wine, arranged so that two cores are both at work:
 //!
-//! 1. The runners' build (seconds), then the Windows runner, in a target folder of its own (`target/windows`: a
-//!    cross-build holds the build folder's lock for minutes, and the other runners build in it), its cross-build in
-//!    Linux's idle scheduling class (`chrt --idle 0`: it takes only what the rest leaves) from the start, stopped
-//!    while `cargo test` runs; its programs under Wine are held until `cargo test` is over. Its output is written
-//!    to `target/windows-runner.log` as it comes and printed whole at the end.
-//! 2. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
+//! 1. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
 //!    optimised, with debug assertions) is the CLI the QEMU suite, the rehost run and the browser tests drive, named
 //!    to them in `RINGPOD_CLI`: no second, release, build of the host.
-//! 3. `cargo test`, alone: the Windows cross-build is stopped meanwhile (`pause`, `go` on its standard input): most
-//!    of its tests wait on a child `ringpod` in real time and measure it (rates, hold-ups, the pose followed), and
-//!    a build beside them, even in the idle scheduling class, takes the cores they wake on. One test thread per core:
-//!    with four or eight the host's suite takes 139 s or 74 s instead of 256 s, but the live motion's tests then
-//!    missed their tolerance in one run of two or three.
-//! 4. The QEMU suite, the rehost run and the browser tests, one after the other, their output as it comes, each
-//!    keeping about one core busy and waiting on real time; the Windows runner's programs under Wine beside them.
+//! 2. `cargo test` alone: most of its tests wait on a child `ringpod` in real time, and a build beside them would
+//!    starve their answers.
+//! 3. Then two lanes side by side. Lane one, its output as it comes: the QEMU suite, the rehost run and the browser
+//!    tests, each keeping about one core busy and waiting on real time. Lane two: the Windows runner, its
+//!    cross-build on both cores at the lowest CPU priority (`nice -n 19`: it takes what lane one leaves, and never
+//!    starves its answers) in a target folder of its own (`target/windows`: a cross-build holds the build folder's
+//!    lock for minutes, and the runners of lane one build in it), then its programs under Wine; its output is
+//!    written to `target/windows-runner.log` as it comes and printed whole once lane one is over.
 //!
 //! Each part runs whatever the others gave. The last lines name each part with its result and time, and the exit
 //! status is 1 when any part failed. On a system other than Linux only `cargo test` runs: the emulators, the
@@ -67,17 +63,15 @@ fn part(name: &str, mut c: Command) -> Part {
     }
 }
 
-/// The Windows runner in its own target folder, its output to `log` (its cross-build yields the CPU to the rest), its
-/// programs under Wine held until a line on its standard input.
+/// The Windows runner in its own target folder, its output to `log` (its cross-build yields the CPU to lane one).
 fn windows_lane(log: &Path) -> Result<Child, String> {
     let target = target_dir().join("windows");
     std::fs::create_dir_all(&target).map_err(|e| format!("{}: {e}", target.display()))?;
     let out = std::fs::File::create(log).map_err(|e| format!("{}: {e}", log.display()))?;
     let err = out.try_clone().map_err(|e| format!("{}: {e}", log.display()))?;
     runner("windows")
-        .arg("--hold-wine")
         .env("CARGO_TARGET_DIR", &target)
-        .stdin(Stdio::piped())
+        .stdin(Stdio::null())
         .stdout(out)
         .stderr(err)
         .spawn()
@@ -97,46 +91,36 @@ fn main() -> ExitCode {
         println!("the QEMU suite, the rehost run, the browser tests and the Windows build under Wine run on Linux");
         return summary(&parts);
     }
-    // The runners first (seconds: `cargo run` built their crate's library for this one), the Windows runner with them.
+    let (built, cli) = test_programs();
     let mut runners = cargo();
     runners.args(["build", "-p", "ringpod-tests", "--bins"]);
     let runners = part("the runners (cargo build -p ringpod-tests --bins)", runners);
+    let ready = built.passed && runners.passed;
+    parts.extend([built, runners]);
+    if !ready {
+        return summary(&parts);
+    }
+    // cargo test alone: most of its tests wait on a child `ringpod` in real time, and a build beside them starves
+    // their answers.
+    let mut test = cargo();
+    test.args(["test", "--no-fail-fast"]);
+    parts.push(part("cargo test", test));
     let log = target_dir().join("windows-runner.log");
     let started = Instant::now();
-    let mut windows = if runners.passed {
-        windows_lane(&log)
-    } else {
-        Err("the runners did not build".into())
-    };
+    let mut windows = windows_lane(&log);
     match &windows {
         Ok(_) => println!(
-            "== the Windows runner, from the start beside the rest: its output at the end ({})",
+            "== the Windows runner, beside the rest: its output at the end ({})",
             log.display()
         ),
         Err(e) => println!("FAIL {e}"),
     }
-    let (built, cli) = test_programs();
-    let ready = built.passed && runners.passed;
-    parts.extend([runners, built]);
-    let mut word = windows.as_mut().ok().and_then(|child| child.stdin.take());
-    if ready {
-        // The Windows cross-build stopped while `cargo test` runs (see `ringpod_tests::gate`).
-        say(&mut word, "pause");
-        let mut test = cargo();
-        test.args(["test", "--no-fail-fast"]);
-        parts.push(part("cargo test", test));
-    }
-    // `cargo test` is over: the cross-build goes on and the Windows runner's programs may run under Wine.
-    say(&mut word, "go");
-    drop(word);
-    if ready {
-        for name in ["qemu", "rehost", "browser"] {
-            let mut c = runner(name);
-            if let Some(cli) = &cli {
-                c.env(ringpod_tests::cli::CLI_VAR, cli);
-            }
-            parts.push(part(&format!("the {name} runner"), c));
+    for name in ["qemu", "rehost", "browser"] {
+        let mut c = runner(name);
+        if let Some(cli) = &cli {
+            c.env(ringpod_tests::cli::CLI_VAR, cli);
         }
+        parts.push(part(&format!("the {name} runner"), c));
     }
     let passed = windows
         .as_mut()
@@ -152,18 +136,11 @@ fn main() -> ExitCode {
         Err(e) => println!("{}: {e}", log.display()),
     }
     parts.push(Part {
-        name: "the windows runner (beside, from the start)".into(),
+        name: "the windows runner (beside)".into(),
         passed,
         took: started.elapsed(),
     });
     summary(&parts)
-}
-
-/// A word to the Windows runner; one that has ended already needs none.
-fn say(to: &mut Option<std::process::ChildStdin>, word: &str) {
-    if let Some(w) = to {
-        let _ = writeln!(w, "{word}").and_then(|()| w.flush());
-    }
 }
 
 /// `cargo test --no-run`, its messages read for the `ringpod` it built (the runners' CLI), its diagnostics and

@@ -3,7 +3,7 @@
 //! 1. The MinGW-w64 cross compiler and Wine (installed with apt-get when missing and allowed, as QEMU is), and the
 //!    `x86_64-pc-windows-gnu` standard library (rustup).
 //! 2. A debug cross-build of the host's test programs, with `ringpod.exe` and the examples (`cargo test --no-run`),
-//!    in Linux's idle scheduling class (`chrt --idle 0`): it uses only what the machine's other work leaves.
+//!    at the lowest CPU priority (`nice -n 19`): it uses what the machine's other work leaves.
 //! 3. Beside them, a test-only `bcryptprimitives.dll` built from `tests/windows/bcryptprimitives.c`: Rust's standard
 //!    library imports `ProcessPrng` from it, which Wine 8 lacks.
 //! 4. The host's tests under Wine, unit and integration (`cargo test` with Wine as the target's runner): the
@@ -13,11 +13,6 @@
 //! 5. Each game of `--telemetry-shm` cued end to end: the example `shm_games.exe GAME` writes a drive into the
 //!    game's named mappings in its publisher's layout while `ringpod.exe stream --sim --telemetry-shm GAME` reads it.
 //!
-//! With `--hold-wine` it follows the test command's word on its standard input ([`ringpod_tests::gate`]): the test
-//! command starts it first, so that the cross-build uses what its own build leaves; `pause` stops the cross-build
-//! while `cargo test`, whose tests wait on child processes in real time, runs; `go` (or the end of the input)
-//! continues it and lets step 4 begin.
-//!
 //! Wine runs in its own prefix under the target folder, so that a developer's `~/.wine` is not touched. Cargo's own
 //! `test result:` lines are passed through; the last line is the sum, `N passed, N failed`, and the exit status is 1
 //! when anything failed.
@@ -26,7 +21,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::Instant;
 
-use ringpod_tests::{gate, setup, wine};
+use ringpod_tests::{setup, wine};
 
 /// The Windows target the host is cross-built for.
 const TARGET: &str = "x86_64-pc-windows-gnu";
@@ -129,31 +124,21 @@ fn step(name: &str, run: impl FnOnce() -> Result<(), String>) -> Result<(), Stri
     result
 }
 
-/// `c` in Linux's idle scheduling class (`chrt --idle 0`, SCHED_IDLE, sched(7)): the cross-build runs only on what
-/// the machine's other work leaves, and a waking process of that work takes the core at once, so that it can run
-/// beside timing-sensitive tests (the test command's) without starving them; a task at `nice -n 19` still has a share
-/// of its own and the ordinary wake-up rules.
+/// `c` at the lowest CPU priority (`nice -n 19`): the cross-build takes only what the machine's other work leaves,
+/// so that it can run beside timing-sensitive tests (the test command's lanes) without starving them.
 fn yielding(c: Command) -> Command {
-    let mut idle = Command::new("chrt");
-    idle.args(["--idle", "0"]).arg(c.get_program()).args(c.get_args());
+    let mut niced = Command::new("nice");
+    niced.args(["-n", "19"]).arg(c.get_program()).args(c.get_args());
     if let Some(dir) = c.get_current_dir() {
-        idle.current_dir(dir);
+        niced.current_dir(dir);
     }
     for (key, value) in c.get_envs() {
         match value {
-            Some(v) => idle.env(key, v),
-            None => idle.env_remove(key),
+            Some(v) => niced.env(key, v),
+            None => niced.env_remove(key),
         };
     }
-    idle
-}
-
-/// The cross-build under the test command's gate: stopped while its `cargo test` runs.
-fn gated(gate: &gate::Gate, mut c: Command) -> Result<(), String> {
-    let s = gate.run(&mut c).map_err(|e| format!("cargo test --no-run: {e}"))?;
-    s.success()
-        .then_some(())
-        .ok_or_else(|| format!("cargo test --no-run failed ({s})"))
+    niced
 }
 
 fn status(mut c: Command, what: &str) -> Result<(), String> {
@@ -334,16 +319,10 @@ fn cue_game(game: &str) -> Result<(), String> {
 }
 
 fn main() -> ExitCode {
-    let hold = match std::env::args().nth(1).as_deref() {
-        None => false,
-        Some("--hold-wine") => true,
-        Some(other) => {
-            eprintln!("windows: unknown argument {other:?} (it takes only --hold-wine)");
-            return ExitCode::from(2);
-        }
-    };
-    // Held: the test command's word on standard input pauses the cross-build and lets the tests run.
-    let gate = hold.then(|| gate::Gate::following(std::io::BufReader::new(std::io::stdin())));
+    if let Some(other) = std::env::args().nth(1) {
+        eprintln!("windows: unknown argument {other:?} (it takes none)");
+        return ExitCode::from(2);
+    }
     let mut failed = 0u32;
     let mut passed = 0u32;
     let prepared = step("MinGW-w64 and Wine", setup::ensure_windows)
@@ -352,18 +331,13 @@ fn main() -> ExitCode {
             step("cross-build (debug)", || {
                 // The test programs, and with them `ringpod.exe` (the integration tests start it) and the examples
                 // (`shm_games.exe`, the games' stand-in): one build, no second one of the host with other features.
-                let build = yielding(cargo(&["test", "-p", "ringpod", "--no-run"]));
-                match &gate {
-                    Some(gate) => gated(gate, build),
-                    None => status(build, "cargo test --no-run"),
-                }
+                status(
+                    yielding(cargo(&["test", "-p", "ringpod", "--no-run"])),
+                    "cargo test --no-run",
+                )
             })
         })
         .and_then(|()| step("the ProcessPrng DLL", shim));
-    if let Some(gate) = &gate {
-        println!("== held until the test command's `cargo test` is over");
-        println!("== held for {:.0} s", gate.wait_open().as_secs_f64());
-    }
     if let Err(e) = prepared {
         println!("FAIL {e}");
         println!("0 passed, 1 failed");
@@ -409,16 +383,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_yielding_command_is_the_same_command_in_the_idle_class() {
+    fn a_yielding_command_is_the_same_command_under_nice() {
         let mut c = Command::new("cargo");
         c.args(["test", "--no-run"])
             .current_dir("/tmp")
             .env("A", "1")
             .env_remove("B");
         let n = yielding(c);
-        assert_eq!(n.get_program(), "chrt");
+        assert_eq!(n.get_program(), "nice");
         let args: Vec<_> = n.get_args().collect();
-        assert_eq!(args, ["--idle", "0", "cargo", "test", "--no-run"]);
+        assert_eq!(args, ["-n", "19", "cargo", "test", "--no-run"]);
         assert_eq!(n.get_current_dir(), Some(Path::new("/tmp")));
         let envs: Vec<_> = n.get_envs().collect();
         assert!(envs.contains(&(std::ffi::OsStr::new("A"), Some(std::ffi::OsStr::new("1")))));
