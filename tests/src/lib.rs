@@ -4,6 +4,7 @@
 pub mod busy;
 pub mod cli;
 pub mod emulator;
+pub mod priority;
 pub mod scenario;
 pub mod sections;
 pub mod setup;

@@ -138,6 +138,14 @@ pub fn ensure_windows() -> Result<(), String> {
     )
 }
 
+/// This process's turn at apt-get among the test command's runners: an exclusive lock on a file in the temporary
+/// folder, held until the returned file is dropped (none when the file cannot be made: then no turns are taken).
+fn apt_turn() -> Option<std::fs::File> {
+    let file = std::fs::File::create(std::env::temp_dir().join("ringpod-apt.lock")).ok()?;
+    file.lock().ok()?;
+    Some(file)
+}
+
 /// Each of `programs` answers `--version`, or `packages` are installed with apt-get when this process may (as
 /// root, or through sudo without a password); otherwise the one line that says what to run.
 fn ensure_packages(programs: &[&str], packages: &[&str], what: &str) -> Result<(), String> {
@@ -186,6 +194,12 @@ fn ensure_packages_with(programs: &[&str], packages: &[&str], what: &str, option
     if !apt || !(root || sudo) || !may_install() {
         return Err(help);
     }
+    // The test command's runners prepare side by side and dpkg takes one installer at a time: they take turns, and
+    // another installer's lock is waited for (`DPkg::Lock::Timeout`) rather than failed on.
+    let _turn = apt_turn();
+    if present() {
+        return Ok(());
+    }
     println!("== {missing} is missing: {command}");
     let apt_get = |args: &[&str]| {
         let mut c = if root {
@@ -195,7 +209,8 @@ fn ensure_packages_with(programs: &[&str], packages: &[&str], what: &str, option
             c.arg("apt-get");
             c
         };
-        c.args(args)
+        c.args(["-o", "DPkg::Lock::Timeout=600"])
+            .args(args)
             .env("DEBIAN_FRONTEND", "noninteractive")
             .status()
             .is_ok_and(|s| s.success())

@@ -4,14 +4,15 @@
 //! 1. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
 //!    optimised, with debug assertions) is the CLI the QEMU suite, the rehost run and the browser tests drive, named
 //!    to them in `RINGPOD_CLI`: no second, release, build of the host.
-//! 2. `cargo test` alone: most of its tests wait on a child `ringpod` in real time, and a build beside them would
-//!    starve their answers.
-//! 3. Then two lanes side by side. Lane one, its output as it comes: the QEMU suite, the rehost run and the browser
-//!    tests, each keeping about one core busy and waiting on real time. Lane two: the Windows runner, its
-//!    cross-build on both cores at the lowest CPU priority (`nice -n 19`: it takes what lane one leaves, and never
-//!    starves its answers) in a target folder of its own (`target/windows`: a cross-build holds the build folder's
-//!    lock for minutes, and the runners of lane one build in it), then its programs under Wine; its output is
-//!    written to `target/windows-runner.log` as it comes and printed whole once lane one is over.
+//! 2. `cargo test`, eight tests at a time: most of its time is the host's tests waiting on a child `ringpod` in real
+//!    time (its suite spends 14 s of CPU in 74 s). Beside it, at the lowest CPU priority (`nice -n 19`: they take
+//!    what the tests leave and never starve their answers), two lanes start: the runners' preparation (the QEMU
+//!    programs, the firmware as flashed, the emulator's venv, Chromium: `--prepare`), and the Windows runner, in a
+//!    target folder of its own (`target/windows`: a cross-build holds the build folder's lock for minutes), whose
+//!    cross-build runs niced and whose programs then run under Wine; its output is written to
+//!    `target/windows-runner.log` as it comes and printed whole at the end.
+//! 3. Once both `cargo test` and the preparation are over: the QEMU suite, the rehost run and the browser tests, one
+//!    after the other, each keeping about one core busy and waiting on real time, beside the Windows lane.
 //!
 //! Each part runs whatever the others gave. The last lines name each part with its result and time, and the exit
 //! status is 1 when any part failed. On a system other than Linux only `cargo test` runs: the emulators, the
@@ -21,6 +22,8 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitCode, Stdio};
 use std::time::{Duration, Instant};
+
+use ringpod_tests::priority::yielding;
 
 /// A part of the run: what it was, whether it passed, how long it took.
 struct Part {
@@ -100,11 +103,7 @@ fn main() -> ExitCode {
     if !ready {
         return summary(&parts);
     }
-    // cargo test alone: most of its tests wait on a child `ringpod` in real time, and a build beside them starves
-    // their answers.
-    let mut test = cargo();
-    test.args(["test", "--no-fail-fast"]);
-    parts.push(part("cargo test", test));
+    let prepared = preparation(cli.clone());
     let log = target_dir().join("windows-runner.log");
     let started = Instant::now();
     let mut windows = windows_lane(&log);
@@ -115,6 +114,17 @@ fn main() -> ExitCode {
         ),
         Err(e) => println!("FAIL {e}"),
     }
+    let mut test = cargo();
+    test.args(["test", "--no-fail-fast"]);
+    if std::env::var_os("RUST_TEST_THREADS").is_none() {
+        test.env("RUST_TEST_THREADS", TEST_THREADS);
+    }
+    parts.push(part("cargo test", test));
+    parts.push(prepared.join().unwrap_or_else(|_| Part {
+        name: PREPARATION.into(),
+        passed: false,
+        took: Duration::ZERO,
+    }));
     for name in ["qemu", "rehost", "browser"] {
         let mut c = runner(name);
         if let Some(cli) = &cli {
@@ -141,6 +151,51 @@ fn main() -> ExitCode {
         took: started.elapsed(),
     });
     summary(&parts)
+}
+
+/// Tests at a time in `cargo test`: most wait on a child `ringpod` in real time, and the live motion's tests (the
+/// pose followed within 5 mrad of the one commanded) hold at eight beside a niced build on two cores.
+const TEST_THREADS: &str = "8";
+
+const PREPARATION: &str = "the runners' preparation (beside cargo test)";
+
+/// The QEMU, rehost and browser runners' `--prepare`, one after the other at the lowest CPU priority, on a thread:
+/// their builds, venv and packages ready when `cargo test` is over. Their output goes to `target/prepare.log`,
+/// printed (indented: its counts are not the runners') only when one failed; the runner then fails on its own.
+fn preparation(cli: Option<PathBuf>) -> std::thread::JoinHandle<Part> {
+    std::thread::spawn(move || {
+        let start = Instant::now();
+        let log = target_dir().join("prepare.log");
+        let passed = std::fs::File::create(&log).is_ok_and(|out| {
+            ["qemu", "rehost", "browser"].iter().all(|name| {
+                let mut c = runner(name);
+                c.arg("--prepare");
+                if let Some(cli) = &cli {
+                    c.env(ringpod_tests::cli::CLI_VAR, cli);
+                }
+                let mut niced = yielding(&c);
+                let (Ok(o), Ok(e)) = (out.try_clone(), out.try_clone()) else {
+                    return false;
+                };
+                niced.stdin(Stdio::null()).stdout(o).stderr(e);
+                niced.status().is_ok_and(|s| s.success())
+            })
+        });
+        if !passed {
+            println!("== {PREPARATION} failed: {}", log.display());
+            if let Ok(f) = std::fs::File::open(&log) {
+                BufReader::new(f)
+                    .lines()
+                    .map_while(Result::ok)
+                    .for_each(|l| println!("    {l}"));
+            }
+        }
+        Part {
+            name: PREPARATION.into(),
+            passed,
+            took: start.elapsed(),
+        }
+    })
 }
 
 /// `cargo test --no-run`, its messages read for the `ringpod` it built (the runners' CLI), its diagnostics and

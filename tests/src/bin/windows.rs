@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::Instant;
 
+use ringpod_tests::priority::yielding;
 use ringpod_tests::{setup, wine};
 
 /// The Windows target the host is cross-built for.
@@ -122,23 +123,6 @@ fn step(name: &str, run: impl FnOnce() -> Result<(), String>) -> Result<(), Stri
     let result = run();
     println!("== {name}: {:.0} s", started.elapsed().as_secs_f64());
     result
-}
-
-/// `c` at the lowest CPU priority (`nice -n 19`): the cross-build takes only what the machine's other work leaves,
-/// so that it can run beside timing-sensitive tests (the test command's lanes) without starving them.
-fn yielding(c: Command) -> Command {
-    let mut niced = Command::new("nice");
-    niced.args(["-n", "19"]).arg(c.get_program()).args(c.get_args());
-    if let Some(dir) = c.get_current_dir() {
-        niced.current_dir(dir);
-    }
-    for (key, value) in c.get_envs() {
-        match value {
-            Some(v) => niced.env(key, v),
-            None => niced.env_remove(key),
-        };
-    }
-    niced
 }
 
 fn status(mut c: Command, what: &str) -> Result<(), String> {
@@ -332,7 +316,7 @@ fn main() -> ExitCode {
                 // The test programs, and with them `ringpod.exe` (the integration tests start it) and the examples
                 // (`shm_games.exe`, the games' stand-in): one build, no second one of the host with other features.
                 status(
-                    yielding(cargo(&["test", "-p", "ringpod", "--no-run"])),
+                    yielding(&cargo(&["test", "-p", "ringpod", "--no-run"])),
                     "cargo test --no-run",
                 )
             })
@@ -381,23 +365,6 @@ fn main() -> ExitCode {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_yielding_command_is_the_same_command_under_nice() {
-        let mut c = Command::new("cargo");
-        c.args(["test", "--no-run"])
-            .current_dir("/tmp")
-            .env("A", "1")
-            .env_remove("B");
-        let n = yielding(c);
-        assert_eq!(n.get_program(), "nice");
-        let args: Vec<_> = n.get_args().collect();
-        assert_eq!(args, ["-n", "19", "cargo", "test", "--no-run"]);
-        assert_eq!(n.get_current_dir(), Some(Path::new("/tmp")));
-        let envs: Vec<_> = n.get_envs().collect();
-        assert!(envs.contains(&(std::ffi::OsStr::new("A"), Some(std::ffi::OsStr::new("1")))));
-        assert!(envs.contains(&(std::ffi::OsStr::new("B"), None)));
-    }
 
     #[test]
     fn tee_keeps_output_and_errors_in_order_and_the_status() {

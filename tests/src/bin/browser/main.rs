@@ -14,7 +14,7 @@
 //!    again; `rig`); a rig builder's task at 1366x768 and 1920x1080 (an F1 session, the Live view read, its profile tuned live,
 //!    saved and found again after a reload; `task`).
 //!
-//! `--screenshots DIR` saves a picture of each panel there (the book's are in `docs/book/src/images/ui/`), and of
+//! `--prepare` installs step 1's packages and stops. `--screenshots DIR` saves a picture of each panel there (the book's are in `docs/book/src/images/ui/`), and of
 //! every panel at 1366x768 and 1920x1080 at the end, in `DIR/sizes/`. The last line is the
 //! sum, `N passed, N failed`; the exit status is 1 when anything failed.
 
@@ -149,8 +149,18 @@ fn main() -> ExitCode {
     let shots = match args.as_slice() {
         [] => None,
         [flag, dir] if flag == "--screenshots" => Some(PathBuf::from(dir)),
+        // Step 1's packages only (the test command's, beside `cargo test`).
+        [flag] if flag == "--prepare" => {
+            return match setup::ensure_browser() {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("browser: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         _ => {
-            eprintln!("usage: browser [--screenshots DIR]");
+            eprintln!("usage: browser [--screenshots DIR | --prepare]");
             return ExitCode::from(2);
         }
     };

@@ -16,7 +16,8 @@
 //! machine.
 //!
 //! `setup` installs what the suite needs first (the target's standard library, QEMU) or says how;
-//! `cargo run -p ringpod-tests --bin qemu -- --preflight` runs only that. `emulator` starts QEMU and the programs;
+//! `cargo run -p ringpod-tests --bin qemu -- --preflight` runs only that, `-- --prepare` that and the builds (the
+//! test command's, beside `cargo test`). `emulator` starts QEMU and the programs;
 //! `host_cli` drives the `ringpod` CLI against them.
 
 mod aux;
@@ -79,6 +80,7 @@ const SECTIONS: [(&str, Section); 6] = [
 enum Mode {
     Suite { busy: bool },
     Preflight,
+    Prepare,
     Section(Section),
 }
 
@@ -87,6 +89,7 @@ fn mode() -> Result<Mode, String> {
     match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
         [] => Ok(Mode::Suite { busy: false }),
         ["--preflight"] => Ok(Mode::Preflight),
+        ["--prepare"] => Ok(Mode::Prepare),
         ["--busy"] => Ok(Mode::Suite { busy: true }),
         ["--section", name] | ["--busy", "--section", name] => SECTIONS
             .iter()
@@ -94,7 +97,7 @@ fn mode() -> Result<Mode, String> {
             .map(|(_, run)| Mode::Section(*run))
             .ok_or_else(|| format!("no section {name:?} (one of {:?})", SECTIONS.map(|(n, _)| n))),
         _ => Err(format!(
-            "unknown arguments {args:?} (--preflight, --busy, or --section NAME)"
+            "unknown arguments {args:?} (--preflight, --prepare, --busy, or --section NAME)"
         )),
     }
 }
@@ -111,6 +114,15 @@ fn main() -> ExitCode {
             return t.end();
         }
         Ok(Mode::Preflight) => return preflight_only(),
+        Ok(Mode::Prepare) => {
+            return match preflight().and_then(|()| controller::build_all()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("qemu: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Ok(Mode::Suite { busy }) => busy,
     };
     // Nothing is built before this passes: a missing piece is one line naming its command, not a compiler error.

@@ -12,6 +12,7 @@
 //!    print `PASS`/`FAIL` lines. The last line is the sum, `N passed, N failed`; the exit status is 1 when anything
 //!    failed.
 //!
+//! `--prepare`: step 1 and the venv only (the test command's, beside `cargo test`).
 //! Other arguments go to run.py (`-- --until serial-status` stops after that check; `-- --help` lists them).
 //! `-- --mutants [NAME...]`: instead, the firmware faults of `tests/rehost/mutants.toml`, each built from a copy of
 //! the sources and run up to the check meant to catch it (`mutants`).
@@ -88,6 +89,9 @@ fn main() -> ExitCode {
         }
     };
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args == ["--prepare"] {
+        return ExitCode::SUCCESS;
+    }
     if args.first().is_some_and(|a| a == "--mutants") {
         return mutants::run(&python, &cli, &args[1..]);
     }
