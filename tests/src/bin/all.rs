@@ -6,13 +6,14 @@
 //!    to them in `RINGPOD_CLI`: no second, release, build of the host.
 //! 2. `cargo test`, eight tests at a time: most of its time is the host's tests waiting on a child `ringpod` in real
 //!    time (its suite spends 14 s of CPU in 74 s). Beside it, at the lowest CPU priority (`nice -n 19`: they take
-//!    what the tests leave and never starve their answers), two lanes start: the runners' preparation (the QEMU
-//!    programs, the firmware as flashed, the emulator's venv, Chromium: `--prepare`), and the Windows runner, in a
-//!    target folder of its own (`target/windows`: a cross-build holds the build folder's lock for minutes), whose
-//!    cross-build runs niced and whose programs then run under Wine; its output is written to
-//!    `target/windows-runner.log` as it comes and printed whole at the end.
-//! 3. Once both `cargo test` and the preparation are over: the QEMU suite, the rehost run and the browser tests, one
-//!    after the other, each keeping about one core busy and waiting on real time, beside the Windows lane.
+//!    what the tests leave and never starve their answers), two lanes start: the runners' preparation, one runner
+//!    after the other (`--prepare`: the QEMU programs; the firmware as flashed and the emulator's venv; Chromium),
+//!    and the Windows runner, in a target folder of its own (`target/windows`: a cross-build holds the build
+//!    folder's lock for minutes), whose cross-build runs niced and whose programs then run under Wine; its output is
+//!    written to `target/windows-runner.log` as it comes and printed whole at the end.
+//! 3. Once `cargo test` is over: the QEMU suite, the rehost run and the browser tests, one after the other, each
+//!    keeping about one core busy and waiting on real time, each once its preparation is over (the rehost run's
+//!    and the browser's go on beside the QEMU suite), beside the Windows lane.
 //!
 //! Each part runs whatever the others gave. The last lines name each part with its result and time, and the exit
 //! status is 1 when any part failed. On a system other than Linux only `cargo test` runs: the emulators, the
@@ -120,12 +121,11 @@ fn main() -> ExitCode {
         test.env("RUST_TEST_THREADS", TEST_THREADS);
     }
     parts.push(part("cargo test", test));
-    parts.push(prepared.join().unwrap_or_else(|_| Part {
-        name: PREPARATION.into(),
-        passed: false,
-        took: Duration::ZERO,
-    }));
-    for name in ["qemu", "rehost", "browser"] {
+    for name in LANE_ONE {
+        // The preparations end in this order; a failed one leaves the runner to build and say why itself.
+        if let Ok(ready) = prepared.recv() {
+            parts.push(ready);
+        }
         let mut c = runner(name);
         if let Some(cli) = &cli {
             c.env(ringpod_tests::cli::CLI_VAR, cli);
@@ -157,45 +157,51 @@ fn main() -> ExitCode {
 /// pose followed within 5 mrad of the one commanded) hold at eight beside a niced build on two cores.
 const TEST_THREADS: &str = "8";
 
-const PREPARATION: &str = "the runners' preparation (beside cargo test)";
+/// The runners after `cargo test`, in their order.
+const LANE_ONE: [&str; 3] = ["qemu", "rehost", "browser"];
 
-/// The QEMU, rehost and browser runners' `--prepare`, one after the other at the lowest CPU priority, on a thread:
-/// their builds, venv and packages ready when `cargo test` is over. Their output goes to `target/prepare.log`,
-/// printed (indented: its counts are not the runners') only when one failed; the runner then fails on its own.
-fn preparation(cli: Option<PathBuf>) -> std::thread::JoinHandle<Part> {
+/// The runners' `--prepare`, in [`LANE_ONE`]'s order, one after the other at the lowest CPU priority on a thread;
+/// each one's part is sent as it ends. Their output goes to `target/prepare-NAME.log`, printed (indented: its counts
+/// are not the runners') only when it failed.
+fn preparation(cli: Option<PathBuf>) -> std::sync::mpsc::Receiver<Part> {
+    let (parts, ready) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
-        let start = Instant::now();
-        let log = target_dir().join("prepare.log");
-        let passed = std::fs::File::create(&log).is_ok_and(|out| {
-            ["qemu", "rehost", "browser"].iter().all(|name| {
-                let mut c = runner(name);
-                c.arg("--prepare");
-                if let Some(cli) = &cli {
-                    c.env(ringpod_tests::cli::CLI_VAR, cli);
+        for name in LANE_ONE {
+            let start = Instant::now();
+            let log = target_dir().join(format!("prepare-{name}.log"));
+            let mut c = runner(name);
+            c.arg("--prepare");
+            if let Some(cli) = &cli {
+                c.env(ringpod_tests::cli::CLI_VAR, cli);
+            }
+            let mut niced = yielding(&c);
+            let passed = std::fs::File::create(&log)
+                .and_then(|out| Ok((out.try_clone()?, out)))
+                .is_ok_and(|(out, err)| {
+                    niced.stdin(Stdio::null()).stdout(out).stderr(err);
+                    niced.status().is_ok_and(|s| s.success())
+                });
+            let part = format!("the {name} runner's preparation (niced)");
+            if !passed {
+                println!("== {part} failed: {}", log.display());
+                if let Ok(f) = std::fs::File::open(&log) {
+                    BufReader::new(f)
+                        .lines()
+                        .map_while(Result::ok)
+                        .for_each(|l| println!("    {l}"));
                 }
-                let mut niced = yielding(&c);
-                let (Ok(o), Ok(e)) = (out.try_clone(), out.try_clone()) else {
-                    return false;
-                };
-                niced.stdin(Stdio::null()).stdout(o).stderr(e);
-                niced.status().is_ok_and(|s| s.success())
-            })
-        });
-        if !passed {
-            println!("== {PREPARATION} failed: {}", log.display());
-            if let Ok(f) = std::fs::File::open(&log) {
-                BufReader::new(f)
-                    .lines()
-                    .map_while(Result::ok)
-                    .for_each(|l| println!("    {l}"));
+            }
+            let sent = parts.send(Part {
+                name: part,
+                passed,
+                took: start.elapsed(),
+            });
+            if sent.is_err() {
+                return;
             }
         }
-        Part {
-            name: PREPARATION.into(),
-            passed,
-            took: start.elapsed(),
-        }
-    })
+    });
+    ready
 }
 
 /// `cargo test --no-run`, its messages read for the `ringpod` it built (the runners' CLI), its diagnostics and
