@@ -10,11 +10,14 @@
 //! last one's, is an input error named by its packet number (as the live path counts an unreadable datagram);
 //! packets that are not UDP, go to another port, are IP fragments or are cut short are skipped and counted, as are
 //! the game's other packets (F1 sends session, lap data, ... to the motion packet's port: [`GAME_PACKETS`]).
+//! A format that carries the lap position (F1, Forza, Codemasters: [`games::LapPosition`]) gives each row the lap
+//! distance as its eighth value, made as the live path makes it ([`LapTrack`]), which `--preview lap` aligns by.
 
 use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use super::lap_track::LapTrack;
 use crate::games;
 use crate::games::outsim2::Opts;
 use crate::games::TelemetryFormat;
@@ -100,6 +103,7 @@ pub fn rows(
     let mut errors = Vec::new();
     let mut first: Option<std::time::Duration> = None;
     let mut last_t: Option<f64> = None;
+    let mut track = LapTrack::default();
     for d in taken {
         let mut refuse = |reason: String| errors.push(InputError { line: d.number, reason });
         let sample = match reader.read(&d.payload) {
@@ -131,7 +135,11 @@ pub fn rows(
         last_t = Some(t);
         let [ax, ay, az] = sample.telemetry.force;
         let [wx, wy, wz] = sample.telemetry.rate;
-        rows.push((d.number, vec![t, ax, ay, az, wx, wy, wz]));
+        let mut row = vec![t, ax, ay, az, wx, wy, wz];
+        if let Some(position) = sample.lap {
+            row.push(track.distance(t, position));
+        }
+        rows.push((d.number, row));
     }
     if cap.cut_short {
         errors.push(InputError {

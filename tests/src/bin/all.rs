@@ -1,4 +1,4 @@
-//! `cargo run -p ringpod-tests --bin all`: the README's test command. Every test of the project, the emulators'
+//! `cargo run --bin all`: the README's test command. Every test of the project, the emulators'
 //! and the browser's runs and the Windows build under Wine, arranged so that two cores are both at work:
 //!
 //! 1. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
@@ -97,8 +97,10 @@ fn main() -> ExitCode {
     }
     let (built, cli) = test_programs();
     let mut runners = cargo();
-    runners.args(["build", "-p", "ringpod-tests", "--bins"]);
-    let runners = part("the runners (cargo build -p ringpod-tests --bins)", runners);
+    // Without `-p`: the workspace's features, as `cargo test` and this program were built with, so that no
+    // dependency is built twice.
+    runners.args(["build"]).args(RUNNERS.iter().flat_map(|r| ["--bin", r]));
+    let runners = part("the runners (cargo build --bin qemu ...)", runners);
     let ready = built.passed && runners.passed;
     parts.extend([built, runners]);
     if !ready {
@@ -156,6 +158,9 @@ fn main() -> ExitCode {
 /// Tests at a time in `cargo test`: most wait on a child `ringpod` in real time, and the live motion's tests (the
 /// pose followed within 5 mrad of the one commanded) hold at eight beside a niced build on two cores.
 const TEST_THREADS: &str = "8";
+
+/// The runners this program starts.
+const RUNNERS: [&str; 4] = ["qemu", "rehost", "browser", "windows"];
 
 /// The runners after `cargo test`, in their order.
 const LANE_ONE: [&str; 3] = ["qemu", "rehost", "browser"];

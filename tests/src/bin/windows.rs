@@ -72,7 +72,7 @@ fn ensure_target() -> Result<(), String> {
 /// host's in 231 s (their time is spent waiting on `ringpod.exe` in real time, not computing).
 const LIGHTER: [&str; 3] = [
     "profile.test.opt-level = 1",
-    "profile.dev.package.\"*\".opt-level = 1",
+    "profile.test.package.\"*\".opt-level = 1",
     "profile.test.debug = false",
 ];
 

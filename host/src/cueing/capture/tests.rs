@@ -167,3 +167,41 @@ fn an_f1_motion_packet_while_spectating_is_refused_by_name() {
     assert!(rows.is_empty());
     assert!(errors[0].reason.contains("spectating"), "{errors:?}");
 }
+
+/// Four 10 s laps of F1 at 20 Hz, each frame's lap data packet before its motion packet, braking over the same
+/// stretch of every lap: each row carries the player's lap distance as its eighth value (wrapping at the line),
+/// and the lap preview fed with the rows keeps the laps and matches the last to an earlier one.
+#[test]
+fn an_f1_captures_lap_distance_reaches_the_lap_preview() {
+    const FRAMES: u64 = 200;
+    const LAP_M: f32 = 600.0;
+    let along = |k: u64| (k % FRAMES) as f32 * LAP_M / FRAMES as f32;
+    let mut frames = Vec::new();
+    for k in 0..4 * FRAMES {
+        let t = k as f32 / 20.0;
+        frames.push((k * 50_000, frame(&packets::f1::lap_data(2024, 3, t, along(k)))));
+        let braking = if (40..80).contains(&(k % FRAMES)) { -0.6 } else { 0.1 };
+        let motion = packets::f1::packet(2024, 0, 3, t, [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, braking, 0.0]);
+        frames.push((k * 50_000 + 1_000, frame(&motion)));
+    }
+    let (rows, errors, _) = rows(&spec::pcap(false, RAW, &frames), TelemetryFormat::Auto, None, None).unwrap();
+    assert!(errors.is_empty(), "{errors:?}");
+    assert_eq!(rows.len() as u64, 4 * FRAMES);
+    for (k, (_, row)) in rows.iter().enumerate() {
+        assert_eq!(row.len(), 8, "row {k}: {row:?}");
+        assert!((row[7] - f64::from(along(k as u64))).abs() < 1e-3, "row {k}: {row:?}");
+    }
+    let mut preview = crate::cueing::lap::LapPreview::new(crate::cueing::lap::Settings::default());
+    for (_, r) in &rows {
+        let sample = ringpod_core::cueing::Telemetry {
+            force: [r[1], r[2], r[3]],
+            rate: [r[4], r[5], r[6]],
+        };
+        preview.observe(r[0], r[7], &sample);
+    }
+    let counts = preview.counts();
+    let state = counts.state.unwrap();
+    assert!(counts.laps >= 3 && counts.kept >= 2, "{counts:?}");
+    assert_eq!((counts.departures, counts.bad_distance), (0, 0), "{counts:?}");
+    assert!(state.matched.is_some() && state.confidence > 0.5, "{counts:?}");
+}
