@@ -53,6 +53,18 @@ pub const GAME_PACKETS: &str = "the game's packets without motion (other types, 
 /// A telemetry row as `cue` reads it from a CSV: its packet number and `t ax ay az wx wy wz`.
 pub type Row = (usize, Vec<f64>);
 
+/// A sample's row at time `t`: `t ax ay az wx wy wz`, and the lap distance where the format carries the lap
+/// position.
+fn row(t: f64, sample: &games::Sample, track: &mut LapTrack) -> Vec<f64> {
+    let [ax, ay, az] = sample.telemetry.force;
+    let [wx, wy, wz] = sample.telemetry.rate;
+    let mut row = vec![t, ax, ay, az, wx, wy, wz];
+    if let Some(position) = sample.lap {
+        row.push(track.distance(t, position));
+    }
+    row
+}
+
 /// The telemetry rows of a capture, the datagrams that could not be used, and what the capture held.
 pub fn rows(
     bytes: &[u8],
@@ -133,13 +145,7 @@ pub fn rows(
             continue;
         }
         last_t = Some(t);
-        let [ax, ay, az] = sample.telemetry.force;
-        let [wx, wy, wz] = sample.telemetry.rate;
-        let mut row = vec![t, ax, ay, az, wx, wy, wz];
-        if let Some(position) = sample.lap {
-            row.push(track.distance(t, position));
-        }
-        rows.push((d.number, row));
+        rows.push((d.number, row(t, &sample, &mut track)));
     }
     if cap.cut_short {
         errors.push(InputError {

@@ -94,7 +94,7 @@ fn failed_checks(python: &Path, elf: &Path, cli: &Path, check: &str) -> Result<V
         python,
         elf,
         cli,
-        &["--until", check, "--max-sim-s", "90", "--max-wall-s", "2400"],
+        &["--until", check, "--max-sim-s", "150", "--max-wall-s", "2400"],
     )?;
     let mut failed = Vec::new();
     if let Some(out) = child.stdout.take() {
