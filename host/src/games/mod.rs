@@ -149,6 +149,7 @@ pub struct Sample {
 /// | `iracing` (shared memory) | `LapDistPct` | along, fraction |
 /// | `rf2`, `lmu` (shared memory) | the player's `mLapDist` over `mScoringInfo.mLapDist` | along, fraction |
 /// | `ams2` (shared memory) | the viewed participant's `mCurrentLapDistance` over `mTrackLength` | along, fraction |
+/// | `text` | the eighth number, after the time (`stream --capture` writes a shared-memory game's there) | along |
 ///
 /// None: `outsim` and `outsim2` (LFS's OutSim has no lap distance; its `OSO_DISTANCE` is not read), `beamng`
 /// (MotionSim carries motion only), `xplane` (an aircraft has no lap), Forza's Sled size (232 bytes: motion only),

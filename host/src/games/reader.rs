@@ -123,13 +123,7 @@ impl Reader {
 
     fn read_one(&mut self, bytes: &[u8]) -> Result<Option<Sample>, String> {
         match self.asked {
-            TelemetryFormat::Text => parse_telemetry(bytes).map(|(time, telemetry)| {
-                Some(Sample {
-                    time,
-                    telemetry,
-                    lap: None,
-                })
-            }),
+            TelemetryFormat::Text => parse_telemetry(bytes).map(Some),
             TelemetryFormat::Game(f) => skipping(decode_with(f, bytes, self.outsim_opts)),
             TelemetryFormat::Auto => match self.locked {
                 Some(f) => self.locked_read(f, bytes),

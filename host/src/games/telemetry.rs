@@ -4,7 +4,7 @@
 use clap::builder::PossibleValue;
 use ringpod_core::cueing::Telemetry;
 
-use super::Format;
+use super::{Format, LapPosition, Sample};
 
 /// The telemetry formats `stream --telemetry-udp` reads: a text line, a game's own format, or whichever of the
 /// games' formats the first readable datagram is.
@@ -45,9 +45,8 @@ impl clap::ValueEnum for TelemetryFormat {
 
     fn to_possible_value(&self) -> Option<PossibleValue> {
         Some(match self {
-            TelemetryFormat::Text => {
-                PossibleValue::new("text").help("`[t] ax ay az wx wy wz`, the units of `ringpod cue`")
-            }
+            TelemetryFormat::Text => PossibleValue::new("text")
+                .help("`[t] ax ay az wx wy wz` or `t ax ay az wx wy wz lap`, the units of `ringpod cue`"),
             TelemetryFormat::Auto => {
                 PossibleValue::new("auto").help("the first game format recognised, said on stderr")
             }
@@ -69,13 +68,16 @@ pub fn numbers(bytes: &[u8]) -> Result<Vec<f64>, String> {
         .collect()
 }
 
-/// Parses a text telemetry datagram: `[t] ax ay az wx wy wz`.
-pub fn parse_telemetry(bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), String> {
+/// Parses a text telemetry datagram: `[t] ax ay az wx wy wz`, or `t ax ay az wx wy wz lap` with the distance along
+/// the lap (any unit that grows along it and falls back at the line: what a capture of a game that gives one holds,
+/// and what a script of one's own can send for the lap preview).
+pub fn parse_telemetry(bytes: &[u8]) -> Result<Sample, String> {
     let v = numbers(bytes)?;
-    let (t, v) = match v.len() {
-        7 => (Some(v[0]), &v[1..]),
-        6 => (None, &v[..]),
-        n => return Err(format!("expected 6 or 7 numbers, got {n}")),
+    let (t, v, lap) = match v.len() {
+        8 => (Some(v[0]), &v[1..7], Some(v[7])),
+        7 => (Some(v[0]), &v[1..], None),
+        6 => (None, &v[..], None),
+        n => return Err(format!("expected 6, 7 or 8 numbers, got {n}")),
     };
     // A time that is not a time would become the reference of every later sample's interval, and a value that is
     // not finite would reach the filters on a first sample: both are unreadable.
@@ -85,14 +87,15 @@ pub fn parse_telemetry(bytes: &[u8]) -> Result<(Option<f64>, Telemetry<f64>), St
             crate::input::numbers::readable(crate::input::table::MAX_TIME_S)
         ));
     }
-    if v.iter().any(|x| !x.is_finite()) {
+    if v.iter().chain(&lap).any(|x| !x.is_finite()) {
         return Err("a value is not finite".into());
     }
-    Ok((
-        t,
-        Telemetry {
+    Ok(Sample {
+        time: t,
+        telemetry: Telemetry {
             force: [v[0], v[1], v[2]],
             rate: [v[3], v[4], v[5]],
         },
-    ))
+        lap: lap.map(LapPosition::Along),
+    })
 }

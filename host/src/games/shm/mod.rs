@@ -32,7 +32,7 @@ pub mod windows;
 #[cfg(test)]
 pub(crate) mod testing;
 
-use super::{checked_values, Sample};
+use super::{checked_values, LapPosition, Sample};
 
 /// The games whose shared memory ringpod reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
@@ -261,15 +261,22 @@ pub fn decode(game: Game, snapshot: &Snapshot) -> Result<Read, Unreadable> {
     Ok(read)
 }
 
-/// The sample as a line of ringpod's `text` telemetry format, `[t] ax ay az wx wy wz` (each number as Rust writes
-/// an `f64`: read back exactly), which `stream --capture` writes and `cue --input` reads.
+/// The sample as a line of ringpod's `text` telemetry format, `[t] ax ay az wx wy wz [lap]` (each number as Rust
+/// writes an `f64`: read back exactly), which `stream --capture` writes and `cue --input` reads. The lap position
+/// goes last where the sample has its time (the format's eighth number follows a time) and it is a distance along
+/// the lap, as every shared-memory game's is.
 pub fn text_line(sample: &Sample) -> String {
     let t = &sample.telemetry;
+    let lap = match (sample.time, sample.lap) {
+        (Some(_), Some(LapPosition::Along(d))) => Some(d),
+        _ => None,
+    };
     let numbers = sample
         .time
         .into_iter()
         .chain(t.force)
         .chain(t.rate)
+        .chain(lap)
         .map(|v| v.to_string())
         .collect::<Vec<_>>();
     numbers.join(" ")

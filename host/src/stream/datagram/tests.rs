@@ -75,12 +75,17 @@ fn every_format_has_a_name_on_the_command_line() {
 
 #[test]
 fn text_telemetry_with_and_without_time() {
-    let (t, s) = parse_telemetry(b"1.5 0.1 -0.2 9.81 0 0 0.3").unwrap();
-    assert_eq!(t, Some(1.5));
-    assert_eq!(s.force, [0.1, -0.2, 9.81]);
-    assert_eq!(s.rate, [0.0, 0.0, 0.3]);
-    let (t, _) = parse_telemetry(b"0.1,-0.2;9.81 0 0 0.3").unwrap();
-    assert_eq!(t, None);
+    let sample = parse_telemetry(b"1.5 0.1 -0.2 9.81 0 0 0.3").unwrap();
+    assert_eq!((sample.time, sample.lap), (Some(1.5), None));
+    assert_eq!(sample.telemetry.force, [0.1, -0.2, 9.81]);
+    assert_eq!(sample.telemetry.rate, [0.0, 0.0, 0.3]);
+    assert_eq!(parse_telemetry(b"0.1,-0.2;9.81 0 0 0.3").unwrap().time, None);
+    // An eighth number, after the time: the distance along the lap.
+    let on_lap = parse_telemetry(b"1.5 0.1 -0.2 9.81 0 0 0.3 812.5").unwrap();
+    assert_eq!(on_lap.lap, Some(crate::games::LapPosition::Along(812.5)));
+    assert_eq!(on_lap.telemetry, sample.telemetry);
+    assert!(parse_telemetry(b"1.5 0.1 -0.2 9.81 0 0 0.3 NaN").is_err());
+    assert!(parse_telemetry(b"1.5 0.1 -0.2 9.81 0 0 0.3 1 2").is_err());
     assert!(parse_telemetry(b"1 2 3").is_err());
     assert!(parse_telemetry(b"1 2 3 4 5 x").is_err());
     assert!(parse_telemetry(&[0xff, 0xfe]).is_err());
