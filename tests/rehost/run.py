@@ -420,7 +420,7 @@ def main():
     ap.add_argument("--usb-full", action="store_true",
                     help="also homing over USB, and the cable pulled mid-stream and plugged again (usb_checks.py)")
     ap.add_argument("--until", help="stop after this check (the mutants' runs)")
-    # The whole run takes about 81 simulated s on idle cores and up to 90 beside a build: the firmware keeps running
+    # The whole run takes about 81 simulated s on idle cores and 90 to 91 beside other work: the firmware keeps running
     # while the host's commands wait on a busy machine, so the limit keeps room for that.
     ap.add_argument("--max-sim-s", type=float, default=150.0, help="stop the run past this many simulated seconds")
     ap.add_argument("--max-wall-s", type=float, default=2400.0, help="stop the run past this many wall seconds")

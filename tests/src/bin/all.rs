@@ -55,6 +55,26 @@ fn runner(name: &str) -> Command {
     c
 }
 
+/// A runner that drives the CLI: `cli`, when the test programs' build gave one, named to it in `RINGPOD_CLI`.
+fn driving(name: &str, cli: Option<&Path>) -> Command {
+    let mut c = runner(name);
+    if let Some(cli) = cli {
+        c.env(ringpod_tests::cli::CLI_VAR, cli);
+    }
+    c
+}
+
+/// Prints the file `log` line by line, each after `indent`.
+fn print_log(log: &Path, indent: &str) {
+    match std::fs::File::open(log) {
+        Ok(f) => BufReader::new(f)
+            .lines()
+            .map_while(Result::ok)
+            .for_each(|l| println!("{indent}{l}")),
+        Err(e) => println!("{indent}{}: {e}", log.display()),
+    }
+}
+
 /// Runs `c` with its output as it comes.
 fn part(name: &str, mut c: Command) -> Part {
     println!("== {name}");
@@ -128,11 +148,7 @@ fn main() -> ExitCode {
         if let Ok(ready) = prepared.recv() {
             parts.push(ready);
         }
-        let mut c = runner(name);
-        if let Some(cli) = &cli {
-            c.env(ringpod_tests::cli::CLI_VAR, cli);
-        }
-        parts.push(part(&format!("the {name} runner"), c));
+        parts.push(part(&format!("the {name} runner"), driving(name, cli.as_deref())));
     }
     let passed = windows
         .as_mut()
@@ -140,13 +156,7 @@ fn main() -> ExitCode {
         .and_then(|child| child.wait().map_err(|e| format!("the Windows runner: {e}")))
         .is_ok_and(|s| s.success());
     println!("== the Windows runner's output");
-    match std::fs::File::open(&log) {
-        Ok(f) => BufReader::new(f)
-            .lines()
-            .map_while(Result::ok)
-            .for_each(|l| println!("{l}")),
-        Err(e) => println!("{}: {e}", log.display()),
-    }
+    print_log(&log, "");
     parts.push(Part {
         name: "the windows runner (beside)".into(),
         passed,
@@ -174,11 +184,8 @@ fn preparation(cli: Option<PathBuf>) -> std::sync::mpsc::Receiver<Part> {
         for name in LANE_ONE {
             let start = Instant::now();
             let log = target_dir().join(format!("prepare-{name}.log"));
-            let mut c = runner(name);
+            let mut c = driving(name, cli.as_deref());
             c.arg("--prepare");
-            if let Some(cli) = &cli {
-                c.env(ringpod_tests::cli::CLI_VAR, cli);
-            }
             let mut niced = yielding(&c);
             let passed = std::fs::File::create(&log)
                 .and_then(|out| Ok((out.try_clone()?, out)))
@@ -189,12 +196,7 @@ fn preparation(cli: Option<PathBuf>) -> std::sync::mpsc::Receiver<Part> {
             let part = format!("the {name} runner's preparation (niced)");
             if !passed {
                 println!("== {part} failed: {}", log.display());
-                if let Ok(f) = std::fs::File::open(&log) {
-                    BufReader::new(f)
-                        .lines()
-                        .map_while(Result::ok)
-                        .for_each(|l| println!("    {l}"));
-                }
+                print_log(&log, "    ");
             }
             let sent = parts.send(Part {
                 name: part,
