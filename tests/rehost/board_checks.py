@@ -3,9 +3,10 @@ the STEP edges the drivers could see, the step signals' timing, and the e-stop c
 
 - `irq-priorities`: the NVIC's IPR bytes (PM0214 4.2.7: 0xE000_E400 + IRQn, the upper 4 bits implemented) of every
   enabled interrupt: the step generator's executor (USART6, IRQ 71) strictly above (a lower number than) USB, TIM5
-  and the EXTI lines, so that none of their handlers delays the next period's rendering; only the DMA interrupt that
-  wakes it (DMA2 stream 5, IRQ 68) and USART1's (a received byte waits at most two byte times, 21.7 us, before the
-  next overruns it: less than a period's rendering) may be at or above it.
+  USART1 and the EXTI lines, so that none of their handlers delays the next period's rendering; only the DMA
+  interrupts (the one that wakes it, DMA2 stream 5, IRQ 68, and USART1's rings' streams 2 and 7, whose handlers note
+  progress and wake) may be at or above it. USART1's bytes go through DMA, so its handler (an idle line, an error)
+  may wait.
 - `inputs-wired` (after boot): every input the plant is wired to reads through the pull its wiring needs (the switches to ground
   the internal pull-up, the supply senses the pull-down, the e-stop chain its external pull-up and no internal
   one), and no read so far found one floating.
@@ -28,10 +29,7 @@ IRQ_NAMES = {6: "EXTI0", 7: "EXTI1", 8: "EXTI2", 9: "EXTI3", 10: "EXTI4", 23: "E
              40: "EXTI15_10", 50: "TIM5", 67: "OTG_FS", 68: "DMA2_STREAM5", 71: "USART6"}
 EXECUTOR, STEP_DMA = 71, 68
 DMA_IRQS = {11, 12, 13, 14, 15, 16, 17, 47, 56, 57, 58, 59, 60, 68, 69, 70}  # RM0383 10.2: DMA1/DMA2 streams 0-7
-MUST_BE_BELOW = ("OTG_FS", "TIM5", "EXTI")
-# USART1 may pre-empt it: a received byte must be taken within two byte times (21.7 us at 921,600 baud), less than a
-# period's rendering takes (firmware/src/board/stm32f411/resources.rs)
-USART1 = 37
+MUST_BE_BELOW = ("OTG_FS", "TIM5", "USART1", "EXTI")
 # the e-stop to the last STEP edge: 3 ms debounce, 1 ms sampling and tick, the ring's two 1 ms periods, and a
 # period of margin for where in its period the chain opens
 ESTOP_STOP_MS = 7.0
@@ -46,18 +44,18 @@ def priority_check(checks, m):
     prio = {irq: ipr(m, irq) >> 4 for irq in enabled}
     mine = prio.get(EXECUTOR)
     named = {IRQ_NAMES.get(irq, f"IRQ{irq}"): p for irq, p in prio.items() if irq not in DMA_IRQS or irq == STEP_DMA}
-    # embassy enables every DMA stream's interrupt at init (`dma_interrupt_priority`); of them only DMA2 stream 5
-    # runs, and it wakes the executor
+    # embassy enables every DMA stream's interrupt at init (`dma_interrupt_priority`); of them DMA2 stream 5 wakes
+    # the executor, and streams 2 and 7 (USART1's rings) wake the link task
     dma = [irq for irq in enabled if irq in DMA_IRQS]
     wrong = [IRQ_NAMES.get(irq, f"IRQ{irq}") for irq in enabled
-             if irq not in (EXECUTOR, USART1, *dma) and mine is not None and prio[irq] <= mine]
+             if irq not in (EXECUTOR, *dma) and mine is not None and prio[irq] <= mine]
     covered = all(any(n.startswith(w) for n in named) for w in MUST_BE_BELOW)
     checks.check("irq-priorities", mine is not None and not wrong and covered
                  and prio.get(STEP_DMA, 16) <= mine,
                  f"NVIC IPR (PM0214 4.2.7, 4 bits; lower pre-empts) of the enabled interrupts: {named}; the step "
-                 f"executor (USART6) at {mine}, above {', '.join(MUST_BE_BELOW)} (USART1 may pre-empt it: its receive "
-                 f"register holds a byte for 21.7 us); the other {len(dma) - 1} DMA streams' "
-                 f"interrupts (enabled by embassy, never raised) not counted" + (f"; not below it: {wrong}" if wrong else "")
+                 f"executor (USART6) at {mine}, above {', '.join(MUST_BE_BELOW)} (USART1 through DMA: no byte waits "
+                 f"for its handler); the other {len(dma) - 1} DMA streams' interrupts (enabled by embassy; short "
+                 f"handlers that wake a task) not counted" + (f"; not below it: {wrong}" if wrong else "")
                  + ("" if covered else "; not all of USB, USART1, TIM5 and EXTI enabled"))
 
 

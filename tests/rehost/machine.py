@@ -74,6 +74,9 @@ COMPARE_REQUESTS = {
     "tim1": {0: [("dma2", 1, 6), ("dma2", 3, 6), ("dma2", 6, 0)], 1: [("dma2", 2, 6), ("dma2", 6, 0)],
              2: [("dma2", 6, 6), ("dma2", 6, 0)], 3: [("dma2", 4, 6)]},
 }
+# RM0383 9.3.3, table 28 (DMA2): USART1's receive and transmit requests (controller, stream, channel)
+USART1_RX_REQUESTS = [("dma2", 2, 4), ("dma2", 5, 4)]
+USART1_TX_REQUESTS = [("dma2", 7, 4)]
 QILING_PERIPHERALS = ["pwr", "syscfg", "dbgmcu", "usart2", "usart6"]
 # RM0383 39.1: the 96-bit unique device ID at 0x1FFF7A10 (X and Y on the wafer, 16 bits each; the wafer number;
 # the lot number, seven ASCII characters), in the page after system memory that also holds the OTP area (RM0383
@@ -198,6 +201,10 @@ class Machine:
         self.dwt = self.install("dwt", 0xE000_1000, Dwt(self.clock))
         self.exti = self.install("exti", 0x4001_3C00, Exti(self.pend, self._exticr))
         self.usart1 = self.install("usart1", 0x4001_1000, Usart("usart1", self.clock, self.pend, USART1_IRQ))
+        self.usart1.rx_dma = [_Request(self.dma[dma], stream, channel) for dma, stream, channel in USART1_RX_REQUESTS]
+        self.usart1.tx_dma = [_Request(self.dma[dma], stream, channel) for dma, stream, channel in USART1_TX_REQUESTS]
+        # a stream enabled while the USART's request holds starts at once (a request is a level, RM0383 9.3.2)
+        self.dma["dma2"].on_enable.append(lambda stream: self.usart1.serve_dma())
         self.timed = [self.iwdg, self.usart1, *self.tim.values()]
 
     def _exticr(self, line):
@@ -537,13 +544,18 @@ class Machine:
 
 
 class _Request:
-    """A timer's update or compare request line into one DMA stream (RM0383 9.3.3)."""
+    """A peripheral's request line into one DMA stream (RM0383 9.3.3): a timer's update or compare, a USART's."""
 
     def __init__(self, dma, stream, channel):
         self.dma, self.stream, self.channel = dma, stream, channel
 
     def __call__(self, n):
         self.dma.request(self.stream, self.channel, n)
+
+    def active(self):
+        """Whether the stream is enabled and selects this line's channel: a request now moves an item."""
+        st = self.dma.streams[self.stream]
+        return bool(st.cr & 1) and st.channel == self.channel
 
     def horizon(self):
         st = self.dma.streams[self.stream]

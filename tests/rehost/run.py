@@ -359,7 +359,12 @@ def settings_check(m, p, log, cli, port):
     start = m.now
     st = cli.run("device", "config", "set", "stream.timeout_ms", "250", *port)
     widened = []  # the reload value while the settings task stores
+    asked = None  # a request whose bytes reach USART1 while the erase stalls the CPU, and the overruns before it
     while m.now - start < 4 * SYSCLK and not any("the configuration" in t for _, _, t in log.lines[lines:]):
+        if asked is None and fl.busy_until > m.now + SYSCLK:
+            overruns, received, stalled_at = m.usart1.overruns, m.usart1.received, m.now
+            r = cli.run("device", "status", *port, hold=True)
+            asked = (r, m.usart1.overruns - overruns, m.usart1.received - received, ms(fl.busy_until - stalled_at))
         m.run(m.now + SYSCLK // 100)
         widened.append(iw.rlr_act)
         log.poll()
@@ -383,12 +388,17 @@ def settings_check(m, p, log, cli, port):
     timeout = max(widened, default=0) * iw.tick(iw.pr_act)
     CHECKS.check("serial-settings", st.code == 0 and stored and "stored" in stored[0] and value == 250
                  and fl.erases[erases:] == [6] and new and not outside and not fl.rejected
-                 and restarted == ["SYSRESETREQ"] and gap < timeout and abs(periods - sim_ms) <= 2 and caught,
+                 and restarted == ["SYSRESETREQ"] and gap < timeout and abs(periods - sim_ms) <= 2 and caught
+                 and asked is not None and asked[0].code == 0 and asked[1] == 0,
                  f"{st}; the settings task: {stored[0] if stored else 'nothing stored'!r}, {len(new)} words programmed, "
                  f"sector erases {fl.erases[erases:]} (BSY and the CPU stalled for {ms(busy):.0f} ms), outside sectors 6-7: {outside or 'none'}, {len(fl.rejected)} rejected stores; "
                  f"the watchdog widened to RLR {max(widened, default=0)} ({ms(timeout):.0f} ms), longest gap between "
                  f"feeds {ms(gap):.0f} ms; device time {periods} ms in {sim_ms:.1f} simulated ms across the save "
-                 f"(at most 2 ms apart; the firmware: {caught}); {rs}: resets {restarted}; {got}")
+                 f"(at most 2 ms apart; the firmware: {caught}); "
+                 + (f"`device status` sent {asked[3]:.0f} ms before the erase's end: exit {asked[0].code}, its bytes "
+                    f"taken by DMA while the CPU stood ({asked[2]} received, {asked[1]} overruns); " if asked else
+                    "no request sent during the erase; ")
+                 + f"{rs}: resets {restarted}; {got}")
 
 
 # Lines above info the run causes on purpose: the watchdog-reset check's reset.

@@ -9,6 +9,7 @@ once a simulated millisecond.
 import os
 import subprocess
 import tempfile
+import time
 import tty
 
 from machine import SYSCLK
@@ -69,12 +70,17 @@ class Cli:
     def __init__(self, m, ringpod, bridge):
         self.m, self.ringpod, self.bridge = m, ringpod, bridge
 
-    def run(self, *args, sim_limit_s=20.0, during=None, expect=(0,)):
+    def run(self, *args, sim_limit_s=20.0, during=None, expect=(0,), hold=False):
         """`during(simulated_s)`, when given, is called between the machine's steps (every 5 simulated ms);
-        `expect`: the exit statuses this run may end with (None: any)."""
+        `expect`: the exit statuses this run may end with (None: any); `hold`: the machine waits (device time stands
+        still) until the CLI's first bytes are on the line, so that they arrive in the state the machine is in now."""
         cmd = [self.ringpod, *args]
         with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
             proc = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL, env=cli_env())
+            sent, deadline = self.bridge.to_board, time.time() + 30
+            while hold and self.bridge.to_board == sent and proc.poll() is None and time.time() < deadline:
+                self.bridge.poll()
+                time.sleep(0.002)
             start = self.m.now
             step = SYSCLK // 200
             while proc.poll() is None and self.m.now - start < sim_limit_s * SYSCLK and self.m.fault is None:

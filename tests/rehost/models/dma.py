@@ -45,6 +45,7 @@ class Dma(Block):
         `bus.read(addr, size)` / `bus.write(addr, size, value)`; `irqs`: the NVIC line of each stream
         (DMA1: 11-17, 47; DMA2: 56-60, 68-70, RM0383 10.2, vector table)."""
         self.name, self.bus, self.pend, self.irqs = name, bus, pend, irqs
+        self.on_enable = []  # called with a stream's number when it is enabled (a request already held is served)
         self.reset()
 
     def reset(self):
@@ -148,6 +149,9 @@ class Dma(Block):
                 else:
                     st.reload, st.done = st.ndtr, 0
             self._irq(s)
+            if st.cr & EN:
+                for listener in self.on_enable:
+                    listener(s)
         elif st.cr & EN:
             return  # RM0383 9.5.6-9.5.9: NDTR, PAR, M0AR are writable only while the stream is disabled
         elif reg == 4:

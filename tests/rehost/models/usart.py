@@ -4,6 +4,9 @@ Qiling's USART model moves bytes at once and raises no interrupts by the registe
 timing: a frame takes (1 start + M data + STOP stop) bit times of BRR peripheral-clock cycles each (19.3.4
 oversampling by 16, OVER8 = 0), bytes from the host arrive one frame after another, and the interrupt line follows
 the flags and their enable bits (19.4 USART interrupts). Everything the firmware sends is handed to `on_tx`.
+With CR3.DMAT or DMAR (19.3.13, continuous communication using DMA), TXE and RXNE request DMA transfers on the
+request lines `tx_dma` and `rx_dma` (the machine wires them to DMA2's streams, RM0383 9.3.3 table 28) while they
+hold and the stream is enabled; the receiver's bytes are then taken even while the CPU is stalled.
 """
 
 from models.base import NEVER, Block
@@ -12,6 +15,8 @@ from models.base import NEVER, Block
 PE, FE, NF, ORE, IDLE, RXNE, TC, TXE = (1 << i for i in range(8))
 # 19.6.4 USART_CR1
 SBK, RWU, RE, TE, IDLEIE, RXNEIE, TCIE, TXEIE, PEIE, PS, PCE, WAKE, M, UE, OVER8 = (1 << i for i in range(16) if i != 14)
+# 19.6.6 USART_CR3
+EIE, DMAR, DMAT = 1 << 0, 1 << 6, 1 << 7
 SR, DR, BRR, CR1, CR2, CR3, GTPR = 0x00, 0x04, 0x08, 0x0C, 0x10, 0x14, 0x18
 
 
@@ -20,6 +25,8 @@ class Usart(Block):
         self.label, self.clock, self.pend, self.irq = label, clock, pend, irq
         self.cycles_per_pclk = cycles_per_pclk  # CPU cycles per peripheral clock cycle (APB prescaler)
         self.on_tx = None  # called with each byte when its stop bit has gone out
+        self.tx_dma = self.rx_dma = ()  # DMA request lines: callables `line(n)` with `line.active()`
+        self.serving_dma = False
         self.reset()
 
     def reset(self):
@@ -62,7 +69,29 @@ class Usart(Block):
         """19.4: the interrupt request, from the event flags and their enable bits."""
         sr, cr1 = self.sr, self.cr1
         return bool((sr & TXE and cr1 & TXEIE) or (sr & TC and cr1 & TCIE) or (sr & (RXNE | ORE) and cr1 & RXNEIE)
-                    or (sr & IDLE and cr1 & IDLEIE) or (sr & PE and cr1 & PEIE))
+                    or (sr & IDLE and cr1 & IDLEIE) or (sr & PE and cr1 & PEIE)
+                    # 19.4: noise, overrun and framing errors interrupt through EIE, which is used with DMAR only
+                    or (sr & (NF | ORE | FE) and self.cr3 & EIE and self.cr3 & DMAR))
+
+    def serve_dma(self):
+        """19.3.13: a DMA request while TXE (DMAT) or RXNE (DMAR) holds; each transfer writes or reads DR, which
+        clears the flag. Called whenever a flag, an enable bit or a stream's enable changes."""
+        if self.serving_dma:
+            return  # the transfer's own DR access comes back here
+        self.serving_dma = True
+        try:
+            moved = True
+            while moved:
+                moved = False
+                for flag, bit, lines in ((TXE, DMAT, self.tx_dma), (RXNE, DMAR, self.rx_dma)):
+                    if self.sr & flag and self.cr3 & bit and self.cr1 & UE:
+                        for line in lines:
+                            if line.active():
+                                line(1)
+                                moved = True
+                                break
+        finally:
+            self.serving_dma = False
 
     def _raise(self):
         if self.level():
@@ -114,6 +143,7 @@ class Usart(Block):
             self.cr3 = value & 0x0FFF
         elif offset == GTPR:
             self.gtpr = value & 0xFFFF
+        self.serve_dma()
         self._raise()
 
     def _load_shift(self, now):
@@ -136,6 +166,7 @@ class Usart(Block):
                 if self.on_tx:
                     self.on_tx(byte)
                 self._load_shift(t)
+                self.serve_dma()
                 if self.shift is None:
                     self.sr |= TC  # 19.6.1 TC: the frame is out and TXE is set
             elif t == self.rx_at:
@@ -152,6 +183,7 @@ class Usart(Block):
                     self.received += 1
                 self.idle_armed = True
                 self.idle_at = NEVER if self.rx_wire else t + self.frame_cycles()
+                self.serve_dma()
             else:
                 self.idle_at = NEVER
                 if self.idle_armed:

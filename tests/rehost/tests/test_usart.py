@@ -1,7 +1,30 @@
 import unittest
 
+from models import dma as D
 from models.exti import Exti
-from models.usart import CR1, DR, IDLE, IDLEIE, ORE, RE, RXNE, RXNEIE, SR, TC, TE, TXE, UE, Usart
+from models.usart import CR1, CR3, DMAR, DMAT, DR, IDLE, IDLEIE, ORE, RE, RXNE, RXNEIE, SR, TC, TE, TXE, UE, Usart
+from tests.helpers import Memory
+
+USART1 = 0x4001_1000
+RING = 0x2000_0100
+
+
+class Bus(Memory):
+    """RAM with USART1's registers mapped where the DMA streams' PAR points."""
+
+    def __init__(self, usart):
+        super().__init__()
+        self.usart = usart
+
+    def read(self, addr, size):
+        if USART1 <= addr < USART1 + 0x400:
+            return self.usart.read(addr - USART1, size)
+        return super().read(addr, size)
+
+    def write(self, addr, size_or_data, value=None):
+        if USART1 <= addr < USART1 + 0x400:
+            return self.usart.write(addr - USART1, size_or_data, value)
+        return super().write(addr, size_or_data, value)
 
 
 class Clock:
@@ -54,6 +77,84 @@ class UsartTest(unittest.TestCase):
         self.run_to(2080)
         self.assertEqual(self.sent, [0x41, 0x42])
         self.assertTrue(self.u.read(SR, 4) & TC)
+
+
+class _Line:
+    def __init__(self, dma, stream, channel):
+        self.dma, self.stream, self.channel = dma, stream, channel
+
+    def __call__(self, n):
+        self.dma.request(self.stream, self.channel, n)
+
+    def active(self):
+        st = self.dma.streams[self.stream]
+        return bool(st.cr & D.EN) and st.channel == self.channel
+
+
+class UsartDmaTest(unittest.TestCase):
+    """19.3.13: with DMAR the receiver's bytes go to memory as they arrive, whatever the CPU does (an erase stalls
+    it); with DMAT the transmitter takes its bytes from memory, one per TXE."""
+
+    def setUp(self):
+        self.clock, self.pended, self.sent = Clock(), [], []
+        self.u = Usart("usart1", self.clock, self.pended.append, 37)
+        self.u.on_tx = self.sent.append
+        self.bus = Bus(self.u)
+        self.dma = D.Dma("dma2", self.bus, self.pended.append, [56, 57, 58, 59, 60, 68, 69, 70])
+        self.u.rx_dma = [_Line(self.dma, 2, 4)]
+        self.u.tx_dma = [_Line(self.dma, 7, 4)]
+        self.dma.on_enable.append(lambda s: self.u.serve_dma())
+        self.u.write(0x08, 4, 104)
+        self.u.write(CR1, 4, UE | TE | RE | IDLEIE)
+
+    def stream(self, s, par, m0ar, n, direction, extra=0):
+        base = 0x10 + s * 0x18
+        self.dma.write(base + 4, 4, n)
+        self.dma.write(base + 8, 4, par)
+        self.dma.write(base + 12, 4, m0ar)
+        self.dma.write(base, 4, (4 << 25) | D.MINC | (direction << 6) | extra | D.EN)
+
+    def run_to(self, t):
+        self.clock.t = t
+        self.u.advance(t)
+
+    def test_receive_into_a_ring_without_the_cpu(self):
+        self.stream(2, USART1 + DR, RING, 8, 0, D.CIRC | D.HTIE | D.TCIE)
+        self.u.write(CR3, 4, DMAR)
+        self.u.feed(b"0123456789")  # more than the ring: it wraps
+        self.run_to(10 * 10 * 104)  # no register read by the CPU meanwhile
+        self.assertEqual(bytes(self.bus.read(RING + i, 1) for i in range(8)), b"89234567")
+        self.assertEqual((self.u.overruns, self.u.received), (0, 10))
+        self.assertFalse(self.u.read(SR, 4) & (RXNE | ORE))
+        self.assertEqual(self.dma.read(0x10 + 2 * 0x18 + 4, 4), 6)  # NDTR: 2 of the second lap moved
+        self.assertIn(58, self.pended)  # DMA2 stream 2's half and complete interrupts
+
+    def test_receive_without_dma_overruns(self):
+        self.stream(2, USART1 + DR, RING, 8, 0, D.CIRC)
+        self.u.feed(b"01")  # DMAR clear: nobody takes the bytes
+        self.run_to(2 * 10 * 104)
+        self.assertEqual(self.u.overruns, 1)
+        self.assertEqual(self.bus.read(RING, 1), 0)
+
+    def test_held_request_served_when_the_stream_is_enabled(self):
+        self.u.write(CR3, 4, DMAR)
+        self.u.feed(b"a")
+        self.run_to(10 * 104)
+        self.assertTrue(self.u.read(SR, 4) & RXNE)  # no stream yet: the byte waits in DR
+        self.stream(2, USART1 + DR, RING, 8, 0, D.CIRC)
+        self.assertEqual(self.bus.read(RING, 1), ord("a"))
+        self.assertFalse(self.u.read(SR, 4) & RXNE)
+
+    def test_transmit_from_memory(self):
+        for i, b in enumerate(b"hello"):
+            self.bus.write(RING + i, 1, b)
+        self.u.write(CR3, 4, DMAT)
+        self.stream(7, USART1 + DR, RING, 5, 1, D.TCIE)
+        self.run_to(5 * 10 * 104)
+        self.assertEqual(bytes(self.sent), b"hello")
+        self.assertTrue(self.u.read(SR, 4) & TC)
+        self.assertFalse(self.dma.streams[7].cr & D.EN)  # NDTR reached 0: the stream is off
+        self.assertIn(70, self.pended)
 
 
 class ExtiTest(unittest.TestCase):

@@ -84,12 +84,13 @@ pub async fn start(spawner: Spawner) {
     // A spare axis fitted in the restored settings takes the supply senses' and USART1's pins for STEP/DIR 7-8
     // (a settings choice, applied at this start: the configuration refuses sensed supplies beside it).
     let spare = spare_renderer(&restored);
-    let (senses, uart) = match spare {
+    // DMA2 stream 2 is the spare port C ring's or USART1's receive ring (resources: why one stream for both).
+    let (senses, uart, spare_dma) = match spare {
         Some(_) => {
             outputs::hold_spare(r.senses, r.uart);
-            (None, None)
+            (None, None, Some(r.spare_dma))
         }
-        None => (Some(r.senses), Some(r.uart)),
+        None => (Some(r.senses), Some((r.uart, r.spare_dma.port_c)), None),
     };
     let mut switches = switches::new(r.switches, senses);
     let shared = share(restored.controller, &mut switches, restored.rig, watchdog_reset);
@@ -99,11 +100,11 @@ pub async fn start(spawner: Spawner) {
     steps::start(
         r.step_generator,
         restored.renderer,
-        spare.map(|s| (r.spare_dma, s)),
+        spare.zip(spare_dma).map(|(s, d)| (d, s)),
         shared,
     );
     let (device, usb_link) = usb::new(r.usb);
-    let uart_link = uart.map(uart::new);
+    let uart_link = uart.map(|(parts, rx_dma)| uart::new(parts, rx_dma));
 
     resources::set_priorities();
     watchdog::start(watchdog::NORMAL_US);

@@ -8,10 +8,11 @@ use ringpod_core::motion::pulse::PortMap;
 
 bind_interrupts!(pub struct Irqs {
     OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
-    USART1 => usart::BufferedInterruptHandler<peripherals::USART1>;
+    USART1 => usart::InterruptHandler<peripherals::USART1>;
     DMA2_STREAM1 => dma::InterruptHandler<peripherals::DMA2_CH1>;
     DMA2_STREAM2 => dma::InterruptHandler<peripherals::DMA2_CH2>;
     DMA2_STREAM5 => dma::InterruptHandler<peripherals::DMA2_CH5>;
+    DMA2_STREAM7 => dma::InterruptHandler<peripherals::DMA2_CH7>;
     EXTI0 => exti::InterruptHandler<interrupt::typelevel::EXTI0>;
     EXTI1 => exti::InterruptHandler<interrupt::typelevel::EXTI1>;
     EXTI2 => exti::InterruptHandler<interrupt::typelevel::EXTI2>;
@@ -22,27 +23,25 @@ bind_interrupts!(pub struct Irqs {
 });
 
 /// The step generator's feeder (the interrupt executor on USART6) renders the next period while the DMA plays the
-/// current one: it has a whole period for that, so only short handlers may pre-empt it: the DMA interrupt that wakes
-/// it (`dma_interrupt_priority`, P0 by default) and USART1's, which must take each received byte within two byte
-/// times (21.7 us at 921,600 baud: the data register and the shift register) or lose the next to an overrun, while a
-/// period's rendering takes longer than that. Lower numbers pre-empt higher ones; the F411 implements 4 priority
-/// bits (PM0214 4.3.7).
+/// current one: it has a whole period for that, so only short handlers may pre-empt it: the DMA interrupts (their
+/// handlers note a transfer's progress and wake; `dma_interrupt_priority`, P0 by default), among them the one that
+/// wakes it. USART1 receives and sends through DMA, so no byte waits for a handler. Lower numbers pre-empt higher
+/// ones; the F411 implements 4 priority bits (PM0214 4.3.7).
 pub const STEP_EXECUTOR_PRIORITY: Priority = Priority::P1;
-/// USART1: above the step executor, for its receive register (see above); its handler moves a byte and wakes.
-const UART_PRIORITY: Priority = Priority::P0;
 /// Embassy's time driver (TIM5): below the step executor, above USB and the switches, so that a long USB handler
 /// does not delay the clock's half-period interrupt.
 const TIME_PRIORITY: Priority = Priority::P2;
-/// USB (its core buffers whole packets and NAKs the host while it is busy) and the switches' edges (debounced over
-/// milliseconds): their handlers only move packets and wake tasks in thread mode.
+/// USB (its core buffers whole packets and NAKs the host while it is busy), USART1 (its handler sees an idle line or
+/// a line error; the bytes go through DMA) and the switches' edges (debounced over milliseconds): their handlers only
+/// move packets and wake tasks in thread mode.
 const IO_PRIORITY: Priority = Priority::P3;
 
 /// Gives every enabled interrupt but the step generator's its priority (embassy's drivers enable theirs at P0).
 pub fn set_priorities() {
-    interrupt::USART1.set_priority(UART_PRIORITY);
     interrupt::TIM5.set_priority(TIME_PRIORITY);
     for irq in [
         interrupt::OTG_FS,
+        interrupt::USART1,
         interrupt::EXTI0,
         interrupt::EXTI1,
         interrupt::EXTI2,
@@ -140,7 +139,9 @@ assign_resources! {
         timer: TIM1,
     }
     /// The spare axes' rings: TIM1's compare 1 paces DMA2 stream 1 into GPIOA's BSRR, compare 2 stream 2 into
-    /// GPIOC's (channel 6 both, RM0383 9.3.3, table 28).
+    /// GPIOC's (channel 6 both, RM0383 9.3.3, table 28). Without spare axes, stream 2 is USART1's receive ring
+    /// (channel 4): the only other stream USART1_RX has is the step generator's 5, and TIM1_CH2's other one (stream 6
+    /// channel 0) also takes compare 1's and 3's requests.
     spare_dma: SpareDmaParts {
         port_a: DMA2_CH1,
         port_c: DMA2_CH2,
@@ -151,11 +152,13 @@ assign_resources! {
         dp: PA12,
         dm: PA11,
     }
-    /// USART1 on RX PA10 and TX PA15; with a spare axis fitted, the pins are DIR7 and STEP8.
+    /// USART1 on RX PA10 and TX PA15, sending through DMA2 stream 7 (channel 4); with a spare axis fitted, the
+    /// pins are DIR7 and STEP8.
     uart: UartParts {
         usart: USART1,
         rx: PA10,
         tx: PA15,
+        tx_dma: DMA2_CH7,
     }
     /// The flash controller (settings in sectors 6 and 7).
     settings: SettingsParts {

@@ -1,7 +1,15 @@
 //! USART1, the second host link (for an isolated USB-serial adapter), served at the same time as USB.
+//!
+//! Both directions go through DMA. A byte that arrives while no code can run is kept: erasing a flash sector for the
+//! settings stalls every read of flash for up to 2 s (RM0383 3.5; the code and the vector table are there), but not
+//! DMA2's writes into SRAM, so a request sent meanwhile waits in the receive ring instead of overrunning the data
+//! register (one byte time, 10.8 us) and being lost.
 
 use embassy_stm32::gpio::Pull;
-use embassy_stm32::usart::{self, BufferedUart};
+use embassy_stm32::mode::Async;
+use embassy_stm32::peripherals::DMA2_CH2;
+use embassy_stm32::usart::{self, RingBufferedUartRx, Uart, UartTx};
+use embassy_stm32::Peri;
 use ringpod_firmware::app::link::{Disconnected, Link};
 use ringpod_firmware::app::{self, Shared};
 use static_cell::StaticCell;
@@ -12,13 +20,17 @@ use super::resources::{Irqs, UartParts};
 /// 96 MHz gives 923,077 baud (+0.16 %), within any adapter's tolerance.
 pub const USART_BAUD: u32 = 921_600;
 
-/// Bytes of each of USART1's software buffers.
-const UART_BUF: usize = 256;
+/// Bytes of the receive ring: a whole request several times over, as the host may send one (and the retries of a
+/// handshake) while a sector erase holds the CPU.
+const RX_RING: usize = 1024;
 
-/// USART1 through embassy's interrupt-driven buffered driver. A UART has no connection to wait for; line errors
-/// (noise, framing, overrun) are logged by the driver and the frame they damaged is answered as malformed.
+/// USART1 through embassy's DMA drivers: the receiver fills a circular ring in the background (woken by an idle
+/// line or the ring's half and end), the transmitter sends each answer as one transfer. A UART has no connection to
+/// wait for; a line error (noise, framing, an overrun of the ring) is logged and the receiver restarts: the frame
+/// it damaged is answered as malformed.
 pub struct UartLink {
-    uart: BufferedUart<'static>,
+    tx: UartTx<'static, Async>,
+    rx: RingBufferedUartRx<'static>,
 }
 
 impl Link for UartLink {
@@ -26,45 +38,34 @@ impl Link for UartLink {
 
     async fn read(&mut self, buf: &mut [u8]) -> Result<usize, Disconnected> {
         loop {
-            if let Ok(n @ 1..) = embedded_io_async::Read::read(&mut self.uart, buf).await {
-                return Ok(n);
+            match self.rx.read(buf).await {
+                Ok(n @ 1..) => return Ok(n),
+                Ok(0) => {}
+                Err(e) => defmt::warn!("USART1: {}", e),
             }
         }
     }
 
-    /// In pieces of at most half the transmit buffer, each sent before the next: embassy's buffered write refuses
-    /// a slice longer than its buffer, and waits for room without a waker when the slice does not fit.
     async fn write(&mut self, bytes: &[u8]) -> Result<(), Disconnected> {
-        for chunk in bytes.chunks(UART_BUF / 2) {
-            embedded_io_async::Write::write_all(&mut self.uart, chunk)
-                .await
-                .map_err(|_| Disconnected)?;
-            embedded_io_async::Write::flush(&mut self.uart)
-                .await
-                .map_err(|_| Disconnected)?;
-        }
-        Ok(())
+        self.tx.write(bytes).await.map_err(|_| Disconnected)
     }
 }
 
 /// USART1 on TX PA15, RX PA10 (pulled up, so an unplugged adapter reads as an idle line, not noise): the second
-/// host link.
-pub fn new(r: UartParts) -> UartLink {
-    static UART_TX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
-    static UART_RX: StaticCell<[u8; UART_BUF]> = StaticCell::new();
+/// host link, receiving through DMA2 stream 2 (`rx_dma`, free when no spare axis is fitted).
+pub fn new(r: UartParts, rx_dma: Peri<'static, DMA2_CH2>) -> UartLink {
+    static RX_BUF: StaticCell<[u8; RX_RING]> = StaticCell::new();
     let mut uart_config = usart::Config::default();
     uart_config.baudrate = USART_BAUD;
     uart_config.rx_pull = Pull::Up;
-    match BufferedUart::new(
-        r.usart,
-        r.rx,
-        r.tx,
-        UART_TX.init([0; UART_BUF]),
-        UART_RX.init([0; UART_BUF]),
-        Irqs,
-        uart_config,
-    ) {
-        Ok(uart) => UartLink { uart },
+    match Uart::new(r.usart, r.rx, r.tx, r.tx_dma, rx_dma, Irqs, uart_config) {
+        Ok(uart) => {
+            let (tx, rx) = uart.split();
+            let mut rx = rx.into_ring_buffered(RX_BUF.init([0; RX_RING]));
+            // Listening from now on, not from the first read: the host may speak before the link task runs.
+            rx.start_uart();
+            UartLink { tx, rx }
+        }
         Err(e) => defmt::panic!("USART1: {}", e),
     }
 }
