@@ -395,8 +395,8 @@ def settings_check(m, p, log, cli, port):
                  f"the watchdog widened to RLR {max(widened, default=0)} ({ms(timeout):.0f} ms), longest gap between "
                  f"feeds {ms(gap):.0f} ms; device time {periods} ms in {sim_ms:.1f} simulated ms across the save "
                  f"(at most 2 ms apart; the firmware: {caught}); "
-                 + (f"`device status` sent {asked[3]:.0f} ms before the erase's end: exit {asked[0].code}, its bytes "
-                    f"taken by DMA while the CPU stood ({asked[2]} received, {asked[1]} overruns); " if asked else
+                 + (f"`device status` sent {asked[3]:.0f} ms before the erase's end: exit {asked[0].code}; while the CPU "
+                    f"stood USART1 received {asked[2]} bytes, {asked[1]} overruns (want 0: DMA takes them); " if asked else
                     "no request sent during the erase; ")
                  + f"{rs}: resets {restarted}; {got}")
 
