@@ -139,9 +139,7 @@ fn main() -> ExitCode {
     }
     let mut test = cargo();
     test.args(["test", "--no-fail-fast"]);
-    if std::env::var_os("RUST_TEST_THREADS").is_none() {
-        test.env("RUST_TEST_THREADS", TEST_THREADS);
-    }
+    ringpod_tests::priority::many_tests_at_once(&mut test);
     parts.push(part("cargo test", test));
     for name in LANE_ONE {
         // The preparations end in this order; a failed one leaves the runner to build and say why itself.
@@ -164,10 +162,6 @@ fn main() -> ExitCode {
     });
     summary(&parts)
 }
-
-/// Tests at a time in `cargo test`: most wait on a child `ringpod` in real time, and the live motion's tests (the
-/// pose followed within 5 mrad of the one commanded) hold at eight beside a niced build on two cores.
-const TEST_THREADS: &str = "8";
 
 /// The runners this program starts.
 const RUNNERS: [&str; 4] = ["qemu", "rehost", "browser", "windows"];

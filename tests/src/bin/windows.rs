@@ -76,10 +76,6 @@ const LIGHTER: [&str; 3] = [
     "profile.test.debug = false",
 ];
 
-/// Tests at a time under Wine: most wait on a child `ringpod.exe` in real time (the suite took 56 s at eight, 180 s
-/// at two).
-const TEST_THREADS: &str = "8";
-
 /// Cargo for the Windows target, with Wine as the runner of what it builds.
 fn cargo(args: &[&str]) -> Command {
     // Cargo's own options go before a `--`: what follows it is the test programs' (`--exact NAME`), which refuse
@@ -149,9 +145,7 @@ fn status(mut c: Command, what: &str) -> Result<(), String> {
 /// [`ringpod_tests::wine`]) is run once more alone, and said; any other failure fails the step.
 fn host_tests() -> Result<(), String> {
     let mut tests = cargo(&["test", "-p", "ringpod", "--no-fail-fast"]);
-    if std::env::var_os("RUST_TEST_THREADS").is_none() {
-        tests.env("RUST_TEST_THREADS", TEST_THREADS);
-    }
+    ringpod_tests::priority::many_tests_at_once(&mut tests);
     let (passed, output) = tee(tests)?;
     if passed {
         return Ok(());
