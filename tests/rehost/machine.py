@@ -27,7 +27,7 @@ from unicorn import UC_HOOK_CODE, UC_HOOK_INTR, UC_HOOK_MEM_WRITE, UC_PROT_READ,
 from unicorn import arm_const as A
 
 from elf import Elf
-from models.dma import Dma, unpack_words
+from models.dma import Dma, RequestLine, unpack_words
 from models.dwt import Dwt
 from models.exti import Exti
 from models.flash import FLASH_BASE, FLASH_SIZE, FlashInterface
@@ -190,9 +190,9 @@ class Machine:
         for label, (base, up, cc, bits) in TIMERS.items():
             tim = self.install(label, base, Tim(label, self.clock, self.pend, up, cc, bits))
             for dma, stream, channel in UPDATE_REQUESTS[label]:
-                tim.update_dma.append(_Request(self.dma[dma], stream, channel))
+                tim.update_dma.append(RequestLine(self.dma[dma], stream, channel))
             for ch, lines in COMPARE_REQUESTS.get(label, {}).items():
-                tim.cc_dma[ch] += [_Request(self.dma[dma], stream, channel) for dma, stream, channel in lines]
+                tim.cc_dma[ch] += [RequestLine(self.dma[dma], stream, channel) for dma, stream, channel in lines]
             self.tim[label] = tim
         self.iwdg = self.install("iwdg", 0x4000_3000, Iwdg(self.clock, self._watchdog_timeout, SYSCLK))
         # RM0383 6.3.10 RCC_AHB2ENR.OTGFSEN (bit 7) clocks the OTG FS core
@@ -201,8 +201,8 @@ class Machine:
         self.dwt = self.install("dwt", 0xE000_1000, Dwt(self.clock))
         self.exti = self.install("exti", 0x4001_3C00, Exti(self.pend, self._exticr))
         self.usart1 = self.install("usart1", 0x4001_1000, Usart("usart1", self.clock, self.pend, USART1_IRQ))
-        self.usart1.rx_dma = [_Request(self.dma[dma], stream, channel) for dma, stream, channel in USART1_RX_REQUESTS]
-        self.usart1.tx_dma = [_Request(self.dma[dma], stream, channel) for dma, stream, channel in USART1_TX_REQUESTS]
+        self.usart1.rx_dma = [RequestLine(self.dma[d], stream, channel) for d, stream, channel in USART1_RX_REQUESTS]
+        self.usart1.tx_dma = [RequestLine(self.dma[d], stream, channel) for d, stream, channel in USART1_TX_REQUESTS]
         # a stream enabled while the USART's request holds starts at once (a request is a level, RM0383 9.3.2)
         self.dma["dma2"].on_enable.append(lambda stream: self.usart1.serve_dma())
         self.timed = [self.iwdg, self.usart1, *self.tim.values()]
@@ -541,22 +541,3 @@ class Machine:
             sp = self.reg(A.UC_ARM_REG_MSP)
             if sp < self.stack_low:
                 self.stack_low = sp
-
-
-class _Request:
-    """A peripheral's request line into one DMA stream (RM0383 9.3.3): a timer's update or compare, a USART's."""
-
-    def __init__(self, dma, stream, channel):
-        self.dma, self.stream, self.channel = dma, stream, channel
-
-    def __call__(self, n):
-        self.dma.request(self.stream, self.channel, n)
-
-    def active(self):
-        """Whether the stream is enabled and selects this line's channel: a request now moves an item."""
-        st = self.dma.streams[self.stream]
-        return bool(st.cr & 1) and st.channel == self.channel
-
-    def horizon(self):
-        st = self.dma.streams[self.stream]
-        return self.dma.horizon(self.stream) if st.channel == self.channel else None

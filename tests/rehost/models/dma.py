@@ -166,5 +166,24 @@ class Dma(Block):
             st.fcr = (st.fcr & 0x38) | (value & 0x87)  # FS (bits 5:3) is read only
 
 
+class RequestLine:
+    """A peripheral's request line into one DMA stream (RM0383 9.3.3): a timer's update or compare, a USART's."""
+
+    def __init__(self, dma, stream, channel):
+        self.dma, self.stream, self.channel = dma, stream, channel
+
+    def __call__(self, n):
+        self.dma.request(self.stream, self.channel, n)
+
+    def active(self):
+        """Whether the stream is enabled and selects this line's channel: a request now moves an item."""
+        st = self.dma.streams[self.stream]
+        return bool(st.cr & EN) and st.channel == self.channel
+
+    def horizon(self):
+        st = self.dma.streams[self.stream]
+        return self.dma.horizon(self.stream) if st.channel == self.channel else None
+
+
 def unpack_words(data):
     return list(struct.unpack(f"<{len(data) // 4}I", data))

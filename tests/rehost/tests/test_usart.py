@@ -79,18 +79,6 @@ class UsartTest(unittest.TestCase):
         self.assertTrue(self.u.read(SR, 4) & TC)
 
 
-class _Line:
-    def __init__(self, dma, stream, channel):
-        self.dma, self.stream, self.channel = dma, stream, channel
-
-    def __call__(self, n):
-        self.dma.request(self.stream, self.channel, n)
-
-    def active(self):
-        st = self.dma.streams[self.stream]
-        return bool(st.cr & D.EN) and st.channel == self.channel
-
-
 class UsartDmaTest(unittest.TestCase):
     """19.3.13: with DMAR the receiver's bytes go to memory as they arrive, whatever the CPU does (an erase stalls
     it); with DMAT the transmitter takes its bytes from memory, one per TXE."""
@@ -101,8 +89,8 @@ class UsartDmaTest(unittest.TestCase):
         self.u.on_tx = self.sent.append
         self.bus = Bus(self.u)
         self.dma = D.Dma("dma2", self.bus, self.pended.append, [56, 57, 58, 59, 60, 68, 69, 70])
-        self.u.rx_dma = [_Line(self.dma, 2, 4)]
-        self.u.tx_dma = [_Line(self.dma, 7, 4)]
+        self.u.rx_dma = [D.RequestLine(self.dma, 2, 4)]
+        self.u.tx_dma = [D.RequestLine(self.dma, 7, 4)]
         self.dma.on_enable.append(lambda s: self.u.serve_dma())
         self.u.write(0x08, 4, 104)
         self.u.write(CR1, 4, UE | TE | RE | IDLEIE)
