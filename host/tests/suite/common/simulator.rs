@@ -5,6 +5,11 @@ use std::process::{Child, Command, Stdio};
 /// The simulator's stream timeout in the tests (see [`Simulator::start`]).
 pub const STREAM_TIMEOUT_MS: u32 = 500;
 
+/// The factor [`Simulator::ringpod`]'s commands lengthen the CLI's waits for an answer by (`RINGPOD_PATIENCE`):
+/// eight tests at a time, each with a simulator and a CLI, beside the test command's niced builds and whatever else
+/// runs, can leave a simulator unscheduled for longer than the CLI's 2 s (seen at a load of 5 on two cores).
+const ANSWER_PATIENCE: &str = "5";
+
 /// `ringpod simulate --pty`, killed when dropped: also when an assertion fails half-way.
 pub struct Simulator {
     /// The simulator's process.
@@ -50,11 +55,14 @@ impl Simulator {
         server
     }
 
-    /// `ringpod WORDS --port PTY`: the exit code and everything it said.
+    /// `ringpod WORDS --port PTY`: the exit code and everything it said. Its waits for an answer are lengthened
+    /// ([`ANSWER_PATIENCE`]): these commands test what the simulated board answers, not how soon a loaded machine
+    /// schedules it.
     pub fn ringpod(&self, words: &[&str]) -> (Option<i32>, String, String) {
         let out = Command::new(assert_cmd::cargo::cargo_bin("ringpod"))
             .args(words)
             .args(["--port", &self.path])
+            .env("RINGPOD_PATIENCE", ANSWER_PATIENCE)
             .output()
             .unwrap();
         (

@@ -36,20 +36,28 @@ pub(crate) fn aux_on_m4f(t: &mut Tally, emulated: &Emulated) {
     let _ = std::fs::remove_file(&input);
     let pins = emulated.wait_for(Duration::from_secs(5), |l| l == "AUX 1");
     let status = ringpod_json(&[&["device", "status"][..], &port].concat());
+    let streamed_ok = streamed
+        .as_ref()
+        .is_ok_and(|r| r["state"] == "Ready" && r["counts_agree"] == true);
+    if !streamed_ok || pins.is_err() {
+        println!("the stream: {streamed:?}; the pins: {pins:?}; then the status: {status:?}");
+    }
     t.check(
-        streamed.is_ok_and(|r| r["state"] == "Ready" && r["counts_agree"] == true)
-            && pins.is_ok()
-            && status.is_ok_and(|s| s["aux"] == 1),
+        streamed_ok && pins.is_ok() && status.is_ok_and(|s| s["aux"] == 1),
         "a pose file's aux1 column switches AUX1's pin on as it streams, and it stays on at rest",
     );
     let off = ringpod_json(&[&["device", "aux", "1", "off"][..], &port].concat());
     let off_pin = emulated.wait_for(Duration::from_secs(5), |l| l == "AUX 0");
     let on = ringpod_json(&[&["device", "aux", "1", "on"][..], &port].concat());
     let on_pin = emulated.wait_for(Duration::from_secs(5), |l| l == "AUX 1");
-    t.check(
-        off.is_ok_and(|s| s["aux"] == 0) && off_pin.is_ok() && on.is_ok_and(|s| s["aux"] == 1) && on_pin.is_ok(),
-        "device aux 1 off|on switches AUX1's pin",
-    );
+    let switched = off.as_ref().is_ok_and(|s| s["aux"] == 0)
+        && off_pin.is_ok()
+        && on.as_ref().is_ok_and(|s| s["aux"] == 1)
+        && on_pin.is_ok();
+    if !switched {
+        println!("off: {off:?}, pins {off_pin:?}; on: {on:?}, pins {on_pin:?}");
+    }
+    t.check(switched, "device aux 1 off|on switches AUX1's pin");
     // AUX2 on opens the e-stop chain (the test's wiring): the fault drops both outputs.
     let (asked, _) = ringpod_text(&[&["device", "aux", "2", "on"][..], &port].concat());
     let dropped = emulated.wait_for(Duration::from_secs(5), |l| l == "AUX 0");

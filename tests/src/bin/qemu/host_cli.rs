@@ -10,13 +10,22 @@ pub(crate) fn ringpod() -> PathBuf {
     ringpod_tests::cli::host().unwrap_or_else(|e| PathBuf::from(format!("<no CLI: {e}>")))
 }
 
+/// The factor the CLI's waits for an answer are lengthened by (`RINGPOD_PATIENCE`). The emulated board runs in
+/// virtual time (`-icount`): on a loaded machine QEMU runs it slower than a board, and an answer due within the
+/// CLI's 2 s comes later (a stream into the rig's controller beside a release build waited longer than that). The
+/// runs check what the firmware answers and does, not how fast the host machine is.
+const PATIENCE: &str = "5";
+
+/// The CLI with its waits for an answer lengthened by [`PATIENCE`], its input closed.
+fn cli(args: &[&str]) -> Command {
+    let mut c = Command::new(ringpod());
+    c.args(args).env("RINGPOD_PATIENCE", PATIENCE).stdin(Stdio::null());
+    c
+}
+
 /// Runs the CLI and parses the JSON it prints.
 pub(crate) fn ringpod_json(args: &[&str]) -> Result<serde_json::Value, String> {
-    let out = Command::new(ringpod())
-        .args(args)
-        .stdin(Stdio::null())
-        .output()
-        .map_err(|e| format!("ringpod: {e}"))?;
+    let out = cli(args).output().map_err(|e| format!("ringpod: {e}"))?;
     if !out.status.success() {
         return Err(format!("ringpod {args:?}: {}", String::from_utf8_lossy(&out.stderr)));
     }
@@ -25,9 +34,7 @@ pub(crate) fn ringpod_json(args: &[&str]) -> Result<serde_json::Value, String> {
 
 /// Runs the CLI; its exit status and what it printed on stdout.
 pub(crate) fn ringpod_text(args: &[&str]) -> (bool, String) {
-    Command::new(ringpod())
-        .args(args)
-        .stdin(Stdio::null())
+    cli(args)
         .stderr(Stdio::null())
         .output()
         .map(|o| (o.status.success(), String::from_utf8_lossy(&o.stdout).into_owned()))
