@@ -523,6 +523,15 @@ mod tests {
         c
     }
 
+    /// [`patient`] with the tuned classical's tilt: 20 deg at 18.75 deg/s, 0.95 of the ranges.
+    pub(super) fn tilting() -> CueConfig {
+        let mut c = patient();
+        c.tilt_limit_deg = [20.0; 2];
+        c.tilt_rate_deg = [18.75; 2];
+        c.optimal.tilt_share = 0.95;
+        c
+    }
+
     #[test]
     fn braking_is_cued_by_moving_back_and_pitching_nose_down() {
         let mut o = Optimal::new(patient(), &ranges().into()).unwrap();
@@ -593,11 +602,7 @@ mod tests {
     fn the_heave_makes_up_the_tilts_loss_of_vertical_force() {
         use ringpod_core::cueing::perception::Perception;
         let drive = |on: bool| {
-            let mut c = patient();
-            c.tilt_limit_deg = [20.0; 2];
-            c.tilt_rate_deg = [18.75; 2];
-            c.optimal.tilt_share = 0.95;
-            let mut o = Optimal::new(c, &ranges().into()).unwrap();
+            let mut o = Optimal::new(tilting(), &ranges().into()).unwrap();
             o.give_heave_the_tilt_loss(on);
             o.begin(&sample(0.0)).unwrap();
             let dt = 0.01;

@@ -70,7 +70,7 @@ impl Axis {
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{patient, ranges};
+    use super::super::tests::{patient, ranges, tilting};
     use super::super::{X, Y};
     use super::*;
     use nalgebra::DVector;
@@ -126,10 +126,7 @@ mod tests {
     #[test]
     fn a_priced_loss_keeps_a_held_corners_vertical_error_under_the_threshold() {
         let drive = |weight: f64| {
-            let mut c = patient();
-            c.tilt_limit_deg = [20.0; 2];
-            c.tilt_rate_deg = [18.75; 2];
-            c.optimal.tilt_share = 0.95;
+            let mut c = tilting();
             c.optimal.tilt_loss_weight = weight;
             let mut o = Optimal::new(c, &ranges().into()).unwrap();
             let level = |ay: f64| Telemetry {

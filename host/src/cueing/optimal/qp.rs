@@ -345,27 +345,33 @@ fn csc(m: &DMatrix<f64>) -> CscMatrix<f64> {
 mod tests {
     use super::*;
 
+    /// The vertical axis's programme over 8 steps of 0.15 s: the force weighed 1, the position 10.
+    fn vertical<'a>(model: &'a Linear, bounds: &'a [Bound], priced: Option<usize>) -> Spec<'a> {
+        Spec {
+            model,
+            steps: 8,
+            h: 0.15,
+            output_weight: &[1.0, 10.0, 1.0],
+            input_weight: &[0.001],
+            bounds,
+            priced,
+        }
+    }
+
     /// The solve is bounded by its iterations, not a clock: too few and it fails (its status says so), enough and
     /// it solves, the same plan bit for bit each time.
     #[test]
     fn a_solve_is_bounded_by_its_iterations_and_repeats_bit_for_bit() {
         let model = super::super::model::vertical();
-        let spec = Spec {
-            model: &model,
-            steps: 8,
-            h: 0.15,
-            output_weight: &[1.0, 10.0, 1.0],
-            input_weight: &[0.001],
-            bounds: &[
-                Bound::State {
-                    output: 1,
-                    lo: -0.03,
-                    hi: 0.03,
-                },
-                Bound::Input { mask: 1, limit: 5.0 },
-            ],
-            priced: None,
-        };
+        let bounds = [
+            Bound::State {
+                output: 1,
+                lo: -0.03,
+                hi: 0.03,
+            },
+            Bound::Input { mask: 1, limit: 5.0 },
+        ];
+        let spec = vertical(&model, &bounds, None);
         let x0 = DVector::zeros(model.dims().0);
         let reference = DVector::from_element(8 * 3, 2.0);
         let mut starved = AxisQp::new(&spec, 1);
@@ -387,19 +393,12 @@ mod tests {
     #[test]
     fn a_price_pulls_its_output_and_leaves_with_its_solve() {
         let model = super::super::model::vertical();
-        let spec = Spec {
-            model: &model,
-            steps: 8,
-            h: 0.15,
-            output_weight: &[1.0, 10.0, 1.0],
-            input_weight: &[0.001],
-            bounds: &[Bound::State {
-                output: 1,
-                lo: -0.05,
-                hi: 0.05,
-            }],
-            priced: Some(1),
-        };
+        let bounds = [Bound::State {
+            output: 1,
+            lo: -0.05,
+            hi: 0.05,
+        }];
+        let spec = vertical(&model, &bounds, Some(1));
         let x0 = DVector::zeros(model.dims().0);
         let reference = DVector::from_fn(8 * 3, |i, _| if i % 3 == 0 { 2.0 } else { 0.0 });
         let mut qp = AxisQp::new(&spec, 60);
