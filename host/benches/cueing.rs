@@ -1,6 +1,7 @@
 //! One sample of the optimal cueing (its three axes' solves and the search of the tilt's room) on the trainer
 //! model's envelope, at the default horizon: the time the 2 ms budget of a 100 Hz sample is measured against; and
-//! the same with the lap preview (its alignment against eight laps kept and its reference), and the preview alone.
+//! the same with the tilts' loss of vertical force priced (a cost matrix that changes every sample), with the lap
+//! preview (its alignment against eight laps kept and its reference), and the preview alone.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use ringpod_core::cueing::{Algorithm, CueConfig, Telemetry, G};
@@ -24,12 +25,13 @@ fn sample(t: f64) -> Telemetry<f64> {
 }
 
 /// The optimal cueing at its defaults on the trainer model, with the rig: each sample also searches the tilt's
-/// shared room.
-fn optimiser() -> (CueConfig, optimal::Optimal) {
-    let config = CueConfig {
+/// shared room; the tilts' loss of vertical force priced at `loss_weight`.
+fn optimiser(loss_weight: f64) -> (CueConfig, optimal::Optimal) {
+    let mut config = CueConfig {
         algorithm: Algorithm::Optimal,
         ..CueConfig::default()
     };
+    config.optimal.tilt_loss_weight = loss_weight;
     // The trainer model's ranges about home as the workspace scan finds them (m, rad).
     let ranges = [
         (-0.129, 0.129),
@@ -50,15 +52,20 @@ fn optimiser() -> (CueConfig, optimal::Optimal) {
 }
 
 fn one_sample(c: &mut Criterion) {
-    let (_, mut o) = optimiser();
-    o.begin(&sample(0.0)).expect("finite");
-    let mut t = 0.0;
-    c.bench_function("optimal cueing: one sample (three axes)", |b| {
-        b.iter(|| {
-            t += 0.01;
-            o.step(&sample(t), 0.01, &[]).expect("finite")
-        })
-    });
+    for (weight, name) in [
+        (0.0, "optimal cueing: one sample (three axes)"),
+        (50.0, "optimal cueing, the tilts' loss priced: one sample (three axes)"),
+    ] {
+        let (_, mut o) = optimiser(weight);
+        o.begin(&sample(0.0)).expect("finite");
+        let mut t = 0.0;
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                t += 0.01;
+                o.step(&sample(t), 0.01, &[]).expect("finite")
+            })
+        });
+    }
 }
 
 /// The lap's input at distance `s` (m) of a 1800 m lap driven at 30 m/s: its forces repeat every lap.
@@ -79,7 +86,7 @@ fn previewing() -> (lap::LapPreview, f64) {
 }
 
 fn one_sample_with_the_lap_preview(c: &mut Criterion) {
-    let (config, mut o) = optimiser();
+    let (config, mut o) = optimiser(0.0);
     o.begin(&on_lap(0.0)).expect("finite");
     let (mut p, mut t) = previewing();
     let (n, h) = (config.optimal.horizon as usize, config.optimal.step_s);

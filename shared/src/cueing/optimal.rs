@@ -38,6 +38,10 @@ pub struct OptimalConfig {
     /// Return to neutral: weight of the tilt, x (pitch) and y (roll) (per rad^2; default 0.1).
     #[serde(deserialize_with = "super::axes::one_or_each")]
     pub tilt_weight: [f64; 2],
+    /// Weight of the tilts' loss of vertical specific force, `g (1 - cos theta_x cos theta_y)`, in their own
+    /// programmes (per (m/s^2)^2; default 0, unpriced): a tilt's perceived vertical error the per-axis linear
+    /// programmes do not otherwise see.
+    pub tilt_loss_weight: f64,
     /// Effort: weight of the platform's acceleration, per axis (per (m/s^2)^2; default 0.001).
     #[serde(deserialize_with = "super::axes::one_or_each")]
     pub acceleration_weight: [f64; 3],
@@ -79,6 +83,7 @@ impl Default for OptimalConfig {
             position_weight: [10.0; 3],
             velocity_weight: [1.0; 3],
             tilt_weight: [0.1; 2],
+            tilt_loss_weight: 0.0,
             acceleration_weight: [0.001; 3],
             rate_weight: [0.01; 2],
             max_velocity: [0.5; 3],
@@ -104,12 +109,16 @@ impl OptimalConfig {
         if !ok(self.step_s, 0.005, 0.5) {
             return err("optimal.step_s", "0.005 to 0.5 s");
         }
-        let weights: [(&'static str, &[f64]); 7] = [
+        let weights: [(&'static str, &[f64]); 8] = [
             ("optimal.force_weight", &self.force_weight),
             ("optimal.rotation_weight", &self.rotation_weight),
             ("optimal.position_weight", &self.position_weight),
             ("optimal.velocity_weight", &self.velocity_weight),
             ("optimal.tilt_weight", &self.tilt_weight),
+            (
+                "optimal.tilt_loss_weight",
+                core::slice::from_ref(&self.tilt_loss_weight),
+            ),
             ("optimal.acceleration_weight", &self.acceleration_weight),
             ("optimal.rate_weight", &self.rate_weight),
         ];

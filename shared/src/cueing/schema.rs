@@ -308,6 +308,13 @@ pub const PARAMS: &[Param] = &[
         WEIGHT,
     ),
     param(
+        "optimal.tilt_loss_weight",
+        "optimal: the tilt's loss of vertical force",
+        one(&["tilt coordination"]),
+        "",
+        WEIGHT,
+    ),
+    param(
         "optimal.acceleration_weight",
         "optimal: acceleration effort",
         (TRANSLATION, TRANSLATION),

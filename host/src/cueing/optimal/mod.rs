@@ -18,6 +18,7 @@ pub mod floor;
 pub mod heave;
 pub mod model;
 pub mod polytope;
+pub mod price;
 pub mod qp;
 pub mod tilt;
 
@@ -225,6 +226,7 @@ impl Optimal {
                 self.axes[i].qp.set_state_bound(tilt::ANGLE_BOUND, lo, hi);
             }
             let classical = self.classical_channels(i);
+            let price = self.loss_price(i, h);
             let axis = &mut self.axes[i];
             let (d_model, d_perception) = axis.at(dt);
             let r = stimulus(i, sample);
@@ -237,7 +239,7 @@ impl Optimal {
                 }
             }
             let t0 = Instant::now();
-            let solved = axis.qp.solve(&axis.x, &reference);
+            let solved = axis.qp.solve(&axis.x, &reference, &price);
             // Measured and counted, never acted on: the motion does not depend on the machine's speed or load.
             late |= t0.elapsed().as_secs_f64() > budget;
             match solved {
@@ -411,6 +413,7 @@ impl Axis {
             output_weight: &weights,
             input_weight: &effort,
             bounds: &bounds,
+            priced: (i != Z).then_some(price::ANGLE),
         };
         let qp = AxisQp::new(&spec, o.iterations);
         let (nx, np) = (model.dims().0, perception.dims().0);
@@ -498,7 +501,7 @@ impl Axis {
 mod tests {
     use super::*;
 
-    fn ranges() -> Ranges {
+    pub(super) fn ranges() -> Ranges {
         [(-0.05, 0.05), (-0.05, 0.05), (-0.03, 0.03), (-0.3, 0.3), (-0.3, 0.3)]
     }
 
@@ -511,12 +514,21 @@ mod tests {
 
     /// The optimal cueing with a budget no solve runs past (the tests run on a loaded machine; the budget is only
     /// counted, and [`the_motion_does_not_depend_on_the_time_a_solve_takes`] shows it).
-    fn patient() -> CueConfig {
+    pub(super) fn patient() -> CueConfig {
         let mut c = CueConfig {
             algorithm: cueing::Algorithm::Optimal,
             ..CueConfig::default()
         };
         c.optimal.budget_ms = 1000.0;
+        c
+    }
+
+    /// [`patient`] with the tuned classical's tilt: 20 deg at 18.75 deg/s, 0.95 of the ranges.
+    pub(super) fn tilting() -> CueConfig {
+        let mut c = patient();
+        c.tilt_limit_deg = [20.0; 2];
+        c.tilt_rate_deg = [18.75; 2];
+        c.optimal.tilt_share = 0.95;
         c
     }
 
@@ -526,7 +538,7 @@ mod tests {
         o.begin(&sample(0.0)).unwrap();
         let r = &mut o.axes[X];
         let reference = r.reference(&stimulus(X, &sample(-6.0)), &[], X);
-        let solved = r.qp.solve(&r.x, &reference);
+        let solved = r.qp.solve(&r.x, &reference, &[]);
         assert!(solved.is_ok(), "{solved:?}");
         let mut last = [0.0; 6];
         for _ in 0..100 {
@@ -590,11 +602,7 @@ mod tests {
     fn the_heave_makes_up_the_tilts_loss_of_vertical_force() {
         use ringpod_core::cueing::perception::Perception;
         let drive = |on: bool| {
-            let mut c = patient();
-            c.tilt_limit_deg = [20.0; 2];
-            c.tilt_rate_deg = [18.75; 2];
-            c.optimal.tilt_share = 0.95;
-            let mut o = Optimal::new(c, &ranges().into()).unwrap();
+            let mut o = Optimal::new(tilting(), &ranges().into()).unwrap();
             o.give_heave_the_tilt_loss(on);
             o.begin(&sample(0.0)).unwrap();
             let dt = 0.01;

@@ -52,6 +52,8 @@ pub struct Spec<'a> {
     pub input_weight: &'a [f64],
     /// The bounds.
     pub bounds: &'a [Bound],
+    /// An output that may be given a price of its own at each solve ([`AxisQp::solve_priced`]).
+    pub priced: Option<usize>,
 }
 
 /// Why a solve gave no plan.
@@ -68,6 +70,13 @@ pub struct AxisQp {
     solver: DefaultSolver<f64>,
     /// Outputs over the horizon from the initial state: `Y = psi x0 + gy U`.
     psi: DMatrix<f64>,
+    gy: DMatrix<f64>,
+    /// The cost's matrix over the inputs as set up, its stored entries (upper triangle, by columns, the slacks'
+    /// after them), and whether the last solve changed it.
+    p: DMatrix<f64>,
+    stored: Vec<(usize, usize)>,
+    priced: Option<usize>,
+    p_changed: bool,
     /// `q = 2 gy' W (psi x0 - Yref)`: this matrix times the error.
     q_of_error: DMatrix<f64>,
     /// Constraint bounds `b = b0 - bx x0`.
@@ -123,7 +132,7 @@ impl AxisQp {
         // feasible from any state (a state a fallback left outside a bound, or one the model's linearisation
         // did not foresee), and a plan that can keep within every bound does.
         let slacks = a.ncols() - n * nu;
-        let p = {
+        let full = {
             let mut full = DMatrix::zeros(n * nu + slacks, n * nu + slacks);
             full.view_mut((0, 0), (n * nu, n * nu)).copy_from(&p);
             for j in 0..slacks {
@@ -131,6 +140,20 @@ impl AxisQp {
             }
             full
         };
+        // The entries stored: the cost's own, and those a price on the priced output can make.
+        let mut pattern = full.map(|v| v != 0.0);
+        if let Some(o) = spec.priced {
+            for k in 0..n {
+                let row = gy.row(k * ny + o);
+                for (i, j) in (0..n * nu).flat_map(|j| (0..=j).map(move |i| (i, j))) {
+                    pattern[(i, j)] |= row[i] != 0.0 && row[j] != 0.0;
+                }
+            }
+        }
+        let stored: Vec<(usize, usize)> = (0..full.ncols())
+            .flat_map(|j| (0..=j).map(move |i| (i, j)))
+            .filter(|&ij| pattern[ij])
+            .collect();
         let settings = DefaultSettings {
             verbose: false,
             presolve_enable: false,
@@ -144,11 +167,21 @@ impl AxisQp {
         };
         let q = vec![0.0; n * nu + slacks];
         let cones = [SupportedConeT::NonnegativeConeT(a.nrows())];
-        let solver = DefaultSolver::new(&csc(&p, true), &q, &csc(&a, false), b0.as_slice(), &cones, settings)
+        let p_csc = {
+            let (rows, cols) = stored.iter().copied().unzip();
+            let vals = stored.iter().map(|&ij| full[ij]).collect();
+            CscMatrix::new_from_triplets(full.nrows(), full.ncols(), rows, cols, vals)
+        };
+        let solver = DefaultSolver::new(&p_csc, &q, &csc(&a), b0.as_slice(), &cones, settings)
             .expect("the programme's dimensions agree by construction");
         Self {
             solver,
             psi,
+            gy,
+            p: full,
+            stored,
+            priced: spec.priced,
+            p_changed: false,
             q_of_error,
             b0,
             bx,
@@ -181,11 +214,46 @@ impl AxisQp {
         self.outputs
     }
 
-    /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`); returns the plan
-    /// (every step's inputs, `N * inputs`) and the solver's iterations.
-    pub fn solve(&mut self, x0: &DVector<f64>, reference: &DVector<f64>) -> Result<(DVector<f64>, u32), SolveError> {
+    /// Solves from state `x0` towards `reference` (every output at every step, `N * outputs`), the priced output
+    /// (the spec's) given a price of its own at this solve, `sum_k w_k (y_k - target_k)^2` with `price[k] = (w_k,
+    /// target_k)` for the first steps (none past them, none at all when empty: the cost as set up). Returns the
+    /// plan (every step's inputs, `N * inputs`) and the solver's iterations. A price changes the cost's matrix,
+    /// which the solver takes in place (its structure kept); the same inputs give the same plan.
+    pub fn solve(
+        &mut self,
+        x0: &DVector<f64>,
+        reference: &DVector<f64>,
+        price: &[(f64, f64)],
+    ) -> Result<(DVector<f64>, u32), SolveError> {
         let error = &self.psi * x0 - reference;
         let mut q: Vec<f64> = (&self.q_of_error * error).iter().copied().collect();
+        let mut p = None;
+        if let Some(o) = self.priced.filter(|_| price.iter().any(|&(w, _)| w != 0.0)) {
+            let mut extra = self.p.clone();
+            for (k, &(w, target)) in price
+                .iter()
+                .enumerate()
+                .take(self.steps)
+                .filter(|(_, (w, _))| *w != 0.0)
+            {
+                let row = k * self.outputs + o;
+                let g = self.gy.row(row);
+                let e = (self.psi.row(row) * x0)[0] - target;
+                for j in 0..g.len() {
+                    q[j] += 2.0 * w * g[j] * e;
+                    for i in 0..=j {
+                        extra[(i, j)] += 2.0 * w * g[i] * g[j];
+                    }
+                }
+            }
+            p = Some(extra);
+        }
+        if p.is_some() || self.p_changed {
+            let m = p.as_ref().unwrap_or(&self.p);
+            let values: Vec<f64> = self.stored.iter().map(|&ij| m[ij]).collect();
+            self.solver.update_P(&values).map_err(|_| SolveError::Update)?;
+            self.p_changed = p.is_some();
+        }
         q.resize(self.steps * self.inputs + self.slacks, SLACK_PRICE);
         let b: Vec<f64> = (&self.b0 - &self.bx * x0).iter().copied().collect();
         self.solver.update_q(&q).map_err(|_| SolveError::Update)?;
@@ -258,12 +326,12 @@ fn constraints(
     (a, b0, bx, starts)
 }
 
-/// A dense matrix as compressed columns (the upper triangle only, for the cost's matrix), zeros left out.
-fn csc(m: &DMatrix<f64>, upper: bool) -> CscMatrix<f64> {
+/// A dense matrix as compressed columns, zeros left out.
+fn csc(m: &DMatrix<f64>) -> CscMatrix<f64> {
     let (mut rows, mut cols, mut vals) = (Vec::new(), Vec::new(), Vec::new());
     for j in 0..m.ncols() {
         for i in 0..m.nrows() {
-            if (!upper || i <= j) && m[(i, j)] != 0.0 {
+            if m[(i, j)] != 0.0 {
                 rows.push(i);
                 cols.push(j);
                 vals.push(m[(i, j)]);
@@ -277,38 +345,84 @@ fn csc(m: &DMatrix<f64>, upper: bool) -> CscMatrix<f64> {
 mod tests {
     use super::*;
 
+    /// The vertical axis's programme over 8 steps of 0.15 s: the force weighed 1, the position 10.
+    fn vertical<'a>(model: &'a Linear, bounds: &'a [Bound], priced: Option<usize>) -> Spec<'a> {
+        Spec {
+            model,
+            steps: 8,
+            h: 0.15,
+            output_weight: &[1.0, 10.0, 1.0],
+            input_weight: &[0.001],
+            bounds,
+            priced,
+        }
+    }
+
     /// The solve is bounded by its iterations, not a clock: too few and it fails (its status says so), enough and
     /// it solves, the same plan bit for bit each time.
     #[test]
     fn a_solve_is_bounded_by_its_iterations_and_repeats_bit_for_bit() {
         let model = super::super::model::vertical();
-        let spec = Spec {
-            model: &model,
-            steps: 8,
-            h: 0.15,
-            output_weight: &[1.0, 10.0, 1.0],
-            input_weight: &[0.001],
-            bounds: &[
-                Bound::State {
-                    output: 1,
-                    lo: -0.03,
-                    hi: 0.03,
-                },
-                Bound::Input { mask: 1, limit: 5.0 },
-            ],
-        };
+        let bounds = [
+            Bound::State {
+                output: 1,
+                lo: -0.03,
+                hi: 0.03,
+            },
+            Bound::Input { mask: 1, limit: 5.0 },
+        ];
+        let spec = vertical(&model, &bounds, None);
         let x0 = DVector::zeros(model.dims().0);
         let reference = DVector::from_element(8 * 3, 2.0);
         let mut starved = AxisQp::new(&spec, 1);
         assert!(matches!(
-            starved.solve(&x0, &reference),
+            starved.solve(&x0, &reference, &[]),
             Err(SolveError::Status(SolverStatus::MaxIterations))
         ));
         let mut qp = AxisQp::new(&spec, 60);
-        let (first, iterations) = qp.solve(&x0, &reference).unwrap();
+        let (first, iterations) = qp.solve(&x0, &reference, &[]).unwrap();
         assert!(iterations > 1 && iterations < 60, "{iterations}");
         for _ in 0..5 {
-            assert_eq!(qp.solve(&x0, &reference).unwrap().0, first);
+            assert_eq!(qp.solve(&x0, &reference, &[]).unwrap().0, first);
         }
+    }
+
+    /// A price on an output pulls the plan's output towards its centre at the steps priced, in proportion to its
+    /// weight; the next solve without it is the unpriced plan again (the cost's matrix restored, to rounding: the
+    /// solver scales the values it is given anew).
+    #[test]
+    fn a_price_pulls_its_output_and_leaves_with_its_solve() {
+        let model = super::super::model::vertical();
+        let bounds = [Bound::State {
+            output: 1,
+            lo: -0.05,
+            hi: 0.05,
+        }];
+        let spec = vertical(&model, &bounds, Some(1));
+        let x0 = DVector::zeros(model.dims().0);
+        let reference = DVector::from_fn(8 * 3, |i, _| if i % 3 == 0 { 2.0 } else { 0.0 });
+        let mut qp = AxisQp::new(&spec, 60);
+        // The position at each step of a plan (output 1, from rest).
+        let gy = qp.gy.clone();
+        let positions = |plan: &DVector<f64>| (0..8).map(|k| (gy.row(k * 3 + 1) * plan)[0]).collect::<Vec<f64>>();
+        let (free, _) = qp.solve(&x0, &reference, &[]).unwrap();
+        let (priced, _) = qp.solve(&x0, &reference, &[(1e5, -0.01); 8]).unwrap();
+        let (light, _) = qp.solve(&x0, &reference, &[(1e2, -0.01); 8]).unwrap();
+        let (again, _) = qp.solve(&x0, &reference, &[]).unwrap();
+        assert!((&again - &free).amax() < 1e-9, "{again} {free}");
+        // How far the positions are from the centre, all steps together.
+        let off = |plan: &DVector<f64>| positions(plan).iter().map(|p| (p + 0.01).abs()).sum::<f64>();
+        let (o_free, o_light, o_priced) = (off(&free), off(&light), off(&priced));
+        assert!(
+            o_priced < 0.05 * o_free && o_priced < o_light && o_light < o_free,
+            "{o_priced} {o_light} {o_free}"
+        );
+        // A price on the first steps alone leaves the plan's end to the cost as set up.
+        let (first, _) = qp.solve(&x0, &reference, &[(1e5, -0.01); 2]).unwrap();
+        assert!(
+            (positions(&first)[1] + 0.01).abs() < 1e-3 && first != priced,
+            "{:?}",
+            positions(&first)
+        );
     }
 }
