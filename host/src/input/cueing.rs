@@ -150,6 +150,8 @@ mod tests {
             [
                 "classical-tuned.toml",
                 "classical.toml",
+                "optimal-tilt-kept.toml",
+                "optimal-tilt-priced.toml",
                 "optimal-tilt.toml",
                 "optimal-unbounded.toml",
                 "optimal.toml",
@@ -166,6 +168,16 @@ mod tests {
         assert_eq!(tilt.algorithm, Algorithm::Optimal);
         assert_eq!((tilt.optimal.envelope_share, tilt.optimal.tilt_share), (0.2, 0.95));
         assert_eq!((tilt.tilt_limit_deg, tilt.tilt_rate_deg), ([20.0; 2], [18.75; 2]));
+        // The same with the tilts' loss of vertical force priced, and then the plan kept from sample to sample:
+        // each file one change from the last.
+        let priced = load("optimal-tilt-priced.toml");
+        let mut expected = tilt;
+        expected.optimal.tilt_loss_weight = 50.0;
+        assert_eq!(priced, expected);
+        let kept = load("optimal-tilt-kept.toml");
+        expected.optimal.tilt_loss_weight = 40.0;
+        expected.optimal.plan_weight = 1000.0;
+        assert_eq!(kept, expected);
         // The yardstick: tilt alone, to the trainer model's roll and pitch ranges, at once.
         let bound = load("tilt-bound.toml");
         assert_eq!(bound.algorithm, Algorithm::Classical);

@@ -42,6 +42,10 @@ pub struct OptimalConfig {
     /// programmes (per (m/s^2)^2; default 0, unpriced): a tilt's perceived vertical error the per-axis linear
     /// programmes do not otherwise see.
     pub tilt_loss_weight: f64,
+    /// Plan consistency: weight of each step's planned angle's departure from the last sample's plan, shifted on
+    /// by the sample, in the x and y programmes (per rad^2; default 0, none): a plan that turns over from one
+    /// sample to the next moves the tilt one way for a sample and back the next, a rotation the canals feel.
+    pub plan_weight: f64,
     /// Effort: weight of the platform's acceleration, per axis (per (m/s^2)^2; default 0.001).
     #[serde(deserialize_with = "super::axes::one_or_each")]
     pub acceleration_weight: [f64; 3],
@@ -84,6 +88,7 @@ impl Default for OptimalConfig {
             velocity_weight: [1.0; 3],
             tilt_weight: [0.1; 2],
             tilt_loss_weight: 0.0,
+            plan_weight: 0.0,
             acceleration_weight: [0.001; 3],
             rate_weight: [0.01; 2],
             max_velocity: [0.5; 3],
@@ -109,7 +114,7 @@ impl OptimalConfig {
         if !ok(self.step_s, 0.005, 0.5) {
             return err("optimal.step_s", "0.005 to 0.5 s");
         }
-        let weights: [(&'static str, &[f64]); 8] = [
+        let weights: [(&'static str, &[f64]); 9] = [
             ("optimal.force_weight", &self.force_weight),
             ("optimal.rotation_weight", &self.rotation_weight),
             ("optimal.position_weight", &self.position_weight),
@@ -119,6 +124,7 @@ impl OptimalConfig {
                 "optimal.tilt_loss_weight",
                 core::slice::from_ref(&self.tilt_loss_weight),
             ),
+            ("optimal.plan_weight", core::slice::from_ref(&self.plan_weight)),
             ("optimal.acceleration_weight", &self.acceleration_weight),
             ("optimal.rate_weight", &self.rate_weight),
         ];

@@ -315,6 +315,13 @@ pub const PARAMS: &[Param] = &[
         WEIGHT,
     ),
     param(
+        "optimal.plan_weight",
+        "optimal: the tilt's plan kept from sample to sample",
+        one(&["tilt coordination"]),
+        "",
+        WEIGHT,
+    ),
+    param(
         "optimal.acceleration_weight",
         "optimal: acceleration effort",
         (TRANSLATION, TRANSLATION),

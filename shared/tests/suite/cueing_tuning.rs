@@ -415,7 +415,7 @@ proptest! {
 #[test]
 fn every_optimal_key_is_refused_out_of_range_by_name() {
     type Set = fn(&mut OptimalConfig, f64);
-    let keys: [(&str, Set, f64, f64); 16] = [
+    let keys: [(&str, Set, f64, f64); 17] = [
         ("optimal.horizon", |o, v| o.horizon = v as u32, 2.0, 60.0),
         ("optimal.step_s", |o, v| o.step_s = v, 0.005, 0.5),
         ("optimal.force_weight", |o, v| o.force_weight[2] = v, 0.0, 1e6),
@@ -424,6 +424,7 @@ fn every_optimal_key_is_refused_out_of_range_by_name() {
         ("optimal.velocity_weight", |o, v| o.velocity_weight[1] = v, 0.0, 1e6),
         ("optimal.tilt_weight", |o, v| o.tilt_weight[0] = v, 0.0, 1e6),
         ("optimal.tilt_loss_weight", |o, v| o.tilt_loss_weight = v, 0.0, 1e6),
+        ("optimal.plan_weight", |o, v| o.plan_weight = v, 0.0, 1e6),
         (
             "optimal.acceleration_weight",
             |o, v| o.acceleration_weight[1] = v,

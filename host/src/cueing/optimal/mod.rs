@@ -226,7 +226,7 @@ impl Optimal {
                 self.axes[i].qp.set_state_bound(tilt::ANGLE_BOUND, lo, hi);
             }
             let classical = self.classical_channels(i);
-            let price = self.loss_price(i, h);
+            let price = self.angle_price(i, h);
             let axis = &mut self.axes[i];
             let (d_model, d_perception) = axis.at(dt);
             let r = stimulus(i, sample);

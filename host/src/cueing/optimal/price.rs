@@ -10,6 +10,12 @@
 //! a roll rate of 0.46 rad/s back and forth). With `l l''` the price near zero is a plain one on the angle,
 //! `w l g theta^2`: the more the other tilt has lost, the dearer this one. The plan moves little from one sample
 //! to the next, so each sample's quadratic is about a near neighbour of its answer.
+//!
+//! The same price keeps the plan (`optimal.plan_weight`): `c (theta_k - theta0_k)^2` at each step about the last
+//! plan's angles shifted on by the sample. Without it each sample's plan answers that sample's noise held over
+//! the horizon (on the laps, 5 % of the force: a tilt target that moves 1.6 deg from sample to sample), its first
+//! step's rate turning one way and the next sample's the other: a pitch or roll rate past the canals' threshold
+//! in episodes of one or two samples, false wherever the vehicle's own small rate is of the other sign.
 
 use ringpod_core::cueing::G;
 
@@ -20,17 +26,38 @@ pub const ANGLE: usize = 4;
 
 impl Optimal {
     /// The price on horizontal axis `i`'s angle at each step of the horizon (steps of `h` seconds): its weight and
-    /// the angle it pulls towards ([`super::qp::AxisQp::solve`]); none on z or with the weight at zero.
-    pub(super) fn loss_price(&self, i: usize, h: f64) -> Vec<(f64, f64)> {
-        let w = self.config.optimal.tilt_loss_weight;
-        if i == Z || w == 0.0 {
+    /// the angle it pulls towards ([`super::qp::AxisQp::solve`]); none on z or with both weights at zero. The
+    /// loss's price, and the plan's consistency: `c (theta_k - theta0_k)^2` about the last plan shifted on by the
+    /// sample (`optimal.plan_weight`), so that a plan that turned one way at the last sample does not turn the
+    /// other at this one for want of a reason (the two quadratics on one angle are one: their weights summed about
+    /// their weighted centre).
+    pub(super) fn angle_price(&self, i: usize, h: f64) -> Vec<(f64, f64)> {
+        let o = &self.config.optimal;
+        let (w, c) = (o.tilt_loss_weight, o.plan_weight);
+        if i == Z || (w == 0.0 && c == 0.0) {
             return Vec::new();
         }
         let n = self.axes[i].qp.steps();
         let mine = self.axes[i].shifted_angles(h, n);
         let other = self.axes[1 - i].shifted_angles(h, n);
-        mine.iter().zip(&other).map(|(&a, &b)| newton(w, a, b)).collect()
+        mine.iter()
+            .zip(&other)
+            .map(|(&a, &b)| {
+                let loss = if w == 0.0 { (0.0, 0.0) } else { newton(w, a, b) };
+                kept(loss, c, a)
+            })
+            .collect()
     }
+}
+
+/// The price `(weight, centre)` with the plan's consistency `c (theta - planned)^2` added: one quadratic, the
+/// weights summed about their weighted centre (the price as it was without it).
+fn kept((weight, centre): (f64, f64), c: f64, planned: f64) -> (f64, f64) {
+    if c == 0.0 {
+        return (weight, centre);
+    }
+    let sum = weight + c;
+    (sum, (weight * centre + c * planned) / sum)
 }
 
 /// The cost `w l^2` of the loss `l` at angles `a` (this axis's) and `b` (the other's) as a price on this axis's
@@ -156,5 +183,56 @@ mod tests {
             "{priced_roll} against {roll}"
         );
         assert!(priced[1] > 0.6 * unpriced[1], "{priced:?} against {unpriced:?}");
+    }
+
+    /// Braking held at 2 m/s^2 (a pitch of some 9.5 deg) with the laps' noise (5 % of the force, sample by sample): the plan solved from
+    /// each noisy sample held chases the noise, its first step's tilt rate turning from one sample to the next,
+    /// and the rider perceives a pitch rate past the canals' threshold in many short episodes where the vehicle
+    /// has none. Kept close to the last plan (`plan_weight`), the pitch is perceived past the threshold a
+    /// fraction as long, while the tilt cues the braking as much.
+    #[test]
+    fn a_plan_kept_from_sample_to_sample_does_not_pitch_with_the_noise() {
+        use ringpod_core::cueing::perception::ROTATION_THRESHOLD_DEG;
+        let drive = |weight: f64| {
+            let mut c = tilting();
+            // `optimal-tilt-kept.toml`'s weights.
+            c.optimal.tilt_loss_weight = 40.0;
+            c.optimal.plan_weight = weight;
+            let mut o = Optimal::new(c, &ranges().into()).unwrap();
+            // A fixed sequence of uniform noise in -1..1 (a linear congruential generator): the same every run.
+            let mut seed = 12345u64;
+            let mut noise = move || {
+                seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+                (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+            };
+            let braking = |ax: f64| Telemetry {
+                force: [ax, 0.0, G],
+                rate: [0.0; 3],
+            };
+            o.begin(&braking(0.0)).unwrap();
+            let dt = 0.01;
+            let pitch: Vec<f64> = (0..600)
+                .map(|_| o.step(&braking(-2.0 * (1.0 + 0.087 * noise())), dt, &[]).unwrap()[4])
+                .collect();
+            let mut p = Perception::<f64>::new();
+            p.begin([0.0; 3], [0.0; 3]);
+            let threshold = ROTATION_THRESHOLD_DEG[1].to_radians();
+            let mut past = 0;
+            for k in 1..pitch.len() {
+                let rate = p.step([0.0; 3], [0.0, (pitch[k] - pitch[k - 1]) / dt, 0.0], dt).rate[1];
+                // From 2 s on: the braking's onset is a true cue, and the tilt has come in.
+                past += usize::from(k >= 200 && rate.abs() > threshold);
+            }
+            let mean = pitch[200..].iter().sum::<f64>() / 400.0;
+            (past, mean)
+        };
+        let (chasing, tilt) = drive(0.0);
+        let (kept, kept_tilt) = drive(1000.0);
+        assert!(tilt > 0.15, "pitched {tilt}");
+        assert!(
+            chasing > 250 && kept * 2 < chasing,
+            "{kept} samples past the threshold kept, {chasing} not"
+        );
+        assert!((kept_tilt - tilt).abs() < 0.02 * tilt, "{kept_tilt} against {tilt}");
     }
 }
