@@ -185,11 +185,12 @@ mod tests {
         assert!(priced[1] > 0.6 * unpriced[1], "{priced:?} against {unpriced:?}");
     }
 
-    /// Braking held at 2 m/s^2 (a pitch of some 9.5 deg) with the laps' noise (5 % of the force, sample by sample): the plan solved from
+    /// Braking held at 2 m/s^2 with the laps' noise (5 % of the force, sample by sample): the plan solved from
     /// each noisy sample held chases the noise, its first step's tilt rate turning from one sample to the next,
     /// and the rider perceives a pitch rate past the canals' threshold in many short episodes where the vehicle
-    /// has none. Kept close to the last plan (`plan_weight`), the pitch is perceived past the threshold a
-    /// fraction as long, while the tilt cues the braking as much.
+    /// has none. Kept close to the last plan (`plan_weight`), the pitch is perceived past the threshold less than
+    /// half as long while the tilt cues the braking as much: 151 samples of 400 against 314, at a mean pitch of
+    /// 0.169 rad (9.7 deg) either way.
     #[test]
     fn a_plan_kept_from_sample_to_sample_does_not_pitch_with_the_noise() {
         use ringpod_core::cueing::perception::ROTATION_THRESHOLD_DEG;
