@@ -150,6 +150,7 @@ mod tests {
             [
                 "classical-tuned.toml",
                 "classical.toml",
+                "optimal-tilt-priced.toml",
                 "optimal-tilt.toml",
                 "optimal-unbounded.toml",
                 "optimal.toml",
@@ -166,6 +167,13 @@ mod tests {
         assert_eq!(tilt.algorithm, Algorithm::Optimal);
         assert_eq!((tilt.optimal.envelope_share, tilt.optimal.tilt_share), (0.2, 0.95));
         assert_eq!((tilt.tilt_limit_deg, tilt.tilt_rate_deg), ([20.0; 2], [18.75; 2]));
+        assert_eq!(tilt.optimal.tilt_loss_weight, 0.0);
+        // The same with the tilts' loss of vertical force priced: only that weight differs.
+        let priced = load("optimal-tilt-priced.toml");
+        assert_eq!(priced.optimal.tilt_loss_weight, 50.0);
+        let mut unpriced = priced.clone();
+        unpriced.optimal.tilt_loss_weight = 0.0;
+        assert_eq!(unpriced, tilt);
         // The yardstick: tilt alone, to the trainer model's roll and pitch ranges, at once.
         let bound = load("tilt-bound.toml");
         assert_eq!(bound.algorithm, Algorithm::Classical);
