@@ -168,13 +168,20 @@ mod tests {
         assert_eq!(tilt.algorithm, Algorithm::Optimal);
         assert_eq!((tilt.optimal.envelope_share, tilt.optimal.tilt_share), (0.2, 0.95));
         assert_eq!((tilt.tilt_limit_deg, tilt.tilt_rate_deg), ([20.0; 2], [18.75; 2]));
-        // The same with the tilts' loss of vertical force priced, and then the plan kept from sample to sample:
-        // each file one change from the last.
+        assert_eq!(tilt.optimal.tilt_loss_weight, 0.0);
+        // The same with the tilts' loss of vertical force priced: only that weight differs.
         let priced = load("optimal-tilt-priced.toml");
-        let mut expected = tilt;
-        expected.optimal.tilt_loss_weight = 50.0;
-        assert_eq!(priced, expected);
+        assert_eq!(priced.optimal.tilt_loss_weight, 50.0);
+        let mut unpriced = priced;
+        unpriced.optimal.tilt_loss_weight = 0.0;
+        assert_eq!(unpriced, tilt);
+        // Then the plan kept from sample to sample, the loss's price eased: only those two weights differ.
         let kept = load("optimal-tilt-kept.toml");
+        assert_eq!(
+            (kept.optimal.tilt_loss_weight, kept.optimal.plan_weight),
+            (40.0, 1000.0)
+        );
+        let mut expected = priced;
         expected.optimal.tilt_loss_weight = 40.0;
         expected.optimal.plan_weight = 1000.0;
         assert_eq!(kept, expected);
