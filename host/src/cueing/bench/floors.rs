@@ -1,14 +1,17 @@
 //! The bench's floors ([`floor`]): the least perceived force error any motion inside the envelope's ranges, or
 //! inside an outer polytope of the rig's whole envelope, can give on the drives, every sample known.
 
-use ringpod_core::cueing::{Forward, Telemetry};
+use ringpod_core::cueing::{CueConfig, Forward, Telemetry};
 use serde::Serialize;
 
+use ringpod_core::motion::{envelope, EnvelopeMargins};
+
 use super::super::engine::row_sample;
-use super::super::offline::CueError;
+use super::super::offline::{CueError, Cued};
 use super::super::optimal::floor::{self, Room};
 use super::super::optimal::polytope::{self, Polytope};
-use super::{score, Rig, Rows};
+use super::score::{Score, Trace};
+use super::{combined, score, Rig, Rows};
 
 /// The floor ([`floor`]) of every drive together.
 #[derive(Debug, Serialize)]
@@ -21,6 +24,57 @@ pub struct FloorReport {
     /// With `--envelope-floor`: the floor inside an outer polytope of the rig's whole envelope, the axes coupled
     /// as the rig couples them.
     pub envelope: Option<EnvelopeFloor>,
+    /// With an optimal cueing as the second file: the floor within that cueing's own limits (its shares of
+    /// the ranges, its velocity, acceleration and rate limits, its perceived rotation's error priced), what it
+    /// could reach with the whole drive known and no horizon.
+    pub limits: Option<FloorFigures>,
+    /// With both: the floor inside the envelope's outer polytope within that cueing's limits (not its shares).
+    pub envelope_limits: Option<FloorFigures>,
+}
+
+/// A floor within an optimal cueing's limits as a motion, every pose through the envelope limiter, scored by
+/// the bench like a cueing's: each drive's score and traces, and the poses the limiter changed.
+#[derive(Default)]
+pub(super) struct LimitsMotion {
+    pub drives: Vec<Score>,
+    pub traces: Vec<Vec<Trace>>,
+    pub limited: usize,
+}
+
+impl LimitsMotion {
+    /// Adds a piece's floor motion, every pose through the limiter, to the drive's `scores` and `traces`.
+    fn add(&mut self, f: &floor::Floor, piece: Piece, rig: &Rig, forward: Forward, scored: &mut Scored) {
+        let margins = EnvelopeMargins::default();
+        let cued: Vec<Cued> = (piece.t.iter().zip(piece.samples).zip(&f.offsets))
+            .map(|((&t, &input), offset)| {
+                let wanted = ringpod_core::cueing::pose(&rig.neutral, offset);
+                let l = envelope::limit(&rig.mechanism, &rig.neutral, &wanted, &margins, 16);
+                self.limited += usize::from(l.is_limited());
+                Cued { t, input, pose: l.pose }
+            })
+            .collect();
+        let (s, trace) = score::score_from(&cued, piece.from, &rig.neutral, &rig.envelope.ranges, forward);
+        scored.0.push(s);
+        scored.1.extend(trace);
+    }
+
+    /// Ends a drive: its pieces' scores as one.
+    fn end_drive(&mut self, scored: &mut Scored) {
+        let (scores, traces) = std::mem::take(scored);
+        self.drives.push(combined(&scores));
+        self.traces.push(traces);
+    }
+}
+
+/// A drive's pieces' scores and traces so far.
+type Scored = (Vec<Score>, Vec<Trace>);
+
+/// One continuous piece of a drive: its times, samples, and its own index of the first sample scored.
+#[derive(Clone, Copy)]
+struct Piece<'a> {
+    t: &'a [f64],
+    samples: &'a [Telemetry<f64>],
+    from: usize,
 }
 
 /// A floor's figures over every drive.
@@ -52,40 +106,68 @@ pub struct EnvelopeFloor {
 /// continuous pieces, each from neutral, as the cueing starts again at a gap. Its motion is not scored:
 /// bounded by the ranges alone, it swings the tilt at any rate and reaches corners of the ranges' box outside the
 /// coupled envelope, so the bench would score the limiter and the finite differences of a motion no cueing
-/// makes, not the floor.
+/// makes, not the floor. With an `optimal` cueing, also the floors within its limits (in its shares, and with
+/// `coupled` in the polytope), and their motions, which keep its rates, as the bench scores any cueing's.
 pub(super) fn floor_of(
     drives: &[Rows],
     from: &[usize],
     rig: &Rig,
     forward: Forward,
     coupled: bool,
-) -> Result<FloorReport, CueError> {
+    optimal: Option<&CueConfig>,
+) -> Result<(FloorReport, Vec<(&'static str, LimitsMotion)>), CueError> {
     let ranges = &rig.envelope.ranges;
     let outer = coupled.then(|| Polytope::of(&rig.mechanism, &rig.neutral, ranges, &polytope::directions(3), RAYS));
     let (mut within_ranges, mut within_envelope) = (Sums::default(), Sums::default());
+    let (mut within_limits, mut envelope_limits) = (Sums::default(), Sums::default());
     let mut envelope_share = [0.0f64; 5];
+    let (mut motion, mut envelope_motion) = (LimitsMotion::default(), LimitsMotion::default());
     for (d, rows) in drives.iter().enumerate() {
+        let (mut scored, mut envelope_scored) = (Scored::default(), Scored::default());
         for piece in pieces(rows) {
             let t: Vec<f64> = piece.iter().map(|(_, v)| v[0]).collect();
             let samples: Vec<Telemetry<f64>> = piece.iter().map(|(_, v)| row_sample(v)).collect();
             // The piece's own index of the drive's first sample scored (lines are unique).
             let start = rows.iter().position(|r| r.0 == piece[0].0).unwrap_or(0);
             let from = from.get(d).map_or(0, |f| f.saturating_sub(start));
-            let f = floor::floor_from(&t, &samples, Room::Ranges(ranges), forward, from).map_err(CueError::Floor)?;
+            let floor_in =
+                |room, limits| floor::floor_from(&t, &samples, room, limits, forward, from).map_err(CueError::Floor);
+            let f = floor_in(Room::Ranges(ranges), None)?;
             within_ranges.add(&f);
             for offset in &f.offsets {
                 score::widen_shares(&mut envelope_share, offset, ranges);
             }
             if let Some(outer) = &outer {
-                let f =
-                    floor::floor_from(&t, &samples, Room::Envelope(outer), forward, from).map_err(CueError::Floor)?;
-                within_envelope.add(&f);
+                within_envelope.add(&floor_in(Room::Envelope(outer), None)?);
+            }
+            let piece = Piece {
+                t: &t,
+                samples: &samples,
+                from,
+            };
+            if let Some(config) = optimal {
+                let f = floor_in(Room::Shares(ranges, config), Some(config))?;
+                within_limits.add(&f);
+                motion.add(&f, piece, rig, forward, &mut scored);
+                if let Some(outer) = &outer {
+                    let f = floor_in(Room::Envelope(outer), Some(config))?;
+                    envelope_limits.add(&f);
+                    envelope_motion.add(&f, piece, rig, forward, &mut envelope_scored);
+                }
             }
         }
         within_ranges.end_drive();
         within_envelope.end_drive();
+        within_limits.end_drive();
+        envelope_limits.end_drive();
+        if optimal.is_some() {
+            motion.end_drive(&mut scored);
+            if outer.is_some() {
+                envelope_motion.end_drive(&mut envelope_scored);
+            }
+        }
     }
-    Ok(FloorReport {
+    let report = FloorReport {
         figures: within_ranges.figures(),
         envelope_share,
         envelope: outer.map(|outer| EnvelopeFloor {
@@ -94,7 +176,17 @@ pub(super) fn floor_of(
             last_gain: outer.last_gain,
             slack: polytope::SLACK,
         }),
-    })
+        limits: optimal.map(|_| within_limits.figures()),
+        envelope_limits: optimal.filter(|_| coupled).map(|_| envelope_limits.figures()),
+    };
+    let mut motions = Vec::new();
+    if optimal.is_some() {
+        motions.push(("limits", motion));
+        if coupled {
+            motions.push(("limits in the envelope", envelope_motion));
+        }
+    }
+    Ok((report, motions))
 }
 
 /// Rays spread through the envelope to find the polytope's supports from: with every face's own direction and
@@ -179,8 +271,9 @@ mod tests {
         (table, report)
     }
 
-    /// On the shipped example drive, neither the classical washout nor the optimal cueing perceives less force
-    /// error than the floor, which keeps to the ranges; the table says it and its ratio.
+    /// On the shipped example drive, neither the classical washout nor the optimal cueing (nor the floors'
+    /// motions within its limits) perceives less force error than the floor, which keeps to the ranges; the
+    /// table says it and its ratio.
     #[test]
     fn no_cueing_on_the_bench_beats_the_floor() {
         let docs = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs");
@@ -193,6 +286,10 @@ mod tests {
         assert!(floor > 0.1, "{report}");
         let coupled = report["floor"]["envelope"]["force_total"].as_f64().unwrap();
         assert!(coupled > 0.1, "{report}");
+        // Within the optimal cueing's limits, a room no larger: no less error on the model.
+        let limits = report["floor"]["limits"]["force_total"].as_f64().unwrap();
+        let coupled_limits = report["floor"]["envelope_limits"]["force_total"].as_f64().unwrap();
+        assert!(limits > floor && coupled_limits > coupled, "{report}");
         for e in report["entries"].as_array().unwrap() {
             let rms: Vec<f64> = e["total"]["force_rms"]
                 .as_array()

@@ -238,17 +238,32 @@ pub fn run(args: &Options) -> Result<(String, u8), CueError> {
             runs.push((second.clone(), b, Preview::None));
             runs.push((format!("{second} (lap preview)"), b, Preview::Lap));
         }
-        p => runs.push((second, b, p)),
+        p => runs.push((second.clone(), b, p)),
     }
     for (n, c, p) in runs {
         let (e, t) = evaluate(&n, c, &drives, &from, &rig, p)?;
         entries.push(e);
         traces.push(t);
     }
-    let floor = args
-        .floor
-        .then(|| floor_of(&drives, &from, &rig, a.forward, args.envelope_floor))
-        .transpose()?;
+    let mut floor = None;
+    if args.floor {
+        let optimal = (b.algorithm == Algorithm::Optimal).then_some(&b);
+        let (report, motions) = floor_of(&drives, &from, &rig, a.forward, args.envelope_floor, optimal)?;
+        floor = Some(report);
+        for (what, m) in motions {
+            entries.push(Entry {
+                name: format!("floor within {second}'s {what} (its motion)"),
+                algorithm: Algorithm::Optimal,
+                total: combined(&m.drives),
+                drives: m.drives,
+                limited: m.limited,
+                fallbacks: None,
+                solve_ms: None,
+                lap: None,
+            });
+            traces.push(m.traces);
+        }
+    }
     let report = Report {
         drives: args.inputs.iter().map(|p| p.display().to_string()).collect(),
         mechanism: selected.name,
@@ -376,6 +391,22 @@ fn floors_and_ratios(r: &Report) -> String {
                 e.faces, e.figures.force_total
             );
         }
+        if let Some(l) = &f.limits {
+            let [x, y, z] = l.force_rms;
+            s += &format!(
+                "floor within the optimal cueing's own limits (its shares, velocity, acceleration and rate \
+                 limits, its rotation error priced): {x:.3} {y:.3} {z:.3}, {:.3} m/s^2\n",
+                l.force_total
+            );
+        }
+        if let Some(l) = &f.envelope_limits {
+            let [x, y, z] = l.force_rms;
+            s += &format!(
+                "floor inside the envelope's outer polytope within the optimal cueing's velocity, acceleration \
+                 and rate limits, its rotation error priced: {x:.3} {y:.3} {z:.3}, {:.3} m/s^2\n",
+                l.force_total
+            );
+        }
     }
     if let [a, rest @ ..] = r.entries.as_slice() {
         for b in rest {
@@ -391,6 +422,15 @@ fn floors_and_ratios(r: &Report) -> String {
             for b in rest {
                 let ratio = b.total.force_total() / f.figures.force_total.max(1e-12);
                 s += &format!("{} / floor perceived force error (RMS, all axes): {ratio:.3}\n", b.name);
+            }
+            if let Some(l) = &f.limits {
+                let ratio = l.force_total / a.total.force_total().max(1e-12);
+                s += &format!(
+                    "floor within the limits / {} perceived force error (RMS, all axes): {ratio:.3}\n",
+                    a.name
+                );
+                let ratio = l.force_total / f.figures.force_total.max(1e-12);
+                s += &format!("floor within the limits / floor perceived force error (RMS, all axes): {ratio:.3}\n");
             }
             if let Some(e) = &f.envelope {
                 let ratio = e.figures.force_total / a.total.force_total().max(1e-12);

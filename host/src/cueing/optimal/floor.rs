@@ -17,7 +17,9 @@ use ringpod_core::cueing::{self, Forward, Telemetry};
 
 use super::model::{self, Discrete, Linear};
 use super::polytope::Polytope;
-use super::{stimulus, Ranges, X, Y, Z};
+use super::qp::Bound;
+use super::{cost_and_bounds, stimulus, Ranges, X, Y, Z};
+use ringpod_core::cueing::CueConfig;
 
 /// The price of each input squared, so that the programme has one solution where several motions perceive
 /// alike (the tilt's and the rotation's parts of one angle); far below any error's.
@@ -56,20 +58,25 @@ pub enum Room<'a> {
     Ranges(&'a Ranges),
     /// An outer polytope of the rig's envelope: the axes together, as the rig couples them.
     Envelope(&'a Polytope),
+    /// An optimal cueing's own room (its file's): its shares of the ranges, within its tilt limit.
+    Shares(&'a Ranges, &'a CueConfig),
 }
 
 /// The floor of a drive (`samples` at times `t`) in `room`, the platform facing `forward`.
 #[cfg(test)]
 pub fn floor(t: &[f64], samples: &[Telemetry<f64>], room: Room, forward: Forward) -> Result<Floor, FloorError> {
-    floor_from(t, samples, room, forward, 0)
+    floor_from(t, samples, room, None, forward, 0)
 }
 
 /// [`floor`] of the samples from index `from` on: the error before it is not priced (the motion is free to
-/// prepare), nor counted.
+/// prepare), nor counted. With `limits`, an optimal cueing's (its file's) velocity, acceleration, tilt-rate and
+/// rotation-rate limits hold too, and its perceived rotation's error is priced at its weight, as in its
+/// programmes: what that cueing could reach in `room` with the whole drive known and no horizon.
 pub fn floor_from(
     t: &[f64],
     samples: &[Telemetry<f64>],
     room: Room,
+    limits: Option<&CueConfig>,
     forward: Forward,
     from: usize,
 ) -> Result<Floor, FloorError> {
@@ -81,8 +88,13 @@ pub fn floor_from(
     }
     let n = t.len().saturating_sub(1);
     let mut base = 0;
+    let rotation = |i: usize| match limits {
+        // The rotation keys are per rotation (roll 0, pitch 1): x's is the pitch, y's the roll.
+        Some(config) if i != Z => config.optimal.rotation_weight[1 - i],
+        _ => 0.0,
+    };
     let parts = [X, Y, Z].map(|i| {
-        let part = Part::new(i, base);
+        let part = Part::new(i, base, rotation(i));
         base += n * part.block();
         part
     });
@@ -99,6 +111,22 @@ pub fn floor_from(
             }
         }
         Room::Envelope(polytope) => within(&mut qp, &parts, polytope, forward, n),
+        Room::Shares(ranges, config) => {
+            for part in &parts {
+                part.limit(&mut qp, &cost_and_bounds(part.i, config, ranges).2, Kind::Room, n);
+            }
+        }
+    }
+    if let Some(config) = limits {
+        // The ranges only size the programme's bounds here; the rates are what is taken.
+        for part in &parts {
+            part.limit(
+                &mut qp,
+                &cost_and_bounds(part.i, config, &[(-1.0, 1.0); 5]).2,
+                Kind::Rates,
+                n,
+            );
+        }
     }
     let x = solve(&qp, variables)?;
     let mut force_rms = [0.0; 3];
@@ -188,10 +216,12 @@ struct Part {
     model: Linear,
     perception: Linear,
     base: usize,
+    /// The weight of the perceived rotation's error, against the force's 1; 0: not priced (no variable).
+    rotation: f64,
 }
 
 impl Part {
-    fn new(i: usize, base: usize) -> Self {
+    fn new(i: usize, base: usize, rotation: f64) -> Self {
         let (model, perception) = if i == Z {
             (model::vertical(), model::perception(false))
         } else {
@@ -202,12 +232,13 @@ impl Part {
             model,
             perception,
             base,
+            rotation,
         }
     }
 
     fn block(&self) -> usize {
         let (nx, nu, _) = self.model.dims();
-        nx + nu + 1
+        nx + nu + 1 + usize::from(self.rotation > 0.0)
     }
 
     fn state(&self, k: usize) -> usize {
@@ -219,14 +250,16 @@ impl Part {
     }
 
     fn error(&self, k: usize) -> usize {
-        self.block() - 1 + self.state(k)
+        let (nx, nu, _) = self.model.dims();
+        self.state(k) + nx + nu
     }
 
     /// The dynamics and the error's definition, as equalities; the error's square and the effort as the cost.
     fn dynamics(&self, qp: &mut Sparse, t: &[f64], samples: &[Telemetry<f64>], from: usize) {
         let (nx, nu, _) = self.model.dims();
         let model = &self.model;
-        let reference = vehicle_perceived(&self.perception, t, samples, self.i);
+        let reference = vehicle_perceived(&self.perception, t, samples, self.i, 0);
+        let rotation = (self.rotation > 0.0).then(|| vehicle_perceived(&self.perception, t, samples, self.i, 1));
         let mut discrete = None;
         for k in 0..t.len().saturating_sub(1) {
             let d = discretised(&mut discrete, model, t[k + 1] - t[k]);
@@ -244,18 +277,23 @@ impl Part {
                 }
                 qp.b.push(0.0);
             }
-            // e - (C x + D u) = -reference: the perceived force's error.
-            let row = qp.b.len();
-            qp.a.push(row, self.error(k), 1.0);
-            for c in 0..nx {
-                qp.a.push(row, self.state(k) + c, -model.c[(0, c)]);
-            }
-            for c in 0..nu {
-                qp.a.push(row, self.input(k) + c, -model.d[(0, c)]);
-            }
-            qp.b.push(-reference[k + 1]);
-            if k + 1 >= from {
-                qp.p.push(self.error(k), self.error(k), 2.0);
+            // e - (C x + D u) = -reference: the perceived force's error (and the rotation's, output 1).
+            let errors = [(0, 1.0, &reference)]
+                .into_iter()
+                .chain(rotation.as_ref().map(|r| (1, self.rotation, r)));
+            for (output, weight, reference) in errors {
+                let (row, e) = (qp.b.len(), self.error(k) + output);
+                qp.a.push(row, e, 1.0);
+                for c in 0..nx {
+                    qp.a.push(row, self.state(k) + c, -model.c[(output, c)]);
+                }
+                for c in 0..nu {
+                    qp.a.push(row, self.input(k) + c, -model.d[(output, c)]);
+                }
+                qp.b.push(-reference[k + 1]);
+                if k + 1 >= from {
+                    qp.p.push(e, e, 2.0 * weight);
+                }
             }
             for c in 0..nu {
                 qp.p.push(self.input(k) + c, self.input(k) + c, 2.0 * EFFORT);
@@ -272,6 +310,57 @@ impl Part {
                     let row = qp.b.len();
                     for c in 0..nx {
                         qp.a.push(row, self.state(k) + c, sign * self.model.c[(output, c)]);
+                    }
+                    qp.b.push(limit);
+                }
+            }
+        }
+    }
+}
+
+/// An optimal cueing's bounds of one kind: on where the platform is, or on how fast it moves.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Room,
+    Rates,
+}
+
+impl Part {
+    /// The velocity's output: a rate, bounded with the inputs; the other bounded outputs are the room.
+    fn velocity(&self) -> usize {
+        if self.i == Z {
+            2
+        } else {
+            3
+        }
+    }
+
+    /// Each of an optimal cueing's bounds of `kind` at every sample: a bounded output (its `D` part zero)
+    /// within its interval, an input sum within its limit.
+    fn limit(&self, qp: &mut Sparse, bounds: &[Bound], kind: Kind, n: usize) {
+        let (nx, nu, _) = self.model.dims();
+        let of = |bound: &Bound| match bound {
+            Bound::State { output, .. } if *output != self.velocity() => Kind::Room,
+            _ => Kind::Rates,
+        };
+        for bound in bounds.iter().filter(|b| of(b) == kind) {
+            for k in 0..n {
+                let (coefficients, first, lo, hi): (Vec<f64>, usize, f64, f64) = match *bound {
+                    Bound::State { output, lo, hi } => (
+                        (0..nx).map(|c| self.model.c[(output, c)]).collect(),
+                        self.state(k),
+                        lo,
+                        hi,
+                    ),
+                    Bound::Input { mask, limit } => {
+                        let on = (0..nu).map(|j| f64::from(u8::from(mask & (1 << j) != 0))).collect();
+                        (on, self.input(k), -limit, limit)
+                    }
+                };
+                for (sign, limit) in [(1.0, hi), (-1.0, -lo)] {
+                    let row = qp.b.len();
+                    for (c, v) in coefficients.iter().enumerate() {
+                        qp.a.push(row, first + c, sign * v);
                     }
                     qp.b.push(limit);
                 }
@@ -356,22 +445,23 @@ fn solve(qp: &Sparse, variables: usize) -> Result<Vec<f64>, FloorError> {
     Err(failed(status))
 }
 
-/// The vehicle's perceived force on axis `i` at every sample, its perception settled on the first sample (as
-/// the optimal cueing's `begin`) and run on each sample's stimulus held over the interval before it.
-fn vehicle_perceived(perception: &Linear, t: &[f64], samples: &[Telemetry<f64>], i: usize) -> Vec<f64> {
+/// The vehicle's perceived force (`output` 0) or rotation (1) on axis `i` at every sample, its perception settled
+/// on the first sample (as the optimal cueing's `begin`) and run on each sample's stimulus held over the interval
+/// before it.
+fn vehicle_perceived(perception: &Linear, t: &[f64], samples: &[Telemetry<f64>], i: usize, output: usize) -> Vec<f64> {
     let Some(first) = samples.first() else {
         return Vec::new();
     };
     let r = stimulus(i, first);
     let rhs = -(&perception.b * &r);
     let mut z = perception.a.clone().lu().solve(&rhs).unwrap_or_else(|| rhs * 0.0);
-    let mut out = vec![perception.output(&z, &r)[0]];
+    let mut out = vec![perception.output(&z, &r)[output]];
     let mut discrete = None;
     for k in 1..samples.len() {
         let d = discretised(&mut discrete, perception, t[k] - t[k - 1]);
         let r = stimulus(i, &samples[k]);
         z = &d.a * &z + &d.b * &r;
-        out.push(perception.output(&z, &r)[0]);
+        out.push(perception.output(&z, &r)[output]);
     }
     out
 }
@@ -462,6 +552,67 @@ mod tests {
                 "{i}: {:?} against {at_rest:?}",
                 f.force_rms
             );
+        }
+    }
+
+    /// An optimal cueing's room and limits loosened past the drive's needs and its rotation unpriced leave the
+    /// floor of the ranges; a slow tilt with the rotation priced keeps the motion within every limit and costs
+    /// error.
+    #[test]
+    fn within_an_optimal_cueings_limits_the_floor_keeps_to_them() {
+        let (t, samples) = drive(1.0);
+        let ranges = wide();
+        let free = floor(&t, &samples, Room::Ranges(&ranges), Forward::PlusX).unwrap();
+        let mut loose = CueConfig::default();
+        loose.tilt_limit_deg = [90.0; 2];
+        loose.tilt_rate_deg = [1000.0; 2];
+        let o = &mut loose.optimal;
+        (o.envelope_share, o.tilt_share, o.rotation_weight) = (1.0, 1.0, [0.0; 2]);
+        (o.max_velocity, o.max_acceleration, o.max_rate_deg) = ([100.0; 3], [1000.0; 3], [1e4; 2]);
+        let within = |config| {
+            floor_from(
+                &t,
+                &samples,
+                Room::Shares(&ranges, config),
+                Some(config),
+                Forward::PlusX,
+                0,
+            )
+        };
+        let same = within(&loose).unwrap();
+        for i in 0..3 {
+            assert!(
+                (same.force_rms[i] - free.force_rms[i]).abs() < 1e-4,
+                "{same:?} against {free:?}"
+            );
+        }
+        let mut slow = CueConfig::default();
+        slow.tilt_rate_deg = [3.0; 2];
+        slow.optimal.envelope_share = 0.2;
+        let limited = within(&slow).unwrap();
+        assert!(
+            limited.force_rms[0] > free.force_rms[0] + 0.1,
+            "{limited:?} against {free:?}"
+        );
+        let rate = slow.optimal.max_rate_deg[1].to_radians();
+        let (speed, angle) = (slow.optimal.max_velocity[0], slow.tilt_limit_deg[0].to_radians());
+        for (k, w) in limited.offsets.windows(2).enumerate() {
+            let dt = t[k + 1] - t[k];
+            assert!(
+                (w[1][4] - w[0][4]).abs() <= rate * dt + 1e-6,
+                "pitch rate at {k}: {w:?}"
+            );
+            assert!(
+                (w[1][0] - w[0][0]).abs() <= speed * dt * 1.5 + 1e-6,
+                "surge speed at {k}: {w:?}"
+            );
+            assert!(w[1][4].abs() <= angle + 1e-6, "pitch at {k}: {w:?}");
+            for (i, (lo, hi)) in ranges.iter().take(3).enumerate() {
+                assert!(
+                    w[1][i] >= 0.2 * lo - 1e-6 && w[1][i] <= 0.2 * hi + 1e-6,
+                    "{i} at {k}: {w:?}"
+                );
+            }
         }
     }
 
