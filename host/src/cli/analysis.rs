@@ -331,12 +331,15 @@ pub struct CueArgs {
     #[arg(long, requires = "compare")]
     pub tune: bool,
     /// With --compare: add the floor, the least perceived force error any motion inside the envelope's ranges
-    /// can give, found with the whole drive known (one programme per axis over the drive), and its motion scored.
+    /// can give, found with the whole drive known (one programme per axis over the drive); with an optimal
+    /// cueing as B, also the floor within B's own room and limits (its shares, velocity, acceleration and rate
+    /// limits, its rotation error priced), its motion scored like a cueing's.
     #[arg(long, requires = "compare")]
     pub floor: bool,
     /// With --floor: also the floor inside an outer polytope of the rig's whole envelope, every axis planned
     /// together as the rig couples them (one programme over the drive with every face at every sample: tens
-    /// of seconds on a few minutes of drive).
+    /// of seconds on a few minutes of drive); with an optimal cueing as B, also within B's limits there, its
+    /// motion scored.
     #[arg(long, requires = "floor")]
     pub envelope_floor: bool,
     /// With `algorithm = "optimal"`: the reference over the horizon is the drive's own next samples (`--preview`

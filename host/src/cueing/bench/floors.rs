@@ -66,6 +66,9 @@ impl LimitsMotion {
     }
 }
 
+/// A floor's motion and what it is within.
+pub(super) type NamedMotion = (&'static str, LimitsMotion);
+
 /// A drive's pieces' scores and traces so far.
 type Scored = (Vec<Score>, Vec<Trace>);
 
@@ -115,7 +118,7 @@ pub(super) fn floor_of(
     forward: Forward,
     coupled: bool,
     optimal: Option<&CueConfig>,
-) -> Result<(FloorReport, Vec<(&'static str, LimitsMotion)>), CueError> {
+) -> Result<(FloorReport, Vec<NamedMotion>), CueError> {
     let ranges = &rig.envelope.ranges;
     let outer = coupled.then(|| Polytope::of(&rig.mechanism, &rig.neutral, ranges, &polytope::directions(3), RAYS));
     let (mut within_ranges, mut within_envelope) = (Sums::default(), Sums::default());

@@ -563,9 +563,11 @@ mod tests {
         let (t, samples) = drive(1.0);
         let ranges = wide();
         let free = floor(&t, &samples, Room::Ranges(&ranges), Forward::PlusX).unwrap();
-        let mut loose = CueConfig::default();
-        loose.tilt_limit_deg = [90.0; 2];
-        loose.tilt_rate_deg = [1000.0; 2];
+        let mut loose = CueConfig {
+            tilt_limit_deg: [90.0; 2],
+            tilt_rate_deg: [1000.0; 2],
+            ..CueConfig::default()
+        };
         let o = &mut loose.optimal;
         (o.envelope_share, o.tilt_share, o.rotation_weight) = (1.0, 1.0, [0.0; 2]);
         (o.max_velocity, o.max_acceleration, o.max_rate_deg) = ([100.0; 3], [1000.0; 3], [1e4; 2]);
@@ -586,8 +588,10 @@ mod tests {
                 "{same:?} against {free:?}"
             );
         }
-        let mut slow = CueConfig::default();
-        slow.tilt_rate_deg = [3.0; 2];
+        let mut slow = CueConfig {
+            tilt_rate_deg: [3.0; 2],
+            ..CueConfig::default()
+        };
         slow.optimal.envelope_share = 0.2;
         let limited = within(&slow).unwrap();
         assert!(
