@@ -4,7 +4,7 @@
 //! 1. `cargo test --no-run`: the workspace's test programs, built with both cores. Its `ringpod` (the test profile:
 //!    optimised, with debug assertions) is the CLI the QEMU suite, the rehost run and the browser tests drive, named
 //!    to them in `RINGPOD_CLI`: no second, release, build of the host.
-//! 2. `cargo test`, eight tests at a time: most of its time is the host's tests waiting on a child `ringpod` in real
+//! 2. `cargo test`, four tests at a time: most of its time is the host's tests waiting on a child `ringpod` in real
 //!    time (its suite spends 14 s of CPU in 74 s). Beside it, at the lowest CPU priority (`nice -n 19`: they take
 //!    what the tests leave and never starve their answers), two lanes start: the runners' preparation, one runner
 //!    after the other (`--prepare`: the QEMU programs; the firmware as flashed and the emulator's venv; Chromium),

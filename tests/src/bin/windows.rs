@@ -7,7 +7,7 @@
 //!    work leaves.
 //! 3. Beside them, a test-only `bcryptprimitives.dll` built from `tests/windows/bcryptprimitives.c`: Rust's standard
 //!    library imports `ProcessPrng` from it, which Wine 8 lacks.
-//! 4. The host's tests under Wine, unit and integration, eight at a time (`cargo test` with Wine as the target's runner): the
+//! 4. The host's tests under Wine, unit and integration, four at a time (`cargo test` with Wine as the target's runner): the
 //!    integration tests start `ringpod.exe` as a user does; the ones that need a Unix facility (a pseudo-terminal,
 //!    signals, FIFOs, inode numbers) are left out by `cfg(unix)` in their source. Then the README's main command,
 //!    `ringpod.exe stream --sim --motion demo`, as a check.

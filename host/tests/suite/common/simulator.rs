@@ -6,7 +6,7 @@ use std::process::{Child, Command, Stdio};
 pub const STREAM_TIMEOUT_MS: u32 = 500;
 
 /// The factor [`Simulator::ringpod`]'s commands lengthen the CLI's waits for an answer by (`RINGPOD_PATIENCE`):
-/// eight tests at a time, each with a simulator and a CLI, beside the test command's niced builds and whatever else
+/// four tests at a time, each with a simulator and a CLI, beside the test command's niced builds and whatever else
 /// runs, can leave a simulator unscheduled for longer than the CLI's 2 s (seen at a load of 5 on two cores).
 const ANSWER_PATIENCE: &str = "5";
 
