@@ -303,18 +303,11 @@ impl Part {
 
     /// Each bounded output within its range, at every sample.
     fn bound(&self, qp: &mut Sparse, ranges: &Ranges, n: usize) {
-        let nx = self.model.dims().0;
-        for (output, (lo, hi)) in bounded_outputs(self.i, ranges) {
-            for k in 0..n {
-                for (sign, limit) in [(1.0, hi), (-1.0, -lo)] {
-                    let row = qp.b.len();
-                    for c in 0..nx {
-                        qp.a.push(row, self.state(k) + c, sign * self.model.c[(output, c)]);
-                    }
-                    qp.b.push(limit);
-                }
-            }
-        }
+        let bounds: Vec<Bound> = bounded_outputs(self.i, ranges)
+            .into_iter()
+            .map(|(output, (lo, hi))| Bound::State { output, lo, hi })
+            .collect();
+        self.limit(qp, &bounds, Kind::Room, n);
     }
 }
 
